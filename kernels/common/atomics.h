@@ -1,0 +1,24 @@
+// atomics.h: floating-point atomic add built on compare-and-swap, as the
+// seed's one-ring sums need (OpenCL 1.2 has no float atomics).
+// float: atomic_cmpxchg on the 32-bit pattern (core 1.1+);
+// double: atom_cmpxchg on the 64-bit pattern (cl_khr_int64_base_atomics).
+#ifdef SC_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    union { ulong u; double f; } old_v, new_v;
+    do {
+        old_v.f = *p;
+        new_v.f = old_v.f + v;
+    } while (atom_cmpxchg((volatile __global ulong *)p, old_v.u, new_v.u) != old_v.u);
+}
+#else
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    union { uint u; float f; } old_v, new_v;
+    do {
+        old_v.f = *p;
+        new_v.f = old_v.f + v;
+    } while (atomic_cmpxchg((volatile __global uint *)p, old_v.u, new_v.u) != old_v.u);
+}
+#endif

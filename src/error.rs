@@ -1,0 +1,119 @@
+//! The library's one error type. Every failure a user can cause names what
+//! was wrong: the file, the element and the problem for bad input; the kernel
+//! file and the build log for an OpenCL build failure.
+
+use std::path::PathBuf;
+
+/// Result alias used throughout the library.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in shapecue.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be opened or read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file could not be written.
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Input data is malformed: names the file (or source), the element and the problem.
+    #[error("{source_name}: {element}: {problem}")]
+    InvalidInput {
+        /// File path or a description of where the data came from.
+        source_name: String,
+        /// The element, e.g. `face 12`, `vertex 7`, `header line 3`.
+        element: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// The file format is not one shapecue reads.
+    #[error("{}: unsupported format: {problem}", path.display())]
+    UnsupportedFormat {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        problem: String,
+    },
+    /// No OpenCL platform is installed.
+    #[error(
+        "no OpenCL platform found ({detail}). Install an OpenCL driver; for the CPU device \
+         used in tests: `sudo apt-get install pocl-opencl-icd ocl-icd-opencl-dev` \
+         (or run scripts/setup.sh)"
+    )]
+    NoPlatform {
+        /// What the ICD loader reported.
+        detail: String,
+    },
+    /// No device matched the user's selection.
+    #[error("no OpenCL device matches '{selector}'; available: {available}")]
+    NoDevice {
+        /// The `--device` / `SHAPECUE_DEVICE` value.
+        selector: String,
+        /// A list of the devices found.
+        available: String,
+    },
+    /// An OpenCL call failed.
+    #[error("OpenCL error in {what}: {code}")]
+    Cl {
+        /// Which call or pass.
+        what: String,
+        /// The OpenCL error name.
+        code: String,
+    },
+    /// An OpenCL program failed to build.
+    #[error("OpenCL build of {file} failed (options: {options}):\n{log}")]
+    Build {
+        /// The kernel file.
+        file: String,
+        /// Build options passed.
+        options: String,
+        /// The compiler's build log.
+        log: String,
+    },
+    /// The chosen device lacks something the requested variant needs.
+    #[error("device '{device}' cannot run this: {what}")]
+    DeviceUnsupported {
+        /// Device name.
+        device: String,
+        /// What is missing.
+        what: String,
+    },
+    /// A caller passed an argument that makes no sense.
+    #[error("invalid argument: {0}")]
+    InvalidArgument(String),
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidInput`].
+    pub fn input(
+        source_name: impl Into<String>,
+        element: impl Into<String>,
+        problem: impl Into<String>,
+    ) -> Self {
+        Error::InvalidInput {
+            source_name: source_name.into(),
+            element: element.into(),
+            problem: problem.into(),
+        }
+    }
+
+    /// Wraps an OpenCL error code with the name of what failed.
+    pub fn cl(what: impl Into<String>, err: impl std::fmt::Display) -> Self {
+        Error::Cl {
+            what: what.into(),
+            code: err.to_string(),
+        }
+    }
+}

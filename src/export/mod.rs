@@ -1,0 +1,3 @@
+//! Writers: PLY (mesh with per-vertex curvature) and JSON stats.
+
+pub mod ply;

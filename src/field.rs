@@ -1,0 +1,194 @@
+//! Per-vertex curvature outputs, shared by the device stage, the CPU
+//! reference and the exporters.
+
+/// Per-vertex differential quantities of a triangle mesh, in the mesh's own
+/// coordinates (whatever centring and scaling a stage used internally has been
+/// undone).
+///
+/// Conventions: `k1 >= k2` (signed), positive where the surface is convex with
+/// outward normals; `d1`, `d2` unit and tangent with `d2 = n × d1`; `dk` is the
+/// curvature derivative tensor (C₁₁₁, C₁₁₂, C₁₂₂, C₂₂₂) in the (d1, d2) frame.
+/// In trimesh2 compatibility mode the ordering is |k1| ≥ |k2| instead.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CurvatureField {
+    /// Unit vertex normals ((0,0,1) where no non-degenerate face touches the vertex).
+    pub normals: Vec<[f64; 3]>,
+    /// Voronoi point areas (0 where no non-degenerate face touches the vertex).
+    pub areas: Vec<f64>,
+    /// Maximum principal curvature.
+    pub k1: Vec<f64>,
+    /// Minimum principal curvature.
+    pub k2: Vec<f64>,
+    /// Principal direction of `k1`.
+    pub d1: Vec<[f64; 3]>,
+    /// Principal direction of `k2`.
+    pub d2: Vec<[f64; 3]>,
+    /// Curvature derivative tensor in the (d1, d2) frame; zeros when not computed.
+    pub dk: Vec<[f64; 4]>,
+}
+
+impl CurvatureField {
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.k1.len()
+    }
+
+    /// True when there are no vertices.
+    pub fn is_empty(&self) -> bool {
+        self.k1.is_empty()
+    }
+
+    /// Mean curvature (k1 + k2) / 2 per vertex.
+    pub fn mean(&self) -> Vec<f64> {
+        self.k1.iter().zip(&self.k2).map(|(a, b)| 0.5 * (a + b)).collect()
+    }
+
+    /// Gaussian curvature k1·k2 per vertex.
+    pub fn gaussian(&self) -> Vec<f64> {
+        self.k1.iter().zip(&self.k2).map(|(a, b)| a * b).collect()
+    }
+
+    /// True if every value is finite.
+    pub fn all_finite(&self) -> bool {
+        let v3 = |v: &Vec<[f64; 3]>| v.iter().flatten().all(|x| x.is_finite());
+        v3(&self.normals)
+            && v3(&self.d1)
+            && v3(&self.d2)
+            && self.areas.iter().all(|x| x.is_finite())
+            && self.k1.iter().all(|x| x.is_finite())
+            && self.k2.iter().all(|x| x.is_finite())
+            && self.dk.iter().flatten().all(|x| x.is_finite())
+    }
+}
+
+/// How the one-ring sums are formed on the device.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Accumulate {
+    /// One work-item per face adds into its vertices with float atomics
+    /// (compare-and-swap), as in the seed. Summation order varies run to run.
+    #[default]
+    Atomic,
+    /// One work-item per vertex sums its one-ring (built once) in face order:
+    /// no atomics, bitwise identical from run to run, three times the
+    /// per-face arithmetic.
+    Gather,
+}
+
+/// Floating-point precision of the device computation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// 32-bit floats (default).
+    #[default]
+    F32,
+    /// 64-bit floats (needs cl_khr_fp64; atomic accumulation also needs
+    /// cl_khr_int64_base_atomics).
+    F64,
+}
+
+/// Which least-squares solve and ordering to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Compat {
+    /// The exact solve of the per-face normal equations; k1 ≥ k2 (signed).
+    #[default]
+    Exact,
+    /// trimesh2 2.16: its 3×3 LDLᵀ pivot quirk and |k1| ≥ |k2| ordering, for
+    /// comparing with that library directly.
+    Trimesh2,
+}
+
+/// Variant choice for curvature estimation (device and CPU reference alike).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct CurvatureOptions {
+    /// One-ring accumulation scheme (device only; the CPU reference is sequential).
+    pub accumulate: Accumulate,
+    /// Device precision (the CPU reference is always f64).
+    pub precision: Precision,
+    /// Exact solve or trimesh2 compatibility.
+    pub compat: Compat,
+    /// Compute the curvature derivative (the dcurv pass).
+    pub dcurv: bool,
+}
+
+impl Default for CurvatureOptions {
+    fn default() -> Self {
+        CurvatureOptions {
+            accumulate: Accumulate::Atomic,
+            precision: Precision::F32,
+            compat: Compat::Exact,
+            dcurv: true,
+        }
+    }
+}
+
+/// The similarity that maps a pose to unit size at the origin before it is
+/// computed on: p' = (p − center) / scale. Curvature is invariant in shape, so
+/// results are mapped back exactly (k / scale, area · scale², dk / scale²).
+/// This keeps f32 meaningful for meshes far from the origin (1e6 away) and at
+/// extreme scales (1e-6, 1e6), and makes the degenerate-face thresholds
+/// relative to the mesh's size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Normalization {
+    /// Centroid of the vertices.
+    pub center: [f64; 3],
+    /// RMS distance of the vertices from the centroid (1 if that is 0).
+    pub scale: f64,
+}
+
+impl Normalization {
+    /// Computes the normalization of a set of positions (in f64).
+    pub fn of(positions: &[[f64; 3]]) -> Self {
+        let n = positions.len().max(1) as f64;
+        let mut c = [0.0; 3];
+        for p in positions {
+            for k in 0..3 {
+                c[k] += p[k];
+            }
+        }
+        let c = c.map(|x| x / n);
+        let mut ss = 0.0;
+        for p in positions {
+            ss += (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
+        }
+        let s = (ss / n).sqrt();
+        Normalization {
+            center: c,
+            scale: if s > 0.0 && s.is_finite() { s } else { 1.0 },
+        }
+    }
+
+    /// Maps a position into normalized coordinates.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let inv = 1.0 / self.scale;
+        [
+            (p[0] - self.center[0]) * inv,
+            (p[1] - self.center[1]) * inv,
+            (p[2] - self.center[2]) * inv,
+        ]
+    }
+
+    /// Maps a field computed on normalized positions back to the original scale.
+    pub fn unapply(&self, f: &mut CurvatureField) {
+        let s = self.scale;
+        f.areas.iter_mut().for_each(|a| *a *= s * s);
+        f.k1.iter_mut().for_each(|k| *k /= s);
+        f.k2.iter_mut().for_each(|k| *k /= s);
+        f.dk.iter_mut().flatten().for_each(|d| *d /= s * s);
+    }
+}
+
+/// Counts of what the estimator had to skip; all zero on a clean mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct CurvatureCounts {
+    /// Faces skipped as degenerate (zero-length edge or (near) zero area).
+    pub degenerate_faces: u32,
+    /// Vertices with no non-degenerate face (unreferenced or only degenerate
+    /// faces): normal (0,0,1) unless faces give one, zero curvature.
+    pub vertices_without_curvature: u32,
+    /// Faces whose curvature least-squares system had a non-positive pivot.
+    pub tensor_solves_skipped: u32,
+    /// Faces whose derivative least-squares system had a non-positive pivot.
+    pub dcurv_solves_skipped: u32,
+}

@@ -1,0 +1,142 @@
+//! Platform and device discovery and the `--device` selection rule.
+
+use crate::error::{Error, Result};
+use opencl3::device::{CL_DEVICE_TYPE_ALL, CL_DEVICE_TYPE_CPU, CL_DEVICE_TYPE_GPU, Device};
+use opencl3::platform::get_platforms;
+use opencl3::types::cl_device_id;
+use serde::Serialize;
+
+/// What `shapecue devices` prints about one device.
+#[derive(Clone, Debug, Serialize)]
+pub struct DeviceInfo {
+    /// Index in the flat list over all platforms (what `--device N` takes).
+    pub index: usize,
+    /// Platform name.
+    pub platform: String,
+    /// Device name.
+    pub name: String,
+    /// "GPU", "CPU", "ACCELERATOR" or "OTHER".
+    pub kind: String,
+    /// OpenCL version string of the device.
+    pub version: String,
+    /// Compute units.
+    pub compute_units: u32,
+    /// Global memory in bytes.
+    pub global_mem: u64,
+    /// Largest single allocation in bytes.
+    pub max_alloc: u64,
+    /// cl_khr_fp64 (double precision).
+    pub fp64: bool,
+    /// cl_khr_gl_sharing (GL interop).
+    pub gl_sharing: bool,
+    /// cl_khr_int64_base_atomics (needed by f64 atomic accumulation).
+    pub int64_atomics: bool,
+    #[serde(skip)]
+    pub(crate) id: cl_device_id,
+}
+
+// SAFETY: cl_device_id is an opaque handle that OpenCL allows to be used from any thread.
+unsafe impl Send for DeviceInfo {}
+unsafe impl Sync for DeviceInfo {}
+
+/// Lists every device of every platform. No platform at all is an error that
+/// says how to install PoCL.
+pub fn list_devices() -> Result<Vec<DeviceInfo>> {
+    let platforms = get_platforms().map_err(|e| Error::NoPlatform {
+        detail: e.to_string(),
+    })?;
+    if platforms.is_empty() {
+        return Err(Error::NoPlatform {
+            detail: "the ICD loader found no platform".into(),
+        });
+    }
+    let mut out = Vec::new();
+    for p in platforms {
+        let pname = p.name().unwrap_or_default();
+        let Ok(ids) = p.get_devices(CL_DEVICE_TYPE_ALL) else {
+            continue;
+        };
+        for id in ids {
+            let d = Device::new(id);
+            let ext = d.extensions().unwrap_or_default();
+            let has = |e: &str| ext.split_whitespace().any(|x| x == e);
+            let ty = d.dev_type().unwrap_or(0);
+            let kind = if ty & CL_DEVICE_TYPE_GPU != 0 {
+                "GPU"
+            } else if ty & CL_DEVICE_TYPE_CPU != 0 {
+                "CPU"
+            } else if ty & opencl3::device::CL_DEVICE_TYPE_ACCELERATOR != 0 {
+                "ACCELERATOR"
+            } else {
+                "OTHER"
+            };
+            out.push(DeviceInfo {
+                index: out.len(),
+                platform: pname.trim().to_string(),
+                name: d.name().unwrap_or_default().trim().to_string(),
+                kind: kind.to_string(),
+                version: d.version().unwrap_or_default().trim().to_string(),
+                compute_units: d.max_compute_units().unwrap_or(0),
+                global_mem: d.global_mem_size().unwrap_or(0),
+                max_alloc: d.max_mem_alloc_size().unwrap_or(0),
+                fp64: has("cl_khr_fp64"),
+                gl_sharing: has("cl_khr_gl_sharing"),
+                int64_atomics: has("cl_khr_int64_base_atomics"),
+                id,
+            });
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::NoPlatform {
+            detail: "platforms exist but expose no device".into(),
+        });
+    }
+    Ok(out)
+}
+
+/// Picks a device: `selector` (or `SHAPECUE_DEVICE`) as an index or a
+/// case-insensitive substring of "platform device"; by default the first GPU,
+/// else the first CPU device, else the first device.
+pub fn select(selector: Option<&str>) -> Result<DeviceInfo> {
+    let all = list_devices()?;
+    let env = std::env::var("SHAPECUE_DEVICE").ok();
+    let sel = selector
+        .map(str::to_string)
+        .or(env)
+        .filter(|s| !s.trim().is_empty());
+    pick(&all, sel.as_deref())
+}
+
+pub(crate) fn pick(all: &[DeviceInfo], sel: Option<&str>) -> Result<DeviceInfo> {
+    let describe = || {
+        all.iter()
+            .map(|d| format!("{}: {} ({})", d.index, d.name, d.platform))
+            .collect::<Vec<_>>()
+            .join("; ")
+    };
+    match sel {
+        Some(s) => {
+            let s = s.trim();
+            if let Ok(i) = s.parse::<usize>() {
+                return all.get(i).cloned().ok_or_else(|| Error::NoDevice {
+                    selector: s.to_string(),
+                    available: describe(),
+                });
+            }
+            let needle = s.to_lowercase();
+            all.iter()
+                .find(|d| format!("{} {}", d.platform, d.name).to_lowercase().contains(&needle))
+                .cloned()
+                .ok_or_else(|| Error::NoDevice {
+                    selector: s.to_string(),
+                    available: describe(),
+                })
+        }
+        None => Ok(all
+            .iter()
+            .find(|d| d.kind == "GPU")
+            .or_else(|| all.iter().find(|d| d.kind == "CPU"))
+            .unwrap_or(&all[0])
+            .clone()),
+    }
+}

@@ -1,0 +1,65 @@
+//! Program building. Kernel files are embedded with `include_str!`; the
+//! shared headers of `kernels/common/` are prepended in order, each preceded
+//! by a `#line` marker so compiler messages point at the right file and line.
+
+use crate::error::{Error, Result};
+use opencl3::context::Context;
+use opencl3::program::Program;
+
+/// One kernel family's source and the shared headers it uses.
+#[derive(Clone, Copy, Debug)]
+pub struct KernelFile {
+    /// File name under `kernels/` (used in errors and logs).
+    pub name: &'static str,
+    /// The file's text.
+    pub source: &'static str,
+    /// `(name, text)` of each header from `kernels/common/`, in include order.
+    pub headers: &'static [(&'static str, &'static str)],
+}
+
+/// The shared headers every kernel family may use.
+pub const COMMON_HEADERS: &[(&str, &str)] = &[
+    (
+        "common/real.h",
+        include_str!("../../kernels/common/real.h"),
+    ),
+    (
+        "common/atomics.h",
+        include_str!("../../kernels/common/atomics.h"),
+    ),
+];
+
+/// Looks up a kernel family by name (`"curvature"`, ...).
+pub fn kernel_file(name: &str) -> Option<KernelFile> {
+    match name {
+        "curvature" => Some(KernelFile {
+            name: "kernels/curvature.cl",
+            source: include_str!("../../kernels/curvature.cl"),
+            headers: COMMON_HEADERS,
+        }),
+        _ => None,
+    }
+}
+
+/// The full text handed to the compiler.
+pub fn assemble(file: &KernelFile) -> String {
+    let mut s = String::new();
+    for (name, text) in file.headers {
+        s.push_str(&format!("#line 1 \"kernels/{name}\"\n"));
+        s.push_str(text);
+        s.push('\n');
+    }
+    s.push_str(&format!("#line 1 \"{}\"\n", file.name));
+    s.push_str(file.source);
+    s
+}
+
+pub(crate) fn build(context: &Context, file: &KernelFile, options: &str) -> Result<Program> {
+    let src = assemble(file);
+    let opts = format!("-cl-std=CL1.2 {options}");
+    Program::create_and_build_from_source(context, &src, &opts).map_err(|log| Error::Build {
+        file: file.name.to_string(),
+        options: opts,
+        log,
+    })
+}

@@ -1,0 +1,22 @@
+//! shapecue: shape cues (curvature, isosurfaces, feature edges, curvature-based
+//! lines and ambient occlusion) computed by OpenCL kernels, each with a plain
+//! Rust reference implementation.
+//!
+//! Data flow (one name per stage, used for the kernel file, the host module,
+//! the CPU reference, the test and the bench):
+//!
+//! ```text
+//! mesh ─► positions ─► [curvature] ─► normals, areas, k1 k2 d1 d2 dk ─► export (PLY, JSON)
+//! ```
+#![warn(missing_docs)]
+
+pub mod cpu;
+pub mod error;
+pub mod export;
+pub mod field;
+pub mod gpu;
+pub mod mesh;
+pub mod stages;
+
+pub use error::{Error, Result};
+pub use mesh::Mesh;

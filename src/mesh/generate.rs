@@ -1,0 +1,220 @@
+//! Procedural meshes with known curvature: the analytic oracles of the tests,
+//! the generated inputs of the benches, and the bundled data of the README's
+//! main job (so it needs no downloaded file).
+
+use super::Mesh;
+use std::f64::consts::PI;
+
+fn grid_faces(nu: usize, nv: usize, wrap_u: bool, wrap_v: bool) -> Vec<[u32; 3]> {
+    // Vertex (i, j) = i * nv + j; quads split along the (i,j)-(i+1,j+1) diagonal,
+    // counter-clockwise when (u, v) is a right-handed tangent frame.
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    let iu = if wrap_u { nu } else { nu - 1 };
+    let iv = if wrap_v { nv } else { nv - 1 };
+    let mut faces = Vec::with_capacity(2 * iu * iv);
+    for i in 0..iu {
+        for j in 0..iv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            faces.push([a, b, c]);
+            faces.push([a, c, d]);
+        }
+    }
+    faces
+}
+
+/// A torus around the z axis with major radius `big_r` and tube radius `r`,
+/// `nu` segments around the axis and `nv` around the tube; closed, genus 1,
+/// outward normals.
+pub fn torus(big_r: f64, r: f64, nu: usize, nv: usize) -> Mesh {
+    let nu = nu.max(3);
+    let nv = nv.max(3);
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        let u = 2.0 * PI * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = 2.0 * PI * j as f64 / nv as f64;
+            let rr = big_r + r * v.cos();
+            positions.push([rr * u.cos(), rr * u.sin(), r * v.sin()]);
+        }
+    }
+    Mesh {
+        positions,
+        faces: grid_faces(nu, nv, true, true),
+    }
+}
+
+/// Analytic principal curvatures (k1 ≥ k2) of [`torus`] at point `p` on it.
+pub fn torus_curvature(big_r: f64, r: f64, p: [f64; 3]) -> (f64, f64) {
+    let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+    let v = p[2].atan2(rho - big_r);
+    let a = 1.0 / r;
+    let b = v.cos() / (big_r + r * v.cos());
+    (a.max(b), a.min(b))
+}
+
+/// An open cylinder of radius `r` and height `h` along z, centred at the
+/// origin: `nu` segments around, `nv` rings along. Boundary at both ends.
+pub fn cylinder(r: f64, h: f64, nu: usize, nv: usize) -> Mesh {
+    let nu = nu.max(3);
+    let nv = nv.max(2);
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        let u = 2.0 * PI * i as f64 / nu as f64;
+        for j in 0..nv {
+            let z = -0.5 * h + h * j as f64 / (nv - 1) as f64;
+            positions.push([r * u.cos(), r * u.sin(), z]);
+        }
+    }
+    Mesh {
+        positions,
+        faces: grid_faces(nu, nv, true, false),
+    }
+}
+
+/// A flat square grid in the z = 0 plane, `n` × `n` vertices over `[-s/2, s/2]²`.
+pub fn plane(n: usize, s: f64) -> Mesh {
+    let n = n.max(2);
+    let mut positions = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let x = -0.5 * s + s * i as f64 / (n - 1) as f64;
+            let y = -0.5 * s + s * j as f64 / (n - 1) as f64;
+            positions.push([x, y, 0.0]);
+        }
+    }
+    Mesh {
+        positions,
+        faces: grid_faces(n, n, false, false),
+    }
+}
+
+/// A geodesic sphere of radius `r`: an icosahedron subdivided `level` times
+/// and projected onto the sphere (10·4^level + 2 vertices).
+pub fn icosphere(r: f64, level: u32) -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let norm = |p: [f64; 3]| {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / l, p[1] / l, p[2] / l]
+    };
+    for p in positions.iter_mut() {
+        *p = norm(*p);
+    }
+    for _ in 0..level {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| -> u32 {
+            let key = (a.min(b), a.max(b));
+            *mid.entry(key).or_insert_with(|| {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                positions.push(norm([
+                    pa[0] + pb[0],
+                    pa[1] + pb[1],
+                    pa[2] + pb[2],
+                ]));
+                (positions.len() - 1) as u32
+            })
+        };
+        for f in &faces {
+            let ab = midpoint(f[0], f[1], &mut positions);
+            let bc = midpoint(f[1], f[2], &mut positions);
+            let ca = midpoint(f[2], f[0], &mut positions);
+            next.push([f[0], ab, ca]);
+            next.push([f[1], bc, ab]);
+            next.push([f[2], ca, bc]);
+            next.push([ab, bc, ca]);
+        }
+        faces = next;
+    }
+    for p in positions.iter_mut() {
+        *p = [p[0] * r, p[1] * r, p[2] * r];
+    }
+    Mesh { positions, faces }
+}
+
+/// An ellipsoid with semi-axes `a`, `b`, `c` (an [`icosphere`] scaled per axis).
+pub fn ellipsoid(a: f64, b: f64, c: f64, level: u32) -> Mesh {
+    icosphere(1.0, level).map_positions(|p| [p[0] * a, p[1] * b, p[2] * c])
+}
+
+/// Analytic principal curvatures (k1 ≥ k2) of the ellipsoid x²/a²+y²/b²+z²/c² = 1
+/// at a point `p` on it (outward normals, so both are positive).
+pub fn ellipsoid_curvature(a: f64, b: f64, c: f64, p: [f64; 3]) -> (f64, f64) {
+    let [x, y, z] = p;
+    let h = x * x / a.powi(4) + y * y / b.powi(4) + z * z / c.powi(4);
+    let abc2 = (a * b * c).powi(2);
+    let gauss = 1.0 / (abc2 * h * h);
+    let mean = (a * a + b * b + c * c - x * x - y * y - z * z) / (2.0 * abc2 * h.powf(1.5));
+    let disc = (mean * mean - gauss).max(0.0).sqrt();
+    (mean + disc, mean - disc)
+}
+
+/// Small deterministic pseudo-random numbers (SplitMix64), so generated test
+/// meshes are the same on every machine without a `rand` dependency.
+pub fn splitmix(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// An [`icosphere`] whose vertices are moved by up to `amount` × the mean edge
+/// length in random directions: an irregular mesh with no symmetry to hide
+/// behind.
+pub fn jittered_sphere(r: f64, level: u32, amount: f64, seed: u64) -> Mesh {
+    let m = icosphere(r, level);
+    let edge = r * 1.1 / (1u64 << level) as f64; // icosahedron edge 1.05 r, halved per level
+    let mut s = seed;
+    m.map_positions(|p| {
+        let d = [
+            splitmix(&mut s) - 0.5,
+            splitmix(&mut s) - 0.5,
+            splitmix(&mut s) - 0.5,
+        ];
+        let k = 2.0 * amount * edge;
+        [p[0] + k * d[0], p[1] + k * d[1], p[2] + k * d[2]]
+    })
+}
+
+/// Torus grid resolution (nu, nv) with nu = 2·nv giving about `n` vertices.
+pub fn torus_resolution_for(n: usize) -> (usize, usize) {
+    let nv = ((n as f64 / 2.0).sqrt().round() as usize).max(3);
+    (2 * nv, nv)
+}

@@ -1,0 +1,135 @@
+//! Triangle meshes: the index-based data type, loaders (OBJ, PLY, OFF),
+//! validation and welding.
+//!
+//! Positions are kept in `f64` on the host so that a mesh far from the origin
+//! or at an extreme scale survives until the stage that uploads it, which
+//! centres and scales it before rounding to the device's precision.
+
+mod generate;
+mod load;
+
+pub use generate::*;
+pub use load::{LoadOptions, load};
+
+use crate::error::{Error, Result};
+
+/// An indexed triangle mesh. Faces index into `positions`; polygons from the
+/// input are fan-triangulated by the loaders.
+///
+/// Degenerate faces, duplicate faces, unreferenced vertices, boundaries and
+/// non-manifold edges are valid: stages must cope with them. What is *not*
+/// valid (and rejected by [`Mesh::validate`]): no faces, an index out of range,
+/// or a non-finite coordinate.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Builds a mesh and validates it; `source` names where it came from in errors.
+    pub fn new(positions: Vec<[f64; 3]>, faces: Vec<[u32; 3]>, source: &str) -> Result<Self> {
+        let m = Mesh { positions, faces };
+        m.validate(source)?;
+        Ok(m)
+    }
+
+    /// Number of vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of triangles.
+    pub fn n_faces(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Rejects what no stage can work with: no faces, indices out of range,
+    /// non-finite coordinates, or more elements than 32-bit indices address.
+    pub fn validate(&self, source: &str) -> Result<()> {
+        if self.faces.is_empty() {
+            return Err(Error::input(source, "faces", "the mesh has no faces"));
+        }
+        if self.positions.len() >= u32::MAX as usize || self.faces.len() >= (u32::MAX / 3) as usize
+        {
+            return Err(Error::input(
+                source,
+                "mesh",
+                format!(
+                    "{} vertices / {} faces exceed the 32-bit index range",
+                    self.positions.len(),
+                    self.faces.len()
+                ),
+            ));
+        }
+        for (i, p) in self.positions.iter().enumerate() {
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(Error::input(
+                    source,
+                    format!("vertex {i}"),
+                    format!("non-finite coordinate ({}, {}, {})", p[0], p[1], p[2]),
+                ));
+            }
+        }
+        let n = self.positions.len() as u32;
+        for (i, f) in self.faces.iter().enumerate() {
+            if let Some(&bad) = f.iter().find(|&&v| v >= n) {
+                return Err(Error::input(
+                    source,
+                    format!("face {i}"),
+                    format!("vertex index {bad} out of range (the mesh has {n} vertices)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Merges vertices with bit-identical positions (as in unwelded exports
+    /// that split vertices per corner). Returns the welded mesh and, for each
+    /// old vertex, its new index. The first occurrence of a position keeps its
+    /// relative order, so welding an already welded mesh changes nothing.
+    pub fn weld(&self) -> (Mesh, Vec<u32>) {
+        use std::collections::HashMap;
+        let mut map: HashMap<[u64; 3], u32> = HashMap::with_capacity(self.positions.len());
+        let mut positions = Vec::with_capacity(self.positions.len());
+        let mut remap = Vec::with_capacity(self.positions.len());
+        for p in &self.positions {
+            // +0.0 and -0.0 are the same point: normalise the sign of zero.
+            let key = p.map(|c| if c == 0.0 { 0u64 } else { c.to_bits() });
+            let idx = *map.entry(key).or_insert_with(|| {
+                positions.push(*p);
+                (positions.len() - 1) as u32
+            });
+            remap.push(idx);
+        }
+        let faces = self
+            .faces
+            .iter()
+            .map(|f| f.map(|v| remap[v as usize]))
+            .collect();
+        (Mesh { positions, faces }, remap)
+    }
+
+    /// Axis-aligned bounding box (min, max).
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Returns a copy with every position transformed by `f`.
+    pub fn map_positions(&self, mut f: impl FnMut([f64; 3]) -> [f64; 3]) -> Mesh {
+        Mesh {
+            positions: self.positions.iter().map(|&p| f(p)).collect(),
+            faces: self.faces.clone(),
+        }
+    }
+}

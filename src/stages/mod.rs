@@ -1,0 +1,3 @@
+//! Host wiring of each kernel family in `kernels/`, one module per family.
+
+pub mod curvature;
