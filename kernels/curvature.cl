@@ -27,9 +27,10 @@
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
 //   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
 //
-// Degenerate faces (an edge shorter than 1e-12 of the mesh's RMS radius, or
-// twice the area below 1e-7 × longest edge²) are skipped in every pass and
-// counted once. A least-squares system whose pivots are not positive (rounding
+// Degenerate faces (an edge shorter than 1e-12 of the mesh's RMS radius,
+// twice the area below 1e-7 × longest edge², or a height below the f32
+// rounding of the positions, 4·2⁻²⁴·max|p|) are skipped in every pass and
+// counted once; the rule is the same at every precision and in the CPU twin. A least-squares system whose pivots are not positive (rounding
 // on extreme slivers) is skipped and counted. Nothing here can write NaN.
 //
 // Build options: -DSC_DOUBLE (double precision), -DSC_COMPAT (trimesh2 2.16:
@@ -38,6 +39,7 @@
 
 #define DEGEN_AREA_REL RL(1e-7)
 #define DEGEN_EDGE2 RL(1e-24)
+#define DEGEN_HEIGHT_ULP RL(2.384185791015625e-7) // 4 × 2^-24: below f32 rounding of positions
 
 #define NEXT3(i) ((i) == 2 ? 0 : (i) + 1)
 #define PREV3(i) ((i) == 0 ? 2 : (i) - 1)
@@ -48,6 +50,7 @@ typedef struct {
     uint v[3];
     REAL3 p[3];
     REAL3 e[3]; // e[i] is the edge opposite corner i: p[PREV3(i)] − p[NEXT3(i)]
+    REAL pmax;  // largest |p| of the corners
 } Tri;
 
 inline Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f)
@@ -59,6 +62,7 @@ inline Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f
     }
     for (int i = 0; i < 3; i++)
         t.e[i] = t.p[PREV3(i)] - t.p[NEXT3(i)];
+    t.pmax = fmax(length(t.p[0]), fmax(length(t.p[1]), length(t.p[2])));
     return t;
 }
 
@@ -68,9 +72,10 @@ inline bool tri_degenerate(const Tri *t)
     // Written as negated comparisons so NaN counts as degenerate too.
     if (!(l0 > DEGEN_EDGE2 && l1 > DEGEN_EDGE2 && l2 > DEGEN_EDGE2))
         return true;
-    REAL3 c = cross(t->e[0], t->e[1]);
+    REAL twice_area = length(cross(t->e[0], t->e[1]));
     REAL lmax = fmax(l0, fmax(l1, l2));
-    return !(length(c) > DEGEN_AREA_REL * lmax);
+    return !(twice_area > DEGEN_AREA_REL * lmax &&
+             twice_area > DEGEN_HEIGHT_ULP * sqrt(lmax) * t->pmax);
 }
 
 // Corner-weighted face normal for corner c (trimesh2 / Max 1999): the face's

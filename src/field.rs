@@ -40,7 +40,11 @@ impl CurvatureField {
 
     /// Mean curvature (k1 + k2) / 2 per vertex.
     pub fn mean(&self) -> Vec<f64> {
-        self.k1.iter().zip(&self.k2).map(|(a, b)| 0.5 * (a + b)).collect()
+        self.k1
+            .iter()
+            .zip(&self.k2)
+            .map(|(a, b)| 0.5 * (a + b))
+            .collect()
     }
 
     /// Gaussian curvature k1·k2 per vertex.
@@ -140,19 +144,28 @@ pub struct Normalization {
 impl Normalization {
     /// Computes the normalization of a set of positions (in f64).
     pub fn of(positions: &[[f64; 3]]) -> Self {
-        let n = positions.len().max(1) as f64;
+        Self::of_masked(positions, None)
+    }
+
+    /// The normalization of the positions whose `mask` entry is true (all if
+    /// `None`): stages pass the vertices that faces reference, so a stray
+    /// unreferenced vertex far away cannot shrink the mesh to nothing.
+    pub fn of_masked(positions: &[[f64; 3]], mask: Option<&[bool]>) -> Self {
+        let used = |i: usize| mask.is_none_or(|m| m[i]);
+        let mut n = 0usize;
         let mut c = [0.0; 3];
-        for p in positions {
+        for (_, p) in positions.iter().enumerate().filter(|(i, _)| used(*i)) {
+            n += 1;
             for k in 0..3 {
                 c[k] += p[k];
             }
         }
-        let c = c.map(|x| x / n);
+        let c = c.map(|x| x / n.max(1) as f64);
         let mut ss = 0.0;
-        for p in positions {
+        for (_, p) in positions.iter().enumerate().filter(|(i, _)| used(*i)) {
             ss += (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
         }
-        let s = (ss / n).sqrt();
+        let s = (ss / n.max(1) as f64).sqrt();
         Normalization {
             center: c,
             scale: if s > 0.0 && s.is_finite() { s } else { 1.0 },

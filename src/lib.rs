@@ -16,6 +16,7 @@ pub mod export;
 pub mod field;
 pub mod gpu;
 pub mod mesh;
+pub mod report;
 pub mod stages;
 
 pub use error::{Error, Result};

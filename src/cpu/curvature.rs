@@ -3,6 +3,10 @@
 //! exact or trimesh2-compatible solve). Step functions are public so tests can
 //! run the pipeline up to a pass and compare it with the device there.
 
+// The reference mirrors the kernel line by line (indexed loops over corners and
+// matrix rows), and `!(x > 0.0)` is deliberate: NaN must fail those tests.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::field::{Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization};
 use crate::mesh::Mesh;
 
@@ -44,6 +48,10 @@ const fn prev3(i: usize) -> usize {
 pub const DEGEN_AREA_REL: f64 = 1e-7;
 /// Squared edge-length threshold in normalized coordinates (same as the kernel).
 pub const DEGEN_EDGE2: f64 = 1e-24;
+/// Heights below this × the largest |p| of the face (normalized coordinates)
+/// are under the f32 rounding of the positions: degenerate at every precision,
+/// so f32, f64 and this reference agree on which faces are skipped.
+pub const DEGEN_HEIGHT_ULP: f64 = 4.0 / 16_777_216.0;
 
 /// A face's vertices, positions and edges (`e[i]` opposite corner i).
 #[derive(Clone, Copy, Debug)]
@@ -52,6 +60,8 @@ pub struct Tri {
     pub v: [usize; 3],
     /// Edges: e[i] = p[prev(i)] − p[next(i)].
     pub e: [V3; 3],
+    /// Largest distance of a corner from the origin (normalized coordinates).
+    pub pmax: f64,
 }
 
 impl Tri {
@@ -62,18 +72,22 @@ impl Tri {
         Tri {
             v,
             e: std::array::from_fn(|i| sub(p[prev3(i)], p[next3(i)])),
+            pmax: len(p[0]).max(len(p[1])).max(len(p[2])),
         }
     }
 
     /// The degenerate-face rule: an edge with squared length ≤ 1e-24 (unit-RMS
-    /// coordinates), or 2·area ≤ 1e-7 · (longest edge)². NaN counts as degenerate.
+    /// coordinates), or 2·area ≤ 1e-7 · (longest edge)², or a height below
+    /// the f32 rounding of the positions. NaN counts as degenerate.
     pub fn degenerate(&self) -> bool {
         let l = self.e.map(|e| dot(e, e));
         if !(l[0] > DEGEN_EDGE2 && l[1] > DEGEN_EDGE2 && l[2] > DEGEN_EDGE2) {
             return true;
         }
         let lmax = l[0].max(l[1]).max(l[2]);
-        !(len(cross(self.e[0], self.e[1])) > DEGEN_AREA_REL * lmax)
+        let twice_area = len(cross(self.e[0], self.e[1]));
+        !(twice_area > DEGEN_AREA_REL * lmax
+            && twice_area > DEGEN_HEIGHT_ULP * lmax.sqrt() * self.pmax)
     }
 
     /// Corner-weighted face normal for corner `c`.
@@ -329,7 +343,12 @@ impl State {
     pub fn new(mesh: &Mesh, norm: &Normalization) -> State {
         let nv = mesh.n_vertices();
         State {
-            pos: mesh.positions.iter().map(|&p| norm.apply(p)).collect(),
+            pos: mesh
+                .positions
+                .iter()
+                .zip(mesh.referenced())
+                .map(|(&p, used)| if used { norm.apply(p) } else { [0.0; 3] })
+                .collect(),
             faces: mesh.faces.clone(),
             owner: max_face(nv, &mesh.faces),
             normals: vec![[0.0; 3]; nv],
@@ -515,7 +534,7 @@ impl State {
 /// Runs the whole reference pipeline. `opts.accumulate` and `opts.precision`
 /// do not apply (the reference is sequential f64).
 pub fn estimate(mesh: &Mesh, opts: &CurvatureOptions) -> (CurvatureField, CurvatureCounts) {
-    let norm = Normalization::of(&mesh.positions);
+    let norm = Normalization::of_masked(&mesh.positions, Some(&mesh.referenced()));
     let mut s = State::new(mesh, &norm);
     s.normals_areas();
     s.frames();

@@ -125,7 +125,11 @@ pub(crate) fn pick(all: &[DeviceInfo], sel: Option<&str>) -> Result<DeviceInfo> 
             }
             let needle = s.to_lowercase();
             all.iter()
-                .find(|d| format!("{} {}", d.platform, d.name).to_lowercase().contains(&needle))
+                .find(|d| {
+                    format!("{} {}", d.platform, d.name)
+                        .to_lowercase()
+                        .contains(&needle)
+                })
                 .cloned()
                 .ok_or_else(|| Error::NoDevice {
                     selector: s.to_string(),
@@ -138,5 +142,56 @@ pub(crate) fn pick(all: &[DeviceInfo], sel: Option<&str>) -> Result<DeviceInfo> 
             .or_else(|| all.iter().find(|d| d.kind == "CPU"))
             .unwrap_or(&all[0])
             .clone()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dev(index: usize, kind: &str, name: &str) -> DeviceInfo {
+        DeviceInfo {
+            index,
+            platform: "Plat".into(),
+            name: name.into(),
+            kind: kind.into(),
+            version: String::new(),
+            compute_units: 1,
+            global_mem: 0,
+            max_alloc: 0,
+            fp64: false,
+            gl_sharing: false,
+            int64_atomics: false,
+            id: std::ptr::null_mut(),
+        }
+    }
+
+    #[test]
+    fn default_prefers_the_first_gpu_then_the_first_cpu() {
+        let all = [
+            dev(0, "CPU", "cpu a"),
+            dev(1, "GPU", "gpu b"),
+            dev(2, "GPU", "gpu c"),
+        ];
+        assert_eq!(pick(&all, None).unwrap().index, 1);
+        let cpus = [dev(0, "ACCELERATOR", "acc"), dev(1, "CPU", "cpu")];
+        assert_eq!(pick(&cpus, None).unwrap().index, 1);
+        let other = [dev(0, "ACCELERATOR", "acc")];
+        assert_eq!(pick(&other, None).unwrap().index, 0);
+    }
+
+    #[test]
+    fn selector_is_an_index_or_a_name_substring() {
+        let all = [
+            dev(0, "CPU", "pthread-skylake"),
+            dev(1, "GPU", "NVIDIA H100"),
+        ];
+        assert_eq!(pick(&all, Some("0")).unwrap().index, 0);
+        assert_eq!(pick(&all, Some(" h100 ")).unwrap().index, 1);
+        assert_eq!(pick(&all, Some("plat")).unwrap().index, 0);
+        let e = pick(&all, Some("7")).unwrap_err().to_string();
+        assert!(e.contains("'7'") && e.contains("1: NVIDIA H100"), "{e}");
+        let e = pick(&all, Some("radeon")).unwrap_err().to_string();
+        assert!(e.contains("radeon") && e.contains("available"), "{e}");
     }
 }

@@ -50,8 +50,7 @@ impl Gpu {
     pub fn new(selector: Option<&str>) -> Result<Gpu> {
         let info = device::select(selector)?;
         let device = Device::new(info.id);
-        let context =
-            Context::from_device(&device).map_err(|e| Error::cl("clCreateContext", e))?;
+        let context = Context::from_device(&device).map_err(|e| Error::cl("clCreateContext", e))?;
         #[allow(deprecated)]
         let queue = CommandQueue::create_default(&context, CL_QUEUE_PROFILING_ENABLE)
             .map_err(|e| Error::cl("clCreateCommandQueue", e))?;
@@ -121,9 +120,12 @@ impl Gpu {
         }
         // SAFETY: blocking write of a live slice into a buffer at least as long
         // (callers size buffers from the same lengths).
-        unsafe { self.queue.enqueue_write_buffer(buf, CL_BLOCKING, 0, data, &[]) }
-            .map(|_| ())
-            .map_err(|e| Error::cl("clEnqueueWriteBuffer", e))
+        unsafe {
+            self.queue
+                .enqueue_write_buffer(buf, CL_BLOCKING, 0, data, &[])
+        }
+        .map(|_| ())
+        .map_err(|e| Error::cl("clEnqueueWriteBuffer", e))
     }
 
     /// Blocking read of `out.len()` elements from the start of `buf`.
@@ -132,9 +134,12 @@ impl Gpu {
             return Ok(());
         }
         // SAFETY: blocking read into a live slice no longer than the buffer.
-        unsafe { self.queue.enqueue_read_buffer(buf, CL_BLOCKING, 0, out, &[]) }
-            .map(|_| ())
-            .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
+        unsafe {
+            self.queue
+                .enqueue_read_buffer(buf, CL_BLOCKING, 0, out, &[])
+        }
+        .map(|_| ())
+        .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
     }
 
     /// Waits for every queued command.

@@ -19,10 +19,7 @@ pub struct KernelFile {
 
 /// The shared headers every kernel family may use.
 pub const COMMON_HEADERS: &[(&str, &str)] = &[
-    (
-        "common/real.h",
-        include_str!("../../kernels/common/real.h"),
-    ),
+    ("common/real.h", include_str!("../../kernels/common/real.h")),
     (
         "common/atomics.h",
         include_str!("../../kernels/common/atomics.h"),

@@ -142,11 +142,7 @@ pub fn icosphere(r: f64, level: u32) -> Mesh {
             let key = (a.min(b), a.max(b));
             *mid.entry(key).or_insert_with(|| {
                 let (pa, pb) = (positions[a as usize], positions[b as usize]);
-                positions.push(norm([
-                    pa[0] + pb[0],
-                    pa[1] + pb[1],
-                    pa[2] + pb[2],
-                ]));
+                positions.push(norm([pa[0] + pb[0], pa[1] + pb[1], pa[2] + pb[2]]));
                 (positions.len() - 1) as u32
             })
         };
@@ -217,4 +213,47 @@ pub fn jittered_sphere(r: f64, level: u32, amount: f64, seed: u64) -> Mesh {
 pub fn torus_resolution_for(n: usize) -> (usize, usize) {
     let nv = ((n as f64 / 2.0).sqrt().round() as usize).max(3);
     (2 * nv, nv)
+}
+
+/// An ellipsoid with semi-axes `a`, `b`, `c` on a latitude–longitude grid:
+/// `nu` segments around z, `nv` latitude bands (poles are single vertices).
+/// Its regular parametrization is what the convergence tests need; an
+/// [`ellipsoid`] built from a scaled geodesic sphere is irregular, and
+/// normal-based estimators do not converge on it.
+pub fn uv_ellipsoid(a: f64, b: f64, c: f64, nu: usize, nv: usize) -> Mesh {
+    let nu = nu.max(3);
+    let nv = nv.max(2);
+    let mut positions = vec![[0.0, 0.0, c]];
+    for j in 1..nv {
+        let th = PI * j as f64 / nv as f64;
+        for i in 0..nu {
+            let ph = 2.0 * PI * i as f64 / nu as f64;
+            positions.push([
+                a * th.sin() * ph.cos(),
+                b * th.sin() * ph.sin(),
+                c * th.cos(),
+            ]);
+        }
+    }
+    positions.push([0.0, 0.0, -c]);
+    let south = (positions.len() - 1) as u32;
+    let ring = |j: usize, i: usize| (1 + (j - 1) * nu + (i % nu)) as u32;
+    let mut faces = Vec::new();
+    for i in 0..nu {
+        faces.push([0, ring(1, i), ring(1, i + 1)]);
+        faces.push([south, ring(nv - 1, i + 1), ring(nv - 1, i)]);
+    }
+    for j in 1..nv - 1 {
+        for i in 0..nu {
+            let (p, q, r, s) = (
+                ring(j, i),
+                ring(j + 1, i),
+                ring(j + 1, i + 1),
+                ring(j, i + 1),
+            );
+            faces.push([p, q, r]);
+            faces.push([p, r, s]);
+        }
+    }
+    Mesh { positions, faces }
 }

@@ -112,6 +112,11 @@ impl Mesh {
         (Mesh { positions, faces }, remap)
     }
 
+    /// For each vertex, whether some face uses it.
+    pub fn referenced(&self) -> Vec<bool> {
+        referenced(self.n_vertices(), &self.faces)
+    }
+
     /// Axis-aligned bounding box (min, max).
     pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
         let mut lo = [f64::INFINITY; 3];
@@ -132,4 +137,15 @@ impl Mesh {
             faces: self.faces.clone(),
         }
     }
+}
+
+/// For each of `nv` vertices, whether one of `faces` uses it.
+pub fn referenced(nv: usize, faces: &[[u32; 3]]) -> Vec<bool> {
+    let mut r = vec![false; nv];
+    for f in faces {
+        for &v in f {
+            r[v as usize] = true;
+        }
+    }
+    r
 }

@@ -11,8 +11,7 @@
 
 use crate::error::{Error, Result};
 use crate::field::{
-    Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision,
+    Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization, Precision,
 };
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use opencl3::kernel::Kernel;
@@ -104,6 +103,7 @@ pub struct CurvatureEstimator {
     nf: usize,
     real: usize,
     norm: Normalization,
+    referenced: Vec<bool>,
     staging: Vec<u8>,
     k: Kernels,
     faces: Buffer<u32>,
@@ -296,6 +296,7 @@ impl CurvatureEstimator {
                 center: [0.0; 3],
                 scale: 1.0,
             },
+            referenced: crate::mesh::referenced(nv, faces),
             staging: Vec::with_capacity(3 * nv * real),
             k,
             faces: faces_b,
@@ -329,7 +330,7 @@ impl CurvatureEstimator {
     }
 
     /// Uploads a new pose (same vertex count) into the existing position
-    /// buffer: centred and scaled in f64 on the host, then rounded to the
+    /// buffer: centred and scaled in f64 on the host (over the vertices faces use), then rounded to the
     /// device precision. No allocation after the first call.
     pub fn set_positions(&mut self, positions: &[[f64; 3]]) -> Result<()> {
         if positions.len() != self.nv {
@@ -347,10 +348,11 @@ impl CurvatureEstimator {
                 "vertex {i} of the pose has a non-finite coordinate"
             )));
         }
-        self.norm = Normalization::of(positions);
+        self.norm = Normalization::of_masked(positions, Some(&self.referenced));
         self.staging.clear();
-        for p in positions {
-            let q = self.norm.apply(*p);
+        for (p, &used) in positions.iter().zip(&self.referenced) {
+            // Unreferenced vertices are never read; zeros keep them finite in f32.
+            let q = if used { self.norm.apply(*p) } else { [0.0; 3] };
             for c in q {
                 match self.opts.precision {
                     Precision::F32 => self.staging.extend_from_slice(&(c as f32).to_ne_bytes()),
@@ -661,11 +663,7 @@ pub struct Estimate {
 }
 
 /// One-shot estimation: allocate, upload, run every pass, read back.
-pub fn estimate(
-    gpu: Arc<Gpu>,
-    mesh: &crate::Mesh,
-    opts: CurvatureOptions,
-) -> Result<Estimate> {
+pub fn estimate(gpu: Arc<Gpu>, mesh: &crate::Mesh, opts: CurvatureOptions) -> Result<Estimate> {
     let mut est = CurvatureEstimator::new(gpu, mesh.n_vertices(), &mesh.faces, opts)?;
     est.set_positions(&mesh.positions)?;
     let timing = est.run()?;

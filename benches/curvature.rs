@@ -1,0 +1,277 @@
+//! Curvature stage benches (`kernels/curvature.cl` ↔ `src/stages/curvature.rs`).
+//!
+//! Groups:
+//! - `curvature/<variant>/<input>`: kernel time from OpenCL profiling events
+//!   (the sum of the pass times of one [`CurvatureEstimator::run`]), mesh
+//!   already on the device, after one warm-up run that pays for JIT.
+//! - `curvature_wall/<variant>/<input>`: host wall time of one run (first
+//!   enqueue to end of the last kernel), default variant only.
+//! - `cpu_reference/bunny`: wall time of the f64 CPU reference, for scale.
+//!
+//! Inputs: the Stanford bunny from `shared/data/meshes` (skipped if absent)
+//! and generated tori of about 500k and 2M vertices.
+//! `SHAPECUE_BENCH_QUICK=1` restricts the run to the bunny.
+//! `SHAPECUE_DEVICE` picks the device as for the CLI.
+
+use criterion::{
+    BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
+    measurement::WallTime,
+};
+use shapecue::Mesh;
+use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::gpu::Gpu;
+use shapecue::mesh::{self, LoadOptions};
+use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
+use std::hint::black_box;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+const BUNNY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../shared/data/meshes/stanford-bunny.obj"
+);
+
+/// The benched variants, default first, with their bench names.
+fn variants() -> Vec<(&'static str, CurvatureOptions)> {
+    let d = CurvatureOptions::default();
+    vec![
+        ("atomic-f32-exact", d),
+        (
+            "gather-f32-exact",
+            CurvatureOptions {
+                accumulate: Accumulate::Gather,
+                ..d
+            },
+        ),
+        (
+            "atomic-f64-exact",
+            CurvatureOptions {
+                precision: Precision::F64,
+                ..d
+            },
+        ),
+        (
+            "atomic-f32-exact-nodcurv",
+            CurvatureOptions { dcurv: false, ..d },
+        ),
+        (
+            "atomic-f32-trimesh2",
+            CurvatureOptions {
+                compat: Compat::Trimesh2,
+                ..d
+            },
+        ),
+    ]
+}
+
+/// A bench input: its name, how to make it, and its sampling settings.
+struct Input {
+    name: &'static str,
+    make: fn() -> Option<Mesh>,
+    sampling: Sampling,
+}
+
+/// Criterion settings for an input. On a 2-core CPU device a run takes
+/// about 20 ms on the bunny, 0.2–0.5 s on 500k vertices and 1–2 s on 2M:
+/// big inputs get 10 samples with flat sampling (one run per iteration
+/// count), sized so that every variant finishes without criterion warnings.
+#[derive(Clone, Copy)]
+struct Sampling {
+    samples: usize,
+    flat: bool,
+    measure_s: u64,
+}
+
+const SMALL: Sampling = Sampling {
+    samples: 20,
+    flat: false,
+    measure_s: 8,
+};
+
+fn bunny() -> Option<Mesh> {
+    let path = Path::new(BUNNY);
+    if !path.exists() {
+        eprintln!("curvature bench: {BUNNY} not found, skipping the bunny");
+        return None;
+    }
+    match mesh::load(path, &LoadOptions::default()) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            eprintln!("curvature bench: cannot load {BUNNY}: {e}; skipping the bunny");
+            None
+        }
+    }
+}
+
+fn torus_of(n: usize) -> Mesh {
+    let (nu, nv) = mesh::torus_resolution_for(n);
+    mesh::torus(1.0, 0.4, nu, nv)
+}
+
+fn inputs() -> Vec<Input> {
+    let mut v = vec![Input {
+        name: "bunny",
+        make: bunny,
+        sampling: SMALL,
+    }];
+    let quick = std::env::var("SHAPECUE_BENCH_QUICK").is_ok_and(|s| !s.is_empty() && s != "0");
+    if quick {
+        eprintln!("curvature bench: SHAPECUE_BENCH_QUICK set, bunny only");
+    } else {
+        v.push(Input {
+            name: "torus-500k",
+            make: || Some(torus_of(500_000)),
+            sampling: Sampling {
+                samples: 10,
+                flat: true,
+                measure_s: 8,
+            },
+        });
+        v.push(Input {
+            name: "torus-2m",
+            make: || Some(torus_of(2_000_000)),
+            sampling: Sampling {
+                samples: 10,
+                flat: true,
+                measure_s: 20,
+            },
+        });
+    }
+    v
+}
+
+fn configure(g: &mut BenchmarkGroup<'_, WallTime>, s: Sampling) {
+    g.sample_size(s.samples)
+        .sampling_mode(if s.flat {
+            SamplingMode::Flat
+        } else {
+            SamplingMode::Linear
+        })
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(s.measure_s));
+}
+
+/// Builds an estimator for `opts` with `m` on the device and one warm-up run
+/// done; `None` (with the reason printed) if the device cannot run it.
+fn ready(
+    gpu: &Arc<Gpu>,
+    m: &Mesh,
+    name: &str,
+    opts: CurvatureOptions,
+) -> Option<CurvatureEstimator> {
+    let mut est = match CurvatureEstimator::new(gpu.clone(), m.n_vertices(), &m.faces, opts) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("curvature bench: skipping {name}: {e}");
+            return None;
+        }
+    };
+    // The first run pays for JIT compilation; the second is printed.
+    let warm = est
+        .set_positions(&m.positions)
+        .and_then(|()| est.run())
+        .and_then(|_| est.run());
+    match warm {
+        Ok(t) => {
+            let passes: Vec<String> = t
+                .passes
+                .iter()
+                .map(|p| format!("{} {:.2}", p.pass, p.kernel_ms))
+                .collect();
+            eprintln!(
+                "curvature bench: {name}: kernel {:.2} ms ({}), wall {:.2} ms",
+                t.kernel_ms,
+                passes.join(", "),
+                t.wall_ms
+            );
+            Some(est)
+        }
+        Err(e) => {
+            eprintln!("curvature bench: skipping {name}: {e}");
+            None
+        }
+    }
+}
+
+/// Runs `iters` times and returns the sum of `pick(timing)` (milliseconds) as a duration.
+fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&RunTiming) -> f64) -> Duration {
+    let mut ms = 0.0;
+    for _ in 0..iters {
+        let t = est.run().expect("curvature run failed");
+        ms += pick(black_box(&t));
+    }
+    Duration::from_secs_f64(ms * 1e-3)
+}
+
+fn curvature_benches(c: &mut Criterion) {
+    let gpu = match Gpu::new(None) {
+        Ok(g) => Arc::new(g),
+        Err(e) => {
+            eprintln!("curvature bench: no OpenCL device ({e}); nothing to bench");
+            return;
+        }
+    };
+    eprintln!(
+        "curvature bench: device {} ({}, {} CUs)",
+        gpu.info.name, gpu.info.platform, gpu.info.compute_units
+    );
+    let variants = variants();
+    let mut cpu_input: Option<Mesh> = None;
+
+    for input in inputs() {
+        let Some(m) = (input.make)() else { continue };
+        eprintln!(
+            "curvature bench: {}: {} vertices, {} faces",
+            input.name,
+            m.n_vertices(),
+            m.n_faces()
+        );
+
+        let mut g = c.benchmark_group("curvature");
+        configure(&mut g, input.sampling);
+        g.throughput(Throughput::Elements(m.n_vertices() as u64));
+        for &(vname, opts) in &variants {
+            let id = format!("{vname}/{}", input.name);
+            let Some(mut est) = ready(&gpu, &m, &id, opts) else {
+                continue;
+            };
+            g.bench_function(&id, |b| {
+                b.iter_custom(|iters| timed(&mut est, iters, |t| t.kernel_ms))
+            });
+        }
+        g.finish();
+
+        let mut g = c.benchmark_group("curvature_wall");
+        configure(&mut g, input.sampling);
+        g.throughput(Throughput::Elements(m.n_vertices() as u64));
+        let (vname, opts) = variants[0];
+        let id = format!("{vname}/{}", input.name);
+        if let Some(mut est) = ready(&gpu, &m, &id, opts) {
+            g.bench_function(&id, |b| {
+                b.iter_custom(|iters| timed(&mut est, iters, |t| t.wall_ms))
+            });
+        }
+        g.finish();
+
+        if input.name == "bunny" {
+            cpu_input = Some(m);
+        }
+    }
+
+    if let Some(m) = cpu_input {
+        let mut g = c.benchmark_group("cpu_reference");
+        g.sample_size(10)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(5))
+            .throughput(Throughput::Elements(m.n_vertices() as u64));
+        let opts = CurvatureOptions::default();
+        g.bench_function("bunny", |b| {
+            b.iter(|| shapecue::cpu::curvature::estimate(black_box(&m), &opts))
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, curvature_benches);
+criterion_main!(benches);

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs what shapecue needs on a Debian/Ubuntu machine that has Rust:
+# the OpenCL ICD loader and headers, and PoCL (an OpenCL device on the CPU, so
+# everything runs without a GPU). Used by the README, .ci/run and the Dockerfile.
+# Idempotent: installs only what is missing.
+set -euo pipefail
+
+pkgs=(ocl-icd-libopencl1 ocl-icd-opencl-dev pocl-opencl-icd clinfo)
+missing=()
+for p in "${pkgs[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+    SUDO=""
+    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    echo "setup: installing ${missing[*]}"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+    echo "setup: cargo not found; install Rust from https://rustup.rs" >&2
+    exit 1
+fi
+if command -v rustup >/dev/null 2>&1; then
+    rustup component list --installed 2>/dev/null | grep -q '^rustfmt' || rustup component add rustfmt
+    rustup component list --installed 2>/dev/null | grep -q '^clippy' || rustup component add clippy
+fi
+echo "setup: OpenCL devices:"
+clinfo -l 2>/dev/null || true

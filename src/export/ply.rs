@@ -1,0 +1,194 @@
+//! PLY output: the mesh with, optionally, every per-vertex curvature quantity,
+//! as `binary_little_endian` with `float` properties.
+//!
+//! Vertex properties, in order: `x y z` ([`POSITION_PROPERTIES`]), then with a
+//! field `nx ny nz area k1 k2 d1x d1y d1z d2x d2y d2z dk0 dk1 dk2 dk3`
+//! ([`FIELD_PROPERTIES`]). Faces: `property list uchar int vertex_indices`.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, PropertyType};
+
+use crate::error::{Error, Result};
+use crate::field::CurvatureField;
+use crate::mesh::Mesh;
+
+/// Names of the vertex position properties, first in every file.
+pub const POSITION_PROPERTIES: [&str; 3] = ["x", "y", "z"];
+
+/// Names of the per-vertex curvature properties written after the position
+/// when a field is given, in file order.
+pub const FIELD_PROPERTIES: [&str; 16] = [
+    "nx", "ny", "nz", "area", "k1", "k2", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z", "dk0", "dk1",
+    "dk2", "dk3",
+];
+
+/// Writes `mesh` (and `field`, when given) to `path` as a binary
+/// little-endian PLY file with `float` vertex properties.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] when the field's arrays do not all have one
+/// entry per vertex or a face index does not fit a PLY `int`;
+/// [`Error::Write`] when the file cannot be created or written.
+pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Result<()> {
+    let n = mesh.n_vertices();
+    if let Some(f) = field {
+        let lens = [
+            ("normals", f.normals.len()),
+            ("areas", f.areas.len()),
+            ("k1", f.k1.len()),
+            ("k2", f.k2.len()),
+            ("d1", f.d1.len()),
+            ("d2", f.d2.len()),
+            ("dk", f.dk.len()),
+        ];
+        if let Some((what, len)) = lens.iter().find(|(_, len)| *len != n) {
+            return Err(Error::InvalidArgument(format!(
+                "curvature field '{what}' has {len} entries for a mesh of {n} vertices"
+            )));
+        }
+    }
+    if let Some(v) = mesh
+        .faces
+        .iter()
+        .flatten()
+        .find(|&&v| i32::try_from(v).is_err())
+    {
+        return Err(Error::InvalidArgument(format!(
+            "face index {v} does not fit the PLY 'int' face list"
+        )));
+    }
+
+    let write_err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = File::create(path).map_err(write_err)?;
+    let mut w = BufWriter::with_capacity(1 << 20, file);
+
+    let mut header = String::new();
+    header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
+    header.push_str(&format!("element vertex {n}\n"));
+    let names = POSITION_PROPERTIES
+        .iter()
+        .chain(field.map_or(&[][..], |_| &FIELD_PROPERTIES[..]));
+    for name in names {
+        header.push_str(&format!("property float {name}\n"));
+    }
+    header.push_str(&format!("element face {}\n", mesh.n_faces()));
+    header.push_str("property list uchar int vertex_indices\nend_header\n");
+    w.write_all(header.as_bytes()).map_err(write_err)?;
+
+    let mut row: Vec<f32> = Vec::with_capacity(POSITION_PROPERTIES.len() + FIELD_PROPERTIES.len());
+    let mut bytes: Vec<u8> = Vec::with_capacity(4 * row.capacity());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        row.clear();
+        row.extend(p.iter().map(|&c| c as f32));
+        if let Some(f) = field {
+            row.extend(f.normals[i].iter().map(|&c| c as f32));
+            row.push(f.areas[i] as f32);
+            row.push(f.k1[i] as f32);
+            row.push(f.k2[i] as f32);
+            row.extend(f.d1[i].iter().map(|&c| c as f32));
+            row.extend(f.d2[i].iter().map(|&c| c as f32));
+            row.extend(f.dk[i].iter().map(|&c| c as f32));
+        }
+        bytes.clear();
+        for v in &row {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        w.write_all(&bytes).map_err(write_err)?;
+    }
+
+    for face in &mesh.faces {
+        let mut rec = [0u8; 13];
+        rec[0] = 3;
+        for (k, &v) in face.iter().enumerate() {
+            // Checked above to fit an i32, so the u32 bytes are the i32 bytes.
+            rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
+        }
+        w.write_all(&rec).map_err(write_err)?;
+    }
+    w.into_inner().map_err(|e| write_err(e.into_error()))?;
+    Ok(())
+}
+
+/// The contents of a PLY file as [`read_ply_properties`] returns them: the
+/// vertex property names in file order, one row of values per vertex (in the
+/// same order, converted to `f32`) and the faces, fan-triangulated.
+pub type PlyProperties = (Vec<String>, Vec<Vec<f32>>, Vec<[u32; 3]>);
+
+/// Reads back any PLY file (used by tests to check what [`write_ply`] wrote):
+/// the names of the scalar properties of element `vertex` in file order, their
+/// values per vertex, and the faces of element `face` (`vertex_indices` or
+/// `vertex_index`), fan-triangulated.
+///
+/// # Errors
+///
+/// [`Error::Io`] when the file cannot be read; [`Error::InvalidInput`] when it
+/// is not a well-formed PLY file or a face has fewer than three or negative
+/// indices.
+pub fn read_ply_properties(path: &Path) -> Result<PlyProperties> {
+    let source = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let flat = |s: String| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut &bytes[..])
+        .map_err(|e| Error::input(&source, "file", flat(e.to_string())))?;
+
+    let names: Vec<String> = ply
+        .header
+        .elements
+        .get("vertex")
+        .map(|def| {
+            def.properties
+                .values()
+                .filter(|p| matches!(p.data_type, PropertyType::Scalar(_)))
+                .map(|p| p.name.clone())
+                .collect()
+        })
+        .unwrap_or_default();
+
+    let mut rows = Vec::new();
+    for (i, v) in ply.payload.get("vertex").into_iter().flatten().enumerate() {
+        let row = names
+            .iter()
+            .map(|n| v.get(n).and_then(|p| p.to_f32_lossy()))
+            .collect::<Option<Vec<f32>>>()
+            .ok_or_else(|| Error::input(&source, format!("vertex {i}"), "missing property"))?;
+        rows.push(row);
+    }
+
+    let mut faces = Vec::new();
+    for (i, f) in ply.payload.get("face").into_iter().flatten().enumerate() {
+        let list = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .and_then(|p| p.to_u32_list())
+            .ok_or_else(|| {
+                Error::input(
+                    &source,
+                    format!("face {i}"),
+                    "no list of non-negative integer vertex indices",
+                )
+            })?;
+        if list.len() < 3 {
+            return Err(Error::input(
+                &source,
+                format!("face {i}"),
+                format!("{} vertex indices; a face needs at least 3", list.len()),
+            ));
+        }
+        for k in 1..list.len() - 1 {
+            faces.push([list[0], list[k], list[k + 1]]);
+        }
+    }
+    Ok((names, rows, faces))
+}

@@ -1,0 +1,184 @@
+//! The command line: outputs, stats, refusals and error messages.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shapecue"))
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shapecue-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+
+#[test]
+fn devices_lists_the_cpu_device() {
+    let out = bin().arg("devices").output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        s.contains("fp64") && s.contains("gl_sharing") && s.contains("int64"),
+        "{s}"
+    );
+    let out = bin().args(["devices", "--json"]).output().unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v.as_array().is_some_and(|a| !a.is_empty()));
+}
+
+#[test]
+fn curvature_writes_ply_with_the_documented_properties_and_stats() {
+    let d = tmpdir("ply");
+    let ply = d.join("sub/torus.ply");
+    let json = d.join("torus.json");
+    let out = bin()
+        .args([
+            "curvature",
+            "--generate",
+            "torus",
+            "--resolution",
+            "2000",
+            "-o",
+        ])
+        .arg(&ply)
+        .arg("--stats")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (names, values, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
+    assert_eq!(
+        names.join(" "),
+        "x y z nx ny nz area k1 k2 d1x d1y d1z d2x d2y d2z dk0 dk1 dk2 dk3"
+    );
+    assert!(!faces.is_empty());
+    // torus R=1 r=0.4: k1 = 2.5 everywhere
+    assert!(values.iter().all(|v| (v[7] - 2.5).abs() < 0.1), "k1 off");
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for key in [
+        "device",
+        "passes",
+        "kernel_ms",
+        "device_bytes",
+        "counts",
+        "vertices",
+        "faces",
+    ] {
+        assert!(stats.get(key).is_some(), "stats lack {key}: {stats}");
+    }
+    let passes: Vec<&str> = stats["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["pass"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        passes,
+        [
+            "clear",
+            "normals_areas",
+            "frames",
+            "tensor",
+            "principal",
+            "dcurv"
+        ]
+    );
+    assert_eq!(stats["counts"]["degenerate_faces"], 0);
+    // existing output is not overwritten without --force
+    let out = bin()
+        .args([
+            "curvature",
+            "--generate",
+            "torus",
+            "--resolution",
+            "2000",
+            "-o",
+        ])
+        .arg(&ply)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--force"));
+}
+
+#[test]
+fn output_equal_to_input_is_refused_and_the_input_survives() {
+    let d = tmpdir("same");
+    let obj = d.join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let out = bin()
+        .arg("curvature")
+        .arg(&obj)
+        .arg("-o")
+        .arg(&obj)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("input file"));
+    assert_eq!(std::fs::read_to_string(&obj).unwrap(), TETRA);
+}
+
+#[test]
+fn bad_input_names_the_file_and_element() {
+    let d = tmpdir("bad");
+    let obj = d.join("bad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    let out = bin().arg("curvature").arg(&obj).output().unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("bad.obj") && e.contains("face"), "{e}");
+    let out = bin()
+        .args(["curvature", "/nonexistent/x.ply"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/x.ply"));
+    let out = bin()
+        .args([
+            "--device",
+            "no-such-device",
+            "curvature",
+            "--generate",
+            "plane",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-device"));
+}
+
+#[test]
+fn cpu_reference_and_every_variant_run_from_the_cli() {
+    let d = tmpdir("variants");
+    let obj = d.join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    for extra in [
+        vec!["--cpu"],
+        vec!["--accumulate", "gather"],
+        vec!["--precision", "f64"],
+        vec!["--compat", "trimesh2"],
+        vec!["--no-dcurv"],
+    ] {
+        let out = bin()
+            .arg("curvature")
+            .arg(&obj)
+            .args(&extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -1,0 +1,645 @@
+//! Curvature: device vs CPU reference (pass by pass and end to end), analytic
+//! oracles with convergence, output conventions, determinism, deforming
+//! meshes, and the hard cases (degenerate, non-manifold, flat, umbilic,
+//! slivers, far from the origin, extreme scales).
+
+use shapecue::cpu::curvature as cpu;
+use shapecue::field::{
+    Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
+};
+use shapecue::gpu::Gpu;
+use shapecue::mesh::{self, Mesh};
+use shapecue::report::{analytic_rms, nrmse, rmse};
+use shapecue::stages::curvature::{self as stage, CurvatureEstimator, Pass};
+use std::sync::{Arc, OnceLock};
+
+fn gpu() -> Arc<Gpu> {
+    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
+    GPU.get_or_init(|| {
+        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
+            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
+        }))
+    })
+    .clone()
+}
+
+fn shared(name: &str) -> Option<Mesh> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/meshes")
+        .join(name);
+    if !p.exists() {
+        eprintln!(
+            "skipping: {} not found (../shared/data is absent)",
+            p.display()
+        );
+        return None;
+    }
+    Some(mesh::load(&p, &Default::default()).expect("shared mesh loads"))
+}
+
+const F64: CurvatureOptions = CurvatureOptions {
+    accumulate: Accumulate::Atomic,
+    precision: Precision::F64,
+    compat: Compat::Exact,
+    dcurv: true,
+};
+
+fn with(o: CurvatureOptions, acc: Accumulate, prec: Precision) -> CurvatureOptions {
+    CurvatureOptions {
+        accumulate: acc,
+        precision: prec,
+        ..o
+    }
+}
+
+fn device(m: &Mesh, o: CurvatureOptions) -> stage::Estimate {
+    stage::estimate(gpu(), m, o).expect("device estimate")
+}
+
+/// The mesh as the f32 device sees it: normalized, rounded to f32, mapped back.
+fn quantized(m: &Mesh) -> Mesh {
+    let n = Normalization::of(&m.positions);
+    m.map_positions(|p| {
+        let a = n.apply(p);
+        std::array::from_fn(|k| (a[k] as f32) as f64 * n.scale + n.center[k])
+    })
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Output conventions: unit n, d1, d2; d1, d2 tangent; d2 = n × d1; all finite.
+fn assert_frames(f: &CurvatureField, tol: f64) {
+    assert!(f.all_finite(), "non-finite output");
+    for i in 0..f.len() {
+        let (n, d1, d2) = (f.normals[i], f.d1[i], f.d2[i]);
+        for (what, v) in [("n", n), ("d1", d1), ("d2", d2)] {
+            assert!(
+                (dot(v, v).sqrt() - 1.0).abs() < tol,
+                "vertex {i}: |{what}| = {}",
+                dot(v, v).sqrt()
+            );
+        }
+        assert!(dot(n, d1).abs() < tol, "vertex {i}: d1 not tangent");
+        assert!(dot(n, d2).abs() < tol, "vertex {i}: d2 not tangent");
+        let c = cross(n, d1);
+        assert!(
+            (0..3).all(|k| (c[k] - d2[k]).abs() < tol),
+            "vertex {i}: d2 != n × d1"
+        );
+    }
+}
+
+fn assert_fields_close(a: &CurvatureField, b: &CurvatureField, tol: f64, what: &str) {
+    let cmp = |x: &[f64], y: &[f64], name: &str| {
+        let e = nrmse(x, y);
+        assert!(e <= tol, "{what}: {name} NRMSE {e:.3e} > {tol:.1e}");
+    };
+    cmp(&a.k1, &b.k1, "k1");
+    cmp(&a.k2, &b.k2, "k2");
+    cmp(&a.mean(), &b.mean(), "H");
+    cmp(&a.gaussian(), &b.gaussian(), "K");
+    cmp(&a.areas, &b.areas, "area");
+}
+
+// ---------------------------------------------------------------- device vs CPU
+
+#[test]
+fn every_pass_matches_the_cpu_reference_in_f64() {
+    let m = mesh::jittered_sphere(1.0, 3, 0.25, 11);
+    for acc in [Accumulate::Atomic, Accumulate::Gather] {
+        let o = with(F64, acc, Precision::F64);
+        let mut est = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();
+        est.set_positions(&m.positions).unwrap();
+        let norm = est.normalization();
+        let mut s = cpu::State::new(&m, &norm);
+        let close = |a: &[f64], b: &[f64], name: &str| {
+            let e = rmse(a, b);
+            assert!(e < 1e-11, "{acc:?} {name}: rmse {e:.3e}");
+        };
+        let flat3 = |v: &[[f64; 3]]| v.iter().flatten().copied().collect::<Vec<_>>();
+
+        est.run_until(Pass::NormalsAreas).unwrap();
+        s.normals_areas();
+        let d = est.read_intermediate().unwrap();
+        close(&d.areas, &s.areas, "areas");
+        // raw normal sums, compared relative to their size
+        let scale = s
+            .normals
+            .iter()
+            .map(|n| dot(*n, *n).sqrt())
+            .fold(0.0, f64::max);
+        close(
+            &flat3(&d.normals)
+                .iter()
+                .map(|x| x / scale)
+                .collect::<Vec<_>>(),
+            &flat3(&s.normals)
+                .iter()
+                .map(|x| x / scale)
+                .collect::<Vec<_>>(),
+            "normal sums",
+        );
+
+        est.run_until(Pass::Frames).unwrap();
+        s.frames();
+        let d = est.read_intermediate().unwrap();
+        close(&flat3(&d.normals), &flat3(&s.normals), "normals");
+        close(&flat3(&d.pd1), &flat3(&s.pd1), "initial pd1");
+        close(&flat3(&d.pd2), &flat3(&s.pd2), "initial pd2");
+
+        est.run_until(Pass::Tensor).unwrap();
+        s.tensor(Compat::Exact);
+        let d = est.read_intermediate().unwrap();
+        close(&flat3(&d.tensor), &flat3(&s.tensor), "tensor");
+
+        est.run_until(Pass::Principal).unwrap();
+        s.principal(Compat::Exact);
+        let d = est.read_intermediate().unwrap();
+        let k = |v: &[[f64; 2]]| v.iter().flatten().copied().collect::<Vec<_>>();
+        close(&k(&d.k), &k(&s.k), "k1 k2");
+        close(&flat3(&d.pd1), &flat3(&s.pd1), "d1");
+
+        est.run_until(Pass::Dcurv).unwrap();
+        s.dcurv();
+        let d = est.read_intermediate().unwrap();
+        let dk = |v: &[[f64; 4]]| v.iter().flatten().copied().collect::<Vec<_>>();
+        let e = nrmse(&dk(&d.dk), &dk(&s.dk));
+        assert!(e < 1e-10, "{acc:?} dcurv NRMSE {e:.3e}");
+    }
+}
+
+#[test]
+fn f32_device_matches_reference_at_table_3_level() {
+    // Same input for both (the f32 rounding of the positions is the input's,
+    // not the estimator's): NRMSE of k1, k2, H, K ≤ 1e-4 % = 1e-6.
+    let mut cases = vec![
+        ("torus", mesh::torus(1.0, 0.4, 256, 128)),
+        ("jittered sphere", mesh::jittered_sphere(1.0, 5, 0.2, 7)),
+    ];
+    if let Some(b) = shared("stanford-bunny.obj") {
+        cases.push(("bunny", b));
+    }
+    for (name, m) in cases {
+        let q = quantized(&m);
+        let (r, _) = cpu::estimate(&q, &CurvatureOptions::default());
+        for acc in [Accumulate::Atomic, Accumulate::Gather] {
+            let g = device(&m, with(CurvatureOptions::default(), acc, Precision::F32));
+            assert_fields_close(&g.field, &r, 1e-6, &format!("{name} {acc:?} f32"));
+        }
+        // f64 on the raw input agrees to rounding.
+        let (r, _) = cpu::estimate(&m, &CurvatureOptions::default());
+        let g = device(&m, F64);
+        assert_fields_close(&g.field, &r, 1e-10, &format!("{name} f64"));
+    }
+}
+
+#[test]
+fn trimesh2_mode_matches_the_reference_and_orders_by_magnitude() {
+    let m = mesh::torus(1.0, 0.4, 64, 32);
+    let o = CurvatureOptions {
+        compat: Compat::Trimesh2,
+        ..F64
+    };
+    let g = device(&m, o);
+    let (r, _) = cpu::estimate(&m, &o);
+    assert_fields_close(&g.field, &r, 1e-10, "trimesh2 f64");
+    for i in 0..g.field.len() {
+        assert!(g.field.k1[i].abs() >= g.field.k2[i].abs());
+    }
+    // and the quirk really changes the answer
+    let (exact, _) = cpu::estimate(&m, &CurvatureOptions::default());
+    assert!(rmse(&exact.k1, &r.k1) > 1e-2);
+}
+
+#[test]
+fn gather_is_bitwise_reproducible_and_agrees_with_atomic() {
+    let m = mesh::jittered_sphere(1.0, 4, 0.3, 3);
+    let o = with(
+        CurvatureOptions::default(),
+        Accumulate::Gather,
+        Precision::F32,
+    );
+    let a = device(&m, o).field;
+    let mut est = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();
+    est.set_positions(&m.positions).unwrap();
+    for _ in 0..3 {
+        est.run().unwrap();
+        let b = est.read().unwrap();
+        assert_eq!(a, b, "gather results differ between runs");
+    }
+    let at = device(&m, CurvatureOptions::default()).field;
+    assert_fields_close(&at, &a, 1e-6, "atomic vs gather");
+}
+
+// ---------------------------------------------------------------- analytic oracles
+
+/// Mean of the larger and smaller RMS errors against the truth.
+fn oracle_error(m: &Mesh, o: CurvatureOptions, truth: &dyn Fn([f64; 3]) -> (f64, f64)) -> f64 {
+    let g = device(m, o);
+    let t: Vec<(f64, f64)> = m.positions.iter().map(|&p| truth(p)).collect();
+    let (e1, e2) = analytic_rms(&g.field, &t);
+    0.5 * (e1 + e2)
+}
+
+#[test]
+fn sphere_cylinder_torus_ellipsoid_converge_like_h_squared() {
+    // Each step halves h; an O(h²) estimator cuts the error ~4×. Require ≥ 3×.
+    type Case = (
+        &'static str,
+        Box<dyn Fn(usize) -> Mesh>,
+        Box<dyn Fn([f64; 3]) -> (f64, f64)>,
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "torus",
+            Box::new(|k| mesh::torus(1.0, 0.4, 16 << k, 8 << k)),
+            Box::new(|p| mesh::torus_curvature(1.0, 0.4, p)),
+        ),
+        (
+            "cylinder (interior rows)",
+            Box::new(|k| mesh::cylinder(1.0, 1.0, 12 << k, (2 << k) + 1)),
+            Box::new(|_| (1.0, 0.0)),
+        ),
+        (
+            // regular lat-long grid: on a scaled geodesic sphere (irregular valences)
+            // normal-based estimators do not converge, which says nothing about the code
+            "ellipsoid",
+            Box::new(|k| mesh::uv_ellipsoid(1.5, 1.0, 0.6, 16 << k, 8 << k)),
+            Box::new(|p| mesh::ellipsoid_curvature(1.5, 1.0, 0.6, p)),
+        ),
+    ];
+    for (name, make, truth) in &cases {
+        let errs: Vec<f64> = (0..3)
+            .map(|k| {
+                let m = make(k);
+                if name.starts_with("cylinder") {
+                    // boundary rows of an open cylinder have one-sided rings: test the interior
+                    let g = device(&m, F64);
+                    let idx: Vec<usize> = (0..m.n_vertices())
+                        .filter(|&i| m.positions[i][2].abs() < 0.49)
+                        .collect();
+                    let e1 = rmse(
+                        &idx.iter().map(|&i| g.field.k1[i]).collect::<Vec<_>>(),
+                        &vec![1.0; idx.len()],
+                    );
+                    let e2 = rmse(
+                        &idx.iter().map(|&i| g.field.k2[i]).collect::<Vec<_>>(),
+                        &vec![0.0; idx.len()],
+                    );
+                    0.5 * (e1 + e2)
+                } else {
+                    oracle_error(&m, F64, truth.as_ref())
+                }
+            })
+            .collect();
+        eprintln!("{name}: errors {errs:?}");
+        if errs[0] < 1e-9 {
+            continue; // exact at every resolution (a regular cylinder is)
+        }
+        for w in errs.windows(2) {
+            assert!(
+                w[1] < w[0] / 3.0,
+                "{name}: error {:.3e} → {:.3e} does not fall like h²",
+                w[0],
+                w[1]
+            );
+        }
+    }
+    // Icospheres are exact up to their irregularity; the error is small at every level.
+    for level in 2..5 {
+        let e = oracle_error(&mesh::icosphere(2.0, level), F64, &|_| (0.5, 0.5));
+        assert!(e < 0.05 * 0.5, "sphere level {level}: {e}");
+    }
+}
+
+#[test]
+fn trimesh2_quirk_error_does_not_vanish_on_the_torus() {
+    let o = CurvatureOptions {
+        compat: Compat::Trimesh2,
+        ..F64
+    };
+    let errs: Vec<f64> = (0..3)
+        .map(|k| {
+            let m = mesh::torus(1.0, 0.4, 16 << k, 8 << k);
+            let t: Vec<(f64, f64)> = m
+                .positions
+                .iter()
+                .map(|&p| mesh::torus_curvature(1.0, 0.4, p))
+                .collect();
+            // trimesh2 orders by magnitude; on this torus |k1| ≥ |k2| everywhere, so compare k1
+            analytic_rms(&device(&m, o).field, &t).0
+        })
+        .collect();
+    eprintln!("trimesh2 torus k1 errors {errs:?}");
+    assert!(errs.iter().all(|&e| e > 0.1), "{errs:?}");
+    assert!(errs[2] > errs[0] * 0.8, "quirk error fell: {errs:?}");
+}
+
+// ---------------------------------------------------------------- conventions
+
+#[test]
+fn sphere_is_convex_positive_and_umbilic_frames_are_orthonormal() {
+    let m = mesh::icosphere(2.0, 4);
+    let g = device(&m, CurvatureOptions::default());
+    assert_frames(&g.field, 1e-5);
+    for i in 0..m.n_vertices() {
+        assert!(g.field.k1[i] >= g.field.k2[i]);
+        assert!((g.field.k1[i] - 0.5).abs() < 0.03, "k1 {}", g.field.k1[i]);
+        assert!((g.field.k2[i] - 0.5).abs() < 0.03, "k2 {}", g.field.k2[i]);
+        // outward normals
+        assert!(dot(g.field.normals[i], m.positions[i]) > 0.0);
+    }
+    // inverted orientation flips the sign
+    let mut inv = m.clone();
+    inv.faces.iter_mut().for_each(|f| f.swap(1, 2));
+    let g = device(&inv, CurvatureOptions::default());
+    assert!(g.field.k1.iter().all(|&k| (k + 0.5).abs() < 0.03));
+}
+
+#[test]
+fn cylinder_directions_follow_the_circumference() {
+    let m = mesh::cylinder(0.5, 1.0, 64, 17);
+    let g = device(&m, CurvatureOptions::default());
+    assert_frames(&g.field, 1e-5);
+    for i in 0..m.n_vertices() {
+        if m.positions[i][2].abs() > 0.45 {
+            continue;
+        }
+        assert!((g.field.k1[i] - 2.0).abs() < 0.01, "k1 {}", g.field.k1[i]);
+        assert!(g.field.k2[i].abs() < 0.01, "k2 {}", g.field.k2[i]);
+        assert!(g.field.d1[i][2].abs() < 1e-3, "d1 not around the axis");
+        assert!(g.field.d2[i][2].abs() > 0.999, "d2 not along the axis");
+    }
+}
+
+#[test]
+fn flat_plane_has_zero_curvature_and_orthonormal_frames() {
+    let m = mesh::plane(20, 3.0);
+    let g = device(&m, CurvatureOptions::default());
+    assert_frames(&g.field, 1e-5);
+    assert!(g.field.k1.iter().chain(&g.field.k2).all(|k| k.abs() < 1e-5));
+    assert!(g.field.dk.iter().flatten().all(|d| d.abs() < 1e-4));
+    assert!(g.field.normals.iter().all(|n| (n[2] - 1.0).abs() < 1e-6));
+    assert_eq!(g.counts.vertices_without_curvature, 0);
+}
+
+// ---------------------------------------------------------------- hard cases
+
+fn check_hard(m: &Mesh, what: &str) -> (stage::Estimate, CurvatureField) {
+    let (r, rc) = cpu::estimate(m, &CurvatureOptions::default());
+    assert!(r.all_finite(), "{what}: CPU reference not finite");
+    for acc in [Accumulate::Atomic, Accumulate::Gather] {
+        for prec in [Precision::F32, Precision::F64] {
+            let g = device(m, with(CurvatureOptions::default(), acc, prec));
+            assert_frames(&g.field, 1e-4);
+            assert_eq!(
+                (
+                    g.counts.degenerate_faces,
+                    g.counts.vertices_without_curvature
+                ),
+                (rc.degenerate_faces, rc.vertices_without_curvature),
+                "{what} {acc:?} {prec:?}: counts differ from the reference"
+            );
+        }
+    }
+    (device(m, CurvatureOptions::default()), r)
+}
+
+#[test]
+fn degenerate_faces_are_skipped_counted_and_do_not_poison_neighbours() {
+    let base = mesh::icosphere(1.0, 3);
+    let clean = device(&base, F64).field;
+    let mut m = base.clone();
+    let n0 = m.positions.len() as u32;
+    // zero-area (collinear) face: midpoint of an existing edge
+    let [a, b, _] = m.faces[0];
+    let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
+    m.positions
+        .push(std::array::from_fn(|k| 0.5 * (pa[k] + pb[k])));
+    m.faces.push([a, b, n0]);
+    // zero-length edge: a face using the same vertex twice, and one with a coincident copy
+    m.faces.push([a, a, b]);
+    m.positions.push(pa);
+    m.faces.push([a, n0 + 1, b]);
+    let (g, _) = check_hard(&m, "degenerate");
+    assert_eq!(g.counts.degenerate_faces, 3);
+    assert_eq!(g.counts.vertices_without_curvature, 2);
+    // every original vertex is exactly as without the degenerate faces
+    let g64 = device(&m, F64).field;
+    for i in 0..base.n_vertices() {
+        assert!(
+            (g64.k1[i] - clean.k1[i]).abs() < 1e-9,
+            "vertex {i} poisoned"
+        );
+        assert!(
+            (g64.k2[i] - clean.k2[i]).abs() < 1e-9,
+            "vertex {i} poisoned"
+        );
+    }
+}
+
+#[test]
+fn duplicate_faces_unreferenced_vertices_and_a_lone_triangle() {
+    let mut m = mesh::icosphere(1.0, 2);
+    let f0 = m.faces[0];
+    m.faces.push(f0);
+    m.positions.push([5.0, 5.0, 5.0]);
+    m.positions.push([f64::MAX.sqrt(), 0.0, 0.0]); // far away, unreferenced
+    let (g, _) = check_hard(&m, "duplicates + unreferenced");
+    assert_eq!(g.counts.vertices_without_curvature, 2);
+    let n = m.n_vertices();
+    assert_eq!(g.field.normals[n - 1], [0.0, 0.0, 1.0]);
+    assert_eq!((g.field.k1[n - 1], g.field.k2[n - 1]), (0.0, 0.0));
+
+    let lone = Mesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+        "lone",
+    )
+    .unwrap();
+    let (g, _) = check_hard(&lone, "lone triangle");
+    assert!(g.field.k1.iter().all(|k| k.abs() < 1e-6));
+    assert!(g.field.normals.iter().all(|n| (n[2] - 1.0).abs() < 1e-6));
+}
+
+#[test]
+fn non_manifold_edges_and_vertices_and_boundaries() {
+    // three fins sharing one edge
+    let p = vec![
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.5],
+        [-0.5, 0.8, 0.5],
+        [-0.5, -0.8, 0.5],
+    ];
+    let fins = Mesh::new(p, vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]], "fins").unwrap();
+    check_hard(&fins, "non-manifold edge");
+    // two cones touching at their apex (non-manifold vertex)
+    let mut cones = Mesh::default();
+    cones.positions.push([0.0, 0.0, 0.0]);
+    for s in [1.0, -1.0] {
+        let base = cones.positions.len() as u32;
+        for i in 0..8 {
+            let a = i as f64 * std::f64::consts::TAU / 8.0;
+            cones.positions.push([a.cos(), a.sin(), s]);
+        }
+        for i in 0..8u32 {
+            let (u, v) = (base + i, base + (i + 1) % 8);
+            cones
+                .faces
+                .push(if s > 0.0 { [0, u, v] } else { [0, v, u] });
+        }
+    }
+    check_hard(&cones, "non-manifold vertex");
+    // open cylinder: boundary rows
+    check_hard(&mesh::cylinder(1.0, 1.0, 16, 4), "boundary");
+    if let Some(m) = shared("beetle.obj") {
+        check_hard(&m, "beetle (47 non-manifold edges)");
+    }
+}
+
+#[test]
+fn slivers_with_aspect_ratio_1e6_stay_finite() {
+    let mut m = mesh::plane(6, 1.0);
+    let n = m.positions.len() as u32;
+    // needles: a long edge and an apex 1e-6 of its length off the line, bent out of plane
+    m.positions.push([0.0, 2.0, 0.0]);
+    m.positions.push([1.0, 2.0, 1e-6]);
+    m.positions.push([0.5, 2.0 + 1e-6, 0.0]);
+    m.faces.push([n, n + 1, n + 2]);
+    // a cap: nearly 180° angle
+    m.positions.push([0.0, 3.0, 0.0]);
+    m.positions.push([1.0, 3.0, 0.0]);
+    m.positions.push([0.5, 3.0 + 1e-6, 0.0]);
+    m.faces.push([n + 3, n + 4, n + 5]);
+    // slivers inside a curved mesh
+    let mut s = mesh::torus(1.0, 0.4, 24, 12);
+    let k = s.positions.len() as u32;
+    let [a, b, _] = s.faces[5];
+    let (pa, pb) = (s.positions[a as usize], s.positions[b as usize]);
+    s.positions.push(std::array::from_fn(|i| {
+        0.5 * (pa[i] + pb[i]) + if i == 2 { 1e-6 } else { 0.0 }
+    }));
+    s.faces.push([a, b, k]);
+    check_hard(&m, "needles and caps");
+    check_hard(&s, "sliver in a torus");
+}
+
+#[test]
+fn translation_by_1e6_and_scales_1e_minus6_and_1e6() {
+    let m = mesh::torus(1.0, 0.4, 64, 32);
+    let base = device(&m, CurvatureOptions::default()).field;
+    for (what, s, t) in [
+        ("translated by 1e6", 1.0, 1e6),
+        ("scaled by 1e-6", 1e-6, 0.0),
+        ("scaled by 1e6", 1e6, 0.0),
+        ("scaled by 1e-6 at 1e-3", 1e-6, 1e-3),
+    ] {
+        let mm = m.map_positions(|p| p.map(|c| c * s + t));
+        let (g, _) = check_hard(&mm, what);
+        let f = g.field;
+        let k1: Vec<f64> = f.k1.iter().map(|k| k * s).collect();
+        let k2: Vec<f64> = f.k2.iter().map(|k| k * s).collect();
+        let e = nrmse(&k1, &base.k1).max(nrmse(&k2, &base.k2));
+        assert!(
+            e < 1e-5,
+            "{what}: curvature × scale differs by NRMSE {e:.2e}"
+        );
+        let a: Vec<f64> = f.areas.iter().map(|x| x / (s * s)).collect();
+        assert!(nrmse(&a, &base.areas) < 1e-5, "{what}: areas");
+    }
+}
+
+// ---------------------------------------------------------------- deforming meshes
+
+#[test]
+fn two_poses_through_one_estimator_equal_two_fresh_runs() {
+    let rest = mesh::cylinder(0.5, 2.0, 32, 24);
+    let bent = rest.map_positions(|p| {
+        // bend around the y axis
+        let a = p[2] * 0.6;
+        [(p[0] + 1.5) * a.cos() - 1.5, p[1], (p[0] + 1.5) * a.sin()]
+    });
+    for o in [
+        with(
+            CurvatureOptions::default(),
+            Accumulate::Gather,
+            Precision::F32,
+        ),
+        F64,
+    ] {
+        let mut est = CurvatureEstimator::new(gpu(), rest.n_vertices(), &rest.faces, o).unwrap();
+        let bytes = est.device_bytes();
+        let mut poses = Vec::new();
+        for m in [&rest, &bent, &rest] {
+            est.set_positions(&m.positions).unwrap();
+            est.run().unwrap();
+            poses.push(est.read().unwrap());
+        }
+        assert_eq!(est.device_bytes(), bytes);
+        let fresh_rest = device(&rest, o).field;
+        let fresh_bent = device(&bent, o).field;
+        if o.accumulate == Accumulate::Gather {
+            assert_eq!(poses[0], fresh_rest);
+            assert_eq!(poses[1], fresh_bent);
+            assert_eq!(poses[2], fresh_rest);
+        } else {
+            // atomics sum in a varying order: equal to rounding, measured against
+            // the curvature scale (k2 of a straight cylinder is ~0, so NRMSE would
+            // divide rounding noise by a zero range)
+            for (a, b, what) in [
+                (&poses[1], &fresh_bent, "bent"),
+                (&poses[2], &fresh_rest, "rest"),
+            ] {
+                let scale = b.k1.iter().map(|k| k.abs()).fold(0.0, f64::max);
+                for (x, y) in [(&a.k1, &b.k1), (&a.k2, &b.k2)] {
+                    let e = rmse(x, y) / scale;
+                    assert!(e < 1e-12, "{what} pose: {e:.2e}");
+                }
+            }
+        }
+        assert!(rmse(&poses[0].k2, &poses[1].k2) > 0.01, "the poses differ");
+    }
+}
+
+#[test]
+fn wrong_pose_sizes_and_non_finite_poses_are_errors() {
+    let m = mesh::icosphere(1.0, 1);
+    let mut est =
+        CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, Default::default()).unwrap();
+    let e = est
+        .set_positions(&m.positions[1..])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("vertices"), "{e}");
+    let mut bad = m.positions.clone();
+    bad[3][1] = f64::NAN;
+    let e = est.set_positions(&bad).unwrap_err().to_string();
+    assert!(e.contains("vertex 3"), "{e}");
+    let e = CurvatureEstimator::new(gpu(), 3, &[[0, 1, 7]], Default::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("face 0"), "{e}");
+}
+
+#[test]
+fn memory_stays_within_budget() {
+    // ≤ 192 bytes per vertex + 32 per face, for every f32 variant
+    let m = mesh::torus(1.0, 0.4, 200, 100);
+    for acc in [Accumulate::Atomic, Accumulate::Gather] {
+        let o = with(CurvatureOptions::default(), acc, Precision::F32);
+        let b = stage::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
+        let budget = 192 * m.n_vertices() as u64 + 32 * m.n_faces() as u64;
+        assert!(b <= budget, "{acc:?}: {b} > {budget}");
+    }
+}
