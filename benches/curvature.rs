@@ -84,7 +84,7 @@ struct Sampling {
 }
 
 const SMALL: Sampling = Sampling {
-    samples: 20,
+    samples: 15,
     flat: false,
     measure_s: 8,
 };

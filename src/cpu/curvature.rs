@@ -44,14 +44,14 @@ const fn prev3(i: usize) -> usize {
     if i == 0 { 2 } else { i - 1 }
 }
 
-/// Relative area threshold of the degenerate-face rule (same as the kernel).
-pub const DEGEN_AREA_REL: f64 = 1e-7;
+/// Relative area threshold of the degenerate-face rule, × Σ edge² (same as the kernel).
+pub const DEGEN_AREA_REL: f64 = 5e-8;
 /// Squared edge-length threshold in normalized coordinates (same as the kernel).
 pub const DEGEN_EDGE2: f64 = 1e-24;
-/// Heights below this × the largest |p| of the face (normalized coordinates)
-/// are under the f32 rounding of the positions: degenerate at every precision,
-/// so f32, f64 and this reference agree on which faces are skipped.
-pub const DEGEN_HEIGHT_ULP: f64 = 4.0 / 16_777_216.0;
+/// Heights below this × (|p0| + |p1| + |p2|) (normalized coordinates) are
+/// under the f32 rounding of the positions: degenerate at every precision, so
+/// f32, f64 and this reference agree on which faces are skipped.
+pub const DEGEN_HEIGHT_ULP: f64 = 1.0 / 8_388_608.0;
 
 /// A face's vertices, positions and edges (`e[i]` opposite corner i).
 #[derive(Clone, Copy, Debug)]
@@ -60,8 +60,8 @@ pub struct Tri {
     pub v: [usize; 3],
     /// Edges: e[i] = p[prev(i)] − p[next(i)].
     pub e: [V3; 3],
-    /// Largest distance of a corner from the origin (normalized coordinates).
-    pub pmax: f64,
+    /// |p0| + |p1| + |p2| (normalized coordinates).
+    pub psum: f64,
 }
 
 impl Tri {
@@ -72,22 +72,22 @@ impl Tri {
         Tri {
             v,
             e: std::array::from_fn(|i| sub(p[prev3(i)], p[next3(i)])),
-            pmax: len(p[0]).max(len(p[1])).max(len(p[2])),
+            psum: len(p[0]) + len(p[1]) + len(p[2]),
         }
     }
 
     /// The degenerate-face rule: an edge with squared length ≤ 1e-24 (unit-RMS
-    /// coordinates), or 2·area ≤ 1e-7 · (longest edge)², or a height below
-    /// the f32 rounding of the positions. NaN counts as degenerate.
+    /// coordinates), or 2·area ≤ 5e-8 · Σ edge², or 2·area/√(Σ edge²) below
+    /// the f32 rounding of the positions (2⁻²³ · Σ|p|). NaN counts as degenerate.
     pub fn degenerate(&self) -> bool {
         let l = self.e.map(|e| dot(e, e));
         if !(l[0] > DEGEN_EDGE2 && l[1] > DEGEN_EDGE2 && l[2] > DEGEN_EDGE2) {
             return true;
         }
-        let lmax = l[0].max(l[1]).max(l[2]);
+        let lsum = l[0] + l[1] + l[2];
         let twice_area = len(cross(self.e[0], self.e[1]));
-        !(twice_area > DEGEN_AREA_REL * lmax
-            && twice_area > DEGEN_HEIGHT_ULP * lmax.sqrt() * self.pmax)
+        !(twice_area > DEGEN_AREA_REL * lsum
+            && twice_area > DEGEN_HEIGHT_ULP * lsum.sqrt() * self.psum)
     }
 
     /// Corner-weighted face normal for corner `c`.
@@ -238,66 +238,42 @@ pub fn face_tensor(t: &Tri, ft: V3, fb: V3, n: [V3; 3], compat: Compat) -> Optio
     x.iter().all(|c| c.is_finite()).then_some(x)
 }
 
-/// Per-face least-squares derivative tensor; `None` when a pivot is not positive.
+/// Per-face least-squares derivative tensor; `None` when a pivot is not
+/// positive. The 4×4 normal equations [[a b 0 0] [b 2a+c 2b 0] [0 2b a+2c b]
+/// [0 0 b c]] (a = Σu², b = Σuv, c = Σv²) are tridiagonal; LDLᵀ unrolled.
 pub fn face_dcurv(t: &Tri, ft: V3, fb: V3, fc: [V3; 3]) -> Option<[f64; 4]> {
-    let mut w = [[0.0f64; 4]; 4];
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
     let mut m = [0.0f64; 4];
     for j in 0..3 {
         let d = sub(fc[prev3(j)], fc[next3(j)]);
         let (u, v) = (dot(t.e[j], ft), dot(t.e[j], fb));
-        w[0][0] += u * u;
-        w[0][1] += u * v;
-        w[3][3] += v * v;
+        a += u * u;
+        b += u * v;
+        c += v * v;
         m[0] += u * d[0];
         m[1] += v * d[0] + 2.0 * u * d[1];
         m[2] += 2.0 * v * d[1] + u * d[2];
         m[3] += v * d[2];
     }
-    w[1][1] = 2.0 * w[0][0] + w[3][3];
-    w[1][2] = 2.0 * w[0][1];
-    w[2][2] = w[0][0] + 2.0 * w[3][3];
-    w[2][3] = w[0][1];
-    for i in 0..4 {
-        for j in 0..i {
-            w[i][j] = w[j][i];
-        }
+    let d0 = a;
+    let l10 = b / d0;
+    let d1 = 2.0 * a + c - l10 * b;
+    let l21 = 2.0 * b / d1;
+    let d2 = a + 2.0 * c - l21 * (2.0 * b);
+    let l32 = b / d2;
+    let d3 = c - l32 * b;
+    if !(d0 > 0.0 && d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
+        return None;
     }
-    let mut l = [[0.0f64; 4]; 4];
-    let mut dd = [0.0f64; 4];
-    for j in 0..4 {
-        let mut s = w[j][j];
-        for k in 0..j {
-            s -= l[j][k] * l[j][k] * dd[k];
-        }
-        if !(s > 0.0) {
-            return None;
-        }
-        dd[j] = s;
-        for i in j + 1..4 {
-            let mut r = w[i][j];
-            for k in 0..j {
-                r -= l[i][k] * l[j][k] * dd[k];
-            }
-            l[i][j] = r / s;
-        }
-    }
-    let mut y = [0.0; 4];
-    for i in 0..4 {
-        let mut s = m[i];
-        for k in 0..i {
-            s -= l[i][k] * y[k];
-        }
-        y[i] = s;
-    }
-    let mut x = [0.0; 4];
-    for i in (0..4).rev() {
-        let mut s = y[i] / dd[i];
-        for k in i + 1..4 {
-            s -= l[k][i] * x[k];
-        }
-        x[i] = s;
-    }
-    x.iter().all(|c| c.is_finite()).then_some(x)
+    let y1 = m[1] - l10 * m[0];
+    let y2 = m[2] - l21 * y1;
+    let y3 = m[3] - l32 * y2;
+    let x3 = y3 / d3;
+    let x2 = y2 / d2 - l32 * x3;
+    let x1 = y1 / d1 - l21 * x2;
+    let x0 = m[0] / d0 - l10 * x1;
+    let x = [x0, x1, x2, x3];
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// State of the reference pipeline, pass by pass (normalized coordinates).

@@ -108,8 +108,7 @@ pub struct CurvatureEstimator {
     k: Kernels,
     faces: Buffer<u32>,
     owner: Buffer<i32>,
-    ring_off: Option<Buffer<u32>>,
-    ring: Option<Buffer<u32>>,
+    gather: Option<GatherBufs>,
     pos: Buffer<u8>,
     nrm: Buffer<u8>,
     area: Buffer<u8>,
@@ -125,11 +124,23 @@ pub struct CurvatureEstimator {
 
 struct Kernels {
     clear: Kernel,
+    /// Atomic variant: the per-face scatter kernel; gather: the per-face corner kernel.
     normals_areas: Kernel,
     frames: Kernel,
+    count_empty: Kernel,
     tensor: Kernel,
     principal: Kernel,
     dcurv: Kernel,
+    /// Gather variant only: the per-vertex one-ring sums of the three passes.
+    sums: Option<[Kernel; 3]>,
+}
+
+/// Buffers of the gather variant: one-ring lists, corner contributions, face status.
+struct GatherBufs {
+    ring_off: Buffer<u32>,
+    ring: Buffer<u32>,
+    corner: Buffer<u8>,
+    status: Buffer<u8>,
 }
 
 /// Bytes of device memory the estimator allocates for a mesh, by variant
@@ -142,7 +153,8 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 
     let per_face = 12;
     let mut b = nv * per_vertex + nf * per_face + 16;
     if opts.accumulate == Accumulate::Gather {
-        b += (nv + 1) * 4 + 3 * nf * 4;
+        // one-ring CSR, 4 reals per face corner, one status byte per face
+        b += (nv + 1) * 4 + 3 * nf * 4 + 12 * nf * r + nf;
     }
     b
 }
@@ -236,19 +248,30 @@ impl CurvatureEstimator {
         let program = gpu.program(&file, &build_options(&opts))?;
         let gather = opts.accumulate == Accumulate::Gather;
         let kname = |base: &str| {
-            if gather && matches!(base, "curv_normals_areas" | "curv_tensor" | "curv_dcurv") {
-                format!("{base}_gather")
+            if gather {
+                format!("{base}_corners")
             } else {
                 base.to_string()
             }
+        };
+        let sums = if gather {
+            Some([
+                gpu.kernel(&program, "curv_normals_areas_sum")?,
+                gpu.kernel(&program, "curv_tensor_sum")?,
+                gpu.kernel(&program, "curv_dcurv_sum")?,
+            ])
+        } else {
+            None
         };
         let k = Kernels {
             clear: gpu.kernel(&program, "curv_clear")?,
             normals_areas: gpu.kernel(&program, &kname("curv_normals_areas"))?,
             frames: gpu.kernel(&program, "curv_frames")?,
+            count_empty: gpu.kernel(&program, "curv_count_empty")?,
             tensor: gpu.kernel(&program, &kname("curv_tensor"))?,
             principal: gpu.kernel(&program, "curv_principal")?,
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
+            sums,
         };
         let max_face = gpu.kernel(&program, "curv_max_face")?;
 
@@ -257,15 +280,20 @@ impl CurvatureEstimator {
         gpu.write(&mut faces_b, flat)?;
         let mut owner = gpu.buffer::<i32>(nv)?;
         gpu.write(&mut owner, &vec![-1i32; nv])?;
-        let (ring_off, ring) = if gather {
+        let gather_bufs = if gather {
             let (off, ring) = one_rings(nv, faces);
-            let mut ob = gpu.buffer::<u32>(off.len())?;
-            gpu.write(&mut ob, &off)?;
-            let mut rb = gpu.buffer::<u32>(ring.len())?;
-            gpu.write(&mut rb, &ring)?;
-            (Some(ob), Some(rb))
+            let mut ring_off = gpu.buffer::<u32>(off.len())?;
+            gpu.write(&mut ring_off, &off)?;
+            let mut ring_b = gpu.buffer::<u32>(ring.len())?;
+            gpu.write(&mut ring_b, &ring)?;
+            Some(GatherBufs {
+                ring_off,
+                ring: ring_b,
+                corner: gpu.buffer::<u8>(12 * nf * real)?,
+                status: gpu.buffer::<u8>(nf)?,
+            })
         } else {
-            (None, None)
+            None
         };
         let ev = launch(
             &gpu,
@@ -301,8 +329,7 @@ impl CurvatureEstimator {
             k,
             faces: faces_b,
             owner,
-            ring_off,
-            ring,
+            gather: gather_bufs,
             topology_ms: t0.elapsed().as_secs_f64() * 1e3,
         };
         Ok(est)
@@ -377,203 +404,108 @@ impl CurvatureEstimator {
     /// (the dcurv pass only if the options ask for it).
     pub fn run_until(&mut self, last: Pass) -> Result<RunTiming> {
         let g = &*self.gpu;
-        let (nv, nf) = (self.nv as u32, self.nf as u32);
-        let gather = self.opts.accumulate == Accumulate::Gather;
+        let (nv, nf) = (self.nv, self.nf);
+        let (nv32, nf32) = (nv as u32, nf as u32);
         g.write(&mut self.counters, &[0u32; 4])?;
         let t0 = Instant::now();
-        let mut events = Vec::new();
-        let mut go = |pass: Pass, ev: Option<opencl3::event::Event>| {
+        let mut events: Vec<(Pass, opencl3::event::Event)> = Vec::new();
+        let mut record = |pass: Pass, ev: Option<opencl3::event::Event>| {
             if let Some(e) = ev {
                 events.push((pass, e));
             }
         };
-        let (ro, rl) = match (&self.ring_off, &self.ring) {
-            (Some(o), Some(r)) => (buf(o), buf(r)),
-            _ => (buf(&self.faces), buf(&self.faces)), // unused by the atomic kernels
-        };
-        let nvn = self.nv;
-        let nfn = self.nf;
-        let wanted = |p: Pass| p <= last;
+        let (pos, faces, cnt) = (buf(&self.pos), buf(&self.faces), buf(&self.counters));
+        let (nrm, area, pd1, pd2) = (
+            buf(&self.nrm),
+            buf(&self.area),
+            buf(&self.pd1),
+            buf(&self.pd2),
+        );
+        let (tens, kk, dk) = (buf(&self.tens), buf(&self.kk), buf(&self.dk));
+        let dcurv = self.opts.dcurv && Pass::Dcurv <= last;
 
-        if !gather {
-            go(
-                Pass::Clear,
-                launch(
-                    g,
-                    &self.k.clear,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.tens),
-                        buf(&self.dk),
-                    ],
-                )?,
-            );
+        // A one-ring pass: the atomic variant scatters from its face kernel (args
+        // + output + counters); the gather variant writes corners, then sums them.
+        let one_ring = |face_kernel: &Kernel,
+                        face_args: &[Arg],
+                        sum: usize,
+                        outputs: &[Arg],
+                        pass: Pass|
+         -> Result<Vec<(Pass, opencl3::event::Event)>> {
+            let mut evs = Vec::new();
+            match (&self.gather, &self.k.sums) {
+                (Some(gb), Some(sums)) => {
+                    let mut a = vec![Arg::U32(nf32)];
+                    a.extend_from_slice(face_args);
+                    a.extend([buf(&gb.corner), buf(&gb.status)]);
+                    evs.extend(launch(g, face_kernel, nf, &a)?.map(|e| (pass, e)));
+                    let mut a = vec![
+                        Arg::U32(nv32),
+                        buf(&gb.ring_off),
+                        buf(&gb.ring),
+                        buf(&gb.corner),
+                        buf(&gb.status),
+                    ];
+                    a.extend_from_slice(outputs);
+                    a.push(cnt);
+                    evs.extend(launch(g, &sums[sum], nv, &a)?.map(|e| (pass, e)));
+                }
+                _ => {
+                    let mut a = vec![Arg::U32(nf32)];
+                    a.extend_from_slice(face_args);
+                    a.extend_from_slice(outputs);
+                    a.push(cnt);
+                    evs.extend(launch(g, face_kernel, nf, &a)?.map(|e| (pass, e)));
+                }
+            }
+            Ok(evs)
+        };
+
+        if self.gather.is_none() {
+            let ev = launch(g, &self.k.clear, nv, &[Arg::U32(nv32), nrm, area, tens, dk])?;
+            record(Pass::Clear, ev);
         }
-        if wanted(Pass::NormalsAreas) {
-            let ev = if gather {
-                launch(
-                    g,
-                    &self.k.normals_areas,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        ro,
-                        rl,
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.counters),
-                    ],
-                )?
-            } else {
-                launch(
-                    g,
-                    &self.k.normals_areas,
-                    nfn,
-                    &[
-                        Arg::U32(nf),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.counters),
-                    ],
-                )?
-            };
-            go(Pass::NormalsAreas, ev);
+        if Pass::NormalsAreas <= last {
+            for (p, e) in one_ring(&self.k.normals_areas, &[pos, faces], 0, &[nrm, area], Pass::NormalsAreas)? {
+                record(p, Some(e));
+            }
         }
-        if wanted(Pass::Frames) {
-            go(
-                Pass::Frames,
-                launch(
-                    g,
-                    &self.k.frames,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        buf(&self.owner),
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.counters),
-                    ],
-                )?,
-            );
+        if Pass::Frames <= last {
+            let args = [Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
+            record(Pass::Frames, launch(g, &self.k.frames, nv, &args)?);
+            let args = [Arg::U32(nv32), area, cnt];
+            record(Pass::Frames, launch(g, &self.k.count_empty, nv, &args)?);
         }
-        if wanted(Pass::Tensor) {
-            let ev = if gather {
-                launch(
-                    g,
-                    &self.k.tensor,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        ro,
-                        rl,
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.tens),
-                        buf(&self.counters),
-                    ],
-                )?
-            } else {
-                launch(
-                    g,
-                    &self.k.tensor,
-                    nfn,
-                    &[
-                        Arg::U32(nf),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        buf(&self.nrm),
-                        buf(&self.area),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.tens),
-                        buf(&self.counters),
-                    ],
-                )?
-            };
-            go(Pass::Tensor, ev);
+        if Pass::Tensor <= last {
+            let args = [pos, faces, nrm, area, pd1, pd2];
+            for (p, e) in one_ring(&self.k.tensor, &args, 1, &[tens], Pass::Tensor)? {
+                record(p, Some(e));
+            }
         }
-        if wanted(Pass::Principal) {
-            go(
-                Pass::Principal,
-                launch(
-                    g,
-                    &self.k.principal,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.nrm),
-                        buf(&self.tens),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.kk),
-                    ],
-                )?,
-            );
+        if Pass::Principal <= last {
+            let args = [Arg::U32(nv32), nrm, tens, pd1, pd2, kk];
+            record(Pass::Principal, launch(g, &self.k.principal, nv, &args)?);
         }
-        if wanted(Pass::Dcurv) && self.opts.dcurv {
-            let ev = if gather {
-                launch(
-                    g,
-                    &self.k.dcurv,
-                    nvn,
-                    &[
-                        Arg::U32(nv),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        ro,
-                        rl,
-                        buf(&self.area),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.kk),
-                        buf(&self.dk),
-                        buf(&self.counters),
-                    ],
-                )?
-            } else {
-                launch(
-                    g,
-                    &self.k.dcurv,
-                    nfn,
-                    &[
-                        Arg::U32(nf),
-                        buf(&self.pos),
-                        buf(&self.faces),
-                        buf(&self.area),
-                        buf(&self.pd1),
-                        buf(&self.pd2),
-                        buf(&self.kk),
-                        buf(&self.dk),
-                        buf(&self.counters),
-                    ],
-                )?
-            };
-            go(Pass::Dcurv, ev);
+        if dcurv {
+            let args = [pos, faces, area, pd1, pd2, kk];
+            for (p, e) in one_ring(&self.k.dcurv, &args, 2, &[dk], Pass::Dcurv)? {
+                record(p, Some(e));
+            }
         }
         g.finish()?;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let passes: Vec<PassTime> = events
-            .iter()
-            .map(|(p, e)| PassTime {
-                pass: p.name(),
-                kernel_ms: event_ms(e),
-            })
-            .collect();
+        // One entry per pass: a gather pass's face and sum kernels are added up.
+        let mut passes: Vec<PassTime> = Vec::new();
+        for (p, e) in &events {
+            let ms = event_ms(e);
+            match passes.last_mut() {
+                Some(last) if last.pass == p.name() => last.kernel_ms += ms,
+                _ => passes.push(PassTime {
+                    pass: p.name(),
+                    kernel_ms: ms,
+                }),
+            }
+        }
         let kernel_ms = passes.iter().map(|p| p.kernel_ms).sum();
         Ok(RunTiming {
             passes,
