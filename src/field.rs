@@ -73,9 +73,9 @@ pub enum Accumulate {
     /// (compare-and-swap), as in the seed. Summation order varies run to run.
     #[default]
     Atomic,
-    /// One work-item per vertex sums its one-ring (built once) in face order:
-    /// no atomics, bitwise identical from run to run, three times the
-    /// per-face arithmetic.
+    /// Per-face kernels write each corner's contribution to a buffer (12
+    /// reals per face, no atomics); per-vertex kernels sum their one-ring
+    /// (built once) in face order. Bitwise identical from run to run.
     Gather,
 }
 

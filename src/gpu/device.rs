@@ -42,6 +42,7 @@ unsafe impl Sync for DeviceInfo {}
 /// Lists every device of every platform. No platform at all is an error that
 /// says how to install PoCL.
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
+    let _guard = super::program::driver_lock();
     let platforms = get_platforms().map_err(|e| Error::NoPlatform {
         detail: e.to_string(),
     })?;

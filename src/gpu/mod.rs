@@ -49,6 +49,7 @@ impl Gpu {
     /// the first CPU device.
     pub fn new(selector: Option<&str>) -> Result<Gpu> {
         let info = device::select(selector)?;
+        let _guard = program::driver_lock();
         let device = Device::new(info.id);
         let context = Context::from_device(&device).map_err(|e| Error::cl("clCreateContext", e))?;
         #[allow(deprecated)]
@@ -150,8 +151,8 @@ impl Gpu {
 
 /// A kernel argument: a buffer or a plain scalar value.
 #[derive(Clone, Copy)]
-pub enum Arg<'a> {
-    /// A device buffer (any element type).
+pub enum Arg {
+    /// A device buffer (any element type), as its handle.
     Buf(opencl3::types::cl_mem),
     /// A 32-bit unsigned scalar.
     U32(u32),
@@ -159,12 +160,10 @@ pub enum Arg<'a> {
     I32(i32),
     /// A 32-bit float scalar.
     F32(f32),
-    #[doc(hidden)]
-    _Lifetime(std::marker::PhantomData<&'a ()>),
 }
 
 /// Wraps a buffer as a kernel argument.
-pub fn buf<T>(b: &Buffer<T>) -> Arg<'_> {
+pub fn buf<T>(b: &Buffer<T>) -> Arg {
     use opencl3::memory::ClMem;
     Arg::Buf(b.get())
 }
@@ -187,7 +186,6 @@ pub fn launch(gpu: &Gpu, kernel: &Kernel, n: usize, args: &[Arg]) -> Result<Opti
                 Arg::U32(v) => exec.set_arg(v),
                 Arg::I32(v) => exec.set_arg(v),
                 Arg::F32(v) => exec.set_arg(v),
-                Arg::_Lifetime(_) => unreachable!("marker variant is never constructed"),
             };
         }
         exec.set_global_work_size(global)

@@ -51,9 +51,21 @@ pub fn assemble(file: &KernelFile) -> String {
     s
 }
 
+/// Serialises driver set-up across the whole process (platform and device
+/// queries, context creation, program builds): PoCL 3.1's lazy platform
+/// initialisation is not thread-safe; two threads querying devices for the
+/// first time crashed it (SIGSEGV in clGetDeviceInfo) in this project's
+/// parallel tests. Kernel launches are not serialised. Not reentrant.
+static DRIVER_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+pub(crate) fn driver_lock() -> std::sync::MutexGuard<'static, ()> {
+    DRIVER_LOCK.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 pub(crate) fn build(context: &Context, file: &KernelFile, options: &str) -> Result<Program> {
     let src = assemble(file);
     let opts = format!("-cl-std=CL1.2 {options}");
+    let _guard = driver_lock();
     Program::create_and_build_from_source(context, &src, &opts).map_err(|log| Error::Build {
         file: file.name.to_string(),
         options: opts,

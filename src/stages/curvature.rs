@@ -295,14 +295,13 @@ impl CurvatureEstimator {
         } else {
             None
         };
-        let ev = launch(
+        launch(
             &gpu,
             &max_face,
             nf,
             &[Arg::U32(nf as u32), buf(&faces_b), buf(&owner)],
         )?;
         gpu.finish()?;
-        let _ = ev;
         let rb = |n: usize| gpu.buffer::<u8>(n * real);
         let est = CurvatureEstimator {
             pos: rb(3 * nv)?,
@@ -466,7 +465,13 @@ impl CurvatureEstimator {
             record(Pass::Clear, ev);
         }
         if Pass::NormalsAreas <= last {
-            for (p, e) in one_ring(&self.k.normals_areas, &[pos, faces], 0, &[nrm, area], Pass::NormalsAreas)? {
+            for (p, e) in one_ring(
+                &self.k.normals_areas,
+                &[pos, faces],
+                0,
+                &[nrm, area],
+                Pass::NormalsAreas,
+            )? {
                 record(p, Some(e));
             }
         }
