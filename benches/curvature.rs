@@ -18,7 +18,7 @@ use criterion::{
     measurement::WallTime,
 };
 use shapecue::Mesh;
-use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::field::CurvatureOptions;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::{self, LoadOptions};
 use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
@@ -31,39 +31,6 @@ const BUNNY: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../shared/data/meshes/stanford-bunny.obj"
 );
-
-/// The benched variants, default first, with their bench names.
-fn variants() -> Vec<(&'static str, CurvatureOptions)> {
-    let d = CurvatureOptions::default();
-    vec![
-        ("atomic-f32-exact", d),
-        (
-            "gather-f32-exact",
-            CurvatureOptions {
-                accumulate: Accumulate::Gather,
-                ..d
-            },
-        ),
-        (
-            "atomic-f64-exact",
-            CurvatureOptions {
-                precision: Precision::F64,
-                ..d
-            },
-        ),
-        (
-            "atomic-f32-exact-nodcurv",
-            CurvatureOptions { dcurv: false, ..d },
-        ),
-        (
-            "atomic-f32-trimesh2",
-            CurvatureOptions {
-                compat: Compat::Trimesh2,
-                ..d
-            },
-        ),
-    ]
-}
 
 /// A bench input: its name, how to make it, and its sampling settings.
 struct Input {
@@ -216,7 +183,11 @@ fn curvature_benches(c: &mut Criterion) {
         "curvature bench: device {} ({}, {} CUs)",
         gpu.info.name, gpu.info.platform, gpu.info.compute_units
     );
-    let variants = variants();
+    // the report's variants, so the README table and the bench cover the same set
+    let variants: Vec<(String, _)> = shapecue::report::variants()
+        .into_iter()
+        .map(|o| (shapecue::report::label(&o).replace(' ', "-"), o))
+        .collect();
     let mut cpu_input: Option<Mesh> = None;
 
     for input in inputs() {
@@ -231,7 +202,8 @@ fn curvature_benches(c: &mut Criterion) {
         let mut g = c.benchmark_group("curvature");
         configure(&mut g, input.sampling);
         g.throughput(Throughput::Elements(m.n_vertices() as u64));
-        for &(vname, opts) in &variants {
+        for (vname, opts) in &variants {
+            let opts = *opts;
             let id = format!("{vname}/{}", input.name);
             let Some(mut est) = ready(&gpu, &m, &id, opts) else {
                 continue;
@@ -245,7 +217,7 @@ fn curvature_benches(c: &mut Criterion) {
         let mut g = c.benchmark_group("curvature_wall");
         configure(&mut g, input.sampling);
         g.throughput(Throughput::Elements(m.n_vertices() as u64));
-        let (vname, opts) = variants[0];
+        let (vname, opts) = (&variants[0].0, variants[0].1);
         let id = format!("{vname}/{}", input.name);
         if let Some(mut est) = ready(&gpu, &m, &id, opts) {
             g.bench_function(&id, |b| {

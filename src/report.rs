@@ -94,7 +94,9 @@ pub fn measure(gpu: &Arc<Gpu>, m: &Mesh, opts: CurvatureOptions, runs: usize) ->
     })
 }
 
-fn label(o: &CurvatureOptions) -> String {
+/// A variant's name, e.g. `atomic f32 exact` or `gather f64 exact no-dcurv`
+/// (the report's rows; the bench uses it with dashes).
+pub fn label(o: &CurvatureOptions) -> String {
     format!(
         "{} {} {}{}",
         match o.accumulate {
@@ -113,7 +115,7 @@ fn label(o: &CurvatureOptions) -> String {
     )
 }
 
-/// The variants the report compares, default first.
+/// The variants the report and the criterion bench compare, default first.
 pub fn variants() -> Vec<CurvatureOptions> {
     let d = CurvatureOptions::default();
     vec![

@@ -49,41 +49,8 @@ impl Mesh {
     /// Rejects what no stage can work with: no faces, indices out of range,
     /// non-finite coordinates, or more elements than 32-bit indices address.
     pub fn validate(&self, source: &str) -> Result<()> {
-        if self.faces.is_empty() {
-            return Err(Error::input(source, "faces", "the mesh has no faces"));
-        }
-        if self.positions.len() >= u32::MAX as usize || self.faces.len() >= (u32::MAX / 3) as usize
-        {
-            return Err(Error::input(
-                source,
-                "mesh",
-                format!(
-                    "{} vertices / {} faces exceed the 32-bit index range",
-                    self.positions.len(),
-                    self.faces.len()
-                ),
-            ));
-        }
-        for (i, p) in self.positions.iter().enumerate() {
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(Error::input(
-                    source,
-                    format!("vertex {i}"),
-                    format!("non-finite coordinate ({}, {}, {})", p[0], p[1], p[2]),
-                ));
-            }
-        }
-        let n = self.positions.len() as u32;
-        for (i, f) in self.faces.iter().enumerate() {
-            if let Some(&bad) = f.iter().find(|&&v| v >= n) {
-                return Err(Error::input(
-                    source,
-                    format!("face {i}"),
-                    format!("vertex index {bad} out of range (the mesh has {n} vertices)"),
-                ));
-            }
-        }
-        Ok(())
+        check_faces(self.positions.len(), &self.faces, source)?;
+        check_positions(&self.positions, source)
     }
 
     /// Merges vertices with bit-identical positions (as in unwelded exports
@@ -148,4 +115,47 @@ pub fn referenced(nv: usize, faces: &[[u32; 3]]) -> Vec<bool> {
         }
     }
     r
+}
+
+/// Rejects face lists no stage can work with: none at all, more elements than
+/// 32-bit indices address, or an index past the `nv` vertices. `source` names
+/// where the data came from in the error.
+pub fn check_faces(nv: usize, faces: &[[u32; 3]], source: &str) -> Result<()> {
+    if faces.is_empty() {
+        return Err(Error::input(source, "faces", "the mesh has no faces"));
+    }
+    if nv >= u32::MAX as usize || faces.len() >= (u32::MAX / 3) as usize {
+        return Err(Error::input(
+            source,
+            "mesh",
+            format!(
+                "{nv} vertices / {} faces exceed the 32-bit index range",
+                faces.len()
+            ),
+        ));
+    }
+    for (i, f) in faces.iter().enumerate() {
+        if let Some(&bad) = f.iter().find(|&&v| v as usize >= nv) {
+            return Err(Error::input(
+                source,
+                format!("face {i}"),
+                format!("vertex index {bad} out of range (the mesh has {nv} vertices)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Rejects a non-finite coordinate, naming the vertex.
+pub fn check_positions(positions: &[[f64; 3]], source: &str) -> Result<()> {
+    for (i, p) in positions.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(Error::input(
+                source,
+                format!("vertex {i}"),
+                format!("non-finite coordinate ({}, {}, {})", p[0], p[1], p[2]),
+            ));
+        }
+    }
+    Ok(())
 }

@@ -212,18 +212,7 @@ impl CurvatureEstimator {
         faces: &[[u32; 3]],
         opts: CurvatureOptions,
     ) -> Result<Self> {
-        if faces.is_empty() {
-            return Err(Error::InvalidArgument("the mesh has no faces".into()));
-        }
-        if let Some((i, f)) = faces
-            .iter()
-            .enumerate()
-            .find(|(_, f)| f.iter().any(|&v| v as usize >= n_vertices))
-        {
-            return Err(Error::InvalidArgument(format!(
-                "face {i} {f:?} indexes past the {n_vertices} vertices"
-            )));
-        }
+        crate::mesh::check_faces(n_vertices, faces, "curvature estimator")?;
         if opts.precision == Precision::F64 {
             if !gpu.info.fp64 {
                 return Err(Error::DeviceUnsupported {
@@ -366,14 +355,7 @@ impl CurvatureEstimator {
                 self.nv
             )));
         }
-        if let Some(i) = positions
-            .iter()
-            .position(|p| !p.iter().all(|c| c.is_finite()))
-        {
-            return Err(Error::InvalidArgument(format!(
-                "vertex {i} of the pose has a non-finite coordinate"
-            )));
-        }
+        crate::mesh::check_positions(positions, "pose")?;
         self.norm = Normalization::of_masked(positions, Some(&self.referenced));
         self.staging.clear();
         for (p, &used) in positions.iter().zip(&self.referenced) {
