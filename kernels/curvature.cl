@@ -547,7 +547,7 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     st_corner(corner, gid, 0, use, ext4(tensor_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x), 0));
     st_corner(corner, gid, 1, use, ext4(tensor_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x), 0));
     st_corner(corner, gid, 2, use, ext4(tensor_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x), 0));
-    status[gid] = (deg ? 1 : 0) | (!deg & !ok ? 2 : 0);
+    status[gid] = (deg ? 1 : 0) | ((!deg & !ok) ? 2 : 0);
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
@@ -569,7 +569,7 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     st_corner(corner, gid, 0, use, dcurv_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x));
     st_corner(corner, gid, 1, use, dcurv_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x));
     st_corner(corner, gid, 2, use, dcurv_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x));
-    status[gid] = (deg ? 1 : 0) | (!deg & !ok ? 4 : 0);
+    status[gid] = (deg ? 1 : 0) | ((!deg & !ok) ? 4 : 0);
 }
 
 // Sums the corners of vertex v's one-ring in face order, counting (once per
@@ -621,4 +621,17 @@ __kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off, __global co
     dk[4 * gid + 1] = s.y;
     dk[4 * gid + 2] = s.z;
     dk[4 * gid + 3] = s.w;
+}
+
+// ---------------------------------------------------------------------------
+// Positions of a device-resident mesh (a fused isosurface, index space):
+// pos = a ⊙ src + b, the host's normalization folded with the volume's
+// spacing and origin. One work-item per vertex.
+__kernel void curv_load_positions(uint nv, __global const float *src, REAL ax, REAL ay, REAL az,
+                                  REAL bx, REAL by, REAL bz, __global REAL *pos)
+{
+    GID_OR_RETURN(nv);
+    pos[3 * gid] = ax * (REAL)src[3 * gid] + bx;
+    pos[3 * gid + 1] = ay * (REAL)src[3 * gid + 1] + by;
+    pos[3 * gid + 2] = az * (REAL)src[3 * gid + 2] + bz;
 }

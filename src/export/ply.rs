@@ -63,6 +63,67 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
         )));
     }
 
+    let names: Vec<&str> = POSITION_PROPERTIES
+        .iter()
+        .chain(field.map_or(&[][..], |_| &FIELD_PROPERTIES[..]))
+        .copied()
+        .collect();
+    write_rows(path, mesh, &names, |i, row| {
+        if let Some(f) = field {
+            row.extend(f.normals[i].iter().map(|&c| c as f32));
+            row.push(f.areas[i] as f32);
+            row.push(f.k1[i] as f32);
+            row.push(f.k2[i] as f32);
+            row.extend(f.d1[i].iter().map(|&c| c as f32));
+            row.extend(f.d2[i].iter().map(|&c| c as f32));
+            row.extend(f.dk[i].iter().map(|&c| c as f32));
+        }
+    })
+}
+
+/// Writes `mesh` with per-vertex normals (`x y z nx ny nz`), e.g. an
+/// isosurface with normals from the volume gradient.
+///
+/// # Errors
+///
+/// As [`write_ply`]; also when `normals` does not have one entry per vertex.
+pub fn write_ply_with_normals(path: &Path, mesh: &Mesh, normals: &[[f64; 3]]) -> Result<()> {
+    if normals.len() != mesh.n_vertices() {
+        return Err(Error::InvalidArgument(format!(
+            "{} normals for a mesh of {} vertices",
+            normals.len(),
+            mesh.n_vertices()
+        )));
+    }
+    check_face_indices(mesh)?;
+    write_rows(path, mesh, &["x", "y", "z", "nx", "ny", "nz"], |i, row| {
+        row.extend(normals[i].iter().map(|&c| c as f32));
+    })
+}
+
+fn check_face_indices(mesh: &Mesh) -> Result<()> {
+    if let Some(v) = mesh
+        .faces
+        .iter()
+        .flatten()
+        .find(|&&v| i32::try_from(v).is_err())
+    {
+        return Err(Error::InvalidArgument(format!(
+            "face index {v} does not fit the PLY 'int' face list"
+        )));
+    }
+    Ok(())
+}
+
+/// Writes the header, one row of float properties per vertex (position
+/// first, then what `extra` appends) and the faces.
+fn write_rows(
+    path: &Path,
+    mesh: &Mesh,
+    names: &[&str],
+    extra: impl Fn(usize, &mut Vec<f32>),
+) -> Result<()> {
+    let n = mesh.n_vertices();
     let write_err = |source| Error::Write {
         path: path.to_path_buf(),
         source,
@@ -73,9 +134,6 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
     let mut header = String::new();
     header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
     header.push_str(&format!("element vertex {n}\n"));
-    let names = POSITION_PROPERTIES
-        .iter()
-        .chain(field.map_or(&[][..], |_| &FIELD_PROPERTIES[..]));
     for name in names {
         header.push_str(&format!("property float {name}\n"));
     }
@@ -83,20 +141,12 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
     header.push_str("property list uchar int vertex_indices\nend_header\n");
     w.write_all(header.as_bytes()).map_err(write_err)?;
 
-    let mut row: Vec<f32> = Vec::with_capacity(POSITION_PROPERTIES.len() + FIELD_PROPERTIES.len());
+    let mut row: Vec<f32> = Vec::with_capacity(names.len());
     let mut bytes: Vec<u8> = Vec::with_capacity(4 * row.capacity());
     for (i, p) in mesh.positions.iter().enumerate() {
         row.clear();
         row.extend(p.iter().map(|&c| c as f32));
-        if let Some(f) = field {
-            row.extend(f.normals[i].iter().map(|&c| c as f32));
-            row.push(f.areas[i] as f32);
-            row.push(f.k1[i] as f32);
-            row.push(f.k2[i] as f32);
-            row.extend(f.d1[i].iter().map(|&c| c as f32));
-            row.extend(f.d2[i].iter().map(|&c| c as f32));
-            row.extend(f.dk[i].iter().map(|&c| c as f32));
-        }
+        extra(i, &mut row);
         bytes.clear();
         for v in &row {
             bytes.extend_from_slice(&v.to_le_bytes());

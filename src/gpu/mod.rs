@@ -160,6 +160,8 @@ pub enum Arg {
     I32(i32),
     /// A 32-bit float scalar.
     F32(f32),
+    /// A 64-bit float scalar (kernels built with double precision).
+    F64(f64),
 }
 
 /// Wraps a buffer as a kernel argument.
@@ -186,6 +188,7 @@ pub fn launch(gpu: &Gpu, kernel: &Kernel, n: usize, args: &[Arg]) -> Result<Opti
                 Arg::U32(v) => exec.set_arg(v),
                 Arg::I32(v) => exec.set_arg(v),
                 Arg::F32(v) => exec.set_arg(v),
+                Arg::F64(v) => exec.set_arg(v),
             };
         }
         exec.set_global_work_size(global)

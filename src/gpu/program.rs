@@ -34,9 +34,35 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
             source: include_str!("../../kernels/curvature.cl"),
             headers: COMMON_HEADERS,
         }),
+        "scan" => Some(KernelFile {
+            name: "kernels/scan.cl",
+            source: include_str!("../../kernels/scan.cl"),
+            headers: COMMON_HEADERS,
+        }),
+        "radix_sort" => Some(KernelFile {
+            name: "kernels/radix_sort.cl",
+            source: include_str!("../../kernels/radix_sort.cl"),
+            headers: COMMON_HEADERS,
+        }),
+        "marching_cubes" => Some(KernelFile {
+            name: "kernels/marching_cubes.cl",
+            source: include_str!("../../kernels/marching_cubes.cl"),
+            headers: MC_HEADERS,
+        }),
+        "vertex_fusion" => Some(KernelFile {
+            name: "kernels/vertex_fusion.cl",
+            source: include_str!("../../kernels/vertex_fusion.cl"),
+            headers: MC_HEADERS,
+        }),
         _ => None,
     }
 }
+
+/// Headers of the marching-cubes and vertex-fusion kernels: the common ones and the hash.
+const MC_HEADERS: &[(&str, &str)] = &[
+    ("common/real.h", include_str!("../../kernels/common/real.h")),
+    ("common/hash.h", include_str!("../../kernels/common/hash.h")),
+];
 
 /// The full text handed to the compiler.
 pub fn assemble(file: &KernelFile) -> String {

@@ -7,9 +7,11 @@
 
 mod generate;
 mod load;
+mod quality;
 
 pub use generate::*;
 pub use load::{LoadOptions, load};
+pub use quality::{MeshQuality, quality};
 
 use crate::error::{Error, Result};
 

@@ -133,6 +133,8 @@ struct Kernels {
     dcurv: Kernel,
     /// Gather variant only: the per-vertex one-ring sums of the three passes.
     sums: Option<[Kernel; 3]>,
+    /// Positions from a device buffer of index-space floats (isosurfaces).
+    load_positions: Kernel,
 }
 
 /// Buffers of the gather variant: one-ring lists, corner contributions, face status.
@@ -213,6 +215,28 @@ impl CurvatureEstimator {
         opts: CurvatureOptions,
     ) -> Result<Self> {
         crate::mesh::check_faces(n_vertices, faces, "curvature estimator")?;
+        let t0 = Instant::now();
+        let (k, program) = Self::build(&gpu, &opts)?;
+        let flat: &[u32] = bytemuck::cast_slice(faces);
+        let mut faces_b = gpu.buffer::<u32>(flat.len())?;
+        gpu.write(&mut faces_b, flat)?;
+        Self::with_faces(
+            gpu,
+            n_vertices,
+            faces_b,
+            faces.len(),
+            Some(faces),
+            opts,
+            k,
+            program,
+            t0,
+        )
+    }
+
+    fn build(
+        gpu: &Arc<Gpu>,
+        opts: &CurvatureOptions,
+    ) -> Result<(Kernels, Arc<opencl3::program::Program>)> {
         if opts.precision == Precision::F64 {
             if !gpu.info.fp64 {
                 return Err(Error::DeviceUnsupported {
@@ -229,10 +253,6 @@ impl CurvatureEstimator {
                 });
             }
         }
-        let t0 = Instant::now();
-        let nv = n_vertices;
-        let nf = faces.len();
-        let real = real_size(opts.precision);
         let file = kernel_file("curvature").expect("curvature kernels are embedded");
         let program = gpu.program(&file, &build_options(&opts))?;
         let gather = opts.accumulate == Accumulate::Gather;
@@ -261,16 +281,65 @@ impl CurvatureEstimator {
             principal: gpu.kernel(&program, "curv_principal")?,
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
             sums,
+            load_positions: gpu.kernel(&program, "curv_load_positions")?,
         };
-        let max_face = gpu.kernel(&program, "curv_max_face")?;
+        Ok((k, program))
+    }
 
-        let flat: &[u32] = bytemuck::cast_slice(faces);
-        let mut faces_b = gpu.buffer::<u32>(flat.len())?;
-        gpu.write(&mut faces_b, flat)?;
+    /// Like [`CurvatureEstimator::new`] for a mesh whose faces are already on
+    /// the device (e.g. a fused isosurface): no host round trip. Every vertex
+    /// must be used by a face (as after vertex fusion's compaction). The
+    /// gather variant needs one-ring lists built on the host and is refused
+    /// here; positions come from [`CurvatureEstimator::set_positions_device`].
+    pub fn from_device(
+        gpu: Arc<Gpu>,
+        n_vertices: usize,
+        faces: &Buffer<u32>,
+        n_faces: usize,
+        opts: CurvatureOptions,
+    ) -> Result<Self> {
+        if opts.accumulate == Accumulate::Gather {
+            return Err(Error::InvalidArgument(
+                "curvature of a device-resident mesh uses --accumulate atomic \
+                 (the gather variant builds its one-ring lists on the host)"
+                    .into(),
+            ));
+        }
+        let mut faces_b = gpu.buffer::<u32>(3 * n_faces)?;
+        if n_faces > 0 {
+            // SAFETY: both buffers hold at least 3·n_faces u32.
+            unsafe {
+                gpu.queue()
+                    .enqueue_copy_buffer(faces, &mut faces_b, 0, 0, 12 * n_faces, &[])
+            }
+            .map_err(|e| Error::cl("clEnqueueCopyBuffer", e))?;
+        }
+        let t0 = Instant::now();
+        let (k, program) = Self::build(&gpu, &opts)?;
+        Self::with_faces(
+            gpu, n_vertices, faces_b, n_faces, None, opts, k, program, t0,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn with_faces(
+        gpu: Arc<Gpu>,
+        nv: usize,
+        faces_b: Buffer<u32>,
+        nf: usize,
+        faces: Option<&[[u32; 3]]>,
+        opts: CurvatureOptions,
+        k: Kernels,
+        program: Arc<opencl3::program::Program>,
+        t0: Instant,
+    ) -> Result<Self> {
+        let gather = opts.accumulate == Accumulate::Gather;
+        let real = real_size(opts.precision);
+        let max_face = gpu.kernel(&program, "curv_max_face")?;
         let mut owner = gpu.buffer::<i32>(nv)?;
         gpu.write(&mut owner, &vec![-1i32; nv])?;
         let gather_bufs = if gather {
-            let (off, ring) = one_rings(nv, faces);
+            let (off, ring) = one_rings(nv, faces.unwrap_or(&[]));
             let mut ring_off = gpu.buffer::<u32>(off.len())?;
             gpu.write(&mut ring_off, &off)?;
             let mut ring_b = gpu.buffer::<u32>(ring.len())?;
@@ -312,7 +381,10 @@ impl CurvatureEstimator {
                 center: [0.0; 3],
                 scale: 1.0,
             },
-            referenced: crate::mesh::referenced(nv, faces),
+            referenced: match faces {
+                Some(f) => crate::mesh::referenced(nv, f),
+                None => vec![true; nv],
+            },
             staging: Vec::with_capacity(3 * nv * real),
             k,
             faces: faces_b,
@@ -369,6 +441,38 @@ impl CurvatureEstimator {
             }
         }
         self.gpu.write(&mut self.pos, &self.staging)
+    }
+
+    /// Loads positions from a device buffer of `3·n_vertices` floats `p`
+    /// (e.g. a fused isosurface in voxel index space) whose world position is
+    /// `origin + spacing ⊙ p`, normalized on the device with `norm`
+    /// (results are mapped back with it). No host round trip.
+    pub fn set_positions_device(
+        &mut self,
+        src: &Buffer<f32>,
+        spacing: [f64; 3],
+        origin: [f64; 3],
+        norm: Normalization,
+    ) -> Result<()> {
+        if !(norm.scale.is_finite() && norm.scale > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "normalization scale must be finite and positive, got {}",
+                norm.scale
+            )));
+        }
+        self.norm = norm;
+        // normalized = (origin + spacing·p − center) / scale = a·p + b
+        let a: [f64; 3] = std::array::from_fn(|i| spacing[i] / norm.scale);
+        let b: [f64; 3] = std::array::from_fn(|i| (origin[i] - norm.center[i]) / norm.scale);
+        let real = |v: f64| match self.opts.precision {
+            Precision::F32 => Arg::F32(v as f32),
+            Precision::F64 => Arg::F64(v),
+        };
+        let mut args = vec![Arg::U32(self.nv as u32), buf(src)];
+        args.extend(a.iter().chain(&b).map(|&v| real(v)));
+        args.push(buf(&self.pos));
+        launch(&self.gpu, &self.k.load_positions, self.nv, &args)?;
+        Ok(())
     }
 
     /// The normalization of the current pose.

@@ -1,0 +1,206 @@
+// marching_cubes.cl: triangle soup of the isosurface value = iso of a scalar
+// volume, with one key per soup vertex for vertex fusion (vertex_fusion.cl).
+//
+// Seed 000 §3.4 (Griffin et al. 2012): classify, scan, triangles. Host:
+// src/stages/marching_cubes.rs; CPU twin with the same step names and the
+// same f32 arithmetic: src/cpu/marching_cubes.rs.
+//   mc_classify   per cell row   triangles the row emits (table counts)
+//   (scan.cl)                     exclusive scan of the row counts → row offsets
+//   mc_triangles  per cell row   soup positions, soup indices, one key per vertex
+// One work-item walks one row of cells along x (all cells with the same y, z),
+// 16 cells at a time with float16 loads: a chunk whose 4×17 values are all on
+// one side of iso emits nothing and is skipped; only mixed chunks are
+// classified cell by cell.
+//
+// Buffers (N = nx·ny·nz voxels, R = (ny−1)(nz−1) cell rows, S soup vertices):
+//   vol    float[N]   values, x fastest
+//   counts uchar[256] triangles per case;  tris uchar[256·16] edge ids, 0xFF ends a row
+//   row_tris uint[R]  mc_classify output;  row_off uint[R] its exclusive scan
+//   pos    float[3S]  soup positions in index space (world = origin + spacing·p, on the host)
+//   key    uint[S]    hash of the position (mode 1) or exact key (mode 2); absent in mode 0
+//   idx    uint[S]    soup index (the "full index buffer"; sorted along with the keys)
+//   counters uint[2]  [0] soup vertices that did not fit (overflow; nothing is written past cap)
+//
+// Conventions (shared with the CPU twin): corner c of a cell is at offset
+// (c&1, (c>>1)&1, c>>2); bit c of the case is set when value < iso (inside);
+// edge e runs along axis e/4 and e%4 picks the other two offsets (low bit:
+// first other axis in x,y,z order). Triangles are wound so normals point to
+// values >= iso (outward for signed distance fields). A cell with a
+// non-finite corner emits nothing. A vertex whose coordinate rounds onto an
+// edge endpoint is placed exactly at that grid point and gets the point's key
+// 4g+3 (others: 4g+axis, g = lower endpoint's linear index), so fusion merges
+// all vertices at a grid point whose value equals iso.
+
+// True when the 16 cells x .. x+15 of a row are all inside or all outside
+// (and finite): they emit nothing. Explicit float16 code (PoCL turns it into
+// AVX-512; its work-item vectoriser gives up on the row loop), so a row is
+// skimmed 16 cells at a time and only mixed chunks go through the per-cell
+// path. Reads the 17 values x .. x+16 of the four rows.
+inline bool chunk_uniform(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                          uint x, float iso)
+{
+    const float16 a = vload16(0, vol + b00 + x), b = vload16(0, vol + b10 + x);
+    const float16 c = vload16(0, vol + b01 + x), d = vload16(0, vol + b11 + x);
+    const float4 t = (float4)(vol[b00 + x + 16], vol[b10 + x + 16], vol[b01 + x + 16],
+                              vol[b11 + x + 16]);
+    const float16 i16 = (float16)(iso);
+    const float4 i4 = (float4)(iso);
+    const int16 fin = isfinite(a) & isfinite(b) & isfinite(c) & isfinite(d);
+    const int16 in = isless(a, i16) & isless(b, i16) & isless(c, i16) & isless(d, i16);
+    const int16 out = isgreaterequal(a, i16) & isgreaterequal(b, i16) &
+                      isgreaterequal(c, i16) & isgreaterequal(d, i16);
+    if (!all(fin) || !all(isfinite(t)))
+        return false;
+    return (all(in) && all(isless(t, i4))) || (all(out) && all(isgreaterequal(t, i4)));
+}
+
+// The case of cell x of a row (bit c set when corner c is inside), or 256
+// when a corner is not finite (the cell emits nothing).
+inline uint cell_case(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                      uint x, float iso, float *v)
+{
+    v[0] = vol[b00 + x];
+    v[1] = vol[b00 + x + 1];
+    v[2] = vol[b10 + x];
+    v[3] = vol[b10 + x + 1];
+    v[4] = vol[b01 + x];
+    v[5] = vol[b01 + x + 1];
+    v[6] = vol[b11 + x];
+    v[7] = vol[b11 + x + 1];
+    uint cas = 0;
+    bool ok = true;
+    for (uint c = 0; c < 8; ++c) {
+        cas |= (uint)(v[c] < iso) << c;
+        ok = ok && isfinite(v[c]);
+    }
+    return ok ? cas : 256;
+}
+
+#define ROW_SETUP                                                                   \
+    const uint y = gid % (ny - 1), z = gid / (ny - 1);                              \
+    const ulong b00 = (ulong)nx * (y + (ulong)ny * z);                              \
+    const ulong b10 = b00 + nx, b01 = b00 + (ulong)nx * ny, b11 = b01 + nx;
+
+__kernel void mc_classify(uint rows, uint nx, uint ny, __global const float *vol, float iso,
+                          __constant uchar *counts, __global uint *row_tris)
+{
+    GID_OR_RETURN(rows);
+    ROW_SETUP
+    float v[8];
+    uint total = 0;
+    uint x = 0;
+    for (; x + 16 < nx; x += 16) {
+        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+            continue;
+        for (uint i = x; i < x + 16; ++i) {
+            const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+            total += cas < 256 ? counts[cas] : 0;
+        }
+    }
+    for (; x + 1 < nx; ++x) {
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        total += cas < 256 ? counts[cas] : 0;
+    }
+    row_tris[gid] = total;
+}
+
+// Linear index of grid point (x, y, z).
+inline uint grid_index(uint x, uint y, uint z, uint nx, uint ny)
+{
+    return x + nx * (y + ny * z);
+}
+
+// Writes the triangles of cell (x, y, z) of case `cas` at soup slot `out`
+// onward; returns the next free slot.
+inline uint emit_cell(uint x, uint y, uint z, uint nx, uint ny, float iso, uint cas,
+                      const float *v, __constant uchar *counts, __constant uchar *tris,
+                      uint out, uint cap, uint mode, __global float *pos, __global uint *key,
+                      __global uint *idx, volatile __global uint *counters)
+{
+    const uint nt = counts[cas];
+    for (uint i = 0; i < 3 * nt; ++i) {
+        const uint e = tris[16 * cas + i];
+        const uint axis = e >> 2, k = e & 3;
+        // Lower corner of the edge: offsets on the two other axes from k.
+        const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+        const uint c0 = ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
+        const uint c1 = c0 | (1u << axis);
+        uint g[3];
+        g[0] = x + (c0 & 1);
+        g[1] = y + ((c0 >> 1) & 1);
+        g[2] = z + (c0 >> 2);
+        const float v0 = v[c0], v1 = v[c1];
+        float t = (iso - v0) / (v1 - v0);
+        if (!(t >= 0.0f))
+            t = 0.0f;
+        if (t > 1.0f)
+            t = 1.0f;
+        const float a = (float)g[axis];
+        const float cc = a + t;
+        float p[3];
+        p[0] = (float)g[0];
+        p[1] = (float)g[1];
+        p[2] = (float)g[2];
+        const uint lin = grid_index(g[0], g[1], g[2], nx, ny);
+        const uint step = axis == 0 ? 1u : (axis == 1 ? nx : nx * ny);
+        uint kk;
+        if (cc == a) {
+            kk = 4 * lin + 3;
+        } else if (cc == (float)(g[axis] + 1)) {
+            p[axis] = cc;
+            kk = 4 * (lin + step) + 3;
+        } else {
+            p[axis] = cc;
+            kk = 4 * lin + axis;
+        }
+        if (out < cap) {
+            pos[3 * out] = p[0];
+            pos[3 * out + 1] = p[1];
+            pos[3 * out + 2] = p[2];
+            if (mode != 0) {
+                key[out] = mode == 1 ? fuse_hash(p[0], p[1], p[2]) : kk;
+                idx[out] = out;
+            }
+        } else {
+            atomic_inc(&counters[0]);
+        }
+        ++out;
+    }
+    return out;
+}
+
+__kernel void mc_triangles(uint rows, uint nx, uint ny, __global const float *vol, float iso,
+                           __constant uchar *counts, __constant uchar *tris,
+                           __global const uint *row_off, uint cap, uint mode,
+                           __global float *pos, __global uint *key, __global uint *idx,
+                           volatile __global uint *counters)
+{
+    GID_OR_RETURN(rows);
+    ROW_SETUP
+    float v[8];
+    uint out = 3 * row_off[gid];
+    uint x = 0;
+    for (; x + 16 < nx; x += 16) {
+        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+            continue;
+        for (uint i = x; i < x + 16; ++i) {
+            const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+            if (cas < 256)
+                out = emit_cell(i, y, z, nx, ny, iso, cas, v, counts, tris, out, cap, mode, pos,
+                                key, idx, counters);
+        }
+    }
+    for (; x + 1 < nx; ++x) {
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        if (cas < 256)
+            out = emit_cell(x, y, z, nx, ny, iso, cas, v, counts, tris, out, cap, mode, pos, key,
+                            idx, counters);
+    }
+}
+
+// Faces of the unfused soup (--fusion none): face t is (3t, 3t+1, 3t+2).
+__kernel void mc_iota(uint n, __global uint *out)
+{
+    GID_OR_RETURN(n);
+    out[gid] = gid;
+}

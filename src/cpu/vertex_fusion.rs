@@ -1,0 +1,188 @@
+//! CPU reference of `kernels/vertex_fusion.cl`: turns the marching-cubes
+//! triangle soup into an indexed mesh with shared vertices, with the same
+//! steps as the device (seed 000, §3.4):
+//! `fuse_keys` (hash of the position, or the exact edge/point key) →
+//! stable sort of (key, soup index) → `fuse_index` (binary search to the first
+//! equal key, then walk forward comparing positions) → `fuse_triangles`
+//! (triangles whose fused corners repeat are dropped; referenced vertices
+//! marked) → compaction (`fuse_compact_vertices`, `fuse_compact_faces`).
+//!
+//! The representative of a set of equal positions is the lowest soup index,
+//! so the hash and the exact variant give the same mesh, vertex for vertex.
+
+use super::marching_cubes::SoupVertex;
+
+/// How soup vertices are merged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Fusion {
+    /// The seed's method: 32-bit hash of the position bits, radix sort,
+    /// collisions resolved by comparing positions.
+    Hash,
+    /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
+    Edge,
+    /// No fusion: the triangle soup, three vertices per triangle.
+    None,
+}
+
+impl Fusion {
+    /// Name used on the command line, in stats and in bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fusion::Hash => "hash",
+            Fusion::Edge => "edge",
+            Fusion::None => "none",
+        }
+    }
+}
+
+/// The 32-bit position hash (same integer mix as the kernel's `fuse_hash`).
+pub fn fuse_hash(p: [f32; 3]) -> u32 {
+    let mut h = p[0].to_bits().wrapping_mul(0x9E37_79B1);
+    h ^= p[1].to_bits();
+    h = (h ^ (h >> 15)).wrapping_mul(0x85EB_CA6B);
+    h ^= p[2].to_bits();
+    h = (h ^ (h >> 13)).wrapping_mul(0xC2B2_AE35);
+    h ^ (h >> 16)
+}
+
+/// An indexed triangle mesh in index space, as fusion leaves it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Fused {
+    /// Unique vertex positions (index space).
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles.
+    pub faces: Vec<[u32; 3]>,
+    /// Triangles dropped: two fused corners were the same vertex, or the
+    /// triangle was cancelled with an opposite twin (a zero-thickness sheet).
+    pub dropped: usize,
+}
+
+/// Soup vertex → representative soup vertex (`fuse_index`), given the soup
+/// keys sorted stably together with their soup indices.
+pub fn fuse_index(
+    soup: &[SoupVertex],
+    keys: &[u64],
+    sorted: &[(u64, u32)],
+    compare_positions: bool,
+) -> Vec<u32> {
+    (0..soup.len())
+        .map(|v| {
+            let k = keys[v];
+            let mut j = sorted.partition_point(|&(s, _)| s < k);
+            if !compare_positions {
+                return sorted[j].1;
+            }
+            loop {
+                let cand = sorted[j].1;
+                if soup[cand as usize].p == soup[v].p {
+                    return cand;
+                }
+                j += 1;
+            }
+        })
+        .collect()
+}
+
+/// Fuses a soup with the given variant (see the module docs for the steps).
+pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
+    if fusion == Fusion::None {
+        return Fused {
+            positions: soup.iter().map(|s| s.p).collect(),
+            faces: (0..soup.len() as u32 / 3)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            dropped: 0,
+        };
+    }
+    // fuse_keys
+    let keys: Vec<u64> = soup
+        .iter()
+        .map(|s| match fusion {
+            Fusion::Hash => fuse_hash(s.p) as u64,
+            _ => s.key,
+        })
+        .collect();
+    // radix_sort (stable)
+    let mut sorted: Vec<(u64, u32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| (k, i as u32))
+        .collect();
+    sorted.sort_by_key(|&(k, _)| k);
+    let rep = fuse_index(soup, &keys, &sorted, fusion == Fusion::Hash);
+    // fuse_triangles
+    let nt = soup.len() / 3;
+    let tri = |t: usize| [rep[3 * t], rep[3 * t + 1], rep[3 * t + 2]];
+    let mut keep = vec![false; nt];
+    let mut cand = Vec::new();
+    for t in 0..nt {
+        let f = tri(t);
+        keep[t] = f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
+        let p = f.map(|v| soup[v as usize].p);
+        if keep[t]
+            && (0..3)
+                .any(|a| p[0][a] == p[1][a] && p[1][a] == p[2][a] && p[0][a] == p[0][a].floor())
+        {
+            cand.push(t);
+        }
+    }
+    // fuse_candidates + fuse_cancel: group candidates by vertex set (in
+    // soup order), drop the first min(n+, n−) of each winding.
+    let mut groups: std::collections::BTreeMap<[u32; 3], Vec<(usize, bool)>> = Default::default();
+    for &t in &cand {
+        let (set, even) = tri_set(tri(t));
+        groups.entry(set).or_default().push((t, even));
+    }
+    for g in groups.values() {
+        let plus = g.iter().filter(|e| e.1).count();
+        let pairs = plus.min(g.len() - plus);
+        for even in [true, false] {
+            for &(t, _) in g.iter().filter(|e| e.1 == even).take(pairs) {
+                keep[t] = false;
+            }
+        }
+    }
+    // fuse_mark
+    let mut referenced = vec![false; soup.len()];
+    let mut kept = Vec::new();
+    for t in 0..nt {
+        if keep[t] {
+            for v in tri(t) {
+                referenced[v as usize] = true;
+            }
+            kept.push(tri(t));
+        }
+    }
+    let dropped = nt - kept.len();
+    // fuse_compact_vertices / fuse_compact_faces
+    let mut new_id = vec![u32::MAX; soup.len()];
+    let mut positions = Vec::new();
+    for (v, &r) in referenced.iter().enumerate() {
+        if r {
+            new_id[v] = positions.len() as u32;
+            positions.push(soup[v].p);
+        }
+    }
+    let faces = kept.iter().map(|f| f.map(|v| new_id[v as usize])).collect();
+    Fused {
+        positions,
+        faces,
+        dropped,
+    }
+}
+
+/// A triangle's sorted vertex set and whether its winding is an even
+/// permutation of it (same rule as the kernel's `tri_set`).
+pub fn tri_set(f: [u32; 3]) -> ([u32; 3], bool) {
+    let mut s = f;
+    s.sort_unstable();
+    let even = if f[0] == s[0] {
+        f[1] < f[2]
+    } else if f[1] == s[0] {
+        f[2] < f[0]
+    } else {
+        f[0] < f[1]
+    };
+    (s, even)
+}

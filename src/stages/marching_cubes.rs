@@ -1,0 +1,404 @@
+//! Host wiring of `kernels/marching_cubes.cl` and the isosurface pipeline:
+//! the volume is uploaded once; each extraction runs `mc_classify` → scan →
+//! `mc_triangles` and then vertex fusion ([`crate::stages::vertex_fusion`]),
+//! leaving the indexed mesh on the device (for the curvature passes) until
+//! the caller reads it. CPU twin: [`crate::cpu::marching_cubes`].
+//!
+//! Memory: the soup is sized exactly from the classify counts; the kernels
+//! still check a capacity and count what would not fit, so a bug can never
+//! write past a buffer. A volume or an output that the device cannot hold is
+//! a clear error naming the bytes needed.
+
+use crate::cpu::marching_cubes::{cell_rows, table};
+use crate::cpu::vertex_fusion::Fusion;
+use crate::error::{Error, Result};
+use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::mesh::Mesh;
+use crate::stages::scan::Scan;
+use crate::stages::vertex_fusion::{Fuser, FusionCounts, FusionTiming, Grow, build_options};
+use crate::volume::Volume;
+use opencl3::kernel::Kernel;
+use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// What one extraction did and how long each pass took.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct IsoStats {
+    /// The fusion variant.
+    pub fusion: &'static str,
+    /// The iso value.
+    pub iso: f32,
+    /// Voxels in the volume.
+    pub voxels: usize,
+    /// Soup triangles (before fusion).
+    pub soup_triangles: usize,
+    /// Soup vertices (3 per triangle: vertices before fusion).
+    pub soup_vertices: usize,
+    /// Vertices after fusion.
+    pub vertices: usize,
+    /// Faces after fusion.
+    pub faces: usize,
+    /// Triangles dropped because two fused corners coincide (iso equal to voxel values).
+    pub degenerate_dropped: usize,
+    /// Kernel ms: mc_classify.
+    pub classify_ms: f64,
+    /// Kernel ms: scan of the row counts.
+    pub scan_ms: f64,
+    /// Kernel ms: mc_triangles.
+    pub triangles_ms: f64,
+    /// Kernel ms of the fusion passes.
+    pub fusion_ms: FusionTiming,
+    /// Sum of all kernel times.
+    pub kernel_ms: f64,
+    /// Wall time of the extraction (volume already on the device).
+    pub wall_ms: f64,
+    /// Device bytes held after the extraction (volume, soup, scratch, outputs).
+    pub device_bytes: u64,
+}
+
+/// Which buffers hold the current result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Holder {
+    Soup,
+    Fused,
+}
+
+/// Extracts isosurfaces of one volume on the device.
+pub struct Isosurfacer {
+    gpu: Arc<Gpu>,
+    dims: [usize; 3],
+    /// World units per voxel step.
+    pub spacing: [f64; 3],
+    /// World position of voxel (0, 0, 0).
+    pub origin: [f64; 3],
+    vol: Buffer<f32>,
+    counts: Buffer<u8>,
+    tris: Buffer<u8>,
+    classify: Kernel,
+    triangles: Kernel,
+    iota: Kernel,
+    scan: Scan,
+    fuser: Fuser,
+    row_tris: Buffer<u32>,
+    row_off: Buffer<u32>,
+    counters: Buffer<u32>,
+    pos: Grow<f32>,
+    key: Grow<u32>,
+    idx: Grow<u32>,
+    soup_faces: Grow<u32>,
+    result: Option<(Holder, usize, usize)>,
+}
+
+/// Bytes of device memory needed to extract a surface of `soup_vertices`
+/// soup vertices from a volume of `voxels` voxels (volume, row buffers, soup,
+/// fusion scratch and outputs): the bound the memory check uses.
+pub fn device_bytes_bound(voxels: usize, rows: usize, soup_vertices: usize) -> u64 {
+    4 * voxels as u64
+        + 8 * rows as u64
+        + 20 * soup_vertices as u64
+        + Fuser::bytes_bound(soup_vertices)
+}
+
+impl Isosurfacer {
+    /// Uploads `vol` to the device (once) and builds the kernels. Errors if
+    /// the device cannot hold the volume, naming the bytes.
+    pub fn new(gpu: Arc<Gpu>, vol: &Volume) -> Result<Self> {
+        Self::with_hash_mask(gpu, vol, None)
+    }
+
+    /// Like [`Isosurfacer::new`], with the position hash masked to
+    /// `collide_mask` (tests: forces hash collisions; fusion stays exact).
+    #[doc(hidden)]
+    pub fn with_hash_mask(gpu: Arc<Gpu>, vol: &Volume, collide_mask: Option<u32>) -> Result<Self> {
+        let bytes = vol.bytes();
+        if bytes > gpu.info.max_alloc || bytes > gpu.info.global_mem {
+            return Err(Error::DeviceUnsupported {
+                device: gpu.info.name.clone(),
+                what: format!(
+                    "the volume needs {bytes} bytes of device memory ({}×{}×{} f32); the device \
+                     allows {} bytes in one buffer and has {} bytes",
+                    vol.dims[0], vol.dims[1], vol.dims[2], gpu.info.max_alloc, gpu.info.global_mem
+                ),
+            });
+        }
+        let n = vol.voxel_count();
+        if vol.dims.iter().any(|&d| d > u32::MAX as usize) || n as u64 >= (1u64 << 32) {
+            return Err(Error::InvalidArgument(format!(
+                "volume of {n} voxels: at most 2^32 − 1 voxels"
+            )));
+        }
+        let file = kernel_file("marching_cubes").expect("marching_cubes kernels are embedded");
+        let p = gpu.program(&file, &build_options(collide_mask))?;
+        let mut volb = gpu.buffer_flags::<f32>(n, CL_MEM_READ_ONLY)?;
+        gpu.write(&mut volb, &vol.values)?;
+        let t = table();
+        let mut counts = gpu.buffer_flags::<u8>(256, CL_MEM_READ_ONLY)?;
+        gpu.write(&mut counts, &t.counts)?;
+        let mut tris = gpu.buffer_flags::<u8>(256 * 16, CL_MEM_READ_ONLY)?;
+        gpu.write(&mut tris, t.tris.as_flattened())?;
+        let rows = cell_rows(vol.dims);
+        Ok(Isosurfacer {
+            dims: vol.dims,
+            spacing: vol.spacing,
+            origin: vol.origin,
+            vol: volb,
+            counts,
+            tris,
+            classify: gpu.kernel(&p, "mc_classify")?,
+            triangles: gpu.kernel(&p, "mc_triangles")?,
+            iota: gpu.kernel(&p, "mc_iota")?,
+            scan: Scan::new(gpu.clone())?,
+            fuser: Fuser::new(gpu.clone())?,
+            row_tris: gpu.buffer::<u32>(rows)?,
+            row_off: gpu.buffer::<u32>(rows)?,
+            counters: gpu.buffer::<u32>(2)?,
+            pos: Grow::new(&gpu)?,
+            key: Grow::new(&gpu)?,
+            idx: Grow::new(&gpu)?,
+            soup_faces: Grow::new(&gpu)?,
+            result: None,
+            gpu,
+        })
+    }
+
+    /// The device.
+    pub fn gpu(&self) -> &Arc<Gpu> {
+        &self.gpu
+    }
+
+    /// Voxels per axis.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// Device bytes held now.
+    pub fn device_bytes(&self) -> u64 {
+        let rows = cell_rows(self.dims) as u64;
+        4 * (self.dims.iter().product::<usize>() as u64)
+            + 8 * rows
+            + self.pos.bytes()
+            + self.key.bytes()
+            + self.idx.bytes()
+            + self.soup_faces.bytes()
+            + self.fuser.device_bytes()
+    }
+
+    /// Extracts the surface `value = iso` with the given fusion; the result
+    /// stays on the device (see [`Isosurfacer::read`], [`Isosurfacer::device_mesh`]).
+    pub fn extract(&mut self, iso: f32, fusion: Fusion) -> Result<IsoStats> {
+        if !iso.is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "iso value must be finite, got {iso}"
+            )));
+        }
+        let g = self.gpu.clone();
+        let t0 = Instant::now();
+        let [nx, ny, nz] = self.dims;
+        let voxels = nx * ny * nz;
+        let mut st = IsoStats {
+            fusion: fusion.name(),
+            iso,
+            voxels,
+            ..Default::default()
+        };
+        self.result = None;
+        let rows = cell_rows(self.dims);
+        if rows == 0 || nx < 2 {
+            st.device_bytes = self.device_bytes();
+            self.result = Some((Holder::Soup, 0, 0));
+            return Ok(st);
+        }
+        if fusion == Fusion::Edge && 4 * voxels as u64 > u32::MAX as u64 + 1 {
+            return Err(Error::InvalidArgument(format!(
+                "--fusion edge keys vertices by 4 × voxel index in 32 bits: at most 2^30 voxels, \
+                 this volume has {voxels}; use --fusion hash"
+            )));
+        }
+        let common = [
+            Arg::U32(rows as u32),
+            Arg::U32(nx as u32),
+            Arg::U32(ny as u32),
+            buf(&self.vol),
+            Arg::F32(iso),
+        ];
+        let mut a = common.to_vec();
+        a.extend([buf(&self.counts), buf(&self.row_tris)]);
+        let e_cls = launch(&g, &self.classify, rows, &a)?;
+        let tris = self.scan.exclusive(&self.row_tris, &self.row_off, rows)? as usize;
+        st.scan_ms = self.scan.last_ms();
+        st.classify_ms = e_cls.as_ref().map(event_ms).unwrap_or(0.0);
+        let soup = 3 * tris;
+        if soup as u64 > u32::MAX as u64 {
+            return Err(Error::InvalidArgument(format!(
+                "iso {iso}: {tris} triangles exceed the 32-bit soup index"
+            )));
+        }
+        let need = device_bytes_bound(voxels, rows, soup);
+        if need > g.info.global_mem {
+            return Err(Error::DeviceUnsupported {
+                device: g.info.name.clone(),
+                what: format!(
+                    "iso {iso} gives {tris} triangles; extracting and fusing them needs about \
+                     {need} bytes of device memory, the device has {}",
+                    g.info.global_mem
+                ),
+            });
+        }
+        self.pos.reserve(&g, 3 * soup)?;
+        if fusion != Fusion::None {
+            self.key.reserve(&g, soup)?;
+            self.idx.reserve(&g, soup)?;
+        }
+        g.write(&mut self.counters, &[0, 0])?;
+        let mode = match fusion {
+            Fusion::None => 0u32,
+            Fusion::Hash => 1,
+            Fusion::Edge => 2,
+        };
+        let mut a = common.to_vec();
+        a.extend([
+            buf(&self.counts),
+            buf(&self.tris),
+            buf(&self.row_off),
+            Arg::U32(soup as u32),
+            Arg::U32(mode),
+            buf(&self.pos.buf),
+            buf(&self.key.buf),
+            buf(&self.idx.buf),
+            buf(&self.counters),
+        ]);
+        let e_tri = launch(&g, &self.triangles, rows, &a)?;
+        let mut c = [0u32; 2];
+        g.read(&self.counters, &mut c)?;
+        st.triangles_ms = e_tri.as_ref().map(event_ms).unwrap_or(0.0);
+        if c[0] != 0 {
+            return Err(Error::InvalidArgument(format!(
+                "internal: mc_triangles produced {} more soup vertices than mc_classify counted \
+                 ({soup}); nothing was written past the buffer",
+                c[0]
+            )));
+        }
+        st.soup_triangles = tris;
+        st.soup_vertices = soup;
+        match fusion {
+            Fusion::None => {
+                self.soup_faces.reserve(&g, soup)?;
+                launch(
+                    &g,
+                    &self.iota,
+                    soup,
+                    &[Arg::U32(soup as u32), buf(&self.soup_faces.buf)],
+                )?;
+                g.finish()?;
+                st.vertices = soup;
+                st.faces = tris;
+                self.result = Some((Holder::Soup, soup, tris));
+            }
+            _ => {
+                let key_bits = match fusion {
+                    Fusion::Hash => 32,
+                    _ => 64 - (4 * voxels as u64 - 1).leading_zeros(),
+                };
+                let (
+                    FusionCounts {
+                        vertices,
+                        faces,
+                        dropped,
+                    },
+                    ft,
+                ) = self.fuser.fuse(
+                    fusion,
+                    &mut self.key.buf,
+                    &mut self.idx.buf,
+                    &self.pos.buf,
+                    soup,
+                    key_bits,
+                )?;
+                st.vertices = vertices;
+                st.faces = faces;
+                st.degenerate_dropped = dropped;
+                st.fusion_ms = ft;
+                self.result = Some((Holder::Fused, vertices, faces));
+            }
+        }
+        st.kernel_ms = st.classify_ms + st.scan_ms + st.triangles_ms + st.fusion_ms.total();
+        st.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        st.device_bytes = self.device_bytes();
+        Ok(st)
+    }
+
+    /// The current result on the device: (positions: 3 floats per vertex in
+    /// index space, faces: 3 indices each, vertex count, face count).
+    pub fn device_mesh(&self) -> Option<(&Buffer<f32>, &Buffer<u32>, usize, usize)> {
+        let (h, nv, nf) = self.result?;
+        Some(match h {
+            Holder::Soup => (&self.pos.buf, &self.soup_faces.buf, nv, nf),
+            Holder::Fused => (&self.fuser.out_pos.buf, &self.fuser.out_faces.buf, nv, nf),
+        })
+    }
+
+    /// Reads the current result: positions in index space and faces.
+    pub fn read_index_space(&self) -> Result<(Vec<[f32; 3]>, Vec<[u32; 3]>)> {
+        let Some((p, f, nv, nf)) = self.device_mesh() else {
+            return Ok((Vec::new(), Vec::new()));
+        };
+        let mut pos = vec![[0f32; 3]; nv];
+        let mut faces = vec![[0u32; 3]; nf];
+        self.gpu.read(p, pos.as_flattened_mut())?;
+        self.gpu.read(f, faces.as_flattened_mut())?;
+        Ok((pos, faces))
+    }
+
+    /// Reads the current result as a mesh in world coordinates
+    /// (origin + spacing ⊙ p, in f64).
+    pub fn read(&self) -> Result<Mesh> {
+        let (pos, faces) = self.read_index_space()?;
+        Ok(Mesh {
+            positions: pos
+                .iter()
+                .map(|p| std::array::from_fn(|i| self.origin[i] + self.spacing[i] * p[i] as f64))
+                .collect(),
+            faces,
+        })
+    }
+}
+
+/// Curvature of the current isosurface, computed without a host round trip:
+/// the fused faces and positions are copied device to device into a
+/// [`CurvatureEstimator`] (atomic accumulation), positions mapped to world
+/// units and normalized on the device. Returns the estimator after its run
+/// (read the field with [`CurvatureEstimator::read`]) and the run's timing.
+pub fn curvature(
+    iso: &Isosurfacer,
+    opts: crate::field::CurvatureOptions,
+) -> Result<(
+    crate::stages::curvature::CurvatureEstimator,
+    crate::stages::curvature::RunTiming,
+)> {
+    let Some((pos, faces, nv, nf)) = iso.device_mesh() else {
+        return Err(Error::InvalidArgument("no isosurface extracted yet".into()));
+    };
+    let mut est = crate::stages::curvature::CurvatureEstimator::from_device(
+        iso.gpu.clone(),
+        nv,
+        faces,
+        nf,
+        opts,
+    )?;
+    // Normalize by the volume's box: centre and half diagonal (world units).
+    let d = iso.dims;
+    let center: [f64; 3] =
+        std::array::from_fn(|i| iso.origin[i] + 0.5 * iso.spacing[i] * (d[i] as f64 - 1.0));
+    let half = (0..3)
+        .map(|i| (0.5 * iso.spacing[i] * (d[i] as f64 - 1.0)).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let norm = crate::field::Normalization {
+        center,
+        scale: if half > 0.0 { half } else { 1.0 },
+    };
+    est.set_positions_device(pos, iso.spacing, iso.origin, norm)?;
+    let timing = est.run()?;
+    Ok((est, timing))
+}

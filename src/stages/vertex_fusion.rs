@@ -1,0 +1,346 @@
+//! Host wiring of `kernels/vertex_fusion.cl`: the marching-cubes soup (one
+//! key per vertex, written by `mc_triangles`) becomes an indexed mesh with
+//! shared vertices, entirely on the device (seed 000 §3.4):
+//! radix sort of (key, soup index) → `fuse_index` → `fuse_triangles` →
+//! twin cancellation (`fuse_candidates`, sort, `fuse_cancel`) → `fuse_mark` →
+//! scans → `fuse_compact_vertices`, `fuse_compact_faces`.
+//! CPU twin: [`crate::cpu::vertex_fusion`].
+
+use crate::cpu::vertex_fusion::Fusion;
+use crate::error::Result;
+use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::stages::radix_sort::RadixSort;
+use crate::stages::scan::Scan;
+use opencl3::kernel::Kernel;
+use opencl3::memory::Buffer;
+use std::sync::Arc;
+
+/// Per-pass kernel times of one fusion, in milliseconds.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FusionTiming {
+    /// Radix sort of the (key, index) pairs.
+    pub sort: f64,
+    /// `fuse_index`.
+    pub index: f64,
+    /// `fuse_clear` + `fuse_triangles` + `fuse_mark`.
+    pub triangles: f64,
+    /// Twin cancellation: candidate scan, `fuse_candidates`, sort, `fuse_cancel`.
+    pub cancel: f64,
+    /// The two exclusive scans.
+    pub scans: f64,
+    /// `fuse_compact_vertices` + `fuse_compact_faces`.
+    pub compact: f64,
+}
+
+impl FusionTiming {
+    /// Sum of the passes.
+    pub fn total(&self) -> f64 {
+        self.sort + self.index + self.triangles + self.cancel + self.scans + self.compact
+    }
+}
+
+/// Counts of one fusion.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct FusionCounts {
+    /// Unique vertices kept.
+    pub vertices: usize,
+    /// Triangles kept.
+    pub faces: usize,
+    /// Triangles dropped: two fused corners were the same vertex, or the
+    /// triangle was cancelled with an opposite twin.
+    pub dropped: usize,
+}
+
+/// A growable device buffer.
+pub(crate) struct Grow<T> {
+    pub(crate) buf: Buffer<T>,
+    pub(crate) len: usize,
+}
+
+impl<T> Grow<T> {
+    pub(crate) fn new(gpu: &Gpu) -> Result<Self> {
+        Ok(Grow {
+            buf: gpu.buffer::<T>(1)?,
+            len: 1,
+        })
+    }
+    /// Makes room for `n` elements (grows by 1/8 extra to avoid re-allocating
+    /// for every slightly larger frame).
+    pub(crate) fn reserve(&mut self, gpu: &Gpu, n: usize) -> Result<()> {
+        if n > self.len {
+            let len = n + n / 8;
+            self.buf = gpu.buffer::<T>(len)?;
+            self.len = len;
+        }
+        Ok(())
+    }
+    pub(crate) fn bytes(&self) -> u64 {
+        (self.len * std::mem::size_of::<T>()) as u64
+    }
+}
+
+/// Fuses a soup on the device; holds its kernels, the scan and sort
+/// primitives and its scratch and output buffers between calls.
+pub struct Fuser {
+    gpu: Arc<Gpu>,
+    sort: RadixSort,
+    scan: Scan,
+    index: Kernel,
+    clear: Kernel,
+    triangles: Kernel,
+    candidates: Kernel,
+    cancel: Kernel,
+    mark: Kernel,
+    compact_vertices: Kernel,
+    compact_faces: Kernel,
+    rep: Grow<u32>,
+    referenced: Grow<u32>,
+    vert_id: Grow<u32>,
+    keep: Grow<u32>,
+    face_off: Grow<u32>,
+    cand: Grow<u32>,
+    cand_off: Grow<u32>,
+    ckeys: Grow<u32>,
+    cvals: Grow<u32>,
+    /// Unique positions (index space), 3 floats per vertex.
+    pub(crate) out_pos: Grow<f32>,
+    /// Faces, 3 indices each.
+    pub(crate) out_faces: Grow<u32>,
+}
+
+/// Build options of `kernels/vertex_fusion.cl` and `kernels/marching_cubes.cl`:
+/// correctly rounded division so positions match the CPU twin bit for bit,
+/// and an optional hash mask that forces collisions (tests).
+pub fn build_options(collide_mask: Option<u32>) -> String {
+    let mut s = String::from("-cl-fp32-correctly-rounded-divide-sqrt");
+    if let Some(m) = collide_mask {
+        s.push_str(&format!(" -DSC_HASH_COLLIDE={m:#x}u"));
+    }
+    s
+}
+
+impl Fuser {
+    /// Builds the kernels (and those of the radix sort and scan).
+    pub fn new(gpu: Arc<Gpu>) -> Result<Self> {
+        let file = kernel_file("vertex_fusion").expect("vertex_fusion kernels are embedded");
+        let p = gpu.program(&file, &build_options(None))?;
+        Ok(Fuser {
+            sort: RadixSort::new(gpu.clone())?,
+            scan: Scan::new(gpu.clone())?,
+            index: gpu.kernel(&p, "fuse_index")?,
+            clear: gpu.kernel(&p, "fuse_clear")?,
+            triangles: gpu.kernel(&p, "fuse_triangles")?,
+            candidates: gpu.kernel(&p, "fuse_candidates")?,
+            cancel: gpu.kernel(&p, "fuse_cancel")?,
+            mark: gpu.kernel(&p, "fuse_mark")?,
+            compact_vertices: gpu.kernel(&p, "fuse_compact_vertices")?,
+            compact_faces: gpu.kernel(&p, "fuse_compact_faces")?,
+            rep: Grow::new(&gpu)?,
+            referenced: Grow::new(&gpu)?,
+            vert_id: Grow::new(&gpu)?,
+            keep: Grow::new(&gpu)?,
+            face_off: Grow::new(&gpu)?,
+            cand: Grow::new(&gpu)?,
+            cand_off: Grow::new(&gpu)?,
+            ckeys: Grow::new(&gpu)?,
+            cvals: Grow::new(&gpu)?,
+            out_pos: Grow::new(&gpu)?,
+            out_faces: Grow::new(&gpu)?,
+            gpu,
+        })
+    }
+
+    /// Device bytes held (scratch, outputs, the sort's scratch).
+    pub fn device_bytes(&self) -> u64 {
+        self.rep.bytes()
+            + self.referenced.bytes()
+            + self.vert_id.bytes()
+            + self.keep.bytes()
+            + self.face_off.bytes()
+            + self.cand.bytes()
+            + self.cand_off.bytes()
+            + self.ckeys.bytes()
+            + self.cvals.bytes()
+            + self.out_pos.bytes()
+            + self.out_faces.bytes()
+            + self.sort.scratch_bytes()
+            + self.scan.scratch_bytes()
+    }
+
+    /// Bytes [`Fuser::fuse`] needs for `n` soup vertices (before outputs),
+    /// for the caller's memory check.
+    pub fn bytes_bound(n: usize) -> u64 {
+        // rep, referenced, vert_id: 4n each; keep, face_off, cand, cand_off:
+        // 4n/3 each (candidate keys at most as many); outputs at most 12n + 4n;
+        // sort scratch ~ 8n + histograms.
+        (12 + 6 + 3 + 16 + 9) * n as u64
+    }
+
+    /// Fuses `n` soup vertices: `keys`/`idx` (sorted in place here) and
+    /// `pos` (3n floats), keys of `key_bits` bits. `fusion` must be `Hash`
+    /// or `Edge` (the soup itself is the `None` variant).
+    pub fn fuse(
+        &mut self,
+        fusion: Fusion,
+        keys: &mut Buffer<u32>,
+        idx: &mut Buffer<u32>,
+        pos: &Buffer<f32>,
+        n: usize,
+        key_bits: u32,
+    ) -> Result<(FusionCounts, FusionTiming)> {
+        let g = self.gpu.clone();
+        let mut t = FusionTiming::default();
+        let nt = n / 3;
+        if n == 0 {
+            return Ok((FusionCounts::default(), t));
+        }
+        self.sort.sort_pairs(keys, idx, n, key_bits)?;
+        t.sort = self.sort.last_ms();
+        for b in [&mut self.rep, &mut self.referenced, &mut self.vert_id] {
+            b.reserve(&g, n)?;
+        }
+        for b in [
+            &mut self.keep,
+            &mut self.face_off,
+            &mut self.cand,
+            &mut self.cand_off,
+        ] {
+            b.reserve(&g, nt)?;
+        }
+        let n32 = n as u32;
+        let compare = u32::from(fusion == Fusion::Hash);
+        let mut evs = Vec::new();
+        evs.push(launch(
+            &g,
+            &self.index,
+            n,
+            &[
+                Arg::U32(n32),
+                buf(keys),
+                buf(idx),
+                buf(pos),
+                Arg::U32(compare),
+                buf(&self.rep.buf),
+            ],
+        )?);
+        let e_clear = launch(
+            &g,
+            &self.clear,
+            n,
+            &[Arg::U32(n32), buf(&self.referenced.buf)],
+        )?;
+        let e_tri = launch(
+            &g,
+            &self.triangles,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                buf(&self.rep.buf),
+                buf(pos),
+                buf(&self.keep.buf),
+                buf(&self.cand.buf),
+            ],
+        )?;
+        let n_cand = self
+            .scan
+            .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
+        t.cancel = self.scan.last_ms();
+        if n_cand > 0 {
+            self.ckeys.reserve(&g, n_cand)?;
+            self.cvals.reserve(&g, n_cand)?;
+            let e = launch(
+                &g,
+                &self.candidates,
+                nt,
+                &[
+                    Arg::U32(nt as u32),
+                    buf(&self.rep.buf),
+                    buf(&self.cand.buf),
+                    buf(&self.cand_off.buf),
+                    buf(&self.ckeys.buf),
+                    buf(&self.cvals.buf),
+                ],
+            )?;
+            self.sort
+                .sort_pairs(&mut self.ckeys.buf, &mut self.cvals.buf, n_cand, 32)?;
+            t.cancel += self.sort.last_ms();
+            let e2 = launch(
+                &g,
+                &self.cancel,
+                n_cand,
+                &[
+                    Arg::U32(n_cand as u32),
+                    buf(&self.ckeys.buf),
+                    buf(&self.cvals.buf),
+                    buf(&self.rep.buf),
+                    buf(&self.keep.buf),
+                ],
+            )?;
+            g.finish()?;
+            t.cancel += [e, e2].iter().flatten().map(event_ms).sum::<f64>();
+        }
+        let e_mark = launch(
+            &g,
+            &self.mark,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                buf(&self.rep.buf),
+                buf(&self.keep.buf),
+                buf(&self.referenced.buf),
+            ],
+        )?;
+        let faces = self
+            .scan
+            .exclusive(&self.keep.buf, &self.face_off.buf, nt)? as usize;
+        let mut scans = self.scan.last_ms();
+        let vertices = self
+            .scan
+            .exclusive(&self.referenced.buf, &self.vert_id.buf, n)? as usize;
+        scans += self.scan.last_ms();
+        t.index = evs.iter().flatten().map(event_ms).sum();
+        t.triangles = [e_clear, e_tri, e_mark]
+            .iter()
+            .flatten()
+            .map(event_ms)
+            .sum();
+        t.scans = scans;
+        self.out_pos.reserve(&g, 3 * vertices)?;
+        self.out_faces.reserve(&g, 3 * faces)?;
+        let e_v = launch(
+            &g,
+            &self.compact_vertices,
+            n,
+            &[
+                Arg::U32(n32),
+                buf(&self.referenced.buf),
+                buf(&self.vert_id.buf),
+                buf(pos),
+                buf(&self.out_pos.buf),
+            ],
+        )?;
+        let e_f = launch(
+            &g,
+            &self.compact_faces,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                buf(&self.rep.buf),
+                buf(&self.keep.buf),
+                buf(&self.face_off.buf),
+                buf(&self.vert_id.buf),
+                buf(&self.out_faces.buf),
+            ],
+        )?;
+        g.finish()?;
+        t.compact = [e_v, e_f].iter().flatten().map(event_ms).sum();
+        Ok((
+            FusionCounts {
+                vertices,
+                faces,
+                dropped: nt - faces,
+            },
+            t,
+        ))
+    }
+}

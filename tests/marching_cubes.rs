@@ -1,0 +1,271 @@
+//! Marching cubes and vertex fusion: the case table, CPU reference invariants,
+//! and the device against the CPU reference.
+
+use shapecue::cpu::marching_cubes::{self as mc, END, table};
+use shapecue::cpu::vertex_fusion::{Fused, Fusion, fuse};
+use shapecue::gpu::Gpu;
+use shapecue::mesh::quality;
+use shapecue::stages::marching_cubes::Isosurfacer;
+use shapecue::volume::Volume;
+use shapecue::volume::sdf::{Sdf, sdf};
+use std::sync::{Arc, OnceLock};
+
+fn gpu() -> Arc<Gpu> {
+    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
+    GPU.get_or_init(|| {
+        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
+            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
+        }))
+    })
+    .clone()
+}
+
+const ALL: [Fusion; 3] = [Fusion::None, Fusion::Hash, Fusion::Edge];
+
+/// Extracts on the device and reads back (index space).
+fn device(vol: &Volume, iso: f32, fusion: Fusion, mask: Option<u32>) -> (Fused, usize) {
+    let mut s = Isosurfacer::with_hash_mask(gpu(), vol, mask).expect("isosurfacer");
+    let st = s.extract(iso, fusion).expect("extract");
+    let (positions, faces) = s.read_index_space().expect("read");
+    assert_eq!(positions.len(), st.vertices);
+    assert_eq!(faces.len(), st.faces);
+    (
+        Fused {
+            positions,
+            faces,
+            dropped: st.degenerate_dropped,
+        },
+        st.soup_triangles,
+    )
+}
+
+/// Device and CPU twin give the same mesh, vertex for vertex.
+fn check_same(vol: &Volume, iso: f32, what: &str) {
+    let soup = mc::mc_triangles(vol, iso);
+    for fusion in ALL {
+        let cpu = fuse(&soup, fusion);
+        let (dev, soup_tris) = device(vol, iso, fusion, None);
+        assert_eq!(soup_tris * 3, soup.len(), "{what} {fusion:?}: soup size");
+        assert_eq!(
+            dev.positions.len(),
+            cpu.positions.len(),
+            "{what} {fusion:?}: vertices"
+        );
+        assert_eq!(dev.faces.len(), cpu.faces.len(), "{what} {fusion:?}: faces");
+        assert!(
+            dev == cpu,
+            "{what} {fusion:?}: device differs from the CPU twin"
+        );
+    }
+}
+
+fn shared_volume(name: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/volumes")
+        .join(name);
+    if !p.exists() {
+        eprintln!(
+            "skipping: {} not found (../shared/data is absent)",
+            p.display()
+        );
+        return None;
+    }
+    Some(p)
+}
+
+fn bucky() -> Option<Volume> {
+    let p = shared_volume("Bucky.raw")?;
+    let b = std::fs::read(p).expect("read Bucky.raw");
+    Some(Volume::new([32; 3], b.iter().map(|&v| v as f32).collect(), "Bucky.raw").unwrap())
+}
+
+fn iron_prot() -> Option<Volume> {
+    let p = shared_volume("ironProt.vtk")?;
+    let f = std::fs::read(p).expect("read ironProt.vtk");
+    let data = &f[f.len() - 68 * 68 * 68..];
+    Some(
+        Volume::new(
+            [68; 3],
+            data.iter().map(|&v| v as f32).collect(),
+            "ironProt.vtk",
+        )
+        .unwrap(),
+    )
+}
+
+#[test]
+fn device_matches_cpu_twin_on_sdfs() {
+    check_same(&sdf(Sdf::Sphere, 40), 0.0, "sphere 40");
+    check_same(&sdf(Sdf::Torus, 33), 0.0, "torus 33");
+    check_same(&sdf(Sdf::Gyroid, 37), 0.1, "gyroid 37");
+}
+
+#[test]
+fn device_matches_cpu_twin_on_integer_volumes_at_voxel_values() {
+    let Some(b) = bucky() else { return };
+    check_same(&b, 51.0, "bucky 51");
+    check_same(&b, 200.0, "bucky 200");
+    let Some(i) = iron_prot() else { return };
+    check_same(&i, 128.0, "ironProt 128");
+}
+
+#[test]
+fn forced_hash_collisions_still_fuse_exactly() {
+    let vol = sdf(Sdf::Torus, 21);
+    let (exact, _) = device(&vol, 0.0, Fusion::Edge, None);
+    for mask in [0xF, 0x0] {
+        let (collided, _) = device(&vol, 0.0, Fusion::Hash, Some(mask));
+        assert!(
+            collided == exact,
+            "hash masked to {mask:#x} differs from exact fusion"
+        );
+    }
+}
+
+#[test]
+fn hard_cases_at_voxel_values_are_clean() {
+    for (vol, iso, name) in [(bucky(), 51.0, "bucky"), (iron_prot(), 128.0, "ironProt")] {
+        let Some(vol) = vol else { return };
+        let (soup, _) = device(&vol, iso, Fusion::None, None);
+        let qs = quality(&soup.positions, &soup.faces);
+        let (m, _) = device(&vol, iso, Fusion::Hash, None);
+        let q = quality(&m.positions, &m.faces);
+        let (e, _) = device(&vol, iso, Fusion::Edge, None);
+        eprintln!("{name} {iso}: soup {qs:?}\nfused {q:?}");
+        assert!(
+            qs.collapsed_faces > 0,
+            "{name}: the soup should have collapsing faces"
+        );
+        assert_eq!(q.collapsed_faces, 0, "{name}: collapsing faces emitted");
+        assert_eq!(
+            q.unique_positions, q.vertices,
+            "{name}: duplicate positions"
+        );
+        assert_eq!(q.unreferenced_vertices, 0);
+        assert_eq!(q.nonmanifold_edges, 0, "{name}: non-manifold edges");
+        assert_eq!(
+            m.dropped, qs.collapsed_faces,
+            "{name}: dropped = collapsing soup faces"
+        );
+        assert!(m == e);
+    }
+}
+
+#[test]
+fn degenerate_volumes() {
+    // Constant volume: empty mesh, not an error.
+    let c = Volume::new([5, 6, 7], vec![3.0; 210], "const").unwrap();
+    for f in ALL {
+        let (m, t) = device(&c, 3.0, f, None);
+        assert_eq!((m.faces.len(), t), (0, 0));
+    }
+    // All inside.
+    let (m, _) = device(&c, 4.0, Fusion::Hash, None);
+    assert!(m.faces.is_empty());
+    // A dimension of 2, and of 1 (no cells).
+    let mut v = vec![0.0f32; 2 * 4 * 4];
+    v[1 + 2 * (1 + 4)] = -1.0;
+    let thin = Volume::new([2, 4, 4], v.clone(), "thin").unwrap();
+    check_same(&thin, -0.5, "2×4×4");
+    let flat = Volume::new([1, 4, 8], v, "flat").unwrap();
+    let (m, _) = device(&flat, -0.5, Fusion::Hash, None);
+    assert!(m.faces.is_empty());
+}
+
+#[test]
+fn nan_and_infinite_voxels_never_make_nan_vertices() {
+    let mut vol = sdf(Sdf::Sphere, 24);
+    let n = vol.values.len();
+    for (i, v) in vol.values.iter_mut().enumerate() {
+        match i % 97 {
+            0 => *v = f32::NAN,
+            1 => *v = f32::INFINITY,
+            2 => *v = f32::NEG_INFINITY,
+            3 => *v = 3e38,
+            4 => *v = -3e38,
+            _ => {}
+        }
+    }
+    assert!(n > 0);
+    check_same(&vol, 0.0, "sphere with non-finite voxels");
+    for f in ALL {
+        let (m, _) = device(&vol, 0.0, f, None);
+        assert!(!m.faces.is_empty());
+        assert!(m.positions.iter().flatten().all(|c| c.is_finite()));
+    }
+    let (m, _) = device(&vol, 0.0, Fusion::Hash, None);
+    let q = quality(&m.positions, &m.faces);
+    assert_eq!(q.collapsed_faces, 0);
+    assert!(
+        q.boundary_edges > 0,
+        "skipped cells leave holes with boundaries"
+    );
+}
+
+#[test]
+fn sdf_surfaces_are_closed_manifolds_on_the_device() {
+    for (kind, chi) in [(Sdf::Sphere, 2), (Sdf::Torus, 0)] {
+        let (m, _) = device(&sdf(kind, 64), 0.0, Fusion::Hash, None);
+        let q = quality(&m.positions, &m.faces);
+        assert_eq!(
+            (q.boundary_edges, q.nonmanifold_edges, q.euler),
+            (0, 0, chi),
+            "{kind:?}"
+        );
+        assert_eq!(q.unique_positions, q.vertices);
+        // Outward normals: positive signed volume.
+        let vol6: f64 = m
+            .faces
+            .iter()
+            .map(|f| {
+                let p = f.map(|v| m.positions[v as usize].map(f64::from));
+                p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1])
+                    - p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0])
+                    + p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])
+            })
+            .sum();
+        assert!(vol6 > 0.0, "{kind:?}: normals must point outward");
+    }
+}
+
+#[test]
+fn table_is_complementary_in_counts_and_closed() {
+    let t = table();
+    assert_eq!(t.counts[0], 0);
+    assert_eq!(t.counts[255], 0);
+    for case in 0..256 {
+        let n = t.tris[case].iter().take_while(|&&e| e != END).count();
+        assert_eq!(n, 3 * t.counts[case] as usize, "case {case}");
+        // Every crossing edge of the case is used, and no other.
+        let mut used = [false; 12];
+        for &e in &t.tris[case][..n] {
+            used[e as usize] = true;
+        }
+        for (e, &u) in used.iter().enumerate() {
+            let (a, b) = mc::edge_corners(e);
+            let crossing = (case >> a & 1) != (case >> b & 1);
+            assert_eq!(u, crossing, "case {case} edge {e}");
+        }
+    }
+}
+
+#[test]
+fn cpu_sphere_and_torus_are_closed_manifolds() {
+    for (kind, chi) in [(Sdf::Sphere, 2), (Sdf::Torus, 0)] {
+        let vol = sdf(kind, 48);
+        let soup = mc::mc_triangles(&vol, 0.0);
+        let rows = mc::mc_classify(&vol, 0.0);
+        assert_eq!(rows.iter().sum::<u32>() as usize * 3, soup.len());
+        for fusion in [Fusion::Edge, Fusion::Hash] {
+            let m = fuse(&soup, fusion);
+            let q = quality(&m.positions, &m.faces);
+            eprintln!("{kind:?} {fusion:?} {q:?}");
+            assert_eq!(q.boundary_edges, 0);
+            assert_eq!(q.nonmanifold_edges, 0);
+            assert_eq!(q.euler, chi);
+            assert_eq!(q.unique_positions, q.vertices);
+            assert_eq!(q.collapsed_faces, 0);
+        }
+        assert_eq!(fuse(&soup, Fusion::Edge), fuse(&soup, Fusion::Hash));
+    }
+}
