@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Installs what shapecue needs on a Debian/Ubuntu machine that has Rust:
-# the OpenCL ICD loader and headers, and PoCL (an OpenCL device on the CPU, so
-# everything runs without a GPU). Used by the README, .ci/run and the Dockerfile.
+# the OpenCL ICD loader and headers, PoCL (an OpenCL device on the CPU, so
+# everything runs without a GPU), and EGL + Mesa (headless OpenGL through
+# llvmpipe for src/render; libEGL is loaded at run time).
+# Used by the README, .ci/run and the Dockerfile.
 # Idempotent: installs only what is missing.
 set -euo pipefail
 
-pkgs=(ocl-icd-libopencl1 ocl-icd-opencl-dev pocl-opencl-icd clinfo)
+pkgs=(ocl-icd-libopencl1 ocl-icd-opencl-dev pocl-opencl-icd clinfo libegl1 libgl1-mesa-dri)
 missing=()
 for p in "${pkgs[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -93,6 +93,24 @@ pub enum Error {
     /// A caller passed an argument that makes no sense.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// Headless OpenGL is unavailable: libEGL could not be loaded, or EGL found
+    /// no display or no OpenGL configuration (no Mesa driver).
+    #[error(
+        "no headless OpenGL ({detail}). Install EGL and Mesa's software rasteriser: \
+         `sudo apt-get install libegl1 libgl1-mesa-dri` (or run scripts/setup.sh)"
+    )]
+    NoGl {
+        /// What EGL reported.
+        detail: String,
+    },
+    /// An EGL or OpenGL call failed, or a shader did not compile.
+    #[error("OpenGL error in {what}: {detail}")]
+    Render {
+        /// Which call or step.
+        what: String,
+        /// The EGL/GL error name, or the shader info log.
+        detail: String,
+    },
 }
 
 impl Error {
@@ -106,6 +124,14 @@ impl Error {
             source_name: source_name.into(),
             element: element.into(),
             problem: problem.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Render`]: what failed and the EGL/GL detail.
+    pub fn render(what: impl Into<String>, detail: impl std::fmt::Display) -> Self {
+        Error::Render {
+            what: what.into(),
+            detail: detail.to_string(),
         }
     }
 

@@ -7,6 +7,7 @@
 //!
 //! ```text
 //! mesh ─► positions ─► [curvature] ─► normals, areas, k1 k2 d1 d2 dk ─► export (PLY, JSON)
+//! all outputs ─► render (headless OpenGL: shaded mesh, clip-space edge quads ─► PNG)
 //! ```
 #![warn(missing_docs)]
 
@@ -16,6 +17,7 @@ pub mod export;
 pub mod field;
 pub mod gpu;
 pub mod mesh;
+pub mod render;
 pub mod report;
 pub mod stages;
 pub mod volume;

@@ -1,0 +1,167 @@
+//! The camera: a right-handed look-at view and an OpenGL projection (clip z in
+//! [-w, w]), the convention the edge kernels must follow when they write
+//! projection-space vertices for [`Renderer::draw_clip_quads`].
+//!
+//! [`Renderer::draw_clip_quads`]: super::Renderer::draw_clip_quads
+
+use glam::camera::rh::{proj::opengl, view};
+use glam::{Mat4, Vec3};
+
+use crate::error::{Error, Result};
+
+/// A pinhole (or orthographic) camera. Plain data: build one with
+/// [`Camera::look_at`] or [`Camera::fit`] and adjust the fields; the renderer
+/// calls [`Camera::validate`] before using it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position (world space).
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Up direction; need not be orthogonal to the view direction, only not parallel.
+    pub up: Vec3,
+    /// Vertical field of view in degrees (perspective only), in (0, 180).
+    pub fov_y_deg: f32,
+    /// `Some(h)`: orthographic projection showing a world-space height `h`.
+    pub ortho_height: Option<f32>,
+    /// Near clipping distance, > 0.
+    pub near: f32,
+    /// Far clipping distance, > near.
+    pub far: f32,
+}
+
+/// An up vector for a view direction: +Y, unless the view is (nearly) vertical,
+/// then +Z.
+fn default_up(dir: Vec3) -> Vec3 {
+    if dir.normalize_or_zero().dot(Vec3::Y).abs() > 0.999 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+impl Camera {
+    /// A 45° perspective camera at `eye` looking at `target`, up +Y (+Z when
+    /// looking straight up or down), near/far at 1/100 and 100 times the distance.
+    pub fn look_at(eye: Vec3, target: Vec3) -> Camera {
+        let dist = eye.distance(target);
+        Camera {
+            eye,
+            target,
+            up: default_up(target - eye),
+            fov_y_deg: 45.0,
+            ortho_height: None,
+            near: 0.01 * dist,
+            far: 100.0 * dist,
+        }
+    }
+
+    /// A 45° perspective camera that looks at the centre of the box
+    /// `bounds_min..bounds_max` from direction `eye_dir` (from the centre
+    /// towards the eye) and keeps the box's bounding sphere inside the view of
+    /// an image with the given `aspect` (width / height), with near and far
+    /// hugging the sphere so that depth precision is not wasted.
+    pub fn fit(bounds_min: Vec3, bounds_max: Vec3, eye_dir: Vec3, aspect: f32) -> Result<Camera> {
+        let finite = bounds_min.is_finite() && bounds_max.is_finite() && eye_dir.is_finite();
+        if !finite || eye_dir.length_squared() == 0.0 || !(aspect > 0.0 && aspect.is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "Camera::fit: bounds {bounds_min}..{bounds_max}, direction {eye_dir} and aspect \
+                 {aspect} must be finite, with a non-zero direction and a positive aspect"
+            )));
+        }
+        let fov_y_deg = 45.0f32;
+        let centre = 0.5 * (bounds_min + bounds_max);
+        // A flat or point-like box still gets a visible, valid frustum.
+        let radius = (0.5 * (bounds_max - bounds_min).length()).max(1e-6 * (1.0 + centre.length()));
+        let half_v = 0.5 * fov_y_deg.to_radians();
+        let half_h = (half_v.tan() * aspect).atan();
+        // Distance at which the sphere touches the narrower half-angle cone.
+        let dist = radius / half_v.min(half_h).sin();
+        let dir = eye_dir.normalize();
+        Ok(Camera {
+            eye: centre + dir * dist,
+            target: centre,
+            up: default_up(-dir),
+            fov_y_deg,
+            ortho_height: None,
+            near: ((dist - radius) * 0.95).max(dist * 1e-4),
+            far: (dist + radius) * 1.05,
+        })
+    }
+
+    /// The world-to-view matrix (right-handed, looking down −Z).
+    pub fn view(&self) -> Mat4 {
+        // glam wants a unit up vector (a zero one is rejected by `validate`).
+        view::look_at_mat4(self.eye, self.target, self.up.normalize_or(Vec3::Y))
+    }
+
+    /// The view-to-clip matrix for an image of the given aspect (width / height),
+    /// OpenGL convention (NDC z in [−1, 1]).
+    pub fn proj(&self, aspect: f32) -> Mat4 {
+        match self.ortho_height {
+            Some(h) => {
+                let (hh, hw) = (0.5 * h, 0.5 * h * aspect);
+                opengl::orthographic(-hw, hw, -hh, hh, self.near, self.far)
+            }
+            None => opengl::perspective(self.fov_y_deg.to_radians(), aspect, self.near, self.far),
+        }
+    }
+
+    /// `proj(aspect) * view()`: world to clip space.
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        self.proj(aspect) * self.view()
+    }
+
+    /// Rejects a camera that would produce a singular or NaN matrix: a
+    /// non-finite field, eye == target, an up vector that is zero or parallel
+    /// to the view direction, a field of view outside (0°, 180°), a
+    /// non-positive orthographic height, near ≤ 0 or far ≤ near.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |problem: String| Err(Error::InvalidArgument(format!("camera: {problem}")));
+        let finite = self.eye.is_finite()
+            && self.target.is_finite()
+            && self.up.is_finite()
+            && self.fov_y_deg.is_finite()
+            && self.near.is_finite()
+            && self.far.is_finite()
+            && self.ortho_height.is_none_or(f32::is_finite);
+        if !finite {
+            return bad(format!("non-finite value in {self:?}"));
+        }
+        let dir = self.target - self.eye;
+        let scale = self.eye.abs().max(self.target.abs()).max_element().max(1.0);
+        if dir.length() <= 1e-6 * scale {
+            return bad(format!(
+                "eye {} and target {} coincide",
+                self.eye, self.target
+            ));
+        }
+        let up = self.up.normalize_or_zero();
+        if up == Vec3::ZERO {
+            return bad("up vector is zero".into());
+        }
+        if dir.normalize().cross(up).length() < 1e-4 {
+            return bad(format!(
+                "up {} is parallel to the view direction {}",
+                self.up, dir
+            ));
+        }
+        match self.ortho_height {
+            Some(h) if h <= 0.0 => return bad(format!("orthographic height {h} must be > 0")),
+            None if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) => {
+                return bad(format!(
+                    "field of view {}° must be in (0°, 180°)",
+                    self.fov_y_deg
+                ));
+            }
+            _ => {}
+        }
+        if self.near <= 0.0 {
+            return bad(format!("near {} must be > 0", self.near));
+        }
+        if self.far <= self.near {
+            return bad(format!("far {} must be > near {}", self.far, self.near));
+        }
+        Ok(())
+    }
+}
