@@ -269,3 +269,73 @@ fn cpu_sphere_and_torus_are_closed_manifolds() {
         assert_eq!(fuse(&soup, Fusion::Edge), fuse(&soup, Fusion::Hash));
     }
 }
+
+#[test]
+fn opposite_twins_cancel_and_leave_no_nonmanifold_edges() {
+    // Bucky at 200 has zero-thickness sheets (planes of voxels equal to the
+    // iso value between inside voxels): without cancellation 45 edges are
+    // non-manifold, each shared by two opposite twin triangles.
+    let Some(b) = bucky() else { return };
+    let (m, _) = device(&b, 200.0, Fusion::Hash, None);
+    let q = quality(&m.positions, &m.faces);
+    assert_eq!(q.nonmanifold_edges, 0);
+    assert_eq!(q.collapsed_faces, 0);
+    let soup = mc::mc_triangles(&b, 200.0);
+    let cpu = fuse(&soup, Fusion::Edge);
+    assert!(cpu.dropped > quality(&soup.iter().map(|s| s.p).collect::<Vec<_>>(), &(0..soup.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect::<Vec<_>>()).collapsed_faces);
+}
+
+#[test]
+fn tri_set_orientation() {
+    use shapecue::cpu::vertex_fusion::tri_set;
+    assert_eq!(tri_set([1, 2, 3]), ([1, 2, 3], true));
+    assert_eq!(tri_set([2, 3, 1]), ([1, 2, 3], true));
+    assert_eq!(tri_set([3, 1, 2]), ([1, 2, 3], true));
+    assert_eq!(tri_set([1, 3, 2]), ([1, 2, 3], false));
+    assert_eq!(tri_set([3, 2, 1]), ([1, 2, 3], false));
+    assert_eq!(tri_set([2, 1, 3]), ([1, 2, 3], false));
+}
+
+#[test]
+fn curvature_on_the_device_resident_isosurface() {
+    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::report::analytic_rms;
+    use shapecue::stages::marching_cubes::curvature;
+    use shapecue::volume::sdf::{SPHERE_RADIUS, TORUS_TUBE, sphere_curvature, torus_curvature};
+    let opts = CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        precision: Precision::F64,
+        compat: Compat::Exact,
+        dcurv: true,
+    };
+    let mut errs = Vec::new();
+    for res in [48, 96] {
+        for kind in [Sdf::Sphere, Sdf::Torus] {
+            let mut ex = Isosurfacer::new(gpu(), &sdf(kind, res)).unwrap();
+            ex.extract(0.0, Fusion::Edge).unwrap();
+            let (est, _) = curvature(&ex, opts).unwrap();
+            let f = est.read().unwrap();
+            assert!(f.all_finite());
+            // Same mesh through the host path: the same field (f64).
+            let mesh = ex.read().unwrap();
+            let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts).unwrap().field;
+            let d = shapecue::report::rmse(&f.k1, &host.k1);
+            assert!(d < 1e-9, "{kind:?} {res}: device-resident vs host path k1 rmse {d}");
+            let (r, truth): (f64, Vec<_>) = match kind {
+                Sdf::Sphere => (SPHERE_RADIUS, mesh.positions.iter().map(|&p| sphere_curvature(p)).collect()),
+                _ => (TORUS_TUBE, mesh.positions.iter().map(|&p| torus_curvature(p)).collect()),
+            };
+            let (e1, e2) = analytic_rms(&f, &truth);
+            eprintln!("{kind:?} {res}: k1 err·r {:.3e}, k2 err·r {:.3e}", e1 * r, e2 * r);
+            errs.push((e1 * r, e2 * r));
+        }
+    }
+    // The per-face estimator's error on marching-cubes meshes is set by the
+    // triangles' shapes (slivers next to grid points), not their size: it
+    // stays near 10 % RMS at every resolution (measured 32³ … 256³; see the
+    // report). Bound it, so a regression (or a sign/orientation error, which
+    // would give ~200 %) fails.
+    for (e1, e2) in &errs {
+        assert!(*e1 < 0.2 && *e2 < 0.25, "{errs:?}");
+    }
+}
