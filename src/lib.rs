@@ -18,6 +18,7 @@ pub mod gpu;
 pub mod mesh;
 pub mod report;
 pub mod stages;
+pub mod volume;
 
 pub use error::{Error, Result};
 pub use mesh::Mesh;

@@ -1,0 +1,150 @@
+//! Procedural scalar fields on the cube `[-1, 1]^3`: the analytic oracles of
+//! the isosurface tests and the generated inputs of the benches, so they
+//! need no downloaded file.
+//!
+//! The sphere and the torus are exact signed distances (negative inside),
+//! computed in `f64` and stored as `f32`, with analytic principal curvatures
+//! for checking curvature estimates on their zero isosurface. The gyroid is
+//! the level-set `sin x cos y + sin y cos z + sin z cos x` (not a distance),
+//! with [`GYROID_PERIODS`] periods across the cube: a large, genus-rich
+//! surface for throughput measurements.
+
+use std::str::FromStr;
+
+use super::Volume;
+use crate::error::{Error, Result};
+
+/// Radius of [`Sdf::Sphere`].
+pub const SPHERE_RADIUS: f64 = 0.8;
+/// Major radius of [`Sdf::Torus`] (centre of the tube to the z axis).
+pub const TORUS_R: f64 = 0.6;
+/// Tube radius of [`Sdf::Torus`].
+pub const TORUS_TUBE: f64 = 0.25;
+/// Periods of [`Sdf::Gyroid`] across the cube along each axis (the field
+/// is evaluated at `π·P·p`). Chosen so that at 256³ samples about 1.3 M
+/// cells have a sign change, i.e. about 2.5 M marching-cubes triangles;
+/// `tests/volume.rs` (`gyroid_calibration`) measures it.
+pub const GYROID_PERIODS: f64 = 4.0;
+
+/// A procedural field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sdf {
+    /// Sphere of radius [`SPHERE_RADIUS`] at the origin.
+    Sphere,
+    /// Torus around the z axis, radii [`TORUS_R`] and [`TORUS_TUBE`].
+    Torus,
+    /// Gyroid with [`GYROID_PERIODS`] periods per axis.
+    Gyroid,
+}
+
+impl FromStr for Sdf {
+    type Err = Error;
+
+    /// `sphere`, `torus` or `gyroid` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "sphere" => Ok(Sdf::Sphere),
+            "torus" => Ok(Sdf::Torus),
+            "gyroid" => Ok(Sdf::Gyroid),
+            _ => Err(Error::InvalidArgument(format!(
+                "unknown procedural volume '{s}' (expected sphere, torus or gyroid)"
+            ))),
+        }
+    }
+}
+
+/// Samples `kind` on a `res³` grid covering `[-1, 1]^3` (spacing
+/// `2/(res-1)`, origin `-1`). `res` below 2 is taken as 2.
+///
+/// The grid coordinates are computed as `(2i - (res-1)) / (res-1)`, exactly
+/// antisymmetric about the centre, so symmetric shapes give symmetric values.
+pub fn sdf(kind: Sdf, res: usize) -> Volume {
+    let res = res.max(2);
+    let n = res - 1;
+    let coord: Vec<f64> = (0..res)
+        .map(|i| (2.0 * i as f64 - n as f64) / n as f64)
+        .collect();
+    let mut values = Vec::with_capacity(res * res * res);
+    match kind {
+        Sdf::Sphere => {
+            for &z in &coord {
+                for &y in &coord {
+                    values.extend(coord.iter().map(|&x| sphere_distance([x, y, z]) as f32));
+                }
+            }
+        }
+        Sdf::Torus => {
+            for &z in &coord {
+                for &y in &coord {
+                    values.extend(coord.iter().map(|&x| torus_distance([x, y, z]) as f32));
+                }
+            }
+        }
+        Sdf::Gyroid => {
+            // sin and cos per axis once: the field is separable per term.
+            let w = std::f64::consts::PI * GYROID_PERIODS;
+            let s: Vec<f64> = coord.iter().map(|c| (w * c).sin()).collect();
+            let c: Vec<f64> = coord.iter().map(|c| (w * c).cos()).collect();
+            for z in 0..res {
+                for y in 0..res {
+                    values
+                        .extend((0..res).map(|x| (s[x] * c[y] + s[y] * c[z] + s[z] * c[x]) as f32));
+                }
+            }
+        }
+    }
+    let h = 2.0 / n as f64;
+    Volume {
+        dims: [res; 3],
+        spacing: [h; 3],
+        origin: [-1.0; 3],
+        values,
+    }
+}
+
+/// [`sdf`] by name (`sphere`, `torus`, `gyroid`), checking `res`.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] for an unknown name, `res < 2`, or a grid too
+/// large to address.
+pub fn sdf_by_name(name: &str, res: usize) -> Result<Volume> {
+    let kind: Sdf = name.parse()?;
+    if res < 2 {
+        return Err(Error::InvalidArgument(format!(
+            "procedural volume resolution {res}: at least 2 samples per axis are needed"
+        )));
+    }
+    res.checked_mul(res)
+        .and_then(|r| r.checked_mul(res))
+        .and_then(|r| r.checked_mul(std::mem::size_of::<f32>()))
+        .ok_or_else(|| {
+            Error::InvalidArgument(format!("procedural volume resolution {res} is too large"))
+        })?;
+    Ok(sdf(kind, res))
+}
+
+/// Signed distance to the sphere (negative inside).
+pub fn sphere_distance(p: [f64; 3]) -> f64 {
+    (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - SPHERE_RADIUS
+}
+
+/// Signed distance to the torus (negative inside the tube).
+pub fn torus_distance(p: [f64; 3]) -> f64 {
+    let q = (p[0] * p[0] + p[1] * p[1]).sqrt() - TORUS_R;
+    (q * q + p[2] * p[2]).sqrt() - TORUS_TUBE
+}
+
+/// Principal curvatures `(k1, k2)`, `k1 >= k2`, of the sphere at a point on
+/// it; positive = convex with respect to the outward normal.
+pub fn sphere_curvature(_p: [f64; 3]) -> (f64, f64) {
+    (1.0 / SPHERE_RADIUS, 1.0 / SPHERE_RADIUS)
+}
+
+/// Principal curvatures `(k1, k2)`, `k1 >= k2`, of the torus at a point on
+/// it (`1/r` around the tube, `cos v / (R + r cos v)` around the axis, which
+/// is negative on the inner half); positive = convex with respect to the
+/// outward normal. Same convention as [`crate::mesh::torus_curvature`].
+pub fn torus_curvature(p: [f64; 3]) -> (f64, f64) {
+    crate::mesh::torus_curvature(TORUS_R, TORUS_TUBE, p)
+}
