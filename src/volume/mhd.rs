@@ -77,7 +77,17 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
                     problem: format!("ObjectType {value}: shapecue reads images only"),
                 });
             }
-            "ndims" => ndims = Some(number(value, "NDims", src, el)?),
+            "ndims" => {
+                let n: usize = number(value, "NDims", src, el)?;
+                if n != 3 {
+                    // Before DimSize, whose count depends on it.
+                    return Err(Error::UnsupportedFormat {
+                        path: path.to_path_buf(),
+                        problem: format!("NDims {n}: shapecue reads 3-D volumes only"),
+                    });
+                }
+                ndims = Some(n);
+            }
             "dimsize" => dims = Some(three(value, "DimSize", src, el)?),
             "elementtype" => {
                 let name = value.to_ascii_lowercase();
@@ -157,15 +167,8 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
     }
 
     let missing = |key: &str| Error::input(src, "header", format!("missing {key}"));
-    match ndims {
-        Some(3) => {}
-        Some(n) => {
-            return Err(Error::UnsupportedFormat {
-                path: path.to_path_buf(),
-                problem: format!("NDims {n}: shapecue reads 3-D volumes only"),
-            });
-        }
-        None => return Err(missing("NDims")),
+    if ndims.is_none() {
+        return Err(missing("NDims"));
     }
     let dims = dims.ok_or_else(|| missing("DimSize"))?;
     let scalar = scalar.ok_or_else(|| missing("ElementType"))?;

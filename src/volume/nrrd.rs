@@ -57,15 +57,8 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
     let src = source.as_str();
     let missing =
         |field: &str| Error::input(src, "header", format!("missing required field '{field}'"));
-    match h.dimension {
-        Some(3) => {}
-        Some(d) => {
-            return Err(Error::UnsupportedFormat {
-                path: path.to_path_buf(),
-                problem: format!("dimension {d}: shapecue reads 3-D volumes only"),
-            });
-        }
-        None => return Err(missing("dimension")),
+    if h.dimension.is_none() {
+        return Err(missing("dimension"));
     }
     let dims = h.sizes.ok_or_else(|| missing("sizes"))?;
     let scalar = h.scalar.ok_or_else(|| missing("type"))?;
@@ -192,7 +185,17 @@ fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
         let value = value.trim();
         let field = key.trim().to_ascii_lowercase();
         match field.as_str() {
-            "dimension" => h.dimension = Some(number(value, "dimension", source, el)?),
+            "dimension" => {
+                let d: usize = number(value, "dimension", source, el)?;
+                if d != 3 {
+                    // Before `sizes`, whose count depends on it.
+                    return Err(Error::UnsupportedFormat {
+                        path: source.into(),
+                        problem: format!("dimension {d}: shapecue reads 3-D volumes only"),
+                    });
+                }
+                h.dimension = Some(d);
+            }
             "type" => h.scalar = Some(scalar_type(value, source, el)?),
             "encoding" => h.encoding = Some(encoding(value, source, el)?),
             "endian" => {

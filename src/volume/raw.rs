@@ -2,9 +2,10 @@
 //! [`RawSpec`]. The file size is checked against the spec before the file is
 //! read, so a wrong type or dimension is reported without reading gigabytes.
 
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-use super::{RawSpec, Volume, byte_count, convert_into, size_problem, voxel_count};
+use super::{RawSpec, ScalarType, Volume, byte_count, convert_into, size_problem, voxel_count};
 use crate::error::{Error, Result};
 
 /// Reads `path` as `spec.dims` samples of `spec.scalar` after
@@ -33,6 +34,17 @@ pub(super) fn load(path: &Path, spec: &RawSpec) -> Result<Volume> {
         }
         return Err(Error::input(&source, "data", problem));
     }
+    if spec.scalar == ScalarType::F32 && spec.big_endian == cfg!(target_endian = "big") {
+        // Native f32: read straight into the samples, no second buffer.
+        let mut values = vec![0.0f32; count];
+        let mut read = || -> std::io::Result<()> {
+            let mut f = std::fs::File::open(path)?;
+            f.seek(SeekFrom::Start(spec.header_bytes as u64))?;
+            f.read_exact(bytemuck::cast_slice_mut(&mut values))
+        };
+        read().map_err(io)?;
+        return finish(spec, values, &source);
+    }
     let bytes = super::read_file(path)?;
     // The file may have changed since its size was taken.
     let data = bytes
@@ -51,7 +63,12 @@ pub(super) fn load(path: &Path, spec: &RawSpec) -> Result<Volume> {
         })?;
     let mut values = Vec::with_capacity(count);
     convert_into(data, spec.scalar, spec.big_endian, &mut values);
-    Volume::new(spec.dims, values, &source)?
+    finish(spec, values, &source)
+}
+
+/// The volume of `values` with the spec's geometry.
+fn finish(spec: &RawSpec, values: Vec<f32>, source: &str) -> Result<Volume> {
+    Volume::new(spec.dims, values, source)?
         .with_geometry(spec.spacing, spec.origin)
-        .map_err(|e| Error::input(&source, "raw geometry", e.to_string()))
+        .map_err(|e| Error::input(source, "raw geometry", e.to_string()))
 }

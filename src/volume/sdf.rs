@@ -21,9 +21,10 @@ pub const TORUS_R: f64 = 0.6;
 /// Tube radius of [`Sdf::Torus`].
 pub const TORUS_TUBE: f64 = 0.25;
 /// Periods of [`Sdf::Gyroid`] across the cube along each axis (the field
-/// is evaluated at `π·P·p`). Chosen so that at 256³ samples about 1.3 M
-/// cells have a sign change, i.e. about 2.5 M marching-cubes triangles;
-/// `tests/volume.rs` (`gyroid_calibration`) measures it.
+/// is evaluated at `π·P·p`). Chosen so that at 256³ samples 1,259,955 cells
+/// have a sign change and 1,269,654 grid edges are crossed, i.e. about
+/// 2.54 M marching-cubes triangles (twice the vertex count of a closed
+/// triangulation); `tests/volume.rs` (`gyroid_calibration`) measures it.
 pub const GYROID_PERIODS: f64 = 4.0;
 
 /// A procedural field.

@@ -71,8 +71,10 @@ pub(super) fn load_legacy(path: &Path) -> Result<Volume> {
         ));
     }
     next_line(&mut pos).ok_or_else(|| Error::input(src, "header line 2", "missing title"))?;
-    let (n, mode) = next_line(&mut pos)
-        .ok_or_else(|| Error::input(src, "header line 3", "missing ASCII or BINARY"))?;
+    // VTK's reader skips blank lines before the keyword (ironProt.vtk has one).
+    let (n, mode) = std::iter::from_fn(|| next_line(&mut pos))
+        .find(|(_, l)| !l.trim_ascii().is_empty())
+        .ok_or_else(|| Error::input(src, "header", "missing ASCII or BINARY"))?;
     let binary = match text(n, mode)?.to_ascii_uppercase().as_str() {
         "BINARY" => true,
         "ASCII" => false,
@@ -230,6 +232,7 @@ struct Xml {
     spacing: [f64; 3],
     direction: [f64; 9],
     pieces: usize,
+    piece_extent: Option<[i64; 6]>,
     array: Option<Array>,
     /// Offsets of every appended array, to bound base64 segments.
     offsets: Vec<usize>,
@@ -298,6 +301,11 @@ pub(super) fn load_xml(path: &Path) -> Result<Volume> {
         return Err(unsupported(format!(
             "{} pieces: shapecue reads ImageData with one piece",
             x.pieces
+        )));
+    }
+    if let Some(p) = x.piece_extent.filter(|p| *p != e) {
+        return Err(unsupported(format!(
+            "a Piece with Extent {p:?} smaller than the WholeExtent {e:?} is not supported"
         )));
     }
     let array = x
@@ -394,6 +402,7 @@ fn parse_xml(xml: &str, src: &str, path: &Path) -> Result<Xml> {
         spacing: [1.0; 3],
         direction: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
         pieces: 0,
+        piece_extent: None,
         array: None,
         offsets: Vec::new(),
         appended: None,
@@ -496,13 +505,8 @@ fn parse_xml(xml: &str, src: &str, path: &Path) -> Result<Xml> {
                 }
                 "Piece" => {
                     x.pieces += 1;
-                    if let (Some(e), Some(whole)) = (attr("Extent")?, x.extent) {
-                        if six(&e, src, "Piece")? != whole {
-                            return Err(unsupported(format!(
-                                "a Piece with Extent {e} smaller than the WholeExtent is \
-                                 not supported"
-                            )));
-                        }
+                    if let Some(e) = attr("Extent")? {
+                        x.piece_extent = Some(six(&e, src, "Piece")?);
                     }
                 }
                 "PointData" => {
