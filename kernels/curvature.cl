@@ -635,3 +635,18 @@ __kernel void curv_load_positions(uint nv, __global const float *src, REAL ax, R
     pos[3 * gid + 1] = ay * (REAL)src[3 * gid + 1] + by;
     pos[3 * gid + 2] = az * (REAL)src[3 * gid + 2] + bz;
 }
+
+// Replaces the accumulated vertex normals with given unit normals (e.g. from
+// an isosurface's volume gradient) where those are finite and non-zero; runs
+// after curv_normals_areas, before curv_frames. One work-item per vertex.
+__kernel void curv_override_normals(uint nv, __global const float *src, __global REAL *nrm)
+{
+    GID_OR_RETURN(nv);
+    const float x = src[3 * gid], y = src[3 * gid + 1], z = src[3 * gid + 2];
+    const float l2 = x * x + y * y + z * z;
+    if (isfinite(l2) && l2 > 0.0f) {
+        nrm[3 * gid] = (REAL)x;
+        nrm[3 * gid + 1] = (REAL)y;
+        nrm[3 * gid + 2] = (REAL)z;
+    }
+}

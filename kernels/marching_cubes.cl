@@ -204,3 +204,54 @@ __kernel void mc_iota(uint n, __global uint *out)
     GID_OR_RETURN(n);
     out[gid] = gid;
 }
+
+// Central-difference gradient of the volume at grid point g along `axis`, in
+// world units (one-sided at the border; 0 when the axis has one sample).
+inline float grad_axis(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+                       uint nz, uint axis, float h)
+{
+    uint n = axis == 0 ? nx : (axis == 1 ? ny : nz);
+    uint c = axis == 0 ? x : (axis == 1 ? y : z);
+    uint lo = c > 0 ? c - 1 : c, hi = c + 1 < n ? c + 1 : c;
+    if (hi == lo)
+        return 0.0f;
+    uint xl = axis == 0 ? lo : x, yl = axis == 1 ? lo : y, zl = axis == 2 ? lo : z;
+    uint xh = axis == 0 ? hi : x, yh = axis == 1 ? hi : y, zh = axis == 2 ? hi : z;
+    return (vol[grid_index(xh, yh, zh, nx, ny)] - vol[grid_index(xl, yl, zl, nx, ny)]) /
+           ((float)(hi - lo) * h);
+}
+
+// Unit normals of mesh vertices (index-space positions) from the volume
+// gradient, trilinearly interpolated from the grid points of the enclosing
+// cell; pointing to increasing values like the triangles' winding. (0,0,0)
+// where the gradient vanishes or is not finite. CPU twin:
+// cpu::marching_cubes::gradient_normals (in f64).
+__kernel void mc_gradient_normals(uint nv, __global const float *pos, __global const float *vol,
+                                  uint nx, uint ny, uint nz, float hx, float hy, float hz,
+                                  __global float *nrm)
+{
+    GID_OR_RETURN(nv);
+    float p[3], f[3];
+    uint b[3];
+    const uint d[3] = {nx, ny, nz};
+    for (uint a = 0; a < 3; ++a) {
+        p[a] = pos[3 * gid + a];
+        const uint top = d[a] >= 2 ? d[a] - 2 : 0;
+        b[a] = min((uint)max(p[a], 0.0f), top);
+        f[a] = clamp(p[a] - (float)b[a], 0.0f, 1.0f);
+    }
+    float n[3] = {0.0f, 0.0f, 0.0f};
+    for (uint c = 0; c < 8; ++c) {
+        const uint o0 = c & 1, o1 = (c >> 1) & 1, o2 = c >> 2;
+        const uint gx = min(b[0] + o0, nx - 1), gy = min(b[1] + o1, ny - 1), gz = min(b[2] + o2, nz - 1);
+        const float w = (o0 ? f[0] : 1.0f - f[0]) * (o1 ? f[1] : 1.0f - f[1]) *
+                        (o2 ? f[2] : 1.0f - f[2]);
+        n[0] += w * grad_axis(vol, gx, gy, gz, nx, ny, nz, 0, hx);
+        n[1] += w * grad_axis(vol, gx, gy, gz, nx, ny, nz, 1, hy);
+        n[2] += w * grad_axis(vol, gx, gy, gz, nx, ny, nz, 2, hz);
+    }
+    const float len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const bool ok = isfinite(len) && len > 0.0f;
+    for (uint a = 0; a < 3; ++a)
+        nrm[3 * gid + a] = ok ? n[a] / len : 0.0f;
+}

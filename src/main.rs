@@ -43,6 +43,12 @@ enum Cmd {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum NormalsArg {
+    Gradient,
+    Mesh,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum FusionArg {
     Hash,
     Edge,
@@ -92,6 +98,10 @@ struct IsoArgs {
     /// Curvature precision.
     #[arg(long, value_enum, default_value = "f32")]
     precision: PrecArg,
+    /// Vertex normals of the curvature passes: the volume gradient (accurate
+    /// on marching-cubes meshes) or the mesh's own face normals (the paper's).
+    #[arg(long, value_enum, default_value = "gradient")]
+    curvature_normals: NormalsArg,
     /// Skip the curvature-derivative pass.
     #[arg(long)]
     no_dcurv: bool,
@@ -484,13 +494,18 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
             compat: Compat::Exact,
             dcurv: !a.no_dcurv,
         };
-        let (est, timing) = mcs::curvature(&ex, opts)?;
+        let normals = match a.curvature_normals {
+            NormalsArg::Gradient => mcs::IsoNormals::Gradient,
+            NormalsArg::Mesh => mcs::IsoNormals::Mesh,
+        };
+        let (est, timing) = mcs::curvature(&ex, opts, normals)?;
         let f = est.read()?;
         if !f.all_finite() {
             bail!("internal error: non-finite curvature (please report with the input)");
         }
         curv_stats = serde_json::json!({
             "options": opts,
+            "normals": normals,
             "passes": timing.passes,
             "kernel_ms": timing.kernel_ms,
             "run_wall_ms": timing.wall_ms,

@@ -388,11 +388,15 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
                 ),
             };
             let mut row = format!(
-                "{:<8} {res:>5} {:>9} {k:>10.2}",
+                "{:<8} {res:>5} {:>9} {k:>8.2}",
                 format!("{kind:?}").to_lowercase(),
                 st.faces
             );
-            for precision in [Precision::F32, Precision::F64] {
+            for (precision, normals) in [
+                (Precision::F32, mcs::IsoNormals::Mesh),
+                (Precision::F32, mcs::IsoNormals::Gradient),
+                (Precision::F64, mcs::IsoNormals::Gradient),
+            ] {
                 let opts = CurvatureOptions {
                     accumulate: Accumulate::Atomic,
                     precision,
@@ -400,7 +404,7 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
                     dcurv: true,
                 };
                 let mut times = Vec::new();
-                let (mut est, _) = mcs::curvature(&ex, opts)?;
+                let (mut est, _) = mcs::curvature(&ex, opts, normals)?;
                 for _ in 0..runs.max(1) {
                     times.push(est.run()?.kernel_ms);
                 }
@@ -421,7 +425,8 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
     w(
         &mut s,
         "\n(k errors: RMS of k − k_analytic over the vertices, × r (sphere r = 0.8, torus tube \
-         r = 0.25); extraction uses --fusion edge; curvature kernel ms include dcurv)"
+         r = 0.25); extraction uses --fusion edge; curvature kernel ms include dcurv and, for gradient \
+         normals, the override pass)"
             .into(),
     );
     Ok(s)

@@ -75,8 +75,8 @@ fn shared_volume(name: &str) -> Option<std::path::PathBuf> {
 
 fn bucky() -> Option<Volume> {
     let p = shared_volume("Bucky.raw")?;
-    let b = std::fs::read(p).expect("read Bucky.raw");
-    Some(Volume::new([32; 3], b.iter().map(|&v| v as f32).collect(), "Bucky.raw").unwrap())
+    let spec = shapecue::volume::RawSpec::new([32; 3], shapecue::volume::ScalarType::U8);
+    Some(shapecue::volume::load(&p, Some(&spec)).expect("Bucky.raw loads"))
 }
 
 fn iron_prot() -> Option<Volume> {
@@ -282,7 +282,16 @@ fn opposite_twins_cancel_and_leave_no_nonmanifold_edges() {
     assert_eq!(q.collapsed_faces, 0);
     let soup = mc::mc_triangles(&b, 200.0);
     let cpu = fuse(&soup, Fusion::Edge);
-    assert!(cpu.dropped > quality(&soup.iter().map(|s| s.p).collect::<Vec<_>>(), &(0..soup.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect::<Vec<_>>()).collapsed_faces);
+    assert!(
+        cpu.dropped
+            > quality(
+                &soup.iter().map(|s| s.p).collect::<Vec<_>>(),
+                &(0..soup.len() as u32 / 3)
+                    .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                    .collect::<Vec<_>>()
+            )
+            .collapsed_faces
+    );
 }
 
 #[test]
@@ -300,7 +309,7 @@ fn tri_set_orientation() {
 fn curvature_on_the_device_resident_isosurface() {
     use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
     use shapecue::report::analytic_rms;
-    use shapecue::stages::marching_cubes::curvature;
+    use shapecue::stages::marching_cubes::{IsoNormals, curvature};
     use shapecue::volume::sdf::{SPHERE_RADIUS, TORUS_TUBE, sphere_curvature, torus_curvature};
     let opts = CurvatureOptions {
         accumulate: Accumulate::Atomic,
@@ -313,20 +322,38 @@ fn curvature_on_the_device_resident_isosurface() {
         for kind in [Sdf::Sphere, Sdf::Torus] {
             let mut ex = Isosurfacer::new(gpu(), &sdf(kind, res)).unwrap();
             ex.extract(0.0, Fusion::Edge).unwrap();
-            let (est, _) = curvature(&ex, opts).unwrap();
+            let (est, _) = curvature(&ex, opts, IsoNormals::Mesh).unwrap();
             let f = est.read().unwrap();
             assert!(f.all_finite());
             // Same mesh through the host path: the same field (f64).
             let mesh = ex.read().unwrap();
-            let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts).unwrap().field;
+            let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts)
+                .unwrap()
+                .field;
             let d = shapecue::report::rmse(&f.k1, &host.k1);
-            assert!(d < 1e-9, "{kind:?} {res}: device-resident vs host path k1 rmse {d}");
+            assert!(
+                d < 1e-9,
+                "{kind:?} {res}: device-resident vs host path k1 rmse {d}"
+            );
             let (r, truth): (f64, Vec<_>) = match kind {
-                Sdf::Sphere => (SPHERE_RADIUS, mesh.positions.iter().map(|&p| sphere_curvature(p)).collect()),
-                _ => (TORUS_TUBE, mesh.positions.iter().map(|&p| torus_curvature(p)).collect()),
+                Sdf::Sphere => (
+                    SPHERE_RADIUS,
+                    mesh.positions
+                        .iter()
+                        .map(|&p| sphere_curvature(p))
+                        .collect(),
+                ),
+                _ => (
+                    TORUS_TUBE,
+                    mesh.positions.iter().map(|&p| torus_curvature(p)).collect(),
+                ),
             };
             let (e1, e2) = analytic_rms(&f, &truth);
-            eprintln!("{kind:?} {res}: k1 err·r {:.3e}, k2 err·r {:.3e}", e1 * r, e2 * r);
+            eprintln!(
+                "{kind:?} {res}: k1 err·r {:.3e}, k2 err·r {:.3e}",
+                e1 * r,
+                e2 * r
+            );
             errs.push((e1 * r, e2 * r));
         }
     }
@@ -338,4 +365,49 @@ fn curvature_on_the_device_resident_isosurface() {
     for (e1, e2) in &errs {
         assert!(*e1 < 0.2 && *e2 < 0.25, "{errs:?}");
     }
+}
+
+#[test]
+fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
+    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::stages::marching_cubes::{IsoNormals, curvature};
+    use shapecue::volume::sdf::SPHERE_RADIUS;
+    let opts = CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        precision: Precision::F32,
+        compat: Compat::Exact,
+        dcurv: true,
+    };
+    let mut errs = Vec::new();
+    for res in [32, 64, 128] {
+        let vol = sdf(Sdf::Sphere, res);
+        let mut ex = Isosurfacer::new(gpu(), &vol).unwrap();
+        ex.extract(0.0, Fusion::Hash).unwrap();
+        let (ip, _) = ex.read_index_space().unwrap();
+        let cpu = mc::gradient_normals(&vol, &ip);
+        let b = ex.gradient_normals().unwrap();
+        let mut dev = vec![[0f32; 3]; ip.len()];
+        gpu().read(&b, dev.as_flattened_mut()).unwrap();
+        for (d, c) in dev.iter().zip(&cpu) {
+            for k in 0..3 {
+                assert!((d[k] as f64 - c[k]).abs() < 1e-5, "{d:?} vs {c:?}");
+            }
+        }
+        let (est, _) = curvature(&ex, opts, IsoNormals::Gradient).unwrap();
+        let f = est.read().unwrap();
+        assert!(f.all_finite());
+        let k = 1.0 / SPHERE_RADIUS;
+        let rms = |v: &[f64]| {
+            (v.iter().map(|x| (x - k) * (x - k)).sum::<f64>() / v.len() as f64).sqrt() / k
+        };
+        errs.push((rms(&f.k1), rms(&f.k2)));
+    }
+    eprintln!("gradient-normal curvature, relative RMS (k1, k2) at 32³, 64³, 128³: {errs:?}");
+    for i in 0..2 {
+        assert!(
+            errs[i + 1].0 < 0.7 * errs[i].0 && errs[i + 1].1 < 0.7 * errs[i].1,
+            "{errs:?}"
+        );
+    }
+    assert!(errs[2].0 < 5e-3, "{errs:?}");
 }

@@ -118,6 +118,7 @@ pub struct CurvatureEstimator {
     kk: Buffer<u8>,
     dk: Buffer<u8>,
     counters: Buffer<u32>,
+    normal_override: Option<Buffer<f32>>,
     device_bytes: u64,
     topology_ms: f64,
 }
@@ -135,6 +136,8 @@ struct Kernels {
     sums: Option<[Kernel; 3]>,
     /// Positions from a device buffer of index-space floats (isosurfaces).
     load_positions: Kernel,
+    /// Given unit normals replace the accumulated ones (isosurfaces).
+    override_normals: Kernel,
 }
 
 /// Buffers of the gather variant: one-ring lists, corner contributions, face status.
@@ -282,6 +285,7 @@ impl CurvatureEstimator {
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
             sums,
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
+            override_normals: gpu.kernel(&program, "curv_override_normals")?,
         };
         Ok((k, program))
     }
@@ -371,6 +375,7 @@ impl CurvatureEstimator {
             kk: rb(2 * nv)?,
             dk: rb(4 * nv)?,
             counters: gpu.buffer::<u32>(4)?,
+            normal_override: None,
             device_bytes: device_bytes_bound(nv, nf, &opts),
             gpu,
             opts,
@@ -475,6 +480,15 @@ impl CurvatureEstimator {
         Ok(())
     }
 
+    /// Uses these unit normals (3 floats per vertex, e.g. from an
+    /// isosurface's volume gradient: see
+    /// [`crate::stages::marching_cubes::Isosurfacer::gradient_normals`])
+    /// instead of the area-weighted face normals in every later pass, where
+    /// they are finite and non-zero. `None` goes back to the mesh normals.
+    pub fn set_normal_override(&mut self, normals: Option<Buffer<f32>>) {
+        self.normal_override = normals;
+    }
+
     /// The normalization of the current pose.
     pub fn normalization(&self) -> Normalization {
         self.norm
@@ -559,6 +573,13 @@ impl CurvatureEstimator {
                 Pass::NormalsAreas,
             )? {
                 record(p, Some(e));
+            }
+            if let Some(src) = &self.normal_override {
+                let args = [Arg::U32(nv32), buf(src), nrm];
+                record(
+                    Pass::NormalsAreas,
+                    launch(g, &self.k.override_normals, nv, &args)?,
+                );
             }
         }
         if Pass::Frames <= last {

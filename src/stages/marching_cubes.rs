@@ -78,6 +78,7 @@ pub struct Isosurfacer {
     classify: Kernel,
     triangles: Kernel,
     iota: Kernel,
+    gradient: Kernel,
     scan: Scan,
     fuser: Fuser,
     row_tris: Buffer<u32>,
@@ -148,6 +149,7 @@ impl Isosurfacer {
             classify: gpu.kernel(&p, "mc_classify")?,
             triangles: gpu.kernel(&p, "mc_triangles")?,
             iota: gpu.kernel(&p, "mc_iota")?,
+            gradient: gpu.kernel(&p, "mc_gradient_normals")?,
             scan: Scan::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
             row_tris: gpu.buffer::<u32>(rows)?,
@@ -338,6 +340,38 @@ impl Isosurfacer {
         })
     }
 
+    /// Unit normals of the current result's vertices from the volume
+    /// gradient (trilinear interpolation of central differences, world
+    /// units), computed on the device into a new buffer of 3 floats per
+    /// vertex; (0,0,0) where the gradient vanishes. CPU twin:
+    /// [`crate::cpu::marching_cubes::gradient_normals`].
+    pub fn gradient_normals(&self) -> Result<Buffer<f32>> {
+        let Some((pos, _, nv, _)) = self.device_mesh() else {
+            return Err(Error::InvalidArgument("no isosurface extracted yet".into()));
+        };
+        let out = self.gpu.buffer::<f32>(3 * nv)?;
+        let [nx, ny, nz] = self.dims;
+        launch(
+            &self.gpu,
+            &self.gradient,
+            nv,
+            &[
+                Arg::U32(nv as u32),
+                buf(pos),
+                buf(&self.vol),
+                Arg::U32(nx as u32),
+                Arg::U32(ny as u32),
+                Arg::U32(nz as u32),
+                Arg::F32(self.spacing[0] as f32),
+                Arg::F32(self.spacing[1] as f32),
+                Arg::F32(self.spacing[2] as f32),
+                buf(&out),
+            ],
+        )?;
+        self.gpu.finish()?;
+        Ok(out)
+    }
+
     /// Reads the current result: positions in index space and faces.
     pub fn read_index_space(&self) -> Result<(Vec<[f32; 3]>, Vec<[u32; 3]>)> {
         let Some((p, f, nv, nf)) = self.device_mesh() else {
@@ -364,14 +398,27 @@ impl Isosurfacer {
     }
 }
 
+/// Which vertex normals the curvature of an isosurface uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IsoNormals {
+    /// The estimator's own area-weighted face normals (Rusinkiewicz).
+    Mesh,
+    /// The volume's gradient at each vertex: far more accurate on
+    /// marching-cubes meshes, whose sliver triangles make face normals noisy.
+    Gradient,
+}
+
 /// Curvature of the current isosurface, computed without a host round trip:
 /// the fused faces and positions are copied device to device into a
-/// [`CurvatureEstimator`] (atomic accumulation), positions mapped to world
-/// units and normalized on the device. Returns the estimator after its run
-/// (read the field with [`CurvatureEstimator::read`]) and the run's timing.
+/// [`crate::stages::curvature::CurvatureEstimator`] (atomic accumulation),
+/// positions mapped to world units and normalized on the device, vertex
+/// normals from the mesh or the volume gradient. Returns the estimator after
+/// its run (read the field with its `read`) and the run's timing.
 pub fn curvature(
     iso: &Isosurfacer,
     opts: crate::field::CurvatureOptions,
+    normals: IsoNormals,
 ) -> Result<(
     crate::stages::curvature::CurvatureEstimator,
     crate::stages::curvature::RunTiming,
@@ -399,6 +446,9 @@ pub fn curvature(
         scale: if half > 0.0 { half } else { 1.0 },
     };
     est.set_positions_device(pos, iso.spacing, iso.origin, norm)?;
+    if normals == IsoNormals::Gradient {
+        est.set_normal_override(Some(iso.gradient_normals()?));
+    }
     let timing = est.run()?;
     Ok((est, timing))
 }
