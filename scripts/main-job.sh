@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's main job, on bundled (generated) data: sets up, builds, lists the
 # OpenCL devices, computes curvature of a torus and an ellipsoid to PLY + JSON
-# stats in out/, and prints the accuracy/time table of every variant.
+# stats in out/, prints the accuracy/time table of every variant, then extracts
+# isosurfaces of procedural fields (with curvature) and prints their report.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -12,3 +13,8 @@ $bin devices
 $bin curvature --generate torus --resolution 40000 -o out/torus.ply --stats out/torus.json --force
 $bin curvature --generate ellipsoid --resolution 40000 -o out/ellipsoid.ply --stats out/ellipsoid.json --force
 $bin curvature --report --resolution 40000
+# Isosurfaces: marching cubes + vertex fusion on the device, then curvature
+# of the fused mesh without a host round trip, on procedural fields.
+$bin isosurface --sdf torus --resolution 128 --curvature --normals -o out/torus-iso.ply --stats out/torus-iso.json --force
+$bin isosurface --sdf gyroid --resolution 128 --fusion hash -o out/gyroid-iso.ply --stats out/gyroid-iso.json --force
+$bin isosurface --report --max-resolution 256 --runs 3

@@ -182,3 +182,96 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
         );
     }
 }
+
+#[test]
+fn isosurface_writes_ply_with_curvature_normals_and_stats() {
+    let d = tmpdir("iso");
+    let ply = d.join("torus.ply");
+    let json = d.join("torus.json");
+    let out = bin()
+        .args([
+            "isosurface",
+            "--sdf",
+            "torus",
+            "--resolution",
+            "40",
+            "--curvature",
+            "--normals",
+            "-o",
+        ])
+        .arg(&ply)
+        .arg("--stats")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (names, rows, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
+    assert_eq!(names.len(), 19);
+    assert!(!faces.is_empty());
+    // Normals from the gradient are unit length and point outward.
+    let outward = rows
+        .iter()
+        .filter(|r| {
+            let (x, y) = (r[0] as f64, r[1] as f64);
+            let rho = (x * x + y * y).sqrt();
+            let c = [x / rho * 0.6, y / rho * 0.6, 0.0];
+            let d = [r[0] as f64 - c[0], r[1] as f64 - c[1], r[2] as f64];
+            d[0] * r[3] as f64 + d[1] * r[4] as f64 + d[2] * r[5] as f64 > 0.0
+        })
+        .count();
+    assert_eq!(outward, rows.len());
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(s["quality"]["boundary_edges"], 0);
+    assert_eq!(s["quality"]["euler"], 0);
+    assert!(
+        s["extraction"]["soup_vertices"].as_u64().unwrap()
+            > s["extraction"]["vertices"].as_u64().unwrap()
+    );
+    assert!(
+        s["curvature"]["passes"]
+            .as_array()
+            .is_some_and(|p| !p.is_empty())
+    );
+    // Refuses to overwrite without --force.
+    let again = bin()
+        .args(["isosurface", "--sdf", "torus", "--resolution", "20", "-o"])
+        .arg(&ply)
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+}
+
+#[test]
+fn isosurface_bad_input_is_a_clear_error() {
+    let d = tmpdir("isobad");
+    let raw = d.join("v.raw");
+    std::fs::write(&raw, vec![0u8; 100]).unwrap();
+    let run = |args: &[&str]| {
+        let out = bin().arg("isosurface").args(args).output().unwrap();
+        assert!(!out.status.success(), "{args:?} should fail");
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let r = raw.to_str().unwrap();
+    let e = run(&[r, "--dims", "8,8,8", "--type", "u8", "--iso", "1"]);
+    assert!(
+        e.contains("v.raw") && e.contains("512") && e.contains("100"),
+        "{e}"
+    );
+    let e = run(&[r, "--dims", "4,5,5", "--type", "q7", "--iso", "1"]);
+    assert!(e.contains("q7"), "{e}");
+    let e = run(&[r, "--dims", "4,5", "--type", "u8", "--iso", "1"]);
+    assert!(e.contains("three"), "{e}");
+    let e = run(&[r, "--dims", "4,5,5", "--type", "u8"]);
+    assert!(e.contains("--iso"), "{e}");
+    let e = run(&["--sdf", "cube"]);
+    assert!(e.contains("cube"), "{e}");
+    let e = run(&[d.join("missing.nhdr").to_str().unwrap(), "--iso", "1"]);
+    assert!(e.contains("missing.nhdr"), "{e}");
+    let e = run(&["--sdf", "sphere", "--iso", "NaN"]);
+    assert!(e.to_lowercase().contains("iso"), "{e}");
+}

@@ -196,7 +196,8 @@ pub fn mc_vertex(vol: &Volume, iso: f32, cell: [usize; 3], e: usize) -> SoupVert
     let v0 = vol.value(lo[0], lo[1], lo[2]);
     let v1 = vol.value(hi[0], hi[1], hi[2]);
     let mut t = (iso - v0) / (v1 - v0);
-    if !(t >= 0.0) {
+    // NaN (from ±inf voxels) fails the test too: the vertex goes to the lower end.
+    if t.is_nan() || t < 0.0 {
         t = 0.0;
     }
     if t > 1.0 {

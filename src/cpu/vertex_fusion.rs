@@ -116,11 +116,11 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
     let tri = |t: usize| [rep[3 * t], rep[3 * t + 1], rep[3 * t + 2]];
     let mut keep = vec![false; nt];
     let mut cand = Vec::new();
-    for t in 0..nt {
+    for (t, kt) in keep.iter_mut().enumerate() {
         let f = tri(t);
-        keep[t] = f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
+        *kt = f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
         let p = f.map(|v| soup[v as usize].p);
-        if keep[t]
+        if *kt
             && (0..3)
                 .any(|a| p[0][a] == p[1][a] && p[1][a] == p[2][a] && p[0][a] == p[0][a].floor())
         {
@@ -146,8 +146,8 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
     // fuse_mark
     let mut referenced = vec![false; soup.len()];
     let mut kept = Vec::new();
-    for t in 0..nt {
-        if keep[t] {
+    for (t, &k) in keep.iter().enumerate() {
+        if k {
             for v in tri(t) {
                 referenced[v as usize] = true;
             }

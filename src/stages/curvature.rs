@@ -257,7 +257,7 @@ impl CurvatureEstimator {
             }
         }
         let file = kernel_file("curvature").expect("curvature kernels are embedded");
-        let program = gpu.program(&file, &build_options(&opts))?;
+        let program = gpu.program(&file, &build_options(opts))?;
         let gather = opts.accumulate == Accumulate::Gather;
         let kname = |base: &str| {
             if gather {

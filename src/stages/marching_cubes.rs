@@ -57,6 +57,9 @@ pub struct IsoStats {
     pub device_bytes: u64,
 }
 
+/// Positions in voxel index space and faces, as read back from the device.
+pub type IndexSpaceMesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
 /// Which buffers hold the current result.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Holder {
@@ -373,7 +376,7 @@ impl Isosurfacer {
     }
 
     /// Reads the current result: positions in index space and faces.
-    pub fn read_index_space(&self) -> Result<(Vec<[f32; 3]>, Vec<[u32; 3]>)> {
+    pub fn read_index_space(&self) -> Result<IndexSpaceMesh> {
         let Some((p, f, nv, nf)) = self.device_mesh() else {
             return Ok((Vec::new(), Vec::new()));
         };

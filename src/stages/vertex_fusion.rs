@@ -209,8 +209,7 @@ impl Fuser {
         }
         let n32 = n as u32;
         let compare = u32::from(fusion == Fusion::Hash);
-        let mut evs = Vec::new();
-        evs.push(launch(
+        let e_index = launch(
             &g,
             &self.index,
             n,
@@ -222,7 +221,7 @@ impl Fuser {
                 Arg::U32(compare),
                 buf(&self.rep.buf),
             ],
-        )?);
+        )?;
         let e_clear = launch(
             &g,
             &self.clear,
@@ -298,7 +297,7 @@ impl Fuser {
             .scan
             .exclusive(&self.referenced.buf, &self.vert_id.buf, n)? as usize;
         scans += self.scan.last_ms();
-        t.index = evs.iter().flatten().map(event_ms).sum();
+        t.index = e_index.as_ref().map(event_ms).unwrap_or(0.0);
         t.triangles = [e_clear, e_tri, e_mark]
             .iter()
             .flatten()
