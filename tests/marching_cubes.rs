@@ -411,3 +411,39 @@ fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
     }
     assert!(errs[2].0 < 5e-3, "{errs:?}");
 }
+
+#[test]
+fn spacing_and_origin_are_honoured_in_world_coordinates() {
+    // The same sphere sampled on an anisotropic grid placed off the origin.
+    let (nx, ny, nz) = (30, 40, 24);
+    let spacing = [0.1, 0.07, 0.125];
+    let origin = [10.0 - 1.45, -3.0 - 1.365, 2.0 - 1.4375];
+    let center = [10.0, -3.0, 2.0];
+    let mut values = Vec::with_capacity(nx * ny * nz);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let p = [
+                    origin[0] + spacing[0] * x as f64 - center[0],
+                    origin[1] + spacing[1] * y as f64 - center[1],
+                    origin[2] + spacing[2] * z as f64 - center[2],
+                ];
+                values.push(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0) as f32);
+            }
+        }
+    }
+    let vol = Volume::new([nx, ny, nz], values, "aniso")
+        .unwrap()
+        .with_geometry(spacing, origin)
+        .unwrap();
+    let mut ex = Isosurfacer::new(gpu(), &vol).unwrap();
+    ex.extract(0.0, Fusion::Hash).unwrap();
+    let m = ex.read().unwrap();
+    assert!(m.n_faces() > 100);
+    for p in &m.positions {
+        let r =
+            ((p[0] - center[0]).powi(2) + (p[1] - center[1]).powi(2) + (p[2] - center[2]).powi(2))
+                .sqrt();
+        assert!((r - 1.0).abs() < 0.01, "vertex {p:?} at radius {r}");
+    }
+}
