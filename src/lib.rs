@@ -19,6 +19,7 @@ pub mod gpu;
 pub mod mesh;
 pub mod render;
 pub mod report;
+pub mod scene;
 pub mod stages;
 pub mod volume;
 

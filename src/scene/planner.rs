@@ -1,0 +1,250 @@
+//! The planner: from the cues a scene asks for to exactly the passes they
+//! need, each with its lifetime (geometry-central's require/ensure, applied
+//! to a frame loop). Pure data: no device, no files.
+//!
+//! Lifetimes: *topology* passes (edge buffer, one-rings and owning faces,
+//! adjacency cap buffer) run once per mesh topology; *pose* passes (skin or
+//! load the frame, normals, curvature, dcurv, AO) once per pose; *view*
+//! passes (contours, suggestive contours, edge detection, caps, render) once
+//! per camera and frame. Across the cameras of one frame the pose passes run
+//! once; across the frames of a static mesh they run once in all. An
+//! isosurface changes topology with every pose, so its topology passes are
+//! pose passes.
+
+use serde::Serialize;
+
+/// A shape cue a scene can ask for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Cue {
+    /// Plain Lambert shading.
+    Shading,
+    /// Curvature colour map (blue concave, red convex, green saddle).
+    CurvatureColors,
+    /// Curvature-based ambient occlusion (Lambert × AO).
+    AmbientOcclusion,
+    /// Occluding contours.
+    Contours,
+    /// Suggestive contours.
+    SuggestiveContours,
+    /// Feature edges (contour, crease, boundary, marked) with caps.
+    FeatureEdges,
+}
+
+impl Cue {
+    /// Every cue.
+    pub const ALL: [Cue; 6] = [
+        Cue::Shading,
+        Cue::CurvatureColors,
+        Cue::AmbientOcclusion,
+        Cue::Contours,
+        Cue::SuggestiveContours,
+        Cue::FeatureEdges,
+    ];
+
+    /// The passes this cue reads directly.
+    pub fn needs(self) -> &'static [Pass] {
+        match self {
+            Cue::Shading => &[Pass::VertexNormals, Pass::Render],
+            Cue::CurvatureColors => &[Pass::Curvature, Pass::Render],
+            Cue::AmbientOcclusion => &[Pass::Ao, Pass::VertexNormals, Pass::Render],
+            Cue::Contours => &[Pass::Contours, Pass::Render],
+            Cue::SuggestiveContours => &[Pass::SuggestiveContours, Pass::Render],
+            Cue::FeatureEdges => &[Pass::EdgeDetect, Pass::Caps, Pass::Render],
+        }
+    }
+}
+
+/// Where a scene's geometry comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Input {
+    /// One mesh, the same in every frame.
+    Static,
+    /// A skinned mesh (glTF skin + animation): topology fixed, poses by skinning.
+    Skinned,
+    /// A sequence of meshes with one topology (OBJ/PLY frames).
+    Flipbook,
+    /// An isosurface of a volume: new topology every pose.
+    Volume,
+}
+
+/// How often a pass runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Lifetime {
+    /// Once per mesh topology.
+    Topology,
+    /// Once per pose (frame).
+    Pose,
+    /// Once per camera and frame.
+    View,
+}
+
+/// A pass of the frame loop. Declaration order is a valid execution order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pass {
+    /// Marching cubes + vertex fusion (volume input).
+    Isosurface,
+    /// Linear blend skinning (skinned input).
+    Skin,
+    /// Upload the frame's positions (flipbook input).
+    LoadFrame,
+    /// Unique edges with their opposite vertices (House & Li's edge buffer).
+    EdgeBuffer,
+    /// One-rings / owning faces of the curvature passes.
+    OneRings,
+    /// Pairs of edges sharing a vertex (adjacency caps).
+    CapBuffer,
+    /// Area-weighted vertex normals.
+    VertexNormals,
+    /// Face normals (crease and contour tests of edge detection).
+    FaceNormals,
+    /// Principal curvatures and directions (k1, k2, d1, d2).
+    Curvature,
+    /// Curvature derivative (dk).
+    Dcurv,
+    /// Ambient occlusion from curvature.
+    Ao,
+    /// Occluding contours (zero crossings of n·v).
+    Contours,
+    /// Suggestive contours (zero crossings of radial curvature, with dk).
+    SuggestiveContours,
+    /// Feature-edge detection into the edge-out buffer.
+    EdgeDetect,
+    /// Cap geometry into the cap-out buffers.
+    Caps,
+    /// Draw the frame.
+    Render,
+}
+
+impl Pass {
+    /// The pass that makes this input's positions, if any.
+    pub fn source(input: Input) -> Option<Pass> {
+        match input {
+            Input::Static => None,
+            Input::Skinned => Some(Pass::Skin),
+            Input::Flipbook => Some(Pass::LoadFrame),
+            Input::Volume => Some(Pass::Isosurface),
+        }
+    }
+
+    /// The passes this one reads directly, for an input kind.
+    pub fn needs(self, input: Input) -> Vec<Pass> {
+        let src = Pass::source(input);
+        let mut v: Vec<Pass> = match self {
+            Pass::Isosurface | Pass::Skin | Pass::LoadFrame => vec![],
+            // An isosurface brings a new topology with every pose.
+            Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer if input == Input::Volume => {
+                vec![Pass::Isosurface]
+            }
+            Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer => vec![],
+            Pass::VertexNormals | Pass::FaceNormals => src.into_iter().collect(),
+            Pass::Curvature => vec![Pass::OneRings, Pass::VertexNormals],
+            Pass::Dcurv => vec![Pass::Curvature],
+            Pass::Ao => vec![Pass::Curvature],
+            Pass::Contours => vec![Pass::VertexNormals],
+            Pass::SuggestiveContours => vec![Pass::Dcurv, Pass::VertexNormals],
+            Pass::EdgeDetect => vec![Pass::EdgeBuffer, Pass::FaceNormals],
+            Pass::Caps => vec![Pass::EdgeDetect, Pass::CapBuffer],
+            Pass::Render => vec![],
+        };
+        v.sort();
+        v
+    }
+
+    /// How often this pass runs for an input kind.
+    pub fn lifetime(self, input: Input) -> Lifetime {
+        match self {
+            Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer if input != Input::Volume => {
+                Lifetime::Topology
+            }
+            Pass::Contours
+            | Pass::SuggestiveContours
+            | Pass::EdgeDetect
+            | Pass::Caps
+            | Pass::Render => Lifetime::View,
+            _ => Lifetime::Pose,
+        }
+    }
+}
+
+/// The passes a set of cues needs, in execution order, with lifetimes.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Plan {
+    /// The input kind planned for.
+    pub input: Input,
+    /// The cues asked for.
+    pub cues: Vec<Cue>,
+    /// The closure of what the cues need, in execution order.
+    pub passes: Vec<Pass>,
+}
+
+/// Plans exactly the passes `cues` need for `input`: the closure of their
+/// needs, nothing else, in an order where every pass follows what it reads.
+pub fn plan(cues: &[Cue], input: Input) -> Plan {
+    let mut set = std::collections::BTreeSet::new();
+    let mut stack: Vec<Pass> = cues
+        .iter()
+        .flat_map(|c| c.needs().iter().copied())
+        .collect();
+    while let Some(p) = stack.pop() {
+        if set.insert(p) {
+            stack.extend(p.needs(input));
+        }
+    }
+    let mut cues = cues.to_vec();
+    cues.sort();
+    cues.dedup();
+    Plan {
+        input,
+        cues,
+        // BTreeSet order is declaration order, which respects every need.
+        passes: set.into_iter().collect(),
+    }
+}
+
+impl Plan {
+    /// Whether the plan runs `pass`.
+    pub fn contains(&self, pass: Pass) -> bool {
+        self.passes.contains(&pass)
+    }
+
+    /// How many times `pass` runs over `frames` frames seen by `views`
+    /// cameras: topology passes once, pose passes once per frame (once in
+    /// all for a static mesh), view passes once per frame and camera.
+    pub fn runs(&self, pass: Pass, frames: usize, views: usize) -> usize {
+        if !self.contains(pass) {
+            return 0;
+        }
+        let poses = if self.input == Input::Static {
+            frames.min(1)
+        } else {
+            frames
+        };
+        match pass.lifetime(self.input) {
+            Lifetime::Topology => frames.min(1),
+            Lifetime::Pose => poses,
+            Lifetime::View => frames * views,
+        }
+    }
+
+    /// Human-readable plan (`--explain`).
+    pub fn explain(&self, frames: usize, views: usize) -> String {
+        let mut s = format!(
+            "input {:?}, cues {:?}; {frames} frame(s) × {views} view(s)\n",
+            self.input, self.cues
+        );
+        for &p in &self.passes {
+            s.push_str(&format!(
+                "  {:<20} {:<9} runs {:>5}  needs {:?}\n",
+                format!("{p:?}"),
+                format!("{:?}", p.lifetime(self.input)),
+                self.runs(p, frames, views),
+                p.needs(self.input)
+            ));
+        }
+        s
+    }
+}

@@ -1,0 +1,131 @@
+//! The scene planner: for every combination of cues and every input kind the
+//! plan is exactly the closure of what the cues need (checked against a
+//! hand-written table per cue), in a valid order, with the run counts the
+//! lifetimes promise.
+
+use shapecue::scene::planner::{Cue, Input, Lifetime, Pass, plan};
+use std::collections::BTreeSet;
+
+const INPUTS: [Input; 4] = [
+    Input::Static,
+    Input::Skinned,
+    Input::Flipbook,
+    Input::Volume,
+];
+
+/// What each cue needs, written out by hand from the issue (not derived from
+/// the planner's tables): AO needs k1, k2 but not dk; suggestive contours need
+/// dk; contours need only normals; creases need face normals and the edge
+/// buffer; curvature colours need k1, k2.
+fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
+    use Pass::*;
+    let mut v: Vec<Pass> = match cue {
+        Cue::Shading => vec![VertexNormals, Render],
+        Cue::CurvatureColors => vec![OneRings, VertexNormals, Curvature, Render],
+        Cue::AmbientOcclusion => vec![OneRings, VertexNormals, Curvature, Ao, Render],
+        Cue::Contours => vec![VertexNormals, Contours, Render],
+        Cue::SuggestiveContours => {
+            vec![
+                OneRings,
+                VertexNormals,
+                Curvature,
+                Dcurv,
+                SuggestiveContours,
+                Render,
+            ]
+        }
+        Cue::FeatureEdges => vec![EdgeBuffer, CapBuffer, FaceNormals, EdgeDetect, Caps, Render],
+    };
+    let needs_geometry = v.iter().any(|p| {
+        matches!(
+            p,
+            VertexNormals | FaceNormals | OneRings | EdgeBuffer | CapBuffer
+        )
+    });
+    if needs_geometry {
+        v.extend(match input {
+            Input::Static => None,
+            Input::Skinned => Some(Skin),
+            Input::Flipbook => Some(LoadFrame),
+            Input::Volume => Some(Isosurface),
+        });
+    }
+    v.into_iter().collect()
+}
+
+#[test]
+fn every_combination_plans_exactly_the_closure() {
+    for input in INPUTS {
+        for mask in 0u32..(1 << Cue::ALL.len()) {
+            let cues: Vec<Cue> = Cue::ALL
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| mask >> i & 1 == 1)
+                .map(|(_, &c)| c)
+                .collect();
+            let p = plan(&cues, input);
+            let want: BTreeSet<Pass> = cues.iter().flat_map(|&c| expected(c, input)).collect();
+            let got: BTreeSet<Pass> = p.passes.iter().copied().collect();
+            assert_eq!(got, want, "{input:?} {cues:?}");
+            assert_eq!(got.len(), p.passes.len(), "no pass twice");
+            // Valid order: every pass follows what it reads.
+            for (i, &pass) in p.passes.iter().enumerate() {
+                for need in pass.needs(input) {
+                    let j = p
+                        .passes
+                        .iter()
+                        .position(|&q| q == need)
+                        .expect("need planned");
+                    assert!(j < i, "{input:?} {cues:?}: {need:?} after {pass:?}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn the_issue_s_dependency_rules() {
+    let s = Input::Skinned;
+    assert!(!plan(&[Cue::AmbientOcclusion], s).contains(Pass::Dcurv));
+    assert!(plan(&[Cue::SuggestiveContours], s).contains(Pass::Dcurv));
+    let c = plan(&[Cue::Contours], s);
+    assert!(!c.contains(Pass::Curvature) && c.contains(Pass::VertexNormals));
+    let e = plan(&[Cue::FeatureEdges], s);
+    assert!(e.contains(Pass::FaceNormals) && e.contains(Pass::EdgeBuffer));
+    assert!(!e.contains(Pass::Curvature));
+    let k = plan(&[Cue::CurvatureColors], s);
+    assert!(k.contains(Pass::Curvature) && !k.contains(Pass::Dcurv) && !k.contains(Pass::Ao));
+    assert!(plan(&[], s).passes.is_empty());
+}
+
+#[test]
+fn run_counts_follow_the_lifetimes() {
+    let all = Cue::ALL;
+    // Skinned: pose passes once per frame, view passes per frame and camera,
+    // topology once.
+    let p = plan(&all, Input::Skinned);
+    assert_eq!(p.runs(Pass::EdgeBuffer, 10, 4), 1);
+    assert_eq!(p.runs(Pass::Skin, 10, 4), 10);
+    assert_eq!(p.runs(Pass::Curvature, 10, 4), 10);
+    assert_eq!(p.runs(Pass::Render, 10, 4), 40);
+    // Static mesh: curvature once over all frames and cameras.
+    let p = plan(&all, Input::Static);
+    assert_eq!(p.runs(Pass::Curvature, 10, 4), 1);
+    assert_eq!(p.runs(Pass::Dcurv, 10, 4), 1);
+    assert_eq!(p.runs(Pass::Contours, 10, 4), 40);
+    // Volume: topology changes every pose.
+    let p = plan(&all, Input::Volume);
+    assert_eq!(Pass::OneRings.lifetime(Input::Volume), Lifetime::Pose);
+    assert_eq!(p.runs(Pass::OneRings, 10, 4), 10);
+    assert_eq!(p.runs(Pass::Isosurface, 10, 4), 10);
+    // Passes not planned never run.
+    assert_eq!(
+        plan(&[Cue::Contours], Input::Static).runs(Pass::Ao, 10, 4),
+        0
+    );
+    let text = plan(&[Cue::AmbientOcclusion], Input::Skinned).explain(3, 2);
+    assert!(
+        text.contains("Ao") && text.contains("Skin") && !text.contains("Dcurv"),
+        "{text}"
+    );
+}
