@@ -4,4 +4,5 @@
 
 pub mod curvature;
 pub mod marching_cubes;
+pub mod skinning;
 pub mod vertex_fusion;

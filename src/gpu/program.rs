@@ -44,6 +44,11 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
             source: include_str!("../../kernels/radix_sort.cl"),
             headers: COMMON_HEADERS,
         }),
+        "skinning" => Some(KernelFile {
+            name: "kernels/skinning.cl",
+            source: include_str!("../../kernels/skinning.cl"),
+            headers: COMMON_HEADERS,
+        }),
         "marching_cubes" => Some(KernelFile {
             name: "kernels/marching_cubes.cl",
             source: include_str!("../../kernels/marching_cubes.cl"),

@@ -8,6 +8,7 @@
 mod generate;
 mod load;
 mod quality;
+pub mod skinned;
 
 pub use generate::*;
 pub use load::{LoadOptions, load};

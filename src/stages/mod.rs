@@ -4,4 +4,5 @@ pub mod curvature;
 pub mod marching_cubes;
 pub mod radix_sort;
 pub mod scan;
+pub mod skinning;
 pub mod vertex_fusion;
