@@ -1,0 +1,117 @@
+// feature_lines.cl: occluding and suggestive contours extracted per face as
+// line segments (DeCarlo et al. 2003, 2004; seed 000 §3.8). Host:
+// src/stages/feature_lines.rs; CPU twin with the same step names:
+// src/cpu/feature_lines.rs.
+//   lines_vertex   per vertex  n·v, the radial curvature κr·sin²θ = k1u² + k2v²
+//                              (u, v: the view vector in the (d1, d2) frame) and
+//                              the suggestive-contour test num = sinθ·D_w κr =
+//                              C(w,w,w)/|w|² − 2(n·v)τr²,  τr = (k2 − k1)uv/|w|²
+//   lines_face     per face    zero crossings of n·v (contours) and of κr where
+//                              the test holds (suggestive), linearly interpolated
+//                              on the face's edges → one segment per face and kind
+// Buffers (V vertices, F faces, S segment capacity):
+//   pos, nrm, d1, d2 float[3V]; k float[2V] (k1, k2); dk float[4V] (C111 C112 C122 C222)
+//   ndv, kr, sc float[V] (lines_vertex output)
+//   seg float[8S]: x0 y0 z0 x1 y1 z1, kind (0 contour, 1 suggestive), strength
+//   counter uint[1]: segments found (all are counted; only the first S written)
+// Camera: eye (perspective) or, with ortho = 1, the constant direction `eye`
+// towards the viewer. A vertex with n·v exactly 0 counts as front-facing.
+// Suggestive contours are kept on front faces where num / (n·v) exceeds
+// `sc_thresh` (already divided by the mesh's feature size on the host), and
+// their strength fades with n·v: min(1, (n·v)/fade).
+
+inline void view_at(float px, float py, float pz, float ex, float ey, float ez, uint ortho,
+                    float *vx, float *vy, float *vz)
+{
+    float x = ortho ? ex : ex - px, y = ortho ? ey : ey - py, z = ortho ? ez : ez - pz;
+    const float l = sqrt(x * x + y * y + z * z);
+    const float s = l > 0.0f ? 1.0f / l : 0.0f;
+    *vx = x * s;
+    *vy = y * s;
+    *vz = z * s;
+}
+
+__kernel void lines_vertex(uint nv, __global const float *pos, __global const float *nrm,
+                           __global const float *d1, __global const float *d2,
+                           __global const float *k, __global const float *dk, float ex, float ey,
+                           float ez, uint ortho, __global float *ndv, __global float *kr,
+                           __global float *sc)
+{
+    GID_OR_RETURN(nv);
+    float vx, vy, vz;
+    view_at(pos[3 * gid], pos[3 * gid + 1], pos[3 * gid + 2], ex, ey, ez, ortho, &vx, &vy, &vz);
+    const float nd = nrm[3 * gid] * vx + nrm[3 * gid + 1] * vy + nrm[3 * gid + 2] * vz;
+    const float u = d1[3 * gid] * vx + d1[3 * gid + 1] * vy + d1[3 * gid + 2] * vz;
+    const float v = d2[3 * gid] * vx + d2[3 * gid + 1] * vy + d2[3 * gid + 2] * vz;
+    const float k1 = k[2 * gid], k2 = k[2 * gid + 1];
+    const float u2 = u * u, v2 = v * v, w2 = u2 + v2;
+    const float cwww = u2 * (u * dk[4 * gid] + 3.0f * v * dk[4 * gid + 1]) +
+                       v2 * (3.0f * u * dk[4 * gid + 2] + v * dk[4 * gid + 3]);
+    // Looking straight down the normal (|w| → 0) the radial direction is
+    // undefined: no suggestive contour there (num = 0 fails the test).
+    const float inv = w2 > 1e-12f ? 1.0f / w2 : 0.0f;
+    const float tr = (k2 - k1) * u * v * inv;
+    ndv[gid] = nd;
+    kr[gid] = k1 * u2 + k2 * v2;
+    sc[gid] = w2 > 1e-12f ? cwww * inv - 2.0f * nd * tr * tr : 0.0f;
+}
+
+// Interpolation parameter of the zero crossing of f on the edge a → b.
+inline float cross_t(float fa, float fb)
+{
+    const float d = fa - fb;
+    const float t = d != 0.0f ? fa / d : 0.5f;
+    return clamp(t, 0.0f, 1.0f);
+}
+
+__kernel void lines_face(uint nf, __global const uint *faces, __global const float *pos,
+                         __global const float *ndv, __global const float *kr,
+                         __global const float *sc, uint want_contours, uint want_suggestive,
+                         float sc_thresh, float fade, uint cap, __global float *seg,
+                         volatile __global uint *counter)
+{
+    GID_OR_RETURN(nf);
+    uint v[3];
+    v[0] = faces[3 * gid];
+    v[1] = faces[3 * gid + 1];
+    v[2] = faces[3 * gid + 2];
+    for (uint kind = 0; kind < 2; ++kind) {
+        if ((kind == 0 && !want_contours) || (kind == 1 && !want_suggestive))
+            continue;
+        float f[3];
+        for (uint i = 0; i < 3; ++i)
+            f[i] = kind == 0 ? ndv[v[i]] : kr[v[i]];
+        // The corner whose sign differs from the other two.
+        const bool s0 = f[0] >= 0.0f, s1 = f[1] >= 0.0f, s2 = f[2] >= 0.0f;
+        if (s0 == s1 && s1 == s2)
+            continue;
+        const uint c = (s0 == s1) ? 2 : ((s0 == s2) ? 1 : 0);
+        const uint a = (c + 1) % 3, b = (c + 2) % 3;
+        const float ta = cross_t(f[c], f[a]), tb = cross_t(f[c], f[b]);
+        float p[6];
+        float strength = 1.0f;
+        for (uint i = 0; i < 3; ++i) {
+            const float pc = pos[3 * v[c] + i];
+            p[i] = pc + ta * (pos[3 * v[a] + i] - pc);
+            p[3 + i] = pc + tb * (pos[3 * v[b] + i] - pc);
+        }
+        if (kind == 1) {
+            // Test and facing interpolated to the segment's midpoint.
+            const float nda = ndv[v[c]] + ta * (ndv[v[a]] - ndv[v[c]]);
+            const float ndb = ndv[v[c]] + tb * (ndv[v[b]] - ndv[v[c]]);
+            const float sca = sc[v[c]] + ta * (sc[v[a]] - sc[v[c]]);
+            const float scb = sc[v[c]] + tb * (sc[v[b]] - sc[v[c]]);
+            const float nd = 0.5f * (nda + ndb), num = 0.5f * (sca + scb);
+            if (!(nd > 0.0f) || !(num > sc_thresh * nd))
+                continue;
+            strength = fade > 0.0f ? min(1.0f, nd / fade) : 1.0f;
+        }
+        const uint o = atomic_inc(counter);
+        if (o < cap) {
+            for (uint i = 0; i < 6; ++i)
+                seg[8 * o + i] = p[i];
+            seg[8 * o + 6] = (float)kind;
+            seg[8 * o + 7] = strength;
+        }
+    }
+}

@@ -1,0 +1,192 @@
+//! Host wiring of `kernels/feature_lines.cl`: occluding and suggestive
+//! contours of a mesh with curvature, per view. The faces are uploaded once;
+//! each call uploads the per-vertex inputs and runs `lines_vertex` and
+//! `lines_face`. The segment buffer holds two segments per face (one of each
+//! kind), the most a face can emit, and the kernel still counts and refuses
+//! what does not fit. CPU twin: [`crate::cpu::feature_lines`].
+
+use crate::cpu::feature_lines::{LineInputs, Segment, View};
+use crate::error::{Error, Result};
+use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use opencl3::kernel::Kernel;
+use opencl3::memory::Buffer;
+use std::sync::Arc;
+
+/// Which lines to extract and their thresholds.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct LineOptions {
+    /// Occluding contours.
+    pub contours: bool,
+    /// Suggestive contours.
+    pub suggestive: bool,
+    /// Suggestive-contour threshold, dimensionless: segments are kept where
+    /// sinθ·D_w κr · s² > `threshold` · n·v, with s the mesh's feature size.
+    pub threshold: f32,
+    /// n·v below which suggestive contours fade (strength = n·v / fade).
+    pub fade: f32,
+}
+
+impl Default for LineOptions {
+    fn default() -> Self {
+        LineOptions {
+            contours: true,
+            suggestive: true,
+            threshold: 0.05,
+            fade: 0.2,
+        }
+    }
+}
+
+/// Kernel times and counts of one extraction.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct LineStats {
+    /// Segments found.
+    pub segments: usize,
+    /// Kernel ms of `lines_vertex`.
+    pub vertex_ms: f64,
+    /// Kernel ms of `lines_face`.
+    pub face_ms: f64,
+}
+
+/// Extracts lines of one mesh topology.
+pub struct LineExtractor {
+    gpu: Arc<Gpu>,
+    nv: usize,
+    nf: usize,
+    vertex: Kernel,
+    face: Kernel,
+    faces: Buffer<u32>,
+    inputs: [Buffer<f32>; 6],
+    terms: [Buffer<f32>; 3],
+    seg: Buffer<f32>,
+    counter: Buffer<u32>,
+}
+
+impl LineExtractor {
+    /// Uploads the faces and allocates the buffers.
+    pub fn new(gpu: Arc<Gpu>, n_vertices: usize, faces: &[[u32; 3]]) -> Result<Self> {
+        crate::mesh::check_faces(n_vertices, faces, "feature lines")?;
+        let file = kernel_file("feature_lines").expect("feature_lines kernels are embedded");
+        let p = gpu.program(&file, "")?;
+        let mut fb = gpu.buffer::<u32>(3 * faces.len())?;
+        gpu.write(&mut fb, faces.as_flattened())?;
+        let nv = n_vertices;
+        Ok(LineExtractor {
+            vertex: gpu.kernel(&p, "lines_vertex")?,
+            face: gpu.kernel(&p, "lines_face")?,
+            faces: fb,
+            inputs: [
+                gpu.buffer(3 * nv)?,
+                gpu.buffer(3 * nv)?,
+                gpu.buffer(3 * nv)?,
+                gpu.buffer(3 * nv)?,
+                gpu.buffer(2 * nv)?,
+                gpu.buffer(4 * nv)?,
+            ],
+            terms: [gpu.buffer(nv)?, gpu.buffer(nv)?, gpu.buffer(nv)?],
+            seg: gpu.buffer(16 * faces.len())?,
+            counter: gpu.buffer(1)?,
+            gpu,
+            nv,
+            nf: faces.len(),
+        })
+    }
+
+    /// Extracts the lines of `x` seen from `view`. `feature_size` (world
+    /// units, > 0) scales the suggestive threshold.
+    pub fn extract(
+        &mut self,
+        x: &LineInputs,
+        view: View,
+        feature_size: f32,
+        opts: LineOptions,
+    ) -> Result<(Vec<Segment>, LineStats)> {
+        let n = self.nv;
+        if [
+            x.pos.len(),
+            x.nrm.len(),
+            x.d1.len(),
+            x.d2.len(),
+            x.k.len(),
+            x.dk.len(),
+        ]
+        .iter()
+        .any(|&l| l != n)
+        {
+            return Err(Error::InvalidArgument(format!(
+                "feature lines: every per-vertex input needs {n} entries"
+            )));
+        }
+        if view.eye.iter().any(|c| !c.is_finite()) || (view.ortho && view.eye == [0.0; 3]) {
+            return Err(Error::InvalidArgument(format!(
+                "feature lines: invalid view {:?} (finite eye; a non-zero direction when orthographic)",
+                view.eye
+            )));
+        }
+        if !(feature_size.is_finite() && feature_size > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "feature size must be finite and positive, got {feature_size}"
+            )));
+        }
+        let g = self.gpu.clone();
+        g.write(&mut self.inputs[0], x.pos.as_flattened())?;
+        g.write(&mut self.inputs[1], x.nrm.as_flattened())?;
+        g.write(&mut self.inputs[2], x.d1.as_flattened())?;
+        g.write(&mut self.inputs[3], x.d2.as_flattened())?;
+        g.write(&mut self.inputs[4], x.k.as_flattened())?;
+        g.write(&mut self.inputs[5], x.dk.as_flattened())?;
+        g.write(&mut self.counter, &[0])?;
+        let [ex, ey, ez] = view.eye;
+        let mut args: Vec<Arg> = vec![Arg::U32(n as u32)];
+        args.extend(self.inputs.iter().map(buf));
+        args.extend([
+            Arg::F32(ex),
+            Arg::F32(ey),
+            Arg::F32(ez),
+            Arg::U32(u32::from(view.ortho)),
+        ]);
+        args.extend(self.terms.iter().map(buf));
+        let e1 = launch(&g, &self.vertex, n, &args)?;
+        let cap = 2 * self.nf;
+        let e2 = launch(
+            &g,
+            &self.face,
+            self.nf,
+            &[
+                Arg::U32(self.nf as u32),
+                buf(&self.faces),
+                buf(&self.inputs[0]),
+                buf(&self.terms[0]),
+                buf(&self.terms[1]),
+                buf(&self.terms[2]),
+                Arg::U32(u32::from(opts.contours)),
+                Arg::U32(u32::from(opts.suggestive)),
+                Arg::F32(opts.threshold / (feature_size * feature_size)),
+                Arg::F32(opts.fade),
+                Arg::U32(cap as u32),
+                buf(&self.seg),
+                buf(&self.counter),
+            ],
+        )?;
+        let mut c = [0u32];
+        g.read(&self.counter, &mut c)?;
+        let found = c[0] as usize;
+        if found > cap {
+            return Err(Error::InvalidArgument(format!(
+                "internal: {found} segments for {cap} slots; nothing was written past the buffer"
+            )));
+        }
+        let mut raw = vec![0f32; 8 * found];
+        g.read(&self.seg, &mut raw)?;
+        let segs = raw
+            .chunks_exact(8)
+            .map(|s| ([s[0], s[1], s[2]], [s[3], s[4], s[5]], s[6] as u32, s[7]))
+            .collect();
+        let stats = LineStats {
+            segments: found,
+            vertex_ms: e1.as_ref().map(event_ms).unwrap_or(0.0),
+            face_ms: e2.as_ref().map(event_ms).unwrap_or(0.0),
+        };
+        Ok((segs, stats))
+    }
+}

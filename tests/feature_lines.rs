@@ -1,0 +1,305 @@
+//! Feature lines: occluding contours of a torus against the analytic
+//! silhouettes (orthographic views along and across its axis), the device
+//! against the CPU twin (torus and bunny, both kinds of line), and nasty
+//! views (eye on the surface, inside the mesh) giving finite segments.
+
+use shapecue::cpu::feature_lines::{LineInputs, Segment, View, lines_face, lines_vertex};
+use shapecue::field::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use shapecue::gpu::Gpu;
+use shapecue::mesh::{self, Mesh};
+use shapecue::stages::curvature::estimate;
+use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
+use std::sync::{Arc, OnceLock};
+
+fn gpu() -> Arc<Gpu> {
+    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
+    GPU.get_or_init(|| Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)")))
+        .clone()
+}
+
+struct F32 {
+    pos: Vec<[f32; 3]>,
+    nrm: Vec<[f32; 3]>,
+    d1: Vec<[f32; 3]>,
+    d2: Vec<[f32; 3]>,
+    k: Vec<[f32; 2]>,
+    dk: Vec<[f32; 4]>,
+}
+
+fn inputs(m: &Mesh) -> F32 {
+    let opts = CurvatureOptions {
+        accumulate: Accumulate::Gather,
+        precision: Precision::F64,
+        compat: Compat::Exact,
+        dcurv: true,
+    };
+    let f: CurvatureField = estimate(gpu(), m, opts).unwrap().field;
+    let c3 = |v: &Vec<[f64; 3]>| v.iter().map(|p| p.map(|c| c as f32)).collect();
+    F32 {
+        pos: c3(&m.positions),
+        nrm: c3(&f.normals),
+        d1: c3(&f.d1),
+        d2: c3(&f.d2),
+        k: f.k1
+            .iter()
+            .zip(&f.k2)
+            .map(|(a, b)| [*a as f32, *b as f32])
+            .collect(),
+        dk: f.dk.iter().map(|d| d.map(|c| c as f32)).collect(),
+    }
+}
+
+fn li(x: &F32) -> LineInputs<'_> {
+    LineInputs {
+        pos: &x.pos,
+        nrm: &x.nrm,
+        d1: &x.d1,
+        d2: &x.d2,
+        k: &x.k,
+        dk: &x.dk,
+    }
+}
+
+fn device(m: &Mesh, x: &F32, view: View, opts: LineOptions) -> Vec<Segment> {
+    let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
+    ex.extract(&li(x), view, 1.0, opts).unwrap().0
+}
+
+/// Every device segment has a CPU segment of the same kind with the same
+/// endpoints (1e-5), and vice versa; f32 rounding differences (fused
+/// multiply-adds on the device) may flip a face whose n·v is within rounding
+/// of 0, so up to 0.5 % may be unmatched.
+fn same(dev: Vec<Segment>, cpu: Vec<Segment>, what: &str) {
+    let close = |a: &Segment, b: &Segment| {
+        let d = |p: [f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-5);
+        a.2 == b.2
+            && (d(a.0, b.0) && d(a.1, b.1) || d(a.0, b.1) && d(a.1, b.0))
+            && (a.3 - b.3).abs() < 1e-4
+    };
+    let key = |s: &Segment| (s.0[0] + s.1[0]) * 0.5;
+    let mut c = cpu.clone();
+    c.sort_by(|a, b| key(a).total_cmp(&key(b)));
+    let mut used = vec![false; c.len()];
+    let mut unmatched = 0;
+    for d in &dev {
+        let k = key(d);
+        let start = c.partition_point(|s| key(s) < k - 1e-4);
+        let hit = (start..c.len())
+            .take_while(|&i| key(&c[i]) <= k + 1e-4)
+            .find(|&i| !used[i] && close(d, &c[i]));
+        match hit {
+            Some(i) => used[i] = true,
+            None => unmatched += 1,
+        }
+    }
+    let allowed = (cpu.len() / 200).max(1);
+    assert!(
+        unmatched <= allowed,
+        "{what}: {unmatched} of {} device segments unmatched",
+        dev.len()
+    );
+    assert!(
+        dev.len().abs_diff(cpu.len()) <= allowed,
+        "{what}: {} vs {} segments",
+        dev.len(),
+        cpu.len()
+    );
+}
+
+#[test]
+fn torus_contours_lie_on_the_analytic_silhouettes() {
+    let m = mesh::torus(1.0, 0.4, 160, 80);
+    let x = inputs(&m);
+    let contours = LineOptions {
+        contours: true,
+        suggestive: false,
+        ..Default::default()
+    };
+    // Along the axis: the outer and inner equators (radius 1.4 and 0.6, z = 0).
+    let s = device(
+        &m,
+        &x,
+        View {
+            eye: [0.0, 0.0, 1.0],
+            ortho: true,
+        },
+        contours,
+    );
+    assert!(s.len() > 300, "{}", s.len());
+    for (a, b, kind, _) in &s {
+        assert_eq!(*kind, 0);
+        for p in [a, b] {
+            let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+            assert!(p[2].abs() < 0.01, "{p:?}");
+            assert!(
+                (rho - 1.4).abs() < 0.01 || (rho - 0.6).abs() < 0.01,
+                "{p:?}"
+            );
+        }
+    }
+    // Across the axis (view along x): n·x = cos v cos u = 0, the circles in
+    // the plane x = 0 and the top and bottom circles z = ±0.4.
+    let s = device(
+        &m,
+        &x,
+        View {
+            eye: [1.0, 0.0, 0.0],
+            ortho: true,
+        },
+        contours,
+    );
+    assert!(s.len() > 300);
+    for (a, b, _, _) in &s {
+        for p in [a, b] {
+            assert!(
+                p[0].abs() < 0.01 || (p[2].abs() - 0.4).abs() < 0.01,
+                "{p:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn device_matches_cpu_twin() {
+    let torus = mesh::torus(1.0, 0.4, 120, 60);
+    let bunny_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/meshes/stanford-bunny.obj");
+    let mut meshes = vec![("torus", torus)];
+    if bunny_path.exists() {
+        meshes.push((
+            "bunny",
+            mesh::load(&bunny_path, &Default::default()).unwrap(),
+        ));
+    } else {
+        eprintln!("skipping the bunny: {} not found", bunny_path.display());
+    }
+    for (name, m) in meshes {
+        let x = inputs(&m);
+        let (lo, hi) = m.bounds();
+        let c: [f32; 3] = std::array::from_fn(|i| (0.5 * (lo[i] + hi[i])) as f32);
+        let d = (0..3).map(|i| (hi[i] - lo[i]) as f32).fold(0.0, f32::max);
+        let opts = LineOptions {
+            threshold: 0.0,
+            ..Default::default()
+        };
+        for view in [
+            View {
+                eye: [c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d],
+                ortho: false,
+            },
+            View {
+                eye: [0.3, 1.0, 0.2],
+                ortho: true,
+            },
+        ] {
+            let dev = device(&m, &x, view, opts);
+            let t = lines_vertex(&li(&x), view);
+            let cpu = lines_face(&m.faces, &x.pos, &t, [true, true], 0.0, opts.fade);
+            assert!(
+                cpu.iter().any(|s| s.2 == 0) && cpu.iter().any(|s| s.2 == 1),
+                "{name}: both kinds"
+            );
+            same(dev, cpu, name);
+        }
+    }
+}
+
+#[test]
+fn suggestive_contours_respect_the_threshold_and_facing() {
+    let m = mesh::torus(1.0, 0.4, 120, 60);
+    let x = inputs(&m);
+    let view = View {
+        eye: [3.0, 0.5, 1.5],
+        ortho: false,
+    };
+    let only_sc = |t: f32| LineOptions {
+        contours: false,
+        suggestive: true,
+        threshold: t,
+        fade: 0.2,
+    };
+    let loose = device(&m, &x, view, only_sc(0.0));
+    let strict = device(&m, &x, view, only_sc(0.5));
+    assert!(!loose.is_empty());
+    assert!(
+        strict.len() < loose.len(),
+        "{} vs {}",
+        strict.len(),
+        loose.len()
+    );
+    assert!(loose.iter().all(|s| s.2 == 1 && s.3 > 0.0 && s.3 <= 1.0));
+    // A sphere is convex everywhere: radial curvature never crosses zero.
+    let sphere = mesh::icosphere(1.0, 4);
+    let xs = inputs(&sphere);
+    assert!(device(&sphere, &xs, view, only_sc(0.0)).is_empty());
+}
+
+#[test]
+fn nasty_views_give_finite_segments_or_clear_errors() {
+    let m = mesh::icosphere(1.0, 3);
+    let x = inputs(&m);
+    let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
+    let opts = LineOptions::default();
+    // Eye exactly on a vertex, and inside the sphere.
+    for eye in [x.pos[0], [0.1, 0.0, 0.0]] {
+        let (s, _) = ex
+            .extract(&li(&x), View { eye, ortho: false }, 1.0, opts)
+            .unwrap();
+        assert!(
+            s.iter()
+                .all(|s| s.0.iter().chain(&s.1).all(|c| c.is_finite()))
+        );
+    }
+    assert!(
+        ex.extract(
+            &li(&x),
+            View {
+                eye: [f32::NAN, 0.0, 0.0],
+                ortho: false
+            },
+            1.0,
+            opts
+        )
+        .is_err()
+    );
+    assert!(
+        ex.extract(
+            &li(&x),
+            View {
+                eye: [0.0; 3],
+                ortho: true
+            },
+            1.0,
+            opts
+        )
+        .is_err()
+    );
+    assert!(
+        ex.extract(
+            &li(&x),
+            View {
+                eye: [0.0, 0.0, 5.0],
+                ortho: false
+            },
+            0.0,
+            opts
+        )
+        .is_err()
+    );
+    let short = F32 {
+        pos: x.pos[..3].to_vec(),
+        ..inputs(&m)
+    };
+    assert!(
+        ex.extract(
+            &li(&short),
+            View {
+                eye: [0.0, 0.0, 5.0],
+                ortho: false
+            },
+            1.0,
+            opts
+        )
+        .is_err()
+    );
+}
