@@ -5,5 +5,7 @@
 pub mod curvature;
 pub mod feature_lines;
 pub mod marching_cubes;
+pub mod radix_sort;
+pub mod scan;
 pub mod skinning;
 pub mod vertex_fusion;

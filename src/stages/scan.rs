@@ -34,13 +34,7 @@ pub fn chunking(n: usize) -> (usize, usize) {
     if n == 0 {
         return (0, 0);
     }
-    let e = |k: &str, d: usize| {
-        std::env::var(k)
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(d)
-    };
-    let chunk = n.div_ceil(e("MAXC", MAX_CHUNKS)).max(e("MINC", MIN_CHUNK));
+    let chunk = n.div_ceil(MAX_CHUNKS).max(MIN_CHUNK);
     (chunk, n.div_ceil(chunk))
 }
 
@@ -90,7 +84,7 @@ impl Scan {
             block_sums: gpu.kernel(&program, "scan_block_sums")?,
             partials_kernel: gpu.kernel(&program, "scan_partials")?,
             apply: gpu.kernel(&program, "scan_apply")?,
-            partials: gpu.buffer::<u64>(65536)?,
+            partials: gpu.buffer::<u64>(MAX_CHUNKS)?,
             total: gpu.buffer::<u64>(1)?,
             gpu,
             last_ms: 0.0,
