@@ -3,5 +3,6 @@
 //! oracles the tests compare the device with.
 
 pub mod curvature;
+pub mod edges;
 pub mod marching_cubes;
 pub mod vertex_fusion;
