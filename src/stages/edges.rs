@@ -501,3 +501,156 @@ impl<'g> EdgeStage<'g> {
         Ok(out)
     }
 }
+
+/// A camera for the edges CLI and tables: perspective with vertical field of
+/// view `fov_deg`, or orthographic showing the height the perspective view
+/// would show at the target; near and far hug the bounding sphere of
+/// `bounds` (near = 1/1000 of the radius when the eye is inside it).
+pub fn camera_for(
+    eye: glam::Vec3,
+    target: glam::Vec3,
+    up: Option<glam::Vec3>,
+    fov_deg: f32,
+    ortho: bool,
+    bounds: ([f64; 3], [f64; 3]),
+) -> Result<Camera> {
+    let (lo, hi) = bounds;
+    let lo = glam::DVec3::from(lo).as_vec3();
+    let hi = glam::DVec3::from(hi).as_vec3();
+    let centre = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-6);
+    let mut cam = Camera::look_at(eye, target);
+    if let Some(u) = up {
+        cam.up = u;
+    }
+    cam.fov_y_deg = fov_deg;
+    let d = eye.distance(centre);
+    cam.near = ((d - radius) * 0.9).max(1e-3 * radius);
+    cam.far = (d + radius) * 1.1 + cam.near;
+    if ortho {
+        let dist = eye.distance(target);
+        cam.ortho_height = Some(2.0 * dist * (0.5 * fov_deg.to_radians()).tan());
+        // Orthographic: nothing is behind the eye, so near can sit at the sphere.
+        cam.near = (d - radius).max(1e-3 * radius) * 0.9;
+    }
+    cam.validate()?;
+    Ok(cam)
+}
+
+/// Draws the edge quads of `out` and the caps it holds (those of the last
+/// run's mode) with flat `color` into the frame in progress.
+pub fn draw(r: &mut crate::render::Renderer, out: &EdgeOutput, color: [f32; 4]) -> Result<()> {
+    r.draw_clip_quads(&out.edge_out, color)?;
+    r.draw_clip_triangles(&out.cap_mh0, color)?;
+    r.draw_clip_triangles(&out.cap_mh1, color)?;
+    r.draw_clip_quads(&out.cap_adj, color)
+}
+
+/// How closely one cap variant's stroke matches the ideal round-joined stroke.
+#[derive(Clone, Debug, Serialize)]
+pub struct CapQuality {
+    /// The cap variant.
+    pub mode: CapMode,
+    /// Pixels of the ideal stroke.
+    pub ideal: usize,
+    /// Pixels the renderer covered (edges and caps, no mesh, no MSAA).
+    pub rendered: usize,
+    /// Ideal covered, rendered not.
+    pub gap: usize,
+    /// Rendered, ideal not.
+    pub extra: usize,
+}
+
+/// The ideal stroke of the drawn edges of `edge_out`: pixels whose centre is
+/// within `half_width` pixels of a projected edge (the union of discs along
+/// every edge), `width × height`, row 0 at the top.
+pub fn ideal_coverage(
+    edge_out: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    half_width: f32,
+) -> Vec<bool> {
+    let (w, h) = (width as usize, height as usize);
+    let mut cov = vec![false; w * h];
+    let px = |a: [f32; 4], b: [f32; 4]| {
+        let (x, y, cw) = (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), a[3]);
+        [
+            (x / cw * 0.5 + 0.5) * w as f32,
+            (0.5 - y / cw * 0.5) * h as f32,
+        ]
+    };
+    for q in edge_out.chunks_exact(4) {
+        if q[0][0].is_nan() || !q.iter().flatten().all(|c| c.is_finite()) {
+            continue;
+        }
+        let (a, b) = (px(q[0], q[3]), px(q[1], q[2]));
+        let r = half_width;
+        let x0 = (a[0].min(b[0]) - r).floor().max(0.0) as usize;
+        let x1 = ((a[0].max(b[0]) + r).ceil().max(0.0) as usize).min(w);
+        let y0 = (a[1].min(b[1]) - r).floor().max(0.0) as usize;
+        let y1 = ((a[1].max(b[1]) + r).ceil().max(0.0) as usize).min(h);
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let dd = d[0] * d[0] + d[1] * d[1];
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let p = [x as f32 + 0.5 - a[0], y as f32 + 0.5 - a[1]];
+                let t = if dd > 0.0 {
+                    ((p[0] * d[0] + p[1] * d[1]) / dd).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (ex, ey) = (p[0] - t * d[0], p[1] - t * d[1]);
+                if ex * ex + ey * ey <= r * r {
+                    cov[y * w + x] = true;
+                }
+            }
+        }
+    }
+    cov
+}
+
+/// Cap quality of every variant for one mesh and view: runs the stage,
+/// renders only the edges and caps (black on white, no MSAA) and compares the
+/// covered pixels with [`ideal_coverage`] (constant width: `depth_scale` is ignored).
+pub fn cap_quality(
+    gpu: &Gpu,
+    mesh: &Mesh,
+    topo: &EdgeTopology,
+    params: &EdgeParams,
+) -> Result<Vec<CapQuality>> {
+    use crate::render::{RenderOptions, Renderer};
+    let mut p = *params;
+    p.depth_scale = None;
+    let mut stage = EdgeStage::new(gpu, mesh, topo)?;
+    let mut r = Renderer::new(RenderOptions {
+        width: p.width,
+        height: p.height,
+        msaa: 0,
+        background: [1.0; 4],
+    })?;
+    let mut rows = Vec::new();
+    for mode in CapMode::ALL {
+        stage.run(&p, mode)?;
+        let out = stage.read()?;
+        r.begin(&p.camera)?;
+        draw(&mut r, &out, [0.0, 0.0, 0.0, 1.0])?;
+        let frame = r.finish()?;
+        let ideal = ideal_coverage(&out.edge_out, p.width, p.height, 0.5 * p.line_width);
+        let mut q = CapQuality {
+            mode,
+            ideal: 0,
+            rendered: 0,
+            gap: 0,
+            extra: 0,
+        };
+        for (i, &want) in ideal.iter().enumerate() {
+            let got = frame.rgba[4 * i] < 128;
+            q.ideal += want as usize;
+            q.rendered += got as usize;
+            q.gap += (want && !got) as usize;
+            q.extra += (got && !want) as usize;
+        }
+        rows.push(q);
+    }
+    Ok(rows)
+}
