@@ -516,3 +516,186 @@ fn shared_meshes_match_the_cpu() {
         compare(&m, &t, &p, mode);
     }
 }
+
+// ---- command line (GL needed for rendering; skipped without EGL) ----
+
+fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_shapecue"))
+}
+
+fn tmpdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("shapecue-edges-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A unit cube as OBJ text (8 shared vertices, 12 triangles).
+fn cube_obj() -> String {
+    let m = mesh::cube(1.0);
+    let mut s = String::new();
+    for p in &m.positions {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in &m.faces {
+        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    s
+}
+
+fn gl_missing(out: &std::process::Output) -> bool {
+    let err = String::from_utf8_lossy(&out.stderr);
+    if err.contains("no headless OpenGL") && std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() {
+        eprintln!("skipping GL part: {err}");
+        return true;
+    }
+    false
+}
+
+#[test]
+fn cli_renders_png_svg_and_stats() {
+    let d = tmpdir("render");
+    let obj = d.join("cube.obj");
+    std::fs::write(&obj, cube_obj()).unwrap();
+    let (png, svg, json) = (d.join("c.png"), d.join("c.svg"), d.join("c.json"));
+    let out = bin()
+        .args([
+            "edges",
+            obj.to_str().unwrap(),
+            "--eye",
+            "3,2,4",
+            "--caps",
+            "adjacency",
+            "--width",
+            "6",
+        ])
+        .args([
+            "--size",
+            "200x150",
+            "-o",
+            png.to_str().unwrap(),
+            "--svg",
+            svg.to_str().unwrap(),
+        ])
+        .args(["--stats", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    if gl_missing(&out) {
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (200, 150));
+    assert!(
+        img.pixels().filter(|p| p[0] < 40).count() > 100,
+        "black edge pixels"
+    );
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(s["edges"], 18);
+    assert_eq!(s["crease"], 12);
+    assert_eq!(s["interop"]["shared"], false);
+    assert!(
+        s["interop"]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("host path")
+    );
+    // From (3,2,4), 9 of the cube's 12 edges are visible (the 3 at the far corner are hidden).
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("stroke-width=\"6\""));
+    let n = s["svg_polylines"].as_u64().unwrap();
+    assert!((1..=9).contains(&n), "{n} polylines");
+    let pts: usize = text
+        .lines()
+        .filter(|l| l.starts_with("<polyline"))
+        .map(|l| l.matches(',').count())
+        .sum();
+    assert!(
+        pts >= 9 + n as usize,
+        "visible edges joined into polylines: {pts} points"
+    );
+    // The output exists now: refused without --force.
+    let again = bin()
+        .args([
+            "edges",
+            obj.to_str().unwrap(),
+            "--eye",
+            "3,2,4",
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+}
+
+#[test]
+fn cli_bad_input_is_a_clear_error() {
+    let d = tmpdir("bad");
+    let obj = d.join("cube.obj");
+    std::fs::write(&obj, cube_obj()).unwrap();
+    let png = d.join("x.png");
+    let run = |extra: &[&str]| {
+        let out = bin()
+            .args(["edges", obj.to_str().unwrap(), "-o", png.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (code, err) = run(&["--eye", "5,5,5", "--interop", "on"]);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("cl_khr_gl_sharing"), "{err}");
+    let (code, err) = run(&["--eye", "5,5,5", "--caps", "round"]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("unknown cap mode \"round\""), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--width", "0"]);
+    assert!(err.contains("--width 0"), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--width", "-3"]);
+    assert!(err.contains("--width -3"), "{err}");
+    let (_, err) = run(&["--eye", "0,0,0", "--target", "0,0,0"]);
+    assert!(err.contains("coincide"), "{err}");
+    let (_, err) = run(&["--eye", "NaN,0,1"]);
+    assert!(err.contains("--eye"), "{err}");
+    let (_, err) = run(&["--eye", "1,2"]);
+    assert!(err.contains("three finite numbers"), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--size", "0x10"]);
+    assert!(err.contains("--size"), "{err}");
+    let marks = d.join("marks.txt");
+    std::fs::write(&marks, "0 1\n0 7\n").unwrap();
+    let (_, err) = run(&["--eye", "5,5,5", "--marked", marks.to_str().unwrap()]);
+    assert!(
+        err.contains("marks.txt: marked edge 2 (0, 7): not an edge"),
+        "{err}"
+    );
+    std::fs::write(&marks, "0 1\nzero one\n").unwrap();
+    let (_, err) = run(&["--eye", "5,5,5", "--marked", marks.to_str().unwrap()]);
+    assert!(err.contains("marks.txt: line 2"), "{err}");
+    assert!(!png.exists());
+}
+
+#[test]
+fn cli_memory_table_lists_the_generated_meshes() {
+    let out = bin().args(["edges", "--memory-table"]).output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    let cube = s.lines().find(|l| l.starts_with("cube")).unwrap();
+    let f: Vec<u64> = cube
+        .split_whitespace()
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(f[0], 18);
+    assert_eq!(f[2], 18 * 21 * 32);
+    for name in ["cylinder", "cone", "icosphere"] {
+        assert!(s.contains(name), "{s}");
+    }
+}

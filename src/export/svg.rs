@@ -6,7 +6,11 @@
 //! taken from the midpoints of its quad ends, i.e. the projected edge, and
 //! sampled about once per pixel in screen space (NDC depth is affine in screen
 //! space along a projected line). A sample is visible when it lies in the image
-//! and its window depth is at most the depth buffer's value plus `bias`; the
+//! and its window depth is at most the farthest depth of the 3×3 pixels around
+//! it (faces beside a crease may be nearer than the edge a fraction of a pixel
+//! away) plus `bias` plus
+//! the edge's depth change over 1.5 pixels (the stored sample need not sit
+//! at the pixel centre); the
 //! edge quads were drawn into that depth buffer, so an unoccluded edge sees its
 //! own depth there.
 
@@ -42,6 +46,9 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
         let (s0, s1) = (to_px(q[0], q[3]), to_px(q[1], q[2]));
         let len = ((s1[0] - s0[0]).powi(2) + (s1[1] - s0[1]).powi(2)).sqrt();
         let n = (len.ceil() as usize).clamp(1, 1 << 16);
+        // The depth buffer holds one (multi)sample per pixel, up to a pixel away
+        // from the sample point: allow the edge's depth change over 1.5 pixels.
+        let bias = bias + 1.5 * (s1[2] - s0[2]).abs() / len.max(1.0);
         let at = |i: usize| {
             let t = i as f32 / n as f32;
             [
@@ -52,13 +59,23 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
         };
         let visible = |p: [f32; 3]| {
             let (x, y) = (p[0].floor(), p[1].floor());
-            x >= 0.0
-                && y >= 0.0
-                && x < w
-                && y < h
-                && frame
-                    .depth_at(x as u32, y as u32)
-                    .is_some_and(|d| p[2] <= d + bias)
+            if !(x >= 0.0 && y >= 0.0 && x < w && y < h) {
+                return false;
+            }
+            // The faces beside a crease can be nearer than the edge a fraction of
+            // a pixel away (the mesh's polygon offset is only a slope's worth):
+            // the farthest depth of the 3×3 neighbourhood decides.
+            let (x, y) = (x as i64, y as i64);
+            let mut far = 0f32;
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if let Some(d) = frame.depth_at((x + dx).max(0) as u32, (y + dy).max(0) as u32)
+                    {
+                        far = far.max(d);
+                    }
+                }
+            }
+            p[2] <= far + bias
         };
         let mut start: Option<usize> = None;
         for i in 0..=n {
