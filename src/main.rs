@@ -40,6 +40,11 @@ enum Cmd {
     /// Isosurface of a volume (marching cubes with vertex fusion on the
     /// device), optionally with curvature computed on the device right after.
     Isosurface(IsoArgs),
+    /// Object-space feature edges with caps (House & Li, seed 002): renders the
+    /// mesh, then contour, crease and boundary/marked edges as thick quads with
+    /// caps, to PNG (and SVG). Exit code 3: `--interop on` on a device without
+    /// cl_khr_gl_sharing (such as PoCL); 1: any other error.
+    Edges(EdgesArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -47,6 +52,103 @@ enum NormalsArg {
     Gradient,
     Mesh,
 }
+
+#[derive(Clone, Copy, ValueEnum)]
+enum CapsArg {
+    None,
+    Mh,
+    Adjacency,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum InteropArg {
+    Auto,
+    On,
+    Off,
+}
+
+#[derive(Args)]
+struct EdgesArgs {
+    /// Input mesh (.obj, .ply, .off).
+    #[arg(required_unless_present_any = ["cap_quality", "memory_table"])]
+    mesh: Option<PathBuf>,
+    /// Eye position, e.g. 5,5,5.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 1,
+        allow_negative_numbers = true
+    )]
+    eye: Option<Vec<f32>>,
+    /// Point looked at (default: the centre of the mesh's bounding box).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    target: Option<Vec<f32>>,
+    /// Up direction (default +Y, or +Z when looking along Y).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    up: Option<Vec<f32>>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 40.0)]
+    fov: f32,
+    /// Orthographic projection (showing the height the perspective view shows at the target).
+    #[arg(long)]
+    ortho: bool,
+    /// Caps filling the gaps between thick edges: none, mh (McGuire-Hughes
+    /// half-caps from vertex normals) or adjacency (House & Li).
+    #[arg(long, default_value = "adjacency")]
+    caps: String,
+    /// Edge width in pixels.
+    #[arg(long, default_value_t = 4.0, allow_negative_numbers = true)]
+    width: f32,
+    /// Crease angle in degrees: edges whose face normals differ by more than
+    /// this are creases (a cube's edges at 90°); 180 or more finds none.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    crease: f32,
+    /// Depth-scaled width: width × max(1, K/w), w the clip-space depth.
+    #[arg(long, allow_negative_numbers = true)]
+    depth_scale: Option<f32>,
+    /// Marked edges: a text file with one pair of 0-based vertex indices per line.
+    #[arg(long)]
+    marked: Option<PathBuf>,
+    /// Image size, e.g. 800x600.
+    #[arg(long, default_value = "800x600")]
+    size: String,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also write the visible edges as SVG polylines.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Write statistics (edge counts, timings, memory, interop path) as JSON.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    force: bool,
+    /// CL-GL buffer sharing: auto (share when the device reports
+    /// cl_khr_gl_sharing, else copy through the host), on (require it: exit
+    /// code 3 without the extension), off (host path).
+    #[arg(long, value_enum, default_value = "auto")]
+    interop: InteropArg,
+    /// Print the cap-quality table (gap and extra pixels against the ideal
+    /// round-joined stroke) for the standard meshes instead.
+    #[arg(long)]
+    cap_quality: bool,
+    /// Print the memory table (bits per mesh for each cap variant) instead.
+    #[arg(long)]
+    memory_table: bool,
+}
+
+/// `--interop on` without cl_khr_gl_sharing: exit code 3.
+#[derive(Debug)]
+struct InteropRefused(shapecue::Error);
+
+impl std::fmt::Display for InteropRefused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for InteropRefused {}
 
 #[derive(Clone, Copy, ValueEnum)]
 enum FusionArg {
@@ -198,7 +300,12 @@ struct CurvatureArgs {
 fn main() {
     if let Err(e) = run() {
         eprintln!("error: {e:#}");
-        std::process::exit(1);
+        let code = if e.downcast_ref::<InteropRefused>().is_some() {
+            3
+        } else {
+            1
+        };
+        std::process::exit(code);
     }
 }
 
@@ -208,6 +315,7 @@ fn run() -> Result<()> {
         Cmd::Devices { json } => devices(json),
         Cmd::Curvature(a) => curvature(cli.device.as_deref(), a),
         Cmd::Isosurface(a) => isosurface(cli.device.as_deref(), a),
+        Cmd::Edges(a) => edges(cli.device.as_deref(), a),
     }
 }
 
@@ -563,6 +671,265 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         std::fs::write(path, serde_json::to_string_pretty(&s)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
+        }
+        Some(v) => bail!("--{what} needs three finite numbers X,Y,Z, got {v:?}"),
+    }
+}
+
+fn size_arg(s: &str) -> Result<(u32, u32)> {
+    let parsed = s
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => Ok((w, h)),
+        _ => bail!("--size {s:?}: expected WIDTHxHEIGHT with both in 1..=16384, e.g. 800x600"),
+    }
+}
+
+/// The meshes of seed 002's tables: generated cube, cylinder, cone and
+/// icosphere, and the shared teapot and bunny when present; all unit-sized.
+fn table_meshes() -> Vec<(String, Mesh)> {
+    use shapecue::mesh as g;
+    let mut v = vec![
+        ("cube".to_string(), g::cube(1.0)),
+        ("cylinder".to_string(), g::capped_cylinder(0.5, 1.0, 32)),
+        ("cone".to_string(), g::cone(0.5, 1.0, 32)),
+        ("icosphere".to_string(), g::icosphere(0.5, 3)),
+    ];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
+    for (name, file) in [("teapot", "teapot.obj"), ("bunny", "stanford-bunny.obj")] {
+        let p = dir.join(file);
+        match shapecue::mesh::load(&p, &LoadOptions::default()) {
+            Ok(m) => v.push((name.to_string(), m)),
+            Err(e) => eprintln!("skipping {name}: {e}"),
+        }
+    }
+    v.into_iter()
+        .map(|(n, m)| (n, shapecue::mesh::unit_sized(&m)))
+        .collect()
+}
+
+fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
+    use shapecue::mesh::edges::{EdgeTopology, read_marked, vertex_normals};
+    use shapecue::render::{MeshStyle, RenderOptions, Renderer};
+    use shapecue::stages::edges::{
+        self as st, CapMode, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
+        KIND_CREASE, KIND_DRAWN,
+    };
+    let mode: CapMode = a.caps.parse()?;
+    let (w, h) = size_arg(&a.size)?;
+    if !(a.width.is_finite() && a.width > 0.0) {
+        bail!(
+            "--width {}: the edge width must be a positive number of pixels",
+            a.width
+        );
+    }
+    let crease = if a.crease >= 180.0 {
+        None
+    } else {
+        Some(a.crease)
+    };
+    if a.crease <= 0.0 || a.crease.is_nan() {
+        bail!(
+            "--crease {}: the crease angle must be in (0, 180] degrees",
+            a.crease
+        );
+    }
+    let mode_interop = match a.interop {
+        InteropArg::Auto => InteropMode::Auto,
+        InteropArg::On => InteropMode::On,
+        InteropArg::Off => InteropMode::Off,
+    };
+    if a.memory_table {
+        println!(
+            "{:<10} {:>8} {:>9} {:>12} {:>12} {:>12}",
+            "mesh", "edges", "caps", "none bits", "mh bits", "adj bits"
+        );
+        for (name, m) in table_meshes() {
+            let t = EdgeTopology::new(&m, &[], &name)?;
+            let bits = |c| {
+                let u = st::memory_use(c, t.edges.len(), t.caps.len());
+                u.edge_bits + u.cap_bits
+            };
+            println!(
+                "{name:<10} {:>8} {:>9} {:>12} {:>12} {:>12}",
+                t.edges.len(),
+                t.caps.len(),
+                bits(CapMode::None),
+                bits(CapMode::Mh),
+                bits(CapMode::Adjacency)
+            );
+        }
+        println!(
+            "(bits of the edge buffer, edge-out and kind, plus each variant's cap buffer and cap-out; 32-bit elements)"
+        );
+        return Ok(());
+    }
+    let gpu = Gpu::new(device)?;
+    let interop = st::decide_interop(mode_interop, gpu.info.gl_sharing, &gpu.info.name)
+        .map_err(|e| anyhow::Error::new(InteropRefused(e)))?;
+    if a.cap_quality {
+        println!(
+            "eye (5,5,5), unit-sized meshes at the origin, {w}x{h}, width {} px, crease {}°",
+            a.width, a.crease
+        );
+        println!(
+            "{:<10} {:<10} {:>8} {:>9} {:>8} {:>8}",
+            "mesh", "caps", "ideal", "rendered", "gap", "extra"
+        );
+        for (name, m) in table_meshes() {
+            let t = EdgeTopology::new(&m, &[], &name)?;
+            let cam = st::camera_for(
+                glam::Vec3::splat(5.0),
+                glam::Vec3::ZERO,
+                None,
+                a.fov,
+                a.ortho,
+                m.bounds(),
+            )?;
+            let mut p = EdgeParams::new(cam, w, h);
+            p.line_width = a.width;
+            p.crease_deg = crease;
+            for q in st::cap_quality(&gpu, &m, &t, &p)? {
+                println!(
+                    "{name:<10} {:<10} {:>8} {:>9} {:>8} {:>8}",
+                    q.mode.name(),
+                    q.ideal,
+                    q.rendered,
+                    q.gap,
+                    q.extra
+                );
+            }
+        }
+        return Ok(());
+    }
+    let path = a.mesh.as_deref().expect("clap requires MESH here");
+    let Some(output) = &a.output else {
+        bail!("give -o OUT.png (or --cap-quality / --memory-table)");
+    };
+    for out in [Some(output), a.svg.as_ref(), a.stats.as_ref()]
+        .into_iter()
+        .flatten()
+    {
+        refuse_overwrite(out, Some(path), a.force)?;
+    }
+    let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
+    let marked = match &a.marked {
+        Some(f) => read_marked(f)?,
+        None => Vec::new(),
+    };
+    let marked_name = a
+        .marked
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    let t_topo = Instant::now();
+    let topo = EdgeTopology::new(&mesh, &marked, &marked_name)?;
+    let topo_ms = t_topo.elapsed().as_secs_f64() * 1e3;
+    let (lo, hi) = mesh.bounds();
+    let centre = glam::Vec3::new(
+        (0.5 * (lo[0] + hi[0])) as f32,
+        (0.5 * (lo[1] + hi[1])) as f32,
+        (0.5 * (lo[2] + hi[2])) as f32,
+    );
+    let Some(eye) = vec3_arg(&a.eye, "eye")? else {
+        bail!("--eye X,Y,Z is required");
+    };
+    let target = vec3_arg(&a.target, "target")?.unwrap_or(centre);
+    let up = vec3_arg(&a.up, "up")?;
+    let cam = st::camera_for(eye, target, up, a.fov, a.ortho, (lo, hi))?;
+    let mut p = EdgeParams::new(cam, w, h);
+    p.line_width = a.width;
+    p.crease_deg = crease;
+    p.depth_scale = a.depth_scale;
+    p.pack()?;
+
+    let t_all = Instant::now();
+    let mut stage = EdgeStage::new(&gpu, &mesh, &topo)?;
+    let timing = stage.run(&p, mode)?;
+    let out = stage.read()?;
+    let mut r = Renderer::new(RenderOptions {
+        width: w,
+        height: h,
+        ..Default::default()
+    })?;
+    r.begin(&cam)?;
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
+    r.draw_mesh(
+        &pos,
+        &vertex_normals(&mesh),
+        &[],
+        &mesh.faces,
+        MeshStyle::default(),
+    )?;
+    st::draw(&mut r, &out, [0.0, 0.0, 0.0, 1.0])?;
+    let frame = r.finish()?;
+    let frame_ms = t_all.elapsed().as_secs_f64() * 1e3;
+    frame.save_png(output)?;
+    let count = |bit: u32| out.kind.iter().filter(|&&k| k & bit != 0).count();
+    println!(
+        "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
+         (contour {}, crease {}, boundary/marked {}); kernels {:.3} ms; wrote {}",
+        path.display(),
+        topo.edges.len(),
+        topo.boundary,
+        topo.non_manifold,
+        topo.marked,
+        topo.caps.len(),
+        count(KIND_DRAWN),
+        count(KIND_CONTOUR),
+        count(KIND_CREASE),
+        count(KIND_BOUNDARY),
+        timing.kernel_ms,
+        output.display()
+    );
+    let mut n_lines = 0;
+    if let Some(svg) = &a.svg {
+        let lines = shapecue::export::svg::visible_polylines(
+            &out.edge_out,
+            &frame,
+            shapecue::export::svg::DEFAULT_BIAS,
+        );
+        n_lines = lines.len();
+        shapecue::export::svg::write_svg(svg, &lines, w, h, a.width)?;
+        println!("wrote {} ({n_lines} polylines)", svg.display());
+    }
+    if let Some(sp) = &a.stats {
+        let mem = st::memory_use(mode, topo.edges.len(), topo.caps.len());
+        let s = serde_json::json!({
+            "input": path.display().to_string(),
+            "device": gpu.info,
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "edges": topo.edges.len(),
+            "cap_pairs": topo.caps.len(),
+            "boundary": topo.boundary,
+            "non_manifold": topo.non_manifold,
+            "marked": topo.marked,
+            "drawn": count(KIND_DRAWN),
+            "contour": count(KIND_CONTOUR),
+            "crease": count(KIND_CREASE),
+            "boundary_or_marked": count(KIND_BOUNDARY),
+            "caps": mode,
+            "interop": interop,
+            "timing": timing,
+            "topology_ms": topo_ms,
+            "frame_ms": frame_ms,
+            "memory_bits": mem,
+            "svg_polylines": n_lines,
+        });
+        std::fs::write(sp, serde_json::to_string_pretty(&s)? + "\n")
+            .with_context(|| format!("writing {}", sp.display()))?;
+        println!("wrote {}", sp.display());
     }
     Ok(())
 }

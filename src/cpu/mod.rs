@@ -3,6 +3,7 @@
 //! oracles the tests compare the device with.
 
 pub mod curvature;
+pub mod edges;
 pub mod feature_lines;
 pub mod marching_cubes;
 pub mod radix_sort;

@@ -1,3 +1,4 @@
-//! Writers: PLY (mesh with per-vertex curvature) and JSON stats.
+//! Writers: PLY (mesh with per-vertex curvature), SVG (visible feature edges) and JSON stats.
 
 pub mod ply;
+pub mod svg;

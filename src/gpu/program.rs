@@ -64,6 +64,11 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
             source: include_str!("../../kernels/vertex_fusion.cl"),
             headers: MC_HEADERS,
         }),
+        "edges" => Some(KernelFile {
+            name: "kernels/edges.cl",
+            source: include_str!("../../kernels/edges.cl"),
+            headers: COMMON_HEADERS,
+        }),
         _ => None,
     }
 }

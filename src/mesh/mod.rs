@@ -5,14 +5,17 @@
 //! or at an extreme scale survives until the stage that uploads it, which
 //! centres and scales it before rounding to the device's precision.
 
+pub mod edges;
 mod generate;
 mod load;
 mod quality;
 pub mod skinned;
+mod solids;
 
 pub use generate::*;
 pub use load::{LoadOptions, load};
 pub use quality::{MeshQuality, quality};
+pub use solids::*;
 
 use crate::error::{Error, Result};
 

@@ -1,6 +1,7 @@
 //! Host wiring of each kernel family in `kernels/`, one module per family.
 
 pub mod curvature;
+pub mod edges;
 pub mod feature_lines;
 pub mod marching_cubes;
 pub mod radix_sort;

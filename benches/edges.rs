@@ -1,0 +1,142 @@
+//! Edges stage benches (`kernels/edges.cl` ↔ `src/stages/edges.rs`), House &
+//! Li's comparison of the McGuire-Hughes and adjacency cap variants (seed 002).
+//!
+//! Group `edges`, ids `<caps variant>/<mesh>/kernel` and `<caps variant>/<mesh>/frame`:
+//! - `kernel`: `edges_detect` + the variant's cap kernel, from OpenCL profiling
+//!   events, topology and positions already on the device, after a warm-up run
+//!   that pays for JIT.
+//! - `frame`: host wall time of a whole frame: parameter upload, kernels,
+//!   read-back of edge-out and cap-out, and the GL frame (mesh, edges, caps,
+//!   read-back of colour and depth). Without headless GL: kernels + read-back
+//!   only (a message says so).
+//!
+//! Inputs: generated cube, capped cylinder, cone, icosphere (level 3), the
+//! shared teapot and Stanford bunny (skipped with a message when absent), and a
+//! generated torus of about 1M edges; all unit-sized at the origin, seen from
+//! (5, 5, 5) at 800x600 with 4-pixel edges and 30° creases.
+//! `SHAPECUE_BENCH_QUICK=1` restricts the run to the bunny.
+//! `SHAPECUE_DEVICE` picks the device as for the CLI.
+
+use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
+use glam::Vec3;
+use shapecue::Mesh;
+use shapecue::gpu::Gpu;
+use shapecue::mesh::{self, LoadOptions, edges::EdgeTopology, edges::vertex_normals};
+use shapecue::render::{MeshStyle, RenderOptions, Renderer};
+use shapecue::stages::edges::{self as st, CapMode, EdgeParams, EdgeStage};
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+const SIZE: (u32, u32) = (800, 600);
+
+fn shared(file: &str) -> Option<Mesh> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/meshes")
+        .join(file);
+    if !p.exists() {
+        eprintln!("edges bench: {} not found, skipping it", p.display());
+        return None;
+    }
+    match mesh::load(&p, &LoadOptions::default()) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            eprintln!("edges bench: cannot load {}: {e}; skipping it", p.display());
+            None
+        }
+    }
+}
+
+fn inputs() -> Vec<(&'static str, Mesh)> {
+    let quick = std::env::var_os("SHAPECUE_BENCH_QUICK").is_some();
+    let mut v: Vec<(&'static str, Option<Mesh>)> = Vec::new();
+    if !quick {
+        v.push(("cube", Some(mesh::cube(1.0))));
+        v.push(("cylinder", Some(mesh::capped_cylinder(0.5, 1.0, 32))));
+        v.push(("cone", Some(mesh::cone(0.5, 1.0, 32))));
+        v.push(("icosphere", Some(mesh::icosphere(0.5, 3))));
+        v.push(("teapot", shared("teapot.obj")));
+    }
+    v.push(("bunny", shared("stanford-bunny.obj")));
+    if !quick {
+        // A torus has 3 edges per vertex: 333,334 vertices ≈ 1M edges.
+        let (nu, nv) = mesh::torus_resolution_for(333_334);
+        v.push(("torus_1m", Some(mesh::torus(1.0, 0.4, nu, nv))));
+    }
+    v.into_iter()
+        .filter_map(|(n, m)| m.map(|m| (n, mesh::unit_sized(&m))))
+        .collect()
+}
+
+fn edges_benches(c: &mut Criterion) {
+    let gpu = match Gpu::new(None) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("edges bench: no OpenCL device ({e}); nothing to measure");
+            return;
+        }
+    };
+    let mut renderer = match Renderer::new(RenderOptions {
+        width: SIZE.0,
+        height: SIZE.1,
+        ..Default::default()
+    }) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            eprintln!("edges bench: {e}; frame times exclude GL");
+            None
+        }
+    };
+    let mut g = c.benchmark_group("edges");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    for (name, m) in inputs() {
+        let topo = EdgeTopology::new(&m, &[], name).expect("topology");
+        let cam = st::camera_for(Vec3::splat(5.0), Vec3::ZERO, None, 40.0, false, m.bounds())
+            .expect("camera");
+        let p = EdgeParams::new(cam, SIZE.0, SIZE.1);
+        let mut stage = EdgeStage::new(&gpu, &m, &topo).expect("stage");
+        let pos: Vec<[f32; 3]> = m.positions.iter().map(|q| q.map(|c| c as f32)).collect();
+        let nrm = vertex_normals(&m);
+        eprintln!(
+            "edges bench: {name}: {} vertices, {} edges, {} cap pairs",
+            m.n_vertices(),
+            topo.edges.len(),
+            topo.caps.len()
+        );
+        for mode in CapMode::ALL {
+            stage.run(&p, mode).expect("warm-up run"); // JIT
+            g.bench_function(format!("{}/{name}/kernel", mode.name()), |b| {
+                b.iter_custom(|iters| {
+                    let mut ms = 0.0;
+                    for _ in 0..iters {
+                        ms += stage.run(&p, mode).expect("run").kernel_ms;
+                    }
+                    Duration::from_secs_f64(ms * 1e-3)
+                })
+            });
+            g.bench_function(format!("{}/{name}/frame", mode.name()), |b| {
+                b.iter_custom(|iters| {
+                    let t = Instant::now();
+                    for _ in 0..iters {
+                        stage.run(&p, mode).expect("run");
+                        let out = stage.read().expect("read");
+                        if let Some(r) = renderer.as_mut() {
+                            r.begin(&cam).expect("begin");
+                            r.draw_mesh(&pos, &nrm, &[], &m.faces, MeshStyle::default())
+                                .expect("mesh");
+                            st::draw(r, &out, [0.0, 0.0, 0.0, 1.0]).expect("edges");
+                            std::hint::black_box(r.finish().expect("finish"));
+                        }
+                    }
+                    t.elapsed()
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, edges_benches);
+criterion_main!(benches);

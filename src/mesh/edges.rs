@@ -1,0 +1,256 @@
+//! Edge topology for the edges stage (House & Li, seed 002), built once per
+//! mesh topology: the edge buffer, the adjacency cap buffer, marked edges and
+//! per-vertex normals for McGuire-Hughes caps.
+//!
+//! Edge buffer: one `[i0, i1, i2, i3]` per unique undirected edge. `i0 → i1`
+//! is the edge as the *first* face using it traverses it (faces in file
+//! order), `i2` is that face's third vertex, `i3` the third vertex of the
+//! second face. Boundary edges (one face) and marked edges have `i3 == i0`,
+//! the seed's "boundary and marked" test.
+//!
+//! **Non-manifold edges** (3 or more faces): the faces around the edge are
+//! taken in file order and paired, (f0, f1), (f2, f3), ...; the edge is emitted
+//! once per pair, with `i0 → i1` from the first face of the pair. An odd face
+//! left over gives one more entry as a boundary edge (`i3 == i0`), so an edge
+//! with three faces is drawn (boundary rule) and one with four is tested like
+//! two ordinary edges. [`EdgeTopology::non_manifold`] counts such edges.
+//!
+//! **Cap buffer**: every unordered pair `(e0, e1)`, `e0 < e1`, of edge-buffer
+//! entries that share an end vertex (`Σ_v deg(v)(deg(v) − 1)/2` pairs), in
+//! order of the shared vertex. Pairs between entries of the same undirected
+//! edge (non-manifold duplicates) are left out: they share both ends.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::Mesh;
+use crate::error::{Error, Result};
+
+/// The index buffers of the edges stage, built by [`EdgeTopology::new`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EdgeTopology {
+    /// `[i0, i1, i2, i3]` per edge entry (see the module documentation).
+    pub edges: Vec<[u32; 4]>,
+    /// `[e0, e1]` per pair of edge entries sharing an end vertex.
+    pub caps: Vec<[u32; 2]>,
+    /// Edges used by exactly one face.
+    pub boundary: usize,
+    /// Undirected edges used by three or more faces.
+    pub non_manifold: usize,
+    /// Edge entries forced drawable by a marked-edge list.
+    pub marked: usize,
+}
+
+impl EdgeTopology {
+    /// Builds the edge and cap buffers of `mesh`; `marked` lists vertex-index
+    /// pairs to draw always (each must be an edge of the mesh; see
+    /// [`read_marked`]). `source` names the marked list in errors.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] for a marked pair that is not an edge, or an
+    /// index past the vertices.
+    pub fn new(mesh: &Mesh, marked: &[[u32; 2]], source: &str) -> Result<EdgeTopology> {
+        let nv = mesh.n_vertices();
+        // Faces around each undirected edge, in file order: (face, i0, i1, opposite).
+        let mut around: HashMap<(u32, u32), Vec<[u32; 3]>> =
+            HashMap::with_capacity(mesh.n_faces() * 3 / 2 + 1);
+        let mut order: Vec<(u32, u32)> = Vec::with_capacity(mesh.n_faces() * 3 / 2 + 1);
+        for f in &mesh.faces {
+            for k in 0..3 {
+                let (a, b, c) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+                if a == b {
+                    continue; // a collapsed face side is no edge
+                }
+                let key = (a.min(b), a.max(b));
+                let list = around.entry(key).or_insert_with(|| {
+                    order.push(key);
+                    Vec::new()
+                });
+                list.push([a, b, c]);
+            }
+        }
+        let mut edges = Vec::with_capacity(order.len());
+        let mut entry_of: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        let (mut boundary, mut non_manifold) = (0, 0);
+        for key in &order {
+            let list = &around[key];
+            if list.len() == 1 {
+                boundary += 1;
+            }
+            if list.len() > 2 {
+                non_manifold += 1;
+            }
+            for pair in list.chunks(2) {
+                let [a, b, c] = pair[0];
+                let d = if pair.len() == 2 { pair[1][2] } else { a };
+                if list.len() > 2 {
+                    entry_of.entry(*key).or_default().push(edges.len() as u32);
+                }
+                edges.push([a, b, c, d]);
+            }
+        }
+        // Marked edges: i3 = i0 on every entry of the edge.
+        let mut n_marked = 0;
+        if !marked.is_empty() {
+            let mut index: HashMap<(u32, u32), u32> = HashMap::with_capacity(edges.len());
+            for (i, e) in edges.iter().enumerate() {
+                index
+                    .entry((e[0].min(e[1]), e[0].max(e[1])))
+                    .or_insert(i as u32);
+            }
+            for (line, &[a, b]) in marked.iter().enumerate() {
+                let el = format!("marked edge {} ({a}, {b})", line + 1);
+                if a as usize >= nv || b as usize >= nv {
+                    return Err(Error::input(
+                        source,
+                        el,
+                        format!("vertex index past the mesh's {nv} vertices"),
+                    ));
+                }
+                let key = (a.min(b), a.max(b));
+                let Some(&first) = index.get(&key) else {
+                    return Err(Error::input(source, el, "not an edge of the mesh"));
+                };
+                let entries = entry_of.get(&key).cloned().unwrap_or_else(|| vec![first]);
+                for e in entries {
+                    let e = &mut edges[e as usize];
+                    if e[3] != e[0] {
+                        e[3] = e[0];
+                        n_marked += 1;
+                    }
+                }
+            }
+        }
+        let caps = cap_pairs(nv, &edges);
+        Ok(EdgeTopology {
+            edges,
+            caps,
+            boundary,
+            non_manifold,
+            marked: n_marked,
+        })
+    }
+}
+
+/// Every pair of edge entries sharing an end vertex (see the module documentation).
+pub fn cap_pairs(nv: usize, edges: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    // CSR of incident edge entries per vertex.
+    let mut off = vec![0u32; nv + 1];
+    for e in edges {
+        off[e[0] as usize + 1] += 1;
+        off[e[1] as usize + 1] += 1;
+    }
+    for v in 0..nv {
+        off[v + 1] += off[v];
+    }
+    let mut fill = off.clone();
+    let mut inc = vec![0u32; off[nv] as usize];
+    for (i, e) in edges.iter().enumerate() {
+        for v in [e[0], e[1]] {
+            inc[fill[v as usize] as usize] = i as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let mut caps = Vec::new();
+    for v in 0..nv {
+        let list = &inc[off[v] as usize..off[v + 1] as usize];
+        for (j, &a) in list.iter().enumerate() {
+            for &b in &list[j + 1..] {
+                let (ea, eb) = (edges[a as usize], edges[b as usize]);
+                let same =
+                    ea[0].min(ea[1]) == eb[0].min(eb[1]) && ea[0].max(ea[1]) == eb[0].max(eb[1]);
+                if !same {
+                    caps.push([a.min(b), a.max(b)]);
+                }
+            }
+        }
+    }
+    caps
+}
+
+/// Parses a marked-edge list: one pair of 0-based vertex indices per line,
+/// separated by whitespace or a comma; blank lines and `#` comments are
+/// skipped. `source` names the text in errors, which give the line number.
+pub fn parse_marked(text: &str, source: &str) -> Result<Vec<[u32; 2]>> {
+    let mut out = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let el = format!("line {}", i + 1);
+        let parts: Vec<&str> = line
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .collect();
+        if parts.len() != 2 {
+            return Err(Error::input(
+                source,
+                el,
+                format!(
+                    "expected two vertex indices, found {} fields in {line:?}",
+                    parts.len()
+                ),
+            ));
+        }
+        let mut pair = [0u32; 2];
+        for (k, p) in parts.iter().enumerate() {
+            pair[k] = p.parse::<u32>().map_err(|_| {
+                Error::input(
+                    source,
+                    el.clone(),
+                    format!("{p:?} is not a vertex index (0-based, non-negative)"),
+                )
+            })?;
+        }
+        if pair[0] == pair[1] {
+            return Err(Error::input(
+                source,
+                el,
+                format!("edge ({}, {}) joins a vertex to itself", pair[0], pair[1]),
+            ));
+        }
+        out.push(pair);
+    }
+    Ok(out)
+}
+
+/// Reads and parses a marked-edge file (see [`parse_marked`]).
+pub fn read_marked(path: &Path) -> Result<Vec<[u32; 2]>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_marked(&text, &path.display().to_string())
+}
+
+/// Area-weighted unit vertex normals in f32 (unreferenced or degenerate
+/// vertices get (0, 0, 0)): the normals McGuire-Hughes caps project.
+pub fn vertex_normals(mesh: &Mesh) -> Vec<[f32; 3]> {
+    let mut n = vec![[0f64; 3]; mesh.n_vertices()];
+    for f in &mesh.faces {
+        let [a, b, c] = f.map(|i| mesh.positions[i as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let cr = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        for &i in f {
+            for k in 0..3 {
+                n[i as usize][k] += cr[k];
+            }
+        }
+    }
+    n.iter()
+        .map(|v| {
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if l > 0.0 && l.is_finite() {
+                [(v[0] / l) as f32, (v[1] / l) as f32, (v[2] / l) as f32]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,701 @@
+//! Edges (House & Li, seed 002): topology rules, device vs CPU reference for
+//! every kernel, analytic oracles (cube creases, flat plane, torus contours,
+//! open-cylinder boundaries), the near-plane rule, degenerate caps, bad input.
+//!
+//! Outputs are indexed by edge or cap pair (no atomics, no appends), so the
+//! canonical order is the index order and device and CPU compare element by
+//! element. Cap kernels are compared on the *device's* edge-out buffer (CPU
+//! from that stage on), so a classification tie cannot cascade.
+
+use glam::Vec3;
+use shapecue::Error;
+use shapecue::cpu::edges as cpu;
+use shapecue::gpu::Gpu;
+use shapecue::mesh::edges::{EdgeTopology, parse_marked, vertex_normals};
+use shapecue::mesh::{self, Mesh};
+use shapecue::render::Camera;
+use shapecue::stages::edges::{
+    CapMode, EdgeOutput, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
+    KIND_CREASE, KIND_DRAWN, decide_interop, memory_use,
+};
+use std::sync::OnceLock;
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| {
+        Gpu::new(None).unwrap_or_else(|e| {
+            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
+        })
+    })
+}
+
+fn params(eye: [f32; 3], target: [f32; 3]) -> EdgeParams {
+    let mut cam = Camera::look_at(Vec3::from(eye), Vec3::from(target));
+    cam.fov_y_deg = 40.0;
+    EdgeParams::new(cam, 320, 240)
+}
+
+fn topo(m: &Mesh) -> EdgeTopology {
+    EdgeTopology::new(m, &[], "test").unwrap()
+}
+
+fn run(m: &Mesh, t: &EdgeTopology, p: &EdgeParams, mode: CapMode) -> EdgeOutput {
+    let mut s = EdgeStage::new(gpu(), m, t).unwrap();
+    s.run(p, mode).unwrap();
+    s.read().unwrap()
+}
+
+fn f32pos(m: &Mesh) -> Vec<[f32; 3]> {
+    m.positions.iter().map(|p| p.map(|c| c as f32)).collect()
+}
+
+fn count(kind: &[u32], bit: u32) -> usize {
+    kind.iter().filter(|&&k| k & bit != 0).count()
+}
+
+fn close(a: [f32; 4], b: [f32; 4]) -> bool {
+    let marker = |v: [f32; 4]| v[0].is_nan() && v[1] == 0.0 && v[2] == -1.0 && v[3] == 1.0;
+    if marker(a) || marker(b) {
+        return marker(a) && marker(b);
+    }
+    a.iter()
+        .zip(b)
+        .all(|(x, y)| (x - y).abs() <= 1e-3 * (1.0 + x.abs().max(y.abs())))
+}
+
+/// Device vs CPU for every kernel; returns the device output with caps of `mode`.
+fn compare(m: &Mesh, t: &EdgeTopology, p: &EdgeParams, mode: CapMode) -> EdgeOutput {
+    let dev = run(m, t, p, mode);
+    let packed = p.pack().unwrap();
+    let pos = f32pos(m);
+    let (out, kind) = cpu::edges_detect(&packed, &pos, &t.edges);
+    let mismatched = (0..t.edges.len())
+        .filter(|&e| kind[e] != dev.kind[e])
+        .count();
+    // Ties (a face exactly edge-on) may classify differently after rounding.
+    assert!(
+        mismatched * 1000 <= t.edges.len(),
+        "{mismatched} of {} edges classified differently",
+        t.edges.len()
+    );
+    for e in 0..t.edges.len() {
+        if kind[e] == dev.kind[e] {
+            for k in 0..4 {
+                let (a, b) = (dev.edge_out[4 * e + k], out[4 * e + k]);
+                assert!(close(a, b), "edge {e} vertex {k}: device {a:?} cpu {b:?}");
+            }
+        }
+    }
+    match mode {
+        CapMode::None => {}
+        CapMode::Mh => {
+            let (c0, c1) = cpu::caps_mh(&packed, &pos, &vertex_normals(m), &t.edges, &dev.edge_out);
+            // A projected normal along the edge makes sign(m·p) a tie, decided by
+            // rounding: allow a few triangles to open to the other side.
+            let pairs: Vec<_> = dev
+                .cap_mh0
+                .iter()
+                .zip(&c0)
+                .chain(dev.cap_mh1.iter().zip(&c1))
+                .collect();
+            let differ = pairs.iter().filter(|(a, b)| !close(**a, **b)).count();
+            assert!(
+                differ <= 2 + pairs.len() / 100,
+                "{differ} of {} mh cap vertices differ",
+                pairs.len()
+            );
+        }
+        CapMode::Adjacency => {
+            let c = cpu::caps_adjacency(&packed, &t.edges, &t.caps, &dev.edge_out);
+            assert_eq!(c.len(), dev.cap_adj.len());
+            let differ = c
+                .iter()
+                .zip(&dev.cap_adj)
+                .filter(|(a, b)| !close(**a, **b))
+                .count();
+            // Near-collinear pairs sit at the 1e-4 threshold: allow a few flips.
+            assert!(
+                differ * 1000 <= c.len().max(1000),
+                "{differ} adjacency cap vertices differ"
+            );
+        }
+    }
+    no_nan_geometry(&dev.edge_out, 4);
+    no_nan_geometry(&dev.cap_mh0, 3);
+    no_nan_geometry(&dev.cap_mh1, 3);
+    no_nan_geometry(&dev.cap_adj, 4);
+    dev
+}
+
+/// Every primitive is either the marker on all its vertices or fully finite.
+fn no_nan_geometry(v: &[[f32; 4]], per: usize) {
+    for (i, prim) in v.chunks(per).enumerate() {
+        let marker = prim
+            .iter()
+            .all(|q| q[0].is_nan() && q[1] == 0.0 && q[2] == -1.0 && q[3] == 1.0);
+        let finite = prim.iter().flatten().all(|c| c.is_finite());
+        assert!(
+            marker || finite,
+            "primitive {i} mixes NaN and geometry: {prim:?}"
+        );
+    }
+}
+
+#[test]
+fn cube_topology_and_creases_at_30_degrees() {
+    let m = mesh::cube(1.0);
+    let t = topo(&m);
+    assert_eq!(t.edges.len(), 18);
+    assert_eq!((t.boundary, t.non_manifold), (0, 0));
+    // Σ_v deg(v)(deg(v)−1)/2 over the 8 vertices.
+    let mut deg = [0usize; 8];
+    for e in &t.edges {
+        deg[e[0] as usize] += 1;
+        deg[e[1] as usize] += 1;
+    }
+    assert_eq!(
+        t.caps.len(),
+        deg.iter().map(|d| d * (d - 1) / 2).sum::<usize>()
+    );
+    let mut p = params([5.0, 5.0, 5.0], [0.0; 3]);
+    p.contours = false;
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    assert_eq!(count(&out.kind, KIND_CREASE), 12);
+    // Every crease edge of the cube is axis-aligned: length 1.
+    for (e, k) in t.edges.iter().zip(&out.kind) {
+        let (a, b) = (m.positions[e[0] as usize], m.positions[e[1] as usize]);
+        let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        assert_eq!(k & KIND_CREASE != 0, (len - 1.0).abs() < 1e-9, "edge {e:?}");
+    }
+    compare(&m, &t, &p, CapMode::Mh);
+    // 100°: no cube edge is that sharp.
+    p.crease_deg = Some(100.0);
+    assert_eq!(count(&run(&m, &t, &p, CapMode::None).kind, KIND_CREASE), 0);
+}
+
+#[test]
+fn flat_subdivided_plane_has_no_creases_and_its_border_is_boundary() {
+    let m = mesh::plane(12, 2.0);
+    let t = topo(&m);
+    assert_eq!(t.boundary, 4 * 11);
+    let p = params([1.0, 2.0, 3.0], [0.0; 3]);
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    assert_eq!(count(&out.kind, KIND_CREASE), 0);
+    assert_eq!(count(&out.kind, KIND_CONTOUR), 0);
+    assert_eq!(count(&out.kind, KIND_BOUNDARY), 44);
+    assert_eq!(count(&out.kind, KIND_DRAWN), 44);
+}
+
+#[test]
+fn torus_along_its_axis_has_inner_and_outer_contours() {
+    let (big_r, r) = (1.0, 0.4);
+    let m = mesh::torus(big_r, r, 64, 32);
+    let t = topo(&m);
+    for ortho in [false, true] {
+        let mut p = params([0.0, 0.0, 6.0], [0.0; 3]);
+        p.crease_deg = None;
+        if ortho {
+            p.camera.ortho_height = Some(4.0);
+        }
+        let out = compare(&m, &t, &p, CapMode::Mh);
+        let rho: Vec<f64> = t
+            .edges
+            .iter()
+            .zip(&out.kind)
+            .filter(|(_, k)| **k & KIND_CONTOUR != 0)
+            .map(|(e, _)| {
+                let (a, b) = (m.positions[e[0] as usize], m.positions[e[1] as usize]);
+                (0.25 * ((a[0] + b[0]).powi(2) + (a[1] + b[1]).powi(2))).sqrt()
+            })
+            .collect();
+        assert!(
+            rho.iter().any(|&x| x > big_r + 0.8 * r),
+            "outer contour (ortho {ortho})"
+        );
+        assert!(
+            rho.iter().any(|&x| x < big_r - 0.8 * r),
+            "inner contour (ortho {ortho})"
+        );
+        assert!(
+            rho.iter().all(|&x| (x - big_r).abs() > 0.5 * r),
+            "only silhouettes (ortho {ortho})"
+        );
+    }
+}
+
+#[test]
+fn open_cylinder_boundary_edges() {
+    let m = mesh::cylinder(0.5, 1.0, 24, 6);
+    let t = topo(&m);
+    assert_eq!(t.boundary, 48);
+    let mut p = params([3.0, 1.0, 2.0], [0.0; 3]);
+    p.contours = false;
+    p.crease_deg = None;
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    assert_eq!(count(&out.kind, KIND_BOUNDARY), 48);
+    assert_eq!(count(&out.kind, KIND_DRAWN), 48);
+    for (e, k) in t.edges.iter().zip(&out.kind) {
+        assert_eq!(e[3] == e[0], k & KIND_BOUNDARY != 0);
+    }
+    // Consecutive boundary edges at a rim vertex form caps.
+    assert!(out.cap_adj.chunks(4).any(|c| !c[0][0].is_nan()));
+    p.boundaries = false;
+    assert_eq!(count(&run(&m, &t, &p, CapMode::None).kind, KIND_DRAWN), 0);
+}
+
+#[test]
+fn icosphere_and_depth_scaled_width_match_the_cpu() {
+    let m = mesh::icosphere(1.0, 3);
+    let t = topo(&m);
+    let mut p = params([2.0, 3.0, 4.0], [0.0; 3]);
+    for mode in CapMode::ALL {
+        let out = compare(&m, &t, &p, mode);
+        assert!(count(&out.kind, KIND_CONTOUR) > 20);
+    }
+    p.depth_scale = Some(10.0);
+    p.line_width = 3.0;
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    // With k/w > 1 everywhere the quads are wider than line_width.
+    let q = &out.edge_out[4 * out.kind.iter().position(|k| k & KIND_DRAWN != 0).unwrap()..][..4];
+    let px = |v: [f32; 4]| [v[0] / v[3] * 160.0, v[1] / v[3] * 120.0];
+    let (a, b) = (px(q[0]), px(q[3]));
+    let w = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+    assert!(w > 3.0 * 1.5, "depth-scaled width {w}");
+}
+
+#[test]
+fn camera_inside_the_mesh_draws_nothing_through_the_near_plane() {
+    let m = mesh::icosphere(1.0, 3);
+    let t = topo(&m);
+    let mut p = params([0.2, 0.1, 0.0], [1.0, 0.3, 0.2]);
+    p.crease_deg = Some(5.0); // icosphere edges bend ~6°: many creases, all around the eye
+    p.camera.near = 0.05;
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    let drawn = count(&out.kind, KIND_DRAWN);
+    assert!(
+        drawn > 0 && drawn < count(&out.kind, KIND_CREASE),
+        "some edges are behind the eye"
+    );
+    for q in out.edge_out.chunks(4).filter(|q| !q[0][0].is_nan()) {
+        for v in q {
+            assert!(v[3] > 0.05, "vertex at w = {} ≤ near", v[3]);
+        }
+    }
+}
+
+#[test]
+fn camera_looking_away_gives_empty_output() {
+    let m = mesh::icosphere(1.0, 2);
+    let t = topo(&m);
+    let p = params([0.0, 0.0, 5.0], [0.0, 0.0, 10.0]);
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    assert_eq!(count(&out.kind, KIND_DRAWN), 0);
+    assert!(out.cap_adj.iter().all(|v| v[0].is_nan()));
+}
+
+#[test]
+fn collinear_and_folded_pairs_give_degenerate_caps_not_nan_geometry() {
+    // A straight polyline of boundary edges: a strip of triangles along x.
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [2.0, 1.0, 0.0],
+    ];
+    let faces = vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
+    let m = Mesh::new(positions, faces, "strip").unwrap();
+    let t = topo(&m);
+    let p = params([1.0, 0.5, 4.0], [1.0, 0.5, 0.0]);
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    // Caps between the two collinear bottom edges (0-1, 1-2) are degenerate.
+    let bottom: Vec<usize> = t
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| {
+            e[3] == e[0]
+                && m.positions[e[0] as usize][1] == 0.0
+                && m.positions[e[1] as usize][1] == 0.0
+        })
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(bottom.len(), 2);
+    let c = t
+        .caps
+        .iter()
+        .position(|c| bottom.contains(&(c[0] as usize)) && bottom.contains(&(c[1] as usize)))
+        .unwrap();
+    assert!(out.cap_adj[4 * c][0].is_nan());
+    // A corner (bottom edge 1-2 with the right edge 2-5) gets a real cap.
+    assert!(
+        out.cap_adj
+            .chunks(4)
+            .any(|q| q.iter().flatten().all(|v| v.is_finite()))
+    );
+}
+
+#[test]
+fn non_manifold_edges_pair_faces_in_order() {
+    // Three triangles on the edge 0-1, and a fourth pair on 0-1 makes four.
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [0.5, -1.0, 0.0],
+        [0.5, 0.0, 1.0],
+        [0.5, 0.0, -1.0],
+    ];
+    let three = Mesh::new(
+        positions.clone(),
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+        "t",
+    )
+    .unwrap();
+    let t = topo(&three);
+    assert_eq!(t.non_manifold, 1);
+    let e01: Vec<[u32; 4]> = t
+        .edges
+        .iter()
+        .copied()
+        .filter(|e| e[0].min(e[1]) == 0 && e[0].max(e[1]) == 1)
+        .collect();
+    assert_eq!(e01, vec![[0, 1, 2, 3], [0, 1, 4, 0]]);
+    let four = Mesh::new(
+        positions,
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [1, 0, 5]],
+        "f",
+    )
+    .unwrap();
+    let t = topo(&four);
+    let e01: Vec<[u32; 4]> = t
+        .edges
+        .iter()
+        .copied()
+        .filter(|e| e[0].min(e[1]) == 0 && e[0].max(e[1]) == 1)
+        .collect();
+    assert_eq!(e01, vec![[0, 1, 2, 3], [0, 1, 4, 5]]);
+    // Duplicates of one edge never form a cap with each other.
+    let dup: Vec<u32> = (0..t.edges.len() as u32)
+        .filter(|&i| {
+            let e = t.edges[i as usize];
+            e[0].min(e[1]) == 0 && e[0].max(e[1]) == 1
+        })
+        .collect();
+    assert!(
+        !t.caps
+            .iter()
+            .any(|c| dup.contains(&c[0]) && dup.contains(&c[1]))
+    );
+    compare(
+        &four,
+        &t,
+        &params([1.0, 2.0, 3.0], [0.5, 0.0, 0.0]),
+        CapMode::Adjacency,
+    );
+}
+
+#[test]
+fn marked_edges_are_drawn_and_bad_lists_name_the_line() {
+    let m = mesh::plane(4, 1.0);
+    // An interior edge: vertices 5 and 6 (row 1, columns 1 and 2).
+    let marked = parse_marked("# interior edge\n5, 6\n\n", "marks.txt").unwrap();
+    assert_eq!(marked, vec![[5, 6]]);
+    let t = EdgeTopology::new(&m, &marked, "marks.txt").unwrap();
+    assert_eq!(t.marked, 1);
+    let mut p = params([0.3, 0.2, 3.0], [0.0; 3]);
+    p.crease_deg = None;
+    let out = compare(&m, &t, &p, CapMode::None);
+    assert_eq!(count(&out.kind, KIND_BOUNDARY), 12 + 1);
+    let err = |text: &str| parse_marked(text, "marks.txt").unwrap_err().to_string();
+    assert!(
+        err("1 2\n3\n").contains("marks.txt: line 2"),
+        "{}",
+        err("1 2\n3\n")
+    );
+    assert!(err("1 x\n").contains("line 1") && err("1 x\n").contains("\"x\""));
+    assert!(err("-1 2\n").contains("line 1"));
+    assert!(err("4 4\n").contains("itself"));
+    let e = EdgeTopology::new(&m, &[[0, 15]], "marks.txt")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("marked edge 1 (0, 15)") && e.contains("not an edge"),
+        "{e}"
+    );
+    let e = EdgeTopology::new(&m, &[[0, 99]], "marks.txt")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("past the mesh's 16 vertices"), "{e}");
+}
+
+#[test]
+fn bad_parameters_are_clear_errors() {
+    let m = mesh::cube(1.0);
+    let t = topo(&m);
+    let mut s = EdgeStage::new(gpu(), &m, &t).unwrap();
+    let ok = params([5.0, 5.0, 5.0], [0.0; 3]);
+    let check = |p: EdgeParams, what: &str, s: &mut EdgeStage| {
+        let e = s.run(&p, CapMode::Mh).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument(_)), "{e}");
+        assert!(e.to_string().contains(what), "{e}");
+    };
+    for w in [0.0, -2.0, f32::NAN, f32::INFINITY] {
+        let mut p = ok;
+        p.line_width = w;
+        check(p, "line width", &mut s);
+    }
+    let mut p = ok;
+    p.camera.eye = p.camera.target;
+    check(p, "camera", &mut s);
+    let mut p = ok;
+    p.camera.eye.x = f32::NAN;
+    check(p, "camera", &mut s);
+    let mut p = ok;
+    p.crease_deg = Some(0.0);
+    check(p, "crease", &mut s);
+    let mut p = ok;
+    p.depth_scale = Some(-1.0);
+    check(p, "depth scale", &mut s);
+    let mut p = ok;
+    p.width = 0;
+    check(p, "viewport", &mut s);
+    let e = "round".parse::<CapMode>().unwrap_err().to_string();
+    assert!(e.contains("unknown cap mode \"round\""), "{e}");
+    assert_eq!("adjacency".parse::<CapMode>().unwrap(), CapMode::Adjacency);
+}
+
+#[test]
+fn interop_decision_uses_only_the_extension_flag() {
+    let d = decide_interop(InteropMode::Auto, false, "pocl").unwrap();
+    assert!(
+        !d.shared && d.reason.contains("cl_khr_gl_sharing"),
+        "{}",
+        d.reason
+    );
+    let e = decide_interop(InteropMode::On, false, "pocl").unwrap_err();
+    assert!(matches!(e, Error::DeviceUnsupported { .. }) && e.to_string().contains("--interop on"));
+    assert!(
+        !decide_interop(InteropMode::Off, true, "gpu")
+            .unwrap()
+            .shared
+    );
+    assert!(!decide_interop(InteropMode::On, true, "gpu").unwrap().shared);
+    assert!(
+        !decide_interop(InteropMode::Auto, gpu().info.gl_sharing, &gpu().info.name)
+            .unwrap()
+            .shared
+    );
+}
+
+#[test]
+fn memory_use_counts_the_buffers() {
+    let m = memory_use(CapMode::Adjacency, 10, 7);
+    assert_eq!(m.edge_bits, 10 * 21 * 32);
+    assert_eq!(m.cap_bits, 7 * 18 * 32);
+    assert_eq!(memory_use(CapMode::Mh, 10, 7).cap_bits, 10 * 24 * 32);
+    assert_eq!(memory_use(CapMode::None, 10, 7).cap_bits, 0);
+}
+
+#[test]
+fn shared_meshes_match_the_cpu() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
+    let path = dir.join("teapot.obj");
+    if !path.exists() {
+        eprintln!(
+            "skipping: {} not found (../shared/data is absent)",
+            path.display()
+        );
+        return;
+    }
+    let m = mesh::unit_sized(&mesh::load(&path, &Default::default()).unwrap());
+    let t = topo(&m);
+    let p = params([5.0, 5.0, 5.0], [0.0; 3]);
+    for mode in CapMode::ALL {
+        compare(&m, &t, &p, mode);
+    }
+}
+
+// ---- command line (GL needed for rendering; skipped without EGL) ----
+
+fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_shapecue"))
+}
+
+fn tmpdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("shapecue-edges-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A unit cube as OBJ text (8 shared vertices, 12 triangles).
+fn cube_obj() -> String {
+    let m = mesh::cube(1.0);
+    let mut s = String::new();
+    for p in &m.positions {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in &m.faces {
+        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    s
+}
+
+fn gl_missing(out: &std::process::Output) -> bool {
+    let err = String::from_utf8_lossy(&out.stderr);
+    if err.contains("no headless OpenGL") && std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() {
+        eprintln!("skipping GL part: {err}");
+        return true;
+    }
+    false
+}
+
+#[test]
+fn cli_renders_png_svg_and_stats() {
+    let d = tmpdir("render");
+    let obj = d.join("cube.obj");
+    std::fs::write(&obj, cube_obj()).unwrap();
+    let (png, svg, json) = (d.join("c.png"), d.join("c.svg"), d.join("c.json"));
+    let out = bin()
+        .args([
+            "edges",
+            obj.to_str().unwrap(),
+            "--eye",
+            "3,2,4",
+            "--caps",
+            "adjacency",
+            "--width",
+            "6",
+        ])
+        .args([
+            "--size",
+            "200x150",
+            "-o",
+            png.to_str().unwrap(),
+            "--svg",
+            svg.to_str().unwrap(),
+        ])
+        .args(["--stats", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    if gl_missing(&out) {
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (200, 150));
+    assert!(
+        img.pixels().filter(|p| p[0] < 40).count() > 100,
+        "black edge pixels"
+    );
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(s["edges"], 18);
+    assert_eq!(s["crease"], 12);
+    assert_eq!(s["interop"]["shared"], false);
+    assert!(
+        s["interop"]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("host path")
+    );
+    // From (3,2,4), 9 of the cube's 12 edges are visible (the 3 at the far corner are hidden).
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("stroke-width=\"6\""));
+    let n = s["svg_polylines"].as_u64().unwrap();
+    assert!((1..=9).contains(&n), "{n} polylines");
+    let pts: usize = text
+        .lines()
+        .filter(|l| l.starts_with("<polyline"))
+        .map(|l| l.matches(',').count())
+        .sum();
+    assert!(
+        pts >= 9 + n as usize,
+        "visible edges joined into polylines: {pts} points"
+    );
+    // The output exists now: refused without --force.
+    let again = bin()
+        .args([
+            "edges",
+            obj.to_str().unwrap(),
+            "--eye",
+            "3,2,4",
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+}
+
+#[test]
+fn cli_bad_input_is_a_clear_error() {
+    let d = tmpdir("bad");
+    let obj = d.join("cube.obj");
+    std::fs::write(&obj, cube_obj()).unwrap();
+    let png = d.join("x.png");
+    let run = |extra: &[&str]| {
+        let out = bin()
+            .args(["edges", obj.to_str().unwrap(), "-o", png.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (code, err) = run(&["--eye", "5,5,5", "--interop", "on"]);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("cl_khr_gl_sharing"), "{err}");
+    let (code, err) = run(&["--eye", "5,5,5", "--caps", "round"]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("unknown cap mode \"round\""), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--width", "0"]);
+    assert!(err.contains("--width 0"), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--width", "-3"]);
+    assert!(err.contains("--width -3"), "{err}");
+    let (_, err) = run(&["--eye", "0,0,0", "--target", "0,0,0"]);
+    assert!(err.contains("coincide"), "{err}");
+    let (_, err) = run(&["--eye", "NaN,0,1"]);
+    assert!(err.contains("--eye"), "{err}");
+    let (_, err) = run(&["--eye", "1,2"]);
+    assert!(err.contains("three finite numbers"), "{err}");
+    let (_, err) = run(&["--eye", "5,5,5", "--size", "0x10"]);
+    assert!(err.contains("--size"), "{err}");
+    let marks = d.join("marks.txt");
+    std::fs::write(&marks, "0 1\n0 7\n").unwrap();
+    let (_, err) = run(&["--eye", "5,5,5", "--marked", marks.to_str().unwrap()]);
+    assert!(
+        err.contains("marks.txt: marked edge 2 (0, 7): not an edge"),
+        "{err}"
+    );
+    std::fs::write(&marks, "0 1\nzero one\n").unwrap();
+    let (_, err) = run(&["--eye", "5,5,5", "--marked", marks.to_str().unwrap()]);
+    assert!(err.contains("marks.txt: line 2"), "{err}");
+    assert!(!png.exists());
+}
+
+#[test]
+fn cli_memory_table_lists_the_generated_meshes() {
+    let out = bin().args(["edges", "--memory-table"]).output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    let cube = s.lines().find(|l| l.starts_with("cube")).unwrap();
+    let f: Vec<u64> = cube
+        .split_whitespace()
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(f[0], 18);
+    assert_eq!(f[2], 18 * 21 * 32);
+    for name in ["cylinder", "cone", "icosphere"] {
+        assert!(s.contains(name), "{s}");
+    }
+}
