@@ -351,17 +351,33 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
     w(
         &mut s,
         format!(
-            "{:<8} {:>5} {:>9} {:>10} {:>10} {:>12} {:>12} {:>10} {:>12} {:>12}",
+            "{:<8} {:>5} {:>9} {:>8} | {:>26} | {:>26} | {:>26}",
             "surface",
             "res",
             "faces",
-            "extract ms",
-            "curv f32",
-            "k1 err f32",
-            "k2 err f32",
-            "curv f64",
-            "k1 err f64",
-            "k2 err f64"
+            "extract",
+            "f32, mesh normals",
+            "f32, gradient normals",
+            "f64, gradient normals"
+        ),
+    );
+    w(
+        &mut s,
+        format!(
+            "{:<8} {:>5} {:>9} {:>8} | {:>6} {:>9} {:>9} | {:>6} {:>9} {:>9} | {:>6} {:>9} {:>9}",
+            "",
+            "",
+            "",
+            "ms",
+            "ms",
+            "k1 err",
+            "k2 err",
+            "ms",
+            "k1 err",
+            "k2 err",
+            "ms",
+            "k1 err",
+            "k2 err"
         ),
     );
     for kind in [Sdf::Sphere, Sdf::Torus] {
