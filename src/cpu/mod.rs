@@ -3,3 +3,5 @@
 //! oracles the tests compare the device with.
 
 pub mod curvature;
+pub mod radix_sort;
+pub mod scan;

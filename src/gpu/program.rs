@@ -26,12 +26,22 @@ pub const COMMON_HEADERS: &[(&str, &str)] = &[
     ),
 ];
 
-/// Looks up a kernel family by name (`"curvature"`, ...).
+/// Looks up a kernel family by name (`"curvature"`, `"scan"`, `"radix_sort"`).
 pub fn kernel_file(name: &str) -> Option<KernelFile> {
     match name {
         "curvature" => Some(KernelFile {
             name: "kernels/curvature.cl",
             source: include_str!("../../kernels/curvature.cl"),
+            headers: COMMON_HEADERS,
+        }),
+        "scan" => Some(KernelFile {
+            name: "kernels/scan.cl",
+            source: include_str!("../../kernels/scan.cl"),
+            headers: COMMON_HEADERS,
+        }),
+        "radix_sort" => Some(KernelFile {
+            name: "kernels/radix_sort.cl",
+            source: include_str!("../../kernels/radix_sort.cl"),
             headers: COMMON_HEADERS,
         }),
         _ => None,
