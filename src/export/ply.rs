@@ -52,17 +52,7 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
             )));
         }
     }
-    if let Some(v) = mesh
-        .faces
-        .iter()
-        .flatten()
-        .find(|&&v| i32::try_from(v).is_err())
-    {
-        return Err(Error::InvalidArgument(format!(
-            "face index {v} does not fit the PLY 'int' face list"
-        )));
-    }
-
+    check_face_indices(mesh)?;
     let names: Vec<&str> = POSITION_PROPERTIES
         .iter()
         .chain(field.map_or(&[][..], |_| &FIELD_PROPERTIES[..]))
