@@ -15,11 +15,15 @@
 //   params   float[32]  per frame, see PARAM_* below (packed by EdgeParams::pack)
 //   pos      float[3V]  world-space positions        nrm float[3V] unit vertex normals
 //   edges    uint[4E]   (i0, i1, i2, i3); i3 == i0: boundary or marked
-//   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex
+//   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex (sorted by vertex)
 //   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p
 //   kind     uint[E]    bit 0 contour, 1 crease, 2 boundary/marked, 3 drawn
 //   cap_mh0, cap_mh1 float[12E]  half-cap triangles (s, s + p·sign(m·p), s + m)
 //   cap_adj  float[16C] cap quads (sM + mv, sM + p0, sM, sM + p1)
+//   cap_drawn uchar[C]  1 where the last run wrote a cap (not the marker)
+// Outputs persist between runs: an edge or cap that is undrawn now and was
+// undrawn in the previous run keeps its marker and is not rewritten (the host
+// fills edge-out and cap-out with markers, kind and cap_drawn with 0, once).
 //
 // Conventions (documented in src/stages/edges.rs): clip space is OpenGL's; the
 // screen is measured in pixels from the viewport centre (x · W/2, y · H/2 after
@@ -71,8 +75,12 @@
 #define CLIP(P, row, x, y, z, h) \
     ((P)[(row)] * (x) + (P)[4 + (row)] * (y) + (P)[8 + (row)] * (z) + (P)[12 + (row)] * (h))
 
-// Depth factor max(1, k/w), or 1 when k = 0.
-inline float depth_factor(float k, float w) { return k > 0.0f ? fmax(1.0f, k / w) : 1.0f; }
+// Depth factor max(1, k/w), or 1 when k = 0 (a select, not fmax: PoCL's
+// work-item vectoriser gives up on fmax).
+inline float depth_factor(float k, float w) {
+    const float f = k / w;
+    return (k > 0.0f && f > 1.0f) ? f : 1.0f;
+}
 
 __kernel void edges_detect(uint n, __global const float* P, __global const float* pos,
                            __global const uint* edges, __global float* edge_out,
@@ -116,11 +124,17 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     const int drawn = k != 0u && c0w > wmin && c1w > wmin;
     __global float* out = edge_out + 16 * gid;
     if (!drawn) {
+        // The marker is already there unless the previous run drew this edge:
+        // skipping the rewrite saves most of the output traffic (edge-out and
+        // kind start as markers and 0, see EdgeStage::new).
+        const uint prev = kind[gid];
         kind[gid] = k;
-        WRITE_MARKER(out, 0);
-        WRITE_MARKER(out, 1);
-        WRITE_MARKER(out, 2);
-        WRITE_MARKER(out, 3);
+        if ((prev & KIND_DRAWN) != 0u) {
+            WRITE_MARKER(out, 0);
+            WRITE_MARKER(out, 1);
+            WRITE_MARKER(out, 2);
+            WRITE_MARKER(out, 3);
+        }
         return;
     }
     kind[gid] = k | KIND_DRAWN;
@@ -142,12 +156,12 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
 
 __kernel void caps_mh(uint n, __global const float* P, __global const float* pos,
                       __global const float* nrm, __global const uint* edges,
-                      __global const float* edge_out, __global float* cap0,
-                      __global float* cap1) {
+                      __global const uint* kind, __global float* cap0, __global float* cap1) {
     GID_OR_RETURN(n)
     __global float* o0 = cap0 + 12 * gid;
     __global float* o1 = cap1 + 12 * gid;
-    if (isnan(edge_out[16 * gid])) {
+    // KIND_DRAWN is set exactly when edge-out holds a quad, not the marker.
+    if ((kind[gid] & KIND_DRAWN) == 0u) {
         WRITE_MARKER(o0, 0);
         WRITE_MARKER(o0, 1);
         WRITE_MARKER(o0, 2);
@@ -187,7 +201,7 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
     // (matrix rows x, y, w times |c| times the viewport), use the perpendicular.
     const float msz = fabs(P[0]) + fabs(P[4]) + fabs(P[8]) + fabs(P[1]) + fabs(P[5]) +
                       fabs(P[9]) + fabs(P[3]) + fabs(P[7]) + fabs(P[11]);
-    const float hvm = fmax(hvw, hvh);
+    const float hvm = hvw > hvh ? hvw : hvh;
     const float t0 = 1e-4f * msz * (fabs(c0x) + fabs(c0y) + fabs(c0w)) * hvm;
     const float t1 = 1e-4f * msz * (fabs(c1x) + fabs(c1y) + fabs(c1w)) * hvm;
     const int ok0 = l0 > t0 && l0 > 0.0f, ok1 = l1 > t1 && l1 > 0.0f;
@@ -206,15 +220,33 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
 }
 
 __kernel void caps_adjacency(uint n, __global const float* P, __global const uint* edges,
-                             __global const uint* caps, __global const float* edge_out,
-                             __global float* cap_out) {
+                             __global const uint* caps, __global const uint* kind,
+                             __global const float* edge_out, __global float* cap_out,
+                             __global uchar* cap_drawn) {
     GID_OR_RETURN(n)
     __global float* o = cap_out + 16 * gid;
     const uint e0 = caps[2 * gid], e1 = caps[2 * gid + 1];
     __global const float* q0 = edge_out + 16 * e0;
     __global const float* q1 = edge_out + 16 * e1;
+    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
+    // cache-resident, where edge-out's first x costs a cache line per edge) before
+    // any other read. KIND_DRAWN is set exactly when the quad is not the marker.
+    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
+    // cache-resident, where edge-out's first x costs a cache line per edge) before
+    // any other read; and rewrite the marker only if the previous run drew a cap
+    // here (cap_drawn, one byte per pair; cap-out starts as markers).
+    if (((kind[e0] & kind[e1]) & KIND_DRAWN) == 0u) {
+        if (cap_drawn[gid] != 0) {
+            cap_drawn[gid] = 0;
+            WRITE_MARKER(o, 0);
+            WRITE_MARKER(o, 1);
+            WRITE_MARKER(o, 2);
+            WRITE_MARKER(o, 3);
+        }
+        return;
+    }
     const float hvw = P[PARAM_HVW], hvh = P[PARAM_HVH];
-    int ok = !isnan(q0[0]) && !isnan(q1[0]);
+    int ok = 1;
     const uint a0 = edges[4 * e0], b0 = edges[4 * e1], b1 = edges[4 * e1 + 1];
     const uint v = (a0 == b0 || a0 == b1) ? a0 : edges[4 * e0 + 1];
     // Quad slots at end 0 are 0 and 3, at end 1 are 1 and 2. First edge: its end at
@@ -244,6 +276,7 @@ __kernel void caps_adjacency(uint n, __global const float* P, __global const uin
     const float ls = sqrt(sx * sx + sy * sy);
     // Collinear edges (straight continuation) leave no gap: no cap.
     ok = ok && ls > 1e-4f;
+    cap_drawn[gid] = ok ? 1 : 0;
     if (!ok) {
         WRITE_MARKER(o, 0);
         WRITE_MARKER(o, 1);

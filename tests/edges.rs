@@ -493,7 +493,7 @@ fn interop_decision_uses_only_the_extension_flag() {
 fn memory_use_counts_the_buffers() {
     let m = memory_use(CapMode::Adjacency, 10, 7);
     assert_eq!(m.edge_bits, 10 * 21 * 32);
-    assert_eq!(m.cap_bits, 7 * 18 * 32);
+    assert_eq!(m.cap_bits, 7 * 18 * 32 + 7 * 8);
     assert_eq!(memory_use(CapMode::Mh, 10, 7).cap_bits, 10 * 24 * 32);
     assert_eq!(memory_use(CapMode::None, 10, 7).cap_bits, 0);
 }
@@ -697,5 +697,65 @@ fn cli_memory_table_lists_the_generated_meshes() {
     assert_eq!(f[2], 18 * 21 * 32);
     for name in ["cylinder", "cone", "icosphere"] {
         assert!(s.contains(name), "{s}");
+    }
+}
+
+#[test]
+fn outputs_persist_correctly_across_frames() {
+    // Undrawn-then-undrawn primitives are not rewritten: a stage reused for
+    // different views, widths and cap modes must still match a fresh CPU run.
+    let m = mesh::torus(1.0, 0.4, 48, 24);
+    let t = topo(&m);
+    let pos = f32pos(&m);
+    let mut s = EdgeStage::new(gpu(), &m, &t).unwrap();
+    let views = [
+        ([0.0, 0.0, 6.0], CapMode::Adjacency, 4.0),
+        ([5.0, 1.0, 0.5], CapMode::Mh, 3.0),
+        ([5.0, 1.0, 0.5], CapMode::Adjacency, 6.0),
+        ([0.0, 0.0, 6.0], CapMode::Adjacency, 2.0),
+        ([0.0, 0.0, -6.0], CapMode::Mh, 4.0),
+        ([0.0, 0.0, 6.0], CapMode::Mh, 4.0),
+    ];
+    for (eye, mode, width) in views {
+        let mut p = params(eye, [0.0; 3]);
+        p.line_width = width;
+        s.run(&p, mode).unwrap();
+        let dev = s.read().unwrap();
+        let packed = p.pack().unwrap();
+        let (out, kind) = cpu::edges_detect(&packed, &pos, &t.edges);
+        let same = (0..t.edges.len())
+            .filter(|&e| kind[e] == dev.kind[e])
+            .count();
+        assert!(same * 1000 >= 999 * t.edges.len(), "kinds after {eye:?}");
+        for e in (0..t.edges.len()).filter(|&e| kind[e] == dev.kind[e]) {
+            for k in 0..4 {
+                assert!(
+                    close(dev.edge_out[4 * e + k], out[4 * e + k]),
+                    "edge {e} after {eye:?}"
+                );
+            }
+        }
+        if mode == CapMode::Adjacency {
+            let c = cpu::caps_adjacency(&packed, &t.edges, &t.caps, &dev.edge_out);
+            let differ = c
+                .iter()
+                .zip(&dev.cap_adj)
+                .filter(|(a, b)| !close(**a, **b))
+                .count();
+            assert!(
+                differ <= 4,
+                "{differ} adjacency cap vertices differ after {eye:?}"
+            );
+        } else {
+            let (c0, c1) =
+                cpu::caps_mh(&packed, &pos, &vertex_normals(&m), &t.edges, &dev.edge_out);
+            let differ = c0
+                .iter()
+                .zip(&dev.cap_mh0)
+                .chain(c1.iter().zip(&dev.cap_mh1))
+                .filter(|(a, b)| !close(**a, **b))
+                .count();
+            assert!(differ <= 6, "{differ} mh cap vertices differ after {eye:?}");
+        }
     }
 }
