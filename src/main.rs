@@ -812,13 +812,13 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         Some(f) => read_marked(f)?,
         None => Vec::new(),
     };
-    let marked_name = a
-        .marked
-        .as_ref()
-        .map(|p| p.display().to_string())
-        .unwrap_or_default();
+    let source = a.marked.as_deref().unwrap_or(path).display().to_string();
     let t_topo = Instant::now();
-    let topo = EdgeTopology::new(&mesh, &marked, &marked_name)?;
+    let topo = if mode == CapMode::Adjacency {
+        EdgeTopology::new(&mesh, &marked, &source)?
+    } else {
+        EdgeTopology::without_caps(&mesh, &marked, &source)?
+    };
     let topo_ms = t_topo.elapsed().as_secs_f64() * 1e3;
     let (lo, hi) = mesh.bounds();
     let centre = glam::Vec3::new(

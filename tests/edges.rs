@@ -759,3 +759,27 @@ fn outputs_persist_correctly_across_frames() {
         }
     }
 }
+
+#[test]
+fn a_huge_fan_is_refused_for_adjacency_caps_only() {
+    // One apex with 30,000 triangles around it: 4.5·10⁸ cap pairs at the apex.
+    let n = 30_000u32;
+    let mut positions = vec![[0.0, 0.0, 1.0]];
+    for i in 0..n {
+        let a = i as f64 / n as f64 * std::f64::consts::TAU;
+        positions.push([a.cos(), a.sin(), 0.0]);
+    }
+    let faces = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+    let m = Mesh::new(positions, faces, "fan").unwrap();
+    let e = EdgeTopology::new(&m, &[], "fan.obj")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("fan.obj: vertex 0:") && e.contains("cap pairs"),
+        "{e}"
+    );
+    let t = EdgeTopology::without_caps(&m, &[], "fan.obj").unwrap();
+    assert_eq!((t.edges.len(), t.caps.len()), (2 * n as usize, 0));
+    let out = run(&m, &t, &params([0.5, 0.5, 3.0], [0.0; 3]), CapMode::Mh);
+    assert_eq!(out.kind.len(), 2 * n as usize);
+}
