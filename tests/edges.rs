@@ -783,3 +783,50 @@ fn a_huge_fan_is_refused_for_adjacency_caps_only() {
     let out = run(&m, &t, &params([0.5, 0.5, 3.0], [0.0; 3]), CapMode::Mh);
     assert_eq!(out.kind.len(), 2 * n as usize);
 }
+
+#[test]
+fn ideal_stroke_of_one_segment_is_a_capsule() {
+    // A horizontal edge from pixel x 20 to 60 at y = 50 (between pixel rows) of a 100x100 image,
+    // half width 5: a 40x10 rectangle plus two half discs of radius 5.
+    let to_clip = |x: f32, y: f32| [x / 50.0 - 1.0, 1.0 - y / 50.0, 0.0, 1.0];
+    let (a, b) = (to_clip(20.0, 50.0), to_clip(60.0, 50.0));
+    let quad = [a, b, b, a];
+    let cov = st_ideal(&quad);
+    let n = cov.iter().filter(|&&c| c).count() as f32;
+    let area = 40.0 * 10.0 + std::f32::consts::PI * 25.0;
+    assert!((n - area).abs() < 0.05 * area, "{n} pixels vs {area}");
+    assert!(cov[50 * 100 + 40] && !cov[50 * 100 + 70] && !cov[40 * 100 + 40]);
+}
+
+fn st_ideal(edge_out: &[[f32; 4]]) -> Vec<bool> {
+    shapecue::stages::edges::ideal_coverage(edge_out, 100, 100, 5.0)
+}
+
+#[test]
+fn caps_close_the_gaps_of_thick_edges() {
+    use shapecue::render::Renderer;
+    if let Err(e @ Error::NoGl { .. }) = Renderer::new(Default::default()) {
+        if std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() {
+            eprintln!("skipping GL test: {e}");
+            return;
+        }
+    }
+    let m = mesh::unit_sized(&mesh::capped_cylinder(0.5, 1.0, 32));
+    let t = topo(&m);
+    let mut p = params([5.0, 5.0, 5.0], [0.0; 3]);
+    p.camera.fov_y_deg = 20.0;
+    p.line_width = 10.0;
+    let q = shapecue::stages::edges::cap_quality(gpu(), &m, &t, &p).unwrap();
+    let (none, mh, adj) = (&q[0], &q[1], &q[2]);
+    assert!(
+        none.gap > 50,
+        "thick edges without caps leave gaps: {none:?}"
+    );
+    assert!(adj.gap * 10 <= none.gap && mh.gap * 5 <= none.gap, "{q:?}");
+    for r in &q {
+        assert!(
+            r.extra * 100 <= r.ideal,
+            "caps stay inside the round stroke: {r:?}"
+        );
+    }
+}
