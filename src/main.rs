@@ -863,7 +863,8 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let count = |bit: u32| out.kind.iter().filter(|&&k| k & bit != 0).count();
     println!(
         "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
-         (contour {}, crease {}, boundary/marked {}); kernels {:.3} ms; wrote {}",
+         (in front of the near plane) of those detected as contour {}, crease {}, \
+         boundary/marked {}; kernels {:.3} ms; wrote {}",
         path.display(),
         topo.edges.len(),
         topo.boundary,
