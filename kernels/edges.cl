@@ -16,7 +16,11 @@
 //   pos      float[3V]  world-space positions        nrm float[3V] unit vertex normals
 //   edges    uint[4E]   (i0, i1, i2, i3); i3 == i0: boundary or marked
 //   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex (sorted by vertex)
-//   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p
+//   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p;
+//                       half quads (contours, optional): s0, s1, s1 + 2p', s0 + 2p',
+//                       p' = p·sign(m0·p) pointing outward (m0: projected normal of i0).
+//                       Their midpoints lie on the stroke's centre line, so adjacency
+//                       caps join them; McGuire-Hughes caps stay centred on the edge.
 //   kind     uint[E]    bit 0 contour, 1 crease, 2 boundary/marked, 3 drawn
 //   cap_mh0, cap_mh1 float[12E]  half-cap triangles (s, s + p·sign(m·p), s + m)
 //   cap_adj  float[16C] cap quads (sM + mv, sM + p0, sM, sM + p1)
@@ -53,6 +57,7 @@
 #define PARAM_W_MIN 28
 #define PARAM_CONTOUR 29
 #define PARAM_BOUNDARY 30
+#define PARAM_HALF 31
 
 #define KIND_CONTOUR 1u
 #define KIND_CREASE 2u
@@ -89,8 +94,8 @@ inline float depth_factor(float k, float w) {
 }
 
 __kernel void edges_detect(uint n, __global const float* P, __global const float* pos,
-                           __global const uint* edges, __global float* edge_out,
-                           __global uint* kind) {
+                           __global const float* nrm, __global const uint* edges,
+                           __global float* edge_out, __global uint* kind) {
     GID_OR_RETURN(n)
     const uint i0 = edges[4 * gid], i1 = edges[4 * gid + 1];
     const uint i2 = edges[4 * gid + 2], i3 = edges[4 * gid + 3];
@@ -154,10 +159,21 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     const float py = len > 0.0f ? dx / len : 1.0f;
     const float f0 = hw * depth_factor(P[PARAM_DEPTH_K], c0w);
     const float f1 = hw * depth_factor(P[PARAM_DEPTH_K], c1w);
-    WRITE_SCREEN(out, 0, s0x - px * f0, s0y - py * f0, c0z, c0w, hvw, hvh);
-    WRITE_SCREEN(out, 1, s1x - px * f1, s1y - py * f1, c1z, c1w, hvw, hvh);
-    WRITE_SCREEN(out, 2, s1x + px * f1, s1y + py * f1, c1z, c1w, hvw, hvh);
-    WRITE_SCREEN(out, 3, s0x + px * f0, s0y + py * f0, c0z, c0w, hvw, hvh);
+    // Half quads (contour-only edges, when asked): from the edge outward by the full
+    // width, outward = the side the projected vertex normal of i0 points to (seed's
+    // sign(m0·p)). Slots stay in perimeter order: 0 = s0, 1 = s1, 2, 3 outside.
+    const int halfq = P[PARAM_HALF] != 0.0f && k == KIND_CONTOUR;
+    const uint j0 = halfq ? i0 : 0u;
+    const float n0x = nrm[3 * j0], n0y = nrm[3 * j0 + 1], n0z = nrm[3 * j0 + 2];
+    const float d0x = CLIP(P, 0, n0x, n0y, n0z, 0.0f), d0y = CLIP(P, 1, n0x, n0y, n0z, 0.0f);
+    const float d0w = CLIP(P, 3, n0x, n0y, n0z, 0.0f);
+    const float m0x = (d0x * c0w - c0x * d0w) * hvw, m0y = (d0y * c0w - c0y * d0w) * hvh;
+    const float g = (m0x * px + m0y * py) >= 0.0f ? 1.0f : -1.0f;
+    const float lo = halfq ? 0.0f : 1.0f, hi = halfq ? 2.0f * g : 1.0f;
+    WRITE_SCREEN(out, 0, s0x - px * f0 * lo, s0y - py * f0 * lo, c0z, c0w, hvw, hvh);
+    WRITE_SCREEN(out, 1, s1x - px * f1 * lo, s1y - py * f1 * lo, c1z, c1w, hvw, hvh);
+    WRITE_SCREEN(out, 2, s1x + px * f1 * hi, s1y + py * f1 * hi, c1z, c1w, hvw, hvh);
+    WRITE_SCREEN(out, 3, s0x + px * f0 * hi, s0y + py * f0 * hi, c0z, c0w, hvw, hvh);
 }
 
 __kernel void caps_mh(uint n, __global const float* P, __global const float* pos,

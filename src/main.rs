@@ -97,6 +97,9 @@ struct EdgesArgs {
     /// this are creases (a cube's edges at 90°); 180 or more finds none.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     crease: f32,
+    /// Draw contour-only edges as half quads, outward from the silhouette.
+    #[arg(long)]
+    half_contours: bool,
     /// Depth-scaled width: width × max(1, K/w), w the clip-space depth.
     #[arg(long, allow_negative_numbers = true)]
     depth_scale: Option<f32>,
@@ -836,6 +839,7 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     p.line_width = a.width;
     p.crease_deg = crease;
     p.depth_scale = a.depth_scale;
+    p.half_contours = a.half_contours;
     p.pack()?;
 
     let t_all = Instant::now();

@@ -68,7 +68,7 @@ fn compare(m: &Mesh, t: &EdgeTopology, p: &EdgeParams, mode: CapMode) -> EdgeOut
     let dev = run(m, t, p, mode);
     let packed = p.pack().unwrap();
     let pos = f32pos(m);
-    let (out, kind) = cpu::edges_detect(&packed, &pos, &t.edges);
+    let (out, kind) = cpu::edges_detect(&packed, &pos, &vertex_normals(m), &t.edges);
     let mismatched = (0..t.edges.len())
         .filter(|&e| kind[e] != dev.kind[e])
         .count();
@@ -722,7 +722,7 @@ fn outputs_persist_correctly_across_frames() {
         s.run(&p, mode).unwrap();
         let dev = s.read().unwrap();
         let packed = p.pack().unwrap();
-        let (out, kind) = cpu::edges_detect(&packed, &pos, &t.edges);
+        let (out, kind) = cpu::edges_detect(&packed, &pos, &vertex_normals(&m), &t.edges);
         let same = (0..t.edges.len())
             .filter(|&e| kind[e] == dev.kind[e])
             .count();
@@ -829,4 +829,35 @@ fn caps_close_the_gaps_of_thick_edges() {
             "caps stay inside the round stroke: {r:?}"
         );
     }
+}
+
+#[test]
+fn half_contour_quads_open_outward() {
+    let (big_r, r) = (1.0, 0.4);
+    let m = mesh::torus(big_r, r, 64, 32);
+    let t = topo(&m);
+    let mut p = params([0.0, 0.0, 6.0], [0.0; 3]);
+    p.crease_deg = None;
+    p.half_contours = true;
+    let out = compare(&m, &t, &p, CapMode::Adjacency);
+    let px = |v: [f32; 4]| ((v[0] / v[3] * 160.0).powi(2) + (v[1] / v[3] * 120.0).powi(2)).sqrt();
+    let (mut outer, mut inner) = (0, 0);
+    for (i, (e, k)) in t.edges.iter().zip(&out.kind).enumerate() {
+        if k & KIND_DRAWN == 0 {
+            continue;
+        }
+        let q = &out.edge_out[4 * i..4 * i + 4];
+        let (a, b) = (m.positions[e[0] as usize], m.positions[e[1] as usize]);
+        let rho = (0.25 * ((a[0] + b[0]).powi(2) + (a[1] + b[1]).powi(2))).sqrt();
+        // Slot 0 is the edge end itself; slot 3 lies outside the silhouette:
+        // farther from the image centre on the outer contour, nearer on the inner one.
+        if rho > big_r {
+            outer += 1;
+            assert!(px(q[3]) > px(q[0]), "outer contour opens outward");
+        } else {
+            inner += 1;
+            assert!(px(q[3]) < px(q[0]), "inner contour opens into the hole");
+        }
+    }
+    assert!(outer > 0 && inner > 0);
 }

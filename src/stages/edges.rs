@@ -25,6 +25,10 @@
 //!   none of its face diagonals. (The seed writes `na·nb < −cos θ'`, i.e.
 //!   θ' = 180° − θ is the dihedral angle between the faces.)
 //! - **Boundary and marked**: `i3 == i0`.
+//! - **Half quads** (`half_contours`): contour-only edges extend from the edge
+//!   outward by the full width; their quad-end midpoints lie on the stroke's
+//!   centre line, so adjacency caps join them (McGuire-Hughes caps stay
+//!   centred on the edge).
 //! - **Width**: `line_width` pixels across, times max(1, k/w) with depth scale
 //!   k (the seed's appendix; k = 0 or `None`: constant screen width).
 //! - **Near plane**: an edge with an end at clip w ≤ near (perspective) is not
@@ -113,6 +117,9 @@ pub struct EdgeParams {
     pub boundaries: bool,
     /// Depth scale k of the width factor max(1, k/w); `None`: constant width.
     pub depth_scale: Option<f32>,
+    /// Draw contour-only edges as half quads, from the edge outward by the
+    /// full width (outward: the side of the projected vertex normal).
+    pub half_contours: bool,
 }
 
 impl EdgeParams {
@@ -127,6 +134,7 @@ impl EdgeParams {
             contours: true,
             boundaries: true,
             depth_scale: None,
+            half_contours: false,
         }
     }
 
@@ -191,6 +199,7 @@ impl EdgeParams {
         };
         p[29] = self.contours as u32 as f32;
         p[30] = self.boundaries as u32 as f32;
+        p[31] = self.half_contours as u32 as f32;
         if p.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidArgument(
                 "edges: the camera gives a non-finite view-projection matrix".into(),
@@ -442,6 +451,7 @@ impl<'g> EdgeStage<'g> {
                 Arg::U32(ne),
                 buf(&self.params),
                 buf(&self.pos),
+                buf(&self.nrm),
                 buf(&self.edges),
                 buf(&self.edge_out),
                 buf(&self.kind),
