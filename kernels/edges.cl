@@ -15,11 +15,19 @@
 //   params   float[32]  per frame, see PARAM_* below (packed by EdgeParams::pack)
 //   pos      float[3V]  world-space positions        nrm float[3V] unit vertex normals
 //   edges    uint[4E]   (i0, i1, i2, i3); i3 == i0: boundary or marked
-//   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex
-//   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p
+//   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex (sorted by vertex)
+//   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p;
+//                       half quads (contours, optional): s0, s1, s1 + 2p', s0 + 2p',
+//                       p' = p·sign(m0·p) pointing outward (m0: projected normal of i0).
+//                       Their midpoints lie on the stroke's centre line, so adjacency
+//                       caps join them; McGuire-Hughes caps stay centred on the edge.
 //   kind     uint[E]    bit 0 contour, 1 crease, 2 boundary/marked, 3 drawn
 //   cap_mh0, cap_mh1 float[12E]  half-cap triangles (s, s + p·sign(m·p), s + m)
 //   cap_adj  float[16C] cap quads (sM + mv, sM + p0, sM, sM + p1)
+//   cap_drawn uchar[C]  1 where the last run wrote a cap (not the marker)
+// Outputs persist between runs: an edge or cap that is undrawn now and was
+// undrawn in the previous run keeps its marker and is not rewritten (the host
+// fills edge-out and cap-out with markers, kind and cap_drawn with 0, once).
 //
 // Conventions (documented in src/stages/edges.rs): clip space is OpenGL's; the
 // screen is measured in pixels from the viewport centre (x · W/2, y · H/2 after
@@ -30,7 +38,13 @@
 // face normals exceeds the user angle θ, i.e. na·nb < cos θ |na||nb|.
 //
 // Scalar code only: PoCL's work-item vectoriser gives up on float3/vload3,
-// private arrays and struct selects (see curvature.cl).
+// private arrays and struct selects (see curvature.cl). Measured with
+// POCL_VECTORIZER_REMARKS=1 (PoCL 3.1): these kernels still run one work-item
+// at a time ("instruction return type cannot be vectorized"), because LLVM's
+// SLP pass first fuses the paired x/y arithmetic into 2-wide vectors; hiding
+// address adjacency did not change that. The time goes to the undrawn path,
+// so drawability is decided from 4-byte kind bits and unchanged markers are
+// not rewritten (below).
 
 #define PARAM_EYE 16
 #define PARAM_VIEW 19
@@ -43,6 +57,7 @@
 #define PARAM_W_MIN 28
 #define PARAM_CONTOUR 29
 #define PARAM_BOUNDARY 30
+#define PARAM_HALF 31
 
 #define KIND_CONTOUR 1u
 #define KIND_CREASE 2u
@@ -71,12 +86,16 @@
 #define CLIP(P, row, x, y, z, h) \
     ((P)[(row)] * (x) + (P)[4 + (row)] * (y) + (P)[8 + (row)] * (z) + (P)[12 + (row)] * (h))
 
-// Depth factor max(1, k/w), or 1 when k = 0.
-inline float depth_factor(float k, float w) { return k > 0.0f ? fmax(1.0f, k / w) : 1.0f; }
+// Depth factor max(1, k/w), or 1 when k = 0 (a select, not fmax: PoCL's
+// work-item vectoriser gives up on fmax).
+inline float depth_factor(float k, float w) {
+    const float f = k / w;
+    return (k > 0.0f && f > 1.0f) ? f : 1.0f;
+}
 
 __kernel void edges_detect(uint n, __global const float* P, __global const float* pos,
-                           __global const uint* edges, __global float* edge_out,
-                           __global uint* kind) {
+                           __global const float* nrm, __global const uint* edges,
+                           __global float* edge_out, __global uint* kind) {
     GID_OR_RETURN(n)
     const uint i0 = edges[4 * gid], i1 = edges[4 * gid + 1];
     const uint i2 = edges[4 * gid + 2], i3 = edges[4 * gid + 3];
@@ -116,11 +135,17 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     const int drawn = k != 0u && c0w > wmin && c1w > wmin;
     __global float* out = edge_out + 16 * gid;
     if (!drawn) {
+        // The marker is already there unless the previous run drew this edge:
+        // skipping the rewrite saves most of the output traffic (edge-out and
+        // kind start as markers and 0, see EdgeStage::new).
+        const uint prev = kind[gid];
         kind[gid] = k;
-        WRITE_MARKER(out, 0);
-        WRITE_MARKER(out, 1);
-        WRITE_MARKER(out, 2);
-        WRITE_MARKER(out, 3);
+        if ((prev & KIND_DRAWN) != 0u) {
+            WRITE_MARKER(out, 0);
+            WRITE_MARKER(out, 1);
+            WRITE_MARKER(out, 2);
+            WRITE_MARKER(out, 3);
+        }
         return;
     }
     kind[gid] = k | KIND_DRAWN;
@@ -134,20 +159,31 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     const float py = len > 0.0f ? dx / len : 1.0f;
     const float f0 = hw * depth_factor(P[PARAM_DEPTH_K], c0w);
     const float f1 = hw * depth_factor(P[PARAM_DEPTH_K], c1w);
-    WRITE_SCREEN(out, 0, s0x - px * f0, s0y - py * f0, c0z, c0w, hvw, hvh);
-    WRITE_SCREEN(out, 1, s1x - px * f1, s1y - py * f1, c1z, c1w, hvw, hvh);
-    WRITE_SCREEN(out, 2, s1x + px * f1, s1y + py * f1, c1z, c1w, hvw, hvh);
-    WRITE_SCREEN(out, 3, s0x + px * f0, s0y + py * f0, c0z, c0w, hvw, hvh);
+    // Half quads (contour-only edges, when asked): from the edge outward by the full
+    // width, outward = the side the projected vertex normal of i0 points to (seed's
+    // sign(m0·p)). Slots stay in perimeter order: 0 = s0, 1 = s1, 2, 3 outside.
+    const int halfq = P[PARAM_HALF] != 0.0f && k == KIND_CONTOUR;
+    const uint j0 = halfq ? i0 : 0u;
+    const float n0x = nrm[3 * j0], n0y = nrm[3 * j0 + 1], n0z = nrm[3 * j0 + 2];
+    const float d0x = CLIP(P, 0, n0x, n0y, n0z, 0.0f), d0y = CLIP(P, 1, n0x, n0y, n0z, 0.0f);
+    const float d0w = CLIP(P, 3, n0x, n0y, n0z, 0.0f);
+    const float m0x = (d0x * c0w - c0x * d0w) * hvw, m0y = (d0y * c0w - c0y * d0w) * hvh;
+    const float g = (m0x * px + m0y * py) >= 0.0f ? 1.0f : -1.0f;
+    const float lo = halfq ? 0.0f : 1.0f, hi = halfq ? 2.0f * g : 1.0f;
+    WRITE_SCREEN(out, 0, s0x - px * f0 * lo, s0y - py * f0 * lo, c0z, c0w, hvw, hvh);
+    WRITE_SCREEN(out, 1, s1x - px * f1 * lo, s1y - py * f1 * lo, c1z, c1w, hvw, hvh);
+    WRITE_SCREEN(out, 2, s1x + px * f1 * hi, s1y + py * f1 * hi, c1z, c1w, hvw, hvh);
+    WRITE_SCREEN(out, 3, s0x + px * f0 * hi, s0y + py * f0 * hi, c0z, c0w, hvw, hvh);
 }
 
 __kernel void caps_mh(uint n, __global const float* P, __global const float* pos,
                       __global const float* nrm, __global const uint* edges,
-                      __global const float* edge_out, __global float* cap0,
-                      __global float* cap1) {
+                      __global const uint* kind, __global float* cap0, __global float* cap1) {
     GID_OR_RETURN(n)
     __global float* o0 = cap0 + 12 * gid;
     __global float* o1 = cap1 + 12 * gid;
-    if (isnan(edge_out[16 * gid])) {
+    // KIND_DRAWN is set exactly when edge-out holds a quad, not the marker.
+    if ((kind[gid] & KIND_DRAWN) == 0u) {
         WRITE_MARKER(o0, 0);
         WRITE_MARKER(o0, 1);
         WRITE_MARKER(o0, 2);
@@ -187,7 +223,7 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
     // (matrix rows x, y, w times |c| times the viewport), use the perpendicular.
     const float msz = fabs(P[0]) + fabs(P[4]) + fabs(P[8]) + fabs(P[1]) + fabs(P[5]) +
                       fabs(P[9]) + fabs(P[3]) + fabs(P[7]) + fabs(P[11]);
-    const float hvm = fmax(hvw, hvh);
+    const float hvm = hvw > hvh ? hvw : hvh;
     const float t0 = 1e-4f * msz * (fabs(c0x) + fabs(c0y) + fabs(c0w)) * hvm;
     const float t1 = 1e-4f * msz * (fabs(c1x) + fabs(c1y) + fabs(c1w)) * hvm;
     const int ok0 = l0 > t0 && l0 > 0.0f, ok1 = l1 > t1 && l1 > 0.0f;
@@ -206,15 +242,33 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
 }
 
 __kernel void caps_adjacency(uint n, __global const float* P, __global const uint* edges,
-                             __global const uint* caps, __global const float* edge_out,
-                             __global float* cap_out) {
+                             __global const uint* caps, __global const uint* kind,
+                             __global const float* edge_out, __global float* cap_out,
+                             __global uchar* cap_drawn) {
     GID_OR_RETURN(n)
     __global float* o = cap_out + 16 * gid;
     const uint e0 = caps[2 * gid], e1 = caps[2 * gid + 1];
     __global const float* q0 = edge_out + 16 * e0;
     __global const float* q1 = edge_out + 16 * e1;
+    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
+    // cache-resident, where edge-out's first x costs a cache line per edge) before
+    // any other read. KIND_DRAWN is set exactly when the quad is not the marker.
+    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
+    // cache-resident, where edge-out's first x costs a cache line per edge) before
+    // any other read; and rewrite the marker only if the previous run drew a cap
+    // here (cap_drawn, one byte per pair; cap-out starts as markers).
+    if (((kind[e0] & kind[e1]) & KIND_DRAWN) == 0u) {
+        if (cap_drawn[gid] != 0) {
+            cap_drawn[gid] = 0;
+            WRITE_MARKER(o, 0);
+            WRITE_MARKER(o, 1);
+            WRITE_MARKER(o, 2);
+            WRITE_MARKER(o, 3);
+        }
+        return;
+    }
     const float hvw = P[PARAM_HVW], hvh = P[PARAM_HVH];
-    int ok = !isnan(q0[0]) && !isnan(q1[0]);
+    int ok = 1;
     const uint a0 = edges[4 * e0], b0 = edges[4 * e1], b1 = edges[4 * e1 + 1];
     const uint v = (a0 == b0 || a0 == b1) ? a0 : edges[4 * e0 + 1];
     // Quad slots at end 0 are 0 and 3, at end 1 are 1 and 2. First edge: its end at
@@ -244,6 +298,7 @@ __kernel void caps_adjacency(uint n, __global const float* P, __global const uin
     const float ls = sqrt(sx * sx + sy * sy);
     // Collinear edges (straight continuation) leave no gap: no cap.
     ok = ok && ls > 1e-4f;
+    cap_drawn[gid] = ok ? 1 : 0;
     if (!ok) {
         WRITE_MARKER(o, 0);
         WRITE_MARKER(o, 1);

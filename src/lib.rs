@@ -7,6 +7,7 @@
 //!
 //! ```text
 //! mesh ─► positions ─► [curvature] ─► normals, areas, k1 k2 d1 d2 dk ─► export (PLY, JSON)
+//! mesh ─► [edges] ─► edge-out + cap-out (House & Li) ─► render, SVG
 //! all outputs ─► render (headless OpenGL: shaded mesh, clip-space edge quads ─► PNG)
 //! ```
 #![warn(missing_docs)]

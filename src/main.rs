@@ -103,6 +103,9 @@ struct EdgesArgs {
     /// this are creases (a cube's edges at 90°); 180 or more finds none.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     crease: f32,
+    /// Draw contour-only edges as half quads, outward from the silhouette.
+    #[arg(long)]
+    half_contours: bool,
     /// Depth-scaled width: width × max(1, K/w), w the clip-space depth.
     #[arg(long, allow_negative_numbers = true)]
     depth_scale: Option<f32>,
@@ -827,13 +830,13 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         Some(f) => read_marked(f)?,
         None => Vec::new(),
     };
-    let marked_name = a
-        .marked
-        .as_ref()
-        .map(|p| p.display().to_string())
-        .unwrap_or_default();
+    let source = a.marked.as_deref().unwrap_or(path).display().to_string();
     let t_topo = Instant::now();
-    let topo = EdgeTopology::new(&mesh, &marked, &marked_name)?;
+    let topo = if mode == CapMode::Adjacency {
+        EdgeTopology::new(&mesh, &marked, &source)?
+    } else {
+        EdgeTopology::without_caps(&mesh, &marked, &source)?
+    };
     let topo_ms = t_topo.elapsed().as_secs_f64() * 1e3;
     let (lo, hi) = mesh.bounds();
     let centre = glam::Vec3::new(
@@ -851,6 +854,7 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     p.line_width = a.width;
     p.crease_deg = crease;
     p.depth_scale = a.depth_scale;
+    p.half_contours = a.half_contours;
     p.pack()?;
 
     let t_all = Instant::now();
@@ -878,7 +882,8 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let count = |bit: u32| out.kind.iter().filter(|&&k| k & bit != 0).count();
     println!(
         "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
-         (contour {}, crease {}, boundary/marked {}); kernels {:.3} ms; wrote {}",
+         (in front of the near plane) of those detected as contour {}, crease {}, \
+         boundary/marked {}; kernels {:.3} ms; wrote {}",
         path.display(),
         topo.edges.len(),
         topo.boundary,

@@ -64,8 +64,14 @@ fn at(pos: &[[f32; 3]], i: u32) -> [f32; 3] {
     pos[i as usize]
 }
 
-/// `edges_detect`: per edge, the kind bits and the quad (4 vertices) or the marker ×4.
-pub fn edges_detect(p: &P, pos: &[[f32; 3]], edges: &[[u32; 4]]) -> (Vec<[f32; 4]>, Vec<u32>) {
+/// `edges_detect`: per edge, the kind bits and the quad (4 vertices) or the
+/// marker ×4; half quads for contour-only edges when the parameters ask.
+pub fn edges_detect(
+    p: &P,
+    pos: &[[f32; 3]],
+    nrm: &[[f32; 3]],
+    edges: &[[u32; 4]],
+) -> (Vec<[f32; 4]>, Vec<u32>) {
     let mut out = Vec::with_capacity(4 * edges.len());
     let mut kinds = Vec::with_capacity(edges.len());
     for &[i0, i1, i2, i3] in edges {
@@ -116,34 +122,33 @@ pub fn edges_detect(p: &P, pos: &[[f32; 3]], edges: &[[u32; 4]]) -> (Vec<[f32; 4
         kinds.push(k | KIND_DRAWN);
         let (s0, s1, q, f0, f1) = (pr.s0, pr.s1, pr.perp, pr.f0, pr.f1);
         let (c0, c1) = (pr.c0, pr.c1);
-        out.push(screen(
-            p,
-            s0[0] - q[0] * f0,
-            s0[1] - q[1] * f0,
-            c0[2],
-            c0[3],
-        ));
-        out.push(screen(
-            p,
-            s1[0] - q[0] * f1,
-            s1[1] - q[1] * f1,
-            c1[2],
-            c1[3],
-        ));
-        out.push(screen(
-            p,
-            s1[0] + q[0] * f1,
-            s1[1] + q[1] * f1,
-            c1[2],
-            c1[3],
-        ));
-        out.push(screen(
-            p,
-            s0[0] + q[0] * f0,
-            s0[1] + q[1] * f0,
-            c0[2],
-            c0[3],
-        ));
+        // Half quads for contour-only edges: outward by the full width.
+        let half = p[31] != 0.0 && k == KIND_CONTOUR;
+        let n = if half { at(nrm, i0) } else { at(nrm, 0) };
+        let d = clip(p, n, 0.0);
+        let m = [
+            (d[0] * c0[3] - c0[0] * d[3]) * p[23],
+            (d[1] * c0[3] - c0[1] * d[3]) * p[24],
+        ];
+        let g = if m[0] * q[0] + m[1] * q[1] >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        let (lo, hi) = if half { (0.0, 2.0 * g) } else { (1.0, 1.0) };
+        let mut put = |s: [f32; 2], c: [f32; 4], f: f32, t: f32| {
+            out.push(screen(
+                p,
+                s[0] + q[0] * f * t,
+                s[1] + q[1] * f * t,
+                c[2],
+                c[3],
+            ));
+        };
+        put(s0, c0, f0, -lo);
+        put(s1, c1, f1, -lo);
+        put(s1, c1, f1, hi);
+        put(s0, c0, f0, hi);
     }
     (out, kinds)
 }

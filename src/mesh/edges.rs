@@ -44,12 +44,28 @@ pub struct EdgeTopology {
 impl EdgeTopology {
     /// Builds the edge and cap buffers of `mesh`; `marked` lists vertex-index
     /// pairs to draw always (each must be an edge of the mesh; see
-    /// [`read_marked`]). `source` names the marked list in errors.
+    /// [`read_marked`]). `source` names the marked list (or the mesh) in errors.
     ///
     /// # Errors
-    /// [`Error::InvalidInput`] for a marked pair that is not an edge, or an
-    /// index past the vertices.
+    /// [`Error::InvalidInput`] for a marked pair that is not an edge, an
+    /// index past the vertices, or more cap pairs than [`MAX_CAP_PAIRS`].
     pub fn new(mesh: &Mesh, marked: &[[u32; 2]], source: &str) -> Result<EdgeTopology> {
+        Self::build(mesh, marked, source, true)
+    }
+
+    /// As [`EdgeTopology::new`] without the cap buffer (`caps` empty), for the
+    /// variants that need none (no caps, McGuire-Hughes caps): no limit on
+    /// vertex degree, less memory and time.
+    pub fn without_caps(mesh: &Mesh, marked: &[[u32; 2]], source: &str) -> Result<EdgeTopology> {
+        Self::build(mesh, marked, source, false)
+    }
+
+    fn build(
+        mesh: &Mesh,
+        marked: &[[u32; 2]],
+        source: &str,
+        with_caps: bool,
+    ) -> Result<EdgeTopology> {
         let nv = mesh.n_vertices();
         // Faces around each undirected edge, in file order: (face, i0, i1, opposite).
         let mut around: HashMap<(u32, u32), Vec<[u32; 3]>> =
@@ -121,7 +137,12 @@ impl EdgeTopology {
                 }
             }
         }
-        let caps = cap_pairs(nv, &edges);
+        let caps = if with_caps {
+            check_cap_count(nv, &edges, source)?;
+            cap_pairs(nv, &edges)
+        } else {
+            Vec::new()
+        };
         Ok(EdgeTopology {
             edges,
             caps,
@@ -130,6 +151,40 @@ impl EdgeTopology {
             marked: n_marked,
         })
     }
+}
+
+/// Largest number of cap pairs: 16 floats per pair must stay addressable with
+/// 32-bit indices on the device.
+pub const MAX_CAP_PAIRS: u64 = (u32::MAX / 16) as u64;
+
+/// Rejects meshes whose cap buffer would not fit ([`MAX_CAP_PAIRS`]): the
+/// count grows with the square of vertex degrees (a fan of 100k triangles
+/// around one apex has 5·10⁹ pairs), so it is counted before anything is
+/// allocated, and the error names the vertex of highest degree.
+fn check_cap_count(nv: usize, edges: &[[u32; 4]], source: &str) -> Result<()> {
+    let mut deg = vec![0u64; nv];
+    for e in edges {
+        deg[e[0] as usize] += 1;
+        deg[e[1] as usize] += 1;
+    }
+    let total: u64 = deg.iter().map(|&d| d * d.saturating_sub(1) / 2).sum();
+    if total > MAX_CAP_PAIRS {
+        let (v, d) = deg
+            .iter()
+            .enumerate()
+            .max_by_key(|(_, d)| **d)
+            .map(|(v, d)| (v, *d))
+            .unwrap_or((0, 0));
+        return Err(Error::input(
+            source,
+            format!("vertex {v}"),
+            format!(
+                "{total} adjacency cap pairs (vertex {v} has {d} edges) exceed the limit of \
+                 {MAX_CAP_PAIRS}; only --caps none or mh can draw this mesh"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Every pair of edge entries sharing an end vertex (see the module documentation).

@@ -11,6 +11,9 @@
 //! handles one edge (`edges_detect`, `caps_mh`) or one cap pair
 //! (`caps_adjacency`). Outputs are indexed by edge or cap, never appended, so
 //! device and CPU ([`crate::cpu::edges`]) results compare element by element.
+//! Outputs persist between runs: a primitive undrawn in this run and the last
+//! one keeps its marker and is not rewritten (`kind` and `cap_drawn uchar[C]`
+//! remember what the last run drew), which removes most of the output traffic.
 //!
 //! Conventions:
 //! - **Contour**: the two face normals face opposite ways seen from the eye
@@ -22,6 +25,10 @@
 //!   none of its face diagonals. (The seed writes `na·nb < −cos θ'`, i.e.
 //!   θ' = 180° − θ is the dihedral angle between the faces.)
 //! - **Boundary and marked**: `i3 == i0`.
+//! - **Half quads** (`half_contours`): contour-only edges extend from the edge
+//!   outward by the full width; their quad-end midpoints lie on the stroke's
+//!   centre line, so adjacency caps join them (McGuire-Hughes caps stay
+//!   centred on the edge).
 //! - **Width**: `line_width` pixels across, times max(1, k/w) with depth scale
 //!   k (the seed's appendix; k = 0 or `None`: constant screen width).
 //! - **Near plane**: an edge with an end at clip w ≤ near (perspective) is not
@@ -110,6 +117,9 @@ pub struct EdgeParams {
     pub boundaries: bool,
     /// Depth scale k of the width factor max(1, k/w); `None`: constant width.
     pub depth_scale: Option<f32>,
+    /// Draw contour-only edges as half quads, from the edge outward by the
+    /// full width (outward: the side of the projected vertex normal).
+    pub half_contours: bool,
 }
 
 impl EdgeParams {
@@ -124,6 +134,7 @@ impl EdgeParams {
             contours: true,
             boundaries: true,
             depth_scale: None,
+            half_contours: false,
         }
     }
 
@@ -188,6 +199,7 @@ impl EdgeParams {
         };
         p[29] = self.contours as u32 as f32;
         p[30] = self.boundaries as u32 as f32;
+        p[31] = self.half_contours as u32 as f32;
         if p.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidArgument(
                 "edges: the camera gives a non-finite view-projection matrix".into(),
@@ -295,7 +307,8 @@ pub struct MemoryUse {
     pub caps: usize,
     /// Edge buffer + edge-out + kind bits.
     pub edge_bits: u64,
-    /// Cap-related bits of the variant (cap buffer + cap-out).
+    /// Cap-related bits of the variant (cap buffer + cap-out, and the
+    /// adjacency variant's one byte of state per cap pair).
     pub cap_bits: u64,
 }
 
@@ -307,7 +320,7 @@ pub fn memory_use(mode: CapMode, edges: usize, caps: usize) -> MemoryUse {
     let cap_bits = match mode {
         CapMode::None => 0,
         CapMode::Mh => 32 * (2 * 12 * e),
-        CapMode::Adjacency => 32 * (2 * c + 16 * c),
+        CapMode::Adjacency => 32 * (2 * c + 16 * c) + 8 * c,
     };
     MemoryUse {
         edges,
@@ -336,6 +349,7 @@ pub struct EdgeStage<'g> {
     cap_mh0: Buffer<f32>,
     cap_mh1: Buffer<f32>,
     cap_adj: Buffer<f32>,
+    cap_drawn: Buffer<u8>,
     last_mode: CapMode,
 }
 
@@ -371,8 +385,18 @@ impl<'g> EdgeStage<'g> {
             cap_mh0: gpu.buffer(12 * ne)?,
             cap_mh1: gpu.buffer(12 * ne)?,
             cap_adj: gpu.buffer(16 * nc)?,
+            cap_drawn: gpu.buffer(nc)?,
             last_mode: CapMode::None,
         };
+        // Outputs persist between runs (undrawn-then-undrawn primitives are not
+        // rewritten): start from markers everywhere.
+        let marker = [f32::NAN, 0.0, -1.0, 1.0];
+        gpu.write(&mut s.edge_out, bytemuck::cast_slice(&vec![marker; 4 * ne]))?;
+        gpu.write(&mut s.cap_mh0, bytemuck::cast_slice(&vec![marker; 3 * ne]))?;
+        gpu.write(&mut s.cap_mh1, bytemuck::cast_slice(&vec![marker; 3 * ne]))?;
+        gpu.write(&mut s.cap_adj, bytemuck::cast_slice(&vec![marker; 4 * nc]))?;
+        gpu.write(&mut s.kind, &vec![0u32; ne])?;
+        gpu.write(&mut s.cap_drawn, &vec![0u8; nc])?;
         gpu.write(&mut s.edges, bytemuck::cast_slice(&topo.edges))?;
         gpu.write(&mut s.caps, bytemuck::cast_slice(&topo.caps))?;
         let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
@@ -427,6 +451,7 @@ impl<'g> EdgeStage<'g> {
                 Arg::U32(ne),
                 buf(&self.params),
                 buf(&self.pos),
+                buf(&self.nrm),
                 buf(&self.edges),
                 buf(&self.edge_out),
                 buf(&self.kind),
@@ -444,7 +469,7 @@ impl<'g> EdgeStage<'g> {
                     buf(&self.pos),
                     buf(&self.nrm),
                     buf(&self.edges),
-                    buf(&self.edge_out),
+                    buf(&self.kind),
                     buf(&self.cap_mh0),
                     buf(&self.cap_mh1),
                 ],
@@ -458,8 +483,10 @@ impl<'g> EdgeStage<'g> {
                     buf(&self.params),
                     buf(&self.edges),
                     buf(&self.caps),
+                    buf(&self.kind),
                     buf(&self.edge_out),
                     buf(&self.cap_adj),
+                    buf(&self.cap_drawn),
                 ],
             )?,
         };
