@@ -2,6 +2,7 @@
 //! the same step names as the kernels. Deliberately simple: they are the
 //! oracles the tests compare the device with.
 
+pub mod ao;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

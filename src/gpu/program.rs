@@ -49,6 +49,11 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
             source: include_str!("../../kernels/skinning.cl"),
             headers: COMMON_HEADERS,
         }),
+        "ao" => Some(KernelFile {
+            name: "kernels/ao.cl",
+            source: include_str!("../../kernels/ao.cl"),
+            headers: COMMON_HEADERS,
+        }),
         "feature_lines" => Some(KernelFile {
             name: "kernels/feature_lines.cl",
             source: include_str!("../../kernels/feature_lines.cl"),

@@ -1,5 +1,6 @@
 //! Host wiring of each kernel family in `kernels/`, one module per family.
 
+pub mod ao;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
