@@ -424,6 +424,30 @@ fn refuse_overwrite(out: &Path, input: Option<&Path>, force: bool) -> Result<()>
     Ok(())
 }
 
+/// Refuses each output that is the input or exists without `--force`, then
+/// creates its parent folder.
+fn prepare_outputs<'a>(
+    outs: impl Iterator<Item = &'a PathBuf>,
+    input: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    for out in outs {
+        refuse_overwrite(out, input, force)?;
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Writes a stats document as pretty JSON and says so.
+fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
 fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let opts = options(&a);
     if a.report {
@@ -442,12 +466,11 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         (None, None) => bail!("give an input mesh, --generate or --report"),
     };
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-    for out in a.output.iter().chain(a.stats.iter()) {
-        refuse_overwrite(out, a.input.as_deref(), a.force)?;
-        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        }
-    }
+    prepare_outputs(
+        a.output.iter().chain(a.stats.iter()),
+        a.input.as_deref(),
+        a.force,
+    )?;
     if a.output.is_none() && a.stats.is_none() {
         eprintln!("note: no --output or --stats given; computing and printing a summary only");
     }
@@ -511,9 +534,7 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         s["counts"] = serde_json::to_value(counts)?;
         s["load_ms"] = serde_json::json!(load_ms);
         s["total_wall_ms"] = serde_json::json!(total_ms);
-        std::fs::write(path, serde_json::to_string_pretty(&s)? + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
-        println!("wrote {}", path.display());
+        write_json(path, &s)?;
     }
     Ok(())
 }
@@ -582,12 +603,11 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         (None, Some(_)) => 0.0,
         (None, None) => bail!("give --iso (the volume's values span {:?})", vol.range()),
     };
-    for out in a.output.iter().chain(a.stats.iter()) {
-        refuse_overwrite(out, a.input.as_deref(), a.force)?;
-        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        }
-    }
+    prepare_outputs(
+        a.output.iter().chain(a.stats.iter()),
+        a.input.as_deref(),
+        a.force,
+    )?;
     let gpu = Arc::new(Gpu::new(device)?);
     let info = gpu.info.clone();
     let t_up = Instant::now();
@@ -627,8 +647,8 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
     } else {
         None
     };
-    let (ipos, _) = ex.read_index_space()?;
-    let mesh = ex.read()?;
+    let (ipos, faces) = ex.read_index_space()?;
+    let mesh = ex.world_mesh(&ipos, faces);
     let q = shapecue::mesh::quality(&mesh.positions, &mesh.faces);
     println!(
         "{name}: iso {iso}, fusion {}: {} vertices, {} faces ({} soup vertices, {} degenerate \
@@ -671,9 +691,7 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
             "quality": q,
             "curvature": curv_stats,
         });
-        std::fs::write(path, serde_json::to_string_pretty(&s)? + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
-        println!("wrote {}", path.display());
+        write_json(path, &s)?;
     }
     Ok(())
 }
@@ -932,9 +950,7 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             "memory_bits": mem,
             "svg_polylines": n_lines,
         });
-        std::fs::write(sp, serde_json::to_string_pretty(&s)? + "\n")
-            .with_context(|| format!("writing {}", sp.display()))?;
-        println!("wrote {}", sp.display());
+        write_json(sp, &s)?;
     }
     Ok(())
 }

@@ -391,13 +391,19 @@ impl Isosurfacer {
     /// (origin + spacing ⊙ p, in f64).
     pub fn read(&self) -> Result<Mesh> {
         let (pos, faces) = self.read_index_space()?;
-        Ok(Mesh {
+        Ok(self.world_mesh(&pos, faces))
+    }
+
+    /// A mesh in world coordinates (origin + spacing ⊙ p, in f64) from
+    /// index-space positions read with [`Isosurfacer::read_index_space`].
+    pub fn world_mesh(&self, pos: &[[f32; 3]], faces: Vec<[u32; 3]>) -> Mesh {
+        Mesh {
             positions: pos
                 .iter()
                 .map(|p| std::array::from_fn(|i| self.origin[i] + self.spacing[i] * p[i] as f64))
                 .collect(),
             faces,
-        })
+        }
     }
 }
 
