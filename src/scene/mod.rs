@@ -1,6 +1,8 @@
-//! Scenes: which shape cues a scene asks for, and the passes they need.
-//! The planner ([`planner`]) is pure data, testable without a device; the
-//! scene file and the executor that runs a plan come with the renderer
-//! integration.
+//! Scenes: a scene file ([`file`]) names an input, cameras, frames and the
+//! shape cues wanted; the planner ([`planner`], pure data, testable without a
+//! device) turns the cues into exactly the passes they need; the executor
+//! ([`exec`]) runs those passes and nothing else, renders, and reports which
+//! passes ran, how often and for how long.
 
+pub mod file;
 pub mod planner;

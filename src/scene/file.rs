@@ -1,0 +1,1018 @@
+//! Scene files (TOML, read with serde through the `toml` crate): what to
+//! draw, from where, which cues, and where the images go.
+//!
+//! ```toml
+//! [input]                      # exactly one source
+//! gltf = "../data/BrainStem.glb"   # or mesh = "bunny.obj", generate = "torus",
+//! clip = 0                         # flipbook = "frames/hand_*.obj", lbs = "elephant.obj",
+//!                                  # volume = "bucky.nhdr" + iso = 51, sdf = "gyroid"
+//! [frames]
+//! start = 0                    # first frame (inclusive)
+//! end = 60                     # last frame (exclusive); default: the whole animation
+//! step = 2
+//! fps = 30                     # glTF clips are sampled at t = frame / fps
+//!
+//! [[camera]]                   # any number; none: one fitted view
+//! orbit = 8                    # 8 fitted views around the up axis
+//! elevation = 20               # degrees above the horizon
+//!
+//! [[camera]]
+//! eye = [0, 1, 4]              # an explicit camera (target defaults to the centre)
+//! fov = 35
+//! ortho = true
+//!
+//! [effects]                    # the cues: only their passes run
+//! shading = {}
+//! curvature_colors = { scale = 2.0 }
+//! ao = { level = "lut", radius = 0.05 }
+//! contours = { width = 2 }
+//! suggestive_contours = { threshold = 0.05, fade = 0.2 }
+//! feature_edges = { crease = 30, caps = "adjacency" }
+//!
+//! [output]
+//! dir = "out/brainstem"        # `--out DIR` on the command line overrides it
+//! size = [640, 480]
+//! formats = ["png", "svg"]
+//! ```
+//!
+//! Every table rejects unknown keys, and every error (syntax, unknown key,
+//! wrong type, a missing or second source, a missing file) names the scene
+//! file and the line. Relative paths are relative to the scene file.
+
+use crate::cpu::ao::AoMode;
+use crate::error::{Error, Result};
+use crate::scene::planner::{Cue, Input};
+use crate::stages::edges::CapMode;
+use serde::Deserialize;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// The scene file as written (after syntax and type checks, before the
+/// cross-field checks of [`Scene::from_str`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Where the geometry comes from.
+    pub input: Spanned<InputSpec>,
+    /// Which frames to render.
+    #[serde(default)]
+    pub frames: Option<Spanned<FramesSpec>>,
+    /// Cameras (`[[camera]]` tables).
+    #[serde(default, rename = "camera")]
+    pub cameras: Vec<Spanned<CameraSpec>>,
+    /// The cues.
+    pub effects: Spanned<EffectsSpec>,
+    /// Images and report.
+    #[serde(default)]
+    pub output: Option<Spanned<OutputSpec>>,
+}
+
+/// `[input]`: exactly one of the source keys.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpec {
+    /// A static mesh file (OBJ, PLY, OFF).
+    pub mesh: Option<Spanned<String>>,
+    /// A generated mesh: torus, sphere, ellipsoid, cylinder or plane.
+    pub generate: Option<Spanned<String>>,
+    /// Vertex count of a generated mesh, or grid resolution of an SDF (default 40000 / 128).
+    pub resolution: Option<usize>,
+    /// A glTF 2.0 file with a skin and animations.
+    pub gltf: Option<Spanned<String>>,
+    /// The glTF clip: index or name (default 0).
+    pub clip: Option<Spanned<ClipRef>>,
+    /// A glob of OBJ/PLY frames with one topology, in natural order.
+    pub flipbook: Option<Spanned<String>>,
+    /// A libigl LBS set: `<stem>.obj` with `<stem>.tgf`, `<stem>-weights.dmat`, `<stem>-anim.dmat`.
+    pub lbs: Option<Spanned<String>>,
+    /// A volume file (NRRD, MetaImage, VTK, VTI, SLC) to extract an isosurface of.
+    pub volume: Option<Spanned<String>>,
+    /// A procedural signed distance field: sphere, torus or gyroid.
+    pub sdf: Option<Spanned<String>>,
+    /// Isovalue (volume: required; SDF: default 0).
+    pub iso: Option<f32>,
+    /// Weld coincident vertices of mesh and flipbook files.
+    #[serde(default)]
+    pub weld: bool,
+}
+
+/// A glTF clip by index or by name.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum ClipRef {
+    /// The clip's index.
+    Index(usize),
+    /// The clip's name.
+    Name(String),
+}
+
+/// `[frames]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FramesSpec {
+    /// First frame (inclusive).
+    #[serde(default)]
+    pub start: usize,
+    /// Last frame (exclusive); default: the whole animation (1 for a static input).
+    pub end: Option<usize>,
+    /// Frame step (≥ 1).
+    #[serde(default = "one")]
+    pub step: usize,
+    /// Frames per second for glTF clips (t = frame / fps).
+    #[serde(default = "thirty")]
+    pub fps: f32,
+}
+
+fn one() -> usize {
+    1
+}
+fn thirty() -> f32 {
+    30.0
+}
+
+impl Default for FramesSpec {
+    fn default() -> Self {
+        FramesSpec {
+            start: 0,
+            end: None,
+            step: 1,
+            fps: 30.0,
+        }
+    }
+}
+
+/// `[[camera]]`: an explicit eye, a fitted direction, or an orbit of fitted views.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Eye position (explicit camera).
+    pub eye: Option<[f32; 3]>,
+    /// Look-at point (default: the centre of the first pose's bounds).
+    pub target: Option<[f32; 3]>,
+    /// Up vector (default +Y).
+    pub up: Option<[f32; 3]>,
+    /// Direction from the centre towards the eye of a fitted camera.
+    pub direction: Option<[f32; 3]>,
+    /// Number of fitted views evenly spaced around the up axis.
+    pub orbit: Option<usize>,
+    /// Orbit elevation above the horizon, degrees (default 20).
+    pub elevation: Option<f32>,
+    /// Azimuth of the first orbit view, degrees (default 0: looking down −Z... from +Z).
+    pub azimuth: Option<f32>,
+    /// Vertical field of view, degrees (default 35).
+    pub fov: Option<f32>,
+    /// Orthographic projection.
+    #[serde(default)]
+    pub ortho: bool,
+}
+
+/// `[effects]`: each present table is a cue.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectsSpec {
+    /// Plain Lambert shading.
+    pub shading: Option<ShadingSpec>,
+    /// Curvature colours.
+    pub curvature_colors: Option<CurvatureColorSpec>,
+    /// Ambient occlusion from curvature (Lambert × AO).
+    pub ao: Option<AoSpec>,
+    /// Occluding contours.
+    pub contours: Option<LineSpec>,
+    /// Suggestive contours.
+    pub suggestive_contours: Option<SuggestiveSpec>,
+    /// Feature edges with caps.
+    pub feature_edges: Option<EdgeSpec>,
+}
+
+/// `[effects.shading]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadingSpec {
+    /// Base colour (default light grey).
+    pub color: Option<[f32; 3]>,
+    /// Ambient term in [0, 1] (default 0.15).
+    pub ambient: Option<f32>,
+}
+
+/// `[effects.curvature_colors]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurvatureColorSpec {
+    /// Curvature (world units⁻¹) at which colours are 76 % saturated (tanh 1);
+    /// default: the 90th percentile of |k| on the first pose.
+    pub scale: Option<f32>,
+}
+
+/// `[effects.ao]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AoSpec {
+    /// `poly` (seed polynomial), `lut` (table, default) or `exact` (integral per vertex).
+    pub level: Option<Spanned<String>>,
+    /// Hemisphere radius as a fraction of the first pose's bounding-box diagonal (default 0.02).
+    pub radius: Option<f32>,
+}
+
+/// `[effects.contours]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineSpec {
+    /// Line width in pixels (default 2).
+    pub width: Option<f32>,
+    /// RGB (default black).
+    pub color: Option<[f32; 3]>,
+}
+
+/// `[effects.suggestive_contours]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuggestiveSpec {
+    /// Line width in pixels (default 1.5).
+    pub width: Option<f32>,
+    /// RGB (default dark grey).
+    pub color: Option<[f32; 3]>,
+    /// Dimensionless threshold (default 0.05; see `LineOptions`).
+    pub threshold: Option<f32>,
+    /// n·v fade (default 0.2).
+    pub fade: Option<f32>,
+}
+
+/// `[effects.feature_edges]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EdgeSpec {
+    /// Width in pixels (default 3).
+    pub width: Option<f32>,
+    /// RGB (default black).
+    pub color: Option<[f32; 3]>,
+    /// Crease angle in degrees, (0, 180]; 180 turns creases off (default 30).
+    pub crease: Option<f32>,
+    /// `none`, `mh` or `adjacency` (default).
+    pub caps: Option<Spanned<String>>,
+    /// Detect contour edges (default true).
+    pub contours: Option<bool>,
+    /// Draw boundary edges (default true).
+    pub boundaries: Option<bool>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Output folder (default `out/<scene name>`, relative to the working directory).
+    pub dir: Option<String>,
+    /// File name prefix (default: the scene file's stem).
+    pub name: Option<String>,
+    /// Image size (default 640 × 480).
+    pub size: Option<[u32; 2]>,
+    /// `png` and/or `svg` (lines only) (default `["png"]`).
+    pub formats: Option<Spanned<Vec<String>>>,
+    /// Multisampling: 0, 2, 4 or 8 (default 4).
+    pub msaa: Option<u32>,
+    /// Background RGB (default white).
+    pub background: Option<[f32; 3]>,
+}
+
+/// Where a scene's geometry comes from, resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// A mesh file.
+    Mesh(PathBuf),
+    /// A generated mesh (kind, vertex count).
+    Generate(String, usize),
+    /// A glTF skin and clip.
+    Gltf(PathBuf, ClipRef),
+    /// A glob of frames.
+    Flipbook(String),
+    /// A libigl LBS set (the OBJ).
+    Lbs(PathBuf),
+    /// A volume file and isovalue.
+    Volume(PathBuf, f32),
+    /// An SDF (kind, resolution, isovalue).
+    Sdf(String, usize, f32),
+}
+
+impl Source {
+    /// The planner's input kind.
+    pub fn input(&self) -> Input {
+        match self {
+            Source::Mesh(_) | Source::Generate(..) => Input::Static,
+            Source::Gltf(..) | Source::Lbs(_) => Input::Skinned,
+            Source::Flipbook(_) => Input::Flipbook,
+            Source::Volume(..) | Source::Sdf(..) => Input::Volume,
+        }
+    }
+}
+
+/// A camera as the scene asks for it (fitted ones are resolved once the
+/// first pose's bounds are known).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraKind {
+    /// Explicit eye; target `None` = the centre of the bounds.
+    LookAt {
+        /// Eye.
+        eye: [f32; 3],
+        /// Target.
+        target: Option<[f32; 3]>,
+    },
+    /// Fitted to the bounds from a direction (centre → eye).
+    Fit([f32; 3]),
+}
+
+/// One resolved view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSpec {
+    /// Position.
+    pub kind: CameraKind,
+    /// Up (default +Y).
+    pub up: Option<[f32; 3]>,
+    /// Vertical field of view in degrees.
+    pub fov: f32,
+    /// Orthographic.
+    pub ortho: bool,
+}
+
+/// Curvature colour, AO, line and edge parameters, resolved with defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Effects {
+    /// The cues asked for.
+    pub cues: Vec<Cue>,
+    /// Shading base colour.
+    pub base_color: [f32; 3],
+    /// Ambient term.
+    pub ambient: f32,
+    /// Curvature colour scale (None: from the first pose).
+    pub curvature_scale: Option<f32>,
+    /// AO level.
+    pub ao_mode: AoMode,
+    /// AO radius as a fraction of the bounding-box diagonal.
+    pub ao_radius: f32,
+    /// Contour width and colour.
+    pub contour: (f32, [f32; 3]),
+    /// Suggestive contour width and colour.
+    pub suggestive: (f32, [f32; 3]),
+    /// Suggestive threshold and fade.
+    pub suggestive_threshold: f32,
+    /// n·v fade.
+    pub suggestive_fade: f32,
+    /// Edge width, colour.
+    pub edge: (f32, [f32; 3]),
+    /// Crease angle (None: off).
+    pub crease: Option<f32>,
+    /// Caps.
+    pub caps: CapMode,
+    /// Edge contours.
+    pub edge_contours: bool,
+    /// Edge boundaries.
+    pub edge_boundaries: bool,
+}
+
+/// A checked scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The scene file.
+    pub path: PathBuf,
+    /// The scene's name (file stem).
+    pub name: String,
+    /// Geometry source.
+    pub source: Source,
+    /// Weld mesh files.
+    pub weld: bool,
+    /// First frame, end (exclusive; None = whole animation), step.
+    pub frames: (usize, Option<usize>, usize),
+    /// Frames per second of glTF sampling.
+    pub fps: f32,
+    /// Views, orbits expanded.
+    pub views: Vec<ViewSpec>,
+    /// Cues and their parameters.
+    pub effects: Effects,
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// File prefix.
+    pub prefix: String,
+    /// Image size.
+    pub size: [u32; 2],
+    /// Write PNG images.
+    pub png: bool,
+    /// Write SVG line drawings.
+    pub svg: bool,
+    /// MSAA samples.
+    pub msaa: u32,
+    /// Background.
+    pub background: [f32; 3],
+}
+
+/// 1-based line and column of a byte offset.
+fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let at = at.min(text.len());
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, col)
+}
+
+/// Checks a scene's cross-field rules with the text at hand for line numbers.
+struct Checker<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Checker<'_> {
+    fn err(&self, span: Range<usize>, problem: impl Into<String>) -> Error {
+        let (l, c) = line_col(self.text, span.start);
+        Error::input(
+            self.path.display().to_string(),
+            format!("line {l}, column {c}"),
+            problem,
+        )
+    }
+
+    /// A path relative to the scene file; it must exist.
+    fn existing(&self, s: &Spanned<String>) -> Result<PathBuf> {
+        let p = self.relative(s.get_ref());
+        if !p.exists() {
+            return Err(self.err(
+                s.span(),
+                format!("{} does not exist", p.display()),
+            ));
+        }
+        Ok(p)
+    }
+
+    fn relative(&self, s: &str) -> PathBuf {
+        let p = Path::new(s);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.path.parent().unwrap_or(Path::new("")).join(p)
+        }
+    }
+}
+
+fn positive(x: Option<f32>, default: f32, what: &str) -> std::result::Result<f32, String> {
+    let v = x.unwrap_or(default);
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{what} must be a positive number, got {v}"))
+    }
+}
+
+fn color(c: Option<[f32; 3]>, default: [f32; 3], what: &str) -> std::result::Result<[f32; 3], String> {
+    let v = c.unwrap_or(default);
+    if v.iter().all(|x| (0.0..=1.0).contains(x)) {
+        Ok(v)
+    } else {
+        Err(format!("{what} {v:?}: components must be in [0, 1]"))
+    }
+}
+
+impl Scene {
+    /// Reads and checks a scene file.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Scene::from_str(path, &text)
+    }
+
+    /// Parses and checks scene text; `path` names it in errors and anchors
+    /// relative paths.
+    pub fn from_str(path: &Path, text: &str) -> Result<Scene> {
+        let ck = Checker { path, text };
+        let file: SceneFile = toml::from_str(text).map_err(|e| {
+            let span = e.span().unwrap_or(0..0);
+            ck.err(span, e.message().trim().to_string())
+        })?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into());
+
+        // Input: exactly one source.
+        let input_span = file.input.span();
+        let inp = file.input.into_inner();
+        let given: Vec<&str> = [
+            ("mesh", inp.mesh.is_some()),
+            ("generate", inp.generate.is_some()),
+            ("gltf", inp.gltf.is_some()),
+            ("flipbook", inp.flipbook.is_some()),
+            ("lbs", inp.lbs.is_some()),
+            ("volume", inp.volume.is_some()),
+            ("sdf", inp.sdf.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(k, g)| g.then_some(k))
+        .collect();
+        if given.len() != 1 {
+            return Err(ck.err(
+                input_span,
+                format!(
+                    "[input] needs exactly one of mesh, generate, gltf, flipbook, lbs, volume, sdf; got {}",
+                    if given.is_empty() {
+                        "none".to_string()
+                    } else {
+                        given.join(", ")
+                    }
+                ),
+            ));
+        }
+        let only = |key: &str, ok: bool| -> Result<()> {
+            if ok {
+                Ok(())
+            } else {
+                Err(ck.err(
+                    input_span.clone(),
+                    format!("`{key}` does not apply to a {} input", given[0]),
+                ))
+            }
+        };
+        only("clip", inp.clip.is_none() || inp.gltf.is_some())?;
+        only(
+            "iso",
+            inp.iso.is_none() || inp.volume.is_some() || inp.sdf.is_some(),
+        )?;
+        only(
+            "resolution",
+            inp.resolution.is_none() || inp.generate.is_some() || inp.sdf.is_some(),
+        )?;
+        only(
+            "weld",
+            !inp.weld || inp.mesh.is_some() || inp.flipbook.is_some(),
+        )?;
+        let source = if let Some(m) = &inp.mesh {
+            Source::Mesh(ck.existing(m)?)
+        } else if let Some(g) = &inp.generate {
+            const KINDS: [&str; 5] = ["torus", "sphere", "ellipsoid", "cylinder", "plane"];
+            if !KINDS.contains(&g.get_ref().as_str()) {
+                return Err(ck.err(
+                    g.span(),
+                    format!("generate = {:?}: expected one of {KINDS:?}", g.get_ref()),
+                ));
+            }
+            Source::Generate(g.get_ref().clone(), inp.resolution.unwrap_or(40_000))
+        } else if let Some(g) = &inp.gltf {
+            let clip = inp
+                .clip
+                .as_ref()
+                .map(|c| c.get_ref().clone())
+                .unwrap_or(ClipRef::Index(0));
+            Source::Gltf(ck.existing(g)?, clip)
+        } else if let Some(f) = &inp.flipbook {
+            let pat = ck.relative(f.get_ref());
+            Source::Flipbook(pat.to_string_lossy().into_owned())
+        } else if let Some(l) = &inp.lbs {
+            Source::Lbs(ck.existing(l)?)
+        } else if let Some(v) = &inp.volume {
+            let Some(iso) = inp.iso else {
+                return Err(ck.err(v.span(), "a volume input needs `iso`"));
+            };
+            if !iso.is_finite() {
+                return Err(ck.err(input_span, format!("iso {iso} must be finite")));
+            }
+            Source::Volume(ck.existing(v)?, iso)
+        } else {
+            let s = inp.sdf.as_ref().expect("one source is given");
+            const KINDS: [&str; 3] = ["sphere", "torus", "gyroid"];
+            if !KINDS.contains(&s.get_ref().as_str()) {
+                return Err(ck.err(
+                    s.span(),
+                    format!("sdf = {:?}: expected one of {KINDS:?}", s.get_ref()),
+                ));
+            }
+            let res = inp.resolution.unwrap_or(128);
+            if !(4..=1024).contains(&res) {
+                return Err(ck.err(
+                    input_span,
+                    format!("resolution {res}: an SDF grid needs 4..=1024 points per axis"),
+                ));
+            }
+            Source::Sdf(s.get_ref().clone(), res, inp.iso.unwrap_or(0.0))
+        };
+        if let Source::Generate(_, n) = &source
+            && !(12..=20_000_000).contains(n)
+        {
+            return Err(ck.err(
+                input_span,
+                format!("resolution {n}: a generated mesh needs 12..=20000000 vertices"),
+            ));
+        }
+
+        // Frames.
+        let (frames, fps) = match &file.frames {
+            None => ((0, None, 1), 30.0),
+            Some(f) => {
+                let s = f.get_ref();
+                if s.step == 0 {
+                    return Err(ck.err(f.span(), "frames.step must be at least 1"));
+                }
+                if let Some(e) = s.end
+                    && e <= s.start
+                {
+                    return Err(ck.err(
+                        f.span(),
+                        format!("frames: end {e} must be greater than start {}", s.start),
+                    ));
+                }
+                if !(s.fps.is_finite() && s.fps > 0.0) {
+                    return Err(ck.err(f.span(), format!("frames.fps {} must be positive", s.fps)));
+                }
+                if source.input() == Input::Static && (s.start > 0 || s.end.is_some_and(|e| e > 1))
+                {
+                    return Err(ck.err(
+                        f.span(),
+                        "a static mesh has one frame (0); use cameras for more views",
+                    ));
+                }
+                ((s.start, s.end, s.step), s.fps)
+            }
+        };
+
+        // Cameras.
+        let mut views = Vec::new();
+        for c in &file.cameras {
+            let s = c.get_ref();
+            let e = |p: String| ck.err(c.span(), p);
+            let fov = s.fov.unwrap_or(35.0);
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(e(format!("fov {fov} must be in (0, 180) degrees")));
+            }
+            let finite = |v: &Option<[f32; 3]>| v.is_none_or(|v| v.iter().all(|x| x.is_finite()));
+            if !(finite(&s.eye) && finite(&s.target) && finite(&s.up) && finite(&s.direction)) {
+                return Err(e("camera vectors must be finite".into()));
+            }
+            if s.up.is_some_and(|u| u == [0.0; 3]) || s.direction.is_some_and(|d| d == [0.0; 3]) {
+                return Err(e("up and direction must be non-zero".into()));
+            }
+            let modes = [s.eye.is_some(), s.direction.is_some(), s.orbit.is_some()];
+            if modes.iter().filter(|&&m| m).count() > 1 {
+                return Err(e("a camera has one of eye, direction or orbit".into()));
+            }
+            if s.target.is_some() && s.eye.is_none() {
+                return Err(e("target goes with eye".into()));
+            }
+            if (s.elevation.is_some() || s.azimuth.is_some()) && s.orbit.is_none() {
+                return Err(e("elevation and azimuth go with orbit".into()));
+            }
+            let view = |kind| ViewSpec {
+                kind,
+                up: s.up,
+                fov,
+                ortho: s.ortho,
+            };
+            if let Some(n) = s.orbit {
+                if !(1..=360).contains(&n) {
+                    return Err(e(format!("orbit {n} must be 1..=360 views")));
+                }
+                let el = s.elevation.unwrap_or(20.0);
+                if !(el.is_finite() && el.abs() < 90.0) {
+                    return Err(e(format!("elevation {el} must be in (−90, 90) degrees")));
+                }
+                let az0 = s.azimuth.unwrap_or(0.0);
+                let up = glam::Vec3::from(s.up.unwrap_or([0.0, 1.0, 0.0])).normalize();
+                // An orthonormal frame around `up`: the azimuth-0 view looks from +Z
+                // when up is +Y.
+                let side = up.any_orthonormal_pair();
+                let (a, b) = if up.abs_diff_eq(glam::Vec3::Y, 1e-6) {
+                    (glam::Vec3::Z, glam::Vec3::X)
+                } else {
+                    (side.1, side.0)
+                };
+                for i in 0..n {
+                    let az = (az0 + 360.0 * i as f32 / n as f32).to_radians();
+                    let (el, az) = (el.to_radians(), az);
+                    let d = (a * az.cos() + b * az.sin()) * el.cos() + up * el.sin();
+                    views.push(view(CameraKind::Fit(d.to_array())));
+                }
+            } else if let Some(eye) = s.eye {
+                if s.target == Some(eye) {
+                    return Err(e("eye and target must differ".into()));
+                }
+                views.push(view(CameraKind::LookAt {
+                    eye,
+                    target: s.target,
+                }));
+            } else {
+                views.push(view(CameraKind::Fit(s.direction.unwrap_or([0.4, 0.3, 1.0]))));
+            }
+        }
+        if views.is_empty() {
+            views.push(ViewSpec {
+                kind: CameraKind::Fit([0.4, 0.3, 1.0]),
+                up: None,
+                fov: 35.0,
+                ortho: false,
+            });
+        }
+
+        // Effects.
+        let fx_span = file.effects.span();
+        let fx = file.effects.into_inner();
+        let e = |p: String| ck.err(fx_span.clone(), p);
+        let mut cues = Vec::new();
+        let shading = fx.shading.clone().unwrap_or_default();
+        if fx.shading.is_some() {
+            cues.push(Cue::Shading);
+        }
+        let base_color = color(shading.color, [0.82, 0.82, 0.8], "shading.color").map_err(e)?;
+        let ambient = shading.ambient.unwrap_or(0.15);
+        if !(0.0..=1.0).contains(&ambient) {
+            return Err(e(format!("shading.ambient {ambient} must be in [0, 1]")));
+        }
+        let mut curvature_scale = None;
+        if let Some(c) = &fx.curvature_colors {
+            cues.push(Cue::CurvatureColors);
+            if let Some(s) = c.scale {
+                curvature_scale = Some(positive(Some(s), 1.0, "curvature_colors.scale").map_err(e)?);
+            }
+        }
+        let mut ao_mode = AoMode::Lut;
+        let mut ao_radius = 0.02;
+        if let Some(a) = &fx.ao {
+            cues.push(Cue::AmbientOcclusion);
+            if let Some(l) = &a.level {
+                ao_mode = match l.get_ref().as_str() {
+                    "poly" => AoMode::Poly,
+                    "lut" => AoMode::Lut,
+                    "exact" => AoMode::Exact,
+                    other => {
+                        return Err(ck.err(
+                            l.span(),
+                            format!("ao.level {other:?}: expected poly, lut or exact"),
+                        ));
+                    }
+                };
+            }
+            ao_radius = positive(a.radius, 0.02, "ao.radius").map_err(e)?;
+        }
+        let c = fx.contours.clone().unwrap_or_default();
+        if fx.contours.is_some() {
+            cues.push(Cue::Contours);
+        }
+        let contour = (
+            positive(c.width, 2.0, "contours.width").map_err(e)?,
+            color(c.color, [0.0; 3], "contours.color").map_err(e)?,
+        );
+        let sc = fx.suggestive_contours.clone().unwrap_or_default();
+        if fx.suggestive_contours.is_some() {
+            cues.push(Cue::SuggestiveContours);
+        }
+        let suggestive = (
+            positive(sc.width, 1.5, "suggestive_contours.width").map_err(e)?,
+            color(sc.color, [0.15; 3], "suggestive_contours.color").map_err(e)?,
+        );
+        let suggestive_threshold = sc.threshold.unwrap_or(0.05);
+        if !(suggestive_threshold.is_finite() && suggestive_threshold >= 0.0) {
+            return Err(e(format!(
+                "suggestive_contours.threshold {suggestive_threshold} must be ≥ 0"
+            )));
+        }
+        let suggestive_fade = positive(sc.fade, 0.2, "suggestive_contours.fade").map_err(e)?;
+        let fe = fx.feature_edges.clone().unwrap_or_default();
+        if fx.feature_edges.is_some() {
+            cues.push(Cue::FeatureEdges);
+        }
+        let edge = (
+            positive(fe.width, 3.0, "feature_edges.width").map_err(e)?,
+            color(fe.color, [0.0; 3], "feature_edges.color").map_err(e)?,
+        );
+        let crease_deg = fe.crease.unwrap_or(30.0);
+        if !(crease_deg > 0.0 && crease_deg <= 180.0) {
+            return Err(e(format!(
+                "feature_edges.crease {crease_deg} must be in (0, 180] degrees"
+            )));
+        }
+        let caps = match &fe.caps {
+            None => CapMode::Adjacency,
+            Some(c) => c
+                .get_ref()
+                .parse()
+                .map_err(|x: Error| ck.err(c.span(), x.to_string()))?,
+        };
+        if cues.is_empty() {
+            return Err(e(
+                "[effects] asks for no cue: add shading, curvature_colors, ao, contours, \
+                 suggestive_contours or feature_edges"
+                    .into(),
+            ));
+        }
+        let effects = Effects {
+            cues,
+            base_color,
+            ambient,
+            curvature_scale,
+            ao_mode,
+            ao_radius,
+            contour,
+            suggestive,
+            suggestive_threshold,
+            suggestive_fade,
+            edge,
+            crease: (crease_deg < 180.0).then_some(crease_deg),
+            caps,
+            edge_contours: fe.contours.unwrap_or(true),
+            edge_boundaries: fe.boundaries.unwrap_or(true),
+        };
+
+        // Output.
+        let (out, out_span) = match file.output {
+            Some(o) => {
+                let s = o.span();
+                (o.into_inner(), s)
+            }
+            None => (OutputSpec::default(), 0..0),
+        };
+        let e = |p: String| ck.err(out_span.clone(), p);
+        let size = out.size.unwrap_or([640, 480]);
+        if size[0] == 0 || size[1] == 0 || size[0] > 16384 || size[1] > 16384 {
+            return Err(e(format!("output.size {size:?} must be 1..=16384 pixels each")));
+        }
+        let msaa = out.msaa.unwrap_or(4);
+        if ![0, 2, 4, 8].contains(&msaa) {
+            return Err(e(format!("output.msaa {msaa} must be 0, 2, 4 or 8")));
+        }
+        let (mut png, mut svg) = (true, false);
+        if let Some(f) = &out.formats {
+            png = false;
+            for x in f.get_ref() {
+                match x.as_str() {
+                    "png" => png = true,
+                    "svg" => svg = true,
+                    other => {
+                        return Err(ck.err(
+                            f.span(),
+                            format!("output format {other:?}: expected png or svg"),
+                        ));
+                    }
+                }
+            }
+            if !png && !svg {
+                return Err(ck.err(f.span(), "output.formats is empty"));
+            }
+        }
+        let background =
+            color(out.background, [1.0, 1.0, 1.0], "output.background").map_err(e)?;
+        let prefix = out.name.clone().unwrap_or_else(|| name.clone());
+        if prefix.is_empty() || prefix.contains(['/', '\\']) {
+            return Err(e(format!(
+                "output.name {prefix:?} must be a non-empty file name prefix"
+            )));
+        }
+        Ok(Scene {
+            path: path.to_path_buf(),
+            out_dir: out
+                .dir
+                .map(PathBuf::from)
+                .unwrap_or_else(|| Path::new("out").join(&name)),
+            name,
+            source,
+            weld: inp.weld,
+            frames,
+            fps,
+            views,
+            effects,
+            prefix,
+            size,
+            png,
+            svg,
+            msaa,
+            background,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Scene> {
+        Scene::from_str(Path::new("/nonexistent/dir/test.toml"), text)
+    }
+
+    fn err(text: &str) -> String {
+        parse(text).expect_err("must fail").to_string()
+    }
+
+    const MIN: &str = "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n";
+
+    #[test]
+    fn a_minimal_scene_gets_defaults() {
+        let s = parse(MIN).unwrap();
+        assert_eq!(s.source, Source::Generate("torus".into(), 40_000));
+        assert_eq!(s.effects.cues, vec![Cue::Shading]);
+        assert_eq!(s.views.len(), 1);
+        assert_eq!(s.size, [640, 480]);
+        assert!(s.png && !s.svg);
+        assert_eq!(s.out_dir, Path::new("out/test"));
+        assert_eq!(s.prefix, "test");
+    }
+
+    #[test]
+    fn unknown_keys_and_wrong_types_name_the_line() {
+        let e = err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\nao = { levle = \"lut\" }\n");
+        assert!(e.contains("test.toml") && e.contains("line 5"), "{e}");
+        assert!(e.contains("levle"), "{e}");
+        let e = err("[input]\ngenerate = \"torus\"\n\n[effects]\nshading = {}\n[output]\nsize = \"big\"\n");
+        assert!(e.contains("line 7"), "{e}");
+        let e = err("[input]\ngenerate = \"torus\"\ncolour = 1\n[effects]\nshading = {}\n");
+        assert!(e.contains("line 3") && e.contains("colour"), "{e}");
+        let e = err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[[camera]]\nfov = \"wide\"\n");
+        assert!(e.contains("line 6"), "{e}");
+        let e = err("[input\n");
+        assert!(e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn sources_must_be_exactly_one_and_files_must_exist() {
+        let e = err("[input]\n[effects]\nshading = {}\n");
+        assert!(e.contains("exactly one") && e.contains("none"), "{e}");
+        let e = err("[input]\ngenerate = \"torus\"\nsdf = \"torus\"\n[effects]\nshading = {}\n");
+        assert!(e.contains("generate, sdf"), "{e}");
+        let e = err("[input]\nmesh = \"missing.obj\"\n[effects]\nshading = {}\n");
+        assert!(
+            e.contains("/nonexistent/dir/missing.obj") && e.contains("line 2"),
+            "{e}"
+        );
+        let e = err("[input]\nvolume = \"v.nrrd\"\n[effects]\nshading = {}\n");
+        assert!(e.contains("iso"), "{e}");
+        let e = err("[input]\ngenerate = \"torus\"\nclip = 2\n[effects]\nshading = {}\n");
+        assert!(e.contains("clip"), "{e}");
+        let e = err("[input]\ngenerate = \"cube\"\n[effects]\nshading = {}\n");
+        assert!(e.contains("line 2") && e.contains("cube"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_are_errors_with_lines() {
+        for (snippet, word) in [
+            ("[effects]\nao = { level = \"fast\" }\n", "fast"),
+            ("[effects]\nao = { radius = -1.0 }\n", "radius"),
+            ("[effects]\nfeature_edges = { caps = \"round\" }\n", "round"),
+            ("[effects]\nfeature_edges = { crease = 0.0 }\n", "crease"),
+            ("[effects]\ncontours = { color = [2.0, 0.0, 0.0] }\n", "color"),
+            ("[effects]\n", "no cue"),
+        ] {
+            let e = err(&format!("[input]\ngenerate = \"torus\"\n{snippet}"));
+            assert!(e.contains(word) && e.contains("line"), "{snippet}: {e}");
+        }
+        for (snippet, word) in [
+            ("[[camera]]\norbit = 0\n", "orbit"),
+            ("[[camera]]\neye = [0.0, 0.0, 1.0]\norbit = 4\n", "one of"),
+            ("[[camera]]\neye = [1.0, 0.0, 0.0]\ntarget = [1.0, 0.0, 0.0]\n", "differ"),
+            ("[[camera]]\nfov = 180.0\n", "fov"),
+            ("[frames]\nstep = 0\n", "step"),
+            ("[frames]\nend = 5\n", "static"),
+            ("[output]\nsize = [0, 10]\n", "size"),
+            ("[output]\nformats = [\"jpg\"]\n", "jpg"),
+            ("[output]\nmsaa = 3\n", "msaa"),
+        ] {
+            let e = err(&format!("{MIN}{snippet}"));
+            assert!(e.contains(word) && e.contains("line"), "{snippet}: {e}");
+        }
+    }
+
+    #[test]
+    fn orbits_expand_to_evenly_spaced_unit_directions() {
+        let s = parse(&format!("{MIN}[[camera]]\norbit = 8\nelevation = 30\n[[camera]]\neye = [0.0, 0.0, 3.0]\northo = true\n")).unwrap();
+        assert_eq!(s.views.len(), 9);
+        let dirs: Vec<glam::Vec3> = s.views[..8]
+            .iter()
+            .map(|v| match v.kind {
+                CameraKind::Fit(d) => glam::Vec3::from(d),
+                _ => panic!("orbit views are fitted"),
+            })
+            .collect();
+        for (i, d) in dirs.iter().enumerate() {
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            assert!((d.y - 30f32.to_radians().sin()).abs() < 1e-5, "elevation");
+            let next = dirs[(i + 1) % 8];
+            let flat = |v: glam::Vec3| glam::Vec2::new(v.x, v.z).normalize();
+            let ang = flat(*d).angle_to(flat(next)).abs().to_degrees();
+            assert!((ang - 45.0).abs() < 1e-3, "{ang}");
+        }
+        assert!(dirs[0].z > 0.8, "azimuth 0 looks from +Z: {:?}", dirs[0]);
+        assert!(s.views[8].ortho);
+    }
+
+    #[test]
+    fn effects_resolve_cues_and_parameters() {
+        let s = parse("[input]\nsdf = \"gyroid\"\nresolution = 64\n[effects]\ncurvature_colors = {}\nao = { level = \"exact\", radius = 0.1 }\nsuggestive_contours = { threshold = 0.1 }\nfeature_edges = { crease = 180, caps = \"mh\" }\n[output]\nformats = [\"svg\"]\n").unwrap();
+        assert_eq!(s.source, Source::Sdf("gyroid".into(), 64, 0.0));
+        assert_eq!(
+            s.effects.cues,
+            vec![
+                Cue::CurvatureColors,
+                Cue::AmbientOcclusion,
+                Cue::SuggestiveContours,
+                Cue::FeatureEdges
+            ]
+        );
+        assert_eq!(s.effects.ao_mode, AoMode::Exact);
+        assert_eq!(s.effects.ao_radius, 0.1);
+        assert_eq!(s.effects.crease, None);
+        assert_eq!(s.effects.caps, CapMode::Mh);
+        assert!(!s.png && s.svg);
+        assert_eq!(s.source.input(), Input::Volume);
+    }
+}
