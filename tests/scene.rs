@@ -129,3 +129,29 @@ fn run_counts_follow_the_lifetimes() {
         "{text}"
     );
 }
+
+#[test]
+fn the_cap_variant_decides_the_cap_passes() {
+    use shapecue::scene::planner::plan_with;
+    use shapecue::stages::edges::CapMode;
+    for input in INPUTS {
+        let adj = plan_with(&[Cue::FeatureEdges], input, CapMode::Adjacency);
+        assert_eq!(adj, plan(&[Cue::FeatureEdges], input));
+        assert!(adj.contains(Pass::Caps) && adj.contains(Pass::CapBuffer));
+        let mh = plan_with(&[Cue::FeatureEdges], input, CapMode::Mh);
+        assert!(mh.contains(Pass::Caps) && !mh.contains(Pass::CapBuffer));
+        let none = plan_with(&[Cue::FeatureEdges], input, CapMode::None);
+        assert!(!none.contains(Pass::Caps) && !none.contains(Pass::CapBuffer));
+        assert!(none.contains(Pass::EdgeDetect) && none.contains(Pass::EdgeBuffer));
+        // Other cues are unaffected.
+        let all = plan_with(&Cue::ALL, input, CapMode::None);
+        let full = plan(&Cue::ALL, input);
+        let diff: Vec<Pass> = full
+            .passes
+            .iter()
+            .copied()
+            .filter(|p| !all.contains(*p))
+            .collect();
+        assert_eq!(diff, vec![Pass::CapBuffer, Pass::Caps]);
+    }
+}

@@ -25,6 +25,7 @@
 //! one after another; each public call makes its own context current first.
 
 mod camera;
+pub mod colormap;
 mod context;
 mod frame;
 mod lines;

@@ -11,6 +11,7 @@
 //! isosurface changes topology with every pose, so its topology passes are
 //! pose passes.
 
+use crate::stages::edges::CapMode;
 use serde::Serialize;
 
 /// A shape cue a scene can ask for.
@@ -184,13 +185,25 @@ pub struct Plan {
 /// Plans exactly the passes `cues` need for `input`: the closure of their
 /// needs, nothing else, in an order where every pass follows what it reads.
 pub fn plan(cues: &[Cue], input: Input) -> Plan {
+    plan_with(cues, input, CapMode::Adjacency)
+}
+
+/// [`plan`] for feature edges drawn with `caps`: adjacency caps need the cap
+/// buffer and the cap pass; McGuire-Hughes half-caps need the cap pass only
+/// (they are built from each edge alone); no caps need neither.
+pub fn plan_with(cues: &[Cue], input: Input, caps: CapMode) -> Plan {
     let mut set = std::collections::BTreeSet::new();
     let mut stack: Vec<Pass> = cues
         .iter()
         .flat_map(|c| c.needs().iter().copied())
         .collect();
     while let Some(p) = stack.pop() {
-        if set.insert(p) {
+        let dropped = match caps {
+            CapMode::Adjacency => false,
+            CapMode::Mh => p == Pass::CapBuffer,
+            CapMode::None => matches!(p, Pass::CapBuffer | Pass::Caps),
+        };
+        if !dropped && set.insert(p) {
             stack.extend(p.needs(input));
         }
     }
