@@ -45,6 +45,27 @@ enum Cmd {
     /// caps, to PNG (and SVG). Exit code 3: `--interop on` on a device without
     /// cl_khr_gl_sharing (such as PoCL); 1: any other error.
     Edges(EdgesArgs),
+    /// Render scene files (TOML): only the passes the scene's cues need run;
+    /// images (PNG, SVG) and a JSON report of the passes that ran go to the
+    /// scene's output folder. See `scenes/` and the README.
+    Render(RenderArgs),
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Scene files.
+    #[arg(required = true)]
+    scenes: Vec<PathBuf>,
+    /// Output folder (overrides each scene's `[output] dir`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Overwrite existing images and reports.
+    #[arg(long)]
+    force: bool,
+    /// Print each scene's plan (passes, lifetimes, run counts) and exit
+    /// without computing or writing anything.
+    #[arg(long)]
+    explain: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -319,6 +340,7 @@ fn run() -> Result<()> {
         Cmd::Curvature(a) => curvature(cli.device.as_deref(), a),
         Cmd::Isosurface(a) => isosurface(cli.device.as_deref(), a),
         Cmd::Edges(a) => edges(cli.device.as_deref(), a),
+        Cmd::Render(a) => render(cli.device.as_deref(), a),
     }
 }
 
@@ -951,6 +973,92 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             "svg_polylines": n_lines,
         });
         write_json(sp, &s)?;
+    }
+    Ok(())
+}
+
+fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use shapecue::scene::exec::{self, ExecOptions};
+    use shapecue::scene::file::Scene;
+    use std::io::IsTerminal;
+    let opts = ExecOptions {
+        out_dir: a.out.clone(),
+        force: a.force,
+        device: device.map(str::to_string),
+    };
+    // Check every scene before running any, so a typo in the last one does
+    // not surface after minutes of rendering.
+    let scenes: Vec<Scene> = a
+        .scenes
+        .iter()
+        .map(|p| Scene::load(p))
+        .collect::<shapecue::Result<_>>()?;
+    for scene in &scenes {
+        if a.explain {
+            print!("{}", exec::explain(scene, &opts)?);
+            continue;
+        }
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        if !std::io::stderr().is_terminal() {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        bar.set_style(
+            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} views {elapsed} ETA {eta}")
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(scene.name.clone());
+        let r = exec::run(scene, &opts, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        })?;
+        bar.finish_and_clear();
+        println!(
+            "{}: {} frame(s) x {} view(s), {} vertices, {} faces on {}",
+            r.scene,
+            r.frames.len(),
+            r.views,
+            r.vertices,
+            r.faces,
+            r.device
+        );
+        println!(
+            "  {:<20} {:<9} {:>6} {:>10} {:>10}  how",
+            "pass", "lifetime", "runs", "total ms", "ms/run"
+        );
+        for p in &r.passes {
+            println!(
+                "  {:<20} {:<9} {:>6} {:>10.2} {:>10.3}  {} ({})",
+                format!("{:?}", p.pass),
+                format!("{:?}", p.lifetime),
+                p.runs,
+                p.ms,
+                p.ms / p.runs.max(1) as f64,
+                p.how,
+                p.clock
+            );
+        }
+        println!(
+            "  per frame: pose passes {:.2} ms (median); per view: lines/edges {:.2} ms, render {:.1} ms; \
+             segments: {} contour, {} suggestive; wall {:.0} ms",
+            r.pose_ms_median,
+            r.view_ms_median,
+            r.render_ms_median,
+            r.segments[0],
+            r.segments[1],
+            r.wall_ms
+        );
+        for n in &r.notes {
+            println!("  note: {n}");
+        }
+        let dir = r
+            .outputs
+            .first()
+            .and_then(|p| p.parent())
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
+        println!("  wrote {} file(s) to {dir} and the report", r.outputs.len());
     }
     Ok(())
 }

@@ -4,5 +4,6 @@
 //! ([`exec`]) runs those passes and nothing else, renders, and reports which
 //! passes ran, how often and for how long.
 
+pub mod exec;
 pub mod file;
 pub mod planner;

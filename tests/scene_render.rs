@@ -1,0 +1,257 @@
+//! The scene executor on real runs: the passes that ran are exactly the
+//! plan's, as often as the lifetimes promise (minimality checked on the
+//! device, not just in the planner); images and the report are written;
+//! nothing is overwritten without `force`; the example scenes parse.
+//!
+//! Needs OpenCL (PoCL) and headless GL; without libEGL the tests print why
+//! and pass, unless `SHAPECUE_REQUIRE_GL=1` (CI).
+
+use shapecue::Error;
+use shapecue::scene::exec::{self, ExecOptions, RunReport};
+use shapecue::scene::file::Scene;
+use shapecue::scene::planner::{Cue, Pass, plan_with};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")
+}
+
+fn tmp_dir(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let d = std::env::temp_dir().join(format!(
+        "shapecue-scene-{}-{tag}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes a scene next to its outputs and parses it.
+fn scene(dir: &Path, text: &str) -> Scene {
+    let p = dir.join("s.toml");
+    std::fs::write(&p, text).unwrap();
+    Scene::load(&p).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// Runs a scene into `dir/out`; `None` (after a message) without GL.
+fn run(s: &Scene, dir: &Path, force: bool) -> Option<Result<RunReport, Error>> {
+    let opts = ExecOptions {
+        out_dir: Some(dir.join("out")),
+        force,
+        device: None,
+    };
+    match exec::run(s, &opts, &mut |_, _| {}) {
+        Err(e @ Error::NoGl { .. }) if std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() => {
+            eprintln!("skipping GL test: {e}");
+            None
+        }
+        r => Some(r),
+    }
+}
+
+/// The passes that ran are exactly the planned ones, each as often as
+/// `Plan::runs` says.
+fn check_minimal(r: &RunReport, what: &str) {
+    let ran: Vec<Pass> = r.passes.iter().map(|p| p.pass).collect();
+    assert_eq!(ran, r.plan.passes, "{what}: passes that ran vs planned");
+    for p in &r.passes {
+        assert_eq!(
+            p.runs,
+            r.plan.runs(p.pass, r.frames.len(), r.views),
+            "{what}: runs of {:?}",
+            p.pass
+        );
+        assert!(p.ms.is_finite() && p.ms >= 0.0, "{what}: {p:?}");
+    }
+}
+
+const CUES: [(&str, Cue); 6] = [
+    ("shading = {}", Cue::Shading),
+    ("curvature_colors = {}", Cue::CurvatureColors),
+    ("ao = {}", Cue::AmbientOcclusion),
+    ("contours = {}", Cue::Contours),
+    ("suggestive_contours = {}", Cue::SuggestiveContours),
+    ("feature_edges = { crease = 20 }", Cue::FeatureEdges),
+];
+
+#[test]
+fn static_scenes_run_exactly_their_passes() {
+    // Each cue alone, some pairs, and all of them; two views of one static
+    // mesh: pose passes once, view passes twice.
+    let mut sets: Vec<Vec<usize>> = (0..6).map(|i| vec![i]).collect();
+    sets.extend([vec![3, 4], vec![2, 3], vec![0, 5], vec![0, 1, 2, 3, 4, 5]]);
+    for set in sets {
+        let dir = tmp_dir("static");
+        let fx: String = set.iter().map(|&i| format!("{}\n", CUES[i].0)).collect();
+        let s = scene(
+            &dir,
+            &format!(
+                "[input]\ngenerate = \"torus\"\nresolution = 3000\n[[camera]]\norbit = 2\n\
+                 [effects]\n{fx}[output]\nsize = [96, 72]\nformats = [\"png\", \"svg\"]\n"
+            ),
+        );
+        let Some(r) = run(&s, &dir, false) else {
+            return;
+        };
+        let r = r.unwrap();
+        let cues: Vec<Cue> = set.iter().map(|&i| CUES[i].1).collect();
+        assert_eq!(
+            r.plan,
+            plan_with(&cues, s.source.input(), s.effects.caps),
+            "{cues:?}"
+        );
+        check_minimal(&r, &format!("{cues:?}"));
+        assert_eq!(r.outputs.len(), 4, "2 views × png + svg");
+        for p in &r.outputs {
+            assert!(p.exists(), "{}", p.display());
+        }
+        let report = dir.join("out/s_report.json");
+        let j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(
+            j["passes"].as_array().unwrap().len(),
+            r.plan.passes.len(),
+            "{cues:?}"
+        );
+        if cues.contains(&Cue::Contours) {
+            assert!(r.segments[0] > 0, "a torus from two views has contours");
+        }
+        if !cues.contains(&Cue::SuggestiveContours) {
+            assert_eq!(r.segments[1], 0);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn curvature_colours_show_convex_red_and_saddle_green_on_a_torus() {
+    let dir = tmp_dir("colors");
+    // Looking down the torus axis (z): the outer half of the ring is convex
+    // (red), the inner half saddle-shaped (green).
+    let s = scene(
+        &dir,
+        "[input]\ngenerate = \"torus\"\nresolution = 8000\n[[camera]]\ndirection = [0.0, 0.0, 1.0]\n\
+         [effects]\ncurvature_colors = {}\n[output]\nsize = [128, 128]\nmsaa = 0\n",
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let r = r.unwrap();
+    let img = image::open(&r.outputs[0]).unwrap().to_rgb8();
+    let (mut red, mut green) = (0, 0);
+    for p in img.pixels() {
+        let [pr, pg, pb] = p.0.map(i32::from);
+        if pr > pg + 40 && pr > pb + 40 {
+            red += 1;
+        }
+        if pg > pr + 40 && pg > pb + 40 {
+            green += 1;
+        }
+    }
+    assert!(red > 200 && green > 100, "red {red}, green {green}");
+    // The centre of the image is the hole: background.
+    assert_eq!(img.get_pixel(64, 64).0, [255, 255, 255]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn outputs_are_not_overwritten_without_force() {
+    let dir = tmp_dir("force");
+    let s = scene(
+        &dir,
+        "[input]\ngenerate = \"sphere\"\nresolution = 500\n[effects]\nshading = {}\n[output]\nsize = [32, 32]\n",
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let png = r.unwrap().outputs[0].clone();
+    std::fs::write(&png, b"mine").unwrap();
+    let e = run(&s, &dir, false).unwrap().expect_err("refuses");
+    assert!(e.to_string().contains("--force"), "{e}");
+    assert_eq!(std::fs::read(&png).unwrap(), b"mine", "untouched");
+    run(&s, &dir, true).unwrap().unwrap();
+    assert_ne!(std::fs::read(&png).unwrap(), b"mine", "overwritten with force");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_isosurface_scene_rebuilds_topology_every_pose() {
+    let dir = tmp_dir("volume");
+    let s = scene(
+        &dir,
+        "[input]\nsdf = \"torus\"\nresolution = 40\n[[camera]]\norbit = 3\n[effects]\n\
+         curvature_colors = {}\nsuggestive_contours = {}\nfeature_edges = { caps = \"mh\" }\n\
+         [output]\nsize = [64, 64]\n",
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "volume");
+    assert!(r.plan.contains(Pass::Isosurface) && !r.plan.contains(Pass::CapBuffer));
+    let _ = std::fs::remove_dir_all(&dir);
+    // An empty isosurface is a clear error, not blank images.
+    let dir = tmp_dir("volume-empty");
+    let s = scene(
+        &dir,
+        "[input]\nsdf = \"sphere\"\nresolution = 16\niso = 5.0\n[effects]\nshading = {}\n",
+    );
+    let e = run(&s, &dir, false).unwrap().expect_err("empty");
+    assert!(e.to_string().contains("empty"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_skinned_scene_runs_pose_passes_per_frame_and_topology_once() {
+    let gltf = shared().join("animations/gltf/RiggedSimple.glb");
+    if !gltf.exists() {
+        eprintln!("skipping: {} not found", gltf.display());
+        return;
+    }
+    let dir = tmp_dir("skinned");
+    let s = scene(
+        &dir,
+        &format!(
+            "[input]\ngltf = {:?}\n[frames]\nend = 6\nstep = 2\n[[camera]]\norbit = 2\n[effects]\n\
+             ao = {{ level = \"poly\" }}\ncontours = {{}}\nsuggestive_contours = {{}}\n\
+             feature_edges = {{}}\n[output]\nsize = [64, 48]\n",
+            gltf.display().to_string()
+        ),
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "skinned");
+    assert_eq!(r.frames, vec![0, 2, 4]);
+    let runs = |p: Pass| r.passes.iter().find(|x| x.pass == p).map(|x| x.runs);
+    assert_eq!(runs(Pass::Skin), Some(3));
+    assert_eq!(runs(Pass::OneRings), Some(1));
+    assert_eq!(runs(Pass::Dcurv), Some(3));
+    assert_eq!(runs(Pass::Contours), Some(6));
+    assert_eq!(r.outputs.len(), 6);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn every_example_scene_parses() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).unwrap();
+        if text.contains("shared/data") && !shared().exists() {
+            eprintln!("skipping {}: ../shared/data not found", p.display());
+            continue;
+        }
+        Scene::load(&p).unwrap_or_else(|e| panic!("{e}"));
+        n += 1;
+    }
+    assert!(n >= 2, "the bundled scenes at least");
+}
