@@ -1,12 +1,15 @@
 //! Triangle meshes: the index-based data type, loaders (OBJ, PLY, OFF),
-//! validation and welding.
+//! validation and welding; animated sources: glTF skins ([`skinned`]),
+//! flipbook sequences ([`flipbook`]) and libigl LBS sets ([`libigl`]).
 //!
 //! Positions are kept in `f64` on the host so that a mesh far from the origin
 //! or at an extreme scale survives until the stage that uploads it, which
 //! centres and scales it before rounding to the device's precision.
 
 pub mod edges;
+pub mod flipbook;
 mod generate;
+pub mod libigl;
 mod load;
 mod quality;
 pub mod skinned;
