@@ -1,11 +1,15 @@
 //! Host wiring of `kernels/ao.cl`: ambient occlusion from (k1, k2) at one of
 //! three accuracy levels. The table of the `lut` level is built once per
 //! process on the host (f64 integral) and uploaded once per stage.
+//! [`AoStage::run`] takes (k1, k2) from the host; [`AoStage::run_device`]
+//! reads them from a curvature estimator's device buffer (the per-frame
+//! pipeline), and both leave the values on the device for [`AoStage::read`].
 //! CPU twin: [`crate::cpu::ao`].
 
 use crate::cpu::ao::{AoMode, LUT_N, build_lut, dirs};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::stages::curvature::CurvatureEstimator;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::{Arc, OnceLock};
@@ -25,6 +29,8 @@ pub struct AoStage {
     k: Buffer<f32>,
     out: Buffer<f32>,
     cap: usize,
+    /// Vertices of the last run (what [`AoStage::read`] may return).
+    computed: usize,
 }
 
 impl AoStage {
@@ -44,6 +50,7 @@ impl AoStage {
             k: gpu.buffer(2)?,
             out: gpu.buffer(1)?,
             cap: 1,
+            computed: 0,
             gpu,
         })
     }
@@ -51,25 +58,73 @@ impl AoStage {
     /// AO of each vertex from its (k1, k2), hemisphere radius `radius`
     /// (world units, > 0); returns the values and the kernel ms.
     pub fn run(&mut self, k: &[[f32; 2]], radius: f32, mode: AoMode) -> Result<(Vec<f32>, f64)> {
-        if !(radius.is_finite() && radius > 0.0) {
+        check_radius(radius)?;
+        let n = k.len();
+        self.reserve(n)?;
+        self.gpu.write(&mut self.k, k.as_flattened())?;
+        let ms = self.enqueue(buf(&self.k), n, radius, mode)?;
+        Ok((self.read(n)?, ms))
+    }
+
+    /// AO of every vertex of the estimator's last run, without a host round
+    /// trip: (k1, k2) are read from its device buffer. `radius` is in world
+    /// units (> 0); the device curvatures are normalized (× scale), so the
+    /// kernel gets `radius / scale` and `k·R` is the same product as in
+    /// [`AoStage::run`]. The values stay on the device ([`AoStage::read`]);
+    /// returns the kernel ms. Needs an f32 estimator.
+    pub fn run_device(
+        &mut self,
+        est: &CurvatureEstimator,
+        radius: f32,
+        mode: AoMode,
+    ) -> Result<f64> {
+        check_radius(radius)?;
+        let d = est.device_outputs()?;
+        let r = (f64::from(radius) / d.norm.scale) as f32;
+        if !(r.is_finite() && r > 0.0) {
             return Err(Error::InvalidArgument(format!(
-                "AO radius must be finite and positive, got {radius}"
+                "AO radius {radius} over the mesh scale {} is not a positive f32",
+                d.norm.scale
             )));
         }
-        let n = k.len();
+        self.reserve(d.nv)?;
+        self.enqueue(buf(d.k), d.nv, r, mode)
+    }
+
+    /// The first `n` AO values of the last run (at most the vertices it computed).
+    pub fn read(&self, n: usize) -> Result<Vec<f32>> {
+        if n > self.computed {
+            return Err(Error::InvalidArgument(format!(
+                "AO read of {n} values: the last run computed {}",
+                self.computed
+            )));
+        }
+        let mut out = vec![0f32; n];
+        self.gpu.read(&self.out, &mut out)?;
+        Ok(out)
+    }
+
+    /// Grows the buffers to `n` vertices.
+    fn reserve(&mut self, n: usize) -> Result<()> {
         if n > self.cap {
             self.k = self.gpu.buffer(2 * n)?;
             self.out = self.gpu.buffer(n)?;
             self.cap = n;
         }
-        self.gpu.write(&mut self.k, k.as_flattened())?;
+        Ok(())
+    }
+
+    /// Runs `ao_vertex` on `n` (k1, k2) pairs of `k` (a float buffer of at
+    /// least 2n) with the curvature-space radius `radius`; waits for it and
+    /// returns its kernel ms.
+    fn enqueue(&mut self, k: Arg, n: usize, radius: f32, mode: AoMode) -> Result<f64> {
         let ev = launch(
             &self.gpu,
             &self.kernel,
             n,
             &[
                 Arg::U32(n as u32),
-                buf(&self.k),
+                k,
                 Arg::F32(radius),
                 Arg::U32(mode.code()),
                 buf(&self.lut),
@@ -78,8 +133,23 @@ impl AoStage {
                 buf(&self.out),
             ],
         )?;
-        let mut out = vec![0f32; n];
-        self.gpu.read(&self.out, &mut out)?;
-        Ok((out, ev.as_ref().map(event_ms).unwrap_or(0.0)))
+        self.computed = n;
+        match ev {
+            Some(e) => {
+                e.wait().map_err(|e| Error::cl("ao_vertex", e))?;
+                Ok(event_ms(&e))
+            }
+            None => Ok(0.0),
+        }
+    }
+}
+
+fn check_radius(radius: f32) -> Result<()> {
+    if radius.is_finite() && radius > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "AO radius must be finite and positive, got {radius}"
+        )))
     }
 }

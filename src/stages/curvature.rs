@@ -95,6 +95,34 @@ pub struct Intermediate {
     pub dk: Vec<[f64; 4]>,
 }
 
+/// Borrowed device buffers of the last run, for stages that chain on the
+/// device ([`crate::stages::ao::AoStage::run_device`],
+/// [`crate::stages::feature_lines::LineExtractor::extract_device`]). Values
+/// are f32 in *normalized* coordinates (`p' = (p − center)/scale`, see
+/// [`Normalization`]): curvatures are multiplied by `scale` and the
+/// derivative by `scale²` relative to the world. Lengths in floats: `pos`,
+/// `nrm`, `d1`, `d2` 3·nv; `k` (k1, k2) 2·nv; `dk` 4·nv. After a run up to
+/// [`Pass::Frames`] only `pos` and `nrm` are current; the others hold the
+/// previous run's values, or zeros.
+pub struct DeviceOutputs<'a> {
+    /// Vertices.
+    pub nv: usize,
+    /// Normalized positions.
+    pub pos: &'a Buffer<u8>,
+    /// Unit normals.
+    pub nrm: &'a Buffer<u8>,
+    /// First principal directions.
+    pub d1: &'a Buffer<u8>,
+    /// Second principal directions.
+    pub d2: &'a Buffer<u8>,
+    /// (k1, k2), normalized.
+    pub k: &'a Buffer<u8>,
+    /// Curvature derivative (C111, C112, C122, C222), normalized.
+    pub dk: &'a Buffer<u8>,
+    /// The pose's normalization, to map results back to world units.
+    pub norm: Normalization,
+}
+
 /// A mesh's curvature estimator on one device.
 pub struct CurvatureEstimator {
     gpu: Arc<Gpu>,
@@ -364,7 +392,14 @@ impl CurvatureEstimator {
             &[Arg::U32(nf as u32), buf(&faces_b), buf(&owner)],
         )?;
         gpu.finish()?;
-        let rb = |n: usize| gpu.buffer::<u8>(n * real);
+        // Zeroed once: a partial run (normals only, for contours) leaves the
+        // curvature buffers unwritten, and later stages reading them through
+        // [`CurvatureEstimator::device_outputs`] must see finite values.
+        let rb = |n: usize| -> Result<Buffer<u8>> {
+            let mut b = gpu.buffer::<u8>(n * real)?;
+            gpu.write(&mut b, &vec![0u8; n * real])?;
+            Ok(b)
+        };
         let est = CurvatureEstimator {
             pos: rb(3 * nv)?,
             nrm: rb(3 * nv)?,
@@ -623,6 +658,29 @@ impl CurvatureEstimator {
             passes,
             kernel_ms,
             wall_ms,
+        })
+    }
+
+    /// The device buffers of the last run, for chaining later stages on the
+    /// device without a host round trip. Only f32 buffers can be chained (the
+    /// line and AO kernels are f32): an f64 estimator is refused.
+    pub fn device_outputs(&self) -> Result<DeviceOutputs<'_>> {
+        if self.opts.precision != Precision::F32 {
+            return Err(Error::InvalidArgument(
+                "device chaining needs f32 precision (this curvature estimator runs f64; \
+                 use --precision f32, or read the field back)"
+                    .into(),
+            ));
+        }
+        Ok(DeviceOutputs {
+            nv: self.nv,
+            pos: &self.pos,
+            nrm: &self.nrm,
+            d1: &self.pd1,
+            d2: &self.pd2,
+            k: &self.kk,
+            dk: &self.dk,
+            norm: self.norm,
         })
     }
 

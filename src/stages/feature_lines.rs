@@ -1,6 +1,8 @@
 //! Host wiring of `kernels/feature_lines.cl`: occluding and suggestive
 //! contours of a mesh with curvature, per view. The faces are uploaded once;
-//! each call uploads the per-vertex inputs and runs `lines_vertex` and
+//! each call uploads the per-vertex inputs ([`LineExtractor::extract`]) or
+//! reads them from a curvature estimator's device buffers
+//! ([`LineExtractor::extract_device`]) and runs `lines_vertex` and
 //! `lines_face`. The segment buffer holds two segments per face (one of each
 //! kind), the most a face can emit, and the kernel still counts and refuses
 //! what does not fit. CPU twin: [`crate::cpu::feature_lines`].
@@ -8,6 +10,7 @@
 use crate::cpu::feature_lines::{LineInputs, Segment, View};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::stages::curvature::CurvatureEstimator;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -117,17 +120,7 @@ impl LineExtractor {
                 "feature lines: every per-vertex input needs {n} entries"
             )));
         }
-        if view.eye.iter().any(|c| !c.is_finite()) || (view.ortho && view.eye == [0.0; 3]) {
-            return Err(Error::InvalidArgument(format!(
-                "feature lines: invalid view {:?} (finite eye; a non-zero direction when orthographic)",
-                view.eye
-            )));
-        }
-        if !(feature_size.is_finite() && feature_size > 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "feature size must be finite and positive, got {feature_size}"
-            )));
-        }
+        check_view(view, feature_size)?;
         let g = self.gpu.clone();
         g.write(&mut self.inputs[0], x.pos.as_flattened())?;
         g.write(&mut self.inputs[1], x.nrm.as_flattened())?;
@@ -135,10 +128,77 @@ impl LineExtractor {
         g.write(&mut self.inputs[3], x.d2.as_flattened())?;
         g.write(&mut self.inputs[4], x.k.as_flattened())?;
         g.write(&mut self.inputs[5], x.dk.as_flattened())?;
+        let inputs = self.inputs.each_ref().map(buf);
+        self.run(inputs, view, feature_size, opts)
+    }
+
+    /// Extracts the lines of the estimator's last run seen from `view`,
+    /// reading its device buffers (no upload; only the segments come back).
+    /// `view` and `feature_size` are in world units like in
+    /// [`LineExtractor::extract`]: the eye of a perspective view is mapped
+    /// into the estimator's normalized coordinates (an orthographic direction
+    /// is unchanged), the feature size is divided by the scale, and the
+    /// segments are mapped back to world coordinates (`p·scale + center`).
+    /// Contours need only the normals: a run up to
+    /// [`crate::stages::curvature::Pass::Frames`] is enough for
+    /// `contours`-only options. Needs an f32 estimator of this topology's
+    /// vertex count.
+    pub fn extract_device(
+        &mut self,
+        est: &CurvatureEstimator,
+        view: View,
+        feature_size: f32,
+        opts: LineOptions,
+    ) -> Result<(Vec<Segment>, LineStats)> {
+        check_view(view, feature_size)?;
+        let d = est.device_outputs()?;
+        if d.nv != self.nv {
+            return Err(Error::InvalidArgument(format!(
+                "feature lines: the curvature estimator has {} vertices, the extractor was built for {}",
+                d.nv, self.nv
+            )));
+        }
+        let norm = d.norm;
+        let eye = if view.ortho {
+            view.eye
+        } else {
+            norm.apply(view.eye.map(f64::from)).map(|c| c as f32)
+        };
+        let local = View {
+            eye,
+            ortho: view.ortho,
+        };
+        let size = (f64::from(feature_size) / norm.scale) as f32;
+        // Huge world values may not survive the mapping into f32.
+        check_view(local, size)?;
+        let inputs = [d.pos, d.nrm, d.d1, d.d2, d.k, d.dk].map(buf);
+        let (mut segs, stats) = self.run(inputs, local, size, opts)?;
+        let world = |p: [f32; 3]| -> [f32; 3] {
+            std::array::from_fn(|i| (f64::from(p[i]) * norm.scale + norm.center[i]) as f32)
+        };
+        for s in &mut segs {
+            s.0 = world(s.0);
+            s.1 = world(s.1);
+        }
+        Ok((segs, stats))
+    }
+
+    /// Runs `lines_vertex` and `lines_face` on the per-vertex float buffers
+    /// `inputs` (pos, nrm, d1, d2, k, dk) in one coordinate system, with
+    /// `view` and `feature_size` in that system, and reads the segments back.
+    fn run(
+        &mut self,
+        inputs: [Arg; 6],
+        view: View,
+        feature_size: f32,
+        opts: LineOptions,
+    ) -> Result<(Vec<Segment>, LineStats)> {
+        let n = self.nv;
+        let g = self.gpu.clone();
         g.write(&mut self.counter, &[0])?;
         let [ex, ey, ez] = view.eye;
         let mut args: Vec<Arg> = vec![Arg::U32(n as u32)];
-        args.extend(self.inputs.iter().map(buf));
+        args.extend(inputs);
         args.extend([
             Arg::F32(ex),
             Arg::F32(ey),
@@ -155,7 +215,7 @@ impl LineExtractor {
             &[
                 Arg::U32(self.nf as u32),
                 buf(&self.faces),
-                buf(&self.inputs[0]),
+                inputs[0],
                 buf(&self.terms[0]),
                 buf(&self.terms[1]),
                 buf(&self.terms[2]),
@@ -189,4 +249,21 @@ impl LineExtractor {
         };
         Ok((segs, stats))
     }
+}
+
+/// A finite eye (a non-zero direction when orthographic) and a finite,
+/// positive feature size.
+fn check_view(view: View, feature_size: f32) -> Result<()> {
+    if view.eye.iter().any(|c| !c.is_finite()) || (view.ortho && view.eye == [0.0; 3]) {
+        return Err(Error::InvalidArgument(format!(
+            "feature lines: invalid view {:?} (finite eye; a non-zero direction when orthographic)",
+            view.eye
+        )));
+    }
+    if !(feature_size.is_finite() && feature_size > 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "feature size must be finite and positive, got {feature_size}"
+        )));
+    }
+    Ok(())
 }

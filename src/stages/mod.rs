@@ -1,10 +1,13 @@
-//! Host wiring of each kernel family in `kernels/`, one module per family.
+//! Host wiring of each kernel family in `kernels/`, one module per family,
+//! and `pipeline`, which chains skinning, curvature, AO and feature lines per
+//! pose on the device.
 
 pub mod ao;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
 pub mod marching_cubes;
+pub mod pipeline;
 pub mod radix_sort;
 pub mod scan;
 pub mod skinning;

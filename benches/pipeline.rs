@@ -1,0 +1,71 @@
+//! Criterion group `pipeline/<model>/total` on the shared glTF models
+//! (skipped with a message when `../shared/data` is absent): one frame of the
+//! default per-pose device pipeline
+//! ([`shapecue::stages::pipeline::PosePipeline::frame`], the code behind
+//! `shapecue::report::pipeline_report`): skin, curvature with dcurv (f32,
+//! atomic), AO (`lut`), contours + suggestive contours from one perspective
+//! view, chained on the device; per frame only the joint matrices go up and
+//! the segments come back. Frames step through the first clip. Per model the
+//! per-pass kernel-ms medians, their total and the wall-clock median are
+//! printed, with the 16 ms frame budget of the issue.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use shapecue::gpu::Gpu;
+use shapecue::mesh::skinned::load_gltf;
+use shapecue::report::median;
+use shapecue::stages::feature_lines::LineOptions;
+use shapecue::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+fn bench(c: &mut Criterion) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/animations/gltf");
+    if !dir.exists() {
+        eprintln!("skipping: {} not found", dir.display());
+        return;
+    }
+    let gpu = Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)"));
+    let mut g = c.benchmark_group("pipeline");
+    g.sample_size(20).measurement_time(Duration::from_secs(4));
+    for name in ["BrainStem", "CesiumMan", "Fox"] {
+        let path = dir.join(format!("{name}.glb"));
+        if !path.exists() {
+            eprintln!("skipping {name}: {} not found", path.display());
+            continue;
+        }
+        let m = load_gltf(&path).expect("model loads");
+        let frames = clip_poses(&m, 30).expect("poses");
+        let mut p =
+            PosePipeline::new(gpu.clone(), &m, PipelineOptions::default()).expect("pipeline");
+        let (view, size, opts) = (p.front_view(), p.feature_size(), LineOptions::default());
+        let mut times: Vec<PassTimes> = Vec::new();
+        let mut i = 0;
+        g.bench_function(format!("{name}/total"), |b| {
+            b.iter(|| {
+                i = (i + 1) % frames.len();
+                let (segs, t) = p.frame(&frames[i], view, size, opts).expect("frame");
+                times.push(t);
+                segs
+            })
+        });
+        let med = |f: fn(&PassTimes) -> f64| median(&mut times.iter().map(f).collect::<Vec<_>>());
+        let (total, wall) = (med(|t| t.kernel_ms()), med(|t| t.wall_ms));
+        eprintln!(
+            "pipeline/{name}: {} vertices, {} frames timed; kernel medians: skin {:.3} ms, \
+             curvature+dcurv {:.3} ms, ao lut {:.3} ms, lines {:.3} ms, total {total:.3} ms; \
+             wall {wall:.3} ms per frame; 16 ms budget {}",
+            m.rest.positions.len(),
+            times.len(),
+            med(|t| t.skin_ms),
+            med(|t| t.curvature_ms),
+            med(|t| t.ao_ms),
+            med(|t| t.lines_ms),
+            if wall <= 16.0 { "met" } else { "NOT met" }
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
