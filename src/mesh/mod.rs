@@ -168,3 +168,30 @@ pub fn check_positions(positions: &[[f64; 3]], source: &str) -> Result<()> {
     }
     Ok(())
 }
+
+/// A characteristic feature size of a mesh: the median edge length (over
+/// each face's three edges, so interior edges count twice, like trimesh2's
+/// `TriMesh::feature_size`, which approximates the same median by sampling).
+/// Feature-line thresholds are scaled by it, so they do not depend on the
+/// mesh's units. Non-finite lengths are ignored; 0 for a mesh without faces.
+pub fn feature_size(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> f64 {
+    let mut l: Vec<f64> = faces
+        .iter()
+        .flat_map(|f| {
+            (0..3).map(move |k| {
+                let (a, b) = (
+                    positions[f[k] as usize],
+                    positions[f[(k + 1) % 3] as usize],
+                );
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            })
+        })
+        .filter(|x| x.is_finite())
+        .collect();
+    if l.is_empty() {
+        return 0.0;
+    }
+    let mid = l.len() / 2;
+    let (_, m, _) = l.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}

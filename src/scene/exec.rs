@@ -308,6 +308,9 @@ fn pass_ms(t: &RunTiming, names: &[&str]) -> f64 {
 /// Per-topology device state.
 struct Topology<'g> {
     mesh: Mesh,
+    /// Median edge length ([`crate::mesh::feature_size`]) of the topology's
+    /// first pose: the scale of the suggestive-contour threshold.
+    feature_size: f32,
     est: Option<CurvatureEstimator>,
     lines: Option<LineExtractor>,
     edges: Option<EdgeStage<'g>>,
@@ -515,7 +518,14 @@ pub fn run(
 
             // Topology passes.
             if let Some(m) = new_mesh {
+                let fs = crate::mesh::feature_size(&m.positions, &m.faces);
+                let fs = if fs > 0.0 {
+                    fs
+                } else {
+                    Normalization::of(&m.positions).scale
+                };
                 let mut t = Topology {
+                    feature_size: fs as f32,
                     mesh: m,
                     est: None,
                     lines: None,
@@ -623,7 +633,7 @@ pub fn run(
                 }
                 bounds = Some(b);
             }
-            pose.feature_size = Normalization::of(&t.mesh.positions).scale as f32;
+            pose.feature_size = t.feature_size;
             if let (Some(ao), Some(est)) = (ao_stage.as_mut(), t.est.as_ref()) {
                 let ms = ao.run_device(est, ao_radius, fx.ao_mode)?;
                 rec.add(Pass::Ao, ms, "kernel", &format!("ao_vertex, level {:?}", fx.ao_mode));
