@@ -53,9 +53,21 @@ enum Cmd {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene files.
-    #[arg(required = true)]
+    /// Scene files (with `--report`: glTF files to time the per-frame device
+    /// pipeline on; default ../shared/data/animations/gltf/BrainStem.glb).
+    #[arg(required_unless_present = "report")]
     scenes: Vec<PathBuf>,
+    /// Print the per-frame device pipeline table (skin, curvature with dcurv,
+    /// AO at each level with its error, contours and suggestive contours) of
+    /// skinned glTF models, timed apart from rendering.
+    #[arg(long)]
+    report: bool,
+    /// Frames of the first clip sampled by `--report`.
+    #[arg(long, default_value_t = 30)]
+    frames: usize,
+    /// Timed runs per frame for `--report` (medians are printed).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
     /// Output folder (overrides each scene's `[output] dir`).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -982,6 +994,29 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
     use shapecue::scene::exec::{self, ExecOptions};
     use shapecue::scene::file::Scene;
     use std::io::IsTerminal;
+    if a.report {
+        let models = if a.scenes.is_empty() {
+            vec![PathBuf::from(
+                "../shared/data/animations/gltf/BrainStem.glb",
+            )]
+        } else {
+            a.scenes.clone()
+        };
+        let gpu = Arc::new(Gpu::new(device)?);
+        for m in &models {
+            if !m.exists() {
+                bail!(
+                    "{}: not found (give the glTF files to time: `shapecue render --report MODEL.glb`)",
+                    m.display()
+                );
+            }
+            print!(
+                "{}",
+                report::pipeline_report(gpu.clone(), m, a.frames.max(1), a.runs.max(1))?
+            );
+        }
+        return Ok(());
+    }
     let opts = ExecOptions {
         out_dir: a.out.clone(),
         force: a.force,
@@ -1004,9 +1039,11 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
             bar.set_draw_target(ProgressDrawTarget::hidden());
         }
         bar.set_style(
-            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} views {elapsed} ETA {eta}")
-                .expect("a valid template")
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{prefix} [{bar:30}] {pos}/{len} views {elapsed} ETA {eta}",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
         );
         bar.set_prefix(scene.name.clone());
         let r = exec::run(scene, &opts, &mut |done, total| {
@@ -1058,7 +1095,10 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
             .and_then(|p| p.parent())
             .map(|p| p.display().to_string())
             .unwrap_or_default();
-        println!("  wrote {} file(s) to {dir} and the report", r.outputs.len());
+        println!(
+            "  wrote {} file(s) to {dir} and the report",
+            r.outputs.len()
+        );
     }
     Ok(())
 }

@@ -275,3 +275,42 @@ fn isosurface_bad_input_is_a_clear_error() {
     let e = run(&["--sdf", "sphere", "--iso", "NaN"]);
     assert!(e.to_lowercase().contains("iso"), "{e}");
 }
+
+#[test]
+fn render_explains_plans_and_names_scene_errors() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/torus.toml");
+    let out = bin().args(["render", scene, "--explain"]).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    // Curvature colours + AO + contours + suggestive contours: dcurv runs,
+    // feature edges do not; 4 orbit views.
+    assert!(
+        s.contains("Dcurv") && s.contains("Ao") && !s.contains("EdgeDetect"),
+        "{s}"
+    );
+    assert!(s.contains("1 frame(s) × 4 view(s)"), "{s}");
+    let d = tmpdir("render-bad");
+    let bad = d.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[input]\ngenerate = \"torus\"\n[effects]\nshadows = {}\n",
+    )
+    .unwrap();
+    let out = bin().args(["render"]).arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("bad.toml") && e.contains("line 4") && e.contains("shadows"),
+        "{e}"
+    );
+    // A missing scene file is named.
+    let out = bin()
+        .args(["render", "no/such/scene.toml"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scene.toml"));
+}

@@ -140,6 +140,7 @@ fn the_cap_variant_decides_the_cap_passes() {
         assert!(adj.contains(Pass::Caps) && adj.contains(Pass::CapBuffer));
         let mh = plan_with(&[Cue::FeatureEdges], input, CapMode::Mh);
         assert!(mh.contains(Pass::Caps) && !mh.contains(Pass::CapBuffer));
+        assert!(mh.contains(Pass::VertexNormals) && !adj.contains(Pass::VertexNormals));
         let none = plan_with(&[Cue::FeatureEdges], input, CapMode::None);
         assert!(!none.contains(Pass::Caps) && !none.contains(Pass::CapBuffer));
         assert!(none.contains(Pass::EdgeDetect) && none.contains(Pass::EdgeBuffer));

@@ -173,7 +173,11 @@ fn outputs_are_not_overwritten_without_force() {
     assert!(e.to_string().contains("--force"), "{e}");
     assert_eq!(std::fs::read(&png).unwrap(), b"mine", "untouched");
     run(&s, &dir, true).unwrap().unwrap();
-    assert_ne!(std::fs::read(&png).unwrap(), b"mine", "overwritten with force");
+    assert_ne!(
+        std::fs::read(&png).unwrap(),
+        b"mine",
+        "overwritten with force"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -254,4 +258,51 @@ fn every_example_scene_parses() {
         n += 1;
     }
     assert!(n >= 2, "the bundled scenes at least");
+}
+
+#[test]
+fn a_flipbook_scene_loads_every_frame_and_builds_topology_once() {
+    let dir = tmp_dir("flipbook");
+    let m = shapecue::mesh::torus(1.0, 0.4, 24, 12);
+    for f in 0..4 {
+        // Frame f: the torus squashed along z by a growing amount.
+        let mut obj = String::new();
+        for p in &m.positions {
+            let s = 1.0 - 0.15 * f as f64;
+            obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2] * s));
+        }
+        for t in &m.faces {
+            obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        }
+        std::fs::write(dir.join(format!("frame_{f}.obj")), obj).unwrap();
+    }
+    let s = scene(
+        &dir,
+        "[input]\nflipbook = \"frame_*.obj\"\n[frames]\nstart = 1\n[effects]\nshading = {}\n\
+         ao = {}\nfeature_edges = { caps = \"mh\" }\n[output]\nsize = [48, 48]\n",
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "flipbook");
+    assert_eq!(r.frames, vec![1, 2, 3]);
+    let runs = |p: Pass| r.passes.iter().find(|x| x.pass == p).map(|x| x.runs);
+    assert_eq!(runs(Pass::LoadFrame), Some(3));
+    assert_eq!(runs(Pass::EdgeBuffer), Some(1));
+    assert_eq!(runs(Pass::CapBuffer), None, "mh caps need no cap buffer");
+    assert_eq!(runs(Pass::Caps), Some(3));
+    // A frame with another topology is an error naming the file.
+    std::fs::write(
+        dir.join("frame_9.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let s = scene(
+        &dir,
+        "[input]\nflipbook = \"frame_*.obj\"\n[effects]\nshading = {}\n[output]\nsize = [48, 48]\n",
+    );
+    let e = run(&s, &dir, true).unwrap().expect_err("topology changes");
+    assert!(e.to_string().contains("frame_9.obj"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

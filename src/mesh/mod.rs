@@ -179,10 +179,7 @@ pub fn feature_size(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> f64 {
         .iter()
         .flat_map(|f| {
             (0..3).map(move |k| {
-                let (a, b) = (
-                    positions[f[k] as usize],
-                    positions[f[(k + 1) % 3] as usize],
-                );
+                let (a, b) = (positions[f[k] as usize], positions[f[(k + 1) % 3] as usize]);
                 ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
             })
         })

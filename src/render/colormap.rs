@@ -30,7 +30,10 @@ pub fn curvature_color(k1: f32, k2: f32, scale: f32, base: [f32; 3]) -> [f32; 3]
     let k = a * b;
     let (target, t) = if k >= 0.0 {
         let h = 0.5 * (a + b);
-        (if h >= 0.0 { CONVEX } else { CONCAVE }, (h.abs() / s).tanh())
+        (
+            if h >= 0.0 { CONVEX } else { CONCAVE },
+            (h.abs() / s).tanh(),
+        )
     } else {
         (SADDLE, ((-k).sqrt() / s).tanh())
     };
@@ -56,7 +59,11 @@ pub fn curvature_scale(k: &[[f32; 2]]) -> f32 {
 
 /// `color` × `ao` (AO clamped to [0, 1]; a non-finite AO counts as 1).
 pub fn with_ao(color: [f32; 3], ao: f32) -> [f32; 3] {
-    let a = if ao.is_finite() { ao.clamp(0.0, 1.0) } else { 1.0 };
+    let a = if ao.is_finite() {
+        ao.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
     color.map(|c| c * a)
 }
 
@@ -86,12 +93,25 @@ mod tests {
         let weak = curvature_color(0.2, 0.1, 1.0, BASE);
         let strong = curvature_color(4.0, 2.0, 1.0, BASE);
         assert!(strong[1] < weak[1]);
-        let nasty = [0.0, 1e-30, -1e-30, 1e30, -1e30, f32::MAX, f32::MIN, f32::NAN, f32::INFINITY];
+        let nasty = [
+            0.0,
+            1e-30,
+            -1e-30,
+            1e30,
+            -1e30,
+            f32::MAX,
+            f32::MIN,
+            f32::NAN,
+            f32::INFINITY,
+        ];
         for &a in &nasty {
             for &b in &nasty {
                 for s in [1e-30, 1.0, 1e30, 0.0, f32::NAN] {
                     let c = curvature_color(a, b, s, BASE);
-                    assert!(c.iter().all(|x| (0.0..=1.0).contains(x)), "{a} {b} {s}: {c:?}");
+                    assert!(
+                        c.iter().all(|x| (0.0..=1.0).contains(x)),
+                        "{a} {b} {s}: {c:?}"
+                    );
                 }
             }
         }

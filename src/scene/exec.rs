@@ -191,9 +191,11 @@ fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
                 frames,
             }
         }
-        Source::Flipbook(pat) => {
-            Loaded::Flipbook(crate::mesh::flipbook::Flipbook::open(pat, Path::new(""), &opts)?)
-        }
+        Source::Flipbook(pat) => Loaded::Flipbook(crate::mesh::flipbook::Flipbook::open(
+            pat,
+            Path::new(""),
+            &opts,
+        )?),
         Source::Volume(p, iso) => Loaded::Volume(Box::new(crate::volume::load(p, None)?), *iso),
         Source::Sdf(kind, res, iso) => {
             Loaded::Volume(Box::new(crate::volume::sdf::sdf_by_name(kind, *res)?), *iso)
@@ -367,7 +369,10 @@ pub fn run(
     let mut notes = Vec::new();
     let loaded = load(scene, &mut notes)?;
     let frames = frame_indices(scene, loaded.frames())?;
-    let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.out_dir.clone());
+    let out_dir = opts
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| scene.out_dir.clone());
     let (images, report_path) = output_paths(scene, &frames, &out_dir);
     // Refuse before any work: nothing the user has is overwritten.
     if !opts.force {
@@ -469,7 +474,12 @@ pub fn run(
                     if let Some(sk) = skinner.as_mut() {
                         let mats = poses(frame)?;
                         let ms = sk.pose(&mats)?;
-                        rec.add(Pass::Skin, ms, "kernel", "skin_lbs (linear blend, ≤ 4 joints)");
+                        rec.add(
+                            Pass::Skin,
+                            ms,
+                            "kernel",
+                            "skin_lbs (linear blend, ≤ 4 joints)",
+                        );
                         t_pose += ms;
                     }
                 }
@@ -542,14 +552,25 @@ pub fn run(
                             crate::stages::marching_cubes::IsoNormals::Gradient,
                         )?;
                         let _ = tt;
-                        rec.add(Pass::OneRings, est.topology_ms(), "kernel", "owning faces (atomic_max), faces copied on the device");
+                        rec.add(
+                            Pass::OneRings,
+                            est.topology_ms(),
+                            "kernel",
+                            "owning faces (atomic_max), faces copied on the device",
+                        );
                         record_curvature(&mut rec, &timing, &plan, "gradient of the volume");
                         t_pose += est.topology_ms() + timing.kernel_ms;
                         t.est = Some(est);
                     } else {
                         let tt = Instant::now();
-                        let est = CurvatureEstimator::new(gpu.clone(), nv, &t.mesh.faces, curv_opts)?;
-                        rec.add(Pass::OneRings, ms_since(tt), "wall", "upload faces, owning faces (atomic_max)");
+                        let est =
+                            CurvatureEstimator::new(gpu.clone(), nv, &t.mesh.faces, curv_opts)?;
+                        rec.add(
+                            Pass::OneRings,
+                            ms_since(tt),
+                            "wall",
+                            "upload faces, owning faces (atomic_max)",
+                        );
                         t.est = Some(est);
                     }
                 }
@@ -565,7 +586,12 @@ pub fn run(
                         EdgeTopology::without_caps(&t.mesh, &[], &name)?
                     };
                     let both = ms_since(tt);
-                    rec.add(Pass::EdgeBuffer, both, "wall", "unique edges with opposite vertices (host, once per topology)");
+                    rec.add(
+                        Pass::EdgeBuffer,
+                        both,
+                        "wall",
+                        "unique edges with opposite vertices (host, once per topology)",
+                    );
                     if has(Pass::CapBuffer) {
                         rec.add(Pass::CapBuffer, 0.0, "wall", "pairs of edges sharing a vertex (built with the edge buffer; time counted there)");
                     }
@@ -573,7 +599,9 @@ pub fn run(
                 }
                 topo = Some(t);
             }
-            let t = topo.as_mut().expect("a topology exists after the first pose");
+            let t = topo
+                .as_mut()
+                .expect("a topology exists after the first pose");
             let nv = t.mesh.n_vertices();
 
             // Curvature (with its normals) on the pose's positions.
@@ -585,7 +613,12 @@ pub fn run(
                     est.set_positions(host_pos.as_deref().unwrap_or(&t.mesh.positions))?;
                 }
                 let timing = est.run_until(last_curv)?;
-                record_curvature(&mut rec, &timing, &plan, "curvature normals (area-weighted)");
+                record_curvature(
+                    &mut rec,
+                    &timing,
+                    &plan,
+                    "curvature normals (area-weighted)",
+                );
                 t_pose += timing.kernel_ms;
             }
             // Host copies for drawing and host passes.
@@ -599,25 +632,30 @@ pub fn run(
             if let Some(est) = t.est.as_ref() {
                 let f = est.read()?;
                 pose.nrm = to_f32(&f.normals);
-                pose.k = f
-                    .k1
-                    .iter()
-                    .zip(&f.k2)
-                    .map(|(&a, &b)| [a as f32, b as f32])
-                    .collect();
-            } else {
+                pose.k =
+                    f.k1.iter()
+                        .zip(&f.k2)
+                        .map(|(&a, &b)| [a as f32, b as f32])
+                        .collect();
+            } else if has(Pass::VertexNormals) {
                 let tt = Instant::now();
                 let m = Mesh {
                     positions: pose.pos.iter().map(|p| p.map(f64::from)).collect(),
                     faces: t.mesh.faces.clone(),
                 };
                 pose.nrm = vertex_normals(&m);
-                pose.k.clear();
-                if has(Pass::VertexNormals) {
-                    let ms = ms_since(tt);
-                    rec.add(Pass::VertexNormals, ms, "wall", "area-weighted, host (no curvature planned)");
-                    t_pose += ms;
-                }
+                let ms = ms_since(tt);
+                rec.add(
+                    Pass::VertexNormals,
+                    ms,
+                    "wall",
+                    "area-weighted, host (no curvature planned)",
+                );
+                t_pose += ms;
+            } else {
+                // Nothing planned reads vertex normals: edges_detect and
+                // caps_adjacency do not, and a lines-only mesh is drawn flat.
+                pose.nrm = vec![[0.0; 3]; nv];
             }
             if bounds.is_none() {
                 let b = bounds_of(&pose.pos);
@@ -636,7 +674,12 @@ pub fn run(
             pose.feature_size = t.feature_size;
             if let (Some(ao), Some(est)) = (ao_stage.as_mut(), t.est.as_ref()) {
                 let ms = ao.run_device(est, ao_radius, fx.ao_mode)?;
-                rec.add(Pass::Ao, ms, "kernel", &format!("ao_vertex, level {:?}", fx.ao_mode));
+                rec.add(
+                    Pass::Ao,
+                    ms,
+                    "kernel",
+                    &format!("ao_vertex, level {:?}", fx.ao_mode),
+                );
                 t_pose += ms;
                 pose.ao = ao.read(nv)?;
             }
@@ -684,13 +727,24 @@ pub fn run(
                 let ms = stats.vertex_ms + stats.face_ms;
                 t_view += ms;
                 if has(Pass::Contours) {
-                    rec.add(Pass::Contours, ms, "kernel", "lines_vertex + lines_face (zero crossings of n·v)");
+                    rec.add(
+                        Pass::Contours,
+                        ms,
+                        "kernel",
+                        "lines_vertex + lines_face (zero crossings of n·v)",
+                    );
                 }
                 if has(Pass::SuggestiveContours) {
                     let (ms, how) = if has(Pass::Contours) {
-                        (0.0, "in the same lines_vertex + lines_face launch as the contours (time counted there)")
+                        (
+                            0.0,
+                            "in the same lines_vertex + lines_face launch as the contours (time counted there)",
+                        )
                     } else {
-                        (ms, "lines_vertex + lines_face (zero crossings of κr with D_w κr > 0)")
+                        (
+                            ms,
+                            "lines_vertex + lines_face (zero crossings of κr with D_w κr > 0)",
+                        )
                     };
                     rec.add(Pass::SuggestiveContours, ms, "kernel", how);
                 }
@@ -704,9 +758,19 @@ pub fn run(
                 p.contours = fx.edge_contours;
                 p.boundaries = fx.edge_boundaries;
                 let timing = es.run(&p, fx.caps)?;
-                rec.add(Pass::EdgeDetect, timing.detect_ms, "kernel", "edges_detect (contour, crease, boundary) into edge-out");
+                rec.add(
+                    Pass::EdgeDetect,
+                    timing.detect_ms,
+                    "kernel",
+                    "edges_detect (contour, crease, boundary) into edge-out",
+                );
                 if has(Pass::Caps) {
-                    rec.add(Pass::Caps, timing.caps_ms, "kernel", &format!("caps_{}", fx.caps.name()));
+                    rec.add(
+                        Pass::Caps,
+                        timing.caps_ms,
+                        "kernel",
+                        &format!("caps_{}", fx.caps.name()),
+                    );
                 }
                 t_view += timing.kernel_ms;
                 edges_out = Some(es.read()?);
@@ -718,7 +782,9 @@ pub fn run(
             renderer.begin(cam)?;
             let lines_only = !(has(Pass::Ao)
                 || fx.cues.contains(&crate::scene::planner::Cue::Shading)
-                || fx.cues.contains(&crate::scene::planner::Cue::CurvatureColors));
+                || fx
+                    .cues
+                    .contains(&crate::scene::planner::Cue::CurvatureColors));
             let style = if lines_only {
                 // Lines only: the mesh is drawn flat in the background colour,
                 // so that it hides the lines behind it.
@@ -764,7 +830,12 @@ pub fn run(
             }
             let image: Frame = renderer.finish()?;
             let ms = ms_since(tr);
-            rec.add(Pass::Render, ms, "wall", "draw mesh, line quads and edge quads; read back");
+            rec.add(
+                Pass::Render,
+                ms,
+                "wall",
+                "draw mesh, line quads and edge quads; read back",
+            );
             render_ms.push(ms);
             for (f, v, path) in images.iter().filter(|i| i.0 == frame && i.1 == vi) {
                 let _ = (f, v);
@@ -853,8 +924,13 @@ fn bounds_of(p: &[[f32; 3]]) -> ([f64; 3], [f64; 3]) {
 /// colour) when neither is asked for.
 fn mesh_colors(scene: &Scene, plan: &Plan, pose: &PoseData, scale: f32) -> Vec<[f32; 3]> {
     let fx = &scene.effects;
-    let colors = fx.cues.contains(&crate::scene::planner::Cue::CurvatureColors);
-    let ao = plan.contains(Pass::Ao) && fx.cues.contains(&crate::scene::planner::Cue::AmbientOcclusion);
+    let colors = fx
+        .cues
+        .contains(&crate::scene::planner::Cue::CurvatureColors);
+    let ao = plan.contains(Pass::Ao)
+        && fx
+            .cues
+            .contains(&crate::scene::planner::Cue::AmbientOcclusion);
     if !colors && !ao {
         return Vec::new();
     }
@@ -880,7 +956,10 @@ pub fn explain(scene: &Scene, opts: &ExecOptions) -> Result<String> {
     let frames = frame_indices(scene, loaded.frames())?;
     let fx = &scene.effects;
     let plan = plan_with(&fx.cues, scene.source.input(), fx.caps);
-    let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.out_dir.clone());
+    let out_dir = opts
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| scene.out_dir.clone());
     let (images, report) = output_paths(scene, &frames, &out_dir);
     let mut s = format!(
         "{}: frames {:?}{}\n",

@@ -432,10 +432,7 @@ impl Checker<'_> {
     fn existing(&self, s: &Spanned<String>) -> Result<PathBuf> {
         let p = self.relative(s.get_ref());
         if !p.exists() {
-            return Err(self.err(
-                s.span(),
-                format!("{} does not exist", p.display()),
-            ));
+            return Err(self.err(s.span(), format!("{} does not exist", p.display())));
         }
         Ok(p)
     }
@@ -459,7 +456,11 @@ fn positive(x: Option<f32>, default: f32, what: &str) -> std::result::Result<f32
     }
 }
 
-fn color(c: Option<[f32; 3]>, default: [f32; 3], what: &str) -> std::result::Result<[f32; 3], String> {
+fn color(
+    c: Option<[f32; 3]>,
+    default: [f32; 3],
+    what: &str,
+) -> std::result::Result<[f32; 3], String> {
     let v = c.unwrap_or(default);
     if v.iter().all(|x| (0.0..=1.0).contains(x)) {
         Ok(v)
@@ -695,7 +696,9 @@ impl Scene {
                     target: s.target,
                 }));
             } else {
-                views.push(view(CameraKind::Fit(s.direction.unwrap_or([0.4, 0.3, 1.0]))));
+                views.push(view(CameraKind::Fit(
+                    s.direction.unwrap_or([0.4, 0.3, 1.0]),
+                )));
             }
         }
         if views.is_empty() {
@@ -725,7 +728,8 @@ impl Scene {
         if let Some(c) = &fx.curvature_colors {
             cues.push(Cue::CurvatureColors);
             if let Some(s) = c.scale {
-                curvature_scale = Some(positive(Some(s), 1.0, "curvature_colors.scale").map_err(e)?);
+                curvature_scale =
+                    Some(positive(Some(s), 1.0, "curvature_colors.scale").map_err(e)?);
             }
         }
         let mut ao_mode = AoMode::Lut;
@@ -827,7 +831,9 @@ impl Scene {
         let e = |p: String| ck.err(out_span.clone(), p);
         let size = out.size.unwrap_or([640, 480]);
         if size[0] == 0 || size[1] == 0 || size[0] > 16384 || size[1] > 16384 {
-            return Err(e(format!("output.size {size:?} must be 1..=16384 pixels each")));
+            return Err(e(format!(
+                "output.size {size:?} must be 1..=16384 pixels each"
+            )));
         }
         let msaa = out.msaa.unwrap_or(4);
         if ![0, 2, 4, 8].contains(&msaa) {
@@ -852,8 +858,7 @@ impl Scene {
                 return Err(ck.err(f.span(), "output.formats is empty"));
             }
         }
-        let background =
-            color(out.background, [1.0, 1.0, 1.0], "output.background").map_err(e)?;
+        let background = color(out.background, [1.0, 1.0, 1.0], "output.background").map_err(e)?;
         let prefix = out.name.clone().unwrap_or_else(|| name.clone());
         if prefix.is_empty() || prefix.contains(['/', '\\']) {
             return Err(e(format!(
@@ -911,14 +916,20 @@ mod tests {
 
     #[test]
     fn unknown_keys_and_wrong_types_name_the_line() {
-        let e = err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\nao = { levle = \"lut\" }\n");
+        let e = err(
+            "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\nao = { levle = \"lut\" }\n",
+        );
         assert!(e.contains("test.toml") && e.contains("line 5"), "{e}");
         assert!(e.contains("levle"), "{e}");
-        let e = err("[input]\ngenerate = \"torus\"\n\n[effects]\nshading = {}\n[output]\nsize = \"big\"\n");
+        let e = err(
+            "[input]\ngenerate = \"torus\"\n\n[effects]\nshading = {}\n[output]\nsize = \"big\"\n",
+        );
         assert!(e.contains("line 7"), "{e}");
         let e = err("[input]\ngenerate = \"torus\"\ncolour = 1\n[effects]\nshading = {}\n");
         assert!(e.contains("line 3") && e.contains("colour"), "{e}");
-        let e = err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[[camera]]\nfov = \"wide\"\n");
+        let e = err(
+            "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[[camera]]\nfov = \"wide\"\n",
+        );
         assert!(e.contains("line 6"), "{e}");
         let e = err("[input\n");
         assert!(e.contains("line 1"), "{e}");
@@ -950,7 +961,10 @@ mod tests {
             ("[effects]\nao = { radius = -1.0 }\n", "radius"),
             ("[effects]\nfeature_edges = { caps = \"round\" }\n", "round"),
             ("[effects]\nfeature_edges = { crease = 0.0 }\n", "crease"),
-            ("[effects]\ncontours = { color = [2.0, 0.0, 0.0] }\n", "color"),
+            (
+                "[effects]\ncontours = { color = [2.0, 0.0, 0.0] }\n",
+                "color",
+            ),
             ("[effects]\n", "no cue"),
         ] {
             let e = err(&format!("[input]\ngenerate = \"torus\"\n{snippet}"));
@@ -959,7 +973,10 @@ mod tests {
         for (snippet, word) in [
             ("[[camera]]\norbit = 0\n", "orbit"),
             ("[[camera]]\neye = [0.0, 0.0, 1.0]\norbit = 4\n", "one of"),
-            ("[[camera]]\neye = [1.0, 0.0, 0.0]\ntarget = [1.0, 0.0, 0.0]\n", "differ"),
+            (
+                "[[camera]]\neye = [1.0, 0.0, 0.0]\ntarget = [1.0, 0.0, 0.0]\n",
+                "differ",
+            ),
             ("[[camera]]\nfov = 180.0\n", "fov"),
             ("[frames]\nstep = 0\n", "step"),
             ("[frames]\nend = 5\n", "static"),

@@ -189,8 +189,9 @@ pub fn plan(cues: &[Cue], input: Input) -> Plan {
 }
 
 /// [`plan`] for feature edges drawn with `caps`: adjacency caps need the cap
-/// buffer and the cap pass; McGuire-Hughes half-caps need the cap pass only
-/// (they are built from each edge alone); no caps need neither.
+/// buffer and the cap pass; McGuire-Hughes half-caps need the cap pass and
+/// the vertex normals (they are built per edge, along the projected normals)
+/// but no cap buffer; no caps need neither.
 pub fn plan_with(cues: &[Cue], input: Input, caps: CapMode) -> Plan {
     let mut set = std::collections::BTreeSet::new();
     let mut stack: Vec<Pass> = cues
@@ -205,6 +206,10 @@ pub fn plan_with(cues: &[Cue], input: Input, caps: CapMode) -> Plan {
         };
         if !dropped && set.insert(p) {
             stack.extend(p.needs(input));
+            // McGuire-Hughes half-caps point along the projected vertex normals.
+            if p == Pass::Caps && caps == CapMode::Mh {
+                stack.push(Pass::VertexNormals);
+            }
         }
     }
     let mut cues = cues.to_vec();
