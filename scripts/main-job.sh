@@ -2,7 +2,8 @@
 # The README's main job, on bundled (generated) data: sets up, builds, lists the
 # OpenCL devices, computes curvature of a torus and an ellipsoid to PLY + JSON
 # stats in out/, prints the accuracy/time table of every variant, then extracts
-# isosurfaces of procedural fields (with curvature) and prints their report.
+# isosurfaces of procedural fields (with curvature) and prints their report,
+# and renders the two bundled scenes (torus, gyroid).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -18,3 +19,6 @@ $bin curvature --report --resolution 40000
 $bin isosurface --sdf torus --resolution 128 --curvature --normals -o out/torus-iso.ply --stats out/torus-iso.json --force
 $bin isosurface --sdf gyroid --resolution 128 --fusion hash -o out/gyroid-iso.ply --stats out/gyroid-iso.json --force
 $bin isosurface --report --max-resolution 256 --runs 3
+# Scenes: only the passes each scene's cues need run; images, SVG line
+# drawings and a JSON report of the passes that ran go to out/scenes/.
+$bin render scenes/torus.toml scenes/gyroid.toml --out out/scenes --force

@@ -545,13 +545,11 @@ pub fn run(
                 if has(Pass::OneRings) {
                     if let Some(ex) = iso.as_ref() {
                         // The isosurface's faces stay on the device; normals from the gradient.
-                        let tt = Instant::now();
                         let (est, timing) = crate::stages::marching_cubes::curvature(
                             ex,
                             curv_opts,
                             crate::stages::marching_cubes::IsoNormals::Gradient,
                         )?;
-                        let _ = tt;
                         rec.add(
                             Pass::OneRings,
                             est.topology_ms(),
@@ -837,8 +835,7 @@ pub fn run(
                 "draw mesh, line quads and edge quads; read back",
             );
             render_ms.push(ms);
-            for (f, v, path) in images.iter().filter(|i| i.0 == frame && i.1 == vi) {
-                let _ = (f, v);
+            for (_, _, path) in images.iter().filter(|i| i.0 == frame && i.1 == vi) {
                 if path.extension().is_some_and(|e| e == "png") {
                     image.save_png(path)?;
                 } else {
