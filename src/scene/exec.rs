@@ -800,26 +800,35 @@ pub fn run(
             };
             renderer.draw_mesh(&pose.pos, &pose.nrm, &colors, &t.mesh.faces, style)?;
             let mut line_quads: Vec<[f32; 4]> = Vec::new();
+            // Contours opaque; suggestive contours in four opacity bins of
+            // their n·v fade (DeCarlo et al. fade them out as they approach
+            // the contour generator, where they are unstable).
+            const BINS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
             for (kind, (width, color)) in [(0u32, fx.contour), (1u32, fx.suggestive)] {
-                let pts: Vec<[f32; 3]> = segs
-                    .iter()
-                    .filter(|s| s.2 == kind)
-                    .flat_map(|s| [s.0, s.1])
-                    .collect();
-                segments[kind as usize] += pts.len() / 2;
-                if pts.is_empty() {
-                    continue;
+                let mut n = 0;
+                for (bi, &alpha) in BINS.iter().enumerate() {
+                    let pts: Vec<[f32; 3]> = segs
+                        .iter()
+                        .filter(|s| s.2 == kind && (kind == 0 || strength_bin(s.3) == bi))
+                        .flat_map(|s| [s.0, s.1])
+                        .collect();
+                    if pts.is_empty() || (kind == 0 && bi > 0) {
+                        continue;
+                    }
+                    n += pts.len() / 2;
+                    let [r, g, b] = color;
+                    let a = if kind == 0 { 1.0 } else { alpha };
+                    renderer.draw_lines(&pts, [r, g, b, a], width)?;
+                    if scene.svg {
+                        line_quads.extend(crate::render::segments_to_clip_quads(
+                            cam.view_proj(w as f32 / h as f32),
+                            [w, h],
+                            &pts,
+                            width,
+                        ));
+                    }
                 }
-                let [r, g, b] = color;
-                renderer.draw_lines(&pts, [r, g, b, 1.0], width)?;
-                if scene.svg {
-                    line_quads.extend(crate::render::segments_to_clip_quads(
-                        cam.view_proj(w as f32 / h as f32),
-                        [w, h],
-                        &pts,
-                        width,
-                    ));
-                }
+                segments[kind as usize] += n;
             }
             if let Some(eo) = &edges_out {
                 let [r, g, b] = fx.edge.1;
@@ -902,6 +911,15 @@ fn record_curvature(rec: &mut Recorder, t: &RunTiming, plan: &Plan, normals: &st
     );
     if plan.contains(Pass::Dcurv) {
         rec.add(Pass::Dcurv, pass_ms(t, &["dcurv"]), "kernel", "dcurv");
+    }
+}
+
+/// The opacity bin (0..4) of a suggestive-contour segment's strength in [0, 1].
+fn strength_bin(strength: f32) -> usize {
+    if strength.is_finite() {
+        ((strength.clamp(0.0, 1.0) * 4.0).ceil() as usize).clamp(1, 4) - 1
+    } else {
+        3
     }
 }
 
