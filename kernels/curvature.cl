@@ -24,7 +24,15 @@
 // work-item vectoriser gives up on OpenCL vector types, private arrays,
 // selects of whole structs, fmax and atomics, but turns scalar code, even with
 // indexed loads, into AVX-512 code (measured on PoCL 3.1 by disassembling
-// the kernel cache).
+// the kernel cache). That holds for the per-vertex passes (frames, principal);
+// the per-face passes stay scalar even without atomics: PoCL runs -O3 with
+// the SLP vectoriser on the single work-item kernel before it builds the
+// work-item loops, SLP packs pairs of corners into <2 x float>, and the loop
+// vectoriser then refuses the vector-typed instructions (POCL_VECTORIZER_REMARKS,
+// "instruction return type cannot be vectorized"). Helpers are SC_INLINE
+// (always_inline): left to PoCL's inliner, proj_dcurv, tensor_at and
+// vertex_curv_in stay calls returning structs through the stack, which cost
+// ~15 % of curv_dcurv.
 //
 // Buffers (V vertices, F faces; REAL is float or double, see real.h):
 //   pos   REAL[3V]  positions, centred and scaled by the host (unit RMS radius)
@@ -67,7 +75,7 @@ typedef struct {
     REAL x, y, z, w;
 } V4;
 
-inline V3 v3(REAL x, REAL y, REAL z)
+SC_INLINE V3 v3(REAL x, REAL y, REAL z)
 {
     V3 r;
     r.x = x;
@@ -75,7 +83,7 @@ inline V3 v3(REAL x, REAL y, REAL z)
     r.z = z;
     return r;
 }
-inline V4 v4(REAL x, REAL y, REAL z, REAL w)
+SC_INLINE V4 v4(REAL x, REAL y, REAL z, REAL w)
 {
     V4 r;
     r.x = x;
@@ -84,27 +92,27 @@ inline V4 v4(REAL x, REAL y, REAL z, REAL w)
     r.w = w;
     return r;
 }
-inline V3 ld3(__global const REAL *a, uint i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
-inline void st3(V3 v, uint i, __global REAL *a)
+SC_INLINE V3 ld3(__global const REAL *a, uint i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+SC_INLINE void st3(V3 v, uint i, __global REAL *a)
 {
     a[3 * i] = v.x;
     a[3 * i + 1] = v.y;
     a[3 * i + 2] = v.z;
 }
-inline V3 add3(V3 a, V3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
-inline V3 sub3(V3 a, V3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
-inline V3 mul3(V3 a, REAL s) { return v3(a.x * s, a.y * s, a.z * s); }
-inline V3 neg3(V3 a) { return v3(-a.x, -a.y, -a.z); }
-inline REAL dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 cross3(V3 a, V3 b)
+SC_INLINE V3 add3(V3 a, V3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+SC_INLINE V3 sub3(V3 a, V3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+SC_INLINE V3 mul3(V3 a, REAL s) { return v3(a.x * s, a.y * s, a.z * s); }
+SC_INLINE V3 neg3(V3 a) { return v3(-a.x, -a.y, -a.z); }
+SC_INLINE REAL dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+SC_INLINE V3 cross3(V3 a, V3 b)
 {
     return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-inline REAL len3(V3 a) { return sqrt(dot3(a, a)); }
-inline V3 normalize3(V3 a) { return mul3(a, RL(1) / len3(a)); }
+SC_INLINE REAL len3(V3 a) { return sqrt(dot3(a, a)); }
+SC_INLINE V3 normalize3(V3 a) { return mul3(a, RL(1) / len3(a)); }
 // Component-wise select (a select of a whole struct keeps PoCL from vectorising).
-inline V3 sel3(bool c, V3 a, V3 b) { return v3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z); }
-inline V4 mul4(V4 a, REAL s) { return v4(a.x * s, a.y * s, a.z * s, a.w * s); }
+SC_INLINE V3 sel3(bool c, V3 a, V3 b) { return v3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z); }
+SC_INLINE V4 mul4(V4 a, REAL s) { return v4(a.x * s, a.y * s, a.z * s, a.w * s); }
 
 // ---------------------------------------------------------------------------
 // Per-face geometry, shared by the atomic and gather variants.
@@ -115,7 +123,7 @@ typedef struct {
     REAL psum;     // |p0| + |p1| + |p2| (sums, not maxima: a max keeps PoCL from vectorising)
 } Tri;
 
-inline Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f)
+SC_INLINE Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f)
 {
     Tri t;
     t.v0 = faces[3 * f];
@@ -129,7 +137,7 @@ inline Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f
     return t;
 }
 
-inline bool tri_degenerate(Tri t)
+SC_INLINE bool tri_degenerate(Tri t)
 {
     REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
     REAL twice_area = len3(cross3(t.e0, t.e1));
@@ -143,14 +151,14 @@ inline bool tri_degenerate(Tri t)
 
 // Corner-weighted face normal (trimesh2 / Max 1999): the face's a×b divided by
 // the squared lengths of the two edges at the corner, la (next edge) then lb.
-inline V3 corner_normal(V3 fn, REAL la, REAL lb)
+SC_INLINE V3 corner_normal(V3 fn, REAL la, REAL lb)
 {
     return mul3(mul3(fn, RL(1) / la), RL(1) / lb); // two steps keep f32 in range
 }
-inline V3 face_normal(Tri t) { return cross3(t.e2, t.e0); } // |.| = 2A, outward for CCW
+SC_INLINE V3 face_normal(Tri t) { return cross3(t.e2, t.e0); } // |.| = 2A, outward for CCW
 
 // Voronoi (circumcentric) corner areas with trimesh2's obtuse-triangle rule.
-inline V3 corner_areas(Tri t)
+SC_INLINE V3 corner_areas(Tri t)
 {
     REAL area = RL(0.5) * len3(cross3(t.e0, t.e1));
     REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
@@ -170,10 +178,10 @@ inline V3 corner_areas(Tri t)
 }
 
 // Weight of a face corner in its vertex's one-ring sum (0 when the vertex has no area).
-inline REAL corner_weight(REAL ca, REAL a) { return a > 0 ? ca / a : RL(0); }
+SC_INLINE REAL corner_weight(REAL ca, REAL a) { return a > 0 ? ca / a : RL(0); }
 
 // Any unit vector perpendicular to n (n unit).
-inline V3 any_perp(V3 n)
+SC_INLINE V3 any_perp(V3 n)
 {
     REAL ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
     V3 a = sel3((ax <= ay) & (ax <= az), v3(1, 0, 0), sel3(ay <= az, v3(0, 1, 0), v3(0, 0, 1)));
@@ -181,7 +189,7 @@ inline V3 any_perp(V3 n)
 }
 
 // Rotate the frame (u, v) by the minimal rotation taking u×v onto nn.
-inline void rot_coord_sys(V3 u, V3 v, V3 nn, V3 *ru, V3 *rv)
+SC_INLINE void rot_coord_sys(V3 u, V3 v, V3 nn, V3 *ru, V3 *rv)
 {
     V3 on = cross3(u, v);
     REAL ndot = dot3(on, nn);
@@ -193,7 +201,7 @@ inline void rot_coord_sys(V3 u, V3 v, V3 nn, V3 *ru, V3 *rv)
 }
 
 // Re-express the tensor k = (ku, kuv, kv) given in (ou, ov) in the frame (nu, nv).
-inline V3 proj_curv(V3 ou, V3 ov, V3 k, V3 nu, V3 nv)
+SC_INLINE V3 proj_curv(V3 ou, V3 ov, V3 k, V3 nu, V3 nv)
 {
     V3 ru, rv;
     rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
@@ -204,7 +212,7 @@ inline V3 proj_curv(V3 ou, V3 ov, V3 k, V3 nu, V3 nv)
 }
 
 // The same for the third-order tensor d = (C111, C112, C122, C222).
-inline V4 proj_dcurv(V3 ou, V3 ov, V4 d, V3 nu, V3 nv)
+SC_INLINE V4 proj_dcurv(V3 ou, V3 ov, V4 d, V3 nu, V3 nv)
 {
     V3 ru, rv;
     rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
@@ -220,7 +228,7 @@ inline V4 proj_dcurv(V3 ou, V3 ov, V4 d, V3 nu, V3 nv)
 }
 
 // Face frame: t along e0, b in the face plane, t × b = face normal.
-inline void face_frame(Tri t, V3 *ft, V3 *fb)
+SC_INLINE void face_frame(Tri t, V3 *ft, V3 *fb)
 {
     *ft = normalize3(t.e0);
     *fb = normalize3(cross3(cross3(t.e0, t.e1), *ft));
@@ -230,7 +238,7 @@ inline void face_frame(Tri t, V3 *ft, V3 *fb)
 // along its edges (edge e_i pairs with n[i−1] − n[i+1]). The normal equations
 // [[w00 w01 0] [w01 w00+w22 w01] [0 w01 w22]] are tridiagonal; LDLᵀ unrolled.
 // Returns false when a pivot is not positive or the result is not finite.
-inline bool face_tensor(Tri t, V3 ft, V3 fb, V3 n0, V3 n1, V3 n2, V3 *x)
+SC_INLINE bool face_tensor(Tri t, V3 ft, V3 fb, V3 n0, V3 n1, V3 n2, V3 *x)
 {
     REAL w00 = 0, w01 = 0, w22 = 0, m0 = 0, m1 = 0, m2 = 0;
 #define TENSOR_EDGE(e, dn)                                 \
@@ -271,7 +279,7 @@ inline bool face_tensor(Tri t, V3 ft, V3 fb, V3 n0, V3 n1, V3 n2, V3 *x)
 // vertex tensors (in the face frame) along its edges. The 4×4 normal equations
 // [[a b 0 0] [b 2a+c 2b 0] [0 2b a+2c b] [0 0 b c]] (a = Σu², b = Σuv, c = Σv²)
 // are tridiagonal too.
-inline bool face_dcurv(Tri t, V3 ft, V3 fb, V3 f0, V3 f1, V3 f2, V4 *x)
+SC_INLINE bool face_dcurv(Tri t, V3 ft, V3 fb, V3 f0, V3 f1, V3 f2, V4 *x)
 {
     REAL a = 0, b = 0, c = 0, m0 = 0, m1 = 0, m2 = 0, m3 = 0;
 #define DCURV_EDGE(e, d)                                   \
@@ -309,7 +317,7 @@ inline bool face_dcurv(Tri t, V3 ft, V3 fb, V3 f0, V3 f1, V3 f2, V4 *x)
 }
 
 // A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame.
-inline V3 vertex_curv_in(__global const REAL *pd1, __global const REAL *pd2,
+SC_INLINE V3 vertex_curv_in(__global const REAL *pd1, __global const REAL *pd2,
                          __global const REAL *kk, uint v, V3 ft, V3 fb)
 {
     return proj_curv(ld3(pd1, v), ld3(pd2, v), v3(kk[2 * v], 0, kk[2 * v + 1]), ft, fb);
@@ -402,14 +410,14 @@ __kernel void curv_clear(uint nv, __global REAL *nrm, __global REAL *area, __glo
     dk[4 * gid + 3] = 0;
 }
 
-inline void atomic_add3(volatile __global REAL *a, uint v, V3 x)
+SC_INLINE void atomic_add3(volatile __global REAL *a, uint v, V3 x)
 {
     atomic_add_real(&a[3 * v], x.x);
     atomic_add_real(&a[3 * v + 1], x.y);
     atomic_add_real(&a[3 * v + 2], x.z);
 }
 
-inline void atomic_add4(volatile __global REAL *a, uint v, V4 x)
+SC_INLINE void atomic_add4(volatile __global REAL *a, uint v, V4 x)
 {
     atomic_add_real(&a[4 * v], x.x);
     atomic_add_real(&a[4 * v + 1], x.y);
@@ -438,7 +446,7 @@ __kernel void curv_normals_areas(uint nf, __global const REAL *pos, __global con
 }
 
 // The weighted tensor of face (t, ft, fb, x) in vertex v's frame.
-inline V3 tensor_at(__global const REAL *pd1, __global const REAL *pd2,
+SC_INLINE V3 tensor_at(__global const REAL *pd1, __global const REAL *pd2,
                     __global const REAL *area, uint v, REAL ca, V3 ft, V3 fb, V3 x)
 {
     return mul3(proj_curv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, area[v]));
@@ -466,7 +474,7 @@ __kernel void curv_tensor(uint nf, __global const REAL *pos, __global const uint
 }
 
 // The weighted derivative tensor of a face in vertex v's frame.
-inline V4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2, __global const REAL *area,
+SC_INLINE V4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2, __global const REAL *area,
                    uint v, REAL ca, V3 ft, V3 fb, V4 x)
 {
     return mul4(proj_dcurv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, area[v]));
@@ -505,7 +513,7 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
 // Corner c of face f, component k, lives at corner[12f + 3k + c]: a face's 12
 // stores form one gap-free group (stores with gaps, or into several planes of
 // one buffer, keep PoCL from vectorising).
-inline void st_corner(__global REAL *corner, uint f, uint c, bool use, V4 x)
+SC_INLINE void st_corner(__global REAL *corner, uint f, uint c, bool use, V4 x)
 {
     uint i = 12 * f + c;
     corner[i] = use ? x.x : 0;
@@ -514,7 +522,7 @@ inline void st_corner(__global REAL *corner, uint f, uint c, bool use, V4 x)
     corner[i + 9] = use ? x.w : 0;
 }
 
-inline V4 ext4(V3 a, REAL w) { return v4(a.x, a.y, a.z, w); }
+SC_INLINE V4 ext4(V3 a, REAL w) { return v4(a.x, a.y, a.z, w); }
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          __global const uint *faces, __global REAL *corner,
@@ -574,7 +582,7 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
 
 // Sums the corners of vertex v's one-ring in face order, counting (once per
 // face, at its corner 0) the faces whose status has `bit`.
-inline V4 sum_ring(uint v, __global const uint *ring_off, __global const uint *ring,
+SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint *ring,
                    __global const REAL *corner, __global const uchar *status, uchar bit,
                    volatile __global uint *counter)
 {

@@ -17,3 +17,8 @@ typedef float3 REAL3;
 #define GID_OR_RETURN(n)                 \
     const uint gid = (uint)get_global_id(0); \
     if (gid >= (n)) return;
+
+// Helpers called several times per kernel are forced inline: PoCL's inliner
+// leaves the larger ones (cost above its threshold) as calls returning
+// structs through the stack (see kernels/curvature.cl).
+#define SC_INLINE inline __attribute__((always_inline))

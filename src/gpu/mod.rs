@@ -143,6 +143,24 @@ impl Gpu {
         .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
     }
 
+    /// Enqueues zeroing the first `len` elements of `buf` without waiting
+    /// (the in-order queue runs it before later commands): resetting a
+    /// counter this way does not stall the host between passes.
+    pub fn zero<T: bytemuck::Zeroable>(&self, buf: &mut Buffer<T>, len: usize) -> Result<()> {
+        if len == 0 {
+            return Ok(());
+        }
+        let pattern = [T::zeroed()];
+        // SAFETY: the pattern is copied at enqueue time (OpenCL 1.2
+        // clEnqueueFillBuffer); callers size `len` within the buffer.
+        unsafe {
+            self.queue
+                .enqueue_fill_buffer(buf, &pattern, 0, len * std::mem::size_of::<T>(), &[])
+        }
+        .map(|_| ())
+        .map_err(|e| Error::cl("clEnqueueFillBuffer", e))
+    }
+
     /// Waits for every queued command.
     pub fn finish(&self) -> Result<()> {
         self.queue.finish().map_err(|e| Error::cl("clFinish", e))
@@ -200,6 +218,18 @@ pub fn launch(gpu: &Gpu, kernel: &Kernel, n: usize, args: &[Arg]) -> Result<Opti
         let name = kernel.function_name().unwrap_or_default();
         Error::cl(format!("clEnqueueNDRangeKernel({name})"), e)
     })
+}
+
+/// Waits for a launched kernel and returns its kernel ms (0 when nothing was
+/// launched, see [`launch`]).
+pub fn wait_ms(ev: Option<Event>) -> Result<f64> {
+    match ev {
+        Some(e) => {
+            e.wait().map_err(|e| Error::cl("clWaitForEvents", e))?;
+            Ok(event_ms(&e))
+        }
+        None => Ok(0.0),
+    }
 }
 
 /// Kernel time of a finished event in milliseconds (from profiling counters).

@@ -8,8 +8,9 @@
 
 use crate::cpu::ao::{AoMode, LUT_N, build_lut, dirs};
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
 use crate::stages::curvature::CurvatureEstimator;
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::{Arc, OnceLock};
@@ -62,7 +63,7 @@ impl AoStage {
         let n = k.len();
         self.reserve(n)?;
         self.gpu.write(&mut self.k, k.as_flattened())?;
-        let ms = self.enqueue(buf(&self.k), n, radius, mode)?;
+        let ms = wait_ms(self.enqueue(buf(&self.k), n, radius, mode)?)?;
         Ok((self.read(n)?, ms))
     }
 
@@ -78,6 +79,17 @@ impl AoStage {
         radius: f32,
         mode: AoMode,
     ) -> Result<f64> {
+        let ev = self.enqueue_device(est, radius, mode)?;
+        wait_ms(ev)
+    }
+
+    /// [`AoStage::run_device`] without waiting: the kernel's profiling event.
+    pub(crate) fn enqueue_device(
+        &mut self,
+        est: &CurvatureEstimator,
+        radius: f32,
+        mode: AoMode,
+    ) -> Result<Option<Event>> {
         check_radius(radius)?;
         let d = est.device_outputs()?;
         let r = (f64::from(radius) / d.norm.scale) as f32;
@@ -114,10 +126,9 @@ impl AoStage {
         Ok(())
     }
 
-    /// Runs `ao_vertex` on `n` (k1, k2) pairs of `k` (a float buffer of at
-    /// least 2n) with the curvature-space radius `radius`; waits for it and
-    /// returns its kernel ms.
-    fn enqueue(&mut self, k: Arg, n: usize, radius: f32, mode: AoMode) -> Result<f64> {
+    /// Enqueues `ao_vertex` on `n` (k1, k2) pairs of `k` (a float buffer of
+    /// at least 2n) with the curvature-space radius `radius`.
+    fn enqueue(&mut self, k: Arg, n: usize, radius: f32, mode: AoMode) -> Result<Option<Event>> {
         let ev = launch(
             &self.gpu,
             &self.kernel,
@@ -134,13 +145,7 @@ impl AoStage {
             ],
         )?;
         self.computed = n;
-        match ev {
-            Some(e) => {
-                e.wait().map_err(|e| Error::cl("ao_vertex", e))?;
-                Ok(event_ms(&e))
-            }
-            None => Ok(0.0),
-        }
+        Ok(ev)
     }
 }
 

@@ -102,8 +102,9 @@ pub struct Intermediate {
 /// [`Normalization`]): curvatures are multiplied by `scale` and the
 /// derivative by `scale²` relative to the world. Lengths in floats: `pos`,
 /// `nrm`, `d1`, `d2` 3·nv; `k` (k1, k2) 2·nv; `dk` 4·nv. After a run up to
-/// [`Pass::Frames`] only `pos` and `nrm` are current; the others hold the
-/// previous run's values, or zeros.
+/// [`Pass::Frames`] only `pos` and `nrm` are current (enough for occluding
+/// contours), `d1`, `d2` hold the initial tangent frames, and `k`, `dk` the
+/// previous run's values, or zeros (zeroed at allocation).
 pub struct DeviceOutputs<'a> {
     /// Vertices.
     pub nv: usize,
@@ -540,8 +541,10 @@ impl CurvatureEstimator {
         let g = &*self.gpu;
         let (nv, nf) = (self.nv, self.nf);
         let (nv32, nf32) = (nv as u32, nf as u32);
-        g.write(&mut self.counters, &[0u32; 4])?;
         let t0 = Instant::now();
+        // Not a blocking write: the skinning or position load queued before
+        // this run keeps going while the passes are enqueued.
+        g.zero(&mut self.counters, 4)?;
         let mut events: Vec<(Pass, opencl3::event::Event)> = Vec::new();
         let mut record = |pass: Pass, ev: Option<opencl3::event::Event>| {
             if let Some(e) = ev {

@@ -195,7 +195,7 @@ impl LineExtractor {
     ) -> Result<(Vec<Segment>, LineStats)> {
         let n = self.nv;
         let g = self.gpu.clone();
-        g.write(&mut self.counter, &[0])?;
+        g.zero(&mut self.counter, 1)?;
         let [ex, ey, ez] = view.eye;
         let mut args: Vec<Arg> = vec![Arg::U32(n as u32)];
         args.extend(inputs);

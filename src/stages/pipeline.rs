@@ -18,12 +18,13 @@ use crate::cpu::ao::AoMode;
 use crate::cpu::feature_lines::{Segment, View};
 use crate::error::{Error, Result};
 use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines::{LineExtractor, LineOptions, LineStats};
 use crate::stages::skinning::Skinner;
+use opencl3::event::Event;
 use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
@@ -125,18 +126,30 @@ impl PosePipeline {
     /// pass and AO at the options' level; the results stay on the device.
     pub fn pose(&mut self, mats: &[f32]) -> Result<PassTimes> {
         let t0 = Instant::now();
-        let skin_ms = self.skinner.pose(mats)?;
+        let (mut t, ao) = self.enqueue_pose(mats)?;
+        t.ao_ms = wait_ms(ao)?;
+        t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(t)
+    }
+
+    /// Queues skinning, every curvature pass and AO. The curvature run waits
+    /// for its passes (its timing needs them), which also finishes the
+    /// skinning queued before it; AO is left running: its event comes back
+    /// for the caller to wait on (or to read after a later blocking call).
+    fn enqueue_pose(&mut self, mats: &[f32]) -> Result<(PassTimes, Option<Event>)> {
+        let skin = self.skinner.enqueue(mats)?;
         self.est
             .set_positions_device(&self.skinner.out, [1.0; 3], [0.0; 3], self.norm)?;
         let curvature_ms = self.est.run()?.kernel_ms;
-        let ao_ms = self.ao(self.opts.ao_mode)?;
-        Ok(PassTimes {
-            skin_ms,
+        let ao = self
+            .ao
+            .enqueue_device(&self.est, self.ao_radius(), self.opts.ao_mode)?;
+        let t = PassTimes {
+            skin_ms: wait_ms(skin)?,
             curvature_ms,
-            ao_ms,
-            wall_ms: t0.elapsed().as_secs_f64() * 1e3,
             ..Default::default()
-        })
+        };
+        Ok((t, ao))
     }
 
     /// Contours and suggestive contours of the current pose from `view`
@@ -151,8 +164,9 @@ impl PosePipeline {
             .extract_device(&self.est, view, feature_size, opts)
     }
 
-    /// One frame: [`PosePipeline::pose`] then [`PosePipeline::lines`]; the
-    /// times of every pass and the wall time of both.
+    /// One frame: [`PosePipeline::pose`] then [`PosePipeline::lines`], with
+    /// no host wait between AO and the lines (the in-order queue keeps them
+    /// in order); the times of every pass and the wall time of both.
     pub fn frame(
         &mut self,
         mats: &[f32],
@@ -161,8 +175,9 @@ impl PosePipeline {
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, PassTimes)> {
         let t0 = Instant::now();
-        let mut t = self.pose(mats)?;
+        let (mut t, ao) = self.enqueue_pose(mats)?;
         let (segs, st) = self.lines(view, feature_size, opts)?;
+        t.ao_ms = wait_ms(ao)?;
         t.lines_ms = st.vertex_ms + st.face_ms;
         t.segments = st.segments;
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;

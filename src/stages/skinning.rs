@@ -6,8 +6,9 @@
 //! CPU twin: [`crate::cpu::skinning`].
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::Arc;
@@ -67,6 +68,13 @@ impl Skinner {
     /// Uploads `mats` (column-major, 16 floats per joint) and skins; returns
     /// the kernel ms.
     pub fn pose(&mut self, mats: &[f32]) -> Result<f64> {
+        wait_ms(self.enqueue(mats)?)
+    }
+
+    /// [`Skinner::pose`] without waiting: the kernel's profiling event, for
+    /// callers that queue more passes behind it
+    /// ([`crate::stages::pipeline::PosePipeline`]).
+    pub(crate) fn enqueue(&mut self, mats: &[f32]) -> Result<Option<Event>> {
         if mats.len() != 16 * self.joints || mats.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidArgument(format!(
                 "pose: {} finite matrix floats expected (16 × {} joints), got {}",
@@ -76,7 +84,7 @@ impl Skinner {
             )));
         }
         self.gpu.write(&mut self.mats, mats)?;
-        let ev = launch(
+        launch(
             &self.gpu,
             &self.kernel,
             self.nv,
@@ -88,9 +96,7 @@ impl Skinner {
                 buf(&self.mats),
                 buf(&self.out),
             ],
-        )?;
-        self.gpu.finish()?;
-        Ok(ev.as_ref().map(event_ms).unwrap_or(0.0))
+        )
     }
 
     /// Reads the skinned positions.
