@@ -92,6 +92,7 @@ pub struct PosePipeline {
     ao: AoStage,
     lines: LineExtractor,
     norm: Normalization,
+    feature_size: f32,
     opts: PipelineOptions,
 }
 
@@ -118,6 +119,10 @@ impl PosePipeline {
             ao: AoStage::new(gpu.clone())?,
             lines: LineExtractor::new(gpu, nv, &rest.faces)?,
             norm: Normalization::of_masked(&rest.positions, Some(&used)),
+            feature_size: match crate::mesh::feature_size(&rest.positions, &rest.faces) {
+                f if f > 0.0 => f as f32,
+                _ => Normalization::of(&rest.positions).scale as f32,
+            },
             opts,
         })
     }
@@ -228,9 +233,10 @@ impl PosePipeline {
     }
 
     /// Feature size for the suggestive-contour threshold: the rest pose's
-    /// RMS radius.
+    /// median edge length ([`crate::mesh::feature_size`]), as the scene
+    /// executor uses.
     pub fn feature_size(&self) -> f32 {
-        self.norm.scale as f32
+        self.feature_size
     }
 }
 
