@@ -553,10 +553,16 @@ pub fn run(
                         rec.add(
                             Pass::OneRings,
                             est.topology_ms(),
-                            "kernel",
-                            "owning faces (atomic_max), faces copied on the device",
+                            "wall",
+                            "faces copied on the device, owning faces (atomic_max); \
+                             includes the first program build",
                         );
-                        record_curvature(&mut rec, &timing, &plan, "gradient of the volume");
+                        record_curvature(
+                            &mut rec,
+                            &timing,
+                            &plan,
+                            "then replaced by the volume's gradient",
+                        );
                         t_pose += est.topology_ms() + timing.kernel_ms;
                         t.est = Some(est);
                     } else {
@@ -567,7 +573,7 @@ pub fn run(
                             Pass::OneRings,
                             ms_since(tt),
                             "wall",
-                            "upload faces, owning faces (atomic_max)",
+                            "upload faces, owning faces (atomic_max); includes the first program build",
                         );
                         t.est = Some(est);
                     }
@@ -899,7 +905,7 @@ pub fn run(
 fn record_curvature(rec: &mut Recorder, t: &RunTiming, plan: &Plan, normals: &str) {
     rec.add(
         Pass::VertexNormals,
-        pass_ms(t, &["clear", "normals_areas", "frames", "override_normals"]),
+        pass_ms(t, &["clear", "normals_areas", "frames"]),
         "kernel",
         &format!("clear + normals_areas + frames ({normals})"),
     );
