@@ -237,6 +237,21 @@ fn a_skinned_scene_runs_pose_passes_per_frame_and_topology_once() {
     assert_eq!(runs(Pass::Dcurv), Some(3));
     assert_eq!(runs(Pass::Contours), Some(6));
     assert_eq!(r.outputs.len(), 6);
+    // Clips that do not exist are named.
+    for (clip, word) in [("\"Nope\"", "no such clip"), ("9", "clips")] {
+        let s = scene(
+            &dir,
+            &format!(
+                "[input]\ngltf = {:?}\nclip = {clip}\n[effects]\nshading = {{}}\n",
+                gltf.display().to_string()
+            ),
+        );
+        let e = run(&s, &dir, true).unwrap().expect_err("bad clip");
+        assert!(
+            e.to_string().contains(word) && e.to_string().contains("RiggedSimple"),
+            "{e}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

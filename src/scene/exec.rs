@@ -139,9 +139,21 @@ fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         Source::Generate(kind, n) => Loaded::Static(generate(kind, *n)?),
         Source::Gltf(p, clip) => {
             let m = crate::mesh::skinned::load_gltf(p)?;
-            let idx = match clip {
-                ClipRef::Index(i) => *i,
-                ClipRef::Name(n) => m.clips.iter().position(|c| &c.name == n).ok_or_else(|| {
+            if m.clips.is_empty() && clip.is_none() {
+                notes.push(format!(
+                    "{}: no animation; the rest pose is the one frame",
+                    p.display()
+                ));
+                let rest = SkinnedMesh::flatten(&m.joint_matrices(None, 0.0)?);
+                return Ok(Loaded::Skinned {
+                    mesh: Box::new(m),
+                    poses: Box::new(move |_| Ok(rest.clone())),
+                    frames: 1,
+                });
+            }
+            let idx = match clip.clone().unwrap_or(ClipRef::Index(0)) {
+                ClipRef::Index(i) => i,
+                ClipRef::Name(n) => m.clips.iter().position(|c| c.name == n).ok_or_else(|| {
                     Error::input(
                         p.display().to_string(),
                         format!("clip {n:?}"),

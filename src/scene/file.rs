@@ -281,8 +281,9 @@ pub enum Source {
     Mesh(PathBuf),
     /// A generated mesh (kind, vertex count).
     Generate(String, usize),
-    /// A glTF skin and clip.
-    Gltf(PathBuf, ClipRef),
+    /// A glTF skin and clip (`None`: clip 0, or the rest pose when the file
+    /// has no animation).
+    Gltf(PathBuf, Option<ClipRef>),
     /// A glob of frames.
     Flipbook(String),
     /// A libigl LBS set (the OBJ).
@@ -555,11 +556,7 @@ impl Scene {
             }
             Source::Generate(g.get_ref().clone(), inp.resolution.unwrap_or(40_000))
         } else if let Some(g) = &inp.gltf {
-            let clip = inp
-                .clip
-                .as_ref()
-                .map(|c| c.get_ref().clone())
-                .unwrap_or(ClipRef::Index(0));
+            let clip = inp.clip.as_ref().map(|c| c.get_ref().clone());
             Source::Gltf(ck.existing(g)?, clip)
         } else if let Some(f) = &inp.flipbook {
             let pat = ck.relative(f.get_ref());
