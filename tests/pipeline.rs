@@ -218,6 +218,32 @@ fn chained_lines_equal_lines_of_host_arrays() {
             assert_eq!(got.len(), want.len(), "{what}: segment count");
             assert_eq!(st.segments, got.len());
             assert_eq!(unmatched(&got, &want, tol), 0, "{what}: endpoints");
+            // Relative to an origin at the mesh centre: the same segments,
+            // shifted (eye given relative to the origin too).
+            let local = View {
+                eye: if view.ortho {
+                    view.eye
+                } else {
+                    std::array::from_fn(|i| (f64::from(view.eye[i]) - c[i]) as f32)
+                },
+                ortho: view.ortho,
+            };
+            let (rel, _) = ex
+                .extract_device_at(&est, local, 0.3 * d as f32, opts, c)
+                .unwrap();
+            let back: Vec<Segment> = rel
+                .iter()
+                .map(|s| {
+                    let w = |p: [f32; 3]| std::array::from_fn(|i| (f64::from(p[i]) + c[i]) as f32);
+                    (w(s.0), w(s.1), s.2, s.3)
+                })
+                .collect();
+            assert_eq!(back.len(), got.len(), "{what}: origin-relative count");
+            assert_eq!(
+                unmatched(&back, &got, tol),
+                0,
+                "{what}: origin-relative endpoints"
+            );
         }
         // Same validation as the host path.
         let bad = View {

@@ -321,3 +321,49 @@ fn a_flipbook_scene_loads_every_frame_and_builds_topology_once() {
     assert!(e.to_string().contains("frame_9.obj"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn nasty_meshes_render_with_every_cue() {
+    // A small torus far from the origin, a zero-area face, a duplicated face
+    // and an unreferenced vertex at 1e30: every cue still runs, the camera
+    // frames the torus, and the image is not empty.
+    let dir = tmp_dir("nasty");
+    let m = shapecue::mesh::torus(1.0, 0.4, 32, 16);
+    let mut obj = String::new();
+    for p in &m.positions {
+        obj.push_str(&format!(
+            "v {} {} {}\n",
+            1e5 + 1e-3 * p[0],
+            -2e5 + 1e-3 * p[1],
+            1e-3 * p[2]
+        ));
+    }
+    obj.push_str("v 1e30 1e30 1e30\n");
+    for t in &m.faces {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    let f0 = m.faces[0];
+    obj.push_str(&format!("f {} {} {}\n", f0[0] + 1, f0[1] + 1, f0[2] + 1));
+    obj.push_str(&format!("f {} {} {}\n", f0[0] + 1, f0[0] + 1, f0[1] + 1));
+    std::fs::write(dir.join("nasty.obj"), obj).unwrap();
+    let fx: String = CUES.iter().map(|c| format!("{}\n", c.0)).collect();
+    let s = scene(
+        &dir,
+        &format!(
+            "[input]\nmesh = \"nasty.obj\"\n[[camera]]\ndirection = [0.0, 0.3, 1.0]\n[effects]\n{fx}\
+             [output]\nsize = [64, 64]\nmsaa = 0\n"
+        ),
+    );
+    let Some(r) = run(&s, &dir, false) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "nasty");
+    let img = image::open(&r.outputs[0]).unwrap().to_rgb8();
+    let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+    assert!(
+        drawn > 300,
+        "the torus covers the middle of the image: {drawn} pixels"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

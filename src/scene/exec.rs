@@ -344,18 +344,42 @@ fn to_f32(v: &[[f64; 3]]) -> Vec<[f32; 3]> {
     v.iter().map(|p| p.map(|c| c as f32)).collect()
 }
 
-/// Resolves a view against the scene bounds.
-fn camera(v: &ViewSpec, bounds: ([f64; 3], [f64; 3]), aspect: f32) -> Result<Camera> {
+/// Centre of the bounds of the used points, in f64.
+fn centre(p: impl Iterator<Item = [f64; 3]>, used: &[bool]) -> [f64; 3] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (q, _) in p.zip(used).filter(|(_, u)| **u) {
+        for i in 0..3 {
+            lo[i] = lo[i].min(q[i]);
+            hi[i] = hi[i].max(q[i]);
+        }
+    }
+    std::array::from_fn(|i| {
+        let c = 0.5 * (lo[i] + hi[i]);
+        if c.is_finite() { c } else { 0.0 }
+    })
+}
+
+/// Resolves a view against the scene bounds (scene frame); explicit eyes and
+/// targets are world positions, moved into the scene frame by `origin`.
+fn camera(
+    v: &ViewSpec,
+    bounds: ([f64; 3], [f64; 3]),
+    aspect: f32,
+    origin: [f64; 3],
+) -> Result<Camera> {
+    let local = |p: [f32; 3]| -> glam::Vec3 {
+        glam::Vec3::from(std::array::from_fn::<f32, 3, _>(|i| {
+            (f64::from(p[i]) - origin[i]) as f32
+        }))
+    };
     let (lo, hi) = bounds;
     let lo3 = glam::DVec3::from(lo).as_vec3();
     let hi3 = glam::DVec3::from(hi).as_vec3();
     let centre = 0.5 * (lo3 + hi3);
     let up = v.up.map(glam::Vec3::from);
     let (eye, target) = match &v.kind {
-        CameraKind::LookAt { eye, target } => (
-            glam::Vec3::from(*eye),
-            target.map(glam::Vec3::from).unwrap_or(centre),
-        ),
+        CameraKind::LookAt { eye, target } => (local(*eye), target.map(local).unwrap_or(centre)),
         CameraKind::Fit(d) => {
             let radius = (0.5 * (hi3 - lo3).length()).max(1e-6 * (1.0 + centre.length()));
             let half_v = 0.5 * v.fov.to_radians();
@@ -456,6 +480,8 @@ pub fn run(
     let mut topo: Option<Topology> = None;
     let mut pose = PoseData::default();
     let mut bounds = None;
+    // World position of the scene frame's origin (see the pose block).
+    let mut origin: Option<[f64; 3]> = None;
     let mut cameras: Vec<Camera> = Vec::new();
     let mut color_scale = fx.curvature_scale;
     let mut ao_radius = 0.0f32;
@@ -637,14 +663,26 @@ pub fn run(
                 );
                 t_pose += timing.kernel_ms;
             }
-            // Host copies for drawing and host passes.
-            pose.pos = if let Some(sk) = skinner.as_ref() {
-                sk.read()?
-            } else if let Some(p) = &host_pos {
-                to_f32(p)
+            // Host copies for drawing and host passes, relative to the scene
+            // origin (the centre of the first pose), so that a mesh far from
+            // the world origin keeps its f32 precision in the renderer.
+            let used = crate::mesh::referenced(nv, &t.mesh.faces);
+            if let Some(sk) = skinner.as_ref() {
+                let p = sk.read()?;
+                let o = *origin
+                    .get_or_insert_with(|| centre(p.iter().map(|q| q.map(f64::from)), &used));
+                pose.pos = p
+                    .iter()
+                    .map(|q| std::array::from_fn(|i| (f64::from(q[i]) - o[i]) as f32))
+                    .collect();
             } else {
-                to_f32(&t.mesh.positions)
-            };
+                let p = host_pos.as_deref().unwrap_or(&t.mesh.positions);
+                let o = *origin.get_or_insert_with(|| centre(p.iter().copied(), &used));
+                pose.pos = p
+                    .iter()
+                    .map(|q| std::array::from_fn(|i| (q[i] - o[i]) as f32))
+                    .collect();
+            }
             if let Some(est) = t.est.as_ref() {
                 let f = est.read()?;
                 pose.nrm = to_f32(&f.normals);
@@ -674,13 +712,13 @@ pub fn run(
                 pose.nrm = vec![[0.0; 3]; nv];
             }
             if bounds.is_none() {
-                let b = bounds_of(&pose.pos);
+                let b = bounds_of(&pose.pos, &used);
                 let diag = ((0..3).map(|i| (b.1[i] - b.0[i]).powi(2)).sum::<f64>()).sqrt();
                 ao_radius = (fx.ao_radius as f64 * diag.max(1e-30)) as f32;
                 cameras = scene
                     .views
                     .iter()
-                    .map(|v| camera(v, b, w as f32 / h as f32))
+                    .map(|v| camera(v, b, w as f32 / h as f32, origin.unwrap_or_default()))
                     .collect::<Result<_>>()?;
                 if color_scale.is_none() && !pose.k.is_empty() {
                     color_scale = Some(curvature_scale(&pose.k));
@@ -725,7 +763,13 @@ pub fn run(
                     ortho: cam.ortho_height.is_some(),
                 };
                 let (s, stats) = match t.est.as_ref() {
-                    Some(est) => lx.extract_device(est, v, pose.feature_size, line_opts)?,
+                    Some(est) => lx.extract_device_at(
+                        est,
+                        v,
+                        pose.feature_size,
+                        line_opts,
+                        origin.unwrap_or_default(),
+                    )?,
                     None => {
                         let n = pose.pos.len();
                         let z3 = vec![[0f32; 3]; n];
@@ -941,10 +985,12 @@ fn strength_bin(strength: f32) -> usize {
     }
 }
 
-fn bounds_of(p: &[[f32; 3]]) -> ([f64; 3], [f64; 3]) {
+/// Bounds of the vertices that faces use (a stray unreferenced vertex far
+/// away must not shrink the mesh to a dot in a fitted camera).
+fn bounds_of(p: &[[f32; 3]], used: &[bool]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for q in p {
+    for (q, _) in p.iter().zip(used).filter(|(_, u)| **u) {
         for i in 0..3 {
             lo[i] = lo[i].min(q[i] as f64);
             hi[i] = hi[i].max(q[i] as f64);

@@ -150,6 +150,21 @@ impl LineExtractor {
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
+        self.extract_device_at(est, view, feature_size, opts, [0.0; 3])
+    }
+
+    /// [`extract_device`](Self::extract_device) with the eye and the
+    /// segments relative to `origin` (world = local + origin, mapped in f64):
+    /// a renderer that draws a mesh far from the world origin relative to a
+    /// point near it keeps f32 precision that world coordinates would lose.
+    pub fn extract_device_at(
+        &mut self,
+        est: &CurvatureEstimator,
+        view: View,
+        feature_size: f32,
+        opts: LineOptions,
+        origin: [f64; 3],
+    ) -> Result<(Vec<Segment>, LineStats)> {
         check_view(view, feature_size)?;
         let d = est.device_outputs()?;
         if d.nv != self.nv {
@@ -162,7 +177,8 @@ impl LineExtractor {
         let eye = if view.ortho {
             view.eye
         } else {
-            norm.apply(view.eye.map(f64::from)).map(|c| c as f32)
+            let e: [f64; 3] = std::array::from_fn(|i| f64::from(view.eye[i]) + origin[i]);
+            norm.apply(e).map(|c| c as f32)
         };
         let local = View {
             eye,
@@ -174,7 +190,9 @@ impl LineExtractor {
         let inputs = [d.pos, d.nrm, d.d1, d.d2, d.k, d.dk].map(buf);
         let (mut segs, stats) = self.run(inputs, local, size, opts)?;
         let world = |p: [f32; 3]| -> [f32; 3] {
-            std::array::from_fn(|i| (f64::from(p[i]) * norm.scale + norm.center[i]) as f32)
+            std::array::from_fn(|i| {
+                (f64::from(p[i]) * norm.scale + (norm.center[i] - origin[i])) as f32
+            })
         };
         for s in &mut segs {
             s.0 = world(s.0);
