@@ -367,3 +367,37 @@ fn nasty_meshes_render_with_every_cue() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_inside_of_a_volume_decides_convex_or_concave() {
+    // A sphere SDF: the ball (below 0) is convex, red; the space around it
+    // (above 0) sees the same surface as concave, blue.
+    for (inside, want_red) in [("below", true), ("above", false)] {
+        let dir = tmp_dir("inside");
+        let s = scene(
+            &dir,
+            &format!(
+                "[input]\nsdf = \"sphere\"\nresolution = 48\ninside = \"{inside}\"\n[effects]\n\
+                 curvature_colors = {{ scale = 0.5 }}\n[output]\nsize = [64, 64]\nmsaa = 0\n"
+            ),
+        );
+        let Some(r) = run(&s, &dir, false) else {
+            return;
+        };
+        let img = image::open(&r.unwrap().outputs[0]).unwrap().to_rgb8();
+        let [pr, _, pb] = img.get_pixel(32, 32).0.map(i32::from);
+        assert_eq!(
+            pr > pb + 40,
+            want_red,
+            "{inside}: centre pixel {:?}",
+            img.get_pixel(32, 32)
+        );
+        assert_eq!(
+            pb > pr + 40,
+            !want_red,
+            "{inside}: centre pixel {:?}",
+            img.get_pixel(32, 32)
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

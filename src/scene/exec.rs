@@ -115,7 +115,8 @@ enum Loaded {
         frames: usize,
     },
     Flipbook(crate::mesh::flipbook::Flipbook),
-    Volume(Box<crate::volume::Volume>, f32),
+    /// The volume, the isovalue used and whether values were negated.
+    Volume(Box<crate::volume::Volume>, f32, bool),
 }
 
 /// Joint matrices (flattened, device layout) of a frame.
@@ -208,11 +209,24 @@ fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
             Path::new(""),
             &opts,
         )?),
-        Source::Volume(p, iso) => Loaded::Volume(Box::new(crate::volume::load(p, None)?), *iso),
-        Source::Sdf(kind, res, iso) => {
-            Loaded::Volume(Box::new(crate::volume::sdf::sdf_by_name(kind, *res)?), *iso)
+        Source::Volume(p, iso, above) => inside_below(crate::volume::load(p, None)?, *iso, *above),
+        Source::Sdf(kind, res, iso, above) => {
+            inside_below(crate::volume::sdf::sdf_by_name(kind, *res)?, *iso, *above)
         }
     })
+}
+
+/// Marching cubes orients its triangles (and the gradient normals) out of
+/// the region *below* the isovalue. When the object is above it (density
+/// data), the values and the isovalue are negated (exact in f32), so normals
+/// point out of the object and its convex parts get positive curvature.
+fn inside_below(mut v: crate::volume::Volume, iso: f32, above: bool) -> Loaded {
+    if above {
+        v.values.iter_mut().for_each(|x| *x = -*x);
+        Loaded::Volume(Box::new(v), -iso, true)
+    } else {
+        Loaded::Volume(Box::new(v), iso, false)
+    }
 }
 
 /// A generated mesh by name with about `n` vertices.
@@ -466,7 +480,7 @@ pub fn run(
         _ => None,
     };
     let mut iso = match &loaded {
-        Loaded::Volume(v, _) if has(Pass::Isosurface) => Some(
+        Loaded::Volume(v, ..) if has(Pass::Isosurface) => Some(
             crate::stages::marching_cubes::Isosurfacer::new(gpu.clone(), v)?,
         ),
         _ => None,
@@ -538,7 +552,7 @@ pub fn run(
                     }
                     host_pos = Some(p);
                 }
-                Loaded::Volume(v, iso_value) => {
+                Loaded::Volume(v, iso_value, negated) => {
                     let ex = iso.as_mut().expect("planned with the isosurface");
                     let s = ex.extract(*iso_value, crate::cpu::vertex_fusion::Fusion::Edge)?;
                     rec.add(
@@ -550,14 +564,17 @@ pub fn run(
                     t_pose += s.kernel_ms;
                     let m = ex.read()?;
                     if m.n_faces() == 0 {
-                        return Err(Error::input(
-                            scene.path.display().to_string(),
-                            "[input]",
+                        return Err(Error::input(scene.path.display().to_string(), "[input]", {
+                            let sign = if *negated { -1.0 } else { 1.0 };
+                            let span = v.range().map(|(a, b)| {
+                                let (a, b) = (sign * a, sign * b);
+                                (a.min(b), a.max(b))
+                            });
                             format!(
-                                "the isosurface at iso {iso_value} is empty (values span {:?})",
-                                v.range()
-                            ),
-                        ));
+                                "the isosurface at iso {} is empty (the values span {span:?})",
+                                sign * iso_value
+                            )
+                        }));
                     }
                     new_mesh = Some(m);
                     topo = None;

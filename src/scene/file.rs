@@ -92,6 +92,11 @@ pub struct InputSpec {
     pub sdf: Option<Spanned<String>>,
     /// Isovalue (volume: required; SDF: default 0).
     pub iso: Option<f32>,
+    /// Which side of the isovalue is the object: `above` (density data such
+    /// as CT or electron density; the default for volume files) or `below`
+    /// (distance fields; the default for SDFs). Normals point out of the
+    /// object, so convex parts of it have positive curvature.
+    pub inside: Option<Spanned<String>>,
     /// Weld coincident vertices of mesh and flipbook files.
     #[serde(default)]
     pub weld: bool,
@@ -288,10 +293,10 @@ pub enum Source {
     Flipbook(String),
     /// A libigl LBS set (the OBJ).
     Lbs(PathBuf),
-    /// A volume file and isovalue.
-    Volume(PathBuf, f32),
-    /// An SDF (kind, resolution, isovalue).
-    Sdf(String, usize, f32),
+    /// A volume file, isovalue, and whether the object is above the isovalue.
+    Volume(PathBuf, f32, bool),
+    /// An SDF (kind, resolution, isovalue, object above the isovalue).
+    Sdf(String, usize, f32, bool),
 }
 
 impl Source {
@@ -541,6 +546,23 @@ impl Scene {
             inp.resolution.is_none() || inp.generate.is_some() || inp.sdf.is_some(),
         )?;
         only(
+            "inside",
+            inp.inside.is_none() || inp.volume.is_some() || inp.sdf.is_some(),
+        )?;
+        let above = |default: bool| -> Result<bool> {
+            match &inp.inside {
+                None => Ok(default),
+                Some(v) => match v.get_ref().as_str() {
+                    "above" => Ok(true),
+                    "below" => Ok(false),
+                    other => Err(ck.err(
+                        v.span(),
+                        format!("inside = {other:?}: expected \"above\" or \"below\""),
+                    )),
+                },
+            }
+        };
+        only(
             "weld",
             !inp.weld || inp.mesh.is_some() || inp.flipbook.is_some(),
         )?;
@@ -570,7 +592,7 @@ impl Scene {
             if !iso.is_finite() {
                 return Err(ck.err(input_span, format!("iso {iso} must be finite")));
             }
-            Source::Volume(ck.existing(v)?, iso)
+            Source::Volume(ck.existing(v)?, iso, above(true)?)
         } else {
             let s = inp.sdf.as_ref().expect("one source is given");
             const KINDS: [&str; 3] = ["sphere", "torus", "gyroid"];
@@ -587,7 +609,12 @@ impl Scene {
                     format!("resolution {res}: an SDF grid needs 4..=1024 points per axis"),
                 ));
             }
-            Source::Sdf(s.get_ref().clone(), res, inp.iso.unwrap_or(0.0))
+            Source::Sdf(
+                s.get_ref().clone(),
+                res,
+                inp.iso.unwrap_or(0.0),
+                above(false)?,
+            )
         };
         if let Source::Generate(_, n) = &source
             && !(12..=20_000_000).contains(n)
@@ -1012,7 +1039,7 @@ mod tests {
     #[test]
     fn effects_resolve_cues_and_parameters() {
         let s = parse("[input]\nsdf = \"gyroid\"\nresolution = 64\n[effects]\ncurvature_colors = {}\nao = { level = \"exact\", radius = 0.1 }\nsuggestive_contours = { threshold = 0.1 }\nfeature_edges = { crease = 180, caps = \"mh\" }\n[output]\nformats = [\"svg\"]\n").unwrap();
-        assert_eq!(s.source, Source::Sdf("gyroid".into(), 64, 0.0));
+        assert_eq!(s.source, Source::Sdf("gyroid".into(), 64, 0.0, false));
         assert_eq!(
             s.effects.cues,
             vec![
