@@ -292,10 +292,11 @@ fn corrupt_dmat_files_are_errors_not_panics() {
     // Real data when present, else a synthetic binary matrix of the same kind.
     let real = data_dir().join("elephant-weights.dmat");
     let bytes = std::fs::read(&real).unwrap_or_else(|_| {
+        // 4 columns: the NaN test below writes into column 3.
         binary_dmat(
-            3,
+            4,
             50,
-            &(0..150).map(|k| k as f64 / 150.0).collect::<Vec<_>>(),
+            &(0..200).map(|k| k as f64 / 200.0).collect::<Vec<_>>(),
         )
     });
     let good = read_dmat(&w("good.dmat", &bytes)).unwrap();
