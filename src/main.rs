@@ -407,39 +407,12 @@ fn options(a: &CurvatureArgs) -> CurvatureOptions {
 }
 
 fn generated(kind: GenArg, n: usize) -> (String, Mesh) {
-    use shapecue::mesh as g;
-    let level = |n: usize| {
-        let mut l = 0;
-        while 10 * 4usize.pow(l + 1) + 2 <= n && l < 10 {
-            l += 1;
-        }
-        l
-    };
-    match kind {
-        GenArg::Torus => {
-            let (nu, nv) = g::torus_resolution_for(n);
-            (
-                format!("torus R=1 r=0.4 {nu}x{nv}"),
-                g::torus(1.0, 0.4, nu, nv),
-            )
-        }
-        GenArg::Sphere => (
-            format!("icosphere level {}", level(n)),
-            g::icosphere(1.0, level(n)),
-        ),
-        GenArg::Ellipsoid => (
-            format!("ellipsoid 1.5,1,0.6 level {}", level(n)),
-            g::ellipsoid(1.5, 1.0, 0.6, level(n)),
-        ),
-        GenArg::Cylinder => {
-            let k = ((n as f64).sqrt() as usize).max(3);
-            (format!("cylinder {k}x{k}"), g::cylinder(1.0, 2.0, k, k))
-        }
-        GenArg::Plane => {
-            let k = ((n as f64).sqrt() as usize).max(2);
-            (format!("plane {k}x{k}"), g::plane(k, 2.0))
-        }
-    }
+    let name = kind
+        .to_possible_value()
+        .expect("every GenArg has a name")
+        .get_name()
+        .to_string();
+    shapecue::mesh::generated_by_name(&name, n).expect("GenArg names are the library's")
 }
 
 fn refuse_overwrite(out: &Path, input: Option<&Path>, force: bool) -> Result<()> {
@@ -1101,4 +1074,17 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_generate_choice_is_a_library_mesh() {
+        for k in GenArg::value_variants() {
+            let (desc, m) = generated(*k, 500);
+            assert!(!desc.is_empty() && m.n_faces() > 0);
+        }
+    }
 }

@@ -257,3 +257,43 @@ pub fn uv_ellipsoid(a: f64, b: f64, c: f64, nu: usize, nv: usize) -> Mesh {
     }
     Mesh { positions, faces }
 }
+
+/// The names [`generated_by_name`] knows.
+pub const GENERATED_NAMES: [&str; 5] = ["torus", "sphere", "ellipsoid", "cylinder", "plane"];
+
+/// A generated mesh by name ([`GENERATED_NAMES`]) with about `n` vertices, and a
+/// description with its parameters: the torus R=1 r=0.4, an icosphere and an
+/// ellipsoid (1.5, 1, 0.6) at the subdivision level nearest below `n`
+/// vertices, a cylinder and a plane of √n × √n. `None` for an unknown name.
+pub fn generated_by_name(kind: &str, n: usize) -> Option<(String, Mesh)> {
+    let level = {
+        let mut l = 0;
+        while 10 * 4usize.pow(l + 1) + 2 <= n && l < 10 {
+            l += 1;
+        }
+        l
+    };
+    Some(match kind {
+        "torus" => {
+            let (nu, nv) = torus_resolution_for(n);
+            (
+                format!("torus R=1 r=0.4 {nu}x{nv}"),
+                torus(1.0, 0.4, nu, nv),
+            )
+        }
+        "sphere" => (format!("icosphere level {level}"), icosphere(1.0, level)),
+        "ellipsoid" => (
+            format!("ellipsoid 1.5,1,0.6 level {level}"),
+            ellipsoid(1.5, 1.0, 0.6, level),
+        ),
+        "cylinder" => {
+            let k = ((n as f64).sqrt() as usize).max(3);
+            (format!("cylinder {k}x{k}"), cylinder(1.0, 2.0, k, k))
+        }
+        "plane" => {
+            let k = ((n as f64).sqrt() as usize).max(2);
+            (format!("plane {k}x{k}"), plane(k, 2.0))
+        }
+        _ => return None,
+    })
+}

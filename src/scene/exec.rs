@@ -137,7 +137,14 @@ fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
     let opts = LoadOptions { weld: scene.weld };
     Ok(match &scene.source {
         Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?),
-        Source::Generate(kind, n) => Loaded::Static(generate(kind, *n)?),
+        Source::Generate(kind, n) => match crate::mesh::generated_by_name(kind, *n) {
+            Some((_, m)) => Loaded::Static(m),
+            None => {
+                return Err(Error::InvalidArgument(format!(
+                    "unknown generated mesh {kind:?}"
+                )));
+            }
+        },
         Source::Gltf(p, clip) => {
             let m = crate::mesh::skinned::load_gltf(p)?;
             if m.clips.is_empty() && clip.is_none() {
@@ -227,39 +234,6 @@ fn inside_below(mut v: crate::volume::Volume, iso: f32, above: bool) -> Loaded {
     } else {
         Loaded::Volume(Box::new(v), iso, false)
     }
-}
-
-/// A generated mesh by name with about `n` vertices.
-pub fn generate(kind: &str, n: usize) -> Result<Mesh> {
-    use crate::mesh as g;
-    let level = {
-        let mut l = 0;
-        while 10 * 4usize.pow(l + 1) + 2 <= n && l < 10 {
-            l += 1;
-        }
-        l
-    };
-    Ok(match kind {
-        "torus" => {
-            let (nu, nv) = g::torus_resolution_for(n);
-            g::torus(1.0, 0.4, nu, nv)
-        }
-        "sphere" => g::icosphere(1.0, level),
-        "ellipsoid" => g::ellipsoid(1.5, 1.0, 0.6, level),
-        "cylinder" => {
-            let k = ((n as f64).sqrt() as usize).max(3);
-            g::cylinder(1.0, 2.0, k, k)
-        }
-        "plane" => {
-            let k = ((n as f64).sqrt() as usize).max(2);
-            g::plane(k, 2.0)
-        }
-        other => {
-            return Err(Error::InvalidArgument(format!(
-                "unknown generated mesh {other:?}"
-            )));
-        }
-    })
 }
 
 /// The frame indices a scene renders, checked against what the input has.

@@ -569,11 +569,11 @@ impl Scene {
         let source = if let Some(m) = &inp.mesh {
             Source::Mesh(ck.existing(m)?)
         } else if let Some(g) = &inp.generate {
-            const KINDS: [&str; 5] = ["torus", "sphere", "ellipsoid", "cylinder", "plane"];
-            if !KINDS.contains(&g.get_ref().as_str()) {
+            use crate::mesh::GENERATED_NAMES as NAMES;
+            if !NAMES.contains(&g.get_ref().as_str()) {
                 return Err(ck.err(
                     g.span(),
-                    format!("generate = {:?}: expected one of {KINDS:?}", g.get_ref()),
+                    format!("generate = {:?}: expected one of {NAMES:?}", g.get_ref()),
                 ));
             }
             Source::Generate(g.get_ref().clone(), inp.resolution.unwrap_or(40_000))
