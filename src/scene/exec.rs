@@ -313,6 +313,11 @@ struct Topology<'g> {
     /// Median edge length ([`crate::mesh::feature_size`]) of the topology's
     /// first pose: the scale of the suggestive-contour threshold.
     feature_size: f32,
+    /// Which vertices faces use.
+    used: Vec<bool>,
+    /// Normalization of the topology's first pose over the used vertices
+    /// (fixed for a skinned mesh's poses, as in `PosePipeline`).
+    norm: Normalization,
     est: Option<CurvatureEstimator>,
     lines: Option<LineExtractor>,
     edges: Option<EdgeStage<'g>>,
@@ -325,27 +330,10 @@ struct PoseData {
     nrm: Vec<[f32; 3]>,
     k: Vec<[f32; 2]>,
     ao: Vec<f32>,
-    feature_size: f32,
 }
 
 fn to_f32(v: &[[f64; 3]]) -> Vec<[f32; 3]> {
     v.iter().map(|p| p.map(|c| c as f32)).collect()
-}
-
-/// Centre of the bounds of the used points, in f64.
-fn centre(p: impl Iterator<Item = [f64; 3]>, used: &[bool]) -> [f64; 3] {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for (q, _) in p.zip(used).filter(|(_, u)| **u) {
-        for i in 0..3 {
-            lo[i] = lo[i].min(q[i]);
-            hi[i] = hi[i].max(q[i]);
-        }
-    }
-    std::array::from_fn(|i| {
-        let c = 0.5 * (lo[i] + hi[i]);
-        if c.is_finite() { c } else { 0.0 }
-    })
 }
 
 /// Resolves a view against the scene bounds (scene frame); explicit eyes and
@@ -557,14 +545,13 @@ pub fn run(
 
             // Topology passes.
             if let Some(m) = new_mesh {
+                let used = crate::mesh::referenced(m.n_vertices(), &m.faces);
+                let norm = Normalization::of_masked(&m.positions, Some(&used));
                 let fs = crate::mesh::feature_size(&m.positions, &m.faces);
-                let fs = if fs > 0.0 {
-                    fs
-                } else {
-                    Normalization::of(&m.positions).scale
-                };
                 let mut t = Topology {
-                    feature_size: fs as f32,
+                    feature_size: if fs > 0.0 { fs } else { norm.scale } as f32,
+                    used,
+                    norm,
                     mesh: m,
                     est: None,
                     lines: None,
@@ -640,8 +627,7 @@ pub fn run(
             // Curvature (with its normals) on the pose's positions.
             if let (Some(est), None) = (t.est.as_mut(), iso.as_ref()) {
                 if let Some(sk) = skinner.as_ref() {
-                    let norm = Normalization::of(&t.mesh.positions);
-                    est.set_positions_device(&sk.out, [1.0; 3], [0.0; 3], norm)?;
+                    est.set_positions_device(&sk.out, [1.0; 3], [0.0; 3], t.norm)?;
                 } else {
                     est.set_positions(host_pos.as_deref().unwrap_or(&t.mesh.positions))?;
                 }
@@ -657,18 +643,19 @@ pub fn run(
             // Host copies for drawing and host passes, relative to the scene
             // origin (the centre of the first pose), so that a mesh far from
             // the world origin keeps its f32 precision in the renderer.
-            let used = crate::mesh::referenced(nv, &t.mesh.faces);
             if let Some(sk) = skinner.as_ref() {
                 let p = sk.read()?;
-                let o = *origin
-                    .get_or_insert_with(|| centre(p.iter().map(|q| q.map(f64::from)), &used));
+                let o = *origin.get_or_insert_with(|| {
+                    centre(bounds_of(p.iter().map(|q| q.map(f64::from)), &t.used))
+                });
                 pose.pos = p
                     .iter()
                     .map(|q| std::array::from_fn(|i| (f64::from(q[i]) - o[i]) as f32))
                     .collect();
             } else {
                 let p = host_pos.as_deref().unwrap_or(&t.mesh.positions);
-                let o = *origin.get_or_insert_with(|| centre(p.iter().copied(), &used));
+                let o =
+                    *origin.get_or_insert_with(|| centre(bounds_of(p.iter().copied(), &t.used)));
                 pose.pos = p
                     .iter()
                     .map(|q| std::array::from_fn(|i| (q[i] - o[i]) as f32))
@@ -703,7 +690,7 @@ pub fn run(
                 pose.nrm = vec![[0.0; 3]; nv];
             }
             if bounds.is_none() {
-                let b = bounds_of(&pose.pos, &used);
+                let b = bounds_of(pose.pos.iter().map(|q| q.map(f64::from)), &t.used);
                 let diag = ((0..3).map(|i| (b.1[i] - b.0[i]).powi(2)).sum::<f64>()).sqrt();
                 ao_radius = (fx.ao_radius as f64 * diag.max(1e-30)) as f32;
                 cameras = scene
@@ -716,7 +703,6 @@ pub fn run(
                 }
                 bounds = Some(b);
             }
-            pose.feature_size = t.feature_size;
             if let (Some(ao), Some(est)) = (ao_stage.as_mut(), t.est.as_ref()) {
                 let ms = ao.run_device(est, ao_radius, fx.ao_mode)?;
                 rec.add(
@@ -757,7 +743,7 @@ pub fn run(
                     Some(est) => lx.extract_device_at(
                         est,
                         v,
-                        pose.feature_size,
+                        t.feature_size,
                         line_opts,
                         origin.unwrap_or_default(),
                     )?,
@@ -772,7 +758,7 @@ pub fn run(
                             k: &vec![[0f32; 2]; n],
                             dk: &vec![[0f32; 4]; n],
                         };
-                        lx.extract(&x, v, pose.feature_size, line_opts)?
+                        lx.extract(&x, v, t.feature_size, line_opts)?
                     }
                 };
                 let ms = stats.vertex_ms + stats.face_ms;
@@ -978,16 +964,24 @@ fn strength_bin(strength: f32) -> usize {
 
 /// Bounds of the vertices that faces use (a stray unreferenced vertex far
 /// away must not shrink the mesh to a dot in a fitted camera).
-fn bounds_of(p: &[[f32; 3]], used: &[bool]) -> ([f64; 3], [f64; 3]) {
+fn bounds_of(p: impl Iterator<Item = [f64; 3]>, used: &[bool]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for (q, _) in p.iter().zip(used).filter(|(_, u)| **u) {
+    for (q, _) in p.zip(used).filter(|(_, u)| **u) {
         for i in 0..3 {
-            lo[i] = lo[i].min(q[i] as f64);
-            hi[i] = hi[i].max(q[i] as f64);
+            lo[i] = lo[i].min(q[i]);
+            hi[i] = hi[i].max(q[i]);
         }
     }
     (lo, hi)
+}
+
+/// Centre of bounds (0 on an axis where it is not finite, e.g. no used vertex).
+fn centre((lo, hi): ([f64; 3], [f64; 3])) -> [f64; 3] {
+    std::array::from_fn(|i| {
+        let c = 0.5 * (lo[i] + hi[i]);
+        if c.is_finite() { c } else { 0.0 }
+    })
 }
 
 /// Per-vertex colours: curvature colours and/or AO; empty (the style's flat
@@ -997,10 +991,8 @@ fn mesh_colors(scene: &Scene, plan: &Plan, pose: &PoseData, scale: f32) -> Vec<[
     let colors = fx
         .cues
         .contains(&crate::scene::planner::Cue::CurvatureColors);
-    let ao = plan.contains(Pass::Ao)
-        && fx
-            .cues
-            .contains(&crate::scene::planner::Cue::AmbientOcclusion);
+    // The AO pass is planned exactly when the AO cue is asked for.
+    let ao = plan.contains(Pass::Ao);
     if !colors && !ao {
         return Vec::new();
     }
