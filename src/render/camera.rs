@@ -40,6 +40,18 @@ fn default_up(dir: Vec3) -> Vec3 {
     }
 }
 
+/// The bounding sphere of the box `lo..hi` (centre, radius; a flat or
+/// point-like box still gets a small positive radius) and the distance from
+/// its centre at which the sphere touches the narrower half-angle of a view
+/// with vertical field of view `fov_y_deg` and `aspect` (width / height).
+pub fn fit_sphere(lo: Vec3, hi: Vec3, fov_y_deg: f32, aspect: f32) -> (Vec3, f32, f32) {
+    let centre = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-6 * (1.0 + centre.length()));
+    let half_v = 0.5 * fov_y_deg.to_radians();
+    let half_h = (half_v.tan() * aspect).atan();
+    (centre, radius, radius / half_v.min(half_h).sin())
+}
+
 impl Camera {
     /// A 45° perspective camera at `eye` looking at `target`, up +Y (+Z when
     /// looking straight up or down), near/far at 1/100 and 100 times the distance.
@@ -70,13 +82,7 @@ impl Camera {
             )));
         }
         let fov_y_deg = 45.0f32;
-        let centre = 0.5 * (bounds_min + bounds_max);
-        // A flat or point-like box still gets a visible, valid frustum.
-        let radius = (0.5 * (bounds_max - bounds_min).length()).max(1e-6 * (1.0 + centre.length()));
-        let half_v = 0.5 * fov_y_deg.to_radians();
-        let half_h = (half_v.tan() * aspect).atan();
-        // Distance at which the sphere touches the narrower half-angle cone.
-        let dist = radius / half_v.min(half_h).sin();
+        let (centre, radius, dist) = fit_sphere(bounds_min, bounds_max, fov_y_deg, aspect);
         let dir = eye_dir.normalize();
         Ok(Camera {
             eye: centre + dir * dist,

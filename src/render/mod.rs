@@ -30,7 +30,7 @@ mod context;
 mod frame;
 mod lines;
 
-pub use camera::Camera;
+pub use camera::{Camera, fit_sphere};
 pub use frame::Frame;
 pub use lines::segments_to_clip_quads;
 

@@ -357,10 +357,8 @@ fn camera(
     let (eye, target) = match &v.kind {
         CameraKind::LookAt { eye, target } => (local(*eye), target.map(local).unwrap_or(centre)),
         CameraKind::Fit(d) => {
-            let radius = (0.5 * (hi3 - lo3).length()).max(1e-6 * (1.0 + centre.length()));
-            let half_v = 0.5 * v.fov.to_radians();
-            let half_h = (half_v.tan() * aspect).atan();
-            let dist = radius / half_v.min(half_h).sin() * 1.05;
+            // 5 % margin around the bounding sphere.
+            let dist = crate::render::fit_sphere(lo3, hi3, v.fov, aspect).2 * 1.05;
             let dir = glam::Vec3::from(*d).normalize();
             (centre + dir * dist, centre)
         }
