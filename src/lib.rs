@@ -21,6 +21,7 @@ pub mod mesh;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod spec;
 pub mod stages;
 pub mod volume;
 

@@ -1,0 +1,1 @@
+//! Shared types of the `curvature` family (see [`crate::spec`]).

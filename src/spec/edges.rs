@@ -1,0 +1,1 @@
+//! Shared types of the `edges` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `feature_lines` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `marching_cubes` family (see [`crate::spec`]).

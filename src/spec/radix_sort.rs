@@ -1,0 +1,1 @@
+//! Shared types of the `radix_sort` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `scan` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `sdf_lines` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `skinning` family (see [`crate::spec`]).

@@ -1,0 +1,1 @@
+//! Shared types of the `vertex_fusion` family (see [`crate::spec`]).
