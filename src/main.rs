@@ -334,6 +334,7 @@ struct CurvatureArgs {
 }
 
 fn main() {
+    shapecue::export::output::install_interrupt_cleanup();
     if let Err(e) = run() {
         eprintln!("error: {e:#}");
         let code = if e.downcast_ref::<InteropRefused>().is_some() {
@@ -449,8 +450,10 @@ fn prepare_outputs<'a>(
 
 /// Writes a stats document as pretty JSON and says so.
 fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
-    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
-        .with_context(|| format!("writing {}", path.display()))?;
+    shapecue::export::output::write_bytes_atomic(
+        path,
+        (serde_json::to_string_pretty(value)? + "\n").as_bytes(),
+    )?;
     println!("wrote {}", path.display());
     Ok(())
 }

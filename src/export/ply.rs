@@ -113,14 +113,22 @@ fn write_rows(
     names: &[&str],
     extra: impl Fn(usize, &mut Vec<f32>),
 ) -> Result<()> {
-    let n = mesh.n_vertices();
     let write_err = |source| Error::Write {
         path: path.to_path_buf(),
         source,
     };
-    let file = File::create(path).map_err(write_err)?;
-    let mut w = BufWriter::with_capacity(1 << 20, file);
+    super::output::write_atomic(path, |w| write_body(w, mesh, names, &extra, write_err))
+}
 
+/// The bytes of [`write_rows`], into a writer.
+fn write_body(
+    w: &mut BufWriter<File>,
+    mesh: &Mesh,
+    names: &[&str],
+    extra: &impl Fn(usize, &mut Vec<f32>),
+    write_err: impl Fn(std::io::Error) -> Error,
+) -> Result<()> {
+    let n = mesh.n_vertices();
     let mut header = String::new();
     header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
     header.push_str(&format!("element vertex {n}\n"));
@@ -129,7 +137,7 @@ fn write_rows(
     }
     header.push_str(&format!("element face {}\n", mesh.n_faces()));
     header.push_str("property list uchar int vertex_indices\nend_header\n");
-    w.write_all(header.as_bytes()).map_err(write_err)?;
+    w.write_all(header.as_bytes()).map_err(&write_err)?;
 
     let mut row: Vec<f32> = Vec::with_capacity(names.len());
     let mut bytes: Vec<u8> = Vec::with_capacity(4 * row.capacity());
@@ -141,7 +149,7 @@ fn write_rows(
         for v in &row {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        w.write_all(&bytes).map_err(write_err)?;
+        w.write_all(&bytes).map_err(&write_err)?;
     }
 
     for face in &mesh.faces {
@@ -151,9 +159,8 @@ fn write_rows(
             // Checked above to fit an i32, so the u32 bytes are the i32 bytes.
             rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
         }
-        w.write_all(&rec).map_err(write_err)?;
+        w.write_all(&rec).map_err(&write_err)?;
     }
-    w.into_inner().map_err(|e| write_err(e.into_error()))?;
     Ok(())
 }
 

@@ -1,0 +1,321 @@
+//! Output files are written whole or not at all, and never over an input.
+//!
+//! - [`check_outputs`] runs before any work: it refuses an output that is one
+//!   of the run's inputs (the same file, compared by device and inode, so a
+//!   hard link or another spelling of the path is caught too), two outputs that
+//!   name the same file, and an existing output without `force`. The first two
+//!   are refused even with `force`: nothing the user gave is overwritten.
+//! - [`write_atomic`] writes to a hidden temporary file in the output's own
+//!   folder and renames it into place only when the whole file was written, so
+//!   a failed or interrupted write leaves the old file (or none) and never a
+//!   truncated one. The rename is atomic on POSIX file systems because the
+//!   temporary file is on the same file system as its target.
+//! - [`install_interrupt_cleanup`] removes the temporary files still being
+//!   written when the process receives SIGINT, SIGTERM or SIGHUP, then exits
+//!   with the conventional status 128 + signal (130 for Ctrl-C).
+
+use crate::error::{Error, Result};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Temporary files being written now, removed on interruption.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Distinguishes temporary files of one process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// The identity of an existing file: device and inode where the platform has
+/// them, else its canonical path.
+#[derive(PartialEq, Eq, Debug)]
+enum Identity {
+    #[cfg(unix)]
+    Inode(u64, u64),
+    #[cfg_attr(unix, allow(dead_code))]
+    Path(PathBuf),
+}
+
+fn identity(path: &Path) -> Option<Identity> {
+    let meta = std::fs::metadata(path).ok()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        Some(Identity::Inode(meta.dev(), meta.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = meta;
+        path.canonicalize().ok().map(Identity::Path)
+    }
+}
+
+/// Where a path that may not exist yet would be: its folder made canonical
+/// (when that folder exists) joined with its file name.
+fn location(path: &Path) -> PathBuf {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    match path.file_name() {
+        Some(name) => dir.join(name),
+        None => dir,
+    }
+}
+
+fn refuse(msg: String) -> Error {
+    Error::InvalidArgument(msg)
+}
+
+/// Checks a run's outputs before it starts, then creates their folders.
+///
+/// `inputs` are every file the run reads (mesh, volume header *and* its
+/// detached data files, marked-edge lists, scene files); `outputs` every file
+/// it will write. Refused, even with `force`: an output that is an input, and
+/// two outputs that are the same file. Refused without `force`: an output that
+/// exists. A path of `-` is refused (outputs are files).
+pub fn check_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Result<()> {
+    let input_ids: Vec<(&Path, Identity)> = inputs
+        .iter()
+        .filter_map(|p| identity(p).map(|id| (*p, id)))
+        .collect();
+    let mut seen: Vec<(&Path, PathBuf, Option<Identity>)> = Vec::new();
+    for &out in outputs {
+        if out.as_os_str() == "-" {
+            return Err(refuse(
+                "an output of '-' is not supported: give a file name".to_string(),
+            ));
+        }
+        if out.as_os_str().is_empty() || out.file_name().is_none() {
+            return Err(refuse(format!(
+                "'{}' is not a file name for an output",
+                out.display()
+            )));
+        }
+        let id = identity(out);
+        if let Some(id) = &id
+            && let Some((inp, _)) = input_ids.iter().find(|(_, i)| i == id)
+        {
+            let how = if location(out) == location(inp) {
+                String::new()
+            } else {
+                " (the same file under another name)".to_string()
+            };
+            return Err(refuse(format!(
+                "refusing to write {}: it is the input file {}{how}; --force never overwrites an input",
+                out.display(),
+                inp.display()
+            )));
+        }
+        let loc = location(out);
+        if let Some((other, _, _)) = seen
+            .iter()
+            .find(|(_, l, i)| *l == loc || (id.is_some() && i.as_ref() == id.as_ref()))
+        {
+            return Err(refuse(format!(
+                "{} and {} name the same output file; give each output its own name",
+                other.display(),
+                out.display()
+            )));
+        }
+        if id.is_some() && !std::fs::metadata(out).map(|m| m.is_file()).unwrap_or(false) {
+            return Err(refuse(format!(
+                "refusing to write {}: it exists and is not a regular file",
+                out.display()
+            )));
+        }
+        if id.is_some() && !force {
+            return Err(refuse(format!(
+                "{} exists; pass --force to overwrite it",
+                out.display()
+            )));
+        }
+        seen.push((out, loc, id));
+    }
+    for &out in outputs {
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The hidden temporary name `write_atomic` uses for `path`.
+fn temp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}.{n}.partial", std::process::id()))
+}
+
+fn pending(path: &Path, add: bool) {
+    let mut list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    if add {
+        list.push(path.to_path_buf());
+    } else {
+        list.retain(|p| p != path);
+    }
+}
+
+/// Writes `path` whole or not at all: `write` fills a buffered temporary file
+/// in the same folder, which is renamed onto `path` only when `write` returned
+/// `Ok` and every byte reached the file. On any error the temporary file is
+/// removed and `path` is left as it was.
+///
+/// Errors that `write` returns are passed through; I/O errors name `path`.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
+) -> Result<()> {
+    let tmp = temp_path(path);
+    let err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    pending(&tmp, true);
+    let result = (|| {
+        let file = File::create(&tmp).map_err(err)?;
+        let mut w = BufWriter::with_capacity(1 << 20, file);
+        write(&mut w)?;
+        let file = w.into_inner().map_err(|e| err(e.into_error()))?;
+        // Space is reserved by the write calls, but some file systems report
+        // a full disk only when the data is flushed: sync before the rename.
+        file.sync_data().map_err(err)?;
+        drop(file);
+        std::fs::rename(&tmp, path).map_err(err)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    pending(&tmp, false);
+    result
+}
+
+/// [`write_atomic`] for a document already in memory.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic(path, |w| {
+        w.write_all(bytes).map_err(|source| Error::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+    })
+}
+
+/// Removes the temporary files of unfinished [`write_atomic`] calls when the
+/// process is interrupted (SIGINT, SIGTERM, SIGHUP), then exits with status
+/// 130. Call once, early in `main`; a second call does nothing.
+pub fn install_interrupt_cleanup() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // If a handler cannot be installed (another one exists), writes are
+        // still atomic; only a leftover hidden `.partial` file is possible.
+        let _ = ctrlc::set_handler(|| {
+            remove_pending();
+            std::process::exit(130);
+        });
+    });
+}
+
+/// Removes every temporary file still being written (for an interrupt handler).
+pub fn remove_pending() {
+    let list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    for p in list.iter() {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("shapecue-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn hard_link_to_an_input_is_refused_even_with_force() {
+        let d = dir("link");
+        let input = d.join("cow.obj");
+        std::fs::write(&input, "v 0 0 0\n").unwrap();
+        let link = d.join("hard.ply");
+        std::fs::hard_link(&input, &link).unwrap();
+        let e = check_outputs(&[&input], &[&link], true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("input file") && e.contains("another name"),
+            "{e}"
+        );
+        // Another spelling of the same path.
+        let dotted = d.join(".").join("cow.obj");
+        let e = check_outputs(&[&input], &[&dotted], true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("input file"), "{e}");
+        assert_eq!(std::fs::read_to_string(&input).unwrap(), "v 0 0 0\n");
+    }
+
+    #[test]
+    fn two_outputs_naming_one_file_are_refused() {
+        let d = dir("twice");
+        let a = d.join("o.ply");
+        let b = d.join(".").join("o.ply");
+        let e = check_outputs(&[], &[&a, &b], true).unwrap_err().to_string();
+        assert!(e.contains("same output file"), "{e}");
+    }
+
+    #[test]
+    fn existing_output_needs_force_and_dash_is_refused() {
+        let d = dir("exists");
+        let a = d.join("o.json");
+        std::fs::write(&a, "{}").unwrap();
+        let e = check_outputs(&[], &[&a], false).unwrap_err().to_string();
+        assert!(e.contains("--force"), "{e}");
+        check_outputs(&[], &[&a], true).unwrap();
+        let e = check_outputs(&[], &[Path::new("-")], true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'-'"), "{e}");
+    }
+
+    #[test]
+    fn failed_write_keeps_the_old_file_and_leaves_no_temporary() {
+        let d = dir("atomic");
+        let a = d.join("o.ply");
+        std::fs::write(&a, "old").unwrap();
+        let r = write_atomic(&a, |w| {
+            w.write_all(b"half of a new").unwrap();
+            Err(Error::InvalidArgument("stop".into()))
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        let names: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        write_bytes_atomic(&a, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new");
+    }
+
+    #[test]
+    fn a_device_or_folder_is_not_replaced() {
+        let d = dir("special");
+        let e = check_outputs(&[], &[&d], true).unwrap_err().to_string();
+        assert!(e.contains("not a regular file"), "{e}");
+        let full = Path::new("/dev/full");
+        if full.exists() {
+            let e = check_outputs(&[], &[full], true).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+    }
+}
