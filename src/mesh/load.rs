@@ -413,7 +413,14 @@ mod ply {
                             return Err(std::io::Error::from(ErrorKind::UnexpectedEof).into());
                         }
                         if !self.line.trim().is_empty() {
-                            return parser.read_ascii_element(&self.line, def);
+                            let e = parser.read_ascii_element(&self.line, def)?;
+                            // The parser ignores values past the declared ones;
+                            // a line with more is a malformed file, not a
+                            // comment.
+                            if extra_values(&self.line, def) {
+                                return Err(std::io::Error::from(ErrorKind::InvalidInput).into());
+                            }
+                            return Ok(e);
                         }
                     }
                 }
@@ -442,6 +449,26 @@ mod ply {
             }
             Ok(())
         }
+    }
+
+    /// True when an ASCII element line holds more values than `def`
+    /// declares (a list property takes its count and that many values).
+    fn extra_values(line: &str, def: &ElementDef) -> bool {
+        let tokens: Vec<&str> = line.split_whitespace().collect();
+        let mut used = 0usize;
+        for p in def.properties.values() {
+            match p.data_type {
+                PropertyType::Scalar(_) => used += 1,
+                PropertyType::List(..) => {
+                    let n = tokens
+                        .get(used)
+                        .and_then(|t| t.parse::<usize>().ok())
+                        .unwrap_or(0);
+                    used = used.saturating_add(1).saturating_add(n);
+                }
+            }
+        }
+        tokens.len() > used
     }
 
     fn is_integer(t: &ScalarType) -> bool {
@@ -488,8 +515,32 @@ mod ply {
         Ok(())
     }
 
+    /// The header is text: a line that is not UTF-8 is named by its number
+    /// (the parser would only say that the stream is not valid UTF-8).
+    fn check_header_text(bytes: &[u8], source: &str) -> Result<()> {
+        for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+            if let Err(e) = std::str::from_utf8(line) {
+                let col = e.valid_up_to();
+                return Err(Error::input(
+                    source,
+                    format!("header line {}", i + 1),
+                    format!(
+                        "byte 0x{:02x} at column {} is not text (the header must be ASCII)",
+                        line[col],
+                        col + 1
+                    ),
+                ));
+            }
+            if line.strip_suffix(b"\r").unwrap_or(line) == b"end_header" {
+                break;
+            }
+        }
+        Ok(())
+    }
+
     /// Parses a PLY file (ASCII, binary little- or big-endian).
     pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
+        check_header_text(bytes, source)?;
         let mut reader = Reader::new(bytes);
         let header = Parser::<Skip>::new()
             .read_header(&mut reader)
@@ -737,5 +788,40 @@ mod obj {
         } else {
             None
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ply;
+
+    const HEAD: &str = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+        property float y\nproperty float z\nelement face 1\n\
+        property list uchar int vertex_indices\nend_header\n";
+
+    #[test]
+    fn ascii_ply_line_with_an_extra_value_is_an_error_naming_the_line() {
+        let good = format!("{HEAD}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+        assert_eq!(ply::parse(good.as_bytes(), "t.ply").unwrap().faces.len(), 1);
+        let bad = format!("{HEAD}0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n");
+        let e = ply::parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(
+            e.contains("t.ply") && e.contains("vertex 1") && e.contains("line 11"),
+            "{e}"
+        );
+        let bad_face = format!("{HEAD}0 0 0\n1 0 0\n0 1 0\n3 0 1 2 2\n");
+        let e = ply::parse(bad_face.as_bytes(), "t.ply")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("face 0"), "{e}");
+    }
+
+    #[test]
+    fn non_text_header_names_the_line() {
+        let mut bytes = b"ply\nformat ascii 1.0\ncomment caf".to_vec();
+        bytes.extend_from_slice(&[0xe9, b'\n']);
+        bytes.extend_from_slice(&HEAD.as_bytes()[20..]);
+        let e = ply::parse(&bytes, "t.ply").unwrap_err().to_string();
+        assert!(e.contains("header line 3") && e.contains("0xe9"), "{e}");
     }
 }
