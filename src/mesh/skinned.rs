@@ -109,13 +109,48 @@ fn bad(path: &Path, element: impl Into<String>, problem: impl Into<String>) -> E
     Error::input(path.display().to_string(), element, problem)
 }
 
+/// When a glTF file reads but a buffer or image it refers to does not, the
+/// error names that file and the glTF file that refers to it (the glTF
+/// crate's I/O error names neither).
+fn missing_part(path: &Path) -> Option<Error> {
+    let doc = gltf::Gltf::open(path).ok()?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let buffers = doc.buffers().filter_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(u) => Some((format!("buffer {}", b.index()), u.to_string())),
+        gltf::buffer::Source::Bin => None,
+    });
+    let images = doc.images().filter_map(|i| match i.source() {
+        gltf::image::Source::Uri { uri, .. } => {
+            Some((format!("image {}", i.index()), uri.to_string()))
+        }
+        gltf::image::Source::View { .. } => None,
+    });
+    for (element, uri) in buffers.chain(images) {
+        if uri.starts_with("data:") {
+            continue;
+        }
+        let file = dir.join(&uri);
+        if let Err(source) = std::fs::metadata(&file) {
+            return Some(bad(
+                path,
+                element,
+                format!(
+                    "cannot read {} (referred to by this file): {source}",
+                    file.display()
+                ),
+            ));
+        }
+    }
+    None
+}
+
 /// Loads every skinned primitive of a glTF file.
 pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
     let (doc, buffers, _) = gltf::import(path).map_err(|e| match e {
-        gltf::Error::Io(source) => Error::Io {
+        gltf::Error::Io(source) => missing_part(path).unwrap_or(Error::Io {
             path: path.to_path_buf(),
             source,
-        },
+        }),
         other => bad(path, "file", other.to_string()),
     })?;
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
@@ -413,5 +448,26 @@ impl SkinnedMesh {
     /// Column-major floats of joint matrices, 16 per joint (device layout).
     pub fn flatten(mats: &[Mat4]) -> Vec<f32> {
         mats.iter().flat_map(|m| m.to_cols_array()).collect()
+    }
+}
+
+#[cfg(test)]
+mod missing_tests {
+    #[test]
+    fn missing_buffer_file_is_named_with_the_gltf_that_refers_to_it() {
+        let dir = std::env::temp_dir().join(format!("shapecue-gltf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.gltf");
+        std::fs::write(
+            &path,
+            r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"gone.bin","byteLength":4}]}"#,
+        )
+        .unwrap();
+        let e = super::load_gltf(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("x.gltf") && e.contains("buffer 0") && e.contains("gone.bin"),
+            "{e}"
+        );
+        assert_eq!(e.matches("No such file").count(), 1, "{e}");
     }
 }
