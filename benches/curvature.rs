@@ -156,10 +156,6 @@ fn curvature_benches(c: &mut Criterion) {
     let Some(gpu) = common::gpu("curvature") else {
         return;
     };
-    eprintln!(
-        "curvature bench: device {} ({}, {} CUs)",
-        gpu.info.name, gpu.info.platform, gpu.info.compute_units
-    );
     // the report's variants, so the README table and the bench cover the same set
     let variants: Vec<(String, _)> = shapecue::report::variants()
         .into_iter()

@@ -109,10 +109,6 @@ fn benches(c: &mut Criterion) {
     let Some(gpu) = common::gpu("radix_sort") else {
         return;
     };
-    eprintln!(
-        "radix_sort bench: device {} ({}, {} CUs)",
-        gpu.info.name, gpu.info.platform, gpu.info.compute_units
-    );
     let mut sorter = RadixSort::new(gpu.clone()).expect("radix sort kernels");
     let mut scan = Scan::new(gpu.clone()).expect("scan kernels");
 

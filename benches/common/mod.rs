@@ -17,10 +17,17 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// The default OpenCL device (`SHAPECUE_DEVICE` picks another, as for the
-/// CLI), or `None` after saying that `bench` has nothing to measure.
+/// CLI), named on stderr, or `None` after saying that `bench` has nothing to
+/// measure.
 pub fn gpu(bench: &str) -> Option<Arc<Gpu>> {
     match Gpu::new(None) {
-        Ok(g) => Some(Arc::new(g)),
+        Ok(g) => {
+            eprintln!(
+                "{bench} bench: device {} ({}, {} CUs)",
+                g.info.name, g.info.platform, g.info.compute_units
+            );
+            Some(Arc::new(g))
+        }
         Err(e) => {
             eprintln!("{bench} bench: no OpenCL device ({e}); nothing to bench");
             None
@@ -34,12 +41,14 @@ pub fn quick() -> bool {
     std::env::var("SHAPECUE_BENCH_QUICK").is_ok_and(|s| !s.is_empty() && s != "0")
 }
 
-/// `rel` inside `../shared/data`, or `None` after saying that `bench`
-/// skips it.
+/// `rel` inside the shared data (`$SHAPECUE_SHARED_DATA`, else
+/// `../shared/data` next to the crate, as for the tests), or `None` after
+/// saying that `bench` skips it.
 pub fn shared(bench: &str, rel: impl AsRef<Path>) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(rel);
+    let root = std::env::var_os("SHAPECUE_SHARED_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    let p = root.join(rel);
     if p.exists() {
         Some(p)
     } else {

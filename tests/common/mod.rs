@@ -93,7 +93,8 @@ pub fn shared(rel: impl AsRef<Path>) -> Option<PathBuf> {
         Some(p)
     } else {
         eprintln!(
-            "skipping: {} not found (../shared/data is absent; set SHAPECUE_SHARED_DATA to use another copy)",
+            "skipping: {} not found (the shared data sets are looked for in \
+             $SHAPECUE_SHARED_DATA, else ../shared/data next to the crate)",
             p.display()
         );
         None
