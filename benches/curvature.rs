@@ -4,14 +4,17 @@
 //! - `curvature/<variant>/<input>`: kernel time from OpenCL profiling events
 //!   (the sum of the pass times of one [`CurvatureEstimator::run`]), mesh
 //!   already on the device, after one warm-up run that pays for JIT.
-//! - `curvature_wall/<variant>/<input>`: host wall time of one run (first
+//! - `curvature/<variant>-wall/<input>`: host wall time of one run (first
 //!   enqueue to end of the last kernel), default variant only.
-//! - `cpu_reference/bunny`: wall time of the f64 CPU reference, for scale.
+//! - `curvature/cpu-reference/bunny`: wall time of the f64 CPU reference,
+//!   for scale.
 //!
 //! Inputs: the Stanford bunny from `shared/data/meshes` (skipped if absent)
 //! and generated tori of about 500k and 2M vertices.
 //! `SHAPECUE_BENCH_QUICK=1` restricts the run to the bunny.
 //! `SHAPECUE_DEVICE` picks the device as for the CLI.
+
+mod common;
 
 use criterion::{
     BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
@@ -20,17 +23,11 @@ use criterion::{
 use shapecue::Mesh;
 use shapecue::field::CurvatureOptions;
 use shapecue::gpu::Gpu;
-use shapecue::mesh::{self, LoadOptions};
+use shapecue::mesh;
 use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
 use std::hint::black_box;
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
-
-const BUNNY: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../shared/data/meshes/stanford-bunny.obj"
-);
 
 /// A bench input: its name, how to make it, and its sampling settings.
 struct Input {
@@ -56,21 +53,6 @@ const SMALL: Sampling = Sampling {
     measure_s: 8,
 };
 
-fn bunny() -> Option<Mesh> {
-    let path = Path::new(BUNNY);
-    if !path.exists() {
-        eprintln!("curvature bench: {BUNNY} not found, skipping the bunny");
-        return None;
-    }
-    match mesh::load(path, &LoadOptions::default()) {
-        Ok(m) => Some(m),
-        Err(e) => {
-            eprintln!("curvature bench: cannot load {BUNNY}: {e}; skipping the bunny");
-            None
-        }
-    }
-}
-
 fn torus_of(n: usize) -> Mesh {
     let (nu, nv) = mesh::torus_resolution_for(n);
     mesh::torus(1.0, 0.4, nu, nv)
@@ -79,11 +61,10 @@ fn torus_of(n: usize) -> Mesh {
 fn inputs() -> Vec<Input> {
     let mut v = vec![Input {
         name: "bunny",
-        make: bunny,
+        make: || common::shared_mesh("curvature", "stanford-bunny.obj"),
         sampling: SMALL,
     }];
-    let quick = std::env::var("SHAPECUE_BENCH_QUICK").is_ok_and(|s| !s.is_empty() && s != "0");
-    if quick {
+    if common::quick() {
         eprintln!("curvature bench: SHAPECUE_BENCH_QUICK set, bunny only");
     } else {
         v.push(Input {
@@ -172,17 +153,9 @@ fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&RunTiming) -> f64) 
 }
 
 fn curvature_benches(c: &mut Criterion) {
-    let gpu = match Gpu::new(None) {
-        Ok(g) => Arc::new(g),
-        Err(e) => {
-            eprintln!("curvature bench: no OpenCL device ({e}); nothing to bench");
-            return;
-        }
+    let Some(gpu) = common::gpu("curvature") else {
+        return;
     };
-    eprintln!(
-        "curvature bench: device {} ({}, {} CUs)",
-        gpu.info.name, gpu.info.platform, gpu.info.compute_units
-    );
     // the report's variants, so the README table and the bench cover the same set
     let variants: Vec<(String, _)> = shapecue::report::variants()
         .into_iter()
@@ -214,11 +187,11 @@ fn curvature_benches(c: &mut Criterion) {
         }
         g.finish();
 
-        let mut g = c.benchmark_group("curvature_wall");
+        let mut g = c.benchmark_group("curvature");
         configure(&mut g, input.sampling);
         g.throughput(Throughput::Elements(m.n_vertices() as u64));
         let (vname, opts) = (&variants[0].0, variants[0].1);
-        let id = format!("{vname}/{}", input.name);
+        let id = format!("{vname}-wall/{}", input.name);
         if let Some(mut est) = ready(&gpu, &m, &id, opts) {
             g.bench_function(&id, |b| {
                 b.iter_custom(|iters| timed(&mut est, iters, |t| t.wall_ms))
@@ -232,13 +205,13 @@ fn curvature_benches(c: &mut Criterion) {
     }
 
     if let Some(m) = cpu_input {
-        let mut g = c.benchmark_group("cpu_reference");
+        let mut g = c.benchmark_group("curvature");
         g.sample_size(10)
             .warm_up_time(Duration::from_secs(1))
             .measurement_time(Duration::from_secs(5))
             .throughput(Throughput::Elements(m.n_vertices() as u64));
         let opts = CurvatureOptions::default();
-        g.bench_function("bunny", |b| {
+        g.bench_function("cpu-reference/bunny", |b| {
             b.iter(|| shapecue::cpu::curvature::estimate(black_box(&m), &opts))
         });
         g.finish();

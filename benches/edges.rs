@@ -1,14 +1,14 @@
 //! Edges stage benches (`kernels/edges.cl` ↔ `src/stages/edges.rs`), House &
 //! Li's comparison of the McGuire-Hughes and adjacency cap variants (seed 002).
 //!
-//! Group `edges`, ids `<caps variant>/<mesh>/kernel` and `<caps variant>/<mesh>/frame`:
-//! - `kernel`: `edges_detect` + the variant's cap kernel, from OpenCL profiling
-//!   events, topology and positions already on the device, after a warm-up run
-//!   that pays for JIT.
-//! - `frame`: host wall time of a whole frame: parameter upload, kernels,
-//!   read-back of edge-out and cap-out, and the GL frame (mesh, edges, caps,
-//!   read-back of colour and depth). Without headless GL: kernels + read-back
-//!   only (a message says so).
+//! Groups, per caps variant (`none`, `mh`, `adjacency`) and mesh:
+//! - `edges/<caps>/<mesh>`: `edges_detect` + the variant's cap kernel, from
+//!   OpenCL profiling events, topology and positions already on the device,
+//!   after a warm-up run that pays for JIT.
+//! - `edges/<caps>-frame/<mesh>`: host wall time of a whole frame: parameter
+//!   upload, kernels, read-back of edge-out and cap-out, and the GL frame
+//!   (mesh, edges, caps, read-back of colour and depth). Without headless GL:
+//!   kernels + read-back only (a message says so).
 //!
 //! Inputs: generated cube, capped cylinder, cone, icosphere (level 3), the
 //! shared teapot and Stanford bunny (skipped with a message when absent), and a
@@ -17,46 +17,29 @@
 //! `SHAPECUE_BENCH_QUICK=1` restricts the run to the bunny.
 //! `SHAPECUE_DEVICE` picks the device as for the CLI.
 
+mod common;
+
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::Mesh;
-use shapecue::gpu::Gpu;
-use shapecue::mesh::{self, LoadOptions, edges::EdgeTopology, edges::vertex_normals};
+use shapecue::mesh::{self, edges::EdgeTopology, edges::vertex_normals};
 use shapecue::render::{MeshStyle, RenderOptions, Renderer};
 use shapecue::stages::edges::{self as st, CapMode, EdgeParams, EdgeStage};
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 const SIZE: (u32, u32) = (800, 600);
 
-fn shared(file: &str) -> Option<Mesh> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes")
-        .join(file);
-    if !p.exists() {
-        eprintln!("edges bench: {} not found, skipping it", p.display());
-        return None;
-    }
-    match mesh::load(&p, &LoadOptions::default()) {
-        Ok(m) => Some(m),
-        Err(e) => {
-            eprintln!("edges bench: cannot load {}: {e}; skipping it", p.display());
-            None
-        }
-    }
-}
-
 fn inputs() -> Vec<(&'static str, Mesh)> {
-    let quick = std::env::var_os("SHAPECUE_BENCH_QUICK").is_some();
+    let quick = common::quick();
     let mut v: Vec<(&'static str, Option<Mesh>)> = Vec::new();
     if !quick {
         v.push(("cube", Some(mesh::cube(1.0))));
         v.push(("cylinder", Some(mesh::capped_cylinder(0.5, 1.0, 32))));
         v.push(("cone", Some(mesh::cone(0.5, 1.0, 32))));
         v.push(("icosphere", Some(mesh::icosphere(0.5, 3))));
-        v.push(("teapot", shared("teapot.obj")));
+        v.push(("teapot", common::shared_mesh("edges", "teapot.obj")));
     }
-    v.push(("bunny", shared("stanford-bunny.obj")));
+    v.push(("bunny", common::shared_mesh("edges", "stanford-bunny.obj")));
     if !quick {
         // A torus has 3 edges per vertex: 333,334 vertices ≈ 1M edges.
         let (nu, nv) = mesh::torus_resolution_for(333_334);
@@ -68,12 +51,8 @@ fn inputs() -> Vec<(&'static str, Mesh)> {
 }
 
 fn edges_benches(c: &mut Criterion) {
-    let gpu = match Gpu::new(None) {
-        Ok(g) => g,
-        Err(e) => {
-            eprintln!("edges bench: no OpenCL device ({e}); nothing to measure");
-            return;
-        }
+    let Some(gpu) = common::gpu("edges") else {
+        return;
     };
     let mut renderer = match Renderer::new(RenderOptions {
         width: SIZE.0,
@@ -107,7 +86,7 @@ fn edges_benches(c: &mut Criterion) {
         );
         for mode in CapMode::ALL {
             stage.run(&p, mode).expect("warm-up run"); // JIT
-            g.bench_function(format!("{}/{name}/kernel", mode.name()), |b| {
+            g.bench_function(format!("{}/{name}", mode.name()), |b| {
                 b.iter_custom(|iters| {
                     let mut ms = 0.0;
                     for _ in 0..iters {
@@ -116,7 +95,7 @@ fn edges_benches(c: &mut Criterion) {
                     Duration::from_secs_f64(ms * 1e-3)
                 })
             });
-            g.bench_function(format!("{}/{name}/frame", mode.name()), |b| {
+            g.bench_function(format!("{}-frame/{name}", mode.name()), |b| {
                 b.iter_custom(|iters| {
                     let t = Instant::now();
                     for _ in 0..iters {

@@ -6,19 +6,18 @@
 //! per input. `SHAPECUE_BENCH_QUICK=1` keeps the 128³ fields only.
 //! 512³ is measured by `shapecue isosurface --report`, not here.
 
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::cpu::vertex_fusion::Fusion;
-use shapecue::gpu::Gpu;
 use shapecue::report::median;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::sdf::{Sdf, sdf};
 use shapecue::volume::{self, RawSpec, ScalarType, Volume};
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Duration;
 
 fn inputs() -> Vec<(String, Volume, f32)> {
-    let quick = std::env::var_os("SHAPECUE_BENCH_QUICK").is_some();
+    let quick = common::quick();
     let mut v = Vec::new();
     for res in [128, 256] {
         if quick && res > 128 {
@@ -32,11 +31,9 @@ fn inputs() -> Vec<(String, Volume, f32)> {
             v.push((format!("{name}-{res}"), sdf(kind, res), 0.0));
         }
     }
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/volumes");
-    if !dir.exists() {
-        eprintln!("skipping the real volumes: {} not found", dir.display());
+    let Some(dir) = common::shared("isosurface", "volumes") else {
         return v;
-    }
+    };
     let bucky = RawSpec::new([32; 3], ScalarType::U8);
     for (file, iso, raw) in [
         ("Bucky.raw", 51.0, Some(&bucky)),
@@ -55,7 +52,9 @@ fn inputs() -> Vec<(String, Volume, f32)> {
 }
 
 fn bench(c: &mut Criterion) {
-    let gpu = Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)"));
+    let Some(gpu) = common::gpu("isosurface") else {
+        return;
+    };
     for (name, vol, iso) in inputs() {
         let mut ex = Isosurfacer::new(gpu.clone(), &vol).expect("upload");
         for fusion in [Fusion::None, Fusion::Edge, Fusion::Hash] {

@@ -1,4 +1,4 @@
-//! Criterion group `pipeline/<model>/total` on the shared glTF models
+//! Criterion group `pipeline/total/<model>` on the shared glTF models
 //! (skipped with a message when `../shared/data` is absent): one frame of the
 //! default per-pose device pipeline
 //! ([`shapecue::stages::pipeline::PosePipeline::frame`], the code behind
@@ -9,31 +9,28 @@
 //! per-pass kernel-ms medians, their total and the wall-clock median are
 //! printed, with the 16 ms frame budget of the issue.
 
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::skinned::load_gltf;
 use shapecue::report::median;
 use shapecue::stages::feature_lines::LineOptions;
 use shapecue::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/animations/gltf");
-    if !dir.exists() {
-        eprintln!("skipping: {} not found", dir.display());
+    if common::shared("pipeline", "animations/gltf").is_none() {
         return;
     }
-    let gpu = Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)"));
+    let Some(gpu) = common::gpu("pipeline") else {
+        return;
+    };
     let mut g = c.benchmark_group("pipeline");
     g.sample_size(20).measurement_time(Duration::from_secs(4));
     for name in ["BrainStem", "CesiumMan", "Fox"] {
-        let path = dir.join(format!("{name}.glb"));
-        if !path.exists() {
-            eprintln!("skipping {name}: {} not found", path.display());
+        let Some(path) = common::shared("pipeline", format!("animations/gltf/{name}.glb")) else {
             continue;
-        }
+        };
         let m = load_gltf(&path).expect("model loads");
         let frames = clip_poses(&m, 30).expect("poses");
         let mut p =
@@ -41,7 +38,7 @@ fn bench(c: &mut Criterion) {
         let (view, size, opts) = (p.front_view(), p.feature_size(), LineOptions::default());
         let mut times: Vec<PassTimes> = Vec::new();
         let mut i = 0;
-        g.bench_function(format!("{name}/total"), |b| {
+        g.bench_function(format!("total/{name}"), |b| {
             b.iter(|| {
                 i = (i + 1) % frames.len();
                 let (segs, t) = p.frame(&frames[i], view, size, opts).expect("frame");

@@ -6,13 +6,15 @@
 //!   pairs by 32-bit keys, from OpenCL profiling events
 //!   ([`RadixSort::last_ms`]); the unsorted input is restored by a device
 //!   copy before every sort, outside the timing.
-//! - `radix_sort_wall/device/<n>`: host wall time of the same call (enqueue
+//! - `radix_sort/device-wall/<n>`: host wall time of the same call (enqueue
 //!   to finish).
-//! - `scan/device/<n>`, `scan_wall/device/<n>`: the same for an out-of-place
+//! - `scan/device/<n>`, `scan/device-wall/<n>`: the same for an out-of-place
 //!   exclusive scan of n u32 values below 256 (total read back included).
 //!
 //! A warm-up call before each group pays for JIT compilation.
 //! `SHAPECUE_DEVICE` picks the device as for the CLI.
+
+mod common;
 
 use criterion::measurement::WallTime;
 use criterion::{
@@ -23,7 +25,6 @@ use shapecue::gpu::Gpu;
 use shapecue::mesh::splitmix;
 use shapecue::stages::radix_sort::RadixSort;
 use shapecue::stages::scan::Scan;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 const SIZES: [(&str, usize); 2] = [("1m", 1 << 20), ("8m", 8 << 20)];
@@ -105,22 +106,13 @@ impl SortInput {
 }
 
 fn benches(c: &mut Criterion) {
-    let gpu = match Gpu::new(None) {
-        Ok(g) => Arc::new(g),
-        Err(e) => {
-            eprintln!("radix_sort bench: no OpenCL device ({e}); nothing to bench");
-            return;
-        }
+    let Some(gpu) = common::gpu("radix_sort") else {
+        return;
     };
-    eprintln!(
-        "radix_sort bench: device {} ({}, {} CUs)",
-        gpu.info.name, gpu.info.platform, gpu.info.compute_units
-    );
     let mut sorter = RadixSort::new(gpu.clone()).expect("radix sort kernels");
     let mut scan = Scan::new(gpu.clone()).expect("scan kernels");
 
     for (name, n) in SIZES {
-        let id = format!("device/{name}");
         let mut input = SortInput::new(&gpu, n);
         let (k, w) = input.run(&gpu, &mut sorter, 2); // JIT warm-up
         eprintln!(
@@ -129,10 +121,10 @@ fn benches(c: &mut Criterion) {
             w.as_secs_f64() * 1e3,
             sorter.scratch_bytes() >> 20
         );
-        for (group, wall) in [("radix_sort", false), ("radix_sort_wall", true)] {
-            let mut g = c.benchmark_group(group);
+        for (variant, wall) in [("device", false), ("device-wall", true)] {
+            let mut g = c.benchmark_group("radix_sort");
             configure(&mut g, n);
-            g.bench_function(&id, |b| {
+            g.bench_function(format!("{variant}/{name}"), |b| {
                 b.iter_custom(|iters| {
                     let (k, w) = input.run(&gpu, &mut sorter, iters);
                     if wall { w } else { k }
@@ -145,10 +137,10 @@ fn benches(c: &mut Criterion) {
         let values = upload(&gpu, &random(n, 256.0, 43));
         let output = gpu.buffer::<u32>(n).expect("allocation");
         scan.exclusive(&values, &output, n).expect("scan"); // JIT warm-up
-        for (group, wall) in [("scan", false), ("scan_wall", true)] {
-            let mut g = c.benchmark_group(group);
+        for (variant, wall) in [("device", false), ("device-wall", true)] {
+            let mut g = c.benchmark_group("scan");
             configure(&mut g, n);
-            g.bench_function(&id, |b| {
+            g.bench_function(format!("{variant}/{name}"), |b| {
                 b.iter_custom(|iters| {
                     let (mut kernel_ms, mut w) = (0.0, Duration::ZERO);
                     for _ in 0..iters {

@@ -5,26 +5,25 @@
 //! positions without a host round trip (`skin+curvature`). Frames step
 //! through the first clip. Kernel-only medians are printed per model.
 
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::report::median;
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::skinning::Skinner;
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/animations/gltf");
-    if !dir.exists() {
-        eprintln!("skipping: {} not found", dir.display());
+    let Some(dir) = common::shared("skinning", "animations/gltf") else {
         return;
-    }
-    let gpu = Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)"));
-    for name in ["BrainStem.glb", "CesiumMan.glb", "Fox.glb"] {
-        let m = load_gltf(&dir.join(name)).expect("model loads");
+    };
+    let Some(gpu) = common::gpu("skinning") else {
+        return;
+    };
+    for name in ["BrainStem", "CesiumMan", "Fox"] {
+        let m = load_gltf(&dir.join(format!("{name}.glb"))).expect("model loads");
         let clip = &m.clips[0];
         let frames: Vec<Vec<f32>> = (0..30)
             .map(|f| {

@@ -2,15 +2,13 @@
 //! on the device against the CPU twin and against the f64 integral (errors
 //! and times printed side by side), and nasty curvatures.
 
+mod common;
+
+use common::gpu;
+
 use shapecue::cpu::ao::{AoMode, LUT_N, ao_reference, ao_vertex};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::splitmix;
 use shapecue::stages::ao::{AoStage, lut};
-use std::sync::Arc;
-
-fn gpu() -> Arc<Gpu> {
-    Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)"))
-}
 
 #[test]
 fn reference_closed_forms() {

@@ -1,41 +1,31 @@
 //! The command line: outputs, stats, refusals and error messages.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_shapecue"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shapecue-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{cli, run_cli, scratch};
 
 const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
 
 #[test]
 fn devices_lists_the_cpu_device() {
-    let out = bin().arg("devices").output().unwrap();
+    let out = run_cli(["devices"]);
     assert!(out.status.success());
     let s = String::from_utf8_lossy(&out.stdout);
     assert!(
         s.contains("fp64") && s.contains("gl_sharing") && s.contains("int64"),
         "{s}"
     );
-    let out = bin().args(["devices", "--json"]).output().unwrap();
+    let out = run_cli(["devices", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v.as_array().is_some_and(|a| !a.is_empty()));
 }
 
 #[test]
 fn curvature_writes_ply_with_the_documented_properties_and_stats() {
-    let d = tmpdir("ply");
+    let d = scratch("ply");
     let ply = d.join("sub/torus.ply");
     let json = d.join("torus.json");
-    let out = bin()
+    let out = cli()
         .args([
             "curvature",
             "--generate",
@@ -94,7 +84,7 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
     );
     assert_eq!(stats["counts"]["degenerate_faces"], 0);
     // existing output is not overwritten without --force
-    let out = bin()
+    let out = cli()
         .args([
             "curvature",
             "--generate",
@@ -112,10 +102,10 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
 
 #[test]
 fn output_equal_to_input_is_refused_and_the_input_survives() {
-    let d = tmpdir("same");
+    let d = scratch("same");
     let obj = d.join("tetra.obj");
     std::fs::write(&obj, TETRA).unwrap();
-    let out = bin()
+    let out = cli()
         .arg("curvature")
         .arg(&obj)
         .arg("-o")
@@ -130,36 +120,30 @@ fn output_equal_to_input_is_refused_and_the_input_survives() {
 
 #[test]
 fn bad_input_names_the_file_and_element() {
-    let d = tmpdir("bad");
+    let d = scratch("bad");
     let obj = d.join("bad.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
-    let out = bin().arg("curvature").arg(&obj).output().unwrap();
+    let out = cli().arg("curvature").arg(&obj).output().unwrap();
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("bad.obj") && e.contains("face"), "{e}");
-    let out = bin()
-        .args(["curvature", "/nonexistent/x.ply"])
-        .output()
-        .unwrap();
+    let out = run_cli(["curvature", "/nonexistent/x.ply"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/x.ply"));
-    let out = bin()
-        .args([
-            "--device",
-            "no-such-device",
-            "curvature",
-            "--generate",
-            "plane",
-        ])
-        .output()
-        .unwrap();
+    let out = run_cli([
+        "--device",
+        "no-such-device",
+        "curvature",
+        "--generate",
+        "plane",
+    ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-device"));
 }
 
 #[test]
 fn cpu_reference_and_every_variant_run_from_the_cli() {
-    let d = tmpdir("variants");
+    let d = scratch("variants");
     let obj = d.join("tetra.obj");
     std::fs::write(&obj, TETRA).unwrap();
     for extra in [
@@ -169,7 +153,7 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
         vec!["--compat", "trimesh2"],
         vec!["--no-dcurv"],
     ] {
-        let out = bin()
+        let out = cli()
             .arg("curvature")
             .arg(&obj)
             .args(&extra)
@@ -185,10 +169,10 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
 
 #[test]
 fn isosurface_writes_ply_with_curvature_normals_and_stats() {
-    let d = tmpdir("iso");
+    let d = scratch("iso");
     let ply = d.join("torus.ply");
     let json = d.join("torus.json");
-    let out = bin()
+    let out = cli()
         .args([
             "isosurface",
             "--sdf",
@@ -237,7 +221,7 @@ fn isosurface_writes_ply_with_curvature_normals_and_stats() {
             .is_some_and(|p| !p.is_empty())
     );
     // Refuses to overwrite without --force.
-    let again = bin()
+    let again = cli()
         .args(["isosurface", "--sdf", "torus", "--resolution", "20", "-o"])
         .arg(&ply)
         .output()
@@ -248,11 +232,11 @@ fn isosurface_writes_ply_with_curvature_normals_and_stats() {
 
 #[test]
 fn isosurface_bad_input_is_a_clear_error() {
-    let d = tmpdir("isobad");
+    let d = scratch("isobad");
     let raw = d.join("v.raw");
     std::fs::write(&raw, vec![0u8; 100]).unwrap();
     let run = |args: &[&str]| {
-        let out = bin().arg("isosurface").args(args).output().unwrap();
+        let out = cli().arg("isosurface").args(args).output().unwrap();
         assert!(!out.status.success(), "{args:?} should fail");
         String::from_utf8_lossy(&out.stderr).to_string()
     };
@@ -279,7 +263,7 @@ fn isosurface_bad_input_is_a_clear_error() {
 #[test]
 fn render_explains_plans_and_names_scene_errors() {
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/torus.toml");
-    let out = bin().args(["render", scene, "--explain"]).output().unwrap();
+    let out = run_cli(["render", scene, "--explain"]);
     assert!(
         out.status.success(),
         "{}",
@@ -293,14 +277,14 @@ fn render_explains_plans_and_names_scene_errors() {
         "{s}"
     );
     assert!(s.contains("1 frame(s) × 4 view(s)"), "{s}");
-    let d = tmpdir("render-bad");
+    let d = scratch("render-bad");
     let bad = d.join("bad.toml");
     std::fs::write(
         &bad,
         "[input]\ngenerate = \"torus\"\n[effects]\nshadows = {}\n",
     )
     .unwrap();
-    let out = bin().args(["render"]).arg(&bad).output().unwrap();
+    let out = cli().args(["render"]).arg(&bad).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -308,9 +292,6 @@ fn render_explains_plans_and_names_scene_errors() {
         "{e}"
     );
     // A missing scene file is named.
-    let out = bin()
-        .args(["render", "no/such/scene.toml"])
-        .output()
-        .unwrap();
+    let out = run_cli(["render", "no/such/scene.toml"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scene.toml"));
 }

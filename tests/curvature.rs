@@ -3,39 +3,17 @@
 //! meshes, and the hard cases (degenerate, non-manifold, flat, umbilic,
 //! slivers, far from the origin, extreme scales).
 
+mod common;
+
+use common::{gpu, shared_mesh};
+
 use shapecue::cpu::curvature as cpu;
 use shapecue::field::{
     Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
 };
-use shapecue::gpu::Gpu;
 use shapecue::mesh::{self, Mesh};
 use shapecue::report::{analytic_rms, nrmse, rmse};
 use shapecue::stages::curvature::{self as stage, CurvatureEstimator, Pass};
-use std::sync::{Arc, OnceLock};
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        }))
-    })
-    .clone()
-}
-
-fn shared(name: &str) -> Option<Mesh> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes")
-        .join(name);
-    if !p.exists() {
-        eprintln!(
-            "skipping: {} not found (../shared/data is absent)",
-            p.display()
-        );
-        return None;
-    }
-    Some(mesh::load(&p, &Default::default()).expect("shared mesh loads"))
-}
 
 const F64: CurvatureOptions = CurvatureOptions {
     accumulate: Accumulate::Atomic,
@@ -185,7 +163,7 @@ fn f32_device_matches_reference_at_table_3_level() {
         ("torus", mesh::torus(1.0, 0.4, 256, 128)),
         ("jittered sphere", mesh::jittered_sphere(1.0, 5, 0.2, 7)),
     ];
-    if let Some(b) = shared("stanford-bunny.obj") {
+    if let Some(b) = shared_mesh("stanford-bunny.obj") {
         cases.push(("bunny", b));
     }
     for (name, m) in cases {
@@ -502,7 +480,7 @@ fn non_manifold_edges_and_vertices_and_boundaries() {
     check_hard(&cones, "non-manifold vertex");
     // open cylinder: boundary rows
     check_hard(&mesh::cylinder(1.0, 1.0, 16, 4), "boundary");
-    if let Some(m) = shared("beetle.obj") {
+    if let Some(m) = shared_mesh("beetle.obj") {
         check_hard(&m, "beetle (47 non-manifold edges)");
     }
 }

@@ -7,10 +7,13 @@
 //! element. Cap kernels are compared on the *device's* edge-out buffer (CPU
 //! from that stage on), so a classification tie cannot cascade.
 
+mod common;
+
+use common::{cli, cli_gl_missing, gpu_ref as gpu, run_cli, scratch, shared_mesh, to_f32};
+
 use glam::Vec3;
 use shapecue::Error;
 use shapecue::cpu::edges as cpu;
-use shapecue::gpu::Gpu;
 use shapecue::mesh::edges::{EdgeTopology, parse_marked, vertex_normals};
 use shapecue::mesh::{self, Mesh};
 use shapecue::render::Camera;
@@ -18,16 +21,6 @@ use shapecue::stages::edges::{
     CapMode, EdgeOutput, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
     KIND_CREASE, KIND_DRAWN, decide_interop, memory_use,
 };
-use std::sync::OnceLock;
-
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        })
-    })
-}
 
 fn params(eye: [f32; 3], target: [f32; 3]) -> EdgeParams {
     let mut cam = Camera::look_at(Vec3::from(eye), Vec3::from(target));
@@ -43,10 +36,6 @@ fn run(m: &Mesh, t: &EdgeTopology, p: &EdgeParams, mode: CapMode) -> EdgeOutput 
     let mut s = EdgeStage::new(gpu(), m, t).unwrap();
     s.run(p, mode).unwrap();
     s.read().unwrap()
-}
-
-fn f32pos(m: &Mesh) -> Vec<[f32; 3]> {
-    m.positions.iter().map(|p| p.map(|c| c as f32)).collect()
 }
 
 fn count(kind: &[u32], bit: u32) -> usize {
@@ -67,7 +56,7 @@ fn close(a: [f32; 4], b: [f32; 4]) -> bool {
 fn compare(m: &Mesh, t: &EdgeTopology, p: &EdgeParams, mode: CapMode) -> EdgeOutput {
     let dev = run(m, t, p, mode);
     let packed = p.pack().unwrap();
-    let pos = f32pos(m);
+    let pos = to_f32(&m.positions);
     let (out, kind) = cpu::edges_detect(&packed, &pos, &vertex_normals(m), &t.edges);
     let mismatched = (0..t.edges.len())
         .filter(|&e| kind[e] != dev.kind[e])
@@ -500,16 +489,10 @@ fn memory_use_counts_the_buffers() {
 
 #[test]
 fn shared_meshes_match_the_cpu() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
-    let path = dir.join("teapot.obj");
-    if !path.exists() {
-        eprintln!(
-            "skipping: {} not found (../shared/data is absent)",
-            path.display()
-        );
+    let Some(m) = shared_mesh("teapot.obj") else {
         return;
-    }
-    let m = mesh::unit_sized(&mesh::load(&path, &Default::default()).unwrap());
+    };
+    let m = mesh::unit_sized(&m);
     let t = topo(&m);
     let p = params([5.0, 5.0, 5.0], [0.0; 3]);
     for mode in CapMode::ALL {
@@ -518,17 +501,6 @@ fn shared_meshes_match_the_cpu() {
 }
 
 // ---- command line (GL needed for rendering; skipped without EGL) ----
-
-fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_shapecue"))
-}
-
-fn tmpdir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("shapecue-edges-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// A unit cube as OBJ text (8 shared vertices, 12 triangles).
 fn cube_obj() -> String {
@@ -543,22 +515,13 @@ fn cube_obj() -> String {
     s
 }
 
-fn gl_missing(out: &std::process::Output) -> bool {
-    let err = String::from_utf8_lossy(&out.stderr);
-    if err.contains("no headless OpenGL") && std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() {
-        eprintln!("skipping GL part: {err}");
-        return true;
-    }
-    false
-}
-
 #[test]
 fn cli_renders_png_svg_and_stats() {
-    let d = tmpdir("render");
+    let d = scratch("render");
     let obj = d.join("cube.obj");
     std::fs::write(&obj, cube_obj()).unwrap();
     let (png, svg, json) = (d.join("c.png"), d.join("c.svg"), d.join("c.json"));
-    let out = bin()
+    let out = cli()
         .args([
             "edges",
             obj.to_str().unwrap(),
@@ -580,7 +543,7 @@ fn cli_renders_png_svg_and_stats() {
         .args(["--stats", json.to_str().unwrap()])
         .output()
         .unwrap();
-    if gl_missing(&out) {
+    if cli_gl_missing(&out) {
         return;
     }
     assert!(
@@ -619,29 +582,26 @@ fn cli_renders_png_svg_and_stats() {
         "visible edges joined into polylines: {pts} points"
     );
     // The output exists now: refused without --force.
-    let again = bin()
-        .args([
-            "edges",
-            obj.to_str().unwrap(),
-            "--eye",
-            "3,2,4",
-            "-o",
-            png.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let again = run_cli([
+        "edges",
+        obj.to_str().unwrap(),
+        "--eye",
+        "3,2,4",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
 }
 
 #[test]
 fn cli_bad_input_is_a_clear_error() {
-    let d = tmpdir("bad");
+    let d = scratch("bad");
     let obj = d.join("cube.obj");
     std::fs::write(&obj, cube_obj()).unwrap();
     let png = d.join("x.png");
     let run = |extra: &[&str]| {
-        let out = bin()
+        let out = cli()
             .args(["edges", obj.to_str().unwrap(), "-o", png.to_str().unwrap()])
             .args(extra)
             .output()
@@ -684,7 +644,7 @@ fn cli_bad_input_is_a_clear_error() {
 
 #[test]
 fn cli_memory_table_lists_the_generated_meshes() {
-    let out = bin().args(["edges", "--memory-table"]).output().unwrap();
+    let out = run_cli(["edges", "--memory-table"]);
     assert!(out.status.success());
     let s = String::from_utf8_lossy(&out.stdout);
     let cube = s.lines().find(|l| l.starts_with("cube")).unwrap();
@@ -706,7 +666,7 @@ fn outputs_persist_correctly_across_frames() {
     // different views, widths and cap modes must still match a fresh CPU run.
     let m = mesh::torus(1.0, 0.4, 48, 24);
     let t = topo(&m);
-    let pos = f32pos(&m);
+    let pos = to_f32(&m.positions);
     let mut s = EdgeStage::new(gpu(), &m, &t).unwrap();
     let views = [
         ([0.0, 0.0, 6.0], CapMode::Adjacency, 4.0),
@@ -805,10 +765,7 @@ fn st_ideal(edge_out: &[[f32; 4]]) -> Vec<bool> {
 #[test]
 fn caps_close_the_gaps_of_thick_edges() {
     use shapecue::render::Renderer;
-    if let Err(e @ Error::NoGl { .. }) = Renderer::new(Default::default())
-        && std::env::var_os("SHAPECUE_REQUIRE_GL").is_none()
-    {
-        eprintln!("skipping GL test: {e}");
+    if common::unless_no_gl(Renderer::new(Default::default())).is_none() {
         return;
     }
     let m = mesh::unit_sized(&mesh::capped_cylinder(0.5, 1.0, 32));

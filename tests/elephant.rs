@@ -5,54 +5,32 @@
 //! vs the CPU twin, and clear errors for corrupt DMAT/TGF files and
 //! mismatched sets.
 
+mod common;
+
+use common::{gpu, max_abs_diff, scratch, shared, shared_data, to_f32};
+
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
 use shapecue::Error;
 use shapecue::cpu::skinning::skin_lbs;
-use shapecue::gpu::Gpu;
 use shapecue::mesh::libigl::{
     LbsAnimation, SIGNIFICANT_WEIGHT, load_elephant_set, read_dmat, read_tgf,
 };
 use shapecue::mesh::skinned::SkinnedMesh;
 use shapecue::stages::skinning::Skinner;
 
-fn data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/animations/elephant")
-}
+/// Where the elephant set is inside the shared data.
+const ELEPHANT: &str = "animations/elephant";
 
 /// The elephant set, loaded once, or `None` (after saying so) when absent.
 fn elephant() -> Option<&'static LbsAnimation> {
     static SET: OnceLock<Option<LbsAnimation>> = OnceLock::new();
     SET.get_or_init(|| {
-        let obj = data_dir().join("elephant.obj");
-        if !obj.is_file() {
-            eprintln!(
-                "skipping: {} not found (../shared/data is absent)",
-                obj.display()
-            );
-            return None;
-        }
+        let obj = shared(Path::new(ELEPHANT).join("elephant.obj"))?;
         Some(load_elephant_set(&obj).unwrap_or_else(|e| panic!("{e}")))
     })
     .as_ref()
-}
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)")))
-        .clone()
-}
-
-/// A fresh, empty folder for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "shapecue-tests-elephant-{}-{test}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
 }
 
 fn diagonal(a: &LbsAnimation) -> f64 {
@@ -62,14 +40,6 @@ fn diagonal(a: &LbsAnimation) -> f64 {
 
 fn dist(p: [f64; 3], q: [f64; 3]) -> f64 {
     (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt()
-}
-
-fn rest_f32(a: &LbsAnimation) -> Vec<[f32; 3]> {
-    a.rest
-        .positions
-        .iter()
-        .map(|p| p.map(|c| c as f32))
-        .collect()
 }
 
 #[test]
@@ -196,7 +166,7 @@ fn top4_truncation_error_against_dense_lbs() {
             .all(|m| m.abs_diff_eq(glam::Mat4::IDENTITY, 0.0))
     );
 
-    let rest = rest_f32(a);
+    let rest = to_f32(&a.rest.positions);
     let diag = diagonal(a);
     let (mut max_d, mut sum_sq, mut n) = (0.0f64, 0.0f64, 0usize);
     let mut worst_frame = 0;
@@ -242,7 +212,7 @@ fn top4_truncation_error_against_dense_lbs() {
 fn device_matches_cpu_twin_on_elephant_frames() {
     let Some(a) = elephant() else { return };
     let (sk, _) = a.to_skinned();
-    let rest = rest_f32(a);
+    let rest = to_f32(&a.rest.positions);
     let diag = diagonal(a) as f32;
     let mut skinner = Skinner::new(gpu(), &sk).unwrap();
     for f in [0, 57, 150, 300, a.frames - 1] {
@@ -250,12 +220,7 @@ fn device_matches_cpu_twin_on_elephant_frames() {
         skinner.pose(&mats).unwrap();
         let dev = skinner.read().unwrap();
         let cpu = skin_lbs(&rest, &sk.joints, &sk.weights, &mats);
-        let d = dev
-            .iter()
-            .zip(&cpu)
-            .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
-            .fold(0.0f32, f32::max)
-            / diag;
+        let d = max_abs_diff(&dev, &cpu) / diag;
         eprintln!("elephant frame {f}: device vs CPU twin max {d:.2e} of the diagonal");
         assert!(d < 1e-5, "frame {f}: device vs CPU {d}");
     }
@@ -290,7 +255,7 @@ fn corrupt_dmat_files_are_errors_not_panics() {
         p
     };
     // Real data when present, else a synthetic binary matrix of the same kind.
-    let real = data_dir().join("elephant-weights.dmat");
+    let real = shared_data().join(ELEPHANT).join("elephant-weights.dmat");
     let bytes = std::fs::read(&real).unwrap_or_else(|_| {
         // 4 columns: the NaN test below writes into column 3.
         binary_dmat(
@@ -461,7 +426,7 @@ fn tiny_set_skins_as_expected_and_mismatches_are_errors() {
     assert_eq!(stats.vertices_over_4, 0);
     assert_eq!(stats.max_dropped, 0.0);
     let mats = SkinnedMesh::flatten(&a.frame_matrices(1).unwrap());
-    let cpu = skin_lbs(&rest_f32(&a), &sk.joints, &sk.weights, &mats);
+    let cpu = skin_lbs(&to_f32(&a.rest.positions), &sk.joints, &sk.weights, &mats);
     for (p, q) in cpu.iter().zip(&u1) {
         for k in 0..3 {
             assert!((f64::from(p[k]) - q[k]).abs() < 1e-6);

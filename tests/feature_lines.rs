@@ -3,30 +3,17 @@
 //! against the CPU twin (torus and bunny, both kinds of line), and nasty
 //! views (eye on the surface, inside the mesh) giving finite segments.
 
+mod common;
+
+use common::{LineArrays, gpu, to_f32};
+
 use shapecue::cpu::feature_lines::{LineInputs, Segment, View, lines_face, lines_vertex};
 use shapecue::field::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::{self, Mesh};
 use shapecue::stages::curvature::estimate;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
-use std::sync::{Arc, OnceLock};
 
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)")))
-        .clone()
-}
-
-struct F32 {
-    pos: Vec<[f32; 3]>,
-    nrm: Vec<[f32; 3]>,
-    d1: Vec<[f32; 3]>,
-    d2: Vec<[f32; 3]>,
-    k: Vec<[f32; 2]>,
-    dk: Vec<[f32; 4]>,
-}
-
-fn inputs(m: &Mesh) -> F32 {
+fn inputs(m: &Mesh) -> LineArrays {
     let opts = CurvatureOptions {
         accumulate: Accumulate::Gather,
         precision: Precision::F64,
@@ -34,33 +21,14 @@ fn inputs(m: &Mesh) -> F32 {
         dcurv: true,
     };
     let f: CurvatureField = estimate(gpu(), m, opts).unwrap().field;
-    let c3 = |v: &Vec<[f64; 3]>| v.iter().map(|p| p.map(|c| c as f32)).collect();
-    F32 {
-        pos: c3(&m.positions),
-        nrm: c3(&f.normals),
-        d1: c3(&f.d1),
-        d2: c3(&f.d2),
-        k: f.k1
-            .iter()
-            .zip(&f.k2)
-            .map(|(a, b)| [*a as f32, *b as f32])
-            .collect(),
-        dk: f.dk.iter().map(|d| d.map(|c| c as f32)).collect(),
-    }
+    LineArrays::new(to_f32(&m.positions), &f)
 }
 
-fn li(x: &F32) -> LineInputs<'_> {
-    LineInputs {
-        pos: &x.pos,
-        nrm: &x.nrm,
-        d1: &x.d1,
-        d2: &x.d2,
-        k: &x.k,
-        dk: &x.dk,
-    }
+fn li(x: &LineArrays) -> LineInputs<'_> {
+    x.inputs()
 }
 
-fn device(m: &Mesh, x: &F32, view: View, opts: LineOptions) -> Vec<Segment> {
+fn device(m: &Mesh, x: &LineArrays, view: View, opts: LineOptions) -> Vec<Segment> {
     let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
     ex.extract(&li(x), view, 1.0, opts).unwrap().0
 }
@@ -286,7 +254,7 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
         )
         .is_err()
     );
-    let short = F32 {
+    let short = LineArrays {
         pos: x.pos[..3].to_vec(),
         ..inputs(&m)
     };

@@ -2,24 +2,17 @@
 //! and float round trip (PLY), one topology enforced across frames, and
 //! clear errors for an empty glob, a corrupt frame and a mismatched frame.
 
+mod common;
+
+use common::scratch;
+
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use shapecue::Error;
 use shapecue::export::ply::write_ply;
 use shapecue::mesh::flipbook::Flipbook;
 use shapecue::mesh::{LoadOptions, Mesh, icosphere};
-
-/// A fresh, empty folder for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "shapecue-tests-flipbook-{}-{test}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
-}
 
 /// Writes `m` as OBJ; `{}` prints the shortest text that parses back to
 /// the same f64, so positions round-trip exactly.

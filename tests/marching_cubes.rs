@@ -1,24 +1,16 @@
 //! Marching cubes and vertex fusion: the case table, CPU reference invariants,
 //! and the device against the CPU reference.
 
+mod common;
+
+use common::gpu;
+
 use shapecue::cpu::marching_cubes::{self as mc, END, table};
 use shapecue::cpu::vertex_fusion::{Fused, Fusion, fuse};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::quality;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::Volume;
 use shapecue::volume::sdf::{Sdf, sdf};
-use std::sync::{Arc, OnceLock};
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        }))
-    })
-    .clone()
-}
 
 const ALL: [Fusion; 3] = [Fusion::None, Fusion::Hash, Fusion::Edge];
 
@@ -59,28 +51,14 @@ fn check_same(vol: &Volume, iso: f32, what: &str) {
     }
 }
 
-fn shared_volume(name: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/volumes")
-        .join(name);
-    if !p.exists() {
-        eprintln!(
-            "skipping: {} not found (../shared/data is absent)",
-            p.display()
-        );
-        return None;
-    }
-    Some(p)
-}
-
 fn bucky() -> Option<Volume> {
-    let p = shared_volume("Bucky.raw")?;
+    let p = common::shared("volumes/Bucky.raw")?;
     let spec = shapecue::volume::RawSpec::new([32; 3], shapecue::volume::ScalarType::U8);
     Some(shapecue::volume::load(&p, Some(&spec)).expect("Bucky.raw loads"))
 }
 
 fn iron_prot() -> Option<Volume> {
-    let p = shared_volume("ironProt.vtk")?;
+    let p = common::shared("volumes/ironProt.vtk")?;
     let f = std::fs::read(p).expect("read ironProt.vtk");
     let data = &f[f.len() - 68 * 68 * 68..];
     Some(

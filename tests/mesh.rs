@@ -3,43 +3,16 @@
 //! Tests on the shared data sets look for `../shared/data` next to the crate
 //! and skip (with a message on stderr) when it is absent.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{scratch, shared, write};
+
+use std::path::Path;
 
 use shapecue::Error;
 use shapecue::export::ply::{FIELD_PROPERTIES, read_ply_properties, write_ply};
 use shapecue::field::CurvatureField;
 use shapecue::mesh::{LoadOptions, Mesh, load};
-
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
-
-/// The shared meshes folder, or `None` (after saying so) when absent.
-fn meshes() -> Option<PathBuf> {
-    let dir = Path::new(DATA).join("meshes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "skipping: ../shared/data not found (looked for {})",
-            dir.display()
-        );
-        None
-    }
-}
-
-/// A fresh, empty folder for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("shapecue-tests-mesh-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
-}
-
-fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).expect("write test file");
-    p
-}
 
 fn plain() -> LoadOptions {
     LoadOptions::default()
@@ -71,7 +44,7 @@ fn load_err(path: &Path) -> String {
 // ---------------------------------------------------------------------------
 
 fn check_counts(file: &str, weld: bool, nv: usize, nf: usize) {
-    let Some(dir) = meshes() else { return };
+    let Some(dir) = shared("meshes") else { return };
     let path = dir.join(file);
     let m = load(&path, &LoadOptions { weld }).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
@@ -125,7 +98,7 @@ fn camelhead_fertility_off() {
 /// and n-1.
 #[test]
 fn obj_keeps_file_vertex_order() {
-    let Some(dir) = meshes() else { return };
+    let Some(dir) = shared("meshes") else { return };
     let path = dir.join("stanford-bunny.obj");
     let text = std::fs::read_to_string(&path).unwrap();
     let vs: Vec<[f64; 3]> = text
@@ -152,7 +125,7 @@ fn obj_keeps_file_vertex_order() {
 /// The two PLY byte orders agree with a re-encoding of the same mesh.
 #[test]
 fn horse_round_trips_through_the_writer() {
-    let Some(dir) = meshes() else { return };
+    let Some(dir) = shared("meshes") else { return };
     let m = load(&dir.join("horse.ply"), &plain()).unwrap();
     let tmp = scratch("horse");
     let out = tmp.join("horse-le.ply");

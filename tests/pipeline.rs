@@ -6,11 +6,14 @@
 //! and chained on the device against the CPU-skinned host path; the
 //! `PosePipeline` wrapper and its report.
 
+mod common;
+
+use common::{LineArrays, gpu, max_abs_diff, model_path, to_f32};
+
 use shapecue::cpu::ao::AoMode;
-use shapecue::cpu::feature_lines::{LineInputs, Segment, View};
+use shapecue::cpu::feature_lines::{Segment, View};
 use shapecue::cpu::skinning::skin_lbs;
 use shapecue::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
-use shapecue::gpu::Gpu;
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::mesh::{self, Mesh};
 use shapecue::stages::ao::AoStage;
@@ -18,14 +21,6 @@ use shapecue::stages::curvature::{CurvatureEstimator, Pass};
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 use shapecue::stages::pipeline::{PipelineOptions, PosePipeline, clip_poses};
 use shapecue::stages::skinning::Skinner;
-use std::path::PathBuf;
-use std::sync::{Arc, OnceLock};
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)")))
-        .clone()
-}
 
 fn f32_opts() -> CurvatureOptions {
     CurvatureOptions {
@@ -42,51 +37,6 @@ fn estimator(m: &Mesh, opts: CurvatureOptions, last: Pass) -> CurvatureEstimator
     est.set_positions(&m.positions).unwrap();
     est.run_until(last).unwrap();
     est
-}
-
-/// Host arrays (f32, world units) of an estimator's last run, with the given
-/// world positions: the inputs of the host-array entry points.
-struct Host {
-    pos: Vec<[f32; 3]>,
-    nrm: Vec<[f32; 3]>,
-    d1: Vec<[f32; 3]>,
-    d2: Vec<[f32; 3]>,
-    k: Vec<[f32; 2]>,
-    dk: Vec<[f32; 4]>,
-}
-
-impl Host {
-    fn read(est: &CurvatureEstimator, pos: Vec<[f32; 3]>) -> Host {
-        let f = est.read().unwrap();
-        let c3 = |v: &Vec<[f64; 3]>| v.iter().map(|p| p.map(|c| c as f32)).collect();
-        Host {
-            pos,
-            nrm: c3(&f.normals),
-            d1: c3(&f.d1),
-            d2: c3(&f.d2),
-            k: f.k1
-                .iter()
-                .zip(&f.k2)
-                .map(|(a, b)| [*a as f32, *b as f32])
-                .collect(),
-            dk: f.dk.iter().map(|d| d.map(|c| c as f32)).collect(),
-        }
-    }
-
-    fn inputs(&self) -> LineInputs<'_> {
-        LineInputs {
-            pos: &self.pos,
-            nrm: &self.nrm,
-            d1: &self.d1,
-            d2: &self.d2,
-            k: &self.k,
-            dk: &self.dk,
-        }
-    }
-}
-
-fn to_f32(p: &[[f64; 3]]) -> Vec<[f32; 3]> {
-    p.iter().map(|q| q.map(|c| c as f32)).collect()
 }
 
 /// Largest extent of the bounding box.
@@ -149,7 +99,7 @@ fn chained_ao_equals_ao_of_host_arrays() {
     let mut ao = AoStage::new(gpu()).unwrap();
     for (name, m) in tori() {
         let est = estimator(&m, f32_opts(), Pass::Dcurv);
-        let host = Host::read(&est, to_f32(&m.positions));
+        let host = LineArrays::new(to_f32(&m.positions), &est.read().unwrap());
         let radius = (0.5 * size(&m)) as f32;
         for mode in AoMode::ALL {
             let (want, _) = ao.run(&host.k, radius, mode).unwrap();
@@ -185,7 +135,7 @@ fn chained_ao_equals_ao_of_host_arrays() {
 fn chained_lines_equal_lines_of_host_arrays() {
     for (name, m) in tori() {
         let est = estimator(&m, f32_opts(), Pass::Dcurv);
-        let host = Host::read(&est, to_f32(&m.positions));
+        let host = LineArrays::new(to_f32(&m.positions), &est.read().unwrap());
         let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
         let (lo, hi) = m.bounds();
         let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
@@ -370,21 +320,6 @@ fn f64_estimator_cannot_be_chained() {
     );
 }
 
-/// The shared glTF model `name`, or `None` (with a message) when
-/// `../shared/data` is absent.
-fn model_path(name: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/animations/gltf")
-        .join(name);
-    p.exists().then_some(p.clone()).or_else(|| {
-        eprintln!(
-            "skipping: {} not found (../shared/data is absent)",
-            p.display()
-        );
-        None
-    })
-}
-
 #[test]
 fn brainstem_frame_chained_on_device_matches_cpu_skinned_host_path() {
     let Some(path) = model_path("BrainStem.glb") else {
@@ -422,7 +357,7 @@ fn brainstem_frame_chained_on_device_matches_cpu_skinned_host_path() {
     // positions are not read back; the skinned ones stand in for them (they
     // differ by the f32 rounding of the normalization, ~1e-7 of the size).
     let skinned = sk.read().unwrap();
-    let host = Host::read(&est, skinned.clone());
+    let host = LineArrays::new(skinned.clone(), &est.read().unwrap());
     let (ao_host, _) = ao.run(&host.k, radius, AoMode::Lut).unwrap();
     let worst = ao_dev
         .iter()
@@ -450,18 +385,14 @@ fn brainstem_frame_chained_on_device_matches_cpu_skinned_host_path() {
     // host from the pose in f64). Skinning agrees to f32 rounding.
     let rest: Vec<[f32; 3]> = to_f32(&m.rest.positions);
     let cpu_pose = skin_lbs(&rest, &m.joints, &m.weights, &mats);
-    let skin_dev = skinned
-        .iter()
-        .zip(&cpu_pose)
-        .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
-        .fold(0.0, f32::max);
+    let skin_dev = max_abs_diff(&skinned, &cpu_pose);
     assert!(f64::from(skin_dev) < 1e-5 * d, "skinning: {skin_dev}");
     let posed = Mesh {
         positions: cpu_pose.iter().map(|p| p.map(f64::from)).collect(),
         faces: m.rest.faces.clone(),
     };
     let est2 = estimator(&posed, f32_opts(), Pass::Dcurv);
-    let host2 = Host::read(&est2, cpu_pose.clone());
+    let host2 = LineArrays::new(cpu_pose.clone(), &est2.read().unwrap());
     let (ao_cpu, _) = ao.run(&host2.k, radius, AoMode::Lut).unwrap();
     // Two f32 curvature runs under different normalizations (rest vs this
     // pose) differ by rounding, which the tensor solve amplifies on

@@ -6,32 +6,20 @@
 //! pairs, the high bits travel with them); keys that all share their top
 //! digit (one bucket holds everything).
 
-use opencl3::memory::Buffer;
+mod common;
+
+use common::{download, gpu, random, upload};
+
 use shapecue::Error;
 use shapecue::cpu::radix_sort as cpu;
-use shapecue::gpu::Gpu;
-use shapecue::mesh::splitmix;
 use shapecue::stages::radix_sort::{MAX_BLOCKS, MIN_BLOCK, RadixSort, Strategy, blocking, digits};
-use std::sync::{Arc, OnceLock};
 
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        }))
-    })
-    .clone()
+/// `n` deterministic 32-bit keys.
+fn random_keys(n: usize, seed: u64) -> Vec<u32> {
+    random(n, 1 << 32, seed)
 }
 
 const SIZES: [usize; 9] = [0, 1, 2, 63, 64, 65, 1000, MIN_BLOCK * 3 + 1, (1 << 20) + 7];
-
-fn random_keys(n: usize, seed: u64) -> Vec<u32> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| (splitmix(&mut s) * 4294967296.0) as u32)
-        .collect()
-}
 
 /// The key patterns every size is tested with.
 fn patterns(n: usize, seed: u64) -> Vec<(&'static str, Vec<u32>)> {
@@ -51,18 +39,6 @@ fn patterns(n: usize, seed: u64) -> Vec<(&'static str, Vec<u32>)> {
         ("few distinct", few),
         ("one top digit", one_bucket),
     ]
-}
-
-fn upload(g: &Gpu, data: &[u32]) -> Buffer<u32> {
-    let mut b = g.buffer::<u32>(data.len()).unwrap();
-    g.write(&mut b, data).unwrap();
-    b
-}
-
-fn download(g: &Gpu, b: &Buffer<u32>, n: usize) -> Vec<u32> {
-    let mut v = vec![0u32; n];
-    g.read(b, &mut v).unwrap();
-    v
 }
 
 /// What a stable sort by the low `key_bits` bits gives, from `std`.

@@ -5,6 +5,8 @@
 //! Without libEGL/Mesa the GL tests print why and pass (skip); set
 //! `SHAPECUE_REQUIRE_GL=1` to make them fail instead (CI, where GL must work).
 
+mod common;
+
 use glam::{DVec3, DVec4, Vec3, Vec4};
 use shapecue::Error;
 use shapecue::render::{Camera, Frame, Light, MeshStyle, RenderOptions, Renderer};
@@ -23,14 +25,8 @@ fn opts(width: u32, height: u32, msaa: u32) -> RenderOptions {
 
 /// A renderer, or `None` (with a message) when this machine has no headless GL.
 fn renderer(o: RenderOptions) -> Option<Renderer> {
-    match Renderer::new(o) {
-        Ok(r) => Some(r),
-        Err(e @ Error::NoGl { .. }) if std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() => {
-            eprintln!("skipping GL test: {e}");
-            None
-        }
-        Err(e) => panic!("Renderer::new({o:?}): {e}"),
-    }
+    common::unless_no_gl(Renderer::new(o))
+        .map(|r| r.unwrap_or_else(|e| panic!("Renderer::new({o:?}): {e}")))
 }
 
 /// Unit cube [-0.5, 0.5]³ as 12 unwelded triangles (3 vertices each, flat

@@ -2,42 +2,13 @@
 //! and chunk boundaries, in place and out of place, and overflow of the
 //! total reported as an error with the output left unchanged.
 
+mod common;
+
+use common::{download, gpu, random, upload};
+
 use shapecue::Error;
 use shapecue::cpu::scan as cpu;
-use shapecue::gpu::Gpu;
-use shapecue::mesh::splitmix;
 use shapecue::stages::scan::{MAX_CHUNKS, MIN_CHUNK, Scan, chunking};
-use std::sync::{Arc, OnceLock};
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        }))
-    })
-    .clone()
-}
-
-/// `n` deterministic values below `bound`.
-fn random(n: usize, bound: u64, seed: u64) -> Vec<u32> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| (splitmix(&mut s) * bound as f64) as u32)
-        .collect()
-}
-
-fn upload(g: &Gpu, data: &[u32]) -> opencl3::memory::Buffer<u32> {
-    let mut b = g.buffer::<u32>(data.len()).unwrap();
-    g.write(&mut b, data).unwrap();
-    b
-}
-
-fn download(g: &Gpu, b: &opencl3::memory::Buffer<u32>, n: usize) -> Vec<u32> {
-    let mut v = vec![0u32; n];
-    g.read(b, &mut v).unwrap();
-    v
-}
 
 /// Scans `data` on the device out of place and in place and checks both
 /// against the CPU reference.

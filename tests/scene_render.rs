@@ -6,28 +6,15 @@
 //! Needs OpenCL (PoCL) and headless GL; without libEGL the tests print why
 //! and pass, unless `SHAPECUE_REQUIRE_GL=1` (CI).
 
+mod common;
+
+use common::{SHARED_DATA, model_path, scratch, unless_no_gl};
+
 use shapecue::Error;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
 use shapecue::scene::planner::{Cue, Pass, plan_with};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")
-}
-
-fn tmp_dir(tag: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "shapecue-scene-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
 
 /// Writes a scene next to its outputs and parses it.
 fn scene(dir: &Path, text: &str) -> Scene {
@@ -43,13 +30,7 @@ fn run(s: &Scene, dir: &Path, force: bool) -> Option<Result<RunReport, Error>> {
         force,
         device: None,
     };
-    match exec::run(s, &opts, &mut |_, _| {}) {
-        Err(e @ Error::NoGl { .. }) if std::env::var_os("SHAPECUE_REQUIRE_GL").is_none() => {
-            eprintln!("skipping GL test: {e}");
-            None
-        }
-        r => Some(r),
-    }
+    unless_no_gl(exec::run(s, &opts, &mut |_, _| {}))
 }
 
 /// The passes that ran are exactly the planned ones, each as often as
@@ -84,7 +65,7 @@ fn static_scenes_run_exactly_their_passes() {
     let mut sets: Vec<Vec<usize>> = (0..6).map(|i| vec![i]).collect();
     sets.extend([vec![3, 4], vec![2, 3], vec![0, 5], vec![0, 1, 2, 3, 4, 5]]);
     for set in sets {
-        let dir = tmp_dir("static");
+        let dir = scratch("static");
         let fx: String = set.iter().map(|&i| format!("{}\n", CUES[i].0)).collect();
         let s = scene(
             &dir,
@@ -128,7 +109,7 @@ fn static_scenes_run_exactly_their_passes() {
 
 #[test]
 fn curvature_colours_show_convex_red_and_saddle_green_on_a_torus() {
-    let dir = tmp_dir("colors");
+    let dir = scratch("colors");
     // Looking down the torus axis (z): the outer half of the ring is convex
     // (red), the inner half saddle-shaped (green).
     let s = scene(
@@ -159,7 +140,7 @@ fn curvature_colours_show_convex_red_and_saddle_green_on_a_torus() {
 
 #[test]
 fn outputs_are_not_overwritten_without_force() {
-    let dir = tmp_dir("force");
+    let dir = scratch("force");
     let s = scene(
         &dir,
         "[input]\ngenerate = \"sphere\"\nresolution = 500\n[effects]\nshading = {}\n[output]\nsize = [32, 32]\n",
@@ -183,7 +164,7 @@ fn outputs_are_not_overwritten_without_force() {
 
 #[test]
 fn an_isosurface_scene_rebuilds_topology_every_pose() {
-    let dir = tmp_dir("volume");
+    let dir = scratch("volume");
     let s = scene(
         &dir,
         "[input]\nsdf = \"torus\"\nresolution = 40\n[[camera]]\norbit = 3\n[effects]\n\
@@ -198,7 +179,7 @@ fn an_isosurface_scene_rebuilds_topology_every_pose() {
     assert!(r.plan.contains(Pass::Isosurface) && !r.plan.contains(Pass::CapBuffer));
     let _ = std::fs::remove_dir_all(&dir);
     // An empty isosurface is a clear error, not blank images.
-    let dir = tmp_dir("volume-empty");
+    let dir = scratch("volume-empty");
     let s = scene(
         &dir,
         "[input]\nsdf = \"sphere\"\nresolution = 16\niso = 5.0\n[effects]\nshading = {}\n",
@@ -210,12 +191,10 @@ fn an_isosurface_scene_rebuilds_topology_every_pose() {
 
 #[test]
 fn a_skinned_scene_runs_pose_passes_per_frame_and_topology_once() {
-    let gltf = shared().join("animations/gltf/RiggedSimple.glb");
-    if !gltf.exists() {
-        eprintln!("skipping: {} not found", gltf.display());
+    let Some(gltf) = model_path("RiggedSimple.glb") else {
         return;
-    }
-    let dir = tmp_dir("skinned");
+    };
+    let dir = scratch("skinned");
     let s = scene(
         &dir,
         &format!(
@@ -265,7 +244,7 @@ fn every_example_scene_parses() {
             continue;
         }
         let text = std::fs::read_to_string(&p).unwrap();
-        if text.contains("shared/data") && !shared().exists() {
+        if text.contains("shared/data") && !Path::new(SHARED_DATA).exists() {
             eprintln!("skipping {}: ../shared/data not found", p.display());
             continue;
         }
@@ -277,7 +256,7 @@ fn every_example_scene_parses() {
 
 #[test]
 fn a_flipbook_scene_loads_every_frame_and_builds_topology_once() {
-    let dir = tmp_dir("flipbook");
+    let dir = scratch("flipbook");
     let m = shapecue::mesh::torus(1.0, 0.4, 24, 12);
     for f in 0..4 {
         // Frame f: the torus squashed along z by a growing amount.
@@ -327,7 +306,7 @@ fn nasty_meshes_render_with_every_cue() {
     // A small torus far from the origin, a zero-area face, a duplicated face
     // and an unreferenced vertex at 1e30: every cue still runs, the camera
     // frames the torus, and the image is not empty.
-    let dir = tmp_dir("nasty");
+    let dir = scratch("nasty");
     let m = shapecue::mesh::torus(1.0, 0.4, 32, 16);
     let mut obj = String::new();
     for p in &m.positions {
@@ -373,7 +352,7 @@ fn the_inside_of_a_volume_decides_convex_or_concave() {
     // A sphere SDF: the ball (below 0) is convex, red; the space around it
     // (above 0) sees the same surface as concave, blue.
     for (inside, want_red) in [("below", true), ("above", false)] {
-        let dir = tmp_dir("inside");
+        let dir = scratch("inside");
         let s = scene(
             &dir,
             &format!(

@@ -2,30 +2,18 @@
 //! mesh, the device matches the CPU twin on several frames of every model,
 //! and bad requests are clear errors.
 
+mod common;
+
+use common::{gpu, max_abs_diff as max_dev, model_path, to_f32};
+
 use shapecue::cpu::skinning::skin_lbs;
-use shapecue::gpu::Gpu;
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::stages::skinning::Skinner;
-use std::path::PathBuf;
-use std::sync::{Arc, OnceLock};
 
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| Arc::new(Gpu::new(None).expect("an OpenCL device (PoCL is enough)")))
-        .clone()
-}
-
+/// The shared glTF model `name`, loaded, or `None` (after saying so) when
+/// absent.
 fn model(name: &str) -> Option<SkinnedMesh> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/animations/gltf")
-        .join(name);
-    if !p.exists() {
-        eprintln!(
-            "skipping: {} not found (../shared/data is absent)",
-            p.display()
-        );
-        return None;
-    }
+    let p = model_path(name)?;
     Some(load_gltf(&p).unwrap_or_else(|e| panic!("{name}: {e}")))
 }
 
@@ -36,21 +24,6 @@ const MODELS: [&str; 5] = [
     "Fox.glb",
     "BrainStem.glb",
 ];
-
-fn rest_f32(m: &SkinnedMesh) -> Vec<[f32; 3]> {
-    m.rest
-        .positions
-        .iter()
-        .map(|p| p.map(|c| c as f32))
-        .collect()
-}
-
-fn max_dev(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
-        .fold(0.0, f32::max)
-}
 
 fn extent(m: &SkinnedMesh) -> f32 {
     let (lo, hi) = m.rest.bounds();
@@ -84,7 +57,7 @@ fn bind_pose_reproduces_the_rest_mesh() {
     // through the device. Translation-only and rotated matrices check the
     // column-major layout.
     if let Some(m) = model("RiggedSimple.glb") {
-        let rest = rest_f32(&m);
+        let rest = to_f32(&m.rest.positions);
         let mut sk = Skinner::new(gpu(), &m).unwrap();
         let ident = SkinnedMesh::flatten(&vec![glam::Mat4::IDENTITY; m.joint_nodes.len()]);
         sk.pose(&ident).unwrap();
@@ -102,7 +75,7 @@ fn bind_pose_reproduces_the_rest_mesh() {
     for name in ["RiggedSimple.glb", "CesiumMan.glb", "BrainStem.glb"] {
         let Some(m) = model(name) else { return };
         let mats = SkinnedMesh::flatten(&m.joint_matrices(None, 0.0).unwrap());
-        let rest = rest_f32(&m);
+        let rest = to_f32(&m.rest.positions);
         let cpu = skin_lbs(&rest, &m.joints, &m.weights, &mats);
         let d = max_dev(&cpu, &rest) / extent(&m);
         eprintln!("{name}: bind pose max deviation {d:.2e} of the extent");
@@ -114,7 +87,7 @@ fn bind_pose_reproduces_the_rest_mesh() {
 fn device_matches_cpu_twin_on_animation_frames() {
     for name in MODELS {
         let Some(m) = model(name) else { return };
-        let rest = rest_f32(&m);
+        let rest = to_f32(&m.rest.positions);
         let mut sk = Skinner::new(gpu(), &m).unwrap();
         let clip = &m.clips[0];
         let mut moved = 0.0f32;

@@ -7,6 +7,10 @@
 //! computed once by an independent Python reader (struct, zlib, base64) and
 //! are hard-coded here.
 
+mod common;
+
+use common::{scratch, shared, write};
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -15,40 +19,6 @@ use shapecue::volume::sdf::{
     self, GYROID_PERIODS, SPHERE_RADIUS, Sdf, TORUS_R, TORUS_TUBE, sdf_by_name,
 };
 use shapecue::volume::{RawSpec, ScalarType, Volume, load};
-
-/// The shared volumes folder, or `None` (after saying so) when absent.
-fn volumes() -> Option<PathBuf> {
-    let root = std::env::var_os("SHAPECUE_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    let dir = root.join("volumes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "skipping: shared data not found (looked for {}; set SHAPECUE_SHARED_DATA)",
-            dir.display()
-        );
-        None
-    }
-}
-
-/// A fresh, empty folder for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "shapecue-tests-volume-{}-{test}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
-}
-
-fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).expect("write test file");
-    p
-}
 
 fn ok(path: &Path) -> Volume {
     load(path, None).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -136,7 +106,7 @@ fn check(v: &Volume, e: &Expect) {
 
 #[test]
 fn bucky_raw_through_rawspec() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     let path = dir.join("Bucky.raw");
     let v = load(&path, Some(&RawSpec::new([32; 3], ScalarType::U8))).unwrap();
     check(
@@ -165,7 +135,7 @@ fn bucky_raw_through_rawspec() {
 
 #[test]
 fn headsq_multi_file_nrrd() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     let v = ok(&dir.join("headsq/quarter.nhdr"));
     check(
         &v,
@@ -182,7 +152,7 @@ fn headsq_multi_file_nrrd() {
 
 #[test]
 fn head_mr_metaimage() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     check(
         &ok(&dir.join("HeadMRVolume.mhd")),
         &Expect {
@@ -197,7 +167,7 @@ fn head_mr_metaimage() {
 
 #[test]
 fn iron_protein_legacy_vtk() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     check(
         &ok(&dir.join("ironProt.vtk")),
         &Expect {
@@ -212,7 +182,7 @@ fn iron_protein_legacy_vtk() {
 
 #[test]
 fn hydrogen_vti_zlib_blocks() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     check(
         &ok(&dir.join("hydrogen.vti")),
         &Expect {
@@ -227,7 +197,7 @@ fn hydrogen_vti_zlib_blocks() {
 
 #[test]
 fn neghip_slc() {
-    let Some(dir) = volumes() else { return };
+    let Some(dir) = shared("volumes") else { return };
     check(
         &ok(&dir.join("neghip.slc")),
         &Expect {

@@ -14,22 +14,14 @@
 //! `fmt min max step [subdim]`. Keys are matched case-insensitively; other
 //! keys (comments, anatomical orientation, ...) are ignored.
 
-use std::borrow::Cow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use super::data_files::{DataFiles, METAIMAGE, detached};
 use super::{
-    Compression, Encoding, Payload, ScalarType, Skip, Volume, diagonal, lines_with_end, number,
-    oriented, pattern_files, read_file, scalar_type, three, voxel_count,
+    Compression, Encoding, Payload, ScalarType, Skip, Volume, diagonal, dimension, lines_with_end,
+    number, numbers, oriented, read_file, scalar_type, voxel_count,
 };
 use crate::error::{Error, Result};
-
-/// Where the samples are.
-enum DataFiles {
-    /// In the header file from this byte offset on.
-    Local(usize),
-    /// In these files; `subdim` is the number of fast axes each holds in full.
-    Files { files: Vec<PathBuf>, subdim: usize },
-}
 
 /// Loads a `.mhd` or `.mha` file.
 pub(super) fn load(path: &Path) -> Result<Volume> {
@@ -77,18 +69,9 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
                     problem: format!("ObjectType {value}: shapecue reads images only"),
                 });
             }
-            "ndims" => {
-                let n: usize = number(value, "NDims", src, el)?;
-                if n != 3 {
-                    // Before DimSize, whose count depends on it.
-                    return Err(Error::UnsupportedFormat {
-                        path: path.to_path_buf(),
-                        problem: format!("NDims {n}: shapecue reads 3-D volumes only"),
-                    });
-                }
-                ndims = Some(n);
-            }
-            "dimsize" => dims = Some(three(value, "DimSize", src, el)?),
+            // Before DimSize, whose count depends on it.
+            "ndims" => ndims = Some(dimension(value, "NDims", path, el)?),
+            "dimsize" => dims = Some(numbers(value, "DimSize", src, el)?),
             "elementtype" => {
                 let name = value.to_ascii_lowercase();
                 let name = name.strip_prefix("met_").ok_or_else(|| {
@@ -109,9 +92,9 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
                     )
                 })?);
             }
-            "elementspacing" => spacing = Some(three(value, "ElementSpacing", src, el)?),
-            "elementsize" => size = Some(three(value, "ElementSize", src, el)?),
-            "offset" | "position" | "origin" => origin = three(value, key.trim(), src, el)?,
+            "elementspacing" => spacing = Some(numbers(value, "ElementSpacing", src, el)?),
+            "elementsize" => size = Some(numbers(value, "ElementSize", src, el)?),
+            "offset" | "position" | "origin" => origin = numbers(value, key.trim(), src, el)?,
             "transformmatrix" | "rotation" | "orientation" => {
                 let toks: Vec<&str> = value.split_whitespace().collect();
                 if toks.len() != 9 {
@@ -132,20 +115,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             }
             "binarydata" => binary = flag()?,
             "compresseddata" => compressed = flag()?,
-            "headersize" => {
-                let n: i64 = number(value, "HeaderSize", src, el)?;
-                skip = match usize::try_from(n) {
-                    Ok(n) => Skip::Bytes(n),
-                    Err(_) if n == -1 => Skip::ToEnd,
-                    Err(_) => {
-                        return Err(Error::input(
-                            src,
-                            el,
-                            format!("HeaderSize {n} must be -1 or at least 0"),
-                        ));
-                    }
-                };
-            }
+            "headersize" => skip = Skip::parse(value, "HeaderSize", src, el)?,
             "elementnumberofchannels" => {
                 let n: usize = number(value, "ElementNumberOfChannels", src, el)?;
                 if n != 1 {
@@ -159,7 +129,11 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             }
             "elementdatafile" => {
                 let rest = lines.by_ref().map(|(_, (l, _))| l);
-                data = Some(data_files(value, end, rest, dims, dir, src, el)?);
+                data = Some(if value.eq_ignore_ascii_case("local") {
+                    DataFiles::Attached(end)
+                } else {
+                    detached(&METAIMAGE, value, rest, dims, dir, src, el)?
+                });
                 break;
             }
             _ => {}
@@ -186,25 +160,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             "-1 (data at the end of the file) is only valid with uncompressed binary data",
         ));
     }
-    let chunk_shape = match &data {
-        DataFiles::Local(_) => dims.to_vec(),
-        DataFiles::Files { files, subdim } => {
-            let shape = dims[..*subdim].to_vec();
-            let per_file: usize = shape.iter().product();
-            if files.len() != total / per_file {
-                return Err(Error::input(
-                    src,
-                    "ElementDataFile",
-                    format!(
-                        "{} data files for {} slabs of {per_file} samples",
-                        files.len(),
-                        total / per_file
-                    ),
-                ));
-            }
-            shape
-        }
-    };
+    let chunk_shape = data.chunk_shape(&METAIMAGE, dims, total, src)?;
     let payload = Payload {
         source: src,
         dims,
@@ -215,16 +171,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
         byte_skip: skip,
         chunk_shape,
     };
-    let values = match data {
-        DataFiles::Local(offset) => {
-            let local = bytes.get(offset..).unwrap_or_default();
-            payload.read([Ok((Cow::Borrowed(local), "local data".to_string()))])?
-        }
-        DataFiles::Files { files, .. } => payload.read(files.iter().map(|f| {
-            let data = read_file(f)?;
-            Ok((Cow::Owned(data), format!("data file {}", f.display())))
-        }))?,
-    };
+    let values = data.read(&METAIMAGE, &payload, &bytes)?;
     let spacing = spacing.or(size).unwrap_or([1.0; 3]);
     let steps = match matrix {
         None => spacing,
@@ -254,95 +201,4 @@ fn boolean(value: &str, key: &str, source: &str, el: &str) -> Result<bool> {
             format!("{key}: '{value}' is neither True nor False"),
         )),
     }
-}
-
-/// Parses the `ElementDataFile` value; `end` is where the line after it
-/// starts (the data of `LOCAL`), `rest` yields the lines after it (the
-/// names of a `LIST`).
-fn data_files<'a>(
-    value: &str,
-    end: usize,
-    rest: impl Iterator<Item = &'a [u8]>,
-    dims: Option<[usize; 3]>,
-    dir: &Path,
-    source: &str,
-    el: &str,
-) -> Result<DataFiles> {
-    let toks: Vec<&str> = value.split_whitespace().collect();
-    if value.eq_ignore_ascii_case("local") {
-        return Ok(DataFiles::Local(end));
-    }
-    let subdim = |tok: Option<&&str>| -> Result<usize> {
-        let d = match tok {
-            None => 2,
-            Some(t) => {
-                // MetaIO writes the slab dimension as e.g. "2D".
-                let t = t.trim_end_matches(['D', 'd']);
-                number(t, "ElementDataFile slab dimension", source, el)?
-            }
-        };
-        if (1..=3).contains(&d) {
-            Ok(d)
-        } else {
-            Err(Error::input(
-                source,
-                el,
-                format!("ElementDataFile slab dimension {d} must be 1, 2 or 3"),
-            ))
-        }
-    };
-    let slabs = |sub: usize| -> Result<usize> {
-        let dims = dims.ok_or_else(|| {
-            Error::input(
-                source,
-                el,
-                "DimSize must come before a multi-file ElementDataFile",
-            )
-        })?;
-        Ok(dims[sub..].iter().fold(1usize, |n, &d| n.saturating_mul(d)))
-    };
-    if toks.first().is_some_and(|t| t.eq_ignore_ascii_case("list")) {
-        let sub = subdim(toks.get(1))?;
-        let max = slabs(sub)?;
-        let mut files = Vec::new();
-        for line in rest {
-            let name = String::from_utf8_lossy(line);
-            let name = name.trim();
-            if name.is_empty() {
-                continue;
-            }
-            if files.len() == max {
-                return Err(Error::input(
-                    source,
-                    el,
-                    format!(
-                        "the ElementDataFile LIST names more than the {max} files DimSize needs"
-                    ),
-                ));
-            }
-            files.push(dir.join(name));
-        }
-        return Ok(DataFiles::Files { files, subdim: sub });
-    }
-    if toks.len() >= 4 && toks.len() <= 5 && toks[0].contains('%') {
-        let sub = subdim(toks.get(4))?;
-        let int = |k: usize, what: &str| number::<i64>(toks[k], what, source, el);
-        let files = pattern_files(
-            toks[0],
-            int(1, "ElementDataFile min")?,
-            int(2, "ElementDataFile max")?,
-            int(3, "ElementDataFile step")?,
-            slabs(sub)?,
-            dir,
-        )
-        .map_err(|p| Error::input(source, el, p))?;
-        return Ok(DataFiles::Files { files, subdim: sub });
-    }
-    if value.is_empty() {
-        return Err(Error::input(source, el, "empty ElementDataFile"));
-    }
-    Ok(DataFiles::Files {
-        files: vec![dir.join(value)],
-        subdim: 3,
-    })
 }

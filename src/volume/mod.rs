@@ -23,6 +23,7 @@
 //! direction matrix with `-1` on its diagonal) are flipped on load so that
 //! spacing is always positive and every sample keeps its world position.
 
+mod data_files;
 mod mhd;
 mod nrrd;
 mod raw;
@@ -32,7 +33,7 @@ mod vtk;
 
 use std::borrow::Cow;
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
@@ -508,6 +509,23 @@ enum Skip {
     ToEnd,
 }
 
+impl Skip {
+    /// Parses a header's skip `field` (NRRD `byte skip`, MetaImage
+    /// `HeaderSize`): a byte count, or -1 for the end of the file.
+    fn parse(value: &str, field: &str, source: &str, element: &str) -> Result<Skip> {
+        let n: i64 = number(value, field, source, element)?;
+        match usize::try_from(n) {
+            Ok(n) => Ok(Skip::Bytes(n)),
+            Err(_) if n == -1 => Ok(Skip::ToEnd),
+            Err(_) => Err(Error::input(
+                source,
+                element,
+                format!("{field} {n} must be -1 or at least 0"),
+            )),
+        }
+    }
+}
+
 /// The payload of a NRRD or MetaImage file: samples stored in one or more
 /// chunks (the attached data, or data files that each hold an equal share).
 struct Payload<'a> {
@@ -641,96 +659,6 @@ fn lines_with_end(bytes: &[u8]) -> impl Iterator<Item = (&[u8], usize)> {
     })
 }
 
-/// The data files of a detached header: a list, or a `printf`-style pattern
-/// with one integer conversion (`slice%03d.raw 1 93 1`), expanded. Names are
-/// resolved against `dir`.
-fn pattern_files(
-    fmt: &str,
-    min: i64,
-    max: i64,
-    step: i64,
-    max_files: usize,
-    dir: &Path,
-) -> std::result::Result<Vec<PathBuf>, String> {
-    if step == 0 {
-        return Err("the step of a data file pattern cannot be 0".into());
-    }
-    if (max - min).signum() * step.signum() < 0 {
-        return Err(format!(
-            "a data file pattern from {min} to {max} cannot use step {step}"
-        ));
-    }
-    let count = (max.abs_diff(min) / step.unsigned_abs()).saturating_add(1);
-    if count > max_files as u64 {
-        return Err(format!(
-            "the data file pattern names {count} files, more than the grid has slices ({max_files})"
-        ));
-    }
-    let (pre, spec, post) = split_format(fmt)?;
-    (0..count)
-        .map(|k| {
-            let i = min + step * k as i64;
-            Ok(dir.join(format!("{pre}{}{post}", spec.format(i))))
-        })
-        .collect()
-}
-
-/// One `%[0][width]d` (or `i`, `u`) conversion of a file name pattern.
-struct IntFormat {
-    zero: bool,
-    width: usize,
-}
-
-impl IntFormat {
-    fn format(&self, i: i64) -> String {
-        if self.zero {
-            format!("{i:0width$}", width = self.width)
-        } else {
-            format!("{i:width$}", width = self.width)
-        }
-    }
-}
-
-/// Splits a `printf` pattern into the text before its one integer
-/// conversion, the conversion and the text after it (`%%` is a literal `%`).
-fn split_format(fmt: &str) -> std::result::Result<(String, IntFormat, String), String> {
-    let bad = || {
-        format!(
-            "data file pattern '{fmt}' must contain exactly one integer conversion such as %d or %03d"
-        )
-    };
-    let mut pre = String::new();
-    let mut post = String::new();
-    let mut conv = None;
-    let mut chars = fmt.chars().peekable();
-    while let Some(c) = chars.next() {
-        let out = if conv.is_some() { &mut post } else { &mut pre };
-        if c != '%' {
-            out.push(c);
-            continue;
-        }
-        if chars.peek() == Some(&'%') {
-            chars.next();
-            out.push('%');
-            continue;
-        }
-        if conv.is_some() {
-            return Err(bad());
-        }
-        let zero = chars.next_if_eq(&'0').is_some();
-        let mut width = 0usize;
-        while let Some(d) = chars.peek().and_then(|c| c.to_digit(10)) {
-            chars.next();
-            width = width.saturating_mul(10).saturating_add(d as usize);
-        }
-        if width > 64 || !matches!(chars.next(), Some('d' | 'i' | 'u')) {
-            return Err(bad());
-        }
-        conv = Some(IntFormat { zero, width });
-    }
-    conv.map(|c| (pre, c, post)).ok_or_else(bad)
-}
-
 /// The per-axis steps of a direction matrix whose rows are the axis
 /// vectors, when it is diagonal (off-diagonal entries below 1e-9 of the
 /// largest entry); `None` when the grid is rotated or sheared.
@@ -818,29 +746,42 @@ fn number<T: FromStr>(tok: &str, what: &str, source: &str, element: &str) -> Res
     })
 }
 
-/// Parses exactly three whitespace-separated numbers.
-fn three<T: FromStr + Copy + Default>(
+/// Parses exactly `N` whitespace-separated numbers.
+fn numbers<T: FromStr + Copy + Default, const N: usize>(
     value: &str,
     what: &str,
     source: &str,
     element: &str,
-) -> Result<[T; 3]> {
+) -> Result<[T; N]> {
     let toks: Vec<&str> = value.split_whitespace().collect();
-    if toks.len() != 3 {
+    if toks.len() != N {
         return Err(Error::input(
             source,
             element,
             format!(
-                "{what}: expected 3 values, found {} ('{value}')",
+                "{what}: expected {N} values, found {} ('{value}')",
                 toks.len()
             ),
         ));
     }
-    let mut out = [T::default(); 3];
+    let mut out = [T::default(); N];
     for (o, t) in out.iter_mut().zip(&toks) {
         *o = number(t, what, source, element)?;
     }
     Ok(out)
+}
+
+/// Parses the number of dimensions a header declares (`field`), which must
+/// be 3: other counts are valid input that shapecue does not read.
+fn dimension(value: &str, field: &str, path: &Path, element: &str) -> Result<usize> {
+    let n: usize = number(value, field, &path.display().to_string(), element)?;
+    if n != 3 {
+        return Err(Error::UnsupportedFormat {
+            path: path.to_path_buf(),
+            problem: format!("{field} {n}: shapecue reads 3-D volumes only"),
+        });
+    }
+    Ok(n)
 }
 
 #[cfg(test)]
@@ -891,30 +832,6 @@ mod tests {
                 -1.0, 1.0, 255.0, 1.0, 258.0, 513.0, -3.0, 7.0, -9.0, 1.5, -2.25
             ]
         );
-    }
-
-    #[test]
-    fn file_patterns() {
-        let dir = Path::new("d");
-        let names = |f, a, b, s| {
-            pattern_files(f, a, b, s, 100, dir).map(|v| {
-                v.iter()
-                    .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
-                    .collect::<Vec<_>>()
-            })
-        };
-        assert_eq!(names("q.%d", 1, 3, 1).unwrap(), ["q.1", "q.2", "q.3"]);
-        assert_eq!(
-            names("s%03d.raw", 9, 11, 2).unwrap(),
-            ["s009.raw", "s011.raw"]
-        );
-        assert_eq!(names("%%%i", 2, 1, -1).unwrap(), ["%2", "%1"]);
-        assert!(names("q.%d", 1, 3, 0).is_err());
-        assert!(names("q.%d", 3, 1, 1).is_err());
-        assert!(names("q.%s", 1, 3, 1).is_err());
-        assert!(names("q.%d.%d", 1, 3, 1).is_err());
-        assert!(names("q", 1, 3, 1).is_err());
-        assert!(names("q.%d", 0, i64::MAX, 1).is_err());
     }
 
     #[test]

@@ -14,23 +14,14 @@
 //! Other fields describe the data (labels, units, kinds, ...) and are
 //! ignored.
 
-use std::borrow::Cow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use super::data_files::{DataFiles, NRRD, detached};
 use super::{
-    Compression, Encoding, Payload, ScalarType, Skip, Volume, diagonal, lines_with_end, number,
-    oriented, pattern_files, read_file, scalar_type, three, voxel_count,
+    Compression, Encoding, Payload, ScalarType, Skip, Volume, diagonal, dimension, lines_with_end,
+    number, numbers, oriented, read_file, scalar_type, voxel_count,
 };
 use crate::error::{Error, Result};
-
-/// Where the samples are.
-enum DataFiles {
-    /// After the header's blank line, at this byte offset.
-    Attached(usize),
-    /// In these files, each holding an equal share along the slowest axes;
-    /// `subdim` is the number of fast axes one file holds in full.
-    Detached { files: Vec<PathBuf>, subdim: usize },
-}
 
 /// The fields shapecue uses, as read from the header.
 #[derive(Default)]
@@ -77,27 +68,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             "no 'data file' field, and no blank line before attached data",
         )
     })?;
-    let chunk_shape = match &data {
-        DataFiles::Attached(_) => dims.to_vec(),
-        DataFiles::Detached { files, subdim } => {
-            let shape = dims[..*subdim].to_vec();
-            let per_file: usize = shape.iter().product();
-            if files.len() != total / per_file {
-                return Err(Error::input(
-                    src,
-                    "data file",
-                    format!(
-                        "{} data files for {} slabs of {} samples ({} grid, {subdim} axes per file)",
-                        files.len(),
-                        total / per_file,
-                        per_file,
-                        super::dims_text(dims),
-                    ),
-                ));
-            }
-            shape
-        }
-    };
+    let chunk_shape = data.chunk_shape(&NRRD, dims, total, src)?;
     let payload = Payload {
         source: src,
         dims,
@@ -115,16 +86,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             "-1 (data at the end of the file) is only valid with raw encoding",
         ));
     }
-    let values = match data {
-        DataFiles::Attached(offset) => {
-            let attached = bytes.get(offset..).unwrap_or_default();
-            payload.read([Ok((Cow::Borrowed(attached), "attached data".to_string()))])?
-        }
-        DataFiles::Detached { files, .. } => payload.read(files.iter().map(|f| {
-            let data = read_file(f)?;
-            Ok((Cow::Owned(data), format!("data file {}", f.display())))
-        }))?,
-    };
+    let values = data.read(&NRRD, &payload, &bytes)?;
     let steps = match (h.directions, h.spacings) {
         (Some(axes), _) => diagonal(axes).ok_or_else(|| Error::UnsupportedFormat {
             path: path.to_path_buf(),
@@ -186,15 +148,8 @@ fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
         let field = key.trim().to_ascii_lowercase();
         match field.as_str() {
             "dimension" => {
-                let d: usize = number(value, "dimension", source, el)?;
-                if d != 3 {
-                    // Before `sizes`, whose count depends on it.
-                    return Err(Error::UnsupportedFormat {
-                        path: source.into(),
-                        problem: format!("dimension {d}: shapecue reads 3-D volumes only"),
-                    });
-                }
-                h.dimension = Some(d);
+                // Before `sizes`, whose count depends on it.
+                h.dimension = Some(dimension(value, "dimension", Path::new(source), el)?);
             }
             "type" => h.scalar = Some(scalar_type(value, source, el)?),
             "encoding" => h.encoding = Some(encoding(value, source, el)?),
@@ -211,8 +166,8 @@ fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
                     }
                 })
             }
-            "sizes" => h.sizes = Some(three(value, "sizes", source, el)?),
-            "spacings" => h.spacings = Some(three(value, "spacings", source, el)?),
+            "sizes" => h.sizes = Some(numbers(value, "sizes", source, el)?),
+            "spacings" => h.spacings = Some(numbers(value, "spacings", source, el)?),
             "space directions" => h.directions = Some(directions(value, source, el)?),
             "space origin" => h.origin = Some(vector(value, "space origin", source, el)?),
             "space dimension" => {
@@ -227,22 +182,11 @@ fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
             }
             "line skip" | "lineskip" => h.line_skip = number(value, "line skip", source, el)?,
             "byte skip" | "byteskip" => {
-                let n: i64 = number(value, "byte skip", source, el)?;
-                h.byte_skip = Some(match usize::try_from(n) {
-                    Ok(n) => Skip::Bytes(n),
-                    Err(_) if n == -1 => Skip::ToEnd,
-                    Err(_) => {
-                        return Err(Error::input(
-                            source,
-                            el,
-                            format!("byte skip {n} must be -1 or at least 0"),
-                        ));
-                    }
-                })
+                h.byte_skip = Some(Skip::parse(value, "byte skip", source, el)?)
             }
             "data file" | "datafile" => {
                 let rest = lines.by_ref().map(|(_, (l, _))| l);
-                h.data = Some(data_files(value, rest, h.sizes, dir, source, el)?);
+                h.data = Some(detached(&NRRD, value, rest, h.sizes, dir, source, el)?);
             }
             _ => {} // descriptive fields: content, kinds, labels, units, ...
         }
@@ -266,98 +210,6 @@ fn encoding(value: &str, source: &str, el: &str) -> Result<Encoding> {
     })
 }
 
-/// Parses the `data file` field. `rest` yields the header lines after it
-/// (the names of a `LIST`). `sizes` must come first (as the format requires
-/// of every field before `data file`) so that a pattern can be bounded.
-fn data_files<'a>(
-    value: &str,
-    rest: impl Iterator<Item = &'a [u8]>,
-    sizes: Option<[usize; 3]>,
-    dir: &Path,
-    source: &str,
-    el: &str,
-) -> Result<DataFiles> {
-    let toks: Vec<&str> = value.split_whitespace().collect();
-    let subdim = |tok: Option<&&str>| -> Result<usize> {
-        match tok {
-            None => Ok(2),
-            Some(t) => {
-                let d: usize = number(t, "data file subdim", source, el)?;
-                if (1..=3).contains(&d) {
-                    Ok(d)
-                } else {
-                    Err(Error::input(
-                        source,
-                        el,
-                        format!("data file subdim {d} must be 1, 2 or 3"),
-                    ))
-                }
-            }
-        }
-    };
-    let slabs = |sub: usize| -> Result<usize> {
-        let sizes = sizes.ok_or_else(|| {
-            Error::input(
-                source,
-                el,
-                "'sizes' must come before a multi-file 'data file'",
-            )
-        })?;
-        Ok(sizes[sub..]
-            .iter()
-            .fold(1usize, |n, &d| n.saturating_mul(d)))
-    };
-    if toks.first().is_some_and(|t| *t == "LIST") {
-        let sub = subdim(toks.get(1))?;
-        let max = slabs(sub)?;
-        let mut files = Vec::new();
-        for line in rest {
-            let name = String::from_utf8_lossy(line);
-            let name = name.trim();
-            if name.is_empty() {
-                continue;
-            }
-            if files.len() == max {
-                return Err(Error::input(
-                    source,
-                    el,
-                    format!("the data file LIST names more than the {max} files the sizes need"),
-                ));
-            }
-            files.push(dir.join(name));
-        }
-        return Ok(DataFiles::Detached { files, subdim: sub });
-    }
-    if toks.len() >= 4 && toks[0].contains('%') {
-        if toks.len() > 5 {
-            return Err(Error::input(
-                source,
-                el,
-                format!("expected 'format min max step [subdim]', found '{value}'"),
-            ));
-        }
-        let sub = subdim(toks.get(4))?;
-        let int = |k: usize, what: &str| number::<i64>(toks[k], what, source, el);
-        let files = pattern_files(
-            toks[0],
-            int(1, "data file min")?,
-            int(2, "data file max")?,
-            int(3, "data file step")?,
-            slabs(sub)?,
-            dir,
-        )
-        .map_err(|p| Error::input(source, el, p))?;
-        return Ok(DataFiles::Detached { files, subdim: sub });
-    }
-    if value.is_empty() {
-        return Err(Error::input(source, el, "empty data file name"));
-    }
-    Ok(DataFiles::Detached {
-        files: vec![dir.join(value)],
-        subdim: 3,
-    })
-}
-
 /// Parses `(x,y,z)`.
 fn vector(value: &str, what: &str, source: &str, el: &str) -> Result<[f64; 3]> {
     let inner = value
@@ -371,7 +223,7 @@ fn vector(value: &str, what: &str, source: &str, el: &str) -> Result<[f64; 3]> {
                 format!("{what}: expected a vector '(x,y,z)', found '{value}'"),
             )
         })?;
-    three(&inner.replace(',', " "), what, source, el)
+    numbers(&inner.replace(',', " "), what, source, el)
 }
 
 /// Parses `space directions`: three vectors (one per axis).
@@ -407,6 +259,7 @@ fn directions(value: &str, source: &str, el: &str) -> Result<[[f64; 3]; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     #[test]
     fn header_fields() {

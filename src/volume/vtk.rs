@@ -26,7 +26,7 @@ use quick_xml::events::{BytesStart, Event};
 
 use super::{
     Compression, ScalarType, Volume, byte_count, convert_into, decompress, diagonal, dims_text,
-    number, oriented, parse_ascii_into, read_file, scalar_type, size_problem, three, voxel_count,
+    number, numbers, oriented, parse_ascii_into, read_file, scalar_type, size_problem, voxel_count,
 };
 use crate::error::{Error, Result};
 
@@ -111,9 +111,9 @@ pub(super) fn load_legacy(path: &Path) -> Result<Volume> {
                 }
                 structured = true;
             }
-            "DIMENSIONS" => dims = Some(three(args, "DIMENSIONS", src, &el)?),
-            "SPACING" | "ASPECT_RATIO" => spacing = three(args, &kw, src, &el)?,
-            "ORIGIN" => origin = three(args, "ORIGIN", src, &el)?,
+            "DIMENSIONS" => dims = Some(numbers(args, "DIMENSIONS", src, &el)?),
+            "SPACING" | "ASPECT_RATIO" => spacing = numbers(args, &kw, src, &el)?,
+            "ORIGIN" => origin = numbers(args, "ORIGIN", src, &el)?,
             "POINT_DATA" => point_data = Some(number(args, "POINT_DATA", src, &el)?),
             "SCALARS" if point_data.is_some() => {
                 let ty = toks.get(2).ok_or_else(|| {
@@ -445,28 +445,20 @@ fn parse_xml(xml: &str, src: &str, path: &Path) -> Result<Xml> {
                             "VTK XML type '{ty}': shapecue reads ImageData (.vti) only"
                         )));
                     }
-                    x.big_endian = match attr("byte_order")?.as_deref() {
-                        None | Some("LittleEndian") => false,
-                        Some("BigEndian") => true,
-                        Some(o) => {
-                            return Err(Error::input(
+                    let either = |key: &str, default: &str, other: &str| -> Result<bool> {
+                        match attr(key)?.as_deref() {
+                            None => Ok(false),
+                            Some(v) if v == default => Ok(false),
+                            Some(v) if v == other => Ok(true),
+                            Some(v) => Err(Error::input(
                                 src,
                                 "VTKFile",
-                                format!("byte_order '{o}' is neither LittleEndian nor BigEndian"),
-                            ));
+                                format!("{key} '{v}' is neither {default} nor {other}"),
+                            )),
                         }
                     };
-                    x.header64 = match attr("header_type")?.as_deref() {
-                        None | Some("UInt32") => false,
-                        Some("UInt64") => true,
-                        Some(h) => {
-                            return Err(Error::input(
-                                src,
-                                "VTKFile",
-                                format!("header_type '{h}' is neither UInt32 nor UInt64"),
-                            ));
-                        }
-                    };
+                    x.big_endian = either("byte_order", "LittleEndian", "BigEndian")?;
+                    x.header64 = either("header_type", "UInt32", "UInt64")?;
                     x.zlib = match attr("compressor")?.as_deref() {
                         None | Some("") => false,
                         Some("vtkZLibDataCompressor") => true,
@@ -482,12 +474,12 @@ fn parse_xml(xml: &str, src: &str, path: &Path) -> Result<Xml> {
                     let el = "ImageData";
                     let ext = attr("WholeExtent")?
                         .ok_or_else(|| Error::input(src, el, "missing WholeExtent"))?;
-                    x.extent = Some(six(&ext, src, el)?);
+                    x.extent = Some(numbers(&ext, "extent", src, el)?);
                     if let Some(o) = attr("Origin")? {
-                        x.origin = three(&o, "Origin", src, el)?;
+                        x.origin = numbers(&o, "Origin", src, el)?;
                     }
                     if let Some(s) = attr("Spacing")? {
-                        x.spacing = three(&s, "Spacing", src, el)?;
+                        x.spacing = numbers(&s, "Spacing", src, el)?;
                     }
                     if let Some(d) = attr("Direction")? {
                         let toks: Vec<&str> = d.split_whitespace().collect();
@@ -506,7 +498,7 @@ fn parse_xml(xml: &str, src: &str, path: &Path) -> Result<Xml> {
                 "Piece" => {
                     x.pieces += 1;
                     if let Some(e) = attr("Extent")? {
-                        x.piece_extent = Some(six(&e, src, "Piece")?);
+                        x.piece_extent = Some(numbers(&e, "extent", src, "Piece")?);
                     }
                 }
                 "PointData" => {
@@ -612,26 +604,6 @@ fn attribute(tag: &BytesStart<'_>, key: &str, src: &str, element: &str) -> Resul
             .map(|v| Some(v.into_owned()))
             .map_err(|e| bad(e.to_string())),
     }
-}
-
-/// Parses an extent: six integers.
-fn six(value: &str, src: &str, element: &str) -> Result<[i64; 6]> {
-    let toks: Vec<&str> = value.split_whitespace().collect();
-    if toks.len() != 6 {
-        return Err(Error::input(
-            src,
-            element,
-            format!(
-                "extent: expected 6 values, found {} ('{value}')",
-                toks.len()
-            ),
-        ));
-    }
-    let mut out = [0i64; 6];
-    for (o, t) in out.iter_mut().zip(toks) {
-        *o = number(t, "extent", src, element)?;
-    }
-    Ok(out)
 }
 
 /// Decodes base64 text that may be several concatenated encodings (VTK
