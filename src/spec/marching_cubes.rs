@@ -166,18 +166,18 @@ pub fn device_bytes_bound(voxels: usize, rows: usize, soup_vertices: usize) -> u
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum IsoNormals {
-    /// The estimator's own area-weighted face normals (Rusinkiewicz).
-    #[value(help = super::NO_HELP)]
-    Mesh,
     /// The volume's gradient at each vertex: far more accurate on
     /// marching-cubes meshes, whose sliver triangles make face normals noisy.
     #[value(help = super::NO_HELP)]
     Gradient,
+    /// The estimator's own area-weighted face normals (Rusinkiewicz).
+    #[value(help = super::NO_HELP)]
+    Mesh,
 }
 
 impl IsoNormals {
-    /// Both choices.
-    pub const ALL: [IsoNormals; 2] = [IsoNormals::Mesh, IsoNormals::Gradient];
+    /// Both choices, in the order of `--help` (the default first).
+    pub const ALL: [IsoNormals; 2] = [IsoNormals::Gradient, IsoNormals::Mesh];
 
     /// The name used on the command line (`--curvature-normals`) and in stats.
     pub fn name(self) -> &'static str {

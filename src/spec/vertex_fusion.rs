@@ -96,3 +96,51 @@ pub fn device_bytes_bound(soup_vertices: usize) -> u64 {
     // sort scratch ~ 8n + histograms.
     (12 + 6 + 3 + 16 + 9) * soup_vertices as u64
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::spec::{ao::AoMode, curvature, marching_cubes, radix_sort, scan};
+    use clap::ValueEnum;
+
+    /// `name()`, `Display`, `FromStr` and the CLI's value names agree.
+    fn names_agree<T>(all: &[T], name: fn(&T) -> &'static str)
+    where
+        T: ValueEnum + std::fmt::Display + std::str::FromStr + PartialEq + std::fmt::Debug,
+    {
+        assert_eq!(all.len(), T::value_variants().len());
+        for (v, cli) in all.iter().zip(T::value_variants()) {
+            let pv = cli.to_possible_value().unwrap();
+            assert_eq!(pv.get_name(), name(v));
+            assert_eq!(v.to_string(), name(v));
+            assert!(name(v).parse::<T>().ok().as_ref() == Some(v));
+            assert!(pv.get_help().is_none(), "--help lists bare names");
+        }
+        assert!("no such choice".parse::<T>().is_err());
+    }
+
+    #[test]
+    fn option_enum_names() {
+        names_agree(&super::Fusion::ALL, |v| v.name());
+        names_agree(&AoMode::ALL, |v| v.name());
+        names_agree(&curvature::Accumulate::ALL, |v| v.name());
+        names_agree(&curvature::Precision::ALL, |v| v.name());
+        names_agree(&curvature::Compat::ALL, |v| v.name());
+        names_agree(&marching_cubes::IsoNormals::ALL, |v| v.name());
+        names_agree(&crate::mesh::Generated::ALL, |v| v.name());
+    }
+
+    #[test]
+    fn splits_and_bounds() {
+        for n in [0, 1, 255, 256, 257, 4096 * 256, 4096 * 256 + 1, 10_000_000] {
+            let (c, k) = scan::chunking(n);
+            assert!(k <= scan::MAX_CHUNKS && (n == 0 || (c >= scan::MIN_CHUNK && c * k >= n)));
+            let (b, g) = radix_sort::blocking(n);
+            assert!(g <= radix_sort::MAX_BLOCKS && (n == 0 || (b >= radix_sort::MIN_BLOCK)));
+            assert_eq!(radix_sort::histogram_len_bound(n), radix_sort::RADIX * g);
+        }
+        assert_eq!(marching_cubes::edge_key_bits(8), Some(5));
+        assert_eq!(marching_cubes::edge_key_bits(1 << 30), Some(32));
+        assert_eq!(marching_cubes::edge_key_bits((1 << 30) + 1), None);
+        assert_eq!(super::fused_faces_bound(9), 3);
+    }
+}
