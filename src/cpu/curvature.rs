@@ -53,7 +53,7 @@ const fn prev3(i: usize) -> usize {
 pub struct Tri {
     /// Vertex indices.
     pub v: [usize; 3],
-    /// Edges: e[i] = p[prev(i)] − p[next(i)].
+    /// Edges: `e[i] = p[prev(i)] − p[next(i)]`.
     pub e: [V3; 3],
     /// |p0| + |p1| + |p2| (normalized coordinates).
     pub psum: f64,
