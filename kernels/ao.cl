@@ -3,6 +3,8 @@
 // normal, and AO is the cosine-weighted fraction of the hemisphere of radius R
 // above it that the quadric does not block. Host: src/stages/ao.rs; CPU twin:
 // src/cpu/ao.rs.
+// Shared with the host (src/spec/ao.rs): the mode numbers (AoMode::code),
+// AO_SAMPLES and its directions, the table side LUT_N and the table itself.
 //
 // Derivation used here (per tangent direction φ, normal curvature κ(φ) =
 // k1cos²φ + k2sin²φ; our k are positive where the surface is convex with

@@ -57,7 +57,10 @@
 // Build options: -DSC_DOUBLE (double precision), -DSC_COMPAT (trimesh2 2.16:
 // its 3×3 LDLᵀ third pivot Σv² instead of Σv² − (Σuv)²/d1, and |k1| ≥ |k2|
 // ordering instead of k1 ≥ k2).
+// Shared with the host (src/spec/curvature.rs): Precision::F64 ↔ SC_DOUBLE,
+// Compat::Trimesh2 ↔ SC_COMPAT, the counters uint[4] in CurvatureCounts order.
 
+// Mirrored by the DEGEN_* constants of src/spec/curvature.rs (the CPU twin uses them).
 #define DEGEN_AREA_REL RL(5e-8)                  // × (l0² + l1² + l2²)
 #define DEGEN_EDGE2 RL(1e-24)
 #define DEGEN_HEIGHT_ULP RL(1.1920928955078125e-7) // 2^-23 × (|p0|+|p1|+|p2|): f32 rounding

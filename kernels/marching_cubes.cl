@@ -4,6 +4,9 @@
 // Seed 000 §3.4 (Griffin et al. 2012): classify, scan, triangles. Host:
 // src/stages/marching_cubes.rs; CPU twin with the same step names and the
 // same f32 arithmetic: src/cpu/marching_cubes.rs.
+// Shared with the host (src/spec/marching_cubes.rs): the case table (counts,
+// tris; 0xFF = END), cell_rows, the soup bound; mode = Fusion::code
+// (src/spec/vertex_fusion.rs).
 //   mc_classify   per cell row   triangles the row emits (table counts)
 //   (scan.cl)                     exclusive scan of the row counts → row offsets
 //   mc_triangles  per cell row   soup positions, soup indices, one key per vertex

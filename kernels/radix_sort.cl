@@ -1,6 +1,8 @@
 // radix_sort.cl: stable radix sort of (uint key, uint value) pairs by the low
 // key_bits bits of the keys. Host: src/stages/radix_sort.rs; CPU twin with the
 // same steps: src/cpu/radix_sort.rs.
+// Shared with the host (src/spec/radix_sort.rs): RADIX_BITS = DIGIT_BITS, RADIX,
+// the blocks of the MSD pass (blocking(), the same split as BLOCK_RANGE).
 //
 // One most-significant-digit pass, then a least-significant-digit sort inside
 // each bucket. The MSD pass splits the n pairs into G contiguous blocks (the

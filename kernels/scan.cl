@@ -2,6 +2,8 @@
 // in place or out of place, with the total in 64 bits so that a sum past
 // UINT_MAX is reported instead of wrapping. Host: src/stages/scan.rs; CPU
 // twin: src/cpu/scan.rs.
+// Shared with the host (src/spec/scan.rs): the chunking (chunking(), the same
+// split as CHUNK_RANGE) and the partials length (MAX_CHUNKS).
 //
 // Reduce-then-scan over C contiguous chunks of `chunk` elements each (the
 // last one shorter), C at most a few thousand, chosen by the host:

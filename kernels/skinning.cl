@@ -2,6 +2,8 @@
 // device each frame from keyframe joint matrices), p' = Σ w_i M_{j_i} p with
 // up to four influences. Host: src/stages/skinning.rs; CPU twin:
 // src/cpu/skinning.rs.
+// Shared with the host (src/spec/skinning.rs): 4 influences per vertex
+// (INFLUENCES), 16 floats per joint matrix (MATRIX_FLOATS).
 //   skin_lbs   per vertex   skinned position
 // Buffers (V vertices, J joints):
 //   rest float[3V]; joints uint[4V]; weights float[4V] (normalized, or all 0:

@@ -1,6 +1,8 @@
 // vertex_fusion.cl: marching-cubes triangle soup → indexed mesh with shared
 // vertices (seed 000 §3.4). Host: src/stages/vertex_fusion.rs; CPU twin with
 // the same step names: src/cpu/vertex_fusion.rs.
+// Shared with the host (src/spec/vertex_fusion.rs): the Fusion variant and its
+// mc_triangles mode code, and the bounds of the buffers below.
 //   (mc_triangles)           soup positions, one key per vertex, soup indices
 //   (radix_sort.cl)          stable sort of (key, soup index) pairs
 //   fuse_index        per sorted entry j: walk back to the first entry with the

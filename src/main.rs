@@ -2,10 +2,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
 use shapecue::gpu::{Gpu, list_devices};
+use shapecue::mesh::Generated;
 use shapecue::mesh::{LoadOptions, Mesh};
 use shapecue::report;
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::marching_cubes::IsoNormals;
+use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::curvature::CurvatureEstimator;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -78,12 +81,6 @@ struct RenderArgs {
     /// without computing or writing anything.
     #[arg(long)]
     explain: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum NormalsArg {
-    Gradient,
-    Mesh,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -186,13 +183,6 @@ impl std::fmt::Display for InteropRefused {
 
 impl std::error::Error for InteropRefused {}
 
-#[derive(Clone, Copy, ValueEnum)]
-enum FusionArg {
-    Hash,
-    Edge,
-    None,
-}
-
 #[derive(Args)]
 struct IsoArgs {
     /// Input volume: .nrrd/.nhdr, .mhd/.mha, .vtk (STRUCTURED_POINTS), .vti, or
@@ -226,7 +216,7 @@ struct IsoArgs {
     /// Vertex fusion: hash (the seed's position hash + radix sort), edge
     /// (exact voxel-edge keys), none (triangle soup).
     #[arg(long, value_enum, default_value = "hash")]
-    fusion: FusionArg,
+    fusion: Fusion,
     /// Write per-vertex normals from the volume gradient.
     #[arg(long)]
     normals: bool,
@@ -235,11 +225,11 @@ struct IsoArgs {
     curvature: bool,
     /// Curvature precision.
     #[arg(long, value_enum, default_value = "f32")]
-    precision: PrecArg,
+    precision: Precision,
     /// Vertex normals of the curvature passes: the volume gradient (accurate
     /// on marching-cubes meshes) or the mesh's own face normals (the paper's).
     #[arg(long, value_enum, default_value = "gradient")]
-    curvature_normals: NormalsArg,
+    curvature_normals: IsoNormals,
     /// Skip the curvature-derivative pass.
     #[arg(long)]
     no_dcurv: bool,
@@ -263,30 +253,6 @@ struct IsoArgs {
     runs: usize,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum AccArg {
-    Atomic,
-    Gather,
-}
-#[derive(Clone, Copy, ValueEnum)]
-enum PrecArg {
-    F32,
-    F64,
-}
-#[derive(Clone, Copy, ValueEnum)]
-enum CompatArg {
-    Exact,
-    Trimesh2,
-}
-#[derive(Clone, Copy, ValueEnum)]
-enum GenArg {
-    Torus,
-    Sphere,
-    Ellipsoid,
-    Cylinder,
-    Plane,
-}
-
 #[derive(Args)]
 struct CurvatureArgs {
     /// Input mesh (.obj, .ply, .off).
@@ -294,7 +260,7 @@ struct CurvatureArgs {
     input: Option<PathBuf>,
     /// Use a generated mesh instead of a file.
     #[arg(long, value_enum, conflicts_with = "input")]
-    generate: Option<GenArg>,
+    generate: Option<Generated>,
     /// Approximate vertex count of a generated mesh.
     #[arg(long, default_value_t = 40_000)]
     resolution: usize,
@@ -306,13 +272,13 @@ struct CurvatureArgs {
     weld: bool,
     /// One-ring accumulation: float atomics per face, or per-vertex gather (deterministic).
     #[arg(long, value_enum, default_value = "atomic")]
-    accumulate: AccArg,
+    accumulate: Accumulate,
     /// Device precision.
     #[arg(long, value_enum, default_value = "f32")]
-    precision: PrecArg,
+    precision: Precision,
     /// Exact least squares, or trimesh2 2.16 compatibility (its pivot quirk, |k1| ≥ |k2|).
     #[arg(long, value_enum, default_value = "exact")]
-    compat: CompatArg,
+    compat: Compat,
     /// Skip the curvature-derivative pass (dk written as zeros).
     #[arg(long)]
     no_dcurv: bool,
@@ -391,29 +357,11 @@ fn devices(json: bool) -> Result<()> {
 
 fn options(a: &CurvatureArgs) -> CurvatureOptions {
     CurvatureOptions {
-        accumulate: match a.accumulate {
-            AccArg::Atomic => Accumulate::Atomic,
-            AccArg::Gather => Accumulate::Gather,
-        },
-        precision: match a.precision {
-            PrecArg::F32 => Precision::F32,
-            PrecArg::F64 => Precision::F64,
-        },
-        compat: match a.compat {
-            CompatArg::Exact => Compat::Exact,
-            CompatArg::Trimesh2 => Compat::Trimesh2,
-        },
+        accumulate: a.accumulate,
+        precision: a.precision,
+        compat: a.compat,
         dcurv: !a.no_dcurv,
     }
-}
-
-fn generated(kind: GenArg, n: usize) -> (String, Mesh) {
-    let name = kind
-        .to_possible_value()
-        .expect("every GenArg has a name")
-        .get_name()
-        .to_string();
-    shapecue::mesh::generated_by_name(&name, n).expect("GenArg names are the library's")
 }
 
 fn refuse_overwrite(out: &Path, input: Option<&Path>, force: bool) -> Result<()> {
@@ -468,7 +416,7 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     }
     let t_load = Instant::now();
     let (name, mesh) = match (&a.input, a.generate) {
-        (_, Some(kind)) => generated(kind, a.resolution),
+        (_, Some(kind)) => kind.mesh(a.resolution),
         (Some(path), None) => {
             let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
             (path.display().to_string(), m)
@@ -557,14 +505,9 @@ fn minmax(v: &[f64]) -> (f64, f64) {
 }
 
 fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
-    use shapecue::cpu::vertex_fusion::Fusion;
     use shapecue::stages::marching_cubes::{self as mcs, Isosurfacer};
     use shapecue::volume::{self, RawSpec, ScalarType};
-    let fusion = match a.fusion {
-        FusionArg::Hash => Fusion::Hash,
-        FusionArg::Edge => Fusion::Edge,
-        FusionArg::None => Fusion::None,
-    };
+    let fusion = a.fusion;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         print!(
@@ -628,17 +571,11 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
     let field = if a.curvature {
         let opts = CurvatureOptions {
             accumulate: Accumulate::Atomic,
-            precision: match a.precision {
-                PrecArg::F32 => Precision::F32,
-                PrecArg::F64 => Precision::F64,
-            },
+            precision: a.precision,
             compat: Compat::Exact,
             dcurv: !a.no_dcurv,
         };
-        let normals = match a.curvature_normals {
-            NormalsArg::Gradient => mcs::IsoNormals::Gradient,
-            NormalsArg::Mesh => mcs::IsoNormals::Mesh,
-        };
+        let normals = a.curvature_normals;
         let (est, timing) = mcs::curvature(&ex, opts, normals)?;
         let f = est.read()?;
         if !f.all_finite() {
@@ -1085,8 +1022,8 @@ mod tests {
 
     #[test]
     fn every_generate_choice_is_a_library_mesh() {
-        for k in GenArg::value_variants() {
-            let (desc, m) = generated(*k, 500);
+        for k in Generated::value_variants() {
+            let (desc, m) = k.mesh(500);
             assert!(!desc.is_empty() && m.n_faces() > 0);
         }
     }

@@ -7,8 +7,12 @@
 // matrix rows), and `!(x > 0.0)` is deliberate: NaN must fail those tests.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::field::{Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization};
 use crate::mesh::Mesh;
+use crate::mesh::topology::max_face;
+use crate::spec::curvature::{
+    Compat, CurvatureCounts, CurvatureField, CurvatureOptions, DEGEN_AREA_REL, DEGEN_EDGE2,
+    DEGEN_HEIGHT_ULP, Normalization,
+};
 
 type V3 = [f64; 3];
 
@@ -44,21 +48,12 @@ const fn prev3(i: usize) -> usize {
     if i == 0 { 2 } else { i - 1 }
 }
 
-/// Relative area threshold of the degenerate-face rule, × Σ edge² (same as the kernel).
-pub const DEGEN_AREA_REL: f64 = 5e-8;
-/// Squared edge-length threshold in normalized coordinates (same as the kernel).
-pub const DEGEN_EDGE2: f64 = 1e-24;
-/// Heights below this × (|p0| + |p1| + |p2|) (normalized coordinates) are
-/// under the f32 rounding of the positions: degenerate at every precision, so
-/// f32, f64 and this reference agree on which faces are skipped.
-pub const DEGEN_HEIGHT_ULP: f64 = 1.0 / 8_388_608.0;
-
 /// A face's vertices, positions and edges (`e[i]` opposite corner i).
 #[derive(Clone, Copy, Debug)]
 pub struct Tri {
     /// Vertex indices.
     pub v: [usize; 3],
-    /// Edges: e[i] = p[prev(i)] − p[next(i)].
+    /// Edges: `e[i] = p[prev(i)] − p[next(i)]`.
     pub e: [V3; 3],
     /// |p0| + |p1| + |p2| (normalized coordinates).
     pub psum: f64,
@@ -301,17 +296,6 @@ pub struct State {
     pub dk: Vec<[f64; 4]>,
     /// What was skipped.
     pub counts: CurvatureCounts,
-}
-
-/// Step `max_face`: the largest face id using each vertex.
-pub fn max_face(nv: usize, faces: &[[u32; 3]]) -> Vec<i64> {
-    let mut owner = vec![-1i64; nv];
-    for (f, face) in faces.iter().enumerate() {
-        for &v in face {
-            owner[v as usize] = owner[v as usize].max(f as i64);
-        }
-    }
-    owner
 }
 
 impl State {

@@ -16,119 +16,13 @@
 //!   every other vertex there (this is what makes iso values equal to voxel
 //!   values safe: the triangles that collapse are dropped after fusion).
 //!
-//! The case table is not copied from anywhere: [`table`] derives it from the
-//! cube's faces (marching squares on each face with the inside corners kept
-//! apart, segments chained into loops, loops fan-triangulated), so every
-//! shared face is cut the same way from both cells and the surface is closed.
+//! The case table, derived rather than copied, is shared with the host
+//! wiring: [`crate::spec::marching_cubes::table`].
 
+use crate::spec::marching_cubes::cell_rows;
 use crate::volume::Volume;
-use std::sync::OnceLock;
 
-/// Most triangles one cell can emit (checked when the table is built).
-pub const MAX_CELL_TRIANGLES: usize = 5;
-/// Table row terminator.
-pub const END: u8 = 0xFF;
-
-/// The 256-case triangle table: `tris[case]` lists edge ids, three per
-/// triangle, terminated by [`END`]; `counts[case]` is the triangle count.
-#[derive(Clone, Debug)]
-pub struct McTable {
-    /// Edge ids per case, `END`-terminated, 16 entries.
-    pub tris: [[u8; 16]; 256],
-    /// Triangles per case.
-    pub counts: [u8; 256],
-}
-
-/// The two corner ids of edge `e` (lower, upper along the edge's axis).
-pub fn edge_corners(e: usize) -> (usize, usize) {
-    let axis = e / 4;
-    let k = e % 4;
-    let others = [(axis + 1) % 3, (axis + 2) % 3];
-    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
-    let lo = ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
-    (lo, lo | (1 << axis))
-}
-
-fn edge_of(c0: usize, c1: usize) -> usize {
-    let d = c0 ^ c1;
-    let axis = d.trailing_zeros() as usize;
-    let lo = c0 & !d;
-    let others = [(axis + 1) % 3, (axis + 2) % 3];
-    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
-    axis * 4 + ((lo >> lo_axis) & 1) + 2 * ((lo >> hi_axis) & 1)
-}
-
-fn build_table() -> McTable {
-    let mut tris = [[END; 16]; 256];
-    let mut counts = [0u8; 256];
-    for case in 0..256usize {
-        let inside = |c: usize| case >> c & 1 == 1;
-        // next[e] = the edge the surface boundary goes to from edge e.
-        let mut next = [usize::MAX; 12];
-        for axis in 0..3 {
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            for side in 0..2 {
-                // Corners counter-clockwise seen from outside the cube.
-                let mut ring: Vec<usize> = [(0, 0), (1, 0), (1, 1), (0, 1)]
-                    .iter()
-                    .map(|&(a, b)| (side << axis) | (a << u) | (b << v))
-                    .collect();
-                if side == 0 {
-                    ring.reverse();
-                }
-                // Crossings in traversal order: (edge, entering the inside?).
-                let mut xs = Vec::new();
-                for i in 0..4 {
-                    let (p, q) = (ring[i], ring[(i + 1) % 4]);
-                    if inside(p) != inside(q) {
-                        xs.push((edge_of(p, q), inside(q)));
-                    }
-                }
-                // Each entry is joined to the exit that follows it: the inside
-                // corners of an ambiguous face are cut off separately.
-                for i in 0..xs.len() {
-                    let (e, entering) = xs[i];
-                    if entering {
-                        let (f, _) = xs[(i + 1) % xs.len()];
-                        next[e] = f;
-                    }
-                }
-            }
-        }
-        let mut used = [false; 12];
-        let mut out = Vec::new();
-        for start in 0..12 {
-            if next[start] == usize::MAX || used[start] {
-                continue;
-            }
-            let mut lp = vec![start];
-            used[start] = true;
-            let mut e = next[start];
-            while e != start {
-                lp.push(e);
-                used[e] = true;
-                e = next[e];
-            }
-            for i in 1..lp.len() - 1 {
-                out.extend_from_slice(&[lp[0] as u8, lp[i] as u8, lp[i + 1] as u8]);
-            }
-        }
-        assert!(
-            out.len() <= 3 * MAX_CELL_TRIANGLES,
-            "case {case}: {} triangles",
-            out.len() / 3
-        );
-        tris[case][..out.len()].copy_from_slice(&out);
-        counts[case] = (out.len() / 3) as u8;
-    }
-    McTable { tris, counts }
-}
-
-/// The case table (built once per process).
-pub fn table() -> &'static McTable {
-    static T: OnceLock<McTable> = OnceLock::new();
-    T.get_or_init(build_table)
-}
+pub use crate::spec::marching_cubes::{END, edge_corners, table}; // compat re-export
 
 /// One vertex of the triangle soup: its position in index space (voxel
 /// units; world = origin + spacing × p) and its exact key: `4g + axis` for a
@@ -155,15 +49,6 @@ pub fn cell_case(vol: &Volume, iso: f32, x: usize, y: usize, z: usize) -> Option
         }
     }
     Some(case)
-}
-
-/// Number of cell rows (one row: every cell with the same y and z).
-pub fn cell_rows(dims: [usize; 3]) -> usize {
-    if dims.iter().any(|&d| d < 2) {
-        0
-    } else {
-        (dims[1] - 1) * (dims[2] - 1)
-    }
 }
 
 /// `mc_classify`: triangles emitted by each cell row `y + (ny-1) z`.

@@ -7,10 +7,10 @@
 //! digit. The block length is a parameter: any length gives the same (stable)
 //! result, and the device's ([`blocking`]) reproduces its histogram.
 //!
-//! [`blocking`]: crate::stages::radix_sort::blocking
+//! [`blocking`]: crate::spec::radix_sort::blocking
 
 use crate::error::{Error, Result};
-use crate::stages::radix_sort::{DIGIT_BITS, RADIX, digits};
+use crate::spec::radix_sort::{DIGIT_BITS, RADIX, digits};
 
 /// Digit of `key` at bit `shift`, under `mask`.
 fn digit(key: u32, shift: u32, mask: u32) -> usize {

@@ -12,29 +12,7 @@
 
 use super::marching_cubes::SoupVertex;
 
-/// How soup vertices are merged.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Fusion {
-    /// The seed's method: 32-bit hash of the position bits, radix sort,
-    /// collisions resolved by comparing positions.
-    Hash,
-    /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
-    Edge,
-    /// No fusion: the triangle soup, three vertices per triangle.
-    None,
-}
-
-impl Fusion {
-    /// Name used on the command line, in stats and in bench ids.
-    pub fn name(self) -> &'static str {
-        match self {
-            Fusion::Hash => "hash",
-            Fusion::Edge => "edge",
-            Fusion::None => "none",
-        }
-    }
-}
+pub use crate::spec::vertex_fusion::Fusion; // compat re-export
 
 /// The 32-bit position hash (same integer mix as the kernel's `fuse_hash`).
 pub fn fuse_hash(p: [f32; 3]) -> u32 {

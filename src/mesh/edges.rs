@@ -279,33 +279,4 @@ pub fn read_marked(path: &Path) -> Result<Vec<[u32; 2]>> {
     parse_marked(&text, &path.display().to_string())
 }
 
-/// Area-weighted unit vertex normals in f32 (unreferenced or degenerate
-/// vertices get (0, 0, 0)): the normals McGuire-Hughes caps project.
-pub fn vertex_normals(mesh: &Mesh) -> Vec<[f32; 3]> {
-    let mut n = vec![[0f64; 3]; mesh.n_vertices()];
-    for f in &mesh.faces {
-        let [a, b, c] = f.map(|i| mesh.positions[i as usize]);
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let cr = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        for &i in f {
-            for k in 0..3 {
-                n[i as usize][k] += cr[k];
-            }
-        }
-    }
-    n.iter()
-        .map(|v| {
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            if l > 0.0 && l.is_finite() {
-                [(v[0] / l) as f32, (v[1] / l) as f32, (v[2] / l) as f32]
-            } else {
-                [0.0; 3]
-            }
-        })
-        .collect()
-}
+pub use super::topology::vertex_normals; // compat re-export

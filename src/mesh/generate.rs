@@ -258,42 +258,99 @@ pub fn uv_ellipsoid(a: f64, b: f64, c: f64, nu: usize, nv: usize) -> Mesh {
     Mesh { positions, faces }
 }
 
-/// The names [`generated_by_name`] knows.
-pub const GENERATED_NAMES: [&str; 5] = ["torus", "sphere", "ellipsoid", "cylinder", "plane"];
+/// A generated mesh with analytic curvature, as the CLI's `--generate` and
+/// scene files name it ([`Generated::name`]); [`Generated::mesh`] builds it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Generated {
+    /// Torus R = 1, r = 0.4.
+    #[value(help = crate::spec::NO_HELP)]
+    Torus,
+    /// Icosphere of radius 1.
+    #[value(help = crate::spec::NO_HELP)]
+    Sphere,
+    /// Subdivided ellipsoid with semi-axes (1.5, 1, 0.6).
+    #[value(help = crate::spec::NO_HELP)]
+    Ellipsoid,
+    /// Open cylinder of radius 1 and height 2.
+    #[value(help = crate::spec::NO_HELP)]
+    Cylinder,
+    /// Square plane of side 2.
+    #[value(help = crate::spec::NO_HELP)]
+    Plane,
+}
+
+impl Generated {
+    /// Every kind, in the order of `--help` and [`GENERATED_NAMES`].
+    pub const ALL: [Generated; 5] = [
+        Generated::Torus,
+        Generated::Sphere,
+        Generated::Ellipsoid,
+        Generated::Cylinder,
+        Generated::Plane,
+    ];
+
+    /// The name on the command line and in scene files.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Generated::Torus => "torus",
+            Generated::Sphere => "sphere",
+            Generated::Ellipsoid => "ellipsoid",
+            Generated::Cylinder => "cylinder",
+            Generated::Plane => "plane",
+        }
+    }
+
+    /// The mesh with about `n` vertices, and a description with its
+    /// parameters: the torus R=1 r=0.4, an icosphere and an ellipsoid
+    /// (1.5, 1, 0.6) at the subdivision level nearest below `n` vertices, a
+    /// cylinder and a plane of √n × √n.
+    pub fn mesh(self, n: usize) -> (String, Mesh) {
+        let level = {
+            let mut l = 0;
+            while 10 * 4usize.pow(l + 1) + 2 <= n && l < 10 {
+                l += 1;
+            }
+            l
+        };
+        match self {
+            Generated::Torus => {
+                let (nu, nv) = torus_resolution_for(n);
+                (
+                    format!("torus R=1 r=0.4 {nu}x{nv}"),
+                    torus(1.0, 0.4, nu, nv),
+                )
+            }
+            Generated::Sphere => (format!("icosphere level {level}"), icosphere(1.0, level)),
+            Generated::Ellipsoid => (
+                format!("ellipsoid 1.5,1,0.6 level {level}"),
+                ellipsoid(1.5, 1.0, 0.6, level),
+            ),
+            Generated::Cylinder => {
+                let k = ((n as f64).sqrt() as usize).max(3);
+                (format!("cylinder {k}x{k}"), cylinder(1.0, 2.0, k, k))
+            }
+            Generated::Plane => {
+                let k = ((n as f64).sqrt() as usize).max(2);
+                (format!("plane {k}x{k}"), plane(k, 2.0))
+            }
+        }
+    }
+}
+
+crate::spec::named_choice!(Generated, "generated mesh");
+
+/// The names [`generated_by_name`] knows (those of [`Generated`]).
+pub const GENERATED_NAMES: [&str; 5] = [
+    Generated::Torus.name(),
+    Generated::Sphere.name(),
+    Generated::Ellipsoid.name(),
+    Generated::Cylinder.name(),
+    Generated::Plane.name(),
+];
 
 /// A generated mesh by name ([`GENERATED_NAMES`]) with about `n` vertices, and a
-/// description with its parameters: the torus R=1 r=0.4, an icosphere and an
-/// ellipsoid (1.5, 1, 0.6) at the subdivision level nearest below `n`
-/// vertices, a cylinder and a plane of √n × √n. `None` for an unknown name.
+/// description with its parameters (see [`Generated::mesh`]). `None` for an
+/// unknown name.
 pub fn generated_by_name(kind: &str, n: usize) -> Option<(String, Mesh)> {
-    let level = {
-        let mut l = 0;
-        while 10 * 4usize.pow(l + 1) + 2 <= n && l < 10 {
-            l += 1;
-        }
-        l
-    };
-    Some(match kind {
-        "torus" => {
-            let (nu, nv) = torus_resolution_for(n);
-            (
-                format!("torus R=1 r=0.4 {nu}x{nv}"),
-                torus(1.0, 0.4, nu, nv),
-            )
-        }
-        "sphere" => (format!("icosphere level {level}"), icosphere(1.0, level)),
-        "ellipsoid" => (
-            format!("ellipsoid 1.5,1,0.6 level {level}"),
-            ellipsoid(1.5, 1.0, 0.6, level),
-        ),
-        "cylinder" => {
-            let k = ((n as f64).sqrt() as usize).max(3);
-            (format!("cylinder {k}x{k}"), cylinder(1.0, 2.0, k, k))
-        }
-        "plane" => {
-            let k = ((n as f64).sqrt() as usize).max(2);
-            (format!("plane {k}x{k}"), plane(k, 2.0))
-        }
-        _ => return None,
-    })
+    kind.parse::<Generated>().ok().map(|g| g.mesh(n))
 }

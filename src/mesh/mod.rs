@@ -14,6 +14,7 @@ mod load;
 mod quality;
 pub mod skinned;
 mod solids;
+pub mod topology;
 
 pub use generate::*;
 pub use load::{LoadOptions, load};

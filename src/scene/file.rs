@@ -39,9 +39,9 @@
 //! wrong type, a missing or second source, a missing file) names the scene
 //! file and the line. Relative paths are relative to the scene file.
 
-use crate::cpu::ao::AoMode;
 use crate::error::{Error, Result};
 use crate::scene::planner::{Cue, Input};
+use crate::spec::ao::AoMode;
 use crate::stages::edges::CapMode;
 use serde::Deserialize;
 use std::ops::Range;

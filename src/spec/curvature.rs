@@ -1,1 +1,322 @@
-//! Shared types of the `curvature` family (see [`crate::spec`]).
+//! Shared types of the `curvature` family (see [`crate::spec`]): the
+//! per-vertex output ([`CurvatureField`]), the skip counters
+//! ([`CurvatureCounts`]), the variant choice ([`CurvatureOptions`] with
+//! [`Accumulate`], [`Precision`], [`Compat`]), the pose [`Normalization`], the
+//! degenerate-face thresholds and the device memory bound.
+//!
+//! Mirrors in `kernels/curvature.cl`: the `DEGEN_*` `#define`s
+//! ([`DEGEN_AREA_REL`], [`DEGEN_EDGE2`], [`DEGEN_HEIGHT_ULP`]); the
+//! `SC_DOUBLE` / `SC_COMPAT` build options select [`Precision::F64`] and
+//! [`Compat::Trimesh2`]; the counters buffer `uint[4]` is
+//! [`CurvatureCounts`] in field order. The kernels take scalar arguments
+//! only, so no parameter struct crosses.
+//!
+//! Used by `stages::curvature` (host wiring), `cpu::curvature` (the twin),
+//! the exporters, the planner and the CLI; imports no device layer.
+
+/// Per-vertex differential quantities of a triangle mesh, in the mesh's own
+/// coordinates (whatever centring and scaling a stage used internally has been
+/// undone).
+///
+/// Conventions: `k1 >= k2` (signed), positive where the surface is convex with
+/// outward normals; `d1`, `d2` unit and tangent with `d2 = n × d1`; `dk` is the
+/// curvature derivative tensor (C₁₁₁, C₁₁₂, C₁₂₂, C₂₂₂) in the (d1, d2) frame.
+/// In trimesh2 compatibility mode the ordering is |k1| ≥ |k2| instead.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CurvatureField {
+    /// Unit vertex normals ((0,0,1) where no non-degenerate face touches the vertex).
+    pub normals: Vec<[f64; 3]>,
+    /// Voronoi point areas (0 where no non-degenerate face touches the vertex).
+    pub areas: Vec<f64>,
+    /// Maximum principal curvature.
+    pub k1: Vec<f64>,
+    /// Minimum principal curvature.
+    pub k2: Vec<f64>,
+    /// Principal direction of `k1`.
+    pub d1: Vec<[f64; 3]>,
+    /// Principal direction of `k2`.
+    pub d2: Vec<[f64; 3]>,
+    /// Curvature derivative tensor in the (d1, d2) frame; zeros when not computed.
+    pub dk: Vec<[f64; 4]>,
+}
+
+impl CurvatureField {
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.k1.len()
+    }
+
+    /// True when there are no vertices.
+    pub fn is_empty(&self) -> bool {
+        self.k1.is_empty()
+    }
+
+    /// Mean curvature (k1 + k2) / 2 per vertex.
+    pub fn mean(&self) -> Vec<f64> {
+        self.k1
+            .iter()
+            .zip(&self.k2)
+            .map(|(a, b)| 0.5 * (a + b))
+            .collect()
+    }
+
+    /// Gaussian curvature k1·k2 per vertex.
+    pub fn gaussian(&self) -> Vec<f64> {
+        self.k1.iter().zip(&self.k2).map(|(a, b)| a * b).collect()
+    }
+
+    /// True if every value is finite.
+    pub fn all_finite(&self) -> bool {
+        let v3 = |v: &Vec<[f64; 3]>| v.iter().flatten().all(|x| x.is_finite());
+        v3(&self.normals)
+            && v3(&self.d1)
+            && v3(&self.d2)
+            && self.areas.iter().all(|x| x.is_finite())
+            && self.k1.iter().all(|x| x.is_finite())
+            && self.k2.iter().all(|x| x.is_finite())
+            && self.dk.iter().flatten().all(|x| x.is_finite())
+    }
+}
+
+/// How the one-ring sums are formed on the device.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Accumulate {
+    /// One work-item per face adds into its vertices with float atomics
+    /// (compare-and-swap), as in the seed. Summation order varies run to run.
+    #[default]
+    #[value(help = super::NO_HELP)]
+    Atomic,
+    /// Per-face kernels write each corner's contribution to a buffer (12
+    /// reals per face, no atomics); per-vertex kernels sum their one-ring
+    /// (built once) in face order. Bitwise identical from run to run.
+    #[value(help = super::NO_HELP)]
+    Gather,
+}
+
+impl Accumulate {
+    /// Both schemes, in the order of tables and benches.
+    pub const ALL: [Accumulate; 2] = [Accumulate::Atomic, Accumulate::Gather];
+
+    /// The name used on the command line (`--accumulate`), in scene files,
+    /// stats and bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accumulate::Atomic => "atomic",
+            Accumulate::Gather => "gather",
+        }
+    }
+}
+
+/// Floating-point precision of the device computation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// 32-bit floats (default).
+    #[default]
+    #[value(help = super::NO_HELP)]
+    F32,
+    /// 64-bit floats (needs cl_khr_fp64; atomic accumulation also needs
+    /// cl_khr_int64_base_atomics). Build option `-DSC_DOUBLE` (`REAL` =
+    /// `double` in `kernels/common/real.h`).
+    #[value(help = super::NO_HELP)]
+    F64,
+}
+
+impl Precision {
+    /// Both precisions, in the order of tables and benches.
+    pub const ALL: [Precision; 2] = [Precision::F32, Precision::F64];
+
+    /// The name used on the command line (`--precision`), in stats and bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
+    /// Bytes of one device real (`REAL` in the kernels).
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+/// Which least-squares solve and ordering to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Compat {
+    /// The exact solve of the per-face normal equations; k1 ≥ k2 (signed).
+    #[default]
+    #[value(help = super::NO_HELP)]
+    Exact,
+    /// trimesh2 2.16: its 3×3 LDLᵀ pivot quirk and |k1| ≥ |k2| ordering, for
+    /// comparing with that library directly. Build option `-DSC_COMPAT`.
+    #[value(help = super::NO_HELP)]
+    Trimesh2,
+}
+
+impl Compat {
+    /// Both modes, in the order of tables and benches.
+    pub const ALL: [Compat; 2] = [Compat::Exact, Compat::Trimesh2];
+
+    /// The name used on the command line (`--compat`), in stats and bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Compat::Exact => "exact",
+            Compat::Trimesh2 => "trimesh2",
+        }
+    }
+}
+
+super::named_choice!(Accumulate, "accumulation");
+super::named_choice!(Precision, "precision");
+super::named_choice!(Compat, "compat mode");
+
+/// Variant choice for curvature estimation (device and CPU reference alike).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct CurvatureOptions {
+    /// One-ring accumulation scheme (device only; the CPU reference is sequential).
+    pub accumulate: Accumulate,
+    /// Device precision (the CPU reference is always f64).
+    pub precision: Precision,
+    /// Exact solve or trimesh2 compatibility.
+    pub compat: Compat,
+    /// Compute the curvature derivative (the dcurv pass).
+    pub dcurv: bool,
+}
+
+impl Default for CurvatureOptions {
+    fn default() -> Self {
+        CurvatureOptions {
+            accumulate: Accumulate::Atomic,
+            precision: Precision::F32,
+            compat: Compat::Exact,
+            dcurv: true,
+        }
+    }
+}
+
+/// The similarity that maps a pose to unit size at the origin before it is
+/// computed on: p' = (p − center) / scale. Curvature is invariant in shape, so
+/// results are mapped back exactly (k / scale, area · scale², dk / scale²).
+/// This keeps f32 meaningful for meshes far from the origin (1e6 away) and at
+/// extreme scales (1e-6, 1e6), and makes the degenerate-face thresholds
+/// relative to the mesh's size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Normalization {
+    /// Centroid of the vertices.
+    pub center: [f64; 3],
+    /// RMS distance of the vertices from the centroid (1 if that is 0).
+    pub scale: f64,
+}
+
+impl Normalization {
+    /// Computes the normalization of a set of positions (in f64).
+    pub fn of(positions: &[[f64; 3]]) -> Self {
+        Self::of_masked(positions, None)
+    }
+
+    /// The normalization of the positions whose `mask` entry is true (all if
+    /// `None`): stages pass the vertices that faces reference, so a stray
+    /// unreferenced vertex far away cannot shrink the mesh to nothing.
+    pub fn of_masked(positions: &[[f64; 3]], mask: Option<&[bool]>) -> Self {
+        let used = |i: usize| mask.is_none_or(|m| m[i]);
+        let mut n = 0usize;
+        let mut c = [0.0; 3];
+        for (_, p) in positions.iter().enumerate().filter(|(i, _)| used(*i)) {
+            n += 1;
+            for k in 0..3 {
+                c[k] += p[k];
+            }
+        }
+        let c = c.map(|x| x / n.max(1) as f64);
+        let mut ss = 0.0;
+        for (_, p) in positions.iter().enumerate().filter(|(i, _)| used(*i)) {
+            ss += (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
+        }
+        let s = (ss / n.max(1) as f64).sqrt();
+        Normalization {
+            center: c,
+            scale: if s > 0.0 && s.is_finite() { s } else { 1.0 },
+        }
+    }
+
+    /// Maps a position into normalized coordinates.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let inv = 1.0 / self.scale;
+        [
+            (p[0] - self.center[0]) * inv,
+            (p[1] - self.center[1]) * inv,
+            (p[2] - self.center[2]) * inv,
+        ]
+    }
+
+    /// Maps a field computed on normalized positions back to the original scale.
+    pub fn unapply(&self, f: &mut CurvatureField) {
+        let s = self.scale;
+        f.areas.iter_mut().for_each(|a| *a *= s * s);
+        f.k1.iter_mut().for_each(|k| *k /= s);
+        f.k2.iter_mut().for_each(|k| *k /= s);
+        f.dk.iter_mut().flatten().for_each(|d| *d /= s * s);
+    }
+}
+
+/// Counts of what the estimator had to skip; all zero on a clean mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct CurvatureCounts {
+    /// Faces skipped as degenerate (zero-length edge or (near) zero area).
+    pub degenerate_faces: u32,
+    /// Vertices with no non-degenerate face (unreferenced or only degenerate
+    /// faces): normal (0,0,1) unless faces give one, zero curvature.
+    pub vertices_without_curvature: u32,
+    /// Faces whose curvature least-squares system had a non-positive pivot.
+    pub tensor_solves_skipped: u32,
+    /// Faces whose derivative least-squares system had a non-positive pivot.
+    pub dcurv_solves_skipped: u32,
+}
+
+/// Relative area threshold of the degenerate-face rule, × Σ edge²
+/// (`DEGEN_AREA_REL` in `kernels/curvature.cl`).
+pub const DEGEN_AREA_REL: f64 = 5e-8;
+/// Squared edge-length threshold in normalized coordinates (`DEGEN_EDGE2`).
+pub const DEGEN_EDGE2: f64 = 1e-24;
+/// Heights below this × (|p0| + |p1| + |p2|) (normalized coordinates) are
+/// under the f32 rounding of the positions: degenerate at every precision, so
+/// f32, f64 and the CPU reference agree on which faces are skipped
+/// (`DEGEN_HEIGHT_ULP`, 2⁻²³).
+pub const DEGEN_HEIGHT_ULP: f64 = 1.0 / 8_388_608.0;
+
+/// Entries of the one-ring lists of a mesh with `nf` faces (one per face
+/// corner; their CSR offsets have `nv + 1` entries): the `ring` buffer of the
+/// gather variant.
+pub fn one_ring_len_bound(nf: usize) -> usize {
+    3 * nf
+}
+
+/// Reals of the gather variant's corner buffer for `nf` faces: 4 per corner
+/// (the widest pass, the derivative tensor), 12 per face.
+pub fn corner_reals_bound(nf: usize) -> usize {
+    12 * nf
+}
+
+/// Bytes of device memory the curvature estimator allocates for a mesh, by
+/// variant (the same arithmetic as its allocations).
+pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 {
+    let r = opts.precision.bytes() as u64;
+    let (nv, nf) = (nv.max(1), nf.max(1));
+    // pos, nrm, pd1, pd2, tens: 3 reals; area: 1; kk: 2; dk: 4  → 20 reals per vertex.
+    let per_vertex = 20 * r + 4; // + owner
+    let per_face = 12;
+    let mut b = nv as u64 * per_vertex + nf as u64 * per_face + 16;
+    if opts.accumulate == Accumulate::Gather {
+        // one-ring CSR, 4 reals per face corner, one status byte per face
+        b += (nv as u64 + 1) * 4
+            + one_ring_len_bound(nf) as u64 * 4
+            + corner_reals_bound(nf) as u64 * r
+            + nf as u64;
+    }
+    b
+}

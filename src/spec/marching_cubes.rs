@@ -1,1 +1,191 @@
-//! Shared types of the `marching_cubes` family (see [`crate::spec`]).
+//! Shared types of the `marching_cubes` family (see [`crate::spec`]): the
+//! case table ([`table`], derived here, not copied: marching squares on each
+//! cube face with the inside corners kept apart, segments chained into loops,
+//! loops fan-triangulated, so every shared face is cut the same way from both
+//! cells and the surface is closed), the cell-row layout ([`cell_rows`]), the
+//! normals choice of isosurface curvature ([`IsoNormals`]) and the bounds
+//! that size the soup and the device memory.
+//!
+//! Mirrors in `kernels/marching_cubes.cl`: the `counts uchar[256]` and
+//! `tris uchar[256·16]` buffers are [`McTable`] (uploaded as is; `0xFF` =
+//! [`END`] ends a row, at most [`MAX_CELL_TRIANGLES`] triangles per case);
+//! the corner and edge numbering of [`edge_corners`] is the kernel's
+//! (see its header); one work-item per cell row, [`cell_rows`] of them;
+//! `mc_triangles`' `mode` is [`crate::spec::vertex_fusion::Fusion::code`].
+//! Scalar arguments only: no parameter struct crosses.
+
+use std::sync::OnceLock;
+
+/// Most triangles one cell can emit (checked when the table is built).
+pub const MAX_CELL_TRIANGLES: usize = 5;
+/// Table row terminator.
+pub const END: u8 = 0xFF;
+
+/// The 256-case triangle table: `tris[case]` lists edge ids, three per
+/// triangle, terminated by [`END`]; `counts[case]` is the triangle count.
+#[derive(Clone, Debug)]
+pub struct McTable {
+    /// Edge ids per case, `END`-terminated, 16 entries.
+    pub tris: [[u8; 16]; 256],
+    /// Triangles per case.
+    pub counts: [u8; 256],
+}
+
+/// The two corner ids of edge `e` (lower, upper along the edge's axis).
+pub fn edge_corners(e: usize) -> (usize, usize) {
+    let axis = e / 4;
+    let k = e % 4;
+    let others = [(axis + 1) % 3, (axis + 2) % 3];
+    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
+    let lo = ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
+    (lo, lo | (1 << axis))
+}
+
+fn edge_of(c0: usize, c1: usize) -> usize {
+    let d = c0 ^ c1;
+    let axis = d.trailing_zeros() as usize;
+    let lo = c0 & !d;
+    let others = [(axis + 1) % 3, (axis + 2) % 3];
+    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
+    axis * 4 + ((lo >> lo_axis) & 1) + 2 * ((lo >> hi_axis) & 1)
+}
+
+fn build_table() -> McTable {
+    let mut tris = [[END; 16]; 256];
+    let mut counts = [0u8; 256];
+    for case in 0..256usize {
+        let inside = |c: usize| case >> c & 1 == 1;
+        // next[e] = the edge the surface boundary goes to from edge e.
+        let mut next = [usize::MAX; 12];
+        for axis in 0..3 {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for side in 0..2 {
+                // Corners counter-clockwise seen from outside the cube.
+                let mut ring: Vec<usize> = [(0, 0), (1, 0), (1, 1), (0, 1)]
+                    .iter()
+                    .map(|&(a, b)| (side << axis) | (a << u) | (b << v))
+                    .collect();
+                if side == 0 {
+                    ring.reverse();
+                }
+                // Crossings in traversal order: (edge, entering the inside?).
+                let mut xs = Vec::new();
+                for i in 0..4 {
+                    let (p, q) = (ring[i], ring[(i + 1) % 4]);
+                    if inside(p) != inside(q) {
+                        xs.push((edge_of(p, q), inside(q)));
+                    }
+                }
+                // Each entry is joined to the exit that follows it: the inside
+                // corners of an ambiguous face are cut off separately.
+                for i in 0..xs.len() {
+                    let (e, entering) = xs[i];
+                    if entering {
+                        let (f, _) = xs[(i + 1) % xs.len()];
+                        next[e] = f;
+                    }
+                }
+            }
+        }
+        let mut used = [false; 12];
+        let mut out = Vec::new();
+        for start in 0..12 {
+            if next[start] == usize::MAX || used[start] {
+                continue;
+            }
+            let mut lp = vec![start];
+            used[start] = true;
+            let mut e = next[start];
+            while e != start {
+                lp.push(e);
+                used[e] = true;
+                e = next[e];
+            }
+            for i in 1..lp.len() - 1 {
+                out.extend_from_slice(&[lp[0] as u8, lp[i] as u8, lp[i + 1] as u8]);
+            }
+        }
+        assert!(
+            out.len() <= 3 * MAX_CELL_TRIANGLES,
+            "case {case}: {} triangles",
+            out.len() / 3
+        );
+        tris[case][..out.len()].copy_from_slice(&out);
+        counts[case] = (out.len() / 3) as u8;
+    }
+    McTable { tris, counts }
+}
+
+/// The case table (built once per process).
+pub fn table() -> &'static McTable {
+    static T: OnceLock<McTable> = OnceLock::new();
+    T.get_or_init(build_table)
+}
+
+/// Number of cell rows (one row: every cell with the same y and z).
+pub fn cell_rows(dims: [usize; 3]) -> usize {
+    if dims.iter().any(|&d| d < 2) {
+        0
+    } else {
+        (dims[1] - 1) * (dims[2] - 1)
+    }
+}
+
+/// Soup vertices of `triangles` soup triangles (the scan total of the
+/// `mc_classify` row counts): three per triangle, no sharing. Sizes `pos`
+/// (3 floats each), `key`, `idx` and, for [`Fusion::None`], the soup's face
+/// indices.
+///
+/// [`Fusion::None`]: crate::spec::vertex_fusion::Fusion::None
+pub fn soup_vertices_bound(triangles: usize) -> usize {
+    3 * triangles
+}
+
+/// Bits of the exact vertex keys of [`Fusion::Edge`] for a volume of
+/// `voxels` voxels (keys `4g + axis` and `4g + 3`, `g` a voxel index), or
+/// `None` when they do not fit the device's 32-bit keys (more than 2^30
+/// voxels).
+///
+/// [`Fusion::Edge`]: crate::spec::vertex_fusion::Fusion::Edge
+pub fn edge_key_bits(voxels: usize) -> Option<u32> {
+    let keys = 4 * voxels as u64;
+    (keys <= u32::MAX as u64 + 1).then(|| 64 - keys.saturating_sub(1).leading_zeros())
+}
+
+/// Bytes of device memory needed to extract a surface of `soup_vertices`
+/// soup vertices from a volume of `voxels` voxels (volume, row buffers, soup,
+/// fusion scratch and outputs): the bound the memory check uses.
+pub fn device_bytes_bound(voxels: usize, rows: usize, soup_vertices: usize) -> u64 {
+    4 * voxels as u64
+        + 8 * rows as u64
+        + 20 * soup_vertices as u64
+        + crate::spec::vertex_fusion::device_bytes_bound(soup_vertices)
+}
+
+/// Which vertex normals the curvature of an isosurface uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IsoNormals {
+    /// The volume's gradient at each vertex: far more accurate on
+    /// marching-cubes meshes, whose sliver triangles make face normals noisy.
+    #[value(help = super::NO_HELP)]
+    Gradient,
+    /// The estimator's own area-weighted face normals (Rusinkiewicz).
+    #[value(help = super::NO_HELP)]
+    Mesh,
+}
+
+impl IsoNormals {
+    /// Both choices, in the order of `--help` (the default first).
+    pub const ALL: [IsoNormals; 2] = [IsoNormals::Gradient, IsoNormals::Mesh];
+
+    /// The name used on the command line (`--curvature-normals`) and in stats.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsoNormals::Mesh => "mesh",
+            IsoNormals::Gradient => "gradient",
+        }
+    }
+}
+
+super::named_choice!(IsoNormals, "isosurface normals choice");

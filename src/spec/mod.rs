@@ -20,3 +20,41 @@ pub mod sdf_lines;
 pub mod skinning;
 pub mod vertex_fusion;
 pub mod view;
+
+// The option enums of the families derive `clap::ValueEnum` for the CLI.
+// Their variant docs are for rustdoc: `#[value(help = super::NO_HELP)]` on
+// each variant keeps them out of `--help`, which lists the bare names
+// (`[possible values: atomic, gather]`), as the CLI always has.
+
+/// No per-value help text in `--help` (see the comment above).
+pub(crate) const NO_HELP: Option<&str> = None;
+
+/// `Display` and `FromStr` by `name()` for an option enum with an `ALL`
+/// array of its variants; `$what` names the option in the parse error.
+macro_rules! named_choice {
+    ($t:ty, $what:literal) => {
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl std::str::FromStr for $t {
+            type Err = $crate::error::Error;
+            fn from_str(s: &str) -> std::result::Result<$t, $crate::error::Error> {
+                <$t>::ALL
+                    .into_iter()
+                    .find(|v| v.name() == s)
+                    .ok_or_else(|| {
+                        let names: Vec<&str> = <$t>::ALL.iter().map(|v| v.name()).collect();
+                        $crate::error::Error::InvalidArgument(format!(
+                            "unknown {} {s:?}: expected {}",
+                            $what,
+                            names.join(", ")
+                        ))
+                    })
+            }
+        }
+    };
+}
+pub(crate) use named_choice;

@@ -1,1 +1,63 @@
-//! Shared types of the `radix_sort` family (see [`crate::spec`]).
+//! Shared types of the `radix_sort` family (see [`crate::spec`]): the digit
+//! width ([`DIGIT_BITS`], [`RADIX`], [`digits`]), the blocks of the MSD pass
+//! ([`blocking`]), the histogram size ([`histogram_len_bound`]) and the
+//! strategy a sort ran with ([`Strategy`], chosen by [`SKEW_LIMIT`]).
+//!
+//! Mirrors in `kernels/radix_sort.cl`: `RADIX_BITS` (the host passes
+//! `-DRADIX_BITS=`[`DIGIT_BITS`]) and `RADIX` (= [`RADIX`]); the `n`,
+//! `block`, `blocks` scalar arguments of `radix_histogram` and
+//! `radix_scatter` are [`blocking`]`(n)`, and the kernels' `BLOCK_RANGE`
+//! macro is the same split; `hist` is `uint[RADIX·G]`, digit-major
+//! (`hist[d × G + b]`). Scalar arguments only: no parameter struct crosses.
+//! The CPU twin (`cpu::radix_sort`) takes the block length as a parameter
+//! and reproduces the device's histogram with [`blocking`]'s.
+
+/// Bits per digit, for the MSD pass (256 buckets) and each pass inside a bucket.
+pub const DIGIT_BITS: u32 = 8;
+
+/// Number of buckets per digit.
+pub const RADIX: usize = 1 << DIGIT_BITS;
+
+/// Most blocks (work-items) of the MSD pass; the histogram has
+/// `RADIX × blocks` entries.
+pub const MAX_BLOCKS: usize = 2048;
+
+/// Fewest pairs per block of the MSD pass: smaller blocks make the histogram
+/// and its scan (`RADIX` counters per block) cost more than the block itself.
+pub const MIN_BLOCK: usize = 1024;
+
+/// Block length and block count of the MSD pass for `n` pairs
+/// (`blocks = ceil(n / block) <= MAX_BLOCKS`; `(0, 0)` for `n = 0`): the same
+/// split as the scan's chunks ([`crate::spec::scan::split`]).
+pub fn blocking(n: usize) -> (usize, usize) {
+    crate::spec::scan::split(n, MAX_BLOCKS, MIN_BLOCK)
+}
+
+/// How a key width is split: `(top, low)`, the bits of the MSD digit
+/// (`min(key_bits, DIGIT_BITS)`) and the bits sorted inside each bucket below it.
+pub fn digits(key_bits: u32) -> (u32, u32) {
+    let top = key_bits.min(DIGIT_BITS);
+    (top, key_bits - top)
+}
+
+/// Entries of the histogram (`hist`, `u32`) of a sort of `n` pairs: `RADIX`
+/// counters per block of [`blocking`].
+pub fn histogram_len_bound(n: usize) -> usize {
+    RADIX * blocking(n).1
+}
+
+/// How a sort ran (chosen per call from the sizes of the top-digit buckets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// MSD pass, then each bucket sorted by one work-item (the usual case).
+    Buckets,
+    /// A bucket held more than `1/SKEW_LIMIT` of the pairs: plain LSD passes
+    /// over the whole data set instead, so that all work-items share the work.
+    Lsd,
+}
+
+/// A sort whose largest top-digit bucket holds more than `n / SKEW_LIMIT`
+/// pairs runs [`Strategy::Lsd`]: one work-item sorting that bucket would
+/// leave the other cores idle (all keys below 2^24 with `key_bits = 32`: 8M
+/// pairs took 180–230 ms that way, against 100–140 ms for LSD).
+pub const SKEW_LIMIT: usize = 8;

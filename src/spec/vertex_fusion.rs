@@ -1,1 +1,146 @@
-//! Shared types of the `vertex_fusion` family (see [`crate::spec`]).
+//! Shared types of the `vertex_fusion` family (see [`crate::spec`]): the
+//! variant ([`Fusion`]), the counts of one fusion ([`FusionCounts`]) and the
+//! bounds that size its scratch and outputs from the soup size.
+//!
+//! Mirrors in `kernels/vertex_fusion.cl` (buffer table in its header, S soup
+//! vertices, T = S/3 soup triangles): `rep`, `ref`, `vert_id` `uint[S]`;
+//! `keep`, `cand`, `cand_off`, `face_off` `uint[T]` ([`soup_triangles`]);
+//! `ckeys`, `cvals` `uint[C]`, C ≤ [`cancel_candidates_bound`]; `out_pos`
+//! `float[3V]`, V ≤ [`fused_vertices_bound`]; `out_faces` `uint[3F]`,
+//! F ≤ [`fused_faces_bound`]. `fuse_index`'s `compare_positions` is 1 for
+//! [`Fusion::Hash`]; `mc_triangles`' `mode` is [`Fusion::code`]. Scalar
+//! arguments only: no parameter struct crosses.
+
+/// How soup vertices are merged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Fusion {
+    /// The seed's method: 32-bit hash of the position bits, radix sort,
+    /// collisions resolved by comparing positions.
+    #[value(help = super::NO_HELP)]
+    Hash,
+    /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
+    #[value(help = super::NO_HELP)]
+    Edge,
+    /// No fusion: the triangle soup, three vertices per triangle.
+    #[value(help = super::NO_HELP)]
+    None,
+}
+
+impl Fusion {
+    /// All variants, in the order of the CLI, tables and benches.
+    pub const ALL: [Fusion; 3] = [Fusion::Hash, Fusion::Edge, Fusion::None];
+
+    /// Name used on the command line, in stats and in bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fusion::Hash => "hash",
+            Fusion::Edge => "edge",
+            Fusion::None => "none",
+        }
+    }
+
+    /// `mc_triangles`' `mode` argument: which key it writes per soup vertex
+    /// (0 none, 1 the position hash, 2 the exact edge key).
+    pub fn code(self) -> u32 {
+        match self {
+            Fusion::None => 0,
+            Fusion::Hash => 1,
+            Fusion::Edge => 2,
+        }
+    }
+}
+
+super::named_choice!(Fusion, "vertex fusion");
+
+/// Counts of one fusion.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct FusionCounts {
+    /// Unique vertices kept.
+    pub vertices: usize,
+    /// Triangles kept.
+    pub faces: usize,
+    /// Triangles dropped: two fused corners were the same vertex, or the
+    /// triangle was cancelled with an opposite twin.
+    pub dropped: usize,
+}
+
+/// Soup triangles of `soup_vertices` soup vertices (three each): the length
+/// of the per-triangle flags and offsets.
+pub fn soup_triangles(soup_vertices: usize) -> usize {
+    soup_vertices / 3
+}
+
+/// Most unique vertices a fusion of `soup_vertices` can keep (every soup
+/// vertex its own).
+pub fn fused_vertices_bound(soup_vertices: usize) -> usize {
+    soup_vertices
+}
+
+/// Most faces a fusion of `soup_vertices` can keep (no triangle dropped).
+pub fn fused_faces_bound(soup_vertices: usize) -> usize {
+    soup_triangles(soup_vertices)
+}
+
+/// Most twin-cancellation candidates (`ckeys`, `cvals`): at most one per
+/// soup triangle.
+pub fn cancel_candidates_bound(soup_vertices: usize) -> usize {
+    soup_triangles(soup_vertices)
+}
+
+/// Bytes a device fusion of `soup_vertices` soup vertices needs (scratch,
+/// outputs and the sort's scratch), for the caller's memory check.
+pub fn device_bytes_bound(soup_vertices: usize) -> u64 {
+    // rep, referenced, vert_id: 4n each; keep, face_off, cand, cand_off:
+    // 4n/3 each (candidate keys at most as many); outputs at most 12n + 4n;
+    // sort scratch ~ 8n + histograms.
+    (12 + 6 + 3 + 16 + 9) * soup_vertices as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::spec::{ao::AoMode, curvature, marching_cubes, radix_sort, scan};
+    use clap::ValueEnum;
+
+    /// `name()`, `Display`, `FromStr` and the CLI's value names agree.
+    fn names_agree<T>(all: &[T], name: fn(&T) -> &'static str)
+    where
+        T: ValueEnum + std::fmt::Display + std::str::FromStr + PartialEq + std::fmt::Debug,
+    {
+        assert_eq!(all.len(), T::value_variants().len());
+        for (v, cli) in all.iter().zip(T::value_variants()) {
+            let pv = cli.to_possible_value().unwrap();
+            assert_eq!(pv.get_name(), name(v));
+            assert_eq!(v.to_string(), name(v));
+            assert!(name(v).parse::<T>().ok().as_ref() == Some(v));
+            assert!(pv.get_help().is_none(), "--help lists bare names");
+        }
+        assert!("no such choice".parse::<T>().is_err());
+    }
+
+    #[test]
+    fn option_enum_names() {
+        names_agree(&super::Fusion::ALL, |v| v.name());
+        names_agree(&AoMode::ALL, |v| v.name());
+        names_agree(&curvature::Accumulate::ALL, |v| v.name());
+        names_agree(&curvature::Precision::ALL, |v| v.name());
+        names_agree(&curvature::Compat::ALL, |v| v.name());
+        names_agree(&marching_cubes::IsoNormals::ALL, |v| v.name());
+        names_agree(&crate::mesh::Generated::ALL, |v| v.name());
+    }
+
+    #[test]
+    fn splits_and_bounds() {
+        for n in [0, 1, 255, 256, 257, 4096 * 256, 4096 * 256 + 1, 10_000_000] {
+            let (c, k) = scan::chunking(n);
+            assert!(k <= scan::MAX_CHUNKS && (n == 0 || (c >= scan::MIN_CHUNK && c * k >= n)));
+            let (b, g) = radix_sort::blocking(n);
+            assert!(g <= radix_sort::MAX_BLOCKS && (n == 0 || (b >= radix_sort::MIN_BLOCK)));
+            assert_eq!(radix_sort::histogram_len_bound(n), radix_sort::RADIX * g);
+        }
+        assert_eq!(marching_cubes::edge_key_bits(8), Some(5));
+        assert_eq!(marching_cubes::edge_key_bits(1 << 30), Some(32));
+        assert_eq!(marching_cubes::edge_key_bits((1 << 30) + 1), None);
+        assert_eq!(super::fused_faces_bound(9), 3);
+    }
+}

@@ -4,22 +4,19 @@
 //! [`AoStage::run`] takes (k1, k2) from the host; [`AoStage::run_device`]
 //! reads them from a curvature estimator's device buffer (the per-frame
 //! pipeline), and both leave the values on the device for [`AoStage::read`].
-//! CPU twin: [`crate::cpu::ao`].
+//! CPU twin: [`crate::cpu::ao`]; shared mode, table and directions:
+//! [`crate::spec::ao`].
 
-use crate::cpu::ao::{AoMode, LUT_N, build_lut, dirs};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
+use crate::spec::ao::{AoMode, LUT_N, dirs};
 use crate::stages::curvature::CurvatureEstimator;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
-/// The `lut` level's table (built on first use).
-pub fn lut() -> &'static [f32] {
-    static L: OnceLock<Vec<f32>> = OnceLock::new();
-    L.get_or_init(|| build_lut(LUT_N))
-}
+pub use crate::spec::ao::lut; // compat re-export
 
 /// Ambient occlusion on the device.
 pub struct AoStage {
@@ -40,7 +37,7 @@ impl AoStage {
         let file = kernel_file("ao").expect("ao kernels are embedded");
         let p = gpu.program(&file, "")?;
         let mut lb = gpu.buffer_flags::<f32>(LUT_N * LUT_N, CL_MEM_READ_ONLY)?;
-        gpu.write(&mut lb, lut())?;
+        gpu.write(&mut lb, crate::spec::ao::lut())?;
         let d = dirs();
         let mut db = gpu.buffer_flags::<f32>(d.len(), CL_MEM_READ_ONLY)?;
         gpu.write(&mut db, &d)?;

@@ -7,13 +7,16 @@
 //! new pose into the existing buffers and [`CurvatureEstimator::run`] reruns
 //! only the position-dependent passes, so a deforming mesh costs no
 //! reallocation per frame (seed 000, §3.6). The CPU twin is
-//! [`crate::cpu::curvature`].
+//! [`crate::cpu::curvature`]; shared types, thresholds and the memory bound:
+//! [`crate::spec::curvature`]; one-ring lists: [`crate::mesh::topology`].
 
 use crate::error::{Error, Result};
-use crate::field::{
-    Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization, Precision,
-};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::mesh::topology::one_rings;
+use crate::spec::curvature::{
+    Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
+    Precision, corner_reals_bound,
+};
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use serde::Serialize;
@@ -177,28 +180,7 @@ struct GatherBufs {
     status: Buffer<u8>,
 }
 
-/// Bytes of device memory the estimator allocates for a mesh, by variant
-/// (the same arithmetic as the allocations in [`CurvatureEstimator::new`]).
-pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 {
-    let r = real_size(opts.precision) as u64;
-    let (nv, nf) = (nv.max(1) as u64, nf.max(1) as u64);
-    // pos, nrm, pd1, pd2, tens: 3 reals; area: 1; kk: 2; dk: 4  → 20 reals per vertex.
-    let per_vertex = 20 * r + 4; // + owner
-    let per_face = 12;
-    let mut b = nv * per_vertex + nf * per_face + 16;
-    if opts.accumulate == Accumulate::Gather {
-        // one-ring CSR, 4 reals per face corner, one status byte per face
-        b += (nv + 1) * 4 + 3 * nf * 4 + 12 * nf * r + nf;
-    }
-    b
-}
-
-fn real_size(p: Precision) -> usize {
-    match p {
-        Precision::F32 => 4,
-        Precision::F64 => 8,
-    }
-}
+pub use crate::spec::curvature::device_bytes_bound; // compat re-export
 
 /// Build options of `kernels/curvature.cl` for a variant.
 pub fn build_options(opts: &CurvatureOptions) -> String {
@@ -210,30 +192,6 @@ pub fn build_options(opts: &CurvatureOptions) -> String {
         s.push_str("-DSC_COMPAT ");
     }
     s.trim_end().to_string()
-}
-
-/// Builds the one-ring lists: for each vertex, the (face·3 + corner) entries of
-/// the faces using it, in increasing face order (CSR: offsets of length V+1).
-pub fn one_rings(nv: usize, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
-    let mut off = vec![0u32; nv + 1];
-    for f in faces {
-        for &v in f {
-            off[v as usize + 1] += 1;
-        }
-    }
-    for i in 0..nv {
-        off[i + 1] += off[i];
-    }
-    let mut fill = off.clone();
-    let mut ring = vec![0u32; faces.len() * 3];
-    for (fi, f) in faces.iter().enumerate() {
-        for (c, &v) in f.iter().enumerate() {
-            let slot = &mut fill[v as usize];
-            ring[*slot as usize] = (fi * 3 + c) as u32;
-            *slot += 1;
-        }
-    }
-    (off, ring)
 }
 
 impl CurvatureEstimator {
@@ -367,7 +325,7 @@ impl CurvatureEstimator {
         t0: Instant,
     ) -> Result<Self> {
         let gather = opts.accumulate == Accumulate::Gather;
-        let real = real_size(opts.precision);
+        let real = opts.precision.bytes();
         let max_face = gpu.kernel(&program, "curv_max_face")?;
         let mut owner = gpu.buffer::<i32>(nv)?;
         gpu.write(&mut owner, &vec![-1i32; nv])?;
@@ -380,7 +338,7 @@ impl CurvatureEstimator {
             Some(GatherBufs {
                 ring_off,
                 ring: ring_b,
-                corner: gpu.buffer::<u8>(12 * nf * real)?,
+                corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
                 status: gpu.buffer::<u8>(nf)?,
             })
         } else {
@@ -412,7 +370,7 @@ impl CurvatureEstimator {
             dk: rb(4 * nv)?,
             counters: gpu.buffer::<u32>(4)?,
             normal_override: None,
-            device_bytes: device_bytes_bound(nv, nf, &opts),
+            device_bytes: crate::spec::curvature::device_bytes_bound(nv, nf, &opts),
             gpu,
             opts,
             nv,

@@ -2,20 +2,23 @@
 //! the volume is uploaded once; each extraction runs `mc_classify` → scan →
 //! `mc_triangles` and then vertex fusion ([`crate::stages::vertex_fusion`]),
 //! leaving the indexed mesh on the device (for the curvature passes) until
-//! the caller reads it. CPU twin: [`crate::cpu::marching_cubes`].
+//! the caller reads it. CPU twin: [`crate::cpu::marching_cubes`]; shared
+//! case table, layout, bounds and options: [`crate::spec::marching_cubes`].
 //!
 //! Memory: the soup is sized exactly from the classify counts; the kernels
 //! still check a capacity and count what would not fit, so a bug can never
 //! write past a buffer. A volume or an output that the device cannot hold is
 //! a clear error naming the bytes needed.
 
-use crate::cpu::marching_cubes::{cell_rows, table};
-use crate::cpu::vertex_fusion::Fusion;
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
+use crate::spec::curvature::{CurvatureOptions, Normalization};
+use crate::spec::marching_cubes::{cell_rows, edge_key_bits, soup_vertices_bound, table};
+use crate::spec::vertex_fusion::{Fusion, FusionCounts};
+use crate::stages::curvature::{CurvatureEstimator, RunTiming};
 use crate::stages::scan::Scan;
-use crate::stages::vertex_fusion::{Fuser, FusionCounts, FusionTiming, Grow, build_options};
+use crate::stages::vertex_fusion::{Fuser, FusionTiming, Grow, build_options};
 use crate::volume::Volume;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -94,15 +97,7 @@ pub struct Isosurfacer {
     result: Option<(Holder, usize, usize)>,
 }
 
-/// Bytes of device memory needed to extract a surface of `soup_vertices`
-/// soup vertices from a volume of `voxels` voxels (volume, row buffers, soup,
-/// fusion scratch and outputs): the bound the memory check uses.
-pub fn device_bytes_bound(voxels: usize, rows: usize, soup_vertices: usize) -> u64 {
-    4 * voxels as u64
-        + 8 * rows as u64
-        + 20 * soup_vertices as u64
-        + Fuser::bytes_bound(soup_vertices)
-}
+pub use crate::spec::marching_cubes::device_bytes_bound; // compat re-export
 
 impl Isosurfacer {
     /// Uploads `vol` to the device (once) and builds the kernels. Errors if
@@ -214,7 +209,7 @@ impl Isosurfacer {
             self.result = Some((Holder::Soup, 0, 0));
             return Ok(st);
         }
-        if fusion == Fusion::Edge && 4 * voxels as u64 > u32::MAX as u64 + 1 {
+        if fusion == Fusion::Edge && edge_key_bits(voxels).is_none() {
             return Err(Error::InvalidArgument(format!(
                 "--fusion edge keys vertices by 4 × voxel index in 32 bits: at most 2^30 voxels, \
                  this volume has {voxels}; use --fusion hash"
@@ -233,13 +228,13 @@ impl Isosurfacer {
         let tris = self.scan.exclusive(&self.row_tris, &self.row_off, rows)? as usize;
         st.scan_ms = self.scan.last_ms();
         st.classify_ms = e_cls.as_ref().map(event_ms).unwrap_or(0.0);
-        let soup = 3 * tris;
+        let soup = soup_vertices_bound(tris);
         if soup as u64 > u32::MAX as u64 {
             return Err(Error::InvalidArgument(format!(
                 "iso {iso}: {tris} triangles exceed the 32-bit soup index"
             )));
         }
-        let need = device_bytes_bound(voxels, rows, soup);
+        let need = crate::spec::marching_cubes::device_bytes_bound(voxels, rows, soup);
         if need > g.info.global_mem {
             return Err(Error::DeviceUnsupported {
                 device: g.info.name.clone(),
@@ -256,18 +251,13 @@ impl Isosurfacer {
             self.idx.reserve(&g, soup)?;
         }
         g.write(&mut self.counters, &[0, 0])?;
-        let mode = match fusion {
-            Fusion::None => 0u32,
-            Fusion::Hash => 1,
-            Fusion::Edge => 2,
-        };
         let mut a = common.to_vec();
         a.extend([
             buf(&self.counts),
             buf(&self.tris),
             buf(&self.row_off),
             Arg::U32(soup as u32),
-            Arg::U32(mode),
+            Arg::U32(fusion.code()),
             buf(&self.pos.buf),
             buf(&self.key.buf),
             buf(&self.idx.buf),
@@ -303,7 +293,7 @@ impl Isosurfacer {
             _ => {
                 let key_bits = match fusion {
                     Fusion::Hash => 32,
-                    _ => 64 - (4 * voxels as u64 - 1).leading_zeros(),
+                    _ => edge_key_bits(voxels).expect("checked above"),
                 };
                 let (
                     FusionCounts {
@@ -407,16 +397,7 @@ impl Isosurfacer {
     }
 }
 
-/// Which vertex normals the curvature of an isosurface uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum IsoNormals {
-    /// The estimator's own area-weighted face normals (Rusinkiewicz).
-    Mesh,
-    /// The volume's gradient at each vertex: far more accurate on
-    /// marching-cubes meshes, whose sliver triangles make face normals noisy.
-    Gradient,
-}
+pub use crate::spec::marching_cubes::IsoNormals; // compat re-export
 
 /// Curvature of the current isosurface, computed without a host round trip:
 /// the fused faces and positions are copied device to device into a
@@ -426,22 +407,13 @@ pub enum IsoNormals {
 /// its run (read the field with its `read`) and the run's timing.
 pub fn curvature(
     iso: &Isosurfacer,
-    opts: crate::field::CurvatureOptions,
+    opts: CurvatureOptions,
     normals: IsoNormals,
-) -> Result<(
-    crate::stages::curvature::CurvatureEstimator,
-    crate::stages::curvature::RunTiming,
-)> {
+) -> Result<(CurvatureEstimator, RunTiming)> {
     let Some((pos, faces, nv, nf)) = iso.device_mesh() else {
         return Err(Error::InvalidArgument("no isosurface extracted yet".into()));
     };
-    let mut est = crate::stages::curvature::CurvatureEstimator::from_device(
-        iso.gpu.clone(),
-        nv,
-        faces,
-        nf,
-        opts,
-    )?;
+    let mut est = CurvatureEstimator::from_device(iso.gpu.clone(), nv, faces, nf, opts)?;
     // Normalize by the volume's box: centre and half diagonal (world units).
     let d = iso.dims;
     let center: [f64; 3] =
@@ -450,7 +422,7 @@ pub fn curvature(
         .map(|i| (0.5 * iso.spacing[i] * (d[i] as f64 - 1.0)).powi(2))
         .sum::<f64>()
         .sqrt();
-    let norm = crate::field::Normalization {
+    let norm = Normalization {
         center,
         scale: if half > 0.0 { half } else { 1.0 },
     };

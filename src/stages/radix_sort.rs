@@ -2,7 +2,8 @@
 //! key, `u32` value) pairs on the device, in place in the caller's buffers,
 //! by the low `key_bits` bits of the keys. Marching cubes vertex fusion sorts
 //! (hash, vertex) pairs with it. The CPU twin with the same steps is
-//! [`crate::cpu::radix_sort`].
+//! [`crate::cpu::radix_sort`]; digit width, blocks and strategy are in
+//! [`crate::spec::radix_sort`].
 //!
 //! Buffers: `keys`, `values` `u32[n]` (caller's); scratch `keys_tmp`,
 //! `values_tmp` `u32[n]` and `hist` `u32[RADIX × G]`, grown on demand and
@@ -31,6 +32,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::radix_sort::histogram_len_bound;
 use crate::stages::scan::{Scan, check_len};
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -39,36 +41,9 @@ use opencl3::types::CL_BLOCKING;
 use std::ffi::c_void;
 use std::sync::Arc;
 
-/// Bits per digit, for the MSD pass (256 buckets) and each pass inside a bucket.
-pub const DIGIT_BITS: u32 = 8;
-
-/// Number of buckets per digit.
-pub const RADIX: usize = 1 << DIGIT_BITS;
-
-/// Most blocks (work-items) of the MSD pass; the histogram has
-/// `RADIX × blocks` entries.
-pub const MAX_BLOCKS: usize = 2048;
-
-/// Fewest pairs per block of the MSD pass: smaller blocks make the histogram
-/// and its scan (`RADIX` counters per block) cost more than the block itself.
-pub const MIN_BLOCK: usize = 1024;
-
-/// Block length and block count of the MSD pass for `n` pairs
-/// (`blocks = ceil(n / block) <= MAX_BLOCKS`; `(0, 0)` for `n = 0`).
-pub fn blocking(n: usize) -> (usize, usize) {
-    if n == 0 {
-        return (0, 0);
-    }
-    let block = n.div_ceil(MAX_BLOCKS).max(MIN_BLOCK);
-    (block, n.div_ceil(block))
-}
-
-/// How a key width is split: `(top, low)`, the bits of the MSD digit
-/// (`min(key_bits, DIGIT_BITS)`) and the bits sorted inside each bucket below it.
-pub fn digits(key_bits: u32) -> (u32, u32) {
-    let top = key_bits.min(DIGIT_BITS);
-    (top, key_bits - top)
-}
+pub use crate::spec::radix_sort::{
+    DIGIT_BITS, MAX_BLOCKS, MIN_BLOCK, RADIX, SKEW_LIMIT, Strategy, blocking, digits,
+}; // compat re-export
 
 /// Stable device radix sort of (key, value) pairs; kernels built once,
 /// scratch kept between calls.
@@ -86,22 +61,6 @@ pub struct RadixSort {
     last_ms: f64,
     last_strategy: Option<Strategy>,
 }
-
-/// How a sort ran (chosen per call from the sizes of the top-digit buckets).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Strategy {
-    /// MSD pass, then each bucket sorted by one work-item (the usual case).
-    Buckets,
-    /// A bucket held more than `1/SKEW_LIMIT` of the pairs: plain LSD passes
-    /// over the whole data set instead, so that all work-items share the work.
-    Lsd,
-}
-
-/// A sort whose largest top-digit bucket holds more than `n / SKEW_LIMIT`
-/// pairs runs [`Strategy::Lsd`]: one work-item sorting that bucket would
-/// leave the other cores idle (all keys below 2^24 with `key_bits = 32`: 8M
-/// pairs took 180–230 ms that way, against 100–140 ms for LSD).
-pub const SKEW_LIMIT: usize = 8;
 
 impl RadixSort {
     /// Builds `kernels/radix_sort.cl` and `kernels/scan.cl` (cached per
@@ -155,7 +114,7 @@ impl RadixSort {
             return Ok(());
         }
         let blocks = blocking(n).1;
-        self.reserve(n, RADIX * blocks)?;
+        self.reserve(n, histogram_len_bound(n))?;
         let (top, low) = digits(key_bits);
         let mut events: Vec<Event> = Vec::with_capacity(8);
 

@@ -1,42 +1,29 @@
 //! Host wiring of `kernels/scan.cl`: exclusive prefix sum of `n` `u32` values
 //! on the device, in place or out of place, with the total checked against
 //! `u32::MAX` (callers size buffers from totals, so a wrapped sum would be a
-//! silent out-of-bounds write later). The CPU twin is [`crate::cpu::scan`].
+//! silent out-of-bounds write later). The CPU twin is [`crate::cpu::scan`];
+//! the chunking and scratch size are in [`crate::spec::scan`].
 //!
 //! Buffers: `input`, `output` `u32[n]` (caller's, may be the same buffer);
 //! internal `partials` `u64[C]` and `total` `u64[1]`, allocated once in
-//! [`Scan::new`] for the largest chunk count [`MAX_CHUNKS`].
+//! [`Scan::new`] for the largest chunk count
+//! ([`crate::spec::scan::partials_len_bound`]).
 //!
 //! Three launches, reduce-then-scan: `scan_block_sums` (one work-item sums
-//! one contiguous chunk of [`chunking`]), `scan_partials` (one work-item scans
+//! one contiguous chunk of [`crate::spec::scan::chunking`]), `scan_partials` (one work-item scans
 //! the chunk sums serially), `scan_apply` (one work-item rescans its chunk from
 //! its offset). `scan_apply` skips every write when the total exceeds
 //! `u32::MAX`, so on overflow the output is left unchanged.
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::scan::partials_len_bound;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, ClMem};
 use std::sync::Arc;
 
-/// Largest number of chunks (work-items) of one scan. A few thousand keeps
-/// every core busy on any device while the serial scan of the partials stays
-/// in the microseconds, so no second level is needed.
-pub const MAX_CHUNKS: usize = 4096;
-
-/// Smallest chunk: below this, per-work-item overhead dominates the loop.
-pub const MIN_CHUNK: usize = 256;
-
-/// The chunk length and chunk count the device uses for `n` values
-/// (`chunks = ceil(n / chunk) <= MAX_CHUNKS`; `(0, 0)` for `n = 0`).
-pub fn chunking(n: usize) -> (usize, usize) {
-    if n == 0 {
-        return (0, 0);
-    }
-    let chunk = n.div_ceil(MAX_CHUNKS).max(MIN_CHUNK);
-    (chunk, n.div_ceil(chunk))
-}
+pub use crate::spec::scan::{MAX_CHUNKS, MIN_CHUNK, chunking}; // compat re-export
 
 /// Number of `u32` elements a device buffer holds.
 pub(crate) fn len_u32(b: &Buffer<u32>) -> Result<usize> {
@@ -84,7 +71,7 @@ impl Scan {
             block_sums: gpu.kernel(&program, "scan_block_sums")?,
             partials_kernel: gpu.kernel(&program, "scan_partials")?,
             apply: gpu.kernel(&program, "scan_apply")?,
-            partials: gpu.buffer::<u64>(MAX_CHUNKS)?,
+            partials: gpu.buffer::<u64>(partials_len_bound())?,
             total: gpu.buffer::<u64>(1)?,
             gpu,
             last_ms: 0.0,
@@ -138,7 +125,7 @@ impl Scan {
         output: &Buffer<u32>,
         n: usize,
     ) -> Result<Vec<Event>> {
-        let (chunk, chunks) = chunking(n);
+        let (chunk, chunks) = crate::spec::scan::chunking(n);
         if chunks == 0 {
             return Ok(Vec::new());
         }
@@ -177,6 +164,6 @@ impl Scan {
 
     /// Device bytes of the internal scratch (chunk partials and total).
     pub fn scratch_bytes(&self) -> u64 {
-        8 * (MAX_CHUNKS as u64 + 1)
+        8 * (partials_len_bound() as u64 + 1)
     }
 }

@@ -3,11 +3,12 @@
 //! per joint) and runs `skin_lbs`, leaving the skinned positions on the
 //! device for the curvature passes
 //! ([`crate::stages::curvature::CurvatureEstimator::set_positions_device`]).
-//! CPU twin: [`crate::cpu::skinning`].
+//! CPU twin: [`crate::cpu::skinning`]; buffer layout: [`crate::spec::skinning`].
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
+use crate::spec::skinning::{INFLUENCES, MATRIX_FLOATS, matrices_len};
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -42,14 +43,14 @@ impl Skinner {
             .collect();
         let mut rest = gpu.buffer_flags::<f32>(3 * nv, CL_MEM_READ_ONLY)?;
         gpu.write(&mut rest, &rest_f)?;
-        let mut joint_ids = gpu.buffer_flags::<u32>(4 * nv, CL_MEM_READ_ONLY)?;
+        let mut joint_ids = gpu.buffer_flags::<u32>(INFLUENCES * nv, CL_MEM_READ_ONLY)?;
         gpu.write(&mut joint_ids, m.joints.as_flattened())?;
-        let mut weights = gpu.buffer_flags::<f32>(4 * nv, CL_MEM_READ_ONLY)?;
+        let mut weights = gpu.buffer_flags::<f32>(INFLUENCES * nv, CL_MEM_READ_ONLY)?;
         gpu.write(&mut weights, m.weights.as_flattened())?;
         let joints = m.joint_nodes.len();
         Ok(Skinner {
             kernel: gpu.kernel(&p, "skin_lbs")?,
-            mats: gpu.buffer_flags::<f32>(16 * joints.max(1), CL_MEM_READ_ONLY)?,
+            mats: gpu.buffer_flags::<f32>(matrices_len(joints.max(1)), CL_MEM_READ_ONLY)?,
             out: gpu.buffer::<f32>(3 * nv)?,
             gpu,
             nv,
@@ -75,10 +76,10 @@ impl Skinner {
     /// callers that queue more passes behind it
     /// ([`crate::stages::pipeline::PosePipeline`]).
     pub(crate) fn enqueue(&mut self, mats: &[f32]) -> Result<Option<Event>> {
-        if mats.len() != 16 * self.joints || mats.iter().any(|v| !v.is_finite()) {
+        if mats.len() != matrices_len(self.joints) || mats.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidArgument(format!(
-                "pose: {} finite matrix floats expected (16 × {} joints), got {}",
-                16 * self.joints,
+                "pose: {} finite matrix floats expected ({MATRIX_FLOATS} × {} joints), got {}",
+                matrices_len(self.joints),
                 self.joints,
                 mats.len()
             )));

@@ -4,11 +4,14 @@
 //! radix sort of (key, soup index) → `fuse_index` → `fuse_triangles` →
 //! twin cancellation (`fuse_candidates`, sort, `fuse_cancel`) → `fuse_mark` →
 //! scans → `fuse_compact_vertices`, `fuse_compact_faces`.
-//! CPU twin: [`crate::cpu::vertex_fusion`].
+//! CPU twin: [`crate::cpu::vertex_fusion`]; shared variant, counts and
+//! bounds: [`crate::spec::vertex_fusion`].
 
-use crate::cpu::vertex_fusion::Fusion;
 use crate::error::Result;
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::vertex_fusion::{
+    Fusion, cancel_candidates_bound, fused_faces_bound, fused_vertices_bound, soup_triangles,
+};
 use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
 use opencl3::kernel::Kernel;
@@ -39,17 +42,7 @@ impl FusionTiming {
     }
 }
 
-/// Counts of one fusion.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
-pub struct FusionCounts {
-    /// Unique vertices kept.
-    pub vertices: usize,
-    /// Triangles kept.
-    pub faces: usize,
-    /// Triangles dropped: two fused corners were the same vertex, or the
-    /// triangle was cancelled with an opposite twin.
-    pub dropped: usize,
-}
+pub use crate::spec::vertex_fusion::FusionCounts; // compat re-export
 
 /// A growable device buffer.
 pub(crate) struct Grow<T> {
@@ -168,12 +161,9 @@ impl Fuser {
     }
 
     /// Bytes [`Fuser::fuse`] needs for `n` soup vertices (before outputs),
-    /// for the caller's memory check.
+    /// for the caller's memory check: [`crate::spec::vertex_fusion::device_bytes_bound`].
     pub fn bytes_bound(n: usize) -> u64 {
-        // rep, referenced, vert_id: 4n each; keep, face_off, cand, cand_off:
-        // 4n/3 each (candidate keys at most as many); outputs at most 12n + 4n;
-        // sort scratch ~ 8n + histograms.
-        (12 + 6 + 3 + 16 + 9) * n as u64
+        crate::spec::vertex_fusion::device_bytes_bound(n)
     }
 
     /// Fuses `n` soup vertices: `keys`/`idx` (sorted in place here) and
@@ -190,7 +180,7 @@ impl Fuser {
     ) -> Result<(FusionCounts, FusionTiming)> {
         let g = self.gpu.clone();
         let mut t = FusionTiming::default();
-        let nt = n / 3;
+        let nt = soup_triangles(n);
         if n == 0 {
             return Ok((FusionCounts::default(), t));
         }
@@ -244,6 +234,7 @@ impl Fuser {
             .scan
             .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
         t.cancel = self.scan.last_ms();
+        debug_assert!(n_cand <= cancel_candidates_bound(n));
         if n_cand > 0 {
             self.ckeys.reserve(&g, n_cand)?;
             self.cvals.reserve(&g, n_cand)?;
@@ -304,6 +295,8 @@ impl Fuser {
             .map(event_ms)
             .sum();
         t.scans = scans;
+        // Sized from the scans, within the bounds the memory check assumed.
+        debug_assert!(vertices <= fused_vertices_bound(n) && faces <= fused_faces_bound(n));
         self.out_pos.reserve(&g, 3 * vertices)?;
         self.out_faces.reserve(&g, 3 * faces)?;
         let e_v = launch(
