@@ -32,7 +32,7 @@ pub const MARKER: [f32; 4] = [f32::NAN, 0.0, -1.0, 1.0];
 pub const PARAMS_LEN: usize = 32;
 
 /// How the gaps between thick edges are filled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CapMode {
     /// No caps.
@@ -57,6 +57,18 @@ impl CapMode {
     }
 }
 
+/// clap's `ValueEnum` by hand, not derived: the derive would turn each
+/// variant's rustdoc into CLI help and change `--help`'s layout; the names
+/// are [`CapMode::name`]'s.
+impl clap::ValueEnum for CapMode {
+    fn value_variants<'a>() -> &'a [Self] {
+        &CapMode::ALL
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()))
+    }
+}
+
 impl std::str::FromStr for CapMode {
     type Err = Error;
     fn from_str(s: &str) -> Result<CapMode> {
@@ -73,7 +85,7 @@ impl std::str::FromStr for CapMode {
 
 /// What `--interop` asked for: CL-GL buffer sharing between the edges stage
 /// and the renderer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InteropMode {
     /// Use CL-GL sharing when the device offers it, the host path otherwise.
@@ -82,6 +94,30 @@ pub enum InteropMode {
     On,
     /// Always copy through the host.
     Off,
+}
+
+impl InteropMode {
+    /// Every mode, in `--help` order.
+    pub const ALL: [InteropMode; 3] = [InteropMode::Auto, InteropMode::On, InteropMode::Off];
+
+    /// The name used on the command line and in stats.
+    pub fn name(self) -> &'static str {
+        match self {
+            InteropMode::Auto => "auto",
+            InteropMode::On => "on",
+            InteropMode::Off => "off",
+        }
+    }
+}
+
+/// clap's `ValueEnum` by hand, for the same reason as [`CapMode`]'s.
+impl clap::ValueEnum for InteropMode {
+    fn value_variants<'a>() -> &'a [Self] {
+        &InteropMode::ALL
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()))
+    }
 }
 
 /// The interop path chosen and why.
