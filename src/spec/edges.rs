@@ -3,11 +3,11 @@
 //! variants, the kind bits, the per-frame parameter block that crosses to
 //! `kernels/edges.cl`, the output type, the `*_bound` sizes of every output
 //! and the memory each variant uses. Used by the host wiring
-//! ([`crate::stages::edges`]), the CPU twin ([`crate::cpu::edges`]), the
+//! (`stages::edges`), the CPU twin (`cpu::edges`), the
 //! scene planner and file, the renderer's edge drawing and the CLI.
 //!
 //! The conventions of detection (contour, crease, boundary, half quads,
-//! width, near plane, marker) are documented in [`crate::stages::edges`].
+//! width, near plane, marker) are documented in `stages::edges`.
 
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;

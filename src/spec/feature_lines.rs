@@ -1,8 +1,8 @@
 //! Shared types of the `feature_lines` family (occluding and suggestive
 //! contours, DeCarlo et al. 2003): what the stage reads of a view, the
 //! segment type and the bound of the segment buffer. Used by the host wiring
-//! ([`crate::stages::feature_lines`]) and the CPU twin
-//! ([`crate::cpu::feature_lines`]).
+//! (`stages::feature_lines`) and the CPU twin
+//! (`cpu::feature_lines`).
 
 use crate::spec::view::View;
 
