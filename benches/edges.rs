@@ -23,8 +23,9 @@ use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::Mesh;
 use shapecue::mesh::{self, edges::EdgeTopology, edges::vertex_normals};
-use shapecue::render::{MeshStyle, RenderOptions, Renderer};
-use shapecue::stages::edges::{self as st, CapMode, EdgeParams, EdgeStage};
+use shapecue::render::edges::draw_edges;
+use shapecue::render::{MeshStyle, Placement, RenderOptions, Renderer, framed};
+use shapecue::stages::edges::{CapMode, EdgeParams, EdgeStage};
 use std::time::{Duration, Instant};
 
 const SIZE: (u32, u32) = (800, 600);
@@ -72,10 +73,18 @@ fn edges_benches(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     for (name, m) in inputs() {
         let topo = EdgeTopology::new(&m, &[], name).expect("topology");
-        let cam = st::camera_for(Vec3::splat(5.0), Vec3::ZERO, None, 40.0, false, m.bounds())
-            .expect("camera");
-        let p = EdgeParams::new(cam, SIZE.0, SIZE.1);
-        let mut stage = EdgeStage::new(&gpu, &m, &topo).expect("stage");
+        let cam = framed(
+            Placement::At(Vec3::splat(5.0)),
+            Some(Vec3::ZERO),
+            None,
+            40.0,
+            false,
+            m.bounds(),
+            SIZE.0 as f32 / SIZE.1 as f32,
+        )
+        .expect("camera");
+        let p = EdgeParams::new(cam.view(SIZE.0, SIZE.1));
+        let mut stage = EdgeStage::new(gpu.clone(), &m, &topo).expect("stage");
         let pos: Vec<[f32; 3]> = m.positions.iter().map(|q| q.map(|c| c as f32)).collect();
         let nrm = vertex_normals(&m);
         eprintln!(
@@ -105,7 +114,7 @@ fn edges_benches(c: &mut Criterion) {
                             r.begin(&cam).expect("begin");
                             r.draw_mesh(&pos, &nrm, &[], &m.faces, MeshStyle::default())
                                 .expect("mesh");
-                            st::draw(r, &out, [0.0, 0.0, 0.0, 1.0]).expect("edges");
+                            draw_edges(r, &out, [0.0, 0.0, 0.0, 1.0]).expect("edges");
                             std::hint::black_box(r.finish().expect("finish"));
                         }
                     }

@@ -12,7 +12,7 @@
 //                             vertex, both drawn, a quad (middle vector, p0, sM, p1)
 //
 // Buffers (V vertices, E edge entries, C cap pairs):
-//   params   float[32]  per frame, see PARAM_* below (packed by EdgeParams::pack)
+//   params   EdgeParams per frame, see below (packed by EdgeParams::pack)
 //   pos      float[3V]  world-space positions        nrm float[3V] unit vertex normals
 //   edges    uint[4E]   (i0, i1, i2, i3); i3 == i0: boundary or marked
 //   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex (sorted by vertex)
@@ -46,18 +46,25 @@
 // so drawability is decided from 4-byte kind bits and unchanged markers are
 // not rewritten (below).
 
-#define PARAM_EYE 16
-#define PARAM_VIEW 19
-#define PARAM_ORTHO 22
-#define PARAM_HVW 23
-#define PARAM_HVH 24
-#define PARAM_HALF_WIDTH 25
-#define PARAM_COS_CREASE 26
-#define PARAM_DEPTH_K 27
-#define PARAM_W_MIN 28
-#define PARAM_CONTOUR 29
-#define PARAM_BOUNDARY 30
-#define PARAM_HALF 31
+// The per-frame parameter block. Mirrors the Rust struct
+// spec::edges::EdgeParamBlock field by field (same names, same order, every
+// field a 4-byte float, so neither side pads); a probe-kernel test in
+// src/stages/edges.rs checks sizeof and each offsetof on the device.
+typedef struct {
+    float view_proj[16]; // world to clip, column-major
+    float eye[3];
+    float view_dir[3];   // unit, eye towards target
+    float ortho;         // 1: orthographic
+    float half_vw;       // half viewport width, pixels
+    float half_vh;       // half viewport height, pixels
+    float half_width;    // half line width, pixels
+    float cos_crease;    // −2: no creases
+    float depth_k;       // 0: constant width
+    float w_min;         // near-plane w (0 when orthographic)
+    float contours;      // 1: detect contours
+    float boundaries;    // 1: draw boundary and marked edges
+    float half_contours; // 1: contour-only edges as half quads
+} EdgeParams;
 
 #define KIND_CONTOUR 1u
 #define KIND_CREASE 2u
@@ -82,9 +89,10 @@
         (out)[4 * (slot) + 3] = (w);                     \
     } while (0)
 
-// Clip-space coordinate `row` of M·(x, y, z, h) with M column-major in params[0..16].
-#define CLIP(P, row, x, y, z, h) \
-    ((P)[(row)] * (x) + (P)[4 + (row)] * (y) + (P)[8 + (row)] * (z) + (P)[12 + (row)] * (h))
+// Clip-space coordinate `row` of M·(x, y, z, h), M = P->view_proj (column-major).
+#define CLIP(P, row, x, y, z, h)                                                        \
+    ((P)->view_proj[(row)] * (x) + (P)->view_proj[4 + (row)] * (y) +                    \
+     (P)->view_proj[8 + (row)] * (z) + (P)->view_proj[12 + (row)] * (h))
 
 // Depth factor max(1, k/w), or 1 when k = 0 (a select, not fmax: PoCL's
 // work-item vectoriser gives up on fmax).
@@ -93,7 +101,7 @@ inline float depth_factor(float k, float w) {
     return (k > 0.0f && f > 1.0f) ? f : 1.0f;
 }
 
-__kernel void edges_detect(uint n, __global const float* P, __global const float* pos,
+__kernel void edges_detect(uint n, __global const EdgeParams* P, __global const float* pos,
                            __global const float* nrm, __global const uint* edges,
                            __global float* edge_out, __global uint* kind) {
     GID_OR_RETURN(n)
@@ -111,27 +119,27 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     const float nbx = wy * uz - wz * uy, nby = wz * ux - wx * uz, nbz = wx * uy - wy * ux;
     uint k = 0u;
     if (i3 == i0) {
-        if (P[PARAM_BOUNDARY] != 0.0f) k |= KIND_BOUNDARY;
+        if (P->boundaries != 0.0f) k |= KIND_BOUNDARY;
     } else {
         // View vector towards the eye, per edge (perspective) or constant (orthographic).
-        const int ortho = P[PARAM_ORTHO] != 0.0f;
-        const float ex = ortho ? -P[PARAM_VIEW] : P[PARAM_EYE] - x0;
-        const float ey = ortho ? -P[PARAM_VIEW + 1] : P[PARAM_EYE + 1] - y0;
-        const float ez = ortho ? -P[PARAM_VIEW + 2] : P[PARAM_EYE + 2] - z0;
+        const int ortho = P->ortho != 0.0f;
+        const float ex = ortho ? -P->view_dir[0] : P->eye[0] - x0;
+        const float ey = ortho ? -P->view_dir[1] : P->eye[1] - y0;
+        const float ez = ortho ? -P->view_dir[2] : P->eye[2] - z0;
         const float da = nax * ex + nay * ey + naz * ez;
         const float db = nbx * ex + nby * ey + nbz * ez;
-        if (P[PARAM_CONTOUR] != 0.0f && ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)))
+        if (P->contours != 0.0f && ((da < 0.0f && db > 0.0f) || (da > 0.0f && db < 0.0f)))
             k |= KIND_CONTOUR;
         const float dn = nax * nbx + nay * nby + naz * nbz;
         const float la = nax * nax + nay * nay + naz * naz;
         const float lb = nbx * nbx + nby * nby + nbz * nbz;
-        if (dn < P[PARAM_COS_CREASE] * sqrt(la * lb)) k |= KIND_CREASE;
+        if (dn < P->cos_crease * sqrt(la * lb)) k |= KIND_CREASE;
     }
     const float c0x = CLIP(P, 0, x0, y0, z0, 1.0f), c0y = CLIP(P, 1, x0, y0, z0, 1.0f);
     const float c0z = CLIP(P, 2, x0, y0, z0, 1.0f), c0w = CLIP(P, 3, x0, y0, z0, 1.0f);
     const float c1x = CLIP(P, 0, x1, y1, z1, 1.0f), c1y = CLIP(P, 1, x1, y1, z1, 1.0f);
     const float c1z = CLIP(P, 2, x1, y1, z1, 1.0f), c1w = CLIP(P, 3, x1, y1, z1, 1.0f);
-    const float wmin = P[PARAM_W_MIN];
+    const float wmin = P->w_min;
     const int drawn = k != 0u && c0w > wmin && c1w > wmin;
     __global float* out = edge_out + 16 * gid;
     if (!drawn) {
@@ -149,7 +157,7 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
         return;
     }
     kind[gid] = k | KIND_DRAWN;
-    const float hvw = P[PARAM_HVW], hvh = P[PARAM_HVH], hw = P[PARAM_HALF_WIDTH];
+    const float hvw = P->half_vw, hvh = P->half_vh, hw = P->half_width;
     const float s0x = c0x / c0w * hvw, s0y = c0y / c0w * hvh;
     const float s1x = c1x / c1w * hvw, s1y = c1y / c1w * hvh;
     const float dx = s1x - s0x, dy = s1y - s0y;
@@ -157,12 +165,12 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     // An edge seen end-on has no direction: any perpendicular gives a zero-area quad.
     const float px = len > 0.0f ? -dy / len : 0.0f;
     const float py = len > 0.0f ? dx / len : 1.0f;
-    const float f0 = hw * depth_factor(P[PARAM_DEPTH_K], c0w);
-    const float f1 = hw * depth_factor(P[PARAM_DEPTH_K], c1w);
+    const float f0 = hw * depth_factor(P->depth_k, c0w);
+    const float f1 = hw * depth_factor(P->depth_k, c1w);
     // Half quads (contour-only edges, when asked): from the edge outward by the full
     // width, outward = the side the projected vertex normal of i0 points to (seed's
     // sign(m0·p)). Slots stay in perimeter order: 0 = s0, 1 = s1, 2, 3 outside.
-    const int halfq = P[PARAM_HALF] != 0.0f && k == KIND_CONTOUR;
+    const int halfq = P->half_contours != 0.0f && k == KIND_CONTOUR;
     const uint j0 = halfq ? i0 : 0u;
     const float n0x = nrm[3 * j0], n0y = nrm[3 * j0 + 1], n0z = nrm[3 * j0 + 2];
     const float d0x = CLIP(P, 0, n0x, n0y, n0z, 0.0f), d0y = CLIP(P, 1, n0x, n0y, n0z, 0.0f);
@@ -176,7 +184,7 @@ __kernel void edges_detect(uint n, __global const float* P, __global const float
     WRITE_SCREEN(out, 3, s0x + px * f0 * hi, s0y + py * f0 * hi, c0z, c0w, hvw, hvh);
 }
 
-__kernel void caps_mh(uint n, __global const float* P, __global const float* pos,
+__kernel void caps_mh(uint n, __global const EdgeParams* P, __global const float* pos,
                       __global const float* nrm, __global const uint* edges,
                       __global const uint* kind, __global float* cap0, __global float* cap1) {
     GID_OR_RETURN(n)
@@ -199,15 +207,15 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
     const float c0z = CLIP(P, 2, x0, y0, z0, 1.0f), c0w = CLIP(P, 3, x0, y0, z0, 1.0f);
     const float c1x = CLIP(P, 0, x1, y1, z1, 1.0f), c1y = CLIP(P, 1, x1, y1, z1, 1.0f);
     const float c1z = CLIP(P, 2, x1, y1, z1, 1.0f), c1w = CLIP(P, 3, x1, y1, z1, 1.0f);
-    const float hvw = P[PARAM_HVW], hvh = P[PARAM_HVH], hw = P[PARAM_HALF_WIDTH];
+    const float hvw = P->half_vw, hvh = P->half_vh, hw = P->half_width;
     const float s0x = c0x / c0w * hvw, s0y = c0y / c0w * hvh;
     const float s1x = c1x / c1w * hvw, s1y = c1y / c1w * hvh;
     const float dx = s1x - s0x, dy = s1y - s0y;
     const float len = sqrt(dx * dx + dy * dy);
     const float px = len > 0.0f ? -dy / len : 0.0f;
     const float py = len > 0.0f ? dx / len : 1.0f;
-    const float f0 = hw * depth_factor(P[PARAM_DEPTH_K], c0w);
-    const float f1 = hw * depth_factor(P[PARAM_DEPTH_K], c1w);
+    const float f0 = hw * depth_factor(P->depth_k, c0w);
+    const float f1 = hw * depth_factor(P->depth_k, c1w);
     // Screen direction of the vertex normal: d/dt of the projection of p + t·n at t = 0.
     const float n0x = nrm[3 * i0], n0y = nrm[3 * i0 + 1], n0z = nrm[3 * i0 + 2];
     const float n1x = nrm[3 * i1], n1y = nrm[3 * i1 + 1], n1z = nrm[3 * i1 + 2];
@@ -221,8 +229,8 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
     // A normal along the view ray projects to (almost) nothing, and its direction is
     // then rounding noise: below 1e-4 of the size a unit normal can project to
     // (matrix rows x, y, w times |c| times the viewport), use the perpendicular.
-    const float msz = fabs(P[0]) + fabs(P[4]) + fabs(P[8]) + fabs(P[1]) + fabs(P[5]) +
-                      fabs(P[9]) + fabs(P[3]) + fabs(P[7]) + fabs(P[11]);
+    const float msz = fabs(P->view_proj[0]) + fabs(P->view_proj[4]) + fabs(P->view_proj[8]) + fabs(P->view_proj[1]) + fabs(P->view_proj[5]) +
+                      fabs(P->view_proj[9]) + fabs(P->view_proj[3]) + fabs(P->view_proj[7]) + fabs(P->view_proj[11]);
     const float hvm = hvw > hvh ? hvw : hvh;
     const float t0 = 1e-4f * msz * (fabs(c0x) + fabs(c0y) + fabs(c0w)) * hvm;
     const float t1 = 1e-4f * msz * (fabs(c1x) + fabs(c1y) + fabs(c1w)) * hvm;
@@ -241,7 +249,7 @@ __kernel void caps_mh(uint n, __global const float* P, __global const float* pos
     WRITE_SCREEN(o1, 2, s1x + m1x * f1, s1y + m1y * f1, c1z, c1w, hvw, hvh);
 }
 
-__kernel void caps_adjacency(uint n, __global const float* P, __global const uint* edges,
+__kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global const uint* edges,
                              __global const uint* caps, __global const uint* kind,
                              __global const float* edge_out, __global float* cap_out,
                              __global uchar* cap_drawn) {
@@ -250,9 +258,6 @@ __kernel void caps_adjacency(uint n, __global const float* P, __global const uin
     const uint e0 = caps[2 * gid], e1 = caps[2 * gid + 1];
     __global const float* q0 = edge_out + 16 * e0;
     __global const float* q1 = edge_out + 16 * e1;
-    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
-    // cache-resident, where edge-out's first x costs a cache line per edge) before
-    // any other read. KIND_DRAWN is set exactly when the quad is not the marker.
     // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
     // cache-resident, where edge-out's first x costs a cache line per edge) before
     // any other read; and rewrite the marker only if the previous run drew a cap
@@ -267,7 +272,7 @@ __kernel void caps_adjacency(uint n, __global const float* P, __global const uin
         }
         return;
     }
-    const float hvw = P[PARAM_HVW], hvh = P[PARAM_HVH];
+    const float hvw = P->half_vw, hvh = P->half_vh;
     int ok = 1;
     const uint a0 = edges[4 * e0], b0 = edges[4 * e1], b1 = edges[4 * e1 + 1];
     const uint v = (a0 == b0 || a0 == b1) ? a0 : edges[4 * e0 + 1];

@@ -7,6 +7,10 @@ use std::path::PathBuf;
 /// Result alias used throughout the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
+/// What [`Error::gl_sharing_required`] says the device lacks.
+pub const GL_SHARING_REQUIRED: &str =
+    "--interop on needs cl_khr_gl_sharing, which the device does not report";
+
 /// Everything that can go wrong in shapecue.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -132,6 +136,26 @@ impl Error {
         Error::Render {
             what: what.into(),
             detail: detail.to_string(),
+        }
+    }
+
+    /// `--interop on` on a device without `cl_khr_gl_sharing`: a
+    /// [`Error::DeviceUnsupported`] whose `what` is [`GL_SHARING_REQUIRED`],
+    /// the one device refusal with its own exit code (see [`Error::exit_code`]).
+    pub fn gl_sharing_required(device: &str) -> Self {
+        Error::DeviceUnsupported {
+            device: device.to_string(),
+            what: GL_SHARING_REQUIRED.into(),
+        }
+    }
+
+    /// The process exit code of a command that failed with this error: 3 for
+    /// `--interop on` without CL-GL sharing ([`Error::gl_sharing_required`]),
+    /// 1 for everything else. The one place exit codes are decided.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::DeviceUnsupported { what, .. } if what == GL_SHARING_REQUIRED => 3,
+            _ => 1,
         }
     }
 

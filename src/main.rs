@@ -1,7 +1,7 @@
 //! The `shapecue` command line: thin; parses, calls the library, reports.
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use shapecue::gpu::{Gpu, list_devices};
 use shapecue::mesh::Generated;
 use shapecue::mesh::{LoadOptions, Mesh};
@@ -83,20 +83,6 @@ struct RenderArgs {
     explain: bool,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum CapsArg {
-    None,
-    Mh,
-    Adjacency,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum InteropArg {
-    Auto,
-    On,
-    Off,
-}
-
 #[derive(Args)]
 struct EdgesArgs {
     /// Input mesh (.obj, .ply, .off).
@@ -161,7 +147,7 @@ struct EdgesArgs {
     /// cl_khr_gl_sharing, else copy through the host), on (require it: exit
     /// code 3 without the extension), off (host path).
     #[arg(long, value_enum, default_value = "auto")]
-    interop: InteropArg,
+    interop: shapecue::spec::edges::InteropMode,
     /// Print the cap-quality table (gap and extra pixels against the ideal
     /// round-joined stroke) for the standard meshes instead.
     #[arg(long)]
@@ -170,18 +156,6 @@ struct EdgesArgs {
     #[arg(long)]
     memory_table: bool,
 }
-
-/// `--interop on` without cl_khr_gl_sharing: exit code 3.
-#[derive(Debug)]
-struct InteropRefused(shapecue::Error);
-
-impl std::fmt::Display for InteropRefused {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.0.fmt(f)
-    }
-}
-
-impl std::error::Error for InteropRefused {}
 
 #[derive(Args)]
 struct IsoArgs {
@@ -303,11 +277,11 @@ fn main() {
     shapecue::export::output::install_interrupt_cleanup();
     if let Err(e) = run() {
         eprintln!("error: {e:#}");
-        let code = if e.downcast_ref::<InteropRefused>().is_some() {
-            3
-        } else {
-            1
-        };
+        // The library's error decides the exit code (3: `--interop on`
+        // without CL-GL sharing); everything else, CLI errors included, is 1.
+        let code = e
+            .downcast_ref::<shapecue::Error>()
+            .map_or(1, shapecue::Error::exit_code);
         std::process::exit(code);
     }
 }
@@ -687,12 +661,14 @@ fn table_meshes() -> Vec<(String, Mesh)> {
 }
 
 fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
-    use shapecue::mesh::edges::{EdgeTopology, read_marked, vertex_normals};
-    use shapecue::render::{MeshStyle, RenderOptions, Renderer};
-    use shapecue::stages::edges::{
-        self as st, CapMode, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
-        KIND_CREASE, KIND_DRAWN,
+    use shapecue::mesh::edges::EdgeTopology;
+    use shapecue::render::edges::{EdgeDrawOptions, draw};
+    use shapecue::spec::edges::{
+        CapMode, EdgeParams, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN,
+        crease_from_degrees, decide_interop, memory_use,
     };
+    // Parsed here rather than by clap's ValueEnum so that a bad name keeps
+    // the library's message ("unknown cap mode ...") and exit code 1.
     let mode: CapMode = a.caps.parse()?;
     let (w, h) = size_arg(&a.size)?;
     if !(a.width.is_finite() && a.width > 0.0) {
@@ -701,22 +677,6 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             a.width
         );
     }
-    let crease = if a.crease >= 180.0 {
-        None
-    } else {
-        Some(a.crease)
-    };
-    if a.crease <= 0.0 || a.crease.is_nan() {
-        bail!(
-            "--crease {}: the crease angle must be in (0, 180] degrees",
-            a.crease
-        );
-    }
-    let mode_interop = match a.interop {
-        InteropArg::Auto => InteropMode::Auto,
-        InteropArg::On => InteropMode::On,
-        InteropArg::Off => InteropMode::Off,
-    };
     if a.memory_table {
         println!(
             "{:<10} {:>8} {:>9} {:>12} {:>12} {:>12}",
@@ -725,7 +685,7 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         for (name, m) in table_meshes() {
             let t = EdgeTopology::new(&m, &[], &name)?;
             let bits = |c| {
-                let u = st::memory_use(c, t.edges.len(), t.caps.len());
+                let u = memory_use(c, t.edges.len(), t.caps.len());
                 u.edge_bits + u.cap_bits
             };
             println!(
@@ -742,10 +702,10 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let gpu = Gpu::new(device)?;
-    let interop = st::decide_interop(mode_interop, gpu.info.gl_sharing, &gpu.info.name)
-        .map_err(|e| anyhow::Error::new(InteropRefused(e)))?;
+    let gpu = Arc::new(Gpu::new(device)?);
+    let interop = decide_interop(a.interop, gpu.info.gl_sharing, &gpu.info.name)?;
     if a.cap_quality {
+        let crease = crease_from_degrees(a.crease)?;
         println!(
             "eye (5,5,5), unit-sized meshes at the origin, {w}x{h}, width {} px, crease {}°",
             a.width, a.crease
@@ -756,18 +716,19 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         );
         for (name, m) in table_meshes() {
             let t = EdgeTopology::new(&m, &[], &name)?;
-            let cam = st::camera_for(
-                glam::Vec3::splat(5.0),
-                glam::Vec3::ZERO,
+            let cam = shapecue::render::framed(
+                shapecue::render::Placement::At(glam::Vec3::splat(5.0)),
+                Some(glam::Vec3::ZERO),
                 None,
                 a.fov,
                 a.ortho,
                 m.bounds(),
+                w as f32 / h as f32,
             )?;
-            let mut p = EdgeParams::new(cam, w, h);
+            let mut p = EdgeParams::new(cam.view(w, h));
             p.line_width = a.width;
             p.crease_deg = crease;
-            for q in st::cap_quality(&gpu, &m, &t, &p)? {
+            for q in shapecue::render::cap_quality::cap_quality(gpu.clone(), &m, &t, &p)? {
                 println!(
                     "{name:<10} {:<10} {:>8} {:>9} {:>8} {:>8}",
                     q.mode.name(),
@@ -791,113 +752,51 @@ fn edges(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         refuse_overwrite(out, Some(path), a.force)?;
     }
     let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
-    let marked = match &a.marked {
-        Some(f) => read_marked(f)?,
-        None => Vec::new(),
-    };
-    let source = a.marked.as_deref().unwrap_or(path).display().to_string();
-    let t_topo = Instant::now();
-    let topo = if mode == CapMode::Adjacency {
-        EdgeTopology::new(&mesh, &marked, &source)?
-    } else {
-        EdgeTopology::without_caps(&mesh, &marked, &source)?
-    };
-    let topo_ms = t_topo.elapsed().as_secs_f64() * 1e3;
-    let (lo, hi) = mesh.bounds();
-    let centre = glam::Vec3::new(
-        (0.5 * (lo[0] + hi[0])) as f32,
-        (0.5 * (lo[1] + hi[1])) as f32,
-        (0.5 * (lo[2] + hi[2])) as f32,
-    );
     let Some(eye) = vec3_arg(&a.eye, "eye")? else {
         bail!("--eye X,Y,Z is required");
     };
-    let target = vec3_arg(&a.target, "target")?.unwrap_or(centre);
-    let up = vec3_arg(&a.up, "up")?;
-    let cam = st::camera_for(eye, target, up, a.fov, a.ortho, (lo, hi))?;
-    let mut p = EdgeParams::new(cam, w, h);
-    p.line_width = a.width;
-    p.crease_deg = crease;
-    p.depth_scale = a.depth_scale;
-    p.half_contours = a.half_contours;
-    p.pack()?;
-
-    let t_all = Instant::now();
-    let mut stage = EdgeStage::new(&gpu, &mesh, &topo)?;
-    let timing = stage.run(&p, mode)?;
-    let out = stage.read()?;
-    let mut r = Renderer::new(RenderOptions {
+    let opts = EdgeDrawOptions {
+        eye,
+        target: vec3_arg(&a.target, "target")?,
+        up: vec3_arg(&a.up, "up")?,
+        fov_deg: a.fov,
+        ortho: a.ortho,
         width: w,
         height: h,
-        ..Default::default()
-    })?;
-    r.begin(&cam)?;
-    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
-    r.draw_mesh(
-        &pos,
-        &vertex_normals(&mesh),
-        &[],
-        &mesh.faces,
-        MeshStyle::default(),
-    )?;
-    st::draw(&mut r, &out, [0.0, 0.0, 0.0, 1.0])?;
-    let frame = r.finish()?;
-    let frame_ms = t_all.elapsed().as_secs_f64() * 1e3;
-    frame.save_png(output)?;
-    let count = |bit: u32| out.kind.iter().filter(|&&k| k & bit != 0).count();
+        caps: mode,
+        line_width: a.width,
+        crease_deg: a.crease,
+        depth_scale: a.depth_scale,
+        half_contours: a.half_contours,
+        marked: a.marked.clone(),
+        polylines: a.svg.is_some(),
+    };
+    let d = draw(gpu, &mesh, &path.display().to_string(), &opts)?;
+    d.frame.save_png(output)?;
+    let t = &d.topology;
     println!(
         "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
          (in front of the near plane) of those detected as contour {}, crease {}, \
          boundary/marked {}; kernels {:.3} ms; wrote {}",
         path.display(),
-        topo.edges.len(),
-        topo.boundary,
-        topo.non_manifold,
-        topo.marked,
-        topo.caps.len(),
-        count(KIND_DRAWN),
-        count(KIND_CONTOUR),
-        count(KIND_CREASE),
-        count(KIND_BOUNDARY),
-        timing.kernel_ms,
+        t.edges.len(),
+        t.boundary,
+        t.non_manifold,
+        t.marked,
+        t.caps.len(),
+        d.count(KIND_DRAWN),
+        d.count(KIND_CONTOUR),
+        d.count(KIND_CREASE),
+        d.count(KIND_BOUNDARY),
+        d.timing.kernel_ms,
         output.display()
     );
-    let mut n_lines = 0;
-    if let Some(svg) = &a.svg {
-        let lines = shapecue::export::svg::visible_polylines(
-            &out.edge_out,
-            &frame,
-            shapecue::export::svg::DEFAULT_BIAS,
-        );
-        n_lines = lines.len();
-        shapecue::export::svg::write_svg(svg, &lines, w, h, a.width)?;
-        println!("wrote {} ({n_lines} polylines)", svg.display());
+    if let (Some(svg), Some(lines)) = (&a.svg, &d.polylines) {
+        shapecue::export::svg::write_svg(svg, lines, w, h, a.width)?;
+        println!("wrote {} ({} polylines)", svg.display(), lines.len());
     }
     if let Some(sp) = &a.stats {
-        let mem = st::memory_use(mode, topo.edges.len(), topo.caps.len());
-        let s = serde_json::json!({
-            "input": path.display().to_string(),
-            "device": gpu.info,
-            "vertices": mesh.n_vertices(),
-            "faces": mesh.n_faces(),
-            "edges": topo.edges.len(),
-            "cap_pairs": topo.caps.len(),
-            "boundary": topo.boundary,
-            "non_manifold": topo.non_manifold,
-            "marked": topo.marked,
-            "drawn": count(KIND_DRAWN),
-            "contour": count(KIND_CONTOUR),
-            "crease": count(KIND_CREASE),
-            "boundary_or_marked": count(KIND_BOUNDARY),
-            "caps": mode,
-            "interop": interop,
-            "timing": timing,
-            "topology_ms": topo_ms,
-            "frame_ms": frame_ms,
-            "memory_bits": mem,
-            "svg_polylines": n_lines,
-        });
-        write_json(sp, &s)?;
+        write_json(sp, &d.stats(&path.display().to_string(), &interop))?;
     }
     Ok(())
 }

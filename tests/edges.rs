@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{cli, cli_gl_missing, gpu_ref as gpu, run_cli, scratch, shared_mesh, to_f32};
+use common::{cli, cli_gl_missing, gpu, run_cli, scratch, shared_mesh, to_f32};
 
 use glam::Vec3;
 use shapecue::Error;
@@ -21,11 +21,18 @@ use shapecue::stages::edges::{
     CapMode, EdgeOutput, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
     KIND_CREASE, KIND_DRAWN, decide_interop, memory_use,
 };
-
-fn params(eye: [f32; 3], target: [f32; 3]) -> EdgeParams {
+fn camera(eye: [f32; 3], target: [f32; 3]) -> Camera {
     let mut cam = Camera::look_at(Vec3::from(eye), Vec3::from(target));
     cam.fov_y_deg = 40.0;
-    EdgeParams::new(cam, 320, 240)
+    cam
+}
+
+fn params(eye: [f32; 3], target: [f32; 3]) -> EdgeParams {
+    params_of(camera(eye, target))
+}
+
+fn params_of(cam: Camera) -> EdgeParams {
+    EdgeParams::new(cam.view(320, 240))
 }
 
 fn topo(m: &Mesh) -> EdgeTopology {
@@ -181,11 +188,12 @@ fn torus_along_its_axis_has_inner_and_outer_contours() {
     let m = mesh::torus(big_r, r, 64, 32);
     let t = topo(&m);
     for ortho in [false, true] {
-        let mut p = params([0.0, 0.0, 6.0], [0.0; 3]);
-        p.crease_deg = None;
+        let mut cam = camera([0.0, 0.0, 6.0], [0.0; 3]);
         if ortho {
-            p.camera.ortho_height = Some(4.0);
+            cam.ortho_height = Some(4.0);
         }
+        let mut p = params_of(cam);
+        p.crease_deg = None;
         let out = compare(&m, &t, &p, CapMode::Mh);
         let rho: Vec<f64> = t
             .edges
@@ -256,9 +264,10 @@ fn icosphere_and_depth_scaled_width_match_the_cpu() {
 fn camera_inside_the_mesh_draws_nothing_through_the_near_plane() {
     let m = mesh::icosphere(1.0, 3);
     let t = topo(&m);
-    let mut p = params([0.2, 0.1, 0.0], [1.0, 0.3, 0.2]);
+    let mut cam = camera([0.2, 0.1, 0.0], [1.0, 0.3, 0.2]);
+    cam.near = 0.05;
+    let mut p = params_of(cam);
     p.crease_deg = Some(5.0); // icosphere edges bend ~6°: many creases, all around the eye
-    p.camera.near = 0.05;
     let out = compare(&m, &t, &p, CapMode::Adjacency);
     let drawn = count(&out.kind, KIND_DRAWN);
     assert!(
@@ -435,12 +444,12 @@ fn bad_parameters_are_clear_errors() {
         p.line_width = w;
         check(p, "line width", &mut s);
     }
-    let mut p = ok;
-    p.camera.eye = p.camera.target;
-    check(p, "camera", &mut s);
-    let mut p = ok;
-    p.camera.eye.x = f32::NAN;
-    check(p, "camera", &mut s);
+    let mut cam = camera([5.0, 5.0, 5.0], [0.0; 3]);
+    cam.eye = cam.target;
+    check(params_of(cam), "camera", &mut s);
+    let mut cam = camera([5.0, 5.0, 5.0], [0.0; 3]);
+    cam.eye.x = f32::NAN;
+    check(params_of(cam), "camera", &mut s);
     let mut p = ok;
     p.crease_deg = Some(0.0);
     check(p, "crease", &mut s);
@@ -448,7 +457,7 @@ fn bad_parameters_are_clear_errors() {
     p.depth_scale = Some(-1.0);
     check(p, "depth scale", &mut s);
     let mut p = ok;
-    p.width = 0;
+    p.view.width = 0;
     check(p, "viewport", &mut s);
     let e = "round".parse::<CapMode>().unwrap_err().to_string();
     assert!(e.contains("unknown cap mode \"round\""), "{e}");
@@ -759,7 +768,7 @@ fn ideal_stroke_of_one_segment_is_a_capsule() {
 }
 
 fn st_ideal(edge_out: &[[f32; 4]]) -> Vec<bool> {
-    shapecue::stages::edges::ideal_coverage(edge_out, 100, 100, 5.0)
+    shapecue::render::cap_quality::ideal_coverage(edge_out, 100, 100, 5.0)
 }
 
 #[test]
@@ -770,10 +779,11 @@ fn caps_close_the_gaps_of_thick_edges() {
     }
     let m = mesh::unit_sized(&mesh::capped_cylinder(0.5, 1.0, 32));
     let t = topo(&m);
-    let mut p = params([5.0, 5.0, 5.0], [0.0; 3]);
-    p.camera.fov_y_deg = 20.0;
+    let mut cam = camera([5.0, 5.0, 5.0], [0.0; 3]);
+    cam.fov_y_deg = 20.0;
+    let mut p = params_of(cam);
     p.line_width = 10.0;
-    let q = shapecue::stages::edges::cap_quality(gpu(), &m, &t, &p).unwrap();
+    let q = shapecue::render::cap_quality::cap_quality(gpu(), &m, &t, &p).unwrap();
     let (none, mh, adj) = (&q[0], &q[1], &q[2]);
     assert!(
         none.gap > 50,

@@ -2,19 +2,21 @@
 //! the same step names: [`edges_detect`], [`caps_mh`], [`caps_adjacency`].
 //!
 //! Inputs are the device's: the packed parameter block
-//! ([`crate::stages::edges::EdgeParams::pack`]), f32 positions and normals,
+//! ([`EdgeParamBlock`], from [`crate::spec::edges::EdgeParams::pack`]), f32
+//! positions and normals,
 //! the edge and cap buffers. The arithmetic is f32 in the kernel's order, so
 //! outputs agree with the device up to rounding (fused multiply-adds), and
 //! classification can differ only for ties (a face seen exactly edge-on).
 
-use crate::stages::edges::{KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, PARAMS_LEN};
+use crate::spec::edges::{
+    EdgeParamBlock, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, MARKER,
+};
 
-const MARKER: [f32; 4] = [f32::NAN, 0.0, -1.0, 1.0];
-
-type P = [f32; PARAMS_LEN];
+type P = EdgeParamBlock;
 
 fn clip(p: &P, v: [f32; 3], h: f32) -> [f32; 4] {
-    let r = |row: usize| p[row] * v[0] + p[4 + row] * v[1] + p[8 + row] * v[2] + p[12 + row] * h;
+    let m = &p.view_proj;
+    let r = |row: usize| m[row] * v[0] + m[4 + row] * v[1] + m[8 + row] * v[2] + m[12 + row] * h;
     [r(0), r(1), r(2), r(3)]
 }
 
@@ -23,7 +25,7 @@ fn depth_factor(k: f32, w: f32) -> f32 {
 }
 
 fn screen(p: &P, sx: f32, sy: f32, z: f32, w: f32) -> [f32; 4] {
-    [sx / p[23] * w, sy / p[24] * w, z, w]
+    [sx / p.half_vw * w, sy / p.half_vh * w, z, w]
 }
 
 /// Screen points, unit perpendicular and scaled half widths of edge `i0 → i1`.
@@ -39,7 +41,7 @@ struct Projected {
 
 fn project(p: &P, a: [f32; 3], b: [f32; 3]) -> Projected {
     let (c0, c1) = (clip(p, a, 1.0), clip(p, b, 1.0));
-    let (hvw, hvh, hw) = (p[23], p[24], p[25]);
+    let (hvw, hvh, hw) = (p.half_vw, p.half_vh, p.half_width);
     let s0 = [c0[0] / c0[3] * hvw, c0[1] / c0[3] * hvh];
     let s1 = [c1[0] / c1[3] * hvw, c1[1] / c1[3] * hvh];
     let (dx, dy) = (s1[0] - s0[0], s1[1] - s0[1]);
@@ -55,8 +57,8 @@ fn project(p: &P, a: [f32; 3], b: [f32; 3]) -> Projected {
         s0,
         s1,
         perp,
-        f0: hw * depth_factor(p[27], c0[3]),
-        f1: hw * depth_factor(p[27], c1[3]),
+        f0: hw * depth_factor(p.depth_k, c0[3]),
+        f1: hw * depth_factor(p.depth_k, c1[3]),
     }
 }
 
@@ -91,29 +93,29 @@ pub fn edges_detect(
         ];
         let mut k = 0;
         if i3 == i0 {
-            if p[30] != 0.0 {
+            if p.boundaries != 0.0 {
                 k |= KIND_BOUNDARY;
             }
         } else {
-            let e = if p[22] != 0.0 {
-                [-p[19], -p[20], -p[21]]
+            let e = if p.ortho != 0.0 {
+                p.view_dir.map(|c| -c)
             } else {
-                [p[16] - v0[0], p[17] - v0[1], p[18] - v0[2]]
+                [p.eye[0] - v0[0], p.eye[1] - v0[1], p.eye[2] - v0[2]]
             };
             let da = na[0] * e[0] + na[1] * e[1] + na[2] * e[2];
             let db = nb[0] * e[0] + nb[1] * e[1] + nb[2] * e[2];
-            if p[29] != 0.0 && ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+            if p.contours != 0.0 && ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
                 k |= KIND_CONTOUR;
             }
             let dn = na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2];
             let la = na[0] * na[0] + na[1] * na[1] + na[2] * na[2];
             let lb = nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2];
-            if dn < p[26] * (la * lb).sqrt() {
+            if dn < p.cos_crease * (la * lb).sqrt() {
                 k |= KIND_CREASE;
             }
         }
         let pr = project(p, v0, v1);
-        let drawn = k != 0 && pr.c0[3] > p[28] && pr.c1[3] > p[28];
+        let drawn = k != 0 && pr.c0[3] > p.w_min && pr.c1[3] > p.w_min;
         if !drawn {
             kinds.push(k);
             out.extend_from_slice(&[MARKER; 4]);
@@ -123,12 +125,12 @@ pub fn edges_detect(
         let (s0, s1, q, f0, f1) = (pr.s0, pr.s1, pr.perp, pr.f0, pr.f1);
         let (c0, c1) = (pr.c0, pr.c1);
         // Half quads for contour-only edges: outward by the full width.
-        let half = p[31] != 0.0 && k == KIND_CONTOUR;
+        let half = p.half_contours != 0.0 && k == KIND_CONTOUR;
         let n = if half { at(nrm, i0) } else { at(nrm, 0) };
         let d = clip(p, n, 0.0);
         let m = [
-            (d[0] * c0[3] - c0[0] * d[3]) * p[23],
-            (d[1] * c0[3] - c0[1] * d[3]) * p[24],
+            (d[0] * c0[3] - c0[0] * d[3]) * p.half_vw,
+            (d[1] * c0[3] - c0[1] * d[3]) * p.half_vh,
         ];
         let g = if m[0] * q[0] + m[1] * q[1] >= 0.0 {
             1.0
@@ -177,14 +179,15 @@ pub fn caps_mh(
             (pr.c1, pr.s1, at(nrm, i1), pr.f1, &mut o1),
         ] {
             let d = clip(p, n, 0.0);
-            let mx = (d[0] * c[3] - c[0] * d[3]) * p[23];
-            let my = (d[1] * c[3] - c[1] * d[3]) * p[24];
+            let mx = (d[0] * c[3] - c[0] * d[3]) * p.half_vw;
+            let my = (d[1] * c[3] - c[1] * d[3]) * p.half_vh;
             let l = (mx * mx + my * my).sqrt();
             let msz: f32 = [0, 4, 8, 1, 5, 9, 3, 7, 11]
                 .iter()
-                .map(|&i| p[i].abs())
+                .map(|&i| p.view_proj[i].abs())
                 .sum();
-            let tol = 1e-4 * msz * (c[0].abs() + c[1].abs() + c[3].abs()) * p[23].max(p[24]);
+            let tol =
+                1e-4 * msz * (c[0].abs() + c[1].abs() + c[3].abs()) * p.half_vw.max(p.half_vh);
             let m = if l > tol && l > 0.0 {
                 [mx / l, my / l]
             } else {
@@ -217,7 +220,7 @@ pub fn caps_adjacency(
     caps: &[[u32; 2]],
     edge_out: &[[f32; 4]],
 ) -> Vec<[f32; 4]> {
-    let (hvw, hvh) = (p[23], p[24]);
+    let (hvw, hvh) = (p.half_vw, p.half_vh);
     let mut out = Vec::with_capacity(4 * caps.len());
     for &[e0, e1] in caps {
         let q0 = &edge_out[4 * e0 as usize..4 * e0 as usize + 4];

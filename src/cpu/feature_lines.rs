@@ -3,15 +3,10 @@
 //! face order; the device's order is that of its atomic counter, so tests
 //! compare canonically sorted segment lists.
 
-/// Camera for line extraction: an eye point, or a direction towards the
-/// viewer for orthographic views.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct View {
-    /// Eye position, or direction towards the viewer when `ortho`.
-    pub eye: [f32; 3],
-    /// Orthographic projection.
-    pub ortho: bool,
-}
+pub use crate::spec::feature_lines::EyeView as View; // compat re-export
+pub use crate::spec::feature_lines::LineInputs; // compat re-export
+use crate::spec::feature_lines::LineView;
+pub use crate::spec::feature_lines::Segment; // compat re-export
 
 /// Per-vertex values of `lines_vertex`: n·v, κr·sin²θ and the suggestive test.
 pub struct VertexTerms {
@@ -23,31 +18,14 @@ pub struct VertexTerms {
     pub sc: Vec<f32>,
 }
 
-/// A segment: endpoints, kind (0 contour, 1 suggestive) and strength.
-pub type Segment = ([f32; 3], [f32; 3], u32, f32);
-
-/// Inputs of the stage, f32 per vertex.
-pub struct LineInputs<'a> {
-    /// Positions.
-    pub pos: &'a [[f32; 3]],
-    /// Unit normals.
-    pub nrm: &'a [[f32; 3]],
-    /// First principal directions.
-    pub d1: &'a [[f32; 3]],
-    /// Second principal directions.
-    pub d2: &'a [[f32; 3]],
-    /// (k1, k2).
-    pub k: &'a [[f32; 2]],
-    /// (C111, C112, C122, C222).
-    pub dk: &'a [[f32; 4]],
-}
-
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `lines_vertex`.
-pub fn lines_vertex(x: &LineInputs, view: View) -> VertexTerms {
+/// `lines_vertex`, seen from `view` (a [`crate::spec::view::View`], or the
+/// eye-only [`View`]).
+pub fn lines_vertex(x: &LineInputs, view: impl LineView) -> VertexTerms {
+    let (eye, ortho) = (view.line_eye(), view.is_ortho());
     let n = x.pos.len();
     let mut t = VertexTerms {
         ndv: Vec::with_capacity(n),
@@ -56,10 +34,10 @@ pub fn lines_vertex(x: &LineInputs, view: View) -> VertexTerms {
     };
     for i in 0..n {
         let p = x.pos[i];
-        let mut v = if view.ortho {
-            view.eye
+        let mut v = if ortho {
+            eye
         } else {
-            [view.eye[0] - p[0], view.eye[1] - p[1], view.eye[2] - p[2]]
+            [eye[0] - p[0], eye[1] - p[1], eye[2] - p[2]]
         };
         let l = dot(v, v).sqrt();
         let s = if l > 0.0 { 1.0 / l } else { 0.0 };

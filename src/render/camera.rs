@@ -8,6 +8,7 @@ use glam::camera::rh::{proj::opengl, view};
 use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
+use crate::spec::view::View;
 
 /// A pinhole (or orthographic) camera. Plain data: build one with
 /// [`Camera::look_at`] or [`Camera::fit`] and adjust the fields; the renderer
@@ -95,8 +96,24 @@ impl Camera {
         })
     }
 
+    /// The [`View`] the stages take: this camera's view-projection for a
+    /// `width × height` viewport, eye, direction (target − eye), projection
+    /// kind and near plane. Plain data; [`View::check`] (called by the
+    /// stages) rejects what is unusable.
+    pub fn view(&self, width: u32, height: u32) -> View {
+        View {
+            view_proj: self.view_proj(width as f32 / height as f32),
+            eye: self.eye,
+            dir: self.target - self.eye,
+            ortho: self.ortho_height.is_some(),
+            near: self.near,
+            width,
+            height,
+        }
+    }
+
     /// The world-to-view matrix (right-handed, looking down −Z).
-    pub fn view(&self) -> Mat4 {
+    pub fn view_matrix(&self) -> Mat4 {
         // glam wants a unit up vector (a zero one is rejected by `validate`).
         view::look_at_mat4(self.eye, self.target, self.up.normalize_or(Vec3::Y))
     }
@@ -115,7 +132,7 @@ impl Camera {
 
     /// `proj(aspect) * view()`: world to clip space.
     pub fn view_proj(&self, aspect: f32) -> Mat4 {
-        self.proj(aspect) * self.view()
+        self.proj(aspect) * self.view_matrix()
     }
 
     /// Rejects a camera that would produce a singular or NaN matrix: a
@@ -170,4 +187,64 @@ impl Camera {
         }
         Ok(())
     }
+}
+
+/// Where a framed camera's eye is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Placement {
+    /// At this point (world space).
+    At(Vec3),
+    /// On this direction from the centre of the bounds, far enough that the
+    /// bounding sphere fits the view with a 5 % margin (looking at the centre).
+    Fit(Vec3),
+}
+
+/// The one framing of the CLI, the tables and the scene executor:
+/// perspective with vertical field of view `fov_deg`, or orthographic showing
+/// the height the perspective view would show at the target; near and far
+/// hug the bounding sphere of `bounds` (near = 1/1000 of the radius when the
+/// eye is inside it). `target` defaults to the centre of `bounds` (a
+/// [`Placement::Fit`] always looks at the centre); `aspect` (width / height)
+/// matters only for [`Placement::Fit`].
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for a camera [`Camera::validate`] rejects.
+pub fn framed(
+    placement: Placement,
+    target: Option<Vec3>,
+    up: Option<Vec3>,
+    fov_deg: f32,
+    ortho: bool,
+    bounds: ([f64; 3], [f64; 3]),
+    aspect: f32,
+) -> Result<Camera> {
+    let (lo, hi) = bounds;
+    let lo = glam::DVec3::from(lo).as_vec3();
+    let hi = glam::DVec3::from(hi).as_vec3();
+    let centre = 0.5 * (lo + hi);
+    let (eye, target) = match placement {
+        Placement::At(eye) => (eye, target.unwrap_or(centre)),
+        Placement::Fit(d) => {
+            // 5 % margin around the bounding sphere.
+            let dist = fit_sphere(lo, hi, fov_deg, aspect).2 * 1.05;
+            (centre + d.normalize() * dist, centre)
+        }
+    };
+    let radius = (0.5 * (hi - lo).length()).max(1e-6);
+    let mut cam = Camera::look_at(eye, target);
+    if let Some(u) = up {
+        cam.up = u;
+    }
+    cam.fov_y_deg = fov_deg;
+    let d = eye.distance(centre);
+    cam.near = ((d - radius) * 0.9).max(1e-3 * radius);
+    cam.far = (d + radius) * 1.1 + cam.near;
+    if ortho {
+        let dist = eye.distance(target);
+        cam.ortho_height = Some(2.0 * dist * (0.5 * fov_deg.to_radians()).tan());
+        // Orthographic: nothing is behind the eye, so near can sit at the sphere.
+        cam.near = (d - radius).max(1e-3 * radius) * 0.9;
+    }
+    cam.validate()?;
+    Ok(cam)
 }

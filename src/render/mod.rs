@@ -25,19 +25,22 @@
 //! one after another; each public call makes its own context current first.
 
 mod camera;
+pub mod cap_quality;
 pub mod colormap;
 mod context;
+pub mod edges;
 mod frame;
 mod lines;
 
-pub use camera::{Camera, fit_sphere};
+pub use camera::{Camera, Placement, fit_sphere, framed};
 pub use frame::Frame;
 pub use lines::segments_to_clip_quads;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use glow::HasContext;
 
 use crate::error::{Error, Result};
+use crate::spec::view::View;
 use context::GlContext;
 
 /// Size, antialiasing and background of the images a [`Renderer`] produces.
@@ -170,8 +173,7 @@ struct MeshUniforms {
 
 /// The camera state of the frame being drawn.
 struct FrameState {
-    view_proj: Mat4,
-    camera: Camera,
+    view: View,
 }
 
 /// A headless OpenGL renderer with its own EGL context and framebuffers.
@@ -475,6 +477,23 @@ impl Renderer {
     /// [`draw_mesh`](Self::draw_mesh) and [`draw_lines`](Self::draw_lines).
     pub fn begin(&mut self, cam: &Camera) -> Result<()> {
         cam.validate()?;
+        self.begin_view(&cam.view(self.opts.width, self.opts.height))
+    }
+
+    /// [`begin`](Self::begin) with a [`View`] (the stages' view type) made
+    /// for this renderer's image size.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a view of another size or one
+    /// [`View::check`] rejects.
+    pub fn begin_view(&mut self, view: &View) -> Result<()> {
+        if (view.width, view.height) != (self.opts.width, self.opts.height) {
+            return Err(Error::InvalidArgument(format!(
+                "Renderer::begin_view: a {}x{} view for {}x{} images",
+                view.width, view.height, self.opts.width, self.opts.height
+            )));
+        }
+        view.check("render")?;
         self.ctx.make_current()?;
         let gl = &self.gl;
         let target = self.ms.as_ref().unwrap_or(&self.resolve);
@@ -488,10 +507,7 @@ impl Renderer {
             gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
         }
         check(gl, "clearing the frame")?;
-        self.frame = Some(FrameState {
-            view_proj: cam.view_proj(self.aspect()),
-            camera: *cam,
-        });
+        self.frame = Some(FrameState { view: *view });
         Ok(())
     }
 
@@ -554,8 +570,8 @@ impl Renderer {
             Light::Directional(d) => (d.try_normalize().unwrap_or(Vec3::Z), false),
         };
         let f = self.frame("draw_mesh")?;
-        let cam = &f.camera;
-        let view_dir = (cam.target - cam.eye).normalize();
+        let cam = &f.view;
+        let view_dir = cam.unit_dir();
         let gl = &self.gl;
         let u = &self.mesh_u;
         // SAFETY: the context is current (`frame`); the buffers uploaded below
@@ -565,11 +581,11 @@ impl Renderer {
             gl.uniform_matrix_4_f32_slice(
                 u.view_proj.as_ref(),
                 false,
-                &f.view_proj.to_cols_array(),
+                &cam.view_proj.to_cols_array(),
             );
             gl.uniform_3_f32(u.eye.as_ref(), cam.eye.x, cam.eye.y, cam.eye.z);
             gl.uniform_3_f32(u.view_dir.as_ref(), view_dir.x, view_dir.y, view_dir.z);
-            gl.uniform_1_i32(u.ortho.as_ref(), cam.ortho_height.is_some() as i32);
+            gl.uniform_1_i32(u.ortho.as_ref(), cam.ortho as i32);
             gl.uniform_1_i32(u.headlight.as_ref(), headlight as i32);
             gl.uniform_3_f32(u.light_dir.as_ref(), light_dir.x, light_dir.y, light_dir.z);
             gl.uniform_1_f32(u.ambient.as_ref(), style.ambient.clamp(0.0, 1.0));
@@ -652,7 +668,7 @@ impl Renderer {
                 segments.len()
             )));
         }
-        let view_proj = self.frame("draw_lines")?.view_proj;
+        let view_proj = self.frame("draw_lines")?.view.view_proj;
         let quads = segments_to_clip_quads(
             view_proj,
             [self.opts.width, self.opts.height],

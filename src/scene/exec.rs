@@ -18,7 +18,7 @@
 //! flipbook frame, host normals, building topology, rendering) report wall
 //! time. The report says which, per pass.
 
-use crate::cpu::feature_lines::{LineInputs, Segment, View};
+use crate::cpu::feature_lines::{LineInputs, Segment};
 use crate::error::{Error, Result};
 use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use crate::gpu::Gpu;
@@ -26,12 +26,14 @@ use crate::mesh::edges::{EdgeTopology, vertex_normals};
 use crate::mesh::skinned::SkinnedMesh;
 use crate::mesh::{LoadOptions, Mesh};
 use crate::render::colormap::{curvature_color, curvature_scale, with_ao};
+use crate::render::edges::draw_edges;
 use crate::render::{Camera, Frame, MeshStyle, RenderOptions, Renderer};
+use crate::render::{Placement, framed};
 use crate::scene::file::{CameraKind, ClipRef, Scene, Source, ViewSpec};
 use crate::scene::planner::{Lifetime, Pass, Plan, plan_with};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::{CurvatureEstimator, Pass as CPass, RunTiming};
-use crate::stages::edges::{self as st, EdgeOutput, EdgeParams, EdgeStage};
+use crate::stages::edges::{EdgeOutput, EdgeParams, EdgeStage};
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use crate::stages::skinning::Skinner;
 use serde::Serialize;
@@ -308,7 +310,7 @@ fn pass_ms(t: &RunTiming, names: &[&str]) -> f64 {
 }
 
 /// Per-topology device state.
-struct Topology<'g> {
+struct Topology {
     mesh: Mesh,
     /// Median edge length ([`crate::mesh::feature_size`]) of the topology's
     /// first pose: the scale of the suggestive-contour threshold.
@@ -320,7 +322,7 @@ struct Topology<'g> {
     norm: Normalization,
     est: Option<CurvatureEstimator>,
     lines: Option<LineExtractor>,
-    edges: Option<EdgeStage<'g>>,
+    edges: Option<EdgeStage>,
 }
 
 /// Host copies of the pose that the renderer and the host-side passes use.
@@ -349,21 +351,12 @@ fn camera(
             (f64::from(p[i]) - origin[i]) as f32
         }))
     };
-    let (lo, hi) = bounds;
-    let lo3 = glam::DVec3::from(lo).as_vec3();
-    let hi3 = glam::DVec3::from(hi).as_vec3();
-    let centre = 0.5 * (lo3 + hi3);
     let up = v.up.map(glam::Vec3::from);
-    let (eye, target) = match &v.kind {
-        CameraKind::LookAt { eye, target } => (local(*eye), target.map(local).unwrap_or(centre)),
-        CameraKind::Fit(d) => {
-            // 5 % margin around the bounding sphere.
-            let dist = crate::render::fit_sphere(lo3, hi3, v.fov, aspect).2 * 1.05;
-            let dir = glam::Vec3::from(*d).normalize();
-            (centre + dir * dist, centre)
-        }
+    let (placement, target) = match &v.kind {
+        CameraKind::LookAt { eye, target } => (Placement::At(local(*eye)), target.map(local)),
+        CameraKind::Fit(d) => (Placement::Fit(glam::Vec3::from(*d)), None),
     };
-    st::camera_for(eye, target, up, v.fov, v.ortho, bounds)
+    framed(placement, target, up, v.fov, v.ortho, bounds, aspect)
 }
 
 /// Runs a scene: loads the input, plans, refuses to overwrite outputs
@@ -613,7 +606,7 @@ pub fn run(
                     if has(Pass::CapBuffer) {
                         rec.add(Pass::CapBuffer, 0.0, "wall", "pairs of edges sharing a vertex (built with the edge buffer; time counted there)");
                     }
-                    t.edges = Some(EdgeStage::new(&gpu, &t.mesh, &et)?);
+                    t.edges = Some(EdgeStage::new(gpu.clone(), &t.mesh, &et)?);
                 }
                 topo = Some(t);
             }
@@ -729,14 +722,7 @@ pub fn run(
             let mut t_view = 0.0;
             let mut segs: Vec<Segment> = Vec::new();
             if let Some(lx) = t.lines.as_mut() {
-                let v = View {
-                    eye: if cam.ortho_height.is_some() {
-                        (cam.eye - cam.target).to_array()
-                    } else {
-                        cam.eye.to_array()
-                    },
-                    ortho: cam.ortho_height.is_some(),
-                };
+                let v = cam.view(w, h);
                 let (s, stats) = match t.est.as_ref() {
                     Some(est) => lx.extract_device_at(
                         est,
@@ -787,7 +773,7 @@ pub fn run(
             }
             let mut edges_out: Option<EdgeOutput> = None;
             if let Some(es) = t.edges.as_mut() {
-                let mut p = EdgeParams::new(*cam, w, h);
+                let mut p = EdgeParams::new(cam.view(w, h));
                 p.line_width = fx.edge.0;
                 p.crease_deg = fx.crease;
                 p.contours = fx.edge_contours;
@@ -869,7 +855,7 @@ pub fn run(
             }
             if let Some(eo) = &edges_out {
                 let [r, g, b] = fx.edge.1;
-                st::draw(&mut renderer, eo, [r, g, b, 1.0])?;
+                draw_edges(&mut renderer, eo, [r, g, b, 1.0])?;
                 line_quads.extend_from_slice(&eo.edge_out);
             }
             let image: Frame = renderer.finish()?;

@@ -42,7 +42,7 @@
 use crate::error::{Error, Result};
 use crate::scene::planner::{Cue, Input};
 use crate::spec::ao::AoMode;
-use crate::stages::edges::CapMode;
+use crate::spec::edges::CapMode;
 use serde::Deserialize;
 use std::ops::Range;
 use std::path::{Path, PathBuf};

@@ -11,7 +11,7 @@
 //! isosurface changes topology with every pose, so its topology passes are
 //! pose passes.
 
-use crate::stages::edges::CapMode;
+use crate::spec::edges::CapMode;
 use serde::Serialize;
 
 /// A shape cue a scene can ask for.

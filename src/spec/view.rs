@@ -1,1 +1,91 @@
-//! The one view type (camera, projection, viewport) that the renderer makes and the edge and line stages consume.
+//! The one view type: what a stage needs to know of a camera and an image,
+//! as plain data. The renderer's camera makes it (`render::Camera::view`);
+//! the edges stage packs it into its parameter block
+//! ([`crate::spec::edges::EdgeParams`]) and the feature-line stage reads its
+//! eye ([`crate::spec::feature_lines::LineView`]). Nothing here knows GL or
+//! the device: compute takes a view, it never frames or draws one.
+
+use glam::{Mat4, Vec3};
+
+use crate::error::{Error, Result};
+
+/// A camera seen from a stage: world-to-clip matrix, eye, view direction,
+/// projection kind, near plane and viewport. Clip space is OpenGL's (z in
+/// [−w, w]), the convention of the renderer that draws what stages write.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// World to clip space (projection × view), for the viewport's aspect.
+    pub view_proj: Mat4,
+    /// Eye position (world space).
+    pub eye: Vec3,
+    /// From the eye towards the point looked at, *not* normalized (its
+    /// length is the distance to that point); [`View::unit_dir`] is the unit
+    /// vector. Kept unnormalized so that `-dir` is exactly `eye − target`,
+    /// the direction towards the viewer that orthographic line extraction
+    /// has always used.
+    pub dir: Vec3,
+    /// Orthographic projection.
+    pub ortho: bool,
+    /// Near clipping distance (> 0).
+    pub near: f32,
+    /// Viewport width in pixels.
+    pub width: u32,
+    /// Viewport height in pixels.
+    pub height: u32,
+}
+
+impl View {
+    /// The unit view direction (eye towards the point looked at).
+    pub fn unit_dir(&self) -> Vec3 {
+        self.dir.normalize()
+    }
+
+    /// Width / height of the viewport.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The direction towards the viewer, `eye − target` (orthographic line
+    /// extraction's constant view vector).
+    pub fn toward_viewer(&self) -> Vec3 {
+        -self.dir
+    }
+
+    /// Rejects a view no stage can use: a non-finite eye or direction, a zero
+    /// direction (eye and target coincide), a non-positive near plane, or a
+    /// non-finite matrix, each as a `camera:` problem; an empty viewport as a
+    /// `{what}: viewport` problem.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming the problem.
+    pub fn check(&self, what: &str) -> Result<()> {
+        let bad = |problem: String| Err(Error::InvalidArgument(problem));
+        if !(self.eye.is_finite() && self.dir.is_finite() && self.near.is_finite()) {
+            return bad(format!(
+                "camera: non-finite value (eye {}, direction {}, near {})",
+                self.eye, self.dir, self.near
+            ));
+        }
+        if self.dir.length_squared() == 0.0 {
+            return bad(format!(
+                "camera: eye and target coincide at {} (no view direction)",
+                self.eye
+            ));
+        }
+        if !self.ortho && self.near <= 0.0 {
+            return bad(format!("camera: near {} must be > 0", self.near));
+        }
+        if self.width == 0 || self.height == 0 {
+            return bad(format!(
+                "{what}: viewport {}x{} is empty",
+                self.width, self.height
+            ));
+        }
+        if !self.view_proj.is_finite() {
+            return bad(format!(
+                "{what}: the camera gives a non-finite view-projection matrix"
+            ));
+        }
+        Ok(())
+    }
+}

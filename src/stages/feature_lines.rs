@@ -4,12 +4,15 @@
 //! reads them from a curvature estimator's device buffers
 //! ([`LineExtractor::extract_device`]) and runs `lines_vertex` and
 //! `lines_face`. The segment buffer holds two segments per face (one of each
-//! kind), the most a face can emit, and the kernel still counts and refuses
-//! what does not fit. CPU twin: [`crate::cpu::feature_lines`].
+//! kind), the most a face can emit ([`segments_bound`]), and the kernel still
+//! counts and refuses what does not fit. CPU twin:
+//! [`crate::cpu::feature_lines`]. Views are [`crate::spec::view::View`]s
+//! (made by the renderer's camera) or the eye-only
+//! [`crate::spec::feature_lines::EyeView`], through [`LineView`].
 
-use crate::cpu::feature_lines::{LineInputs, Segment, View};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::feature_lines::{LineInputs, LineView, Segment, segments_bound};
 use crate::stages::curvature::CurvatureEstimator;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -87,7 +90,7 @@ impl LineExtractor {
                 gpu.buffer(4 * nv)?,
             ],
             terms: [gpu.buffer(nv)?, gpu.buffer(nv)?, gpu.buffer(nv)?],
-            seg: gpu.buffer(16 * faces.len())?,
+            seg: gpu.buffer(8 * segments_bound(faces.len()))?,
             counter: gpu.buffer(1)?,
             gpu,
             nv,
@@ -100,7 +103,7 @@ impl LineExtractor {
     pub fn extract(
         &mut self,
         x: &LineInputs,
-        view: View,
+        view: impl LineView,
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
@@ -120,6 +123,7 @@ impl LineExtractor {
                 "feature lines: every per-vertex input needs {n} entries"
             )));
         }
+        let view = (view.line_eye(), view.is_ortho());
         check_view(view, feature_size)?;
         let g = self.gpu.clone();
         g.write(&mut self.inputs[0], x.pos.as_flattened())?;
@@ -146,7 +150,7 @@ impl LineExtractor {
     pub fn extract_device(
         &mut self,
         est: &CurvatureEstimator,
-        view: View,
+        view: impl LineView,
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
@@ -160,12 +164,13 @@ impl LineExtractor {
     pub fn extract_device_at(
         &mut self,
         est: &CurvatureEstimator,
-        view: View,
+        view: impl LineView,
         feature_size: f32,
         opts: LineOptions,
         origin: [f64; 3],
     ) -> Result<(Vec<Segment>, LineStats)> {
-        check_view(view, feature_size)?;
+        let (view_eye, ortho) = (view.line_eye(), view.is_ortho());
+        check_view((view_eye, ortho), feature_size)?;
         let d = est.device_outputs()?;
         if d.nv != self.nv {
             return Err(Error::InvalidArgument(format!(
@@ -174,16 +179,13 @@ impl LineExtractor {
             )));
         }
         let norm = d.norm;
-        let eye = if view.ortho {
-            view.eye
+        let eye = if ortho {
+            view_eye
         } else {
-            let e: [f64; 3] = std::array::from_fn(|i| f64::from(view.eye[i]) + origin[i]);
+            let e: [f64; 3] = std::array::from_fn(|i| f64::from(view_eye[i]) + origin[i]);
             norm.apply(e).map(|c| c as f32)
         };
-        let local = View {
-            eye,
-            ortho: view.ortho,
-        };
+        let local = (eye, ortho);
         let size = (f64::from(feature_size) / norm.scale) as f32;
         // Huge world values may not survive the mapping into f32.
         check_view(local, size)?;
@@ -203,29 +205,30 @@ impl LineExtractor {
 
     /// Runs `lines_vertex` and `lines_face` on the per-vertex float buffers
     /// `inputs` (pos, nrm, d1, d2, k, dk) in one coordinate system, with
-    /// `view` and `feature_size` in that system, and reads the segments back.
+    /// `view` (eye or direction towards the viewer, ortho flag) and
+    /// `feature_size` in that system, and reads the segments back.
     fn run(
         &mut self,
         inputs: [Arg; 6],
-        view: View,
+        view: ([f32; 3], bool),
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
         let n = self.nv;
         let g = self.gpu.clone();
         g.zero(&mut self.counter, 1)?;
-        let [ex, ey, ez] = view.eye;
+        let ([ex, ey, ez], ortho) = view;
         let mut args: Vec<Arg> = vec![Arg::U32(n as u32)];
         args.extend(inputs);
         args.extend([
             Arg::F32(ex),
             Arg::F32(ey),
             Arg::F32(ez),
-            Arg::U32(u32::from(view.ortho)),
+            Arg::U32(u32::from(ortho)),
         ]);
         args.extend(self.terms.iter().map(buf));
         let e1 = launch(&g, &self.vertex, n, &args)?;
-        let cap = 2 * self.nf;
+        let cap = segments_bound(self.nf);
         let e2 = launch(
             &g,
             &self.face,
@@ -271,11 +274,10 @@ impl LineExtractor {
 
 /// A finite eye (a non-zero direction when orthographic) and a finite,
 /// positive feature size.
-fn check_view(view: View, feature_size: f32) -> Result<()> {
-    if view.eye.iter().any(|c| !c.is_finite()) || (view.ortho && view.eye == [0.0; 3]) {
+fn check_view((eye, ortho): ([f32; 3], bool), feature_size: f32) -> Result<()> {
+    if eye.iter().any(|c| !c.is_finite()) || (ortho && eye == [0.0; 3]) {
         return Err(Error::InvalidArgument(format!(
-            "feature lines: invalid view {:?} (finite eye; a non-zero direction when orthographic)",
-            view.eye
+            "feature lines: invalid view {eye:?} (finite eye; a non-zero direction when orthographic)"
         )));
     }
     if !(feature_size.is_finite() && feature_size > 0.0) {

@@ -1,0 +1,251 @@
+//! Drawing the edges stage's output (House & Li, seed 002): the edge-out and
+//! cap-out buffers as projection-space quads and triangles
+//! ([`draw_edges`]), and [`draw`], the whole `shapecue edges` picture in one
+//! call: topology, framing, the stage, the shaded mesh with its edges, the
+//! visible polylines for SVG and the statistics.
+//!
+//! This is where the screen meets the edges stage; the stage itself
+//! ([`crate::stages::edges`]) takes a [`crate::spec::view::View`] and knows
+//! nothing of framing or GL.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, framed};
+use crate::error::Result;
+use crate::export::svg::{DEFAULT_BIAS, visible_polylines};
+use crate::gpu::{DeviceInfo, Gpu};
+use crate::mesh::Mesh;
+use crate::mesh::edges::{EdgeTopology, read_marked, vertex_normals};
+use crate::spec::edges::{
+    CapMode, EdgeOutput, EdgeParams, InteropDecision, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
+    KIND_DRAWN, MemoryUse, crease_from_degrees, memory_use,
+};
+use crate::stages::edges::{EdgeStage, RunTiming};
+
+/// Draws the edge quads of `out` and the caps it holds (those of the last
+/// run's mode) with flat `color` into the frame in progress.
+pub fn draw_edges(r: &mut Renderer, out: &EdgeOutput, color: [f32; 4]) -> Result<()> {
+    r.draw_clip_quads(&out.edge_out, color)?;
+    r.draw_clip_triangles(&out.cap_mh0, color)?;
+    r.draw_clip_triangles(&out.cap_mh1, color)?;
+    r.draw_clip_quads(&out.cap_adj, color)
+}
+
+/// What [`draw`] draws and how (the `shapecue edges` options).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgeDrawOptions {
+    /// Eye position (world space).
+    pub eye: Vec3,
+    /// Point looked at; `None`: the centre of the mesh's bounding box.
+    pub target: Option<Vec3>,
+    /// Up direction; `None`: +Y, or +Z when looking along Y.
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    pub fov_deg: f32,
+    /// Orthographic projection (showing the height the perspective view shows at the target).
+    pub ortho: bool,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Cap variant.
+    pub caps: CapMode,
+    /// Edge width in pixels.
+    pub line_width: f32,
+    /// Crease angle in degrees; 180 or more finds none
+    /// ([`crease_from_degrees`]).
+    pub crease_deg: f32,
+    /// Depth scale k of the width factor max(1, k/w).
+    pub depth_scale: Option<f32>,
+    /// Contour-only edges as half quads, outward from the silhouette.
+    pub half_contours: bool,
+    /// Marked edges: a text file of vertex-index pairs
+    /// ([`crate::mesh::edges::read_marked`]).
+    pub marked: Option<PathBuf>,
+    /// Also find the visible edges as polylines (for SVG).
+    pub polylines: bool,
+}
+
+impl Default for EdgeDrawOptions {
+    fn default() -> Self {
+        EdgeDrawOptions {
+            eye: Vec3::splat(5.0),
+            target: None,
+            up: None,
+            fov_deg: 40.0,
+            ortho: false,
+            width: 800,
+            height: 600,
+            caps: CapMode::Adjacency,
+            line_width: 4.0,
+            crease_deg: 30.0,
+            depth_scale: None,
+            half_contours: false,
+            marked: None,
+            polylines: false,
+        }
+    }
+}
+
+/// What [`draw`] made.
+#[derive(Clone, Debug)]
+pub struct EdgeDrawing {
+    /// The picture: the shaded mesh with its edges and caps in black.
+    pub frame: Frame,
+    /// The stage's outputs.
+    pub output: EdgeOutput,
+    /// The edge and cap buffers (and their counts).
+    pub topology: EdgeTopology,
+    /// The cap variant drawn.
+    pub caps: CapMode,
+    /// The camera used.
+    pub camera: Camera,
+    /// Mesh vertices and faces.
+    pub vertices: usize,
+    /// Mesh faces.
+    pub faces: usize,
+    /// Kernel and wall times of the stage's run.
+    pub timing: RunTiming,
+    /// Building the topology, ms.
+    pub topology_ms: f64,
+    /// The stage, its run and read-back, and the whole GL frame, ms.
+    pub frame_ms: f64,
+    /// Device memory of the variant.
+    pub memory: MemoryUse,
+    /// The visible parts of the drawn edges, joined into polylines (pixels),
+    /// when [`EdgeDrawOptions::polylines`] asked for them.
+    pub polylines: Option<Vec<Vec<[f32; 2]>>>,
+    /// The device that ran the stage.
+    pub device: DeviceInfo,
+}
+
+impl EdgeDrawing {
+    /// Edges whose kind has `bit` set (`KIND_*`).
+    pub fn count(&self, bit: u32) -> usize {
+        self.output.count(bit)
+    }
+
+    /// The statistics document of `shapecue edges --stats`: counts, timings,
+    /// memory, the interop path; `input` names the mesh.
+    pub fn stats(&self, input: &str, interop: &InteropDecision) -> serde_json::Value {
+        let t = &self.topology;
+        serde_json::json!({
+            "input": input,
+            "device": self.device,
+            "vertices": self.vertices,
+            "faces": self.faces,
+            "edges": t.edges.len(),
+            "cap_pairs": t.caps.len(),
+            "boundary": t.boundary,
+            "non_manifold": t.non_manifold,
+            "marked": t.marked,
+            "drawn": self.count(KIND_DRAWN),
+            "contour": self.count(KIND_CONTOUR),
+            "crease": self.count(KIND_CREASE),
+            "boundary_or_marked": self.count(KIND_BOUNDARY),
+            "caps": self.caps,
+            "interop": interop,
+            "timing": self.timing,
+            "topology_ms": self.topology_ms,
+            "frame_ms": self.frame_ms,
+            "memory_bits": self.memory,
+            "svg_polylines": self.polylines.as_ref().map_or(0, Vec::len),
+        })
+    }
+}
+
+/// The edges picture of `mesh` in one call: reads the marked edges, builds
+/// the topology (with the cap buffer only for adjacency caps), frames the
+/// camera ([`framed`]; the default target is the bounding-box centre,
+/// computed in f64), runs the stage once, renders the shaded mesh and the
+/// edges and caps in black, and finds the visible polylines when asked.
+/// `name` names the mesh in errors (the marked file names itself).
+///
+/// # Errors
+/// Bad marked edges, parameters the stage rejects (width, crease, depth
+/// scale, camera), device and GL failures.
+pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> Result<EdgeDrawing> {
+    let crease = crease_from_degrees(opts.crease_deg)?;
+    let (w, h) = (opts.width, opts.height);
+    let marked = match &opts.marked {
+        Some(f) => read_marked(f)?,
+        None => Vec::new(),
+    };
+    let source = opts
+        .marked
+        .as_ref()
+        .map_or_else(|| name.to_string(), |m| m.display().to_string());
+    let t_topo = Instant::now();
+    let topo = if opts.caps == CapMode::Adjacency {
+        EdgeTopology::new(mesh, &marked, &source)?
+    } else {
+        EdgeTopology::without_caps(mesh, &marked, &source)?
+    };
+    let topology_ms = t_topo.elapsed().as_secs_f64() * 1e3;
+    let (lo, hi) = mesh.bounds();
+    let centre = Vec3::new(
+        (0.5 * (lo[0] + hi[0])) as f32,
+        (0.5 * (lo[1] + hi[1])) as f32,
+        (0.5 * (lo[2] + hi[2])) as f32,
+    );
+    let target = opts.target.unwrap_or(centre);
+    let cam = framed(
+        Placement::At(opts.eye),
+        Some(target),
+        opts.up,
+        opts.fov_deg,
+        opts.ortho,
+        (lo, hi),
+        w as f32 / h as f32,
+    )?;
+    let mut p = EdgeParams::new(cam.view(w, h));
+    p.line_width = opts.line_width;
+    p.crease_deg = crease;
+    p.depth_scale = opts.depth_scale;
+    p.half_contours = opts.half_contours;
+    p.pack()?;
+
+    let t_all = Instant::now();
+    let mut stage = EdgeStage::new(gpu.clone(), mesh, &topo)?;
+    let timing = stage.run(&p, opts.caps)?;
+    let output = stage.read()?;
+    let mut r = Renderer::new(RenderOptions {
+        width: w,
+        height: h,
+        ..Default::default()
+    })?;
+    r.begin(&cam)?;
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
+    r.draw_mesh(
+        &pos,
+        &vertex_normals(mesh),
+        &[],
+        &mesh.faces,
+        MeshStyle::default(),
+    )?;
+    draw_edges(&mut r, &output, [0.0, 0.0, 0.0, 1.0])?;
+    let frame = r.finish()?;
+    let frame_ms = t_all.elapsed().as_secs_f64() * 1e3;
+    let polylines = opts
+        .polylines
+        .then(|| visible_polylines(&output.edge_out, &frame, DEFAULT_BIAS));
+    Ok(EdgeDrawing {
+        memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),
+        frame,
+        output,
+        topology: topo,
+        caps: opts.caps,
+        camera: cam,
+        vertices: mesh.n_vertices(),
+        faces: mesh.n_faces(),
+        timing,
+        topology_ms,
+        frame_ms,
+        polylines,
+        device: gpu.info.clone(),
+    })
+}
