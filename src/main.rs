@@ -505,7 +505,7 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         let stats = serde_json::json!({
             "device": info,
             "topology_ms": topo_ms,
-            "passes": timing.passes,
+            "passes": curvature_passes(&timing),
             "kernel_ms": timing.kernel_ms,
             "run_wall_ms": timing.wall_ms,
             "device_bytes": est.device_bytes(),
@@ -644,7 +644,7 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         curv_stats = serde_json::json!({
             "options": opts,
             "normals": normals,
-            "passes": timing.passes,
+            "passes": curvature_passes(&timing),
             "kernel_ms": timing.kernel_ms,
             "run_wall_ms": timing.wall_ms,
             "counts": est.counts()?,
@@ -665,8 +665,8 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         st.faces,
         st.soup_vertices,
         st.degenerate_dropped,
-        st.kernel_ms,
-        st.wall_ms
+        st.timing.kernel_ms,
+        st.timing.wall_ms
     );
     if let Some(out) = &a.output {
         let normals = a
@@ -1074,6 +1074,15 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The curvature stats' `passes`: one `{pass, kernel_ms}` per curvature
+/// step, named without the `curv_` prefix (`tensor`, `dcurv`).
+fn curvature_passes(t: &shapecue::spec::timing::Timing) -> serde_json::Value {
+    t.steps
+        .iter()
+        .map(|s| serde_json::json!({ "pass": s.step.name(), "kernel_ms": s.kernel_ms }))
+        .collect()
 }
 
 #[cfg(test)]

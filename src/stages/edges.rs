@@ -41,6 +41,7 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::{EdgeTopology, vertex_normals};
 use crate::render::Camera;
+use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use serde::Serialize;
@@ -268,18 +269,9 @@ pub fn decide_interop(
     }
 }
 
-/// Kernel and wall times of one [`EdgeStage::run`].
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RunTiming {
-    /// `edges_detect` kernel time (profiling events), ms.
-    pub detect_ms: f64,
-    /// Cap kernel time (`caps_mh` or `caps_adjacency`), ms; 0 without caps.
-    pub caps_ms: f64,
-    /// Sum of the kernel times, ms.
-    pub kernel_ms: f64,
-    /// Host wall time from the parameter upload to the end of the last kernel, ms.
-    pub wall_ms: f64,
-}
+/// Kernel and wall times of one [`EdgeStage::run`]: steps `edges_detect`
+/// and `caps_mh` or `caps_adjacency`.
+pub type RunTiming = Timing; // compat re-export
 
 /// The stage's outputs read back to the host.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -437,7 +429,7 @@ impl<'g> EdgeStage<'g> {
     }
 
     /// Runs detection and the caps of `mode` for one frame and waits for it.
-    pub fn run(&mut self, params: &EdgeParams, mode: CapMode) -> Result<RunTiming> {
+    pub fn run(&mut self, params: &EdgeParams, mode: CapMode) -> Result<Timing> {
         let packed = params.pack()?;
         let t0 = Instant::now();
         let g = self.gpu;
@@ -492,14 +484,19 @@ impl<'g> EdgeStage<'g> {
         };
         g.finish()?;
         self.last_mode = mode;
-        let detect_ms = ev_d.as_ref().map_or(0.0, event_ms);
-        let caps_ms = ev_c.as_ref().map_or(0.0, event_ms);
-        Ok(RunTiming {
-            detect_ms,
-            caps_ms,
-            kernel_ms: detect_ms + caps_ms,
-            wall_ms: t0.elapsed().as_secs_f64() * 1e3,
-        })
+        let mut t = Timing::default();
+        if let Some(e) = &ev_d {
+            t.add(Step::EdgesDetect, event_ms(e));
+        }
+        if let Some(e) = &ev_c {
+            let step = match mode {
+                CapMode::Mh => Step::CapsMh,
+                _ => Step::CapsAdjacency,
+            };
+            t.add(step, event_ms(e));
+        }
+        t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(t)
     }
 
     /// Reads back the outputs of the last run (caps of the last run's mode only).
