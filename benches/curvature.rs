@@ -123,9 +123,9 @@ fn ready(
     match warm {
         Ok(t) => {
             let passes: Vec<String> = t
-                .passes
+                .steps
                 .iter()
-                .map(|p| format!("{} {:.2}", p.pass, p.kernel_ms))
+                .map(|p| format!("{} {:.2}", p.step.name(), p.kernel_ms))
                 .collect();
             eprintln!(
                 "curvature bench: {name}: kernel {:.2} ms ({}), wall {:.2} ms",

@@ -64,7 +64,7 @@ fn bench(c: &mut Criterion) {
             g.bench_function(&name, |b| {
                 b.iter(|| {
                     let st = ex.extract(iso, fusion).expect("extract");
-                    kernel.push(st.kernel_ms);
+                    kernel.push(st.timing.kernel_ms);
                 })
             });
             g.finish();

@@ -14,6 +14,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::mesh::skinned::load_gltf;
 use shapecue::report::median;
+use shapecue::spec::timing::Family;
 use shapecue::stages::feature_lines::LineOptions;
 use shapecue::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
 use std::time::Duration;
@@ -47,17 +48,17 @@ fn bench(c: &mut Criterion) {
             })
         });
         let med = |f: fn(&PassTimes) -> f64| median(&mut times.iter().map(f).collect::<Vec<_>>());
-        let (total, wall) = (med(|t| t.kernel_ms()), med(|t| t.wall_ms));
+        let (total, wall) = (med(|t| t.kernel_ms), med(|t| t.wall_ms));
         eprintln!(
             "pipeline/{name}: {} vertices, {} frames timed; kernel medians: skin {:.3} ms, \
              curvature+dcurv {:.3} ms, ao lut {:.3} ms, lines {:.3} ms, total {total:.3} ms; \
              wall {wall:.3} ms per frame; 16 ms budget {}",
             m.rest.positions.len(),
             times.len(),
-            med(|t| t.skin_ms),
-            med(|t| t.curvature_ms),
-            med(|t| t.ao_ms),
-            med(|t| t.lines_ms),
+            med(|t| t.family_ms(Family::Skinning)),
+            med(|t| t.family_ms(Family::Curvature)),
+            med(|t| t.family_ms(Family::Ao)),
+            med(|t| t.family_ms(Family::FeatureLines)),
             if wall <= 16.0 { "met" } else { "NOT met" }
         );
     }

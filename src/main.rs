@@ -430,7 +430,7 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         let stats = serde_json::json!({
             "device": info,
             "topology_ms": topo_ms,
-            "passes": timing.passes,
+            "passes": curvature_passes(&timing),
             "kernel_ms": timing.kernel_ms,
             "run_wall_ms": timing.wall_ms,
             "device_bytes": est.device_bytes(),
@@ -558,7 +558,7 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         curv_stats = serde_json::json!({
             "options": opts,
             "normals": normals,
-            "passes": timing.passes,
+            "passes": curvature_passes(&timing),
             "kernel_ms": timing.kernel_ms,
             "run_wall_ms": timing.wall_ms,
             "counts": est.counts()?,
@@ -579,8 +579,8 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         st.faces,
         st.soup_vertices,
         st.degenerate_dropped,
-        st.kernel_ms,
-        st.wall_ms
+        st.timing.kernel_ms,
+        st.timing.wall_ms
     );
     if let Some(out) = &a.output {
         let normals = a
@@ -915,13 +915,22 @@ fn render(device: Option<&str>, a: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The curvature stats' `passes`: one `{pass, kernel_ms}` per curvature
+/// step, named without the `curv_` prefix (`tensor`, `dcurv`).
+fn curvature_passes(t: &shapecue::spec::timing::Timing) -> serde_json::Value {
+    t.steps
+        .iter()
+        .map(|s| serde_json::json!({ "pass": s.step.name(), "kernel_ms": s.kernel_ms }))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn every_generate_choice_is_a_library_mesh() {
-        for k in Generated::value_variants() {
+        for k in Generated::ALL {
             let (desc, m) = k.mesh(500);
             assert!(!desc.is_empty() && m.n_faces() > 0);
         }

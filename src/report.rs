@@ -266,8 +266,8 @@ pub fn measure_isosurface(
     let (mut k, mut w) = (Vec::new(), Vec::new());
     for _ in 0..runs.max(1) {
         st = ex.extract(iso, fusion)?;
-        k.push(st.kernel_ms);
-        w.push(st.wall_ms);
+        k.push(st.timing.kernel_ms);
+        w.push(st.timing.wall_ms);
     }
     Ok((median(&mut k), median(&mut w), st))
 }
@@ -466,6 +466,7 @@ pub fn pipeline_report(
     runs: usize,
 ) -> Result<String> {
     use crate::cpu::ao::AoMode;
+    use crate::spec::timing::Family;
     use crate::stages::feature_lines::LineOptions;
     use crate::stages::pipeline::{PipelineOptions, PosePipeline, clip_poses};
     let m = crate::mesh::skinned::load_gltf(gltf)?;
@@ -525,12 +526,17 @@ pub fn pipeline_report(
     let row = |s: &mut String, pass: &str, ms: f64, err: &str| {
         let _ = writeln!(s, "| {pass} | {ms:.3} | {err} |");
     };
-    row(&mut s, "skin", med(&|x| x.skin_ms), "");
-    row(&mut s, "curvature+dcurv", med(&|x| x.curvature_ms), "");
+    row(&mut s, "skin", med(&|x| x.family_ms(Family::Skinning)), "");
+    row(
+        &mut s,
+        "curvature+dcurv",
+        med(&|x| x.family_ms(Family::Curvature)),
+        "",
+    );
     row(
         &mut s,
         "ao lut",
-        med(&|x| x.ao_ms),
+        med(&|x| x.family_ms(Family::Ao)),
         &format!("{:.2e}", rms(se_lut)),
     );
     row(
@@ -540,8 +546,13 @@ pub fn pipeline_report(
         &format!("{:.2e}", rms(se_poly)),
     );
     row(&mut s, "ao exact", median(&mut exact), "0 (reference)");
-    row(&mut s, "contours+suggestive", med(&|x| x.lines_ms), "");
-    let (kernel, wall) = (med(&|x| x.kernel_ms()), med(&|x| x.wall_ms));
+    row(
+        &mut s,
+        "contours+suggestive",
+        med(&|x| x.family_ms(Family::FeatureLines)),
+        "",
+    );
+    let (kernel, wall) = (med(&|x| x.kernel_ms), med(&|x| x.wall_ms));
     row(
         &mut s,
         "**total (skin+curv+dcurv+ao lut+lines)**",

@@ -34,7 +34,7 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
                 Render,
             ]
         }
-        Cue::FeatureEdges => vec![EdgeBuffer, CapBuffer, FaceNormals, EdgeDetect, Caps, Render],
+        Cue::FeatureEdges => vec![EdgeBuffer, CapBuffer, FaceNormals, Edges, Caps, Render],
     };
     let needs_geometry = v.iter().any(|p| {
         matches!(
@@ -45,7 +45,7 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
     if needs_geometry {
         v.extend(match input {
             Input::Static => None,
-            Input::Skinned => Some(Skin),
+            Input::Skinned => Some(Skinning),
             Input::Flipbook => Some(LoadFrame),
             Input::Volume => Some(Isosurface),
         });

@@ -12,6 +12,7 @@
 //! pose passes.
 
 use crate::spec::edges::CapMode;
+use crate::spec::timing::Step;
 use serde::Serialize;
 
 /// A shape cue a scene can ask for.
@@ -51,7 +52,7 @@ impl Cue {
             Cue::AmbientOcclusion => &[Pass::Ao, Pass::VertexNormals, Pass::Render],
             Cue::Contours => &[Pass::Contours, Pass::Render],
             Cue::SuggestiveContours => &[Pass::SuggestiveContours, Pass::Render],
-            Cue::FeatureEdges => &[Pass::EdgeDetect, Pass::Caps, Pass::Render],
+            Cue::FeatureEdges => &[Pass::Edges, Pass::Caps, Pass::Render],
         }
     }
 }
@@ -88,8 +89,8 @@ pub enum Lifetime {
 pub enum Pass {
     /// Marching cubes + vertex fusion (volume input).
     Isosurface,
-    /// Linear blend skinning (skinned input).
-    Skin,
+    /// Linear blend skinning (skinned input; family `skinning`).
+    Skinning,
     /// Upload the frame's positions (flipbook input).
     LoadFrame,
     /// Unique edges with their opposite vertices (House & Li's edge buffer).
@@ -112,8 +113,8 @@ pub enum Pass {
     Contours,
     /// Suggestive contours (zero crossings of radial curvature, with dk).
     SuggestiveContours,
-    /// Feature-edge detection into the edge-out buffer.
-    EdgeDetect,
+    /// Feature-edge detection into the edge-out buffer (family `edges`).
+    Edges,
     /// Cap geometry into the cap-out buffers.
     Caps,
     /// Draw the frame.
@@ -121,11 +122,56 @@ pub enum Pass {
 }
 
 impl Pass {
+    /// Old name of [`Pass::Skinning`].
+    #[allow(non_upper_case_globals)]
+    pub const Skin: Pass = Pass::Skinning; // compat re-export
+    /// Old name of [`Pass::Edges`].
+    #[allow(non_upper_case_globals)]
+    pub const EdgeDetect: Pass = Pass::Edges; // compat re-export
+
+    /// The device steps this pass launches (empty for host passes), by
+    /// which the executor joins a stage's [`crate::spec::timing::Timing`]
+    /// to the plan. Contours and suggestive contours share one
+    /// `lines_vertex` + `lines_face` launch.
+    pub fn kernels(self) -> &'static [Step] {
+        use Step::*;
+        match self {
+            Pass::Isosurface => &[
+                McClassify,
+                ScanExclusive,
+                McTriangles,
+                McIota,
+                FuseIndex,
+                FuseTriangles,
+                FuseCandidates,
+                RadixSortPairs,
+                FuseCancel,
+                FuseMark,
+                FuseCompactVertices,
+                FuseCompactFaces,
+            ],
+            Pass::Skinning => &[SkinLbs],
+            Pass::OneRings => &[CurvMaxFace],
+            Pass::VertexNormals => &[CurvClear, CurvNormalsAreas, CurvFrames],
+            Pass::Curvature => &[CurvTensor, CurvPrincipal],
+            Pass::Dcurv => &[CurvDcurv],
+            Pass::Ao => &[AoVertex],
+            Pass::Contours | Pass::SuggestiveContours => &[LinesVertex, LinesFace],
+            Pass::Edges => &[EdgesDetect],
+            Pass::Caps => &[CapsMh, CapsAdjacency],
+            Pass::LoadFrame
+            | Pass::EdgeBuffer
+            | Pass::CapBuffer
+            | Pass::FaceNormals
+            | Pass::Render => &[],
+        }
+    }
+
     /// The pass that makes this input's positions, if any.
     pub fn source(input: Input) -> Option<Pass> {
         match input {
             Input::Static => None,
-            Input::Skinned => Some(Pass::Skin),
+            Input::Skinned => Some(Pass::Skinning),
             Input::Flipbook => Some(Pass::LoadFrame),
             Input::Volume => Some(Pass::Isosurface),
         }
@@ -135,7 +181,7 @@ impl Pass {
     pub fn needs(self, input: Input) -> Vec<Pass> {
         let src = Pass::source(input);
         let mut v: Vec<Pass> = match self {
-            Pass::Isosurface | Pass::Skin | Pass::LoadFrame => vec![],
+            Pass::Isosurface | Pass::Skinning | Pass::LoadFrame => vec![],
             // An isosurface brings a new topology with every pose.
             Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer if input == Input::Volume => {
                 vec![Pass::Isosurface]
@@ -147,8 +193,8 @@ impl Pass {
             Pass::Ao => vec![Pass::Curvature],
             Pass::Contours => vec![Pass::VertexNormals],
             Pass::SuggestiveContours => vec![Pass::Dcurv, Pass::VertexNormals],
-            Pass::EdgeDetect => vec![Pass::EdgeBuffer, Pass::FaceNormals],
-            Pass::Caps => vec![Pass::EdgeDetect, Pass::CapBuffer],
+            Pass::Edges => vec![Pass::EdgeBuffer, Pass::FaceNormals],
+            Pass::Caps => vec![Pass::Edges, Pass::CapBuffer],
             Pass::Render => vec![],
         };
         v.sort();
@@ -161,11 +207,9 @@ impl Pass {
             Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer if input != Input::Volume => {
                 Lifetime::Topology
             }
-            Pass::Contours
-            | Pass::SuggestiveContours
-            | Pass::EdgeDetect
-            | Pass::Caps
-            | Pass::Render => Lifetime::View,
+            Pass::Contours | Pass::SuggestiveContours | Pass::Edges | Pass::Caps | Pass::Render => {
+                Lifetime::View
+            }
             _ => Lifetime::Pose,
         }
     }

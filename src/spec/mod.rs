@@ -18,6 +18,7 @@ pub mod radix_sort;
 pub mod scan;
 pub mod sdf_lines;
 pub mod skinning;
+pub mod timing;
 pub mod vertex_fusion;
 pub mod view;
 

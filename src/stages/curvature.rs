@@ -17,6 +17,7 @@ use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
     Precision, corner_reals_bound,
 };
+use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use serde::Serialize;
@@ -58,25 +59,23 @@ impl Pass {
     }
 }
 
-/// Kernel time of one pass in one run.
-#[derive(Clone, Debug, Serialize)]
-pub struct PassTime {
-    /// Pass name (see [`Pass::name`]).
-    pub pass: &'static str,
-    /// Kernel time from OpenCL profiling events, in milliseconds.
-    pub kernel_ms: f64,
+impl Pass {
+    /// The timing step of this pass (its kernel entry point `curv_<name>`).
+    pub fn step(self) -> Step {
+        match self {
+            Pass::MaxFace => Step::CurvMaxFace,
+            Pass::Clear => Step::CurvClear,
+            Pass::NormalsAreas => Step::CurvNormalsAreas,
+            Pass::Frames => Step::CurvFrames,
+            Pass::Tensor => Step::CurvTensor,
+            Pass::Principal => Step::CurvPrincipal,
+            Pass::Dcurv => Step::CurvDcurv,
+        }
+    }
 }
 
-/// Timing of one [`CurvatureEstimator::run`].
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RunTiming {
-    /// Kernel time per pass, in execution order.
-    pub passes: Vec<PassTime>,
-    /// Sum of the pass kernel times.
-    pub kernel_ms: f64,
-    /// Host wall time from the first enqueue to the end of the last kernel.
-    pub wall_ms: f64,
-}
+/// Timing of one [`CurvatureEstimator::run`]: one step per pass.
+pub type RunTiming = Timing; // compat re-export
 
 /// Device state after a partial run, for pass-by-pass comparison with the
 /// CPU reference. All values in normalized coordinates.
@@ -489,13 +488,13 @@ impl CurvatureEstimator {
     }
 
     /// Runs every position-dependent pass on the current pose.
-    pub fn run(&mut self) -> Result<RunTiming> {
+    pub fn run(&mut self) -> Result<Timing> {
         self.run_until(Pass::Dcurv)
     }
 
     /// Runs the position-dependent passes up to and including `last`
     /// (the dcurv pass only if the options ask for it).
-    pub fn run_until(&mut self, last: Pass) -> Result<RunTiming> {
+    pub fn run_until(&mut self, last: Pass) -> Result<Timing> {
         let g = &*self.gpu;
         let (nv, nf) = (self.nv, self.nf);
         let (nv32, nf32) = (nv as u32, nf as u32);
@@ -603,23 +602,12 @@ impl CurvatureEstimator {
         g.finish()?;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         // One entry per pass: a gather pass's face and sum kernels are added up.
-        let mut passes: Vec<PassTime> = Vec::new();
+        let mut timing = Timing::default();
         for (p, e) in &events {
-            let ms = event_ms(e);
-            match passes.last_mut() {
-                Some(last) if last.pass == p.name() => last.kernel_ms += ms,
-                _ => passes.push(PassTime {
-                    pass: p.name(),
-                    kernel_ms: ms,
-                }),
-            }
+            timing.add(p.step(), event_ms(e));
         }
-        let kernel_ms = passes.iter().map(|p| p.kernel_ms).sum();
-        Ok(RunTiming {
-            passes,
-            kernel_ms,
-            wall_ms,
-        })
+        timing.wall_ms = wall_ms;
+        Ok(timing)
     }
 
     /// The device buffers of the last run, for chaining later stages on the
@@ -720,7 +708,7 @@ pub struct Estimate {
     /// Skip counters.
     pub counts: CurvatureCounts,
     /// Timing of the run.
-    pub timing: RunTiming,
+    pub timing: Timing,
     /// Device bytes allocated.
     pub device_bytes: u64,
 }

@@ -45,9 +45,9 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::{EdgeTopology, vertex_normals};
 use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
+use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
-use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -56,18 +56,9 @@ pub use crate::spec::edges::{
     KIND_CREASE, KIND_DRAWN, MemoryUse, decide_interop, memory_use,
 }; // compat re-export
 
-/// Kernel and wall times of one [`EdgeStage::run`].
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RunTiming {
-    /// `edges_detect` kernel time (profiling events), ms.
-    pub detect_ms: f64,
-    /// Cap kernel time (`caps_mh` or `caps_adjacency`), ms; 0 without caps.
-    pub caps_ms: f64,
-    /// Sum of the kernel times, ms.
-    pub kernel_ms: f64,
-    /// Host wall time from the parameter upload to the end of the last kernel, ms.
-    pub wall_ms: f64,
-}
+/// Kernel and wall times of one [`EdgeStage::run`]: steps `edges_detect`
+/// and `caps_mh` or `caps_adjacency`.
+pub type RunTiming = Timing; // compat re-export
 
 /// Device buffers and kernels of the edges stage for one mesh topology.
 pub struct EdgeStage {
@@ -181,7 +172,7 @@ impl EdgeStage {
     }
 
     /// Runs detection and the caps of `mode` for one frame and waits for it.
-    pub fn run(&mut self, params: &EdgeParams, mode: CapMode) -> Result<RunTiming> {
+    pub fn run(&mut self, params: &EdgeParams, mode: CapMode) -> Result<Timing> {
         let packed = params.pack()?;
         let t0 = Instant::now();
         let g = self.gpu.clone();
@@ -236,14 +227,19 @@ impl EdgeStage {
         };
         g.finish()?;
         self.last_mode = mode;
-        let detect_ms = ev_d.as_ref().map_or(0.0, event_ms);
-        let caps_ms = ev_c.as_ref().map_or(0.0, event_ms);
-        Ok(RunTiming {
-            detect_ms,
-            caps_ms,
-            kernel_ms: detect_ms + caps_ms,
-            wall_ms: t0.elapsed().as_secs_f64() * 1e3,
-        })
+        let mut t = Timing::default();
+        if let Some(e) = &ev_d {
+            t.add(Step::EdgesDetect, event_ms(e));
+        }
+        if let Some(e) = &ev_c {
+            let step = match mode {
+                CapMode::Mh => Step::CapsMh,
+                _ => Step::CapsAdjacency,
+            };
+            t.add(step, event_ms(e));
+        }
+        t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(t)
     }
 
     /// Reads back the outputs of the last run (caps of the last run's mode only).

@@ -13,6 +13,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::spec::feature_lines::{LineInputs, LineView, Segment, segments_bound};
+use crate::spec::timing::{Step, Timing};
 use crate::stages::curvature::CurvatureEstimator;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -44,14 +45,12 @@ impl Default for LineOptions {
 }
 
 /// Kernel times and counts of one extraction.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct LineStats {
     /// Segments found.
     pub segments: usize,
-    /// Kernel ms of `lines_vertex`.
-    pub vertex_ms: f64,
-    /// Kernel ms of `lines_face`.
-    pub face_ms: f64,
+    /// Kernel ms of `lines_vertex` and `lines_face`.
+    pub timing: Timing,
 }
 
 /// Extracts lines of one mesh topology.
@@ -263,10 +262,16 @@ impl LineExtractor {
             .chunks_exact(8)
             .map(|s| ([s[0], s[1], s[2]], [s[3], s[4], s[5]], s[6] as u32, s[7]))
             .collect();
+        let mut timing = Timing::default();
+        if let Some(e) = &e1 {
+            timing.add(Step::LinesVertex, event_ms(e));
+        }
+        if let Some(e) = &e2 {
+            timing.add(Step::LinesFace, event_ms(e));
+        }
         let stats = LineStats {
             segments: found,
-            vertex_ms: e1.as_ref().map(event_ms).unwrap_or(0.0),
-            face_ms: e2.as_ref().map(event_ms).unwrap_or(0.0),
+            timing,
         };
         Ok((segs, stats))
     }

@@ -15,10 +15,11 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureOptions, Normalization};
 use crate::spec::marching_cubes::{cell_rows, edge_key_bits, soup_vertices_bound, table};
+use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::{Fusion, FusionCounts};
-use crate::stages::curvature::{CurvatureEstimator, RunTiming};
+use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::scan::Scan;
-use crate::stages::vertex_fusion::{Fuser, FusionTiming, Grow, build_options};
+use crate::stages::vertex_fusion::{Fuser, Grow, build_options};
 use crate::volume::Volume;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -44,18 +45,10 @@ pub struct IsoStats {
     pub faces: usize,
     /// Triangles dropped because two fused corners coincide (iso equal to voxel values).
     pub degenerate_dropped: usize,
-    /// Kernel ms: mc_classify.
-    pub classify_ms: f64,
-    /// Kernel ms: scan of the row counts.
-    pub scan_ms: f64,
-    /// Kernel ms: mc_triangles.
-    pub triangles_ms: f64,
-    /// Kernel ms of the fusion passes.
-    pub fusion_ms: FusionTiming,
-    /// Sum of all kernel times.
-    pub kernel_ms: f64,
-    /// Wall time of the extraction (volume already on the device).
-    pub wall_ms: f64,
+    /// Kernel ms per step (`mc_classify`, the row scan, `mc_triangles`,
+    /// `mc_iota` or the fusion steps), their sum, and the wall time of the
+    /// extraction (volume already on the device).
+    pub timing: Timing,
     /// Device bytes held after the extraction (volume, soup, scratch, outputs).
     pub device_bytes: u64,
 }
@@ -226,8 +219,10 @@ impl Isosurfacer {
         a.extend([buf(&self.counts), buf(&self.row_tris)]);
         let e_cls = launch(&g, &self.classify, rows, &a)?;
         let tris = self.scan.exclusive(&self.row_tris, &self.row_off, rows)? as usize;
-        st.scan_ms = self.scan.last_ms();
-        st.classify_ms = e_cls.as_ref().map(event_ms).unwrap_or(0.0);
+        if let Some(e) = &e_cls {
+            st.timing.add(Step::McClassify, event_ms(e));
+        }
+        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
         let soup = soup_vertices_bound(tris);
         if soup as u64 > u32::MAX as u64 {
             return Err(Error::InvalidArgument(format!(
@@ -266,7 +261,9 @@ impl Isosurfacer {
         let e_tri = launch(&g, &self.triangles, rows, &a)?;
         let mut c = [0u32; 2];
         g.read(&self.counters, &mut c)?;
-        st.triangles_ms = e_tri.as_ref().map(event_ms).unwrap_or(0.0);
+        if let Some(e) = &e_tri {
+            st.timing.add(Step::McTriangles, event_ms(e));
+        }
         if c[0] != 0 {
             return Err(Error::InvalidArgument(format!(
                 "internal: mc_triangles produced {} more soup vertices than mc_classify counted \
@@ -279,13 +276,16 @@ impl Isosurfacer {
         match fusion {
             Fusion::None => {
                 self.soup_faces.reserve(&g, soup)?;
-                launch(
+                let e = launch(
                     &g,
                     &self.iota,
                     soup,
                     &[Arg::U32(soup as u32), buf(&self.soup_faces.buf)],
                 )?;
                 g.finish()?;
+                if let Some(e) = &e {
+                    st.timing.add(Step::McIota, event_ms(e));
+                }
                 st.vertices = soup;
                 st.faces = tris;
                 self.result = Some((Holder::Soup, soup, tris));
@@ -313,12 +313,11 @@ impl Isosurfacer {
                 st.vertices = vertices;
                 st.faces = faces;
                 st.degenerate_dropped = dropped;
-                st.fusion_ms = ft;
+                st.timing.extend(&ft);
                 self.result = Some((Holder::Fused, vertices, faces));
             }
         }
-        st.kernel_ms = st.classify_ms + st.scan_ms + st.triangles_ms + st.fusion_ms.total();
-        st.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         st.device_bytes = self.device_bytes();
         Ok(st)
     }
@@ -409,7 +408,7 @@ pub fn curvature(
     iso: &Isosurfacer,
     opts: CurvatureOptions,
     normals: IsoNormals,
-) -> Result<(CurvatureEstimator, RunTiming)> {
+) -> Result<(CurvatureEstimator, Timing)> {
     let Some((pos, faces, nv, nf)) = iso.device_mesh() else {
         return Err(Error::InvalidArgument("no isosurface extracted yet".into()));
     };

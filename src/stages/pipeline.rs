@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use crate::gpu::{Gpu, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
+use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines::{LineExtractor, LineOptions, LineStats};
@@ -59,46 +60,79 @@ impl Default for PipelineOptions {
     }
 }
 
-/// Kernel ms of each pass of one frame (OpenCL profiling events) and the
-/// frame's host wall time.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+/// One frame of [`PosePipeline::frame`]: the [`Timing`] of its steps
+/// (`skin_lbs`, the curvature steps, `ao_vertex`, `lines_vertex`,
+/// `lines_face`; per family with [`Timing::family_ms`]) with the frame's
+/// host wall time, and the segments read back. Dereferences to the timing.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct PassTimes {
-    /// `skin_lbs`.
-    pub skin_ms: f64,
-    /// Every curvature pass including dcurv (and the position load).
-    pub curvature_ms: f64,
-    /// `ao_vertex`.
-    pub ao_ms: f64,
-    /// `lines_vertex` + `lines_face` (0 from [`PosePipeline::pose`]).
-    pub lines_ms: f64,
-    /// Segments read back (0 from [`PosePipeline::pose`]).
+    /// Kernel ms per step and the wall time of the frame.
+    pub timing: Timing,
+    /// Segments read back.
     pub segments: usize,
-    /// Host wall time of the call, uploads and read-backs included.
-    pub wall_ms: f64,
 }
 
-impl PassTimes {
-    /// Sum of the kernel times.
-    pub fn kernel_ms(&self) -> f64 {
-        self.skin_ms + self.curvature_ms + self.ao_ms + self.lines_ms
+impl std::ops::Deref for PassTimes {
+    type Target = Timing;
+    fn deref(&self) -> &Timing {
+        &self.timing
     }
 }
 
+/// Which stages a [`PosePipeline`] builds besides the skinner: the scene
+/// executor builds only what its plan runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PipelineStages {
+    /// The curvature estimator (needed by AO and the feature lines).
+    pub curvature: bool,
+    /// The AO stage.
+    pub ao: bool,
+    /// The feature-line extractor.
+    pub lines: bool,
+}
+
+impl PipelineStages {
+    /// Every stage.
+    pub const ALL: PipelineStages = PipelineStages {
+        curvature: true,
+        ao: true,
+        lines: true,
+    };
+}
+
 /// Skinning, curvature, AO and line extraction of one skinned mesh, every
-/// buffer allocated once.
+/// buffer allocated once. Built with every stage ([`PosePipeline::new`]) for
+/// the bench and the report, or with the stages a scene's plan runs
+/// ([`PosePipeline::with_stages`]) for the scene executor, which drives it
+/// pass by pass ([`PosePipeline::skin`], [`PosePipeline::curvature`],
+/// [`PosePipeline::run_ao`], [`PosePipeline::lines_at`]).
 pub struct PosePipeline {
     skinner: Skinner,
-    est: CurvatureEstimator,
-    ao: AoStage,
-    lines: LineExtractor,
+    est: Option<CurvatureEstimator>,
+    ao: Option<AoStage>,
+    lines: Option<LineExtractor>,
     norm: Normalization,
     feature_size: f32,
+    /// AO hemisphere radius, world units.
+    ao_radius: f32,
     opts: PipelineOptions,
 }
 
 impl PosePipeline {
     /// Uploads the rest mesh, builds every kernel and allocates every buffer.
     pub fn new(gpu: Arc<Gpu>, mesh: &SkinnedMesh, opts: PipelineOptions) -> Result<Self> {
+        Self::with_stages(gpu, mesh, opts, PipelineStages::ALL)
+    }
+
+    /// [`PosePipeline::new`] building only `stages` (and the skinner). AO
+    /// and the lines read the curvature estimator's buffers, so they need
+    /// it.
+    pub fn with_stages(
+        gpu: Arc<Gpu>,
+        mesh: &SkinnedMesh,
+        opts: PipelineOptions,
+        stages: PipelineStages,
+    ) -> Result<Self> {
         if opts.curvature.precision != Precision::F32 {
             return Err(Error::InvalidArgument(
                 "the pose pipeline chains stages on the device and needs f32 curvature".into(),
@@ -110,29 +144,77 @@ impl PosePipeline {
                 opts.ao_radius
             )));
         }
+        if (stages.ao || stages.lines) && !stages.curvature {
+            return Err(Error::InvalidArgument(
+                "the pose pipeline's AO and line stages read the curvature estimator".into(),
+            ));
+        }
         let rest = &mesh.rest;
         let nv = rest.positions.len();
         let used = crate::mesh::referenced(nv, &rest.faces);
+        let norm = Normalization::of_masked(&rest.positions, Some(&used));
         Ok(PosePipeline {
             skinner: Skinner::new(gpu.clone(), mesh)?,
-            est: CurvatureEstimator::new(gpu.clone(), nv, &rest.faces, opts.curvature)?,
-            ao: AoStage::new(gpu.clone())?,
-            lines: LineExtractor::new(gpu, nv, &rest.faces)?,
-            norm: Normalization::of_masked(&rest.positions, Some(&used)),
+            est: match stages.curvature {
+                true => Some(CurvatureEstimator::new(
+                    gpu.clone(),
+                    nv,
+                    &rest.faces,
+                    opts.curvature,
+                )?),
+                false => None,
+            },
+            ao: match stages.ao {
+                true => Some(AoStage::new(gpu.clone())?),
+                false => None,
+            },
+            lines: match stages.lines {
+                true => Some(LineExtractor::new(gpu, nv, &rest.faces)?),
+                false => None,
+            },
+            norm,
             feature_size: match crate::mesh::feature_size(&rest.positions, &rest.faces) {
                 f if f > 0.0 => f as f32,
                 _ => Normalization::of(&rest.positions).scale as f32,
             },
+            ao_radius: (opts.ao_radius * norm.scale) as f32,
             opts,
         })
     }
 
-    /// Skins `mats` (column-major, 16 floats per joint), runs every curvature
-    /// pass and AO at the options' level; the results stay on the device.
-    pub fn pose(&mut self, mats: &[f32]) -> Result<PassTimes> {
+    fn est(&self) -> Result<&CurvatureEstimator> {
+        self.est.as_ref().ok_or_else(|| {
+            Error::InvalidArgument("this pose pipeline was built without curvature".into())
+        })
+    }
+
+    /// Skins `mats` (column-major, 16 floats per joint) and waits:
+    /// step `skin_lbs`.
+    pub fn skin(&mut self, mats: &[f32]) -> Result<Timing> {
+        let ev = self.skinner.enqueue(mats)?;
+        Ok(Timing::of(Step::SkinLbs, wait_ms(ev)?))
+    }
+
+    /// Every curvature pass on the skinned positions (in the rest pose's
+    /// normalized coordinates), on the device.
+    pub fn curvature(&mut self) -> Result<Timing> {
+        let Some(est) = self.est.as_mut() else {
+            return Err(Error::InvalidArgument(
+                "this pose pipeline was built without curvature".into(),
+            ));
+        };
+        est.set_positions_device(&self.skinner.out, [1.0; 3], [0.0; 3], self.norm)?;
+        est.run()
+    }
+
+    /// Skins `mats`, runs every curvature pass and AO at the options' level;
+    /// the results stay on the device.
+    pub fn pose(&mut self, mats: &[f32]) -> Result<Timing> {
         let t0 = Instant::now();
         let (mut t, ao) = self.enqueue_pose(mats)?;
-        t.ao_ms = wait_ms(ao)?;
+        if self.ao.is_some() {
+            t.add(Step::AoVertex, wait_ms(ao)?);
+        }
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(t)
     }
@@ -141,19 +223,18 @@ impl PosePipeline {
     /// for its passes (its timing needs them), which also finishes the
     /// skinning queued before it; AO is left running: its event comes back
     /// for the caller to wait on (or to read after a later blocking call).
-    fn enqueue_pose(&mut self, mats: &[f32]) -> Result<(PassTimes, Option<Event>)> {
+    fn enqueue_pose(&mut self, mats: &[f32]) -> Result<(Timing, Option<Event>)> {
         let skin = self.skinner.enqueue(mats)?;
-        self.est
-            .set_positions_device(&self.skinner.out, [1.0; 3], [0.0; 3], self.norm)?;
-        let curvature_ms = self.est.run()?.kernel_ms;
-        let ao = self
-            .ao
-            .enqueue_device(&self.est, self.ao_radius(), self.opts.ao_mode)?;
-        let t = PassTimes {
-            skin_ms: wait_ms(skin)?,
-            curvature_ms,
-            ..Default::default()
+        let curvature = self.curvature()?;
+        let (radius, mode) = (self.ao_radius, self.opts.ao_mode);
+        let est = self.est.as_ref().expect("curvature ran");
+        let ao = match self.ao.as_mut() {
+            Some(ao) => ao.enqueue_device(est, radius, mode)?,
+            None => None,
         };
+        let mut t = Timing::of(Step::SkinLbs, wait_ms(skin)?);
+        t.extend(&curvature);
+        t.wall_ms = 0.0;
         Ok((t, ao))
     }
 
@@ -165,13 +246,29 @@ impl PosePipeline {
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
-        self.lines
-            .extract_device(&self.est, view, feature_size, opts)
+        self.lines_at(view, feature_size, opts, [0.0; 3])
+    }
+
+    /// [`PosePipeline::lines`] with the eye and the segments relative to
+    /// `origin` ([`LineExtractor::extract_device_at`]).
+    pub fn lines_at(
+        &mut self,
+        view: View,
+        feature_size: f32,
+        opts: LineOptions,
+        origin: [f64; 3],
+    ) -> Result<(Vec<Segment>, LineStats)> {
+        let (Some(lines), Some(est)) = (self.lines.as_mut(), self.est.as_ref()) else {
+            return Err(Error::InvalidArgument(
+                "this pose pipeline was built without the line stage".into(),
+            ));
+        };
+        lines.extract_device_at(est, view, feature_size, opts, origin)
     }
 
     /// One frame: [`PosePipeline::pose`] then [`PosePipeline::lines`], with
     /// no host wait between AO and the lines (the in-order queue keeps them
-    /// in order); the times of every pass and the wall time of both.
+    /// in order); the times of every step and the wall time of both.
     pub fn frame(
         &mut self,
         mats: &[f32],
@@ -182,27 +279,60 @@ impl PosePipeline {
         let t0 = Instant::now();
         let (mut t, ao) = self.enqueue_pose(mats)?;
         let (segs, st) = self.lines(view, feature_size, opts)?;
-        t.ao_ms = wait_ms(ao)?;
-        t.lines_ms = st.vertex_ms + st.face_ms;
-        t.segments = st.segments;
+        if self.ao.is_some() {
+            t.add(Step::AoVertex, wait_ms(ao)?);
+        }
+        t.extend(&st.timing);
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok((segs, t))
+        let segments = st.segments;
+        Ok((
+            segs,
+            PassTimes {
+                timing: t,
+                segments,
+            },
+        ))
+    }
+
+    /// Sets the AO hemisphere radius in world units (by default the
+    /// options' fraction of the rest pose's RMS radius).
+    pub fn set_ao_radius(&mut self, radius: f32) {
+        self.ao_radius = radius;
     }
 
     /// Reruns AO on the current curvatures at `mode` (e.g. to compare
-    /// levels); returns the kernel ms.
+    /// levels): step `ao_vertex`.
+    pub fn run_ao(&mut self, mode: AoMode) -> Result<Timing> {
+        let radius = self.ao_radius;
+        let (Some(ao), Some(est)) = (self.ao.as_mut(), self.est.as_ref()) else {
+            return Err(Error::InvalidArgument(
+                "this pose pipeline was built without AO".into(),
+            ));
+        };
+        Ok(Timing::of(
+            Step::AoVertex,
+            ao.run_device(est, radius, mode)?,
+        ))
+    }
+
+    /// [`PosePipeline::run_ao`]'s kernel ms.
     pub fn ao(&mut self, mode: AoMode) -> Result<f64> {
-        self.ao.run_device(&self.est, self.ao_radius(), mode)
+        Ok(self.run_ao(mode)?.kernel_ms)
     }
 
     /// The AO values of the last AO run, one per vertex.
     pub fn read_ao(&self) -> Result<Vec<f32>> {
-        self.ao.read(self.skinner.n_vertices())
+        match &self.ao {
+            Some(ao) => ao.read(self.skinner.n_vertices()),
+            None => Err(Error::InvalidArgument(
+                "this pose pipeline was built without AO".into(),
+            )),
+        }
     }
 
     /// AO hemisphere radius in world units.
     pub fn ao_radius(&self) -> f32 {
-        (self.opts.ao_radius * self.norm.scale) as f32
+        self.ao_radius
     }
 
     /// The rest pose's normalization (fixed for every pose).
@@ -210,9 +340,9 @@ impl PosePipeline {
         self.norm
     }
 
-    /// The curvature estimator (its last run is the current pose).
-    pub fn estimator(&self) -> &CurvatureEstimator {
-        &self.est
+    /// The curvature estimator (its last run is the current pose), if built.
+    pub fn estimator(&self) -> Option<&CurvatureEstimator> {
+        self.est().ok()
     }
 
     /// The skinner (its output buffer is the current pose).

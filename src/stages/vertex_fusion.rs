@@ -9,6 +9,7 @@
 
 use crate::error::Result;
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::{
     Fusion, cancel_candidates_bound, fused_faces_bound, fused_vertices_bound, soup_triangles,
 };
@@ -18,29 +19,8 @@ use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
 
-/// Per-pass kernel times of one fusion, in milliseconds.
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct FusionTiming {
-    /// Radix sort of the (key, index) pairs.
-    pub sort: f64,
-    /// `fuse_index`.
-    pub index: f64,
-    /// `fuse_clear` + `fuse_triangles` + `fuse_mark`.
-    pub triangles: f64,
-    /// Twin cancellation: candidate scan, `fuse_candidates`, sort, `fuse_cancel`.
-    pub cancel: f64,
-    /// The two exclusive scans.
-    pub scans: f64,
-    /// `fuse_compact_vertices` + `fuse_compact_faces`.
-    pub compact: f64,
-}
-
-impl FusionTiming {
-    /// Sum of the passes.
-    pub fn total(&self) -> f64 {
-        self.sort + self.index + self.triangles + self.cancel + self.scans + self.compact
-    }
-}
+/// Kernel times of one fusion, per step.
+pub type FusionTiming = Timing; // compat re-export
 
 pub use crate::spec::vertex_fusion::FusionCounts; // compat re-export
 
@@ -177,15 +157,15 @@ impl Fuser {
         pos: &Buffer<f32>,
         n: usize,
         key_bits: u32,
-    ) -> Result<(FusionCounts, FusionTiming)> {
+    ) -> Result<(FusionCounts, Timing)> {
         let g = self.gpu.clone();
-        let mut t = FusionTiming::default();
+        let mut t = Timing::default();
         let nt = soup_triangles(n);
         if n == 0 {
             return Ok((FusionCounts::default(), t));
         }
         self.sort.sort_pairs(keys, idx, n, key_bits)?;
-        t.sort = self.sort.last_ms();
+        t.add(Step::RadixSortPairs, self.sort.last_ms());
         for b in [&mut self.rep, &mut self.referenced, &mut self.vert_id] {
             b.reserve(&g, n)?;
         }
@@ -233,8 +213,10 @@ impl Fuser {
         let n_cand = self
             .scan
             .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
-        t.cancel = self.scan.last_ms();
         debug_assert!(n_cand <= cancel_candidates_bound(n));
+        // Steps in execution order; the kernel events are read once done.
+        let cand_scan = self.scan.last_ms();
+        let mut cancel = Timing::default();
         if n_cand > 0 {
             self.ckeys.reserve(&g, n_cand)?;
             self.cvals.reserve(&g, n_cand)?;
@@ -253,7 +235,7 @@ impl Fuser {
             )?;
             self.sort
                 .sort_pairs(&mut self.ckeys.buf, &mut self.cvals.buf, n_cand, 32)?;
-            t.cancel += self.sort.last_ms();
+            let sort_ms = self.sort.last_ms();
             let e2 = launch(
                 &g,
                 &self.cancel,
@@ -267,7 +249,13 @@ impl Fuser {
                 ],
             )?;
             g.finish()?;
-            t.cancel += [e, e2].iter().flatten().map(event_ms).sum::<f64>();
+            if let Some(e) = &e {
+                cancel.add(Step::FuseCandidates, event_ms(e));
+            }
+            cancel.add(Step::RadixSortPairs, sort_ms);
+            if let Some(e) = &e2 {
+                cancel.add(Step::FuseCancel, event_ms(e));
+            }
         }
         let e_mark = launch(
             &g,
@@ -283,18 +271,25 @@ impl Fuser {
         let faces = self
             .scan
             .exclusive(&self.keep.buf, &self.face_off.buf, nt)? as usize;
-        let mut scans = self.scan.last_ms();
+        let face_scan = self.scan.last_ms();
         let vertices = self
             .scan
             .exclusive(&self.referenced.buf, &self.vert_id.buf, n)? as usize;
-        scans += self.scan.last_ms();
-        t.index = e_index.as_ref().map(event_ms).unwrap_or(0.0);
-        t.triangles = [e_clear, e_tri, e_mark]
-            .iter()
-            .flatten()
-            .map(event_ms)
-            .sum();
-        t.scans = scans;
+        let vertex_scan = self.scan.last_ms();
+        if let Some(e) = &e_index {
+            t.add(Step::FuseIndex, event_ms(e));
+        }
+        // `fuse_clear` is counted in the triangles step it prepares.
+        for e in [&e_clear, &e_tri].into_iter().flatten() {
+            t.add(Step::FuseTriangles, event_ms(e));
+        }
+        t.add(Step::ScanExclusive, cand_scan);
+        t.extend(&cancel);
+        if let Some(e) = &e_mark {
+            t.add(Step::FuseMark, event_ms(e));
+        }
+        t.add(Step::ScanExclusive, face_scan);
+        t.add(Step::ScanExclusive, vertex_scan);
         // Sized from the scans, within the bounds the memory check assumed.
         debug_assert!(vertices <= fused_vertices_bound(n) && faces <= fused_faces_bound(n));
         self.out_pos.reserve(&g, 3 * vertices)?;
@@ -325,7 +320,12 @@ impl Fuser {
             ],
         )?;
         g.finish()?;
-        t.compact = [e_v, e_f].iter().flatten().map(event_ms).sum();
+        if let Some(e) = &e_v {
+            t.add(Step::FuseCompactVertices, event_ms(e));
+        }
+        if let Some(e) = &e_f {
+            t.add(Step::FuseCompactFaces, event_ms(e));
+        }
         Ok((
             FusionCounts {
                 vertices,

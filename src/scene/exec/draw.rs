@@ -1,0 +1,203 @@
+//! Drawing and outputs: the scene's cameras resolved against the first
+//! pose's bounds, the mesh colours and style, the line and edge quads, and
+//! the PNG and SVG files of one view.
+
+use crate::cpu::feature_lines::Segment;
+use crate::error::Result;
+use crate::render::colormap::{curvature_color, with_ao};
+use crate::render::edges::draw_edges;
+use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
+use crate::scene::file::{CameraKind, Scene, ViewSpec};
+use crate::scene::planner::{Cue, Pass, Plan};
+use crate::stages::edges::EdgeOutput;
+use std::path::PathBuf;
+
+/// Host copies of the pose that the renderer and the host-side passes use,
+/// relative to the scene origin.
+#[derive(Default)]
+pub(super) struct PoseData {
+    pub(super) pos: Vec<[f32; 3]>,
+    pub(super) nrm: Vec<[f32; 3]>,
+    pub(super) k: Vec<[f32; 2]>,
+    pub(super) ao: Vec<f32>,
+}
+
+/// Resolves a view against the scene bounds (scene frame); explicit eyes and
+/// targets are world positions, moved into the scene frame by `origin`.
+pub(super) fn camera(
+    v: &ViewSpec,
+    bounds: ([f64; 3], [f64; 3]),
+    aspect: f32,
+    origin: [f64; 3],
+) -> Result<Camera> {
+    let local = |p: [f32; 3]| -> glam::Vec3 {
+        glam::Vec3::from(std::array::from_fn::<f32, 3, _>(|i| {
+            (f64::from(p[i]) - origin[i]) as f32
+        }))
+    };
+    let up = v.up.map(glam::Vec3::from);
+    let (placement, target) = match &v.kind {
+        CameraKind::LookAt { eye, target } => (Placement::At(local(*eye)), target.map(local)),
+        CameraKind::Fit(d) => (Placement::Fit(glam::Vec3::from(*d)), None),
+    };
+    framed(placement, target, up, v.fov, v.ortho, bounds, aspect)
+}
+
+/// Bounds of the vertices that faces use (a stray unreferenced vertex far
+/// away must not shrink the mesh to a dot in a fitted camera).
+pub(super) fn bounds_of(p: impl Iterator<Item = [f64; 3]>, used: &[bool]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (q, _) in p.zip(used).filter(|(_, u)| **u) {
+        for i in 0..3 {
+            lo[i] = lo[i].min(q[i]);
+            hi[i] = hi[i].max(q[i]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Centre of bounds (0 on an axis where it is not finite, e.g. no used vertex).
+pub(super) fn centre((lo, hi): ([f64; 3], [f64; 3])) -> [f64; 3] {
+    std::array::from_fn(|i| {
+        let c = 0.5 * (lo[i] + hi[i]);
+        if c.is_finite() { c } else { 0.0 }
+    })
+}
+
+/// Per-vertex colours: curvature colours and/or AO; empty (the style's flat
+/// colour) when neither is asked for.
+pub(super) fn mesh_colors(
+    scene: &Scene,
+    plan: &Plan,
+    pose: &PoseData,
+    scale: f32,
+) -> Vec<[f32; 3]> {
+    let fx = &scene.effects;
+    let colors = fx.cues.contains(&Cue::CurvatureColors);
+    // The AO pass is planned exactly when the AO cue is asked for.
+    let ao = plan.contains(Pass::Ao);
+    if !colors && !ao {
+        return Vec::new();
+    }
+    (0..pose.pos.len())
+        .map(|i| {
+            let c = if colors {
+                let [a, b] = pose.k[i];
+                curvature_color(a, b, scale, fx.base_color)
+            } else {
+                fx.base_color
+            };
+            if ao { with_ao(c, pose.ao[i]) } else { c }
+        })
+        .collect()
+}
+
+/// The opacity bin (0..4) of a suggestive-contour segment's strength in [0, 1].
+fn strength_bin(strength: f32) -> usize {
+    if strength.is_finite() {
+        ((strength.clamp(0.0, 1.0) * 4.0).ceil() as usize).clamp(1, 4) - 1
+    } else {
+        3
+    }
+}
+
+/// What one view draws on top of the mesh.
+pub(super) struct ViewLines<'a> {
+    /// Contour and suggestive-contour segments (scene frame).
+    pub(super) segments: &'a [Segment],
+    /// The edge stage's outputs, when feature edges are planned.
+    pub(super) edges: Option<&'a EdgeOutput>,
+}
+
+/// Draws one view (mesh, line quads, edge quads), reads it back and writes
+/// its images to `paths`. Returns the contour and suggestive-contour
+/// segments drawn.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn draw_view(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    plan: &Plan,
+    cam: &Camera,
+    pose: &PoseData,
+    colors: &[[f32; 3]],
+    faces: &[[u32; 3]],
+    lines: ViewLines<'_>,
+    paths: &[&PathBuf],
+) -> Result<[usize; 2]> {
+    let fx = &scene.effects;
+    let [w, h] = scene.size;
+    renderer.begin(cam)?;
+    let lines_only = !(plan.contains(Pass::Ao)
+        || fx.cues.contains(&Cue::Shading)
+        || fx.cues.contains(&Cue::CurvatureColors));
+    let style = if lines_only {
+        // Lines only: the mesh is drawn flat in the background colour,
+        // so that it hides the lines behind it.
+        MeshStyle {
+            ambient: 1.0,
+            color: scene.background,
+            ..MeshStyle::default()
+        }
+    } else {
+        MeshStyle {
+            ambient: fx.ambient,
+            color: fx.base_color,
+            ..MeshStyle::default()
+        }
+    };
+    renderer.draw_mesh(&pose.pos, &pose.nrm, colors, faces, style)?;
+    let mut line_quads: Vec<[f32; 4]> = Vec::new();
+    let mut drawn = [0usize; 2];
+    // Contours opaque; suggestive contours in four opacity bins of
+    // their n·v fade (DeCarlo et al. fade them out as they approach
+    // the contour generator, where they are unstable).
+    const BINS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
+    for (kind, (width, color)) in [(0u32, fx.contour), (1u32, fx.suggestive)] {
+        let mut n = 0;
+        for (bi, &alpha) in BINS.iter().enumerate() {
+            let pts: Vec<[f32; 3]> = lines
+                .segments
+                .iter()
+                .filter(|s| s.2 == kind && (kind == 0 || strength_bin(s.3) == bi))
+                .flat_map(|s| [s.0, s.1])
+                .collect();
+            if pts.is_empty() || (kind == 0 && bi > 0) {
+                continue;
+            }
+            n += pts.len() / 2;
+            let [r, g, b] = color;
+            let a = if kind == 0 { 1.0 } else { alpha };
+            renderer.draw_lines(&pts, [r, g, b, a], width)?;
+            if scene.svg {
+                line_quads.extend(crate::render::segments_to_clip_quads(
+                    cam.view_proj(w as f32 / h as f32),
+                    [w, h],
+                    &pts,
+                    width,
+                ));
+            }
+        }
+        drawn[kind as usize] += n;
+    }
+    if let Some(eo) = lines.edges {
+        let [r, g, b] = fx.edge.1;
+        draw_edges(renderer, eo, [r, g, b, 1.0])?;
+        line_quads.extend_from_slice(&eo.edge_out);
+    }
+    let image: Frame = renderer.finish()?;
+    for path in paths {
+        if path.extension().is_some_and(|e| e == "png") {
+            image.save_png(path)?;
+        } else {
+            let lines = crate::export::svg::visible_polylines(
+                &line_quads,
+                &image,
+                crate::export::svg::DEFAULT_BIAS,
+            );
+            let width = fx.contour.0.max(fx.edge.0);
+            crate::export::svg::write_svg(path, &lines, w, h, width)?;
+        }
+    }
+    Ok(drawn)
+}

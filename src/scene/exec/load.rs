@@ -1,0 +1,179 @@
+//! Loading a scene's input on the host (a mesh, a skinned mesh with its
+//! poses, a flipbook, a volume or an SDF), the frames it renders, and the
+//! paths of the files a run writes.
+
+use crate::error::{Error, Result};
+use crate::mesh::LoadOptions;
+use crate::mesh::Mesh;
+use crate::mesh::skinned::SkinnedMesh;
+use crate::scene::file::{ClipRef, Scene, Source};
+use std::path::{Path, PathBuf};
+
+/// The geometry of a scene, loaded on the host.
+pub(super) enum Loaded {
+    Static(Mesh),
+    Skinned {
+        mesh: Box<SkinnedMesh>,
+        /// Joint matrices per frame index.
+        poses: PoseFn,
+        frames: usize,
+    },
+    Flipbook(crate::mesh::flipbook::Flipbook),
+    /// The volume, the isovalue used and whether values were negated.
+    Volume(Box<crate::volume::Volume>, f32, bool),
+}
+
+/// Joint matrices (flattened, device layout) of a frame.
+pub(super) type PoseFn = Box<dyn Fn(usize) -> Result<Vec<f32>>>;
+
+impl Loaded {
+    /// Frames available (None: unbounded, a static mesh's one frame repeats).
+    pub(super) fn frames(&self) -> usize {
+        match self {
+            Loaded::Static(_) | Loaded::Volume(..) => 1,
+            Loaded::Skinned { frames, .. } => *frames,
+            Loaded::Flipbook(f) => f.frames.len(),
+        }
+    }
+}
+
+/// Loads the scene's input; what was assumed or dropped goes to `notes`.
+pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
+    let opts = LoadOptions { weld: scene.weld };
+    Ok(match &scene.source {
+        Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?),
+        Source::Generate(kind, n) => match crate::mesh::generated_by_name(kind, *n) {
+            Some((_, m)) => Loaded::Static(m),
+            None => {
+                return Err(Error::InvalidArgument(format!(
+                    "unknown generated mesh {kind:?}"
+                )));
+            }
+        },
+        Source::Gltf(p, clip) => {
+            let m = crate::mesh::skinned::load_gltf(p)?;
+            if m.clips.is_empty() && clip.is_none() {
+                notes.push(format!(
+                    "{}: no animation; the rest pose is the one frame",
+                    p.display()
+                ));
+                let rest = SkinnedMesh::flatten(&m.joint_matrices(None, 0.0)?);
+                return Ok(Loaded::Skinned {
+                    mesh: Box::new(m),
+                    poses: Box::new(move |_| Ok(rest.clone())),
+                    frames: 1,
+                });
+            }
+            let idx = match clip.clone().unwrap_or(ClipRef::Index(0)) {
+                ClipRef::Index(i) => i,
+                ClipRef::Name(n) => m.clips.iter().position(|c| c.name == n).ok_or_else(|| {
+                    Error::input(
+                        p.display().to_string(),
+                        format!("clip {n:?}"),
+                        format!(
+                            "no such clip; the file has {:?}",
+                            m.clips.iter().map(|c| c.name.as_str()).collect::<Vec<_>>()
+                        ),
+                    )
+                })?,
+            };
+            if idx >= m.clips.len() {
+                return Err(Error::input(
+                    p.display().to_string(),
+                    format!("clip {idx}"),
+                    format!("the file has {} clips", m.clips.len()),
+                ));
+            }
+            let duration = m.clips[idx].duration;
+            let fps = scene.fps;
+            let frames = (duration * fps).floor() as usize + 1;
+            notes.push(format!(
+                "clip {idx} {:?}: {duration:.3} s at {fps} fps = {frames} frames",
+                m.clips[idx].name
+            ));
+            let mm = m.clone();
+            Loaded::Skinned {
+                mesh: Box::new(m),
+                poses: Box::new(move |f| {
+                    let t = (f as f32 / fps).min(duration);
+                    Ok(SkinnedMesh::flatten(&mm.joint_matrices(Some(idx), t)?))
+                }),
+                frames,
+            }
+        }
+        Source::Lbs(p) => {
+            let a = crate::mesh::libigl::load_elephant_set(p)?;
+            let (m, trunc) = a.to_skinned();
+            notes.push(format!(
+                "{}: {} bones, weights cut to the 4 largest per vertex: {trunc:?}",
+                p.display(),
+                m.joint_nodes.len()
+            ));
+            let frames = a.frames;
+            Loaded::Skinned {
+                mesh: Box::new(m),
+                poses: Box::new(move |f| Ok(SkinnedMesh::flatten(&a.frame_matrices(f)?))),
+                frames,
+            }
+        }
+        Source::Flipbook(pat) => Loaded::Flipbook(crate::mesh::flipbook::Flipbook::open(
+            pat,
+            Path::new(""),
+            &opts,
+        )?),
+        Source::Volume(p, iso, above) => inside_below(crate::volume::load(p, None)?, *iso, *above),
+        Source::Sdf(kind, res, iso, above) => {
+            inside_below(crate::volume::sdf::sdf_by_name(kind, *res)?, *iso, *above)
+        }
+    })
+}
+
+/// Marching cubes orients its triangles (and the gradient normals) out of
+/// the region *below* the isovalue. When the object is above it (density
+/// data), the values and the isovalue are negated (exact in f32), so normals
+/// point out of the object and its convex parts get positive curvature.
+fn inside_below(mut v: crate::volume::Volume, iso: f32, above: bool) -> Loaded {
+    if above {
+        v.values.iter_mut().for_each(|x| *x = -*x);
+        Loaded::Volume(Box::new(v), -iso, true)
+    } else {
+        Loaded::Volume(Box::new(v), iso, false)
+    }
+}
+
+/// The frame indices a scene renders, checked against what the input has.
+pub fn frame_indices(scene: &Scene, available: usize) -> Result<Vec<usize>> {
+    let (start, end, step) = scene.frames;
+    let end = end.unwrap_or(available);
+    if end > available || start >= end {
+        return Err(Error::input(
+            scene.path.display().to_string(),
+            "[frames]",
+            format!("frames {start}..{end} are outside the input's {available} frame(s)"),
+        ));
+    }
+    Ok((start..end).step_by(step).collect())
+}
+
+/// The image files a run writes, in order (frame-major), and the report.
+pub fn output_paths(
+    scene: &Scene,
+    frames: &[usize],
+    out_dir: &Path,
+) -> (Vec<(usize, usize, PathBuf)>, PathBuf) {
+    let mut v = Vec::new();
+    for &f in frames {
+        for view in 0..scene.views.len() {
+            for (on, ext) in [(scene.png, "png"), (scene.svg, "svg")] {
+                if on {
+                    v.push((
+                        f,
+                        view,
+                        out_dir.join(format!("{}_f{f:04}_v{view:02}.{ext}", scene.prefix)),
+                    ));
+                }
+            }
+        }
+    }
+    (v, out_dir.join(format!("{}_report.json", scene.prefix)))
+}

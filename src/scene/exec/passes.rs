@@ -1,0 +1,703 @@
+//! Per-pass execution: the executor's state and one arm per planner pass.
+//! [`Executor::pose_pass`] runs a topology or pose pass, [`Executor::view_pass`]
+//! a view pass; the caller walks the plan's passes in order, filtered by
+//! lifetime, and calls them. Nothing here decides *what* runs: an arm runs
+//! because its pass is in the plan.
+//!
+//! Stages: a skinned input runs skinning, curvature and AO through
+//! [`PosePipeline`] (built with only the stages the plan needs); the other
+//! inputs hold their curvature estimator per topology (an isosurface's on
+//! the device, from the fusion kernels) and one [`AoStage`]. The feature
+//! lines and the edge stage are per topology for every input.
+
+use super::draw::{self, PoseData, ViewLines};
+use super::load::Loaded;
+use super::report::{Recorder, ms_since};
+use crate::cpu::feature_lines::{LineInputs, Segment};
+use crate::error::{Error, Result};
+use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use crate::gpu::Gpu;
+use crate::mesh::Mesh;
+use crate::mesh::edges::{EdgeTopology, vertex_normals};
+use crate::render::colormap::curvature_scale;
+use crate::render::{Camera, Renderer};
+use crate::scene::file::Scene;
+use crate::scene::planner::{Pass, Plan};
+use crate::spec::timing::{Step, Timing};
+use crate::stages::ao::AoStage;
+use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::edges::{EdgeOutput, EdgeParams, EdgeStage};
+use crate::stages::feature_lines::{LineExtractor, LineOptions};
+use crate::stages::marching_cubes::{IsoNormals, Isosurfacer};
+use crate::stages::pipeline::{PipelineOptions, PipelineStages, PosePipeline};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Per-topology state.
+struct Topology {
+    mesh: Mesh,
+    /// Median edge length ([`crate::mesh::feature_size`]) of the topology's
+    /// first pose: the scale of the suggestive-contour threshold.
+    feature_size: f32,
+    /// Which vertices faces use.
+    used: Vec<bool>,
+    /// The curvature estimator of an unskinned input.
+    est: Option<CurvatureEstimator>,
+    lines: Option<LineExtractor>,
+    edges: Option<EdgeStage>,
+}
+
+impl Topology {
+    fn new(mesh: Mesh) -> Self {
+        let used = crate::mesh::referenced(mesh.n_vertices(), &mesh.faces);
+        let fs = match crate::mesh::feature_size(&mesh.positions, &mesh.faces) {
+            // No edge length: the RMS radius of the used vertices.
+            fs if fs <= 0.0 => Normalization::of_masked(&mesh.positions, Some(&used)).scale,
+            fs => fs,
+        };
+        Topology {
+            feature_size: fs as f32,
+            used,
+            mesh,
+            est: None,
+            lines: None,
+            edges: None,
+        }
+    }
+}
+
+/// What the first pose fixes for the whole run: the scene origin, the
+/// cameras, the AO radius and the curvature colour scale.
+struct Framing {
+    /// World position of the scene frame's origin (the centre of the first
+    /// pose), so that a mesh far from the world origin keeps its f32
+    /// precision in the renderer.
+    origin: [f64; 3],
+    cameras: Vec<Camera>,
+    ao_radius: f32,
+}
+
+/// The executor's state over a run.
+pub(super) struct Executor<'s, 'g> {
+    scene: &'s Scene,
+    plan: &'s Plan,
+    loaded: Loaded,
+    gpu: &'g Arc<Gpu>,
+    pub(super) rec: Recorder,
+    renderer: Renderer,
+    curv_opts: CurvatureOptions,
+    line_opts: LineOptions,
+    /// Skinning, curvature and AO of a skinned input.
+    pipe: Option<PosePipeline>,
+    iso: Option<Isosurfacer>,
+    /// AO of an unskinned input.
+    ao: Option<AoStage>,
+    topo: Option<Topology>,
+    framing: Option<Framing>,
+    color_scale: Option<f32>,
+    pose: PoseData,
+    /// This pose: a flipbook frame's positions.
+    frame_pos: Option<Vec<[f64; 3]>>,
+    /// This pose: the curvature run (normals, curvature, dcurv steps).
+    curv: Option<Timing>,
+    /// This pose: whether the host copies are made.
+    pose_ready: bool,
+    /// This view: the lines and the edge stage's run and outputs.
+    segs: Vec<Segment>,
+    lines_ran: Option<Timing>,
+    edges_ran: Option<(Timing, EdgeOutput)>,
+    /// Contour and suggestive-contour segments over all views.
+    pub(super) segments: [usize; 2],
+    /// Files written.
+    pub(super) outputs: Vec<PathBuf>,
+}
+
+impl<'s, 'g> Executor<'s, 'g> {
+    /// Builds the stages whose passes the plan holds that live for the
+    /// whole run (skinning pipeline, isosurfacer, AO).
+    pub(super) fn new(
+        scene: &'s Scene,
+        plan: &'s Plan,
+        loaded: Loaded,
+        gpu: &'g Arc<Gpu>,
+        renderer: Renderer,
+    ) -> Result<Self> {
+        let fx = &scene.effects;
+        let has = |p: Pass| plan.contains(p);
+        let curv_opts = CurvatureOptions {
+            accumulate: Accumulate::Atomic,
+            precision: Precision::F32,
+            compat: Compat::Exact,
+            dcurv: has(Pass::Dcurv),
+        };
+        let line_opts = LineOptions {
+            contours: has(Pass::Contours),
+            suggestive: has(Pass::SuggestiveContours),
+            threshold: fx.suggestive_threshold,
+            fade: fx.suggestive_fade,
+        };
+        let pipe = match &loaded {
+            Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(
+                gpu.clone(),
+                mesh,
+                PipelineOptions {
+                    curvature: curv_opts,
+                    ao_mode: fx.ao_mode,
+                    ..PipelineOptions::default()
+                },
+                PipelineStages {
+                    curvature: has(Pass::OneRings),
+                    ao: has(Pass::Ao),
+                    // The lines are per topology for every input (contours
+                    // alone are found from host normals, without curvature).
+                    lines: false,
+                },
+            )?),
+            _ => None,
+        };
+        let iso = match &loaded {
+            Loaded::Volume(v, ..) if has(Pass::Isosurface) => {
+                Some(Isosurfacer::new(gpu.clone(), v)?)
+            }
+            _ => None,
+        };
+        let ao = match (&pipe, has(Pass::Ao)) {
+            (None, true) => Some(AoStage::new(gpu.clone())?),
+            _ => None,
+        };
+        Ok(Executor {
+            scene,
+            plan,
+            loaded,
+            gpu,
+            rec: Recorder::new(plan.input),
+            renderer,
+            curv_opts,
+            line_opts,
+            pipe,
+            iso,
+            ao,
+            topo: None,
+            framing: None,
+            color_scale: fx.curvature_scale,
+            pose: PoseData::default(),
+            frame_pos: None,
+            curv: None,
+            pose_ready: false,
+            segs: Vec::new(),
+            lines_ran: None,
+            edges_ran: None,
+            segments: [0; 2],
+            outputs: Vec::new(),
+        })
+    }
+
+    /// The renderer's GL description.
+    pub(super) fn gl_info(&self) -> String {
+        self.renderer.gl_info()
+    }
+
+    /// Vertices and faces of the current topology.
+    pub(super) fn counts(&self) -> (usize, usize) {
+        self.topo
+            .as_ref()
+            .map_or((0, 0), |t| (t.mesh.n_vertices(), t.mesh.n_faces()))
+    }
+
+    /// The cameras fixed by the first pose.
+    pub(super) fn cameras(&self) -> Vec<Camera> {
+        self.framing
+            .as_ref()
+            .map(|f| f.cameras.clone())
+            .unwrap_or_default()
+    }
+
+    /// The curvature estimator of the current pose, wherever it lives.
+    fn est(&self) -> Option<&CurvatureEstimator> {
+        match &self.pipe {
+            Some(p) => p.estimator(),
+            None => self.topo.as_ref().and_then(|t| t.est.as_ref()),
+        }
+    }
+
+    /// Starts a pose: nothing of the last one is reused.
+    pub(super) fn begin_pose(&mut self) {
+        self.frame_pos = None;
+        self.curv = None;
+        self.pose_ready = false;
+    }
+
+    /// Ends a pose: host copies made (if no pass needed them), the colour
+    /// scale fixed on the first pose.
+    pub(super) fn end_pose(&mut self, frame: usize) -> Result<()> {
+        self.host_pose(frame)?;
+        if self.color_scale.is_none() && !self.pose.k.is_empty() {
+            self.color_scale = Some(curvature_scale(&self.pose.k));
+        }
+        Ok(())
+    }
+
+    /// The current topology, made from the input on the first pose (an
+    /// isosurface's comes from its pass).
+    fn topology(&mut self, frame: usize) -> Result<&mut Topology> {
+        if self.topo.is_none() {
+            let mesh = match &self.loaded {
+                Loaded::Static(m) => m.clone(),
+                Loaded::Skinned { mesh, .. } => mesh.rest.clone(),
+                Loaded::Flipbook(fb) => {
+                    let p = match self.frame_pos.take() {
+                        Some(p) => p,
+                        None => fb.frame(frame)?,
+                    };
+                    self.frame_pos = Some(p.clone());
+                    let name = fb.frames[frame].display().to_string();
+                    Mesh::new(p, fb.faces.clone(), &name)?
+                }
+                Loaded::Volume(..) => {
+                    return Err(Error::InvalidArgument(
+                        "internal: an isosurface scene without its isosurface pass".into(),
+                    ));
+                }
+            };
+            self.topo = Some(Topology::new(mesh));
+        }
+        Ok(self.topo.as_mut().expect("made above"))
+    }
+
+    /// Host copies of the pose's positions for drawing and host passes,
+    /// relative to the scene origin; on the first pose, the bounds fix the
+    /// origin, the cameras and the AO radius. Normals start at zero: only a
+    /// planned normals pass fills them (`edges_detect` and `caps_adjacency`
+    /// do not read them, and a lines-only mesh is drawn flat).
+    fn host_pose(&mut self, frame: usize) -> Result<()> {
+        if self.pose_ready {
+            return Ok(());
+        }
+        self.topology(frame)?;
+        let t = self.topo.as_ref().expect("made above");
+        let skinned = match &self.pipe {
+            Some(p) => Some(p.skinner().read()?),
+            None => None,
+        };
+        let host: Vec<[f64; 3]> = match (&skinned, &self.frame_pos) {
+            (Some(p), _) => p.iter().map(|q| q.map(f64::from)).collect(),
+            (None, Some(p)) => p.clone(),
+            (None, None) => t.mesh.positions.clone(),
+        };
+        let o = match &self.framing {
+            Some(f) => f.origin,
+            None => draw::centre(draw::bounds_of(host.iter().copied(), &t.used)),
+        };
+        self.pose.pos = match &skinned {
+            // f32 positions: subtract in f64 from the f32 values.
+            Some(p) => p
+                .iter()
+                .map(|q| std::array::from_fn(|i| (f64::from(q[i]) - o[i]) as f32))
+                .collect(),
+            None => host
+                .iter()
+                .map(|q| std::array::from_fn(|i| (q[i] - o[i]) as f32))
+                .collect(),
+        };
+        self.pose.nrm = vec![[0.0; 3]; t.mesh.n_vertices()];
+        if self.framing.is_none() {
+            let b = draw::bounds_of(self.pose.pos.iter().map(|q| q.map(f64::from)), &t.used);
+            let diag = ((0..3).map(|i| (b.1[i] - b.0[i]).powi(2)).sum::<f64>()).sqrt();
+            let [w, h] = self.scene.size;
+            let cameras = self
+                .scene
+                .views
+                .iter()
+                .map(|v| draw::camera(v, b, w as f32 / h as f32, o))
+                .collect::<Result<_>>()?;
+            self.framing = Some(Framing {
+                origin: o,
+                cameras,
+                ao_radius: (self.scene.effects.ao_radius as f64 * diag.max(1e-30)) as f32,
+            });
+        }
+        self.pose_ready = true;
+        Ok(())
+    }
+
+    /// The curvature run of this pose (normals, curvature, dcurv), run on
+    /// first use: from the skinned buffer, or from the host positions.
+    fn curvature_run(&mut self, frame: usize) -> Result<Timing> {
+        if let Some(t) = &self.curv {
+            return Ok(t.clone());
+        }
+        let t = match self.pipe.as_mut() {
+            Some(p) => p.curvature()?,
+            None => {
+                self.topology(frame)?;
+                let fp = self.frame_pos.take();
+                let t = self.topo.as_mut().expect("made above");
+                let est = t.est.as_mut().expect("planned with the one-rings");
+                est.set_positions(fp.as_deref().unwrap_or(&t.mesh.positions))?;
+                self.frame_pos = fp;
+                est.run()?
+            }
+        };
+        self.curv = Some(t.clone());
+        Ok(t)
+    }
+
+    /// Runs one topology or pose pass.
+    pub(super) fn pose_pass(&mut self, pass: Pass, frame: usize) -> Result<()> {
+        let has = |p: Pass| self.plan.contains(p);
+        match pass {
+            Pass::Isosurface => self.isosurface()?,
+            Pass::Skinning => {
+                let Loaded::Skinned { poses, .. } = &self.loaded else {
+                    unreachable!("planned for a skinned input")
+                };
+                let mats = poses(frame)?;
+                let pipe = self.pipe.as_mut().expect("built for the skinning pass");
+                let t = pipe.skin(&mats)?;
+                self.rec
+                    .kernels(pass, &t, "skin_lbs (linear blend, ≤ 4 joints)");
+            }
+            Pass::LoadFrame => {
+                let Loaded::Flipbook(fb) = &self.loaded else {
+                    unreachable!("planned for a flipbook input")
+                };
+                let t0 = Instant::now();
+                let p = fb.frame(frame)?;
+                self.rec.wall(pass, ms_since(t0), "read the frame file");
+                self.frame_pos = Some(p);
+            }
+            Pass::EdgeBuffer => {
+                let t0 = Instant::now();
+                let name = self.scene.path.display().to_string();
+                let caps = has(Pass::CapBuffer);
+                let t = self.topology(frame)?;
+                let et = if caps {
+                    EdgeTopology::new(&t.mesh, &[], &name)?
+                } else {
+                    EdgeTopology::without_caps(&t.mesh, &[], &name)?
+                };
+                self.rec.wall(
+                    pass,
+                    ms_since(t0),
+                    "unique edges with opposite vertices (host, once per topology)",
+                );
+                let t = self.topo.as_mut().expect("made above");
+                t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
+            }
+            Pass::OneRings => self.one_rings(frame)?,
+            Pass::CapBuffer => self.rec.wall(
+                pass,
+                0.0,
+                "pairs of edges sharing a vertex (built with the edge buffer; time counted there)",
+            ),
+            Pass::VertexNormals => self.vertex_normals(frame)?,
+            Pass::FaceNormals => {
+                self.host_pose(frame)?;
+                let t0 = Instant::now();
+                let t = self.topo.as_mut().expect("made by the host copies");
+                let es = t.edges.as_mut().expect("planned with the edge buffer");
+                es.set_positions(&self.pose.pos, &self.pose.nrm)?;
+                self.rec.wall(
+                    pass,
+                    ms_since(t0),
+                    "upload the pose to the edge stage; face normals are computed inside edges_detect",
+                );
+            }
+            Pass::Curvature => {
+                let t = self.curvature_run(frame)?;
+                self.rec
+                    .kernels(pass, &t, "tensor + principal (Rusinkiewicz, atomic f32)");
+            }
+            Pass::Dcurv => {
+                let t = self.curvature_run(frame)?;
+                self.rec.kernels(pass, &t, "dcurv");
+            }
+            Pass::Ao => self.ao(frame)?,
+            Pass::Contours | Pass::SuggestiveContours | Pass::Edges | Pass::Caps | Pass::Render => {
+                unreachable!("{pass:?} is a view pass")
+            }
+        }
+        Ok(())
+    }
+
+    /// Marching cubes + fusion: a new topology.
+    fn isosurface(&mut self) -> Result<()> {
+        let Loaded::Volume(v, iso_value, negated) = &self.loaded else {
+            unreachable!("planned for a volume input")
+        };
+        let ex = self.iso.as_mut().expect("built for the isosurface pass");
+        let s = ex.extract(*iso_value, crate::cpu::vertex_fusion::Fusion::Edge)?;
+        self.rec.kernels(
+            Pass::Isosurface,
+            &s.timing,
+            "marching cubes + exact edge-key fusion",
+        );
+        let m = ex.read()?;
+        if m.n_faces() == 0 {
+            return Err(Error::input(
+                self.scene.path.display().to_string(),
+                "[input]",
+                {
+                    let sign = if *negated { -1.0 } else { 1.0 };
+                    let span = v.range().map(|(a, b)| {
+                        let (a, b) = (sign * a, sign * b);
+                        (a.min(b), a.max(b))
+                    });
+                    format!(
+                        "the isosurface at iso {} is empty (the values span {span:?})",
+                        sign * iso_value
+                    )
+                },
+            ));
+        }
+        self.topo = Some(Topology::new(m));
+        Ok(())
+    }
+
+    /// The curvature estimator's topology (owning faces), built once per
+    /// topology; an isosurface's faces stay on the device and its estimator
+    /// runs here, with normals from the volume gradient.
+    fn one_rings(&mut self, frame: usize) -> Result<()> {
+        let how = "owning faces (atomic_max); includes the first program build";
+        if let Some(p) = &self.pipe {
+            let est = p.estimator().expect("built for the one-rings pass");
+            let ms = est.topology_ms();
+            self.rec
+                .wall(Pass::OneRings, ms, &format!("upload faces, {how}"));
+            return Ok(());
+        }
+        if let Some(ex) = self.iso.as_ref() {
+            let (est, timing) =
+                crate::stages::marching_cubes::curvature(ex, self.curv_opts, IsoNormals::Gradient)?;
+            let how = format!("faces copied on the device, {how}");
+            self.rec.wall(Pass::OneRings, est.topology_ms(), &how);
+            self.curv = Some(timing);
+            self.topo.as_mut().expect("made by the isosurface").est = Some(est);
+            return Ok(());
+        }
+        let (gpu, opts) = (self.gpu.clone(), self.curv_opts);
+        let t = self.topology(frame)?;
+        let est = CurvatureEstimator::new(gpu, t.mesh.n_vertices(), &t.mesh.faces, opts)?;
+        let ms = est.topology_ms();
+        t.est = Some(est);
+        self.rec
+            .wall(Pass::OneRings, ms, &format!("upload faces, {how}"));
+        Ok(())
+    }
+
+    /// Vertex normals: from the curvature run when curvature is planned,
+    /// else area-weighted on the host.
+    fn vertex_normals(&mut self, frame: usize) -> Result<()> {
+        self.host_pose(frame)?;
+        if self.est().is_some() {
+            let t = self.curvature_run(frame)?;
+            let f = self.est().expect("checked above").read()?;
+            self.pose.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
+            self.pose.k =
+                f.k1.iter()
+                    .zip(&f.k2)
+                    .map(|(&a, &b)| [a as f32, b as f32])
+                    .collect();
+            let normals = if self.iso.is_some() {
+                "then replaced by the volume's gradient"
+            } else {
+                "curvature normals (area-weighted)"
+            };
+            let how = format!("clear + normals_areas + frames ({normals})");
+            self.rec.kernels(Pass::VertexNormals, &t, &how);
+        } else {
+            let t0 = Instant::now();
+            let faces = self.topo.as_ref().expect("made above").mesh.faces.clone();
+            let m = Mesh {
+                positions: self.pose.pos.iter().map(|p| p.map(f64::from)).collect(),
+                faces,
+            };
+            self.pose.nrm = vertex_normals(&m);
+            self.rec.wall(
+                Pass::VertexNormals,
+                ms_since(t0),
+                "area-weighted, host (no curvature planned)",
+            );
+        }
+        Ok(())
+    }
+
+    /// Ambient occlusion from the pose's curvatures.
+    fn ao(&mut self, frame: usize) -> Result<()> {
+        self.host_pose(frame)?;
+        let radius = self
+            .framing
+            .as_ref()
+            .expect("made by the host copies")
+            .ao_radius;
+        let mode = self.scene.effects.ao_mode;
+        let t = match self.pipe.as_mut() {
+            Some(p) => {
+                p.set_ao_radius(radius);
+                let t = p.run_ao(mode)?;
+                self.pose.ao = p.read_ao()?;
+                t
+            }
+            None => {
+                let est = self.topo.as_ref().and_then(|t| t.est.as_ref());
+                let est = est.expect("planned with curvature");
+                let ao = self.ao.as_mut().expect("built for the AO pass");
+                let t = Timing::of(Step::AoVertex, ao.run_device(est, radius, mode)?);
+                self.pose.ao = ao.read(self.pose.pos.len())?;
+                t
+            }
+        };
+        self.rec
+            .kernels(Pass::Ao, &t, &format!("ao_vertex, level {mode:?}"));
+        Ok(())
+    }
+
+    /// Starts a view.
+    pub(super) fn begin_view(&mut self) {
+        self.segs.clear();
+        self.lines_ran = None;
+        self.edges_ran = None;
+    }
+
+    /// Runs one view pass from `cam`; the render pass writes `paths`.
+    pub(super) fn view_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
+        match pass {
+            Pass::Contours => {
+                let t = self.lines(cam)?;
+                self.rec.kernels(
+                    pass,
+                    &t,
+                    "lines_vertex + lines_face (zero crossings of n·v)",
+                );
+            }
+            Pass::SuggestiveContours => {
+                let shared = self.lines_ran.is_some();
+                let t = self.lines(cam)?;
+                if shared {
+                    self.rec.shared(
+                        pass,
+                        "in the same lines_vertex + lines_face launch as the contours (time counted there)",
+                    );
+                } else {
+                    self.rec.kernels(
+                        pass,
+                        &t,
+                        "lines_vertex + lines_face (zero crossings of κr with D_w κr > 0)",
+                    );
+                }
+            }
+            Pass::Edges => {
+                let fx = &self.scene.effects;
+                let [w, h] = self.scene.size;
+                let mut p = EdgeParams::new(cam.view(w, h));
+                p.line_width = fx.edge.0;
+                p.crease_deg = fx.crease;
+                p.contours = fx.edge_contours;
+                p.boundaries = fx.edge_boundaries;
+                let t = self.topo.as_mut().expect("a pose ran");
+                let es = t.edges.as_mut().expect("planned with the edge buffer");
+                let timing = es.run(&p, fx.caps)?;
+                let out = es.read()?;
+                self.rec.kernels(
+                    pass,
+                    &timing,
+                    "edges_detect (contour, crease, boundary) into edge-out",
+                );
+                self.edges_ran = Some((timing, out));
+            }
+            Pass::Caps => {
+                let (timing, _) = self.edges_ran.as_ref().expect("planned after the edges");
+                let how = format!("caps_{}", self.scene.effects.caps.name());
+                self.rec.kernels(pass, timing, &how);
+            }
+            Pass::Render => {
+                let t0 = Instant::now();
+                let colors = draw::mesh_colors(
+                    self.scene,
+                    self.plan,
+                    &self.pose,
+                    self.color_scale.unwrap_or(1.0),
+                );
+                let t = self.topo.as_ref().expect("a pose ran");
+                let lines = ViewLines {
+                    segments: &self.segs,
+                    edges: self.edges_ran.as_ref().map(|e| &e.1),
+                };
+                let drawn = draw::draw_view(
+                    &mut self.renderer,
+                    self.scene,
+                    self.plan,
+                    cam,
+                    &self.pose,
+                    &colors,
+                    &t.mesh.faces,
+                    lines,
+                    paths,
+                )?;
+                self.rec.wall(
+                    pass,
+                    ms_since(t0),
+                    "draw mesh, line quads and edge quads; read back",
+                );
+                self.segments[0] += drawn[0];
+                self.segments[1] += drawn[1];
+                self.outputs.extend(paths.iter().map(|p| (*p).clone()));
+            }
+            _ => unreachable!("{pass:?} is not a view pass"),
+        }
+        Ok(())
+    }
+
+    /// Contours and suggestive contours of this view, found once per view
+    /// (one launch finds both): on the device from the curvature buffers,
+    /// or from host normals when no curvature is planned.
+    fn lines(&mut self, cam: &Camera) -> Result<Timing> {
+        if let Some(t) = &self.lines_ran {
+            return Ok(t.clone());
+        }
+        let [w, h] = self.scene.size;
+        let v = cam.view(w, h);
+        let origin = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let opts = self.line_opts;
+        let Topology {
+            mesh,
+            feature_size,
+            est,
+            lines,
+            ..
+        } = self.topo.as_mut().expect("a pose ran");
+        let est = match &self.pipe {
+            Some(p) => p.estimator(),
+            None => est.as_ref(),
+        };
+        let lx = match lines {
+            Some(lx) => lx,
+            None => lines.insert(LineExtractor::new(
+                self.gpu.clone(),
+                mesh.n_vertices(),
+                &mesh.faces,
+            )?),
+        };
+        let feature_size = *feature_size;
+        let (s, stats) = match est {
+            Some(est) => lx.extract_device_at(est, v, feature_size, opts, origin)?,
+            None => {
+                let n = self.pose.pos.len();
+                let z3 = vec![[0f32; 3]; n];
+                let x = LineInputs {
+                    pos: &self.pose.pos,
+                    nrm: &self.pose.nrm,
+                    d1: &z3,
+                    d2: &z3,
+                    k: &vec![[0f32; 2]; n],
+                    dk: &vec![[0f32; 4]; n],
+                };
+                lx.extract(&x, v, feature_size, opts)?
+            }
+        };
+        self.segs = s;
+        self.lines_ran = Some(stats.timing.clone());
+        Ok(stats.timing)
+    }
+}

@@ -1,0 +1,136 @@
+//! The run report: which passes ran, how often, for how long and by which
+//! clock. Device passes take their kernel ms from their stage's
+//! [`Timing`], joined to the plan by [`Pass::kernels`]; host passes report
+//! wall time.
+
+use crate::scene::planner::{Input, Lifetime, Pass, Plan};
+use crate::spec::timing::Timing;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What ran of one pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassRecord {
+    /// The pass.
+    pub pass: Pass,
+    /// Its lifetime for this input.
+    pub lifetime: Lifetime,
+    /// How many times it ran.
+    pub runs: usize,
+    /// Total milliseconds over all runs.
+    pub ms: f64,
+    /// `kernel` (OpenCL profiling time) or `wall` (host time).
+    pub clock: &'static str,
+    /// What the pass did here.
+    pub how: String,
+}
+
+/// The report of one scene run.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// The scene file.
+    pub scene: String,
+    /// The OpenCL device.
+    pub device: String,
+    /// The GL renderer.
+    pub renderer: String,
+    /// The plan: input kind, cues, passes in order.
+    pub plan: Plan,
+    /// Frame indices rendered.
+    pub frames: Vec<usize>,
+    /// Cameras per frame.
+    pub views: usize,
+    /// Vertices and faces of the (last) pose.
+    pub vertices: usize,
+    /// Faces.
+    pub faces: usize,
+    /// The passes that ran, in plan order, with counts and times.
+    pub passes: Vec<PassRecord>,
+    /// Median per-frame time of the pose passes (ms, their own clocks).
+    pub pose_ms_median: f64,
+    /// Median per-view time of the view passes other than rendering (ms).
+    pub view_ms_median: f64,
+    /// Median per-view render time (draw + read back), ms.
+    pub render_ms_median: f64,
+    /// Contour and suggestive-contour segments over all views.
+    pub segments: [usize; 2],
+    /// Notes (e.g. what skinning weights were dropped).
+    pub notes: Vec<String>,
+    /// Files written (images; the report itself is written last).
+    pub outputs: Vec<PathBuf>,
+    /// Wall time of the whole run, ms.
+    pub wall_ms: f64,
+}
+
+/// Accumulates what each pass did, and the time of the current pose or
+/// view (the sum of what its passes recorded).
+pub(super) struct Recorder {
+    input: Input,
+    map: BTreeMap<Pass, PassRecord>,
+    /// Milliseconds recorded since the last [`Recorder::lap`] (topology
+    /// passes left out).
+    current: f64,
+}
+
+impl Recorder {
+    pub(super) fn new(input: Input) -> Recorder {
+        Recorder {
+            input,
+            map: BTreeMap::new(),
+            current: 0.0,
+        }
+    }
+
+    fn add(&mut self, pass: Pass, ms: f64, clock: &'static str, how: &str) {
+        let r = self.map.entry(pass).or_insert_with(|| PassRecord {
+            pass,
+            lifetime: pass.lifetime(self.input),
+            runs: 0,
+            ms: 0.0,
+            clock,
+            how: how.to_string(),
+        });
+        r.runs += 1;
+        r.ms += ms;
+        // The pose time is that of the passes run per pose.
+        if r.lifetime != Lifetime::Topology {
+            self.current += ms;
+        }
+    }
+
+    /// One run of a host pass taking `ms` of wall time.
+    pub(super) fn wall(&mut self, pass: Pass, ms: f64, how: &str) {
+        self.add(pass, ms, "wall", how);
+    }
+
+    /// One run of a device pass: the kernel ms of its steps in `t`.
+    pub(super) fn kernels(&mut self, pass: Pass, t: &Timing, how: &str) {
+        self.add(pass, t.ms(pass.kernels()), "kernel", how);
+    }
+
+    /// One run of a device pass whose kernels ran in another pass's launch
+    /// (time counted there).
+    pub(super) fn shared(&mut self, pass: Pass, how: &str) {
+        self.add(pass, 0.0, "kernel", how);
+    }
+
+    /// The milliseconds recorded since the last call.
+    pub(super) fn lap(&mut self) -> f64 {
+        std::mem::take(&mut self.current)
+    }
+
+    /// The records of the passes that ran, in plan order.
+    pub(super) fn in_plan_order(&self, plan: &Plan) -> Vec<PassRecord> {
+        plan.passes
+            .iter()
+            .filter_map(|p| self.map.get(p).cloned())
+            .collect()
+    }
+}
+
+/// Milliseconds since `t`.
+pub(super) fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}

@@ -1,0 +1,238 @@
+//! The scene file as written: the TOML tables, deserialized with their
+//! spans (serde through the `toml` crate), before the cross-field checks of
+//! [`Scene::from_str`](super::Scene::from_str). Every table rejects unknown
+//! keys.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// The scene file as written (after syntax and type checks, before the
+/// cross-field checks of [`Scene::from_str`](super::Scene::from_str)).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Where the geometry comes from.
+    pub input: Spanned<InputSpec>,
+    /// Which frames to render.
+    #[serde(default)]
+    pub frames: Option<Spanned<FramesSpec>>,
+    /// Cameras (`[[camera]]` tables).
+    #[serde(default, rename = "camera")]
+    pub cameras: Vec<Spanned<CameraSpec>>,
+    /// The cues.
+    pub effects: Spanned<EffectsSpec>,
+    /// Images and report.
+    #[serde(default)]
+    pub output: Option<Spanned<OutputSpec>>,
+}
+
+/// `[input]`: exactly one of the source keys.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpec {
+    /// A static mesh file (OBJ, PLY, OFF).
+    pub mesh: Option<Spanned<String>>,
+    /// A generated mesh: torus, sphere, ellipsoid, cylinder or plane.
+    pub generate: Option<Spanned<String>>,
+    /// Vertex count of a generated mesh, or grid resolution of an SDF (default 40000 / 128).
+    pub resolution: Option<usize>,
+    /// A glTF 2.0 file with a skin and animations.
+    pub gltf: Option<Spanned<String>>,
+    /// The glTF clip: index or name (default 0).
+    pub clip: Option<Spanned<ClipRef>>,
+    /// A glob of OBJ/PLY frames with one topology, in natural order.
+    pub flipbook: Option<Spanned<String>>,
+    /// A libigl LBS set: `<stem>.obj` with `<stem>.tgf`, `<stem>-weights.dmat`, `<stem>-anim.dmat`.
+    pub lbs: Option<Spanned<String>>,
+    /// A volume file (NRRD, MetaImage, VTK, VTI, SLC) to extract an isosurface of.
+    pub volume: Option<Spanned<String>>,
+    /// A procedural signed distance field: sphere, torus or gyroid.
+    pub sdf: Option<Spanned<String>>,
+    /// Isovalue (volume: required; SDF: default 0).
+    pub iso: Option<f32>,
+    /// Which side of the isovalue is the object: `above` (density data such
+    /// as CT or electron density; the default for volume files) or `below`
+    /// (distance fields; the default for SDFs). Normals point out of the
+    /// object, so convex parts of it have positive curvature.
+    pub inside: Option<Spanned<String>>,
+    /// Weld coincident vertices of mesh and flipbook files.
+    #[serde(default)]
+    pub weld: bool,
+}
+
+/// A glTF clip by index or by name.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum ClipRef {
+    /// The clip's index.
+    Index(usize),
+    /// The clip's name.
+    Name(String),
+}
+
+/// `[frames]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FramesSpec {
+    /// First frame (inclusive).
+    #[serde(default)]
+    pub start: usize,
+    /// Last frame (exclusive); default: the whole animation (1 for a static input).
+    pub end: Option<usize>,
+    /// Frame step (≥ 1).
+    #[serde(default = "one")]
+    pub step: usize,
+    /// Frames per second for glTF clips (t = frame / fps).
+    #[serde(default = "thirty")]
+    pub fps: f32,
+}
+
+fn one() -> usize {
+    1
+}
+fn thirty() -> f32 {
+    30.0
+}
+
+impl Default for FramesSpec {
+    fn default() -> Self {
+        FramesSpec {
+            start: 0,
+            end: None,
+            step: 1,
+            fps: 30.0,
+        }
+    }
+}
+
+/// `[[camera]]`: an explicit eye, a fitted direction, or an orbit of fitted views.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Eye position (explicit camera).
+    pub eye: Option<[f32; 3]>,
+    /// Look-at point (default: the centre of the first pose's bounds).
+    pub target: Option<[f32; 3]>,
+    /// Up vector (default +Y).
+    pub up: Option<[f32; 3]>,
+    /// Direction from the centre towards the eye of a fitted camera.
+    pub direction: Option<[f32; 3]>,
+    /// Number of fitted views evenly spaced around the up axis.
+    pub orbit: Option<usize>,
+    /// Orbit elevation above the horizon, degrees (default 20).
+    pub elevation: Option<f32>,
+    /// Azimuth of the first orbit view, degrees (default 0: looking down −Z... from +Z).
+    pub azimuth: Option<f32>,
+    /// Vertical field of view, degrees (default 35).
+    pub fov: Option<f32>,
+    /// Orthographic projection.
+    #[serde(default)]
+    pub ortho: bool,
+}
+
+/// `[effects]`: each present table is a cue.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectsSpec {
+    /// Plain Lambert shading.
+    pub shading: Option<ShadingSpec>,
+    /// Curvature colours.
+    pub curvature_colors: Option<CurvatureColorSpec>,
+    /// Ambient occlusion from curvature (Lambert × AO).
+    pub ao: Option<AoSpec>,
+    /// Occluding contours.
+    pub contours: Option<LineSpec>,
+    /// Suggestive contours.
+    pub suggestive_contours: Option<SuggestiveSpec>,
+    /// Feature edges with caps.
+    pub feature_edges: Option<EdgeSpec>,
+}
+
+/// `[effects.shading]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadingSpec {
+    /// Base colour (default light grey).
+    pub color: Option<[f32; 3]>,
+    /// Ambient term in [0, 1] (default 0.15).
+    pub ambient: Option<f32>,
+}
+
+/// `[effects.curvature_colors]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurvatureColorSpec {
+    /// Curvature (world units⁻¹) at which colours are 76 % saturated (tanh 1);
+    /// default: the 90th percentile of |k| on the first pose.
+    pub scale: Option<f32>,
+}
+
+/// `[effects.ao]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AoSpec {
+    /// `poly` (seed polynomial), `lut` (table, default) or `exact` (integral per vertex).
+    pub level: Option<Spanned<String>>,
+    /// Hemisphere radius as a fraction of the first pose's bounding-box diagonal (default 0.02).
+    pub radius: Option<f32>,
+}
+
+/// `[effects.contours]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineSpec {
+    /// Line width in pixels (default 2).
+    pub width: Option<f32>,
+    /// RGB (default black).
+    pub color: Option<[f32; 3]>,
+}
+
+/// `[effects.suggestive_contours]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuggestiveSpec {
+    /// Line width in pixels (default 1.5).
+    pub width: Option<f32>,
+    /// RGB (default dark grey).
+    pub color: Option<[f32; 3]>,
+    /// Dimensionless threshold (default 0.05; see `LineOptions`).
+    pub threshold: Option<f32>,
+    /// n·v fade (default 0.2).
+    pub fade: Option<f32>,
+}
+
+/// `[effects.feature_edges]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EdgeSpec {
+    /// Width in pixels (default 3).
+    pub width: Option<f32>,
+    /// RGB (default black).
+    pub color: Option<[f32; 3]>,
+    /// Crease angle in degrees, (0, 180]; 180 turns creases off (default 30).
+    pub crease: Option<f32>,
+    /// `none`, `mh` or `adjacency` (default).
+    pub caps: Option<Spanned<String>>,
+    /// Detect contour edges (default true).
+    pub contours: Option<bool>,
+    /// Draw boundary edges (default true).
+    pub boundaries: Option<bool>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Output folder (default `out/<scene name>`, relative to the working directory).
+    pub dir: Option<String>,
+    /// File name prefix (default: the scene file's stem).
+    pub name: Option<String>,
+    /// Image size (default 640 × 480).
+    pub size: Option<[u32; 2]>,
+    /// `png` and/or `svg` (lines only) (default `["png"]`).
+    pub formats: Option<Spanned<Vec<String>>>,
+    /// Multisampling: 0, 2, 4 or 8 (default 4).
+    pub msaa: Option<u32>,
+    /// Background RGB (default white).
+    pub background: Option<[f32; 3]>,
+}

@@ -1,0 +1,141 @@
+//! Scene-file parsing and checks.
+
+use super::*;
+
+fn parse(text: &str) -> Result<Scene> {
+    Scene::from_str(Path::new("/nonexistent/dir/test.toml"), text)
+}
+
+fn err(text: &str) -> String {
+    parse(text).expect_err("must fail").to_string()
+}
+
+const MIN: &str = "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n";
+
+#[test]
+fn a_minimal_scene_gets_defaults() {
+    let s = parse(MIN).unwrap();
+    assert_eq!(s.source, Source::Generate("torus".into(), 40_000));
+    assert_eq!(s.effects.cues, vec![Cue::Shading]);
+    assert_eq!(s.views.len(), 1);
+    assert_eq!(s.size, [640, 480]);
+    assert!(s.png && !s.svg);
+    assert_eq!(s.out_dir, Path::new("out/test"));
+    assert_eq!(s.prefix, "test");
+}
+
+#[test]
+fn unknown_keys_and_wrong_types_name_the_line() {
+    let e =
+        err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\nao = { levle = \"lut\" }\n");
+    assert!(e.contains("test.toml") && e.contains("line 5"), "{e}");
+    assert!(e.contains("levle"), "{e}");
+    let e =
+        err("[input]\ngenerate = \"torus\"\n\n[effects]\nshading = {}\n[output]\nsize = \"big\"\n");
+    assert!(e.contains("line 7"), "{e}");
+    let e = err("[input]\ngenerate = \"torus\"\ncolour = 1\n[effects]\nshading = {}\n");
+    assert!(e.contains("line 3") && e.contains("colour"), "{e}");
+    let e =
+        err("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[[camera]]\nfov = \"wide\"\n");
+    assert!(e.contains("line 6"), "{e}");
+    let e = err("[input\n");
+    assert!(e.contains("line 1"), "{e}");
+}
+
+#[test]
+fn sources_must_be_exactly_one_and_files_must_exist() {
+    let e = err("[input]\n[effects]\nshading = {}\n");
+    assert!(e.contains("exactly one") && e.contains("none"), "{e}");
+    let e = err("[input]\ngenerate = \"torus\"\nsdf = \"torus\"\n[effects]\nshading = {}\n");
+    assert!(e.contains("generate, sdf"), "{e}");
+    let e = err("[input]\nmesh = \"missing.obj\"\n[effects]\nshading = {}\n");
+    assert!(
+        e.contains("/nonexistent/dir/missing.obj") && e.contains("line 2"),
+        "{e}"
+    );
+    let e = err("[input]\nvolume = \"v.nrrd\"\n[effects]\nshading = {}\n");
+    assert!(e.contains("iso"), "{e}");
+    let e = err("[input]\ngenerate = \"torus\"\nclip = 2\n[effects]\nshading = {}\n");
+    assert!(e.contains("clip"), "{e}");
+    let e = err("[input]\ngenerate = \"cube\"\n[effects]\nshading = {}\n");
+    assert!(e.contains("line 2") && e.contains("cube"), "{e}");
+}
+
+#[test]
+fn bad_values_are_errors_with_lines() {
+    for (snippet, word) in [
+        ("[effects]\nao = { level = \"fast\" }\n", "fast"),
+        ("[effects]\nao = { radius = -1.0 }\n", "radius"),
+        ("[effects]\nfeature_edges = { caps = \"round\" }\n", "round"),
+        ("[effects]\nfeature_edges = { crease = 0.0 }\n", "crease"),
+        (
+            "[effects]\ncontours = { color = [2.0, 0.0, 0.0] }\n",
+            "color",
+        ),
+        ("[effects]\n", "no cue"),
+    ] {
+        let e = err(&format!("[input]\ngenerate = \"torus\"\n{snippet}"));
+        assert!(e.contains(word) && e.contains("line"), "{snippet}: {e}");
+    }
+    for (snippet, word) in [
+        ("[[camera]]\norbit = 0\n", "orbit"),
+        ("[[camera]]\neye = [0.0, 0.0, 1.0]\norbit = 4\n", "one of"),
+        (
+            "[[camera]]\neye = [1.0, 0.0, 0.0]\ntarget = [1.0, 0.0, 0.0]\n",
+            "differ",
+        ),
+        ("[[camera]]\nfov = 180.0\n", "fov"),
+        ("[frames]\nstep = 0\n", "step"),
+        ("[frames]\nend = 5\n", "static"),
+        ("[output]\nsize = [0, 10]\n", "size"),
+        ("[output]\nformats = [\"jpg\"]\n", "jpg"),
+        ("[output]\nmsaa = 3\n", "msaa"),
+    ] {
+        let e = err(&format!("{MIN}{snippet}"));
+        assert!(e.contains(word) && e.contains("line"), "{snippet}: {e}");
+    }
+}
+
+#[test]
+fn orbits_expand_to_evenly_spaced_unit_directions() {
+    let s = parse(&format!("{MIN}[[camera]]\norbit = 8\nelevation = 30\n[[camera]]\neye = [0.0, 0.0, 3.0]\northo = true\n")).unwrap();
+    assert_eq!(s.views.len(), 9);
+    let dirs: Vec<glam::Vec3> = s.views[..8]
+        .iter()
+        .map(|v| match v.kind {
+            CameraKind::Fit(d) => glam::Vec3::from(d),
+            _ => panic!("orbit views are fitted"),
+        })
+        .collect();
+    for (i, d) in dirs.iter().enumerate() {
+        assert!((d.length() - 1.0).abs() < 1e-5);
+        assert!((d.y - 30f32.to_radians().sin()).abs() < 1e-5, "elevation");
+        let next = dirs[(i + 1) % 8];
+        let flat = |v: glam::Vec3| glam::Vec2::new(v.x, v.z).normalize();
+        let ang = flat(*d).angle_to(flat(next)).abs().to_degrees();
+        assert!((ang - 45.0).abs() < 1e-3, "{ang}");
+    }
+    assert!(dirs[0].z > 0.8, "azimuth 0 looks from +Z: {:?}", dirs[0]);
+    assert!(s.views[8].ortho);
+}
+
+#[test]
+fn effects_resolve_cues_and_parameters() {
+    let s = parse("[input]\nsdf = \"gyroid\"\nresolution = 64\n[effects]\ncurvature_colors = {}\nao = { level = \"exact\", radius = 0.1 }\nsuggestive_contours = { threshold = 0.1 }\nfeature_edges = { crease = 180, caps = \"mh\" }\n[output]\nformats = [\"svg\"]\n").unwrap();
+    assert_eq!(s.source, Source::Sdf("gyroid".into(), 64, 0.0, false));
+    assert_eq!(
+        s.effects.cues,
+        vec![
+            Cue::CurvatureColors,
+            Cue::AmbientOcclusion,
+            Cue::SuggestiveContours,
+            Cue::FeatureEdges
+        ]
+    );
+    assert_eq!(s.effects.ao_mode, AoMode::Exact);
+    assert_eq!(s.effects.ao_radius, 0.1);
+    assert_eq!(s.effects.crease, None);
+    assert_eq!(s.effects.caps, CapMode::Mh);
+    assert!(!s.png && s.svg);
+    assert_eq!(s.source.input(), Input::Volume);
+}

@@ -1,0 +1,295 @@
+//! One timing type for every stage: which steps ran (typed [`Step`] ids, one
+//! per kernel entry point of `kernels/<family>.cl`), their kernel time from
+//! OpenCL profiling events, how many launches each took, and the host wall
+//! time of the call.
+//!
+//! The scene planner's passes name the steps they run
+//! (`scene::planner::Pass::kernels`), so the executor joins a stage's
+//! [`Timing`] to the planned passes by these ids, never by kernel-name
+//! strings. Pure data: no device, no clock.
+
+use serde::Serialize;
+
+/// The stage family a [`Step`] belongs to (one name per family across
+/// kernel file, host module, CPU twin, tests and benches).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// `kernels/curvature.cl` (Rusinkiewicz 2004).
+    Curvature,
+    /// `kernels/marching_cubes.cl`.
+    MarchingCubes,
+    /// `kernels/vertex_fusion.cl`.
+    VertexFusion,
+    /// `kernels/scan.cl`.
+    Scan,
+    /// `kernels/radix_sort.cl`.
+    RadixSort,
+    /// `kernels/edges.cl` (House & Li).
+    Edges,
+    /// `kernels/skinning.cl`.
+    Skinning,
+    /// `kernels/feature_lines.cl`.
+    FeatureLines,
+    /// `kernels/ao.cl`.
+    Ao,
+}
+
+/// A step of a stage: a kernel entry point `<prefix>_<step>` of
+/// `kernels/<family>.cl`. Serialized as the entry point's name.
+///
+/// Where a step launches helper kernels they are counted in it: the gather
+/// variant's `curv_*_corners` + `curv_*_sum` in the curvature step they
+/// serve, `curv_count_empty` in [`Step::CurvFrames`],
+/// `curv_override_normals` in [`Step::CurvNormalsAreas`], `fuse_clear` in
+/// [`Step::FuseTriangles`]. A call of the scan or the radix sort from
+/// another stage is one step ([`Step::ScanExclusive`],
+/// [`Step::RadixSortPairs`]) holding the kernel time of all its launches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Step {
+    /// `curv_max_face`: owning face per vertex (topology).
+    CurvMaxFace,
+    /// `curv_clear`: zero the accumulators (atomic variant).
+    CurvClear,
+    /// `curv_normals_areas`: corner-weighted normals and Voronoi areas.
+    CurvNormalsAreas,
+    /// `curv_frames` (+ `curv_count_empty`): unit normals, initial frames.
+    CurvFrames,
+    /// `curv_tensor`: per-face curvature tensors over the one-ring.
+    CurvTensor,
+    /// `curv_principal`: k1, k2, d1, d2.
+    CurvPrincipal,
+    /// `curv_dcurv`: the curvature derivative.
+    CurvDcurv,
+    /// `mc_classify`: triangles per cell row.
+    McClassify,
+    /// `mc_triangles`: the soup, one key per vertex.
+    McTriangles,
+    /// `mc_iota`: identity faces of an unfused soup.
+    McIota,
+    /// `mc_gradient_normals`: normals from the volume gradient.
+    McGradientNormals,
+    /// `fuse_index`: representative per sorted key.
+    FuseIndex,
+    /// `fuse_triangles` (+ `fuse_clear`): triangles kept, twin candidates.
+    FuseTriangles,
+    /// `fuse_candidates`: keys of the twin candidates.
+    FuseCandidates,
+    /// `fuse_cancel`: cancel opposite twins.
+    FuseCancel,
+    /// `fuse_mark`: referenced vertices.
+    FuseMark,
+    /// `fuse_compact_vertices`.
+    FuseCompactVertices,
+    /// `fuse_compact_faces`.
+    FuseCompactFaces,
+    /// One exclusive scan (`scan_block_sums`, `scan_partials`, `scan_apply`).
+    ScanExclusive,
+    /// One radix sort of (key, value) pairs (`radix_histogram`,
+    /// `radix_scatter`, `radix_bucket_sort` and their scans).
+    RadixSortPairs,
+    /// `edges_detect`: contour, crease, boundary tests into edge-out.
+    EdgesDetect,
+    /// `caps_mh`: McGuire-Hughes half-caps.
+    CapsMh,
+    /// `caps_adjacency`: House & Li adjacency caps.
+    CapsAdjacency,
+    /// `skin_lbs`: linear blend skinning.
+    SkinLbs,
+    /// `lines_vertex`: per-vertex n·v and radial curvature.
+    LinesVertex,
+    /// `lines_face`: one contour / suggestive-contour segment per face.
+    LinesFace,
+    /// `ao_vertex`: ambient occlusion from (k1, k2).
+    AoVertex,
+}
+
+impl Step {
+    /// The kernel entry point (`<prefix>_<step>`), or for a sub-stage call
+    /// the host entry point (`scan_exclusive`, `radix_sort_pairs`).
+    pub fn kernel(self) -> &'static str {
+        match self {
+            Step::CurvMaxFace => "curv_max_face",
+            Step::CurvClear => "curv_clear",
+            Step::CurvNormalsAreas => "curv_normals_areas",
+            Step::CurvFrames => "curv_frames",
+            Step::CurvTensor => "curv_tensor",
+            Step::CurvPrincipal => "curv_principal",
+            Step::CurvDcurv => "curv_dcurv",
+            Step::McClassify => "mc_classify",
+            Step::McTriangles => "mc_triangles",
+            Step::McIota => "mc_iota",
+            Step::McGradientNormals => "mc_gradient_normals",
+            Step::FuseIndex => "fuse_index",
+            Step::FuseTriangles => "fuse_triangles",
+            Step::FuseCandidates => "fuse_candidates",
+            Step::FuseCancel => "fuse_cancel",
+            Step::FuseMark => "fuse_mark",
+            Step::FuseCompactVertices => "fuse_compact_vertices",
+            Step::FuseCompactFaces => "fuse_compact_faces",
+            Step::ScanExclusive => "scan_exclusive",
+            Step::RadixSortPairs => "radix_sort_pairs",
+            Step::EdgesDetect => "edges_detect",
+            Step::CapsMh => "caps_mh",
+            Step::CapsAdjacency => "caps_adjacency",
+            Step::SkinLbs => "skin_lbs",
+            Step::LinesVertex => "lines_vertex",
+            Step::LinesFace => "lines_face",
+            Step::AoVertex => "ao_vertex",
+        }
+    }
+
+    /// The step's name within its family: the entry point without the
+    /// family prefix (`tensor` for `curv_tensor`), as the curvature stats
+    /// list their passes.
+    pub fn name(self) -> &'static str {
+        let k = self.kernel();
+        match self.family() {
+            Family::Curvature => &k["curv_".len()..],
+            Family::MarchingCubes => &k["mc_".len()..],
+            Family::VertexFusion => &k["fuse_".len()..],
+            Family::Skinning => &k["skin_".len()..],
+            Family::FeatureLines => &k["lines_".len()..],
+            Family::Ao => &k["ao_".len()..],
+            Family::Scan | Family::RadixSort | Family::Edges => k,
+        }
+    }
+
+    /// The family whose kernel file holds the step.
+    pub fn family(self) -> Family {
+        use Step::*;
+        match self {
+            CurvMaxFace | CurvClear | CurvNormalsAreas | CurvFrames | CurvTensor
+            | CurvPrincipal | CurvDcurv => Family::Curvature,
+            McClassify | McTriangles | McIota | McGradientNormals => Family::MarchingCubes,
+            FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
+            | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
+            ScanExclusive => Family::Scan,
+            RadixSortPairs => Family::RadixSort,
+            EdgesDetect | CapsMh | CapsAdjacency => Family::Edges,
+            SkinLbs => Family::Skinning,
+            LinesVertex | LinesFace => Family::FeatureLines,
+            AoVertex => Family::Ao,
+        }
+    }
+}
+
+impl std::fmt::Display for Step {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.kernel())
+    }
+}
+
+impl Serialize for Step {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.kernel())
+    }
+}
+
+/// Kernel time of one step in one call.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct StepTime {
+    /// The step.
+    pub step: Step,
+    /// Kernel time from OpenCL profiling events, in milliseconds.
+    pub kernel_ms: f64,
+    /// Kernel launches counted in it.
+    pub launches: u32,
+}
+
+/// Timing of one stage call (or of a chain of them): kernel ms per step in
+/// execution order, their sum, and the host wall time.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Timing {
+    /// Kernel time per step, in execution order; a step launched again
+    /// right after itself is one entry.
+    pub steps: Vec<StepTime>,
+    /// Sum of the step kernel times.
+    pub kernel_ms: f64,
+    /// Host wall time of the call, uploads and waits included (0 where the
+    /// caller measures it).
+    pub wall_ms: f64,
+}
+
+impl Timing {
+    /// One step of `ms` kernel time (one launch).
+    pub fn of(step: Step, ms: f64) -> Timing {
+        let mut t = Timing::default();
+        t.add(step, ms);
+        t
+    }
+
+    /// Adds one launch of `step` taking `ms`: merged into the last entry
+    /// when it is the same step, a new entry otherwise.
+    pub fn add(&mut self, step: Step, ms: f64) {
+        self.kernel_ms += ms;
+        match self.steps.last_mut() {
+            Some(last) if last.step == step => {
+                last.kernel_ms += ms;
+                last.launches += 1;
+            }
+            _ => self.steps.push(StepTime {
+                step,
+                kernel_ms: ms,
+                launches: 1,
+            }),
+        }
+    }
+
+    /// Appends another call's steps (its wall time added too).
+    pub fn extend(&mut self, other: &Timing) {
+        for s in &other.steps {
+            self.kernel_ms += s.kernel_ms;
+            match self.steps.last_mut() {
+                Some(last) if last.step == s.step => {
+                    last.kernel_ms += s.kernel_ms;
+                    last.launches += s.launches;
+                }
+                _ => self.steps.push(*s),
+            }
+        }
+        self.wall_ms += other.wall_ms;
+    }
+
+    /// Summed kernel ms of the entries whose step is in `steps`.
+    pub fn ms(&self, steps: &[Step]) -> f64 {
+        self.steps
+            .iter()
+            .filter(|s| steps.contains(&s.step))
+            .map(|s| s.kernel_ms)
+            .sum()
+    }
+
+    /// Summed kernel ms of one family's steps.
+    pub fn family_ms(&self, family: Family) -> f64 {
+        self.steps
+            .iter()
+            .filter(|s| s.step.family() == family)
+            .map(|s| s.kernel_ms)
+            .sum()
+    }
+
+    /// Whether any entry's step is in `steps`.
+    pub fn ran(&self, steps: &[Step]) -> bool {
+        self.steps.iter().any(|s| steps.contains(&s.step))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn consecutive_launches_of_a_step_merge() {
+        let mut t = Timing::of(Step::CurvTensor, 1.0);
+        t.add(Step::CurvTensor, 0.5);
+        t.add(Step::CurvPrincipal, 0.25);
+        assert_eq!(t.steps.len(), 2);
+        assert_eq!(t.steps[0].launches, 2);
+        assert_eq!(t.kernel_ms, 1.75);
+        assert_eq!(t.ms(&[Step::CurvPrincipal]), 0.25);
+        assert_eq!(t.family_ms(Family::Curvature), 1.75);
+        assert_eq!(Step::CurvTensor.name(), "tensor");
+        assert_eq!(Step::CapsMh.name(), "caps_mh");
+    }
+}
