@@ -639,7 +639,8 @@ pub fn trace(field: &Field, p: &SdflParams, p0: V3, c0: &Principal, lo: f64, hi:
             pts.push((next, c.n, side as i32 * k as i32));
         }
         if side < 0.0 {
-            for (q, n, k) in pts.into_iter().rev() {
+            // Nearest first: each insert at the front pushes the earlier ones back.
+            for (q, n, k) in pts {
                 out.points.insert(0, q);
                 out.normals.insert(0, n);
                 out.k.insert(0, k);

@@ -22,11 +22,11 @@ use bytemuck::{Pod, Zeroable};
 /// smallest spacing of the volume): the candidates of [`Sampling::Auto`].
 pub const AUTO_SAMPLING_VOXELS: [f64; 7] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0];
 /// Default seed spacing r as a multiple of the sampling distance h.
-pub const SPACING_PER_SAMPLING: f64 = 2.5;
+pub const SPACING_PER_SAMPLING: f64 = 1.5;
 /// Default stroke length (end to end, at the largest κ1) per sampling distance.
-pub const LENGTH_PER_SAMPLING: f64 = 8.0;
+pub const LENGTH_PER_SAMPLING: f64 = 6.0;
 /// Default stroke width (at the seed, at the largest κ1) per sampling distance.
-pub const WIDTH_PER_SAMPLING: f64 = 0.6;
+pub const WIDTH_PER_SAMPLING: f64 = 0.4;
 /// Default RK4 step in voxels.
 pub const STEP_VOXELS: f64 = 0.5;
 /// Seed spacing of the provisional thinning whose seeds the automatic
@@ -130,7 +130,7 @@ impl Default for SdfLineOptions {
             seed: 1,
             max_dense: None,
             max_cells: 1 << 26,
-            max_points: 1 << 24,
+            max_points: 1 << 22,
         }
     }
 }
