@@ -701,3 +701,99 @@ fn automatic_sampling_follows_the_cv_rule() {
             .any(|c| c.distance == h && (c.cv - 1.0).abs() == best)
     );
 }
+
+/// Renders a field's isosurface with its strokes (and the strokes alone)
+/// to `/tmp/sdf-<name>*.png`, plus SVG and PLY; skipped without headless GL.
+fn picture(name: &str, vol: &Volume, opts: &SdfLineOptions, eye: [f32; 3]) {
+    use shapecue::cpu::marching_cubes::{gradient_normals, mc_triangles};
+    use shapecue::cpu::vertex_fusion::{Fusion, fuse};
+    use shapecue::render::strokes::{StrokeStyle, draw};
+    use shapecue::render::{Camera, MeshStyle, RenderOptions, Renderer};
+    let out = SdfLines::new(gpu(), vol, opts).unwrap().run().unwrap();
+    eprintln!("{name}: {:?}", out.stats);
+    let mesh = fuse(&mc_triangles(vol, opts.iso), Fusion::Edge);
+    let normals: Vec<[f32; 3]> = gradient_normals(vol, &mesh.positions)
+        .iter()
+        .map(|n| n.map(|c| c as f32))
+        .collect();
+    let pos: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| std::array::from_fn(|a| (vol.origin[a] + vol.spacing[a] * p[a] as f64) as f32))
+        .collect();
+    let mut r = match Renderer::new(RenderOptions {
+        width: 800,
+        height: 800,
+        ..Default::default()
+    }) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("skipping the pictures: {e}");
+            return;
+        }
+    };
+    let lo = glam::Vec3::from_array(vol.origin.map(|c| c as f32));
+    let ext = twin::extent(vol).map(|c| c as f32);
+    let cam = Camera::fit(
+        lo,
+        lo + glam::Vec3::from_array(ext),
+        glam::Vec3::from_array(eye),
+        1.0,
+    )
+    .unwrap();
+    let style = StrokeStyle {
+        lift: 0.5 * vol.spacing[0] as f32,
+        ..Default::default()
+    };
+    r.begin(&cam).unwrap();
+    r.draw_mesh(&pos, &normals, &[], &mesh.faces, MeshStyle::default())
+        .unwrap();
+    draw(&mut r, &cam, &out.strokes, &style).unwrap();
+    let f = r.finish().unwrap();
+    f.save_png(std::path::Path::new(&format!("/tmp/sdf-{name}.png")))
+        .unwrap();
+    r.begin(&cam).unwrap();
+    draw(&mut r, &cam, &out.strokes, &style).unwrap();
+    let f = r.finish().unwrap();
+    f.save_png(std::path::Path::new(&format!("/tmp/sdf-{name}-alone.png")))
+        .unwrap();
+    let dir = std::env::temp_dir();
+    shapecue::export::strokes::write_svg(
+        &dir.join(format!("sdf-{name}.svg")),
+        &out.strokes,
+        &cam,
+        [800, 800],
+    )
+    .unwrap();
+    shapecue::export::strokes::write_ply(&dir.join(format!("sdf-{name}.ply")), &out.strokes)
+        .unwrap();
+}
+
+#[test]
+fn pictures_torus_and_gyroid() {
+    picture(
+        "torus",
+        &sdf(Sdf::Torus, 128),
+        &SdfLineOptions::default(),
+        [0.3, -1.0, 0.9],
+    );
+    let gyroid = SdfLineOptions {
+        sampling: Sampling::Fixed(0.04),
+        spacing: Some(0.06),
+        length: Some(0.3),
+        width: Some(0.025),
+        length_low: 1.0,
+        ..Default::default()
+    };
+    let mut vol = sdf(Sdf::Gyroid, 96);
+    // A quarter of the gyroid's cube, for a readable picture.
+    vol = shapecue::volume::Volume {
+        dims: [48; 3],
+        spacing: vol.spacing,
+        origin: vol.origin,
+        values: (0..48 * 48 * 48)
+            .map(|i| vol.value(i % 48, i / 48 % 48, i / 2304))
+            .collect(),
+    };
+    picture("gyroid", &vol, &gyroid, [1.0, 0.8, 0.6]);
+}

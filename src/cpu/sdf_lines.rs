@@ -425,12 +425,10 @@ impl<'a> Field<'a> {
                 }
             }
         }
-        for r in 0..3 {
-            for c in r + 1..3 {
-                let s = 0.5 * (m[r][c] + m[c][r]);
-                m[r][c] = s;
-                m[c][r] = s;
-            }
+        for (r, c) in [(0, 1), (0, 2), (1, 2)] {
+            let s = 0.5 * (m[r][c] + m[c][r]);
+            m[r][c] = s;
+            m[c][r] = s;
         }
         m
     }

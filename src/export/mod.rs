@@ -1,4 +1,5 @@
 //! Writers: PLY (mesh with per-vertex curvature), SVG (visible feature edges) and JSON stats.
 
 pub mod ply;
+pub mod strokes;
 pub mod svg;

@@ -29,6 +29,7 @@ pub mod colormap;
 mod context;
 mod frame;
 mod lines;
+pub mod strokes;
 
 pub use camera::{Camera, fit_sphere};
 pub use frame::Frame;
