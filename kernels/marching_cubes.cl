@@ -133,11 +133,7 @@ inline uint emit_cell(uint x, uint y, uint z, uint nx, uint ny, float iso, uint 
         g[1] = y + ((c0 >> 1) & 1);
         g[2] = z + (c0 >> 2);
         const float v0 = v[c0], v1 = v[c1];
-        float t = (iso - v0) / (v1 - v0);
-        if (!(t >= 0.0f))
-            t = 0.0f;
-        if (t > 1.0f)
-            t = 1.0f;
+        const float t = mc_edge_t(v0, v1, iso);
         const float a = (float)g[axis];
         const float cc = a + t;
         float p[3];

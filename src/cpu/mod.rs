@@ -9,5 +9,6 @@ pub mod feature_lines;
 pub mod marching_cubes;
 pub mod radix_sort;
 pub mod scan;
+pub mod sdf_lines;
 pub mod skinning;
 pub mod vertex_fusion;

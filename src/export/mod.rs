@@ -2,4 +2,5 @@
 
 pub mod output;
 pub mod ply;
+pub mod strokes;
 pub mod svg;

@@ -82,6 +82,10 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
 const MC_HEADERS: &[(&str, &str)] = &[
     ("common/real.h", include_str!("../../kernels/common/real.h")),
     ("common/hash.h", include_str!("../../kernels/common/hash.h")),
+    (
+        "common/mc_edge.h",
+        include_str!("../../kernels/common/mc_edge.h"),
+    ),
 ];
 
 /// The full text handed to the compiler.

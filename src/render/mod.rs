@@ -31,6 +31,7 @@ mod context;
 pub mod edges;
 mod frame;
 mod lines;
+pub mod strokes;
 
 pub use camera::{Camera, Placement, fit_sphere, framed};
 pub use frame::Frame;

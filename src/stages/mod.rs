@@ -10,5 +10,6 @@ pub mod marching_cubes;
 pub mod pipeline;
 pub mod radix_sort;
 pub mod scan;
+pub mod sdf_lines;
 pub mod skinning;
 pub mod vertex_fusion;

@@ -1,0 +1,119 @@
+//! Writers for curvature-directed strokes ([`crate::spec::sdf_lines`]):
+//! SVG (each stroke a filled variable-width outline, projected with a
+//! camera) and PLY (the strips as a triangle mesh, vertices on the surface,
+//! with their normals), for other tools.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use glam::{Vec3, Vec4};
+
+use crate::error::{Error, Result};
+use crate::render::Camera;
+use crate::spec::sdf_lines::Stroke;
+
+fn write_err(path: &Path, e: std::io::Error) -> Error {
+    Error::Write {
+        path: path.to_path_buf(),
+        source: e,
+    }
+}
+
+/// The SVG text: a `<path>` per stroke, the closed outline of its strip
+/// (left side forward, right side back), in pixels of a `size` image seen
+/// by `camera`. Strokes with a vertex behind the eye are left out. No
+/// hidden-line removal: strokes on the far side are drawn too unless the
+/// caller filters them (for example by the normal facing the eye).
+pub fn svg_string(strokes: &[Stroke], camera: &Camera, size: [u32; 2], color: &str) -> String {
+    let [w, h] = size;
+    let vp = camera.view_proj(w as f32 / h.max(1) as f32);
+    let px = |p: [f64; 3]| -> Option<(f32, f32)> {
+        let c = vp * Vec4::from((Vec3::from_array(p.map(|c| c as f32)), 1.0));
+        (c.w > 0.0).then(|| {
+            (
+                (c.x / c.w * 0.5 + 0.5) * w as f32,
+                (0.5 - c.y / c.w * 0.5) * h as f32,
+            )
+        })
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">"
+    );
+    let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
+    for st in strokes {
+        let left: Option<Vec<_>> = st.strip.iter().step_by(2).map(|&p| px(p)).collect();
+        let right: Option<Vec<_>> = st.strip.iter().skip(1).step_by(2).map(|&p| px(p)).collect();
+        let (Some(l), Some(r)) = (left, right) else {
+            continue;
+        };
+        let mut d = String::new();
+        for (i, (x, y)) in l.iter().chain(r.iter().rev()).enumerate() {
+            let _ = write!(d, "{}{x:.2},{y:.2} ", if i == 0 { "M" } else { "L" });
+        }
+        let _ = writeln!(s, "<path d=\"{}Z\" fill=\"{color}\"/>", d);
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// Writes [`svg_string`] to `path`.
+///
+/// # Errors
+///
+/// [`Error::Write`] naming the file.
+pub fn write_svg(path: &Path, strokes: &[Stroke], camera: &Camera, size: [u32; 2]) -> Result<()> {
+    std::fs::write(path, svg_string(strokes, camera, size, "#111")).map_err(|e| write_err(path, e))
+}
+
+/// Writes the strips as a binary little-endian PLY triangle mesh: vertices
+/// `x y z nx ny nz width` (float32; two per traced point, on the surface),
+/// faces as triangle-strip triangles.
+///
+/// # Errors
+///
+/// [`Error::Write`] naming the file.
+pub fn write_ply(path: &Path, strokes: &[Stroke]) -> Result<()> {
+    let mut verts: Vec<[f32; 7]> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    for st in strokes {
+        let base = verts.len() as u32;
+        for (j, pair) in st.strip.chunks_exact(2).enumerate() {
+            let n = st.normals[j].map(|c| c as f32);
+            let w = st.widths[j] as f32;
+            for p in pair {
+                verts.push([p[0] as f32, p[1] as f32, p[2] as f32, n[0], n[1], n[2], w]);
+            }
+        }
+        let m = st.strip.len() as u32;
+        for i in 0..m.saturating_sub(2) {
+            let t = [base + i, base + i + 1, base + i + 2];
+            // Alternate the winding so every triangle faces the same way.
+            faces.push(if i % 2 == 0 { t } else { [t[1], t[0], t[2]] });
+        }
+    }
+    let mut b: Vec<u8> = Vec::new();
+    let _ = write!(
+        b,
+        "ply\nformat binary_little_endian 1.0\ncomment shapecue curvature-directed strokes\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\nproperty float width\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        verts.len(),
+        faces.len()
+    );
+    for v in &verts {
+        for c in v {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for f in &faces {
+        b.push(3);
+        for i in f {
+            b.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    std::fs::write(path, b).map_err(|e| write_err(path, e))
+}
