@@ -4,24 +4,14 @@
 //! tests for the defects of the published Unity implementation, and hard
 //! cases (never NaN, never a hang).
 
+mod common;
+
+use common::gpu;
 use shapecue::cpu::sdf_lines::{self as twin, DenseSample, Field, Principal};
-use shapecue::gpu::Gpu;
 use shapecue::spec::sdf_lines::*;
 use shapecue::stages::sdf_lines::{SdfLines, layout_probe, principal_probe};
 use shapecue::volume::Volume;
 use shapecue::volume::sdf::{Sdf, TORUS_R, TORUS_TUBE, sdf};
-use std::sync::{Arc, OnceLock};
-
-fn gpu() -> Arc<Gpu> {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Arc::new(Gpu::new(None).unwrap_or_else(|e| {
-            panic!("these tests need an OpenCL device (PoCL on CPU is enough): {e}")
-        }))
-    })
-    .clone()
-}
-
 /// A field sampled on `res³` points over [-1, 1]³.
 fn field(res: usize, f: impl Fn([f64; 3]) -> f64) -> Volume {
     let n = (res - 1) as f64;

@@ -35,12 +35,6 @@ pub fn gpu() -> Arc<Gpu> {
     opened().clone()
 }
 
-/// The same device, borrowed for the whole run, for stage types that borrow
-/// their device instead of holding an `Arc`.
-pub fn gpu_ref() -> &'static Gpu {
-    opened()
-}
-
 fn opened() -> &'static Arc<Gpu> {
     GPU.get_or_init(|| {
         Arc::new(Gpu::new(None).unwrap_or_else(|e| {
