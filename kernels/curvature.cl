@@ -63,7 +63,13 @@
 // Mirrored by the DEGEN_* constants of src/spec/curvature.rs (the CPU twin uses them).
 #define DEGEN_AREA_REL RL(5e-8)                  // × (l0² + l1² + l2²)
 #define DEGEN_EDGE2 RL(1e-24)
-#define DEGEN_HEIGHT_ULP RL(1.1920928955078125e-7) // 2^-23 × (|p0|+|p1|+|p2|): f32 rounding
+// Heights below DEGEN_HEIGHT_ULP × (|p0|+|p1|+|p2|) are under the rounding of
+// the positions at the precision computed in: 2^-23 (f32), 2^-52 (f64).
+#ifdef SC_DOUBLE
+#define DEGEN_HEIGHT_ULP RL(2.220446049250313080847e-16)
+#else
+#define DEGEN_HEIGHT_ULP RL(1.1920928955078125e-7)
+#endif
 
 #define NEXT3(i) ((i) == 2 ? 0 : (i) + 1)
 #define PREV3(i) ((i) == 0 ? 2 : (i) - 1)

@@ -373,11 +373,15 @@ fn flat_plane_has_zero_curvature_and_orthonormal_frames() {
 // ---------------------------------------------------------------- hard cases
 
 fn check_hard(m: &Mesh, what: &str) -> (stage::Estimate, CurvatureField) {
-    let (r, rc) = cpu::estimate(m, &CurvatureOptions::default());
+    let (r, _) = cpu::estimate(m, &CurvatureOptions::default());
     assert!(r.all_finite(), "{what}: CPU reference not finite");
     for acc in [Accumulate::Atomic, Accumulate::Gather] {
         for prec in [Precision::F32, Precision::F64] {
-            let g = device(m, with(CurvatureOptions::default(), acc, prec));
+            let o = with(CurvatureOptions::default(), acc, prec);
+            let g = device(m, o);
+            // The reference judges faces by the rounding of the precision
+            // the device computes in.
+            let (_, rc) = cpu::estimate(m, &o);
             assert_frames(&g.field, 1e-4);
             assert_eq!(
                 (
@@ -620,4 +624,44 @@ fn memory_stays_within_budget() {
         let budget = 192 * m.n_vertices() as u64 + 32 * m.n_faces() as u64;
         assert!(b <= budget, "{acc:?}: {b} > {budget}");
     }
+}
+
+/// Two unit spheres 10⁶ apart: well resolved in f64, so the f64 device and the
+/// CPU reference keep every face and find k = 1; f32 cannot resolve them
+/// (its rounding at 10⁶ is ~0.06, the edges ~0.1) and skips faces, but
+/// never more than f64 does.
+#[test]
+fn f64_judges_faces_by_f64_rounding() {
+    let one = mesh::icosphere(1.0, 3);
+    let n = one.n_vertices() as u32;
+    let mut m = one.clone();
+    for p in &one.positions {
+        m.positions.push([p[0] + 1e6, p[1], p[2]]);
+    }
+    for f in &one.faces {
+        m.faces.push(f.map(|v| v + n));
+    }
+    for acc in [Accumulate::Atomic, Accumulate::Gather] {
+        let e = device(&m, with(F64, acc, Precision::F64));
+        assert_eq!(e.counts.degenerate_faces, 0, "{acc:?} f64 device");
+        let worst = e
+            .field
+            .k1
+            .iter()
+            .chain(&e.field.k2)
+            .map(|k| (k - 1.0).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.1, "{acc:?}: |k - 1| up to {worst}");
+        let f32run = device(&m, with(F64, acc, Precision::F32));
+        assert!(f32run.counts.degenerate_faces >= e.counts.degenerate_faces);
+    }
+    let (f, c) = cpu::estimate(&m, &F64);
+    assert_eq!(c.degenerate_faces, 0, "CPU reference at f64");
+    assert!(f.k1.iter().all(|k| (k - 1.0).abs() < 0.1));
+    let (_, c32) = cpu::estimate(&m, &with(F64, Accumulate::Atomic, Precision::F32));
+    let d32 = device(&m, with(F64, Accumulate::Atomic, Precision::F32));
+    assert_eq!(
+        c32.degenerate_faces, d32.counts.degenerate_faces,
+        "f32 twin and device agree"
+    );
 }

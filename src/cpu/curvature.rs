@@ -11,7 +11,7 @@ use crate::mesh::Mesh;
 use crate::mesh::topology::max_face;
 use crate::spec::curvature::{
     Compat, CurvatureCounts, CurvatureField, CurvatureOptions, DEGEN_AREA_REL, DEGEN_EDGE2,
-    DEGEN_HEIGHT_ULP, Normalization,
+    Normalization, Precision, degen_height_ulp,
 };
 
 type V3 = [f64; 3];
@@ -73,16 +73,16 @@ impl Tri {
 
     /// The degenerate-face rule: an edge with squared length ≤ 1e-24 (unit-RMS
     /// coordinates), or 2·area ≤ 5e-8 · Σ edge², or 2·area/√(Σ edge²) below
-    /// the f32 rounding of the positions (2⁻²³ · Σ|p|). NaN counts as degenerate.
-    pub fn degenerate(&self) -> bool {
+    /// the rounding of the positions at the computing precision (`ulp` · Σ|p|,
+    /// [`degen_height_ulp`]). NaN counts as degenerate.
+    pub fn degenerate(&self, ulp: f64) -> bool {
         let l = self.e.map(|e| dot(e, e));
         if !(l[0] > DEGEN_EDGE2 && l[1] > DEGEN_EDGE2 && l[2] > DEGEN_EDGE2) {
             return true;
         }
         let lsum = l[0] + l[1] + l[2];
         let twice_area = len(cross(self.e[0], self.e[1]));
-        !(twice_area > DEGEN_AREA_REL * lsum
-            && twice_area > DEGEN_HEIGHT_ULP * lsum.sqrt() * self.psum)
+        !(twice_area > DEGEN_AREA_REL * lsum && twice_area > ulp * lsum.sqrt() * self.psum)
     }
 
     /// Corner-weighted face normal for corner `c`.
@@ -296,11 +296,20 @@ pub struct State {
     pub dk: Vec<[f64; 4]>,
     /// What was skipped.
     pub counts: CurvatureCounts,
+    /// Height threshold of the degenerate-face rule ([`degen_height_ulp`]).
+    pub height_ulp: f64,
 }
 
 impl State {
-    /// Sets up the pipeline on a normalized copy of the mesh.
+    /// Sets up the pipeline on a normalized copy of the mesh, judging faces
+    /// by the f64 rounding (as the f64 device does).
     pub fn new(mesh: &Mesh, norm: &Normalization) -> State {
+        State::for_precision(mesh, norm, Precision::F64)
+    }
+
+    /// As [`State::new`], skipping the faces the device skips at `precision`
+    /// (so that the counts of a device run and of its twin agree).
+    pub fn for_precision(mesh: &Mesh, norm: &Normalization, precision: Precision) -> State {
         let nv = mesh.n_vertices();
         State {
             pos: mesh
@@ -319,6 +328,7 @@ impl State {
             k: vec![[0.0; 2]; nv],
             dk: vec![[0.0; 4]; nv],
             counts: CurvatureCounts::default(),
+            height_ulp: degen_height_ulp(precision),
         }
     }
 
@@ -330,7 +340,7 @@ impl State {
     pub fn normals_areas(&mut self) {
         let tris: Vec<Tri> = self.tris().collect();
         for t in tris {
-            if t.degenerate() {
+            if t.degenerate(self.height_ulp) {
                 self.counts.degenerate_faces += 1;
                 continue;
             }
@@ -384,7 +394,7 @@ impl State {
     pub fn tensor(&mut self, compat: Compat) {
         let tris: Vec<Tri> = self.tris().collect();
         for t in tris {
-            if t.degenerate() {
+            if t.degenerate(self.height_ulp) {
                 continue;
             }
             let (ft, fb) = t.frame();
@@ -441,7 +451,7 @@ impl State {
     pub fn dcurv(&mut self) {
         let tris: Vec<Tri> = self.tris().collect();
         for t in tris {
-            if t.degenerate() {
+            if t.degenerate(self.height_ulp) {
                 continue;
             }
             let (ft, fb) = t.frame();
@@ -491,11 +501,13 @@ impl State {
     }
 }
 
-/// Runs the whole reference pipeline. `opts.accumulate` and `opts.precision`
-/// do not apply (the reference is sequential f64).
+/// Runs the whole reference pipeline. `opts.accumulate` does not apply (the
+/// reference is sequential f64); `opts.precision` only chooses which faces
+/// are too thin for that precision's rounding, so that the reference skips
+/// the faces the device skips.
 pub fn estimate(mesh: &Mesh, opts: &CurvatureOptions) -> (CurvatureField, CurvatureCounts) {
     let norm = Normalization::of_masked(&mesh.positions, Some(&mesh.referenced()));
-    let mut s = State::new(mesh, &norm);
+    let mut s = State::for_precision(mesh, &norm, opts.precision);
     s.normals_areas();
     s.frames();
     s.tensor(opts.compat);

@@ -278,16 +278,37 @@ pub struct CurvatureCounts {
     pub dcurv_solves_skipped: u32,
 }
 
+impl CurvatureCounts {
+    /// True when at least half of the `n_faces` faces were skipped as
+    /// degenerate: the result is then mostly zeros and the caller should say
+    /// so loudly (the usual causes: a mesh far from the origin computed in
+    /// f32, or a mesh of slivers).
+    pub fn mostly_degenerate(&self, n_faces: usize) -> bool {
+        n_faces > 0 && 2 * self.degenerate_faces as usize >= n_faces
+    }
+}
+
 /// Relative area threshold of the degenerate-face rule, × Σ edge²
 /// (`DEGEN_AREA_REL` in `kernels/curvature.cl`).
 pub const DEGEN_AREA_REL: f64 = 5e-8;
 /// Squared edge-length threshold in normalized coordinates (`DEGEN_EDGE2`).
 pub const DEGEN_EDGE2: f64 = 1e-24;
 /// Heights below this × (|p0| + |p1| + |p2|) (normalized coordinates) are
-/// under the f32 rounding of the positions: degenerate at every precision, so
-/// f32, f64 and the CPU reference agree on which faces are skipped
-/// (`DEGEN_HEIGHT_ULP`, 2⁻²³).
+/// under the f32 rounding of the positions (2⁻²³): degenerate when computing
+/// in f32 (`DEGEN_HEIGHT_ULP` in `kernels/curvature.cl` without `SC_DOUBLE`).
 pub const DEGEN_HEIGHT_ULP: f64 = 1.0 / 8_388_608.0;
+/// The same for f64 (2⁻⁵²; `DEGEN_HEIGHT_ULP` with `SC_DOUBLE`). A face is
+/// judged by the rounding of the precision it is computed in: two unit
+/// spheres 10⁶ apart are well resolved in f64 but not in f32.
+pub const DEGEN_HEIGHT_ULP_F64: f64 = f64::EPSILON;
+
+/// The height threshold of the degenerate-face rule at a precision.
+pub fn degen_height_ulp(p: Precision) -> f64 {
+    match p {
+        Precision::F32 => DEGEN_HEIGHT_ULP,
+        Precision::F64 => DEGEN_HEIGHT_ULP_F64,
+    }
+}
 
 /// Entries of the one-ring lists of a mesh with `nf` faces (one per face
 /// corner; their CSR offsets have `nv + 1` entries): the `ring` buffer of the
