@@ -628,10 +628,12 @@ impl Scene {
         };
         let e = |p: String| ck.err(out_span.clone(), p);
         let size = out.size.unwrap_or([640, 480]);
-        if size[0] == 0 || size[1] == 0 || size[0] > 16384 || size[1] > 16384 {
-            return Err(e(format!(
-                "output.size {size:?} must be 1..=16384 pixels each"
-            )));
+        if let Err(err) = crate::spec::limits::check_image_size("output.size", size[0], size[1]) {
+            let msg = err.to_string();
+            return Err(e(msg
+                .strip_prefix("invalid argument: ")
+                .unwrap_or(&msg)
+                .to_string()));
         }
         let msaa = out.msaa.unwrap_or(4);
         if ![0, 2, 4, 8].contains(&msaa) {
