@@ -2,12 +2,14 @@
 // (negative inside). Host: src/stages/mesh_sdf.rs; CPU twin:
 // src/cpu/mesh_sdf.rs; grid, snapping and constants: src/spec/mesh_sdf.rs.
 //
-// Distance: exact point-triangle distance. A spatial grid of triangles
-// (cells of CELL voxels; a triangle is listed in every cell its bounding box
-// grown by BAND voxels touches) makes it exact in a narrow band of BAND
-// voxels around the surface; beyond it, jump flooding (Rong & Tan 2006, with
-// one extra step-1 pass) propagates each voxel's nearest-triangle candidate,
-// and every candidate's distance is again the exact point-triangle distance.
+// Distance: exact point-triangle distance in a narrow band: each triangle
+// measures every voxel of its bounding box grown by BAND voxels (atomic min
+// of the squared distance, then of the triangle index among the nearest).
+// Beyond it, jump flooding (Rong & Tan 2006) propagates each voxel's
+// nearest surface point and its triangle, comparing plain point distances;
+// a last pass measures, exactly, the triangles of the voxel and of its 26
+// neighbours, then walks to edge-adjacent triangles while they are nearer
+// (adj uint[3T]), which repairs the flooding's wrong candidates.
 // Sign: the generalized winding number (Jacobson et al. 2013) is the mean
 // over ray directions of the signed ray-crossing count; here it is estimated
 // with the six axis directions ±x ±y ±z. Crossings are found per grid line
@@ -18,19 +20,23 @@
 // winding number; with a hole, a voxel is misjudged only if three of its six
 // rays leave through holes.
 //
-//   msdf_bin_count  per triangle  count the cells its grown box touches
-//   msdf_bin_fill   per triangle  append its index to those cells' lists
-//   msdf_band       per voxel     nearest triangle among its cell's list
-//   msdf_jfa        per voxel     one jump-flooding pass with step `step`
+//   msdf_clear      per voxel     d2 = +inf, id = none
+//   msdf_band_min   per triangle  atomic min of d2 over its grown box
+//   msdf_band_id    per triangle  atomic min of its index where it is nearest
+//   msdf_seed       per voxel     nearest point q of the voxel's triangle
+//   msdf_jfa        per voxel     one flooding pass with step `step` on (q, id)
+//   msdf_refine     per voxel     exact distance to own + neighbours' triangles,
+//                                 then descent across edge-adjacent triangles
 //   msdf_cross      per triangle  +-1 at the first voxel past each crossing
 //   msdf_wind       per grid line prefix sums -> six-ray winding count
 //   msdf_finish     per voxel     sign(winding) * distance * spacing
-// Buffers (V vertices, T triangles, N voxels, M cells, E list entries):
+// Buffers (V vertices, T triangles, N voxels):
 //   pos float[3V] grid units; fix int[3V] fixed-point grid units (FIX per
-//   voxel); tris uint[3T]; counts, offsets, cursor uint[M]; list uint[E];
-//   d2 float[N] squared distance in voxels²; id uint[N] candidate triangle
-//   (NO_TRI: none); diff int[N]; wind int[N] the sum over the six rays of
-//   the signed crossing counts; out float[N].
+//   voxel); tris uint[3T]; d2 float[N] squared distance in voxels² (as uint
+//   bits for the atomics: non-negative floats order like their bits);
+//   id uint[N] triangle (NO_TRI: none); q float[3N] nearest point (grid
+//   units); diff int[N]; wind int[N] the sum over the six rays of the
+//   signed crossing counts; out float[N].
 // Built with -cl-fp32-correctly-rounded-divide-sqrt and contraction off, so
 // the f32 arithmetic matches the CPU twin's bit for bit.
 
@@ -60,18 +66,29 @@ SC_INLINE P3 p3_cross(P3 a, P3 b)
     return r;
 }
 
-// Squared distance from p to the segment from a along e.
-SC_INLINE float seg_d2(P3 ap, P3 e)
+SC_INLINE float seg_t(P3 ap, P3 e)
 {
     const float ee = p3_dot(e, e);
-    const float t = ee > 0.0f ? fmin(fmax(p3_dot(ap, e) / ee, 0.0f), 1.0f) : 0.0f;
-    const P3 q = { e.x * t - ap.x, e.y * t - ap.y, e.z * t - ap.z };
-    return p3_dot(q, q);
+    return ee > 0.0f ? fmin(fmax(p3_dot(ap, e) / ee, 0.0f), 1.0f) : 0.0f;
 }
 
-// Squared distance from p to triangle (a, b, c): the plane distance when p
-// projects inside (all three inward edge tests >= 0), else the nearest edge.
-SC_INLINE float tri_d2(P3 p, P3 a, P3 b, P3 c)
+SC_INLINE P3 p3_axpy(P3 a, P3 e, float t)
+{
+    P3 r = { a.x + e.x * t, a.y + e.y * t, a.z + e.z * t };
+    return r;
+}
+
+SC_INLINE float p3_d2(P3 a, P3 b)
+{
+    const P3 d = p3_sub(a, b);
+    return p3_dot(d, d);
+}
+
+// Nearest point to p on triangle (a, b, c): the projection onto the plane
+// when it falls inside (all three inward edge tests >= 0), else the nearest
+// point of the nearest edge (first edge on ties). Degenerate triangles fall
+// to the edges.
+SC_INLINE P3 tri_closest(P3 p, P3 a, P3 b, P3 c)
 {
     const P3 e0 = p3_sub(b, a), e1 = p3_sub(c, b), e2 = p3_sub(a, c);
     const P3 ap = p3_sub(p, a), bp = p3_sub(p, b), cp = p3_sub(p, c);
@@ -79,125 +96,186 @@ SC_INLINE float tri_d2(P3 p, P3 a, P3 b, P3 c)
     const float nn = p3_dot(n, n);
     const bool inside = nn > 0.0f && p3_dot(p3_cross(n, e0), ap) >= 0.0f &&
                         p3_dot(p3_cross(n, e1), bp) >= 0.0f && p3_dot(p3_cross(n, e2), cp) >= 0.0f;
-    if (inside) {
-        const float s = p3_dot(n, ap);
-        return s * s / nn;
-    }
-    return fmin(fmin(seg_d2(ap, e0), seg_d2(bp, e1)), seg_d2(cp, e2));
+    if (inside) return p3_axpy(p, n, -(p3_dot(n, ap) / nn));
+    const P3 q0 = p3_axpy(a, e0, seg_t(ap, e0));
+    const P3 q1 = p3_axpy(b, e1, seg_t(bp, e1));
+    const P3 q2 = p3_axpy(c, e2, seg_t(cp, e2));
+    const float d0 = p3_d2(p, q0), d1 = p3_d2(p, q1), d2 = p3_d2(p, q2);
+    P3 q = q0;
+    float d = d0;
+    if (d1 < d) { q = q1; d = d1; }
+    if (d2 < d) q = q2;
+    return q;
 }
 
-SC_INLINE float tri_d2_id(P3 p, __global const uint *tris, __global const float *pos, uint t)
+SC_INLINE P3 tri_closest_id(P3 p, __global const uint *tris, __global const float *pos, uint t)
 {
-    return tri_d2(p, p3_load(pos, tris[3 * t]), p3_load(pos, tris[3 * t + 1]),
-                  p3_load(pos, tris[3 * t + 2]));
+    return tri_closest(p, p3_load(pos, tris[3 * t]), p3_load(pos, tris[3 * t + 1]),
+                       p3_load(pos, tris[3 * t + 2]));
 }
 
-// The cell range of triangle t's bounding box grown by `band` voxels.
-SC_INLINE void cell_range(uint t, __global const uint *tris, __global const float *pos,
-                          float band, float cell, int cx, int cy, int cz, int *lo, int *hi)
+// The voxel range of triangle t's bounding box grown by `band` voxels.
+SC_INLINE void voxel_range(uint t, __global const uint *tris, __global const float *pos,
+                           float band, int nx, int ny, int nz, int *lo, int *hi)
 {
-    const int cd[3] = { cx, cy, cz };
+    const int nd[3] = { nx, ny, nz };
     for (int k = 0; k < 3; ++k) {
         const float a = pos[3 * tris[3 * t] + k], b = pos[3 * tris[3 * t + 1] + k],
                     c = pos[3 * tris[3 * t + 2] + k];
         const float mn = fmin(fmin(a, b), c), mx = fmax(fmax(a, b), c);
-        lo[k] = clamp((int)floor((mn - band) / cell), 0, cd[k] - 1);
-        hi[k] = clamp((int)floor((mx + band) / cell), 0, cd[k] - 1);
+        lo[k] = clamp((int)ceil(mn - band), 0, nd[k] - 1);
+        hi[k] = clamp((int)floor(mx + band), 0, nd[k] - 1);
     }
 }
 
-__kernel void msdf_bin_count(uint ntri, __global const uint *tris, __global const float *pos,
-                             float band, float cell, int cx, int cy, int cz,
-                             __global uint *counts)
+__kernel void msdf_clear(uint nvox, __global uint *d2, __global uint *id)
 {
-    GID_OR_RETURN(ntri);
-    int lo[3], hi[3];
-    cell_range(gid, tris, pos, band, cell, cx, cy, cz, lo, hi);
-    for (int z = lo[2]; z <= hi[2]; ++z)
-        for (int y = lo[1]; y <= hi[1]; ++y)
-            for (int x = lo[0]; x <= hi[0]; ++x)
-                atomic_inc(&counts[x + cx * (y + cy * z)]);
+    GID_OR_RETURN(nvox);
+    d2[gid] = as_uint(INFINITY);
+    id[gid] = NO_TRI;
 }
 
-__kernel void msdf_bin_fill(uint ntri, __global const uint *tris, __global const float *pos,
-                            float band, float cell, int cx, int cy, int cz,
-                            __global const uint *offsets, __global uint *cursor,
-                            __global uint *list)
+__kernel void msdf_band_min(uint ntri, int nx, int ny, int nz, float band,
+                            __global const uint *tris, __global const float *pos,
+                            __global uint *d2)
 {
     GID_OR_RETURN(ntri);
     int lo[3], hi[3];
-    cell_range(gid, tris, pos, band, cell, cx, cy, cz, lo, hi);
+    voxel_range(gid, tris, pos, band, nx, ny, nz, lo, hi);
+    const P3 a = p3_load(pos, tris[3 * gid]), b = p3_load(pos, tris[3 * gid + 1]),
+             c = p3_load(pos, tris[3 * gid + 2]);
     for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y)
             for (int x = lo[0]; x <= hi[0]; ++x) {
-                const uint c = x + cx * (y + cy * z);
-                list[offsets[c] + atomic_inc(&cursor[c])] = gid;
+                const P3 p = { (float)x, (float)y, (float)z };
+                const float d = p3_d2(p, tri_closest(p, a, b, c));
+                atomic_min(&d2[x + nx * (y + ny * z)], as_uint(d));
             }
 }
 
+__kernel void msdf_band_id(uint ntri, int nx, int ny, int nz, float band,
+                           __global const uint *tris, __global const float *pos,
+                           __global const uint *d2, __global uint *id)
+{
+    GID_OR_RETURN(ntri);
+    int lo[3], hi[3];
+    voxel_range(gid, tris, pos, band, nx, ny, nz, lo, hi);
+    const P3 a = p3_load(pos, tris[3 * gid]), b = p3_load(pos, tris[3 * gid + 1]),
+             c = p3_load(pos, tris[3 * gid + 2]);
+    for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+            for (int x = lo[0]; x <= hi[0]; ++x) {
+                const P3 p = { (float)x, (float)y, (float)z };
+                const uint v = x + nx * (y + ny * z);
+                if (as_uint(p3_d2(p, tri_closest(p, a, b, c))) == d2[v]) atomic_min(&id[v], gid);
+            }
+}
+
+__kernel void msdf_seed(uint nvox, int nx, int ny, __global const uint *id,
+                        __global const uint *tris, __global const float *pos, __global float *q)
+{
+    GID_OR_RETURN(nvox);
+    const int x = gid % nx, y = (gid / nx) % ny, z = gid / (nx * ny);
+    const uint t = id[gid];
+    P3 r = { INFINITY, INFINITY, INFINITY };
+    if (t != NO_TRI) {
+        const P3 p = { (float)x, (float)y, (float)z };
+        r = tri_closest_id(p, tris, pos, t);
+    }
+    q[3 * gid] = r.x;
+    q[3 * gid + 1] = r.y;
+    q[3 * gid + 2] = r.z;
+}
+
 // Candidate (d, t) replaces (bd, bt) when nearer, or as near with a smaller
-// index: the result does not depend on list order or work-item schedule.
+// index: the result does not depend on the order of the candidates.
 #define BETTER(d, t, bd, bt) ((d) < (bd) || ((d) == (bd) && (t) < (bt)))
 
-__kernel void msdf_band(uint nvox, int nx, int ny, int cdiv, int cx, int cy,
-                        __global const uint *counts, __global const uint *offsets,
-                        __global const uint *list, __global const uint *tris,
-                        __global const float *pos, __global float *d2, __global uint *id)
+__kernel void msdf_jfa(uint nvox, int nx, int ny, int nz, int step,
+                       __global const float *q_in, __global const uint *id_in,
+                       __global float *q_out, __global uint *id_out)
 {
     GID_OR_RETURN(nvox);
     const int x = gid % nx, y = (gid / nx) % ny, z = gid / (nx * ny);
     const P3 p = { (float)x, (float)y, (float)z };
-    const uint c = x / cdiv + cx * (y / cdiv + cy * (z / cdiv));
-    const uint o = offsets[c], n = counts[c];
-    float bd = INFINITY;
-    uint bt = NO_TRI;
-    for (uint k = 0; k < n; ++k) {
-        const uint t = list[o + k];
-        const float d = tri_d2_id(p, tris, pos, t);
-        if (BETTER(d, t, bd, bt)) {
-            bd = d;
-            bt = t;
-        }
-    }
-    d2[gid] = bd;
-    id[gid] = bt;
-}
-
-__kernel void msdf_jfa(uint nvox, int nx, int ny, int nz, int step, float band2,
-                       __global const float *d2_in, __global const uint *id_in,
-                       __global float *d2_out, __global uint *id_out,
-                       __global const uint *tris, __global const float *pos)
-{
-    GID_OR_RETURN(nvox);
-    float bd = d2_in[gid];
     uint bt = id_in[gid];
-    if (bd > band2) {
-        const int x = gid % nx, y = (gid / nx) % ny, z = gid / (nx * ny);
-        const P3 p = { (float)x, (float)y, (float)z };
-        uint last = bt;
-        for (int dz = -1; dz <= 1; ++dz) {
-            const int qz = z + dz * step;
-            if (qz < 0 || qz >= nz) continue;
-            for (int dy = -1; dy <= 1; ++dy) {
-                const int qy = y + dy * step;
-                if (qy < 0 || qy >= ny) continue;
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int qx = x + dx * step;
-                    if (qx < 0 || qx >= nx) continue;
-                    const uint t = id_in[qx + nx * (qy + ny * qz)];
-                    // Neighbours mostly share candidates: skip repeats.
-                    if (t == NO_TRI || t == bt || t == last) continue;
-                    last = t;
-                    const float d = tri_d2_id(p, tris, pos, t);
-                    if (BETTER(d, t, bd, bt)) {
-                        bd = d;
-                        bt = t;
-                    }
+    P3 bq = p3_load(q_in, gid);
+    float bd = bt == NO_TRI ? INFINITY : p3_d2(p, bq);
+    for (int dz = -1; dz <= 1; ++dz) {
+        const int qz = z + dz * step;
+        if (qz < 0 || qz >= nz) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+            const int qy = y + dy * step;
+            if (qy < 0 || qy >= ny) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = x + dx * step;
+                if (qx < 0 || qx >= nx) continue;
+                const uint v = qx + nx * (qy + ny * qz);
+                const uint t = id_in[v];
+                if (t == NO_TRI) continue;
+                const P3 c = p3_load(q_in, v);
+                const float d = p3_d2(p, c);
+                if (BETTER(d, t, bd, bt)) {
+                    bd = d;
+                    bt = t;
+                    bq = c;
                 }
             }
         }
     }
-    d2_out[gid] = bd;
+    q_out[3 * gid] = bq.x;
+    q_out[3 * gid + 1] = bq.y;
+    q_out[3 * gid + 2] = bq.z;
+    id_out[gid] = bt;
+}
+
+__kernel void msdf_refine(uint nvox, int nx, int ny, int nz, __global const uint *id,
+                          __global const uint *tris, __global const float *pos,
+                          __global const uint *adj, uint max_descent,
+                          __global float *d2, __global uint *id_out)
+{
+    GID_OR_RETURN(nvox);
+    const int x = gid % nx, y = (gid / nx) % ny, z = gid / (nx * ny);
+    const P3 p = { (float)x, (float)y, (float)z };
+    float bd = INFINITY;
+    uint bt = NO_TRI, last = NO_TRI;
+    for (int dz = -1; dz <= 1; ++dz) {
+        const int qz = z + dz;
+        if (qz < 0 || qz >= nz) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+            const int qy = y + dy;
+            if (qy < 0 || qy >= ny) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = x + dx;
+                if (qx < 0 || qx >= nx) continue;
+                const uint t = id[qx + nx * (qy + ny * qz)];
+                // Neighbours mostly share triangles: skip repeats.
+                if (t == NO_TRI || t == bt || t == last) continue;
+                last = t;
+                const float d = p3_d2(p, tri_closest_id(p, tris, pos, t));
+                if (BETTER(d, t, bd, bt)) {
+                    bd = d;
+                    bt = t;
+                }
+            }
+        }
+    }
+    // Descent across edge-adjacent triangles: on a smooth surface the
+    // nearest triangle is next to a nearly nearest one.
+    for (uint it = 0; it < max_descent && bt != NO_TRI; ++it) {
+        const uint from = bt;
+        for (int k = 0; k < 3; ++k) {
+            const uint t = adj[3 * from + k];
+            if (t == NO_TRI) continue;
+            const float d = p3_d2(p, tri_closest_id(p, tris, pos, t));
+            if (BETTER(d, t, bd, bt)) {
+                bd = d;
+                bt = t;
+            }
+        }
+        if (bt == from) break;
+    }
+    d2[gid] = bd;
     id_out[gid] = bt;
 }
 

@@ -171,42 +171,47 @@ fn a_sphere_with_a_hole_keeps_its_sign_away_from_the_hole() {
     }
 }
 
-/// Step-by-step comparison: band, flooding, winding, values.
+/// Step-by-step comparison: band, flooding, refinement, winding, values.
 fn compare_steps(prep: &PreparedMesh, what: &str) {
     let mut dev = MeshSdf::new(gpu()).unwrap();
     let (values, st, trace) = dev.run_traced(prep).unwrap();
-    let bins = cpu::bin(prep);
-    let band = cpu::band(prep, &bins);
-    let mut fl = band.clone();
+    let band = cpu::band(prep);
+    let mut q = cpu::seed(prep, &band.1);
+    let mut id = band.1.clone();
     for step in prep.grid.steps() {
-        fl = cpu::jfa(prep, step, &fl.0, &fl.1);
+        (q, id) = cpu::jfa(prep, step, &q, &id);
     }
+    let refined = cpu::refine(prep, &id);
     let mut winding = vec![0i32; prep.grid.voxels()];
     for axis in 0..3 {
         let diff = cpu::cross(prep, axis);
         cpu::wind(&prep.grid, axis, &diff, &mut winding);
     }
-    let twin = cpu::finish(&prep.grid, &fl.0, &winding);
+    let twin = cpu::finish(&prep.grid, &refined.0, &winding);
     let band_d = max_diff(&trace.band.0, &band.0);
-    let fl_d = max_diff(&trace.flooded.0, &fl.0);
-    let wind_diff = trace
-        .winding
-        .iter()
-        .zip(&winding)
-        .filter(|(a, b)| a != b)
-        .count();
+    let band_ids = count_diff(&trace.band.1, &band.1);
+    let fl_ids = count_diff(&trace.flooded.1, &id);
+    let fl_q = max_diff(trace.flooded.0.as_flattened(), q.as_flattened());
+    let ref_d = max_diff(&trace.refined.0, &refined.0);
+    let wind_diff = count_diff(&trace.winding, &winding);
     let val_d = max_diff(&values, &twin);
     let h = prep.grid.spacing;
     eprintln!(
-        "{what}: device vs twin: band d² {band_d:.2e}, flooded d² {fl_d:.2e} (voxels²), \
-         winding mismatches {wind_diff}, values {val_d:.2e} (h = {h:.3e}); kernel {:.1} ms \
-         (bins {:.1}, band {:.1}, jfa {:.1}, sign {:.1}); {} entries",
-        st.kernel_ms, st.bin_ms, st.band_ms, st.jfa_ms, st.sign_ms, st.bin_entries
+        "{what}: device vs twin: band d² {band_d:.2e} ({band_ids} triangle mismatches), \
+         flooded points {fl_q:.2e} ({fl_ids}), refined d² {ref_d:.2e} (voxels²), winding \
+         mismatches {wind_diff}, values {val_d:.2e} (h = {h:.3e}); kernel {:.1} ms (band {:.1}, \
+         jfa {:.1}, refine {:.1}, sign {:.1}); band work {}",
+        st.kernel_ms, st.band_ms, st.jfa_ms, st.refine_ms, st.sign_ms, st.band_work
     );
     assert_eq!(wind_diff, 0, "{what}: winding");
     assert!(band_d <= 1e-4, "{what}: band");
-    assert!(fl_d <= 1e-3, "{what}: flooding");
+    assert!(ref_d <= 1e-3, "{what}: refined");
     assert!(val_d <= 1e-4 * h, "{what}: values");
+}
+
+fn count_diff<T: PartialEq>(a: &[T], b: &[T]) -> usize {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).filter(|(x, y)| x != y).count()
 }
 
 fn max_diff(a: &[f32], b: &[f32]) -> f64 {
@@ -278,14 +283,14 @@ fn stanford_bunny_at_128() {
     let Some(m) = bunny() else { return };
     let (v, st) = stage::mesh_to_sdf(gpu(), &m, &opts(128)).unwrap();
     eprintln!(
-        "bunny 128³: dims {:?}, {} triangles ({} degenerate), kernel {:.0} ms (bins {:.1}, band {:.1}, jfa {:.1}, sign {:.1}, finish {:.1}), wall {:.0} ms",
+        "bunny 128³: dims {:?}, {} triangles ({} degenerate), kernel {:.0} ms (band {:.1}, jfa {:.1}, refine {:.1}, sign {:.1}, finish {:.1}), wall {:.0} ms",
         st.dims,
         st.triangles,
         st.degenerate_faces,
         st.kernel_ms,
-        st.bin_ms,
         st.band_ms,
         st.jfa_ms,
+        st.refine_ms,
         st.sign_ms,
         st.finish_ms,
         st.wall_ms

@@ -1,24 +1,23 @@
 //! CPU reference of `kernels/mesh_sdf.cl`: a triangle mesh to a signed
 //! distance field (negative inside), with the kernels' steps and names.
 //!
-//! Distance: exact point-triangle distance, exact within
-//! [`BAND_VOXELS`] of the surface through a spatial grid of triangles
-//! ([`bin`], [`band`]), propagated beyond by jump flooding of
-//! nearest-triangle candidates ([`jfa`], Rong & Tan 2006, plus one extra
-//! step-1 pass). Sign: the generalized winding number (Jacobson et al.
+//! Distance: exact point-triangle distance within [`BAND_VOXELS`](crate::spec::mesh_sdf::BAND_VOXELS) of the
+//! surface ([`band`]: each triangle measures the voxels of its grown box),
+//! jump flooding of nearest points beyond it ([`seed`], [`jfa`], Rong & Tan
+//! 2006), and an exact pass over each voxel's own and neighbours' triangles
+//! ([`refine`]). Sign: the generalized winding number (Jacobson et al.
 //! 2013) estimated from the six axis rays, whose signed crossing counts are
 //! found per grid line by exact scan conversion ([`cross`], [`wind`]); see
 //! the kernel file's header for why. The arithmetic is the kernels' `f32`,
 //! in the same order, so the device matches this twin bit for bit (the
 //! kernels are built with correctly rounded division and square root and no
-//! contraction). Band and flooding passes run on all cores (scoped threads
+//! contraction). The per-voxel passes run on all cores (scoped threads
 //! over voxel ranges); the result does not depend on the split.
 
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::spec::mesh_sdf::{
-    BAND_VOXELS, CELL_VOXELS, FIX_BITS, FIX_ONE, MeshSdfOptions, NO_TRIANGLE, PreparedMesh,
-    SdfGrid, prepare,
+    FIX_BITS, FIX_ONE, MAX_DESCENT, MeshSdfOptions, NO_TRIANGLE, PreparedMesh, SdfGrid, prepare,
 };
 use crate::volume::Volume;
 
@@ -30,11 +29,10 @@ use crate::volume::Volume;
 ///
 /// Those of [`prepare`]: a mesh without faces, a bad index, a non-finite
 /// coordinate, only degenerate faces, a resolution out of range; and a
-/// spatial grid of triangles above its bound
-/// ([`PreparedMesh::bin_entries`]).
+/// narrow band above its bound ([`PreparedMesh::band_work`]).
 pub fn mesh_to_sdf(mesh: &Mesh, opts: &MeshSdfOptions) -> Result<Volume> {
     let prep = prepare(mesh, opts, "mesh")?;
-    prep.bin_entries()?;
+    prep.band_work()?;
     let values = run(&prep);
     let g = prep.grid;
     Volume::new(g.dims, values, "mesh signed distance")?.with_geometry([g.spacing; 3], g.origin)
@@ -43,72 +41,18 @@ pub fn mesh_to_sdf(mesh: &Mesh, opts: &MeshSdfOptions) -> Result<Volume> {
 /// All steps on a prepared mesh: the field's samples (x fastest).
 pub fn run(prep: &PreparedMesh) -> Vec<f32> {
     let g = &prep.grid;
-    let bins = bin(prep);
-    let (mut d2, mut id) = band(prep, &bins);
+    let (_, mut id) = band(prep);
+    let mut q = seed(prep, &id);
     for step in g.steps() {
-        (d2, id) = jfa(prep, step, &d2, &id);
+        (q, id) = jfa(prep, step, &q, &id);
     }
+    let (dist, _) = refine(prep, &id);
     let mut winding = vec![0i32; g.voxels()];
     for axis in 0..3 {
         let diff = cross(prep, axis);
         wind(g, axis, &diff, &mut winding);
     }
-    finish(g, &d2, &winding)
-}
-
-/// The spatial grid of triangles in compressed rows: `offsets[c]..offsets[c+1]`
-/// index `list` for cell `c` (x fastest over [`SdfGrid::cell_dims`]).
-#[derive(Clone, Debug)]
-pub struct Bins {
-    /// Start of each cell's entries, plus the total at the end.
-    pub offsets: Vec<u32>,
-    /// Triangle indices (into [`PreparedMesh::triangles`]).
-    pub list: Vec<u32>,
-}
-
-/// `msdf_bin_count` + scan + `msdf_bin_fill`: every triangle listed in each
-/// cell its grown box touches (in triangle order; the device's order within
-/// a cell differs, which the tie rule of [`band`] makes irrelevant).
-pub fn bin(prep: &PreparedMesh) -> Bins {
-    let cd = prep.grid.cell_dims();
-    let m = cd[0] * cd[1] * cd[2];
-    let mut counts = vec![0u32; m + 1];
-    let cells = |t: usize, f: &mut dyn FnMut(usize)| {
-        let (lo, hi) = prep.cell_range(t);
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    f(x + cd[0] * (y + cd[1] * z));
-                }
-            }
-        }
-    };
-    for t in 0..prep.triangles.len() {
-        cells(t, &mut |c| counts[c] += 1);
-    }
-    let mut offsets = counts;
-    let mut run = 0u32;
-    for o in offsets.iter_mut() {
-        let c = *o;
-        *o = run;
-        run += c;
-    }
-    let mut cursor = offsets.clone();
-    let mut list = vec![0u32; run as usize];
-    for t in 0..prep.triangles.len() {
-        cells(t, &mut |c| {
-            list[cursor[c] as usize] = t as u32;
-            cursor[c] += 1;
-        });
-    }
-    Bins { offsets, list }
-}
-
-/// Squared distance (voxels²) from grid point `p` to triangle `t`.
-pub fn triangle_d2(prep: &PreparedMesh, p: [f32; 3], t: u32) -> f32 {
-    let f = prep.triangles[t as usize];
-    let [a, b, c] = f.map(|v| prep.grid_pos[v as usize]);
-    tri_d2(p, a, b, c)
+    finish(g, &dist, &winding)
 }
 
 fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
@@ -127,21 +71,29 @@ fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
-fn seg_d2(ap: [f32; 3], e: [f32; 3]) -> f32 {
+fn axpy(a: [f32; 3], e: [f32; 3], t: f32) -> [f32; 3] {
+    [a[0] + e[0] * t, a[1] + e[1] * t, a[2] + e[2] * t]
+}
+
+fn d2(a: [f32; 3], b: [f32; 3]) -> f32 {
+    let d = sub(a, b);
+    dot(d, d)
+}
+
+fn seg_t(ap: [f32; 3], e: [f32; 3]) -> f32 {
     let ee = dot(e, e);
-    let t = if ee > 0.0 {
+    if ee > 0.0 {
         (dot(ap, e) / ee).max(0.0).min(1.0)
     } else {
         0.0
-    };
-    let q = [e[0] * t - ap[0], e[1] * t - ap[1], e[2] * t - ap[2]];
-    dot(q, q)
+    }
 }
 
-/// Squared distance from `p` to triangle `(a, b, c)`: to the plane when `p`
-/// projects inside, else to the nearest edge (degenerate triangles fall to
-/// the edges).
-pub fn tri_d2(p: [f32; 3], a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> f32 {
+/// Nearest point to `p` on triangle `(a, b, c)`: the projection onto the
+/// plane when it falls inside (all three inward edge tests ≥ 0), else the
+/// nearest point of the nearest edge (the first on ties). Degenerate
+/// triangles fall to the edges.
+pub fn tri_closest(p: [f32; 3], a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [f32; 3] {
     let (e0, e1, e2) = (sub(b, a), sub(c, b), sub(a, c));
     let (ap, bp, cp) = (sub(p, a), sub(p, b), sub(p, c));
     let n = cross3(e0, e1);
@@ -151,10 +103,27 @@ pub fn tri_d2(p: [f32; 3], a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> f32 {
         && dot(cross3(n, e1), bp) >= 0.0
         && dot(cross3(n, e2), cp) >= 0.0;
     if inside {
-        let s = dot(n, ap);
-        return s * s / nn;
+        return axpy(p, n, -(dot(n, ap) / nn));
     }
-    seg_d2(ap, e0).min(seg_d2(bp, e1)).min(seg_d2(cp, e2))
+    let q0 = axpy(a, e0, seg_t(ap, e0));
+    let q1 = axpy(b, e1, seg_t(bp, e1));
+    let q2 = axpy(c, e2, seg_t(cp, e2));
+    let (d0, d1, d2v) = (d2(p, q0), d2(p, q1), d2(p, q2));
+    let (mut q, mut d) = (q0, d0);
+    if d1 < d {
+        (q, d) = (q1, d1);
+    }
+    if d2v < d {
+        q = q2;
+    }
+    q
+}
+
+/// Nearest point to grid point `p` on triangle `t` (grid units).
+pub fn triangle_closest(prep: &PreparedMesh, p: [f32; 3], t: u32) -> [f32; 3] {
+    let f = prep.triangles[t as usize];
+    let [a, b, c] = f.map(|v| prep.grid_pos[v as usize]);
+    tri_closest(p, a, b, c)
 }
 
 /// `(d, t)` replaces `(bd, bt)` when nearer, or as near with a smaller index.
@@ -165,6 +134,10 @@ fn better(d: f32, t: u32, bd: f32, bt: u32) -> bool {
 fn coords(g: &SdfGrid, i: usize) -> [usize; 3] {
     let [nx, ny, _] = g.dims;
     [i % nx, (i / nx) % ny, i / (nx * ny)]
+}
+
+fn point(g: &SdfGrid, i: usize) -> [f32; 3] {
+    coords(g, i).map(|c| c as f32)
 }
 
 /// Runs `f(i)` for every voxel `i` on all cores, in voxel ranges.
@@ -185,70 +158,143 @@ fn par_map<T: Send + Copy + Default>(n: usize, f: impl Fn(usize) -> T + Sync) ->
     out
 }
 
-/// `msdf_band`: each voxel's nearest triangle among its cell's list
-/// (squared distance in voxels², triangle index; `(inf, NO_TRIANGLE)` for
-/// an empty cell). Exact where the distance is within [`BAND_VOXELS`].
-pub fn band(prep: &PreparedMesh, bins: &Bins) -> (Vec<f32>, Vec<u32>) {
+/// `msdf_clear` + `msdf_band_min` + `msdf_band_id`: every triangle measures
+/// the voxels of its box grown by [`BAND_VOXELS`](crate::spec::mesh_sdf::BAND_VOXELS); each voxel keeps the
+/// smallest squared distance (voxels²) and the smallest triangle index at
+/// it (`(inf, NO_TRIANGLE)` for a voxel no triangle measured). Exact
+/// wherever the distance is within the band.
+pub fn band(prep: &PreparedMesh) -> (Vec<f32>, Vec<u32>) {
     let g = &prep.grid;
-    let cd = g.cell_dims();
-    let pairs = par_map(g.voxels(), |i| {
-        let [x, y, z] = coords(g, i);
-        let c = x / CELL_VOXELS + cd[0] * (y / CELL_VOXELS + cd[1] * (z / CELL_VOXELS));
-        let p = [x as f32, y as f32, z as f32];
-        let (mut bd, mut bt) = (f32::INFINITY, NO_TRIANGLE);
-        for &t in &bins.list[bins.offsets[c] as usize..bins.offsets[c + 1] as usize] {
-            let d = triangle_d2(prep, p, t);
-            if better(d, t, bd, bt) {
-                (bd, bt) = (d, t);
+    let [nx, ny, _] = g.dims;
+    let mut dist = vec![f32::INFINITY; g.voxels()];
+    let mut id = vec![NO_TRIANGLE; g.voxels()];
+    for t in 0..prep.triangles.len() {
+        let (lo, hi) = prep.voxel_range(t);
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let p = [x as f32, y as f32, z as f32];
+                    let d = d2(p, triangle_closest(prep, p, t as u32));
+                    let v = x + nx * (y + ny * z);
+                    if better(d, t as u32, dist[v], id[v]) {
+                        (dist[v], id[v]) = (d, t as u32);
+                    }
+                }
             }
         }
-        (bd, bt)
+    }
+    (dist, id)
+}
+
+/// `msdf_seed`: the nearest point (grid units) of each voxel's triangle
+/// (infinite where there is none).
+pub fn seed(prep: &PreparedMesh, id: &[u32]) -> Vec<[f32; 3]> {
+    let g = &prep.grid;
+    par_map(g.voxels(), |i| {
+        if id[i] == NO_TRIANGLE {
+            [f32::INFINITY; 3]
+        } else {
+            triangle_closest(prep, point(g, i), id[i])
+        }
+    })
+}
+
+/// Calls `f(v)` for the voxel `i` and its in-grid neighbours at ±`step`,
+/// z slowest, x fastest (the kernels' order).
+fn neighbours(g: &SdfGrid, i: usize, step: usize, mut f: impl FnMut(usize)) {
+    let [nx, ny, nz] = g.dims.map(|d| d as i64);
+    let [x, y, z] = coords(g, i).map(|c| c as i64);
+    let s = step as i64;
+    for dz in -1..=1 {
+        let qz = z + dz * s;
+        if qz < 0 || qz >= nz {
+            continue;
+        }
+        for dy in -1..=1 {
+            let qy = y + dy * s;
+            if qy < 0 || qy >= ny {
+                continue;
+            }
+            for dx in -1..=1 {
+                let qx = x + dx * s;
+                if qx < 0 || qx >= nx {
+                    continue;
+                }
+                f((qx + nx * (qy + ny * qz)) as usize);
+            }
+        }
+    }
+}
+
+/// `msdf_jfa`: one flooding pass with `step`: each voxel keeps the nearest
+/// of its own point and those of its neighbours at ±`step` (point
+/// distances; ties to the smaller triangle index).
+pub fn jfa(
+    prep: &PreparedMesh,
+    step: usize,
+    q: &[[f32; 3]],
+    id: &[u32],
+) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let g = &prep.grid;
+    let pairs = par_map(g.voxels(), |i| {
+        let p = point(g, i);
+        let (mut bt, mut bq) = (id[i], q[i]);
+        let mut bd = if bt == NO_TRIANGLE {
+            f32::INFINITY
+        } else {
+            d2(p, bq)
+        };
+        neighbours(g, i, step, |v| {
+            let t = id[v];
+            if t == NO_TRIANGLE {
+                return;
+            }
+            let d = d2(p, q[v]);
+            if better(d, t, bd, bt) {
+                (bd, bt, bq) = (d, t, q[v]);
+            }
+        });
+        (bq, bt)
     });
     pairs.into_iter().unzip()
 }
 
-/// `msdf_jfa`: one jump-flooding pass with `step`: a voxel outside the band
-/// takes the nearest of its own candidate and those of its 26 neighbours at
-/// ±`step` (exact distances to each candidate triangle).
-pub fn jfa(prep: &PreparedMesh, step: usize, d2: &[f32], id: &[u32]) -> (Vec<f32>, Vec<u32>) {
+/// `msdf_refine`: the exact squared distance (voxels²) to the nearest of
+/// the triangles of the voxel and its 26 neighbours, improved by a descent
+/// across edge-adjacent triangles (at most [`MAX_DESCENT`] steps), and that
+/// triangle.
+pub fn refine(prep: &PreparedMesh, id: &[u32]) -> (Vec<f32>, Vec<u32>) {
     let g = &prep.grid;
-    let [nx, ny, nz] = g.dims.map(|d| d as i64);
-    let band2 = BAND_VOXELS * BAND_VOXELS;
-    let s = step as i64;
     let pairs = par_map(g.voxels(), |i| {
-        let (mut bd, mut bt) = (d2[i], id[i]);
-        if bd <= band2 {
-            return (bd, bt);
-        }
-        let [x, y, z] = coords(g, i).map(|c| c as i64);
-        let p = [x as f32, y as f32, z as f32];
-        let mut last = bt;
-        for dz in -1..=1 {
-            let qz = z + dz * s;
-            if qz < 0 || qz >= nz {
-                continue;
+        let p = point(g, i);
+        let (mut bd, mut bt, mut last) = (f32::INFINITY, NO_TRIANGLE, NO_TRIANGLE);
+        neighbours(g, i, 1, |v| {
+            let t = id[v];
+            if t == NO_TRIANGLE || t == bt || t == last {
+                return;
             }
-            for dy in -1..=1 {
-                let qy = y + dy * s;
-                if qy < 0 || qy >= ny {
+            last = t;
+            let d = d2(p, triangle_closest(prep, p, t));
+            if better(d, t, bd, bt) {
+                (bd, bt) = (d, t);
+            }
+        });
+        let mut it = 0;
+        while it < MAX_DESCENT && bt != NO_TRIANGLE {
+            let from = bt;
+            for t in prep.adjacent[from as usize] {
+                if t == NO_TRIANGLE {
                     continue;
                 }
-                for dx in -1..=1 {
-                    let qx = x + dx * s;
-                    if qx < 0 || qx >= nx {
-                        continue;
-                    }
-                    let t = id[(qx + nx * (qy + ny * qz)) as usize];
-                    if t == NO_TRIANGLE || t == bt || t == last {
-                        continue;
-                    }
-                    last = t;
-                    let d = triangle_d2(prep, p, t);
-                    if better(d, t, bd, bt) {
-                        (bd, bt) = (d, t);
-                    }
+                let d = d2(p, triangle_closest(prep, p, t));
+                if better(d, t, bd, bt) {
+                    (bd, bt) = (d, t);
                 }
             }
+            if bt == from {
+                break;
+            }
+            it += 1;
         }
         (bd, bt)
     });

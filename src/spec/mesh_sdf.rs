@@ -9,6 +9,11 @@
 //! `resolution` samples. The box is centred on the mesh's box, so world
 //! coordinates of the volume are the mesh's.
 //!
+//! Distances: exact point-triangle distance in a narrow band of
+//! [`BAND_VOXELS`] (each triangle measures the voxels of its grown box),
+//! jump flooding of nearest points beyond it, and a last pass that measures
+//! each voxel's candidate triangles (its own and its 26 neighbours') exactly.
+//!
 //! The prepared input: vertex positions in grid index units, snapped to a
 //! fixed-point lattice of [`FIX_ONE`] steps per voxel. The sign pass
 //! intersects grid lines with triangles using exact 64-bit integer edge
@@ -37,17 +42,16 @@ pub const MARGIN_VOXELS: f64 = 2.0;
 pub const FIX_BITS: u32 = 16;
 /// Fixed-point units per voxel (`2^FIX_BITS`).
 pub const FIX_ONE: i64 = 1 << FIX_BITS;
-/// Edge length, in voxels, of the cells of the spatial grid of triangles.
-pub const CELL_VOXELS: usize = 4;
-/// Half-width, in voxels, of the narrow band where distances are computed
-/// exactly from the spatial grid (every triangle closer than this to a
-/// voxel is in the voxel's cell list); outside it, jump flooding propagates
-/// nearest-triangle candidates.
-pub const BAND_VOXELS: f32 = 2.0;
-/// Most entries the spatial grid of triangles may hold (4 bytes each): a
-/// mesh of many large overlapping triangles is an error rather than a
-/// multi-gigabyte list.
-pub const MAX_BIN_ENTRIES: u64 = 1 << 28;
+/// Half-width, in voxels, of the narrow band where distances are exact:
+/// each triangle measures every voxel of its bounding box grown by this
+/// much, so every voxel within this distance of a triangle has measured it.
+pub const BAND_VOXELS: f32 = 1.0;
+/// Most voxel visits the band pass may make (the sum over triangles of
+/// their grown boxes' voxels): a mesh of many large triangles is an error
+/// naming the count rather than a pass that runs for minutes.
+pub const MAX_BAND_WORK: u64 = 1 << 32;
+/// Most steps of the refinement's descent across neighbouring triangles.
+pub const MAX_DESCENT: u32 = 16;
 /// Triangle index meaning "no candidate yet".
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
@@ -91,11 +95,6 @@ impl SdfGrid {
         self.dims[0] * self.dims[1] * self.dims[2]
     }
 
-    /// Cells of the spatial grid of triangles along each axis.
-    pub fn cell_dims(&self) -> [usize; 3] {
-        self.dims.map(|d| d.div_ceil(CELL_VOXELS))
-    }
-
     /// The first jump-flooding step: the smallest power of two at least
     /// half the largest dimension, so the steps sum to at least the largest
     /// dimension − 1 and a candidate reaches every voxel.
@@ -104,9 +103,9 @@ impl SdfGrid {
         m.div_ceil(2).next_power_of_two()
     }
 
-    /// The jump-flooding steps in order: `first_step`, halving to 1, then 1
-    /// once more (Rong & Tan's JFA+1, which repairs most of plain JFA's rare
-    /// wrong candidates).
+    /// The jump-flooding steps in order: `first_step`, halving to 1 (the
+    /// exact refinement pass after them plays the role of JFA+1's extra
+    /// step-1 pass, Rong & Tan 2006).
     pub fn steps(&self) -> Vec<usize> {
         let mut s = Vec::new();
         let mut k = self.first_step();
@@ -114,7 +113,6 @@ impl SdfGrid {
             s.push(k);
             k /= 2;
         }
-        s.push(1);
         s
     }
 }
@@ -132,6 +130,10 @@ pub struct PreparedMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Faces dropped because their snapped corners are collinear.
     pub degenerate: usize,
+    /// For each kept triangle, across each of its edges (`ab`, `bc`, `ca`),
+    /// the smallest-index other kept triangle sharing that edge, or
+    /// [`NO_TRIANGLE`] on a boundary.
+    pub adjacent: Vec<[u32; 3]>,
 }
 
 /// Validates `mesh`, chooses the grid and snaps the vertices.
@@ -220,13 +222,43 @@ pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<Prepa
     if triangles.is_empty() {
         return Err(all_degenerate());
     }
+    let adjacent = adjacency(&triangles);
     Ok(PreparedMesh {
         grid,
         fixed,
         grid_pos,
         triangles,
         degenerate,
+        adjacent,
     })
+}
+
+/// Edge neighbours of each triangle (see [`PreparedMesh::adjacent`]).
+fn adjacency(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    use std::collections::HashMap;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let mut by_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(3 * tris.len() / 2);
+    for (t, f) in tris.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(key(f[k], f[(k + 1) % 3]))
+                .or_default()
+                .push(t as u32);
+        }
+    }
+    tris.iter()
+        .enumerate()
+        .map(|(t, f)| {
+            std::array::from_fn(|k| {
+                by_edge[&key(f[k], f[(k + 1) % 3])]
+                    .iter()
+                    .copied()
+                    .filter(|&o| o != t as u32)
+                    .min()
+                    .unwrap_or(NO_TRIANGLE)
+            })
+        })
+        .collect()
 }
 
 /// Whether the snapped corners of `f` are collinear (exact, in `i64`).
@@ -240,46 +272,44 @@ fn collinear(q: &[[i32; 3]], f: &[u32; 3]) -> bool {
 }
 
 impl PreparedMesh {
-    /// The cell range (inclusive, per axis) of triangle `t`'s bounding box
+    /// The voxel range (inclusive, per axis) of triangle `t`'s bounding box
     /// grown by [`BAND_VOXELS`], in the `f32` arithmetic of the kernel.
-    pub fn cell_range(&self, t: usize) -> ([usize; 3], [usize; 3]) {
-        let cd = self.grid.cell_dims();
+    pub fn voxel_range(&self, t: usize) -> ([usize; 3], [usize; 3]) {
         let f = self.triangles[t];
-        let cell = CELL_VOXELS as f32;
         let mut lo = [0; 3];
         let mut hi = [0; 3];
         for k in 0..3 {
             let [a, b, c] = f.map(|v| self.grid_pos[v as usize][k]);
             let mn = a.min(b).min(c);
             let mx = a.max(b).max(c);
-            let top = cd[k] as i32 - 1;
-            lo[k] = (((mn - BAND_VOXELS) / cell).floor() as i32).clamp(0, top) as usize;
-            hi[k] = (((mx + BAND_VOXELS) / cell).floor() as i32).clamp(0, top) as usize;
+            let top = self.grid.dims[k] as i32 - 1;
+            lo[k] = ((mn - BAND_VOXELS).ceil() as i32).clamp(0, top) as usize;
+            hi[k] = ((mx + BAND_VOXELS).floor() as i32).clamp(0, top) as usize;
         }
         (lo, hi)
     }
 
-    /// Entries of the spatial grid of triangles (the sum over triangles of
-    /// the cells their ranges cover): the exact size of its list.
+    /// Voxel visits of the band pass (the sum over triangles of their
+    /// ranges' voxels).
     ///
     /// # Errors
     ///
-    /// [`Error::InvalidInput`] above [`MAX_BIN_ENTRIES`], naming the count.
-    pub fn bin_entries(&self) -> Result<u64> {
+    /// [`Error::InvalidInput`] above [`MAX_BAND_WORK`], naming the count.
+    pub fn band_work(&self) -> Result<u64> {
         let n: u64 = (0..self.triangles.len())
             .map(|t| {
-                let (lo, hi) = self.cell_range(t);
+                let (lo, hi) = self.voxel_range(t);
                 (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product::<u64>()
             })
             .sum();
-        if n > MAX_BIN_ENTRIES {
+        if n > MAX_BAND_WORK {
             return Err(Error::input(
                 "mesh",
                 "triangles",
                 format!(
-                    "the spatial grid of {} triangles would hold {n} entries (at most \
-                     {MAX_BIN_ENTRIES}): the triangles are too large for the grid; lower \
-                     the resolution",
+                    "the narrow band of {} triangles would take {n} point-triangle distances \
+                     (at most {MAX_BAND_WORK}): the triangles are too large for the grid; \
+                     lower the resolution",
                     self.triangles.len()
                 ),
             ));

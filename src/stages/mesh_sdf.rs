@@ -4,24 +4,24 @@
 //! strokes need when they are given a mesh. CPU twin:
 //! [`crate::cpu::mesh_sdf`], which matches it bit for bit.
 //!
-//! Passes: `msdf_bin_count` → scan ([`crate::stages::scan`]) →
-//! `msdf_bin_fill` (the spatial grid of triangles) → `msdf_band` (exact
-//! nearest triangle within the band) → `msdf_jfa` per step (jump flooding of
-//! nearest-triangle candidates beyond it) → per axis `msdf_cross` +
-//! `msdf_wind` (six-ray winding number, Jacobson et al. 2013) →
-//! `msdf_finish`. Everything stays on the device until the field is read.
+//! Passes: `msdf_clear` → `msdf_band_min` → `msdf_band_id` (exact nearest
+//! triangle in the narrow band, per triangle with atomics) → `msdf_seed` →
+//! `msdf_jfa` per step (jump flooding of nearest points beyond the band) →
+//! `msdf_refine` (exact distance to each voxel's own and neighbours'
+//! triangles) → per axis `msdf_cross` + `msdf_wind` (six-ray winding
+//! number, Jacobson et al. 2013) → `msdf_finish`. Everything stays on the
+//! device until the field is read.
 //!
-//! Device memory: 7 × 4 bytes per voxel (two candidate buffers of distance
-//! and triangle for the flooding ping-pong, crossings, winding, output),
-//! 12 bytes per cell, 4 per list entry, 24 per vertex, 12 per triangle.
+//! Device memory: 48 bytes per voxel (nearest point and triangle twice for
+//! the flooding ping-pong, distance, crossings, winding, output), 24 per
+//! vertex, 24 per triangle (corners and edge neighbours).
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, COMMON_HEADERS, Gpu, KernelFile, buf, event_ms, launch};
 use crate::mesh::Mesh;
 use crate::spec::mesh_sdf::{
-    BAND_VOXELS, CELL_VOXELS, FIX_BITS, MeshSdfOptions, PreparedMesh, prepare,
+    BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh, prepare,
 };
-use crate::stages::scan::Scan;
 use crate::volume::Volume;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -51,16 +51,16 @@ pub struct MeshSdfStats {
     pub triangles: usize,
     /// Faces skipped because their (snapped) corners are collinear.
     pub degenerate_faces: usize,
-    /// Entries of the spatial grid of triangles.
-    pub bin_entries: u64,
+    /// Point-triangle distances of the band pass.
+    pub band_work: u64,
     /// Jump-flooding passes (steps).
     pub jfa_passes: usize,
-    /// Kernel ms: count, scan and fill of the spatial grid of triangles.
-    pub bin_ms: f64,
-    /// Kernel ms: msdf_band.
+    /// Kernel ms: msdf_clear, msdf_band_min, msdf_band_id.
     pub band_ms: f64,
-    /// Kernel ms: all msdf_jfa passes.
+    /// Kernel ms: msdf_seed and all msdf_jfa passes.
     pub jfa_ms: f64,
+    /// Kernel ms: msdf_refine.
+    pub refine_ms: f64,
     /// Kernel ms: msdf_cross and msdf_wind over the three axes.
     pub sign_ms: f64,
     /// Kernel ms: msdf_finish.
@@ -77,10 +77,12 @@ pub struct MeshSdfStats {
 /// twin ([`MeshSdf::run_traced`]).
 #[derive(Clone, Debug, Default)]
 pub struct MeshSdfTrace {
-    /// `msdf_band`: squared distance (voxels²) and triangle per voxel.
+    /// `msdf_band_id`: squared distance (voxels²) and triangle per voxel.
     pub band: (Vec<f32>, Vec<u32>),
-    /// After the last `msdf_jfa` pass.
-    pub flooded: (Vec<f32>, Vec<u32>),
+    /// After the last `msdf_jfa` pass: nearest point (grid units) and triangle.
+    pub flooded: (Vec<[f32; 3]>, Vec<u32>),
+    /// `msdf_refine`: squared distance (voxels²) and triangle.
+    pub refined: (Vec<f32>, Vec<u32>),
     /// Six-ray winding sum per voxel.
     pub winding: Vec<i32>,
 }
@@ -88,11 +90,12 @@ pub struct MeshSdfTrace {
 /// The program and kernels of the family on one device (built once).
 pub struct MeshSdf {
     gpu: Arc<Gpu>,
-    scan: Scan,
-    bin_count: Kernel,
-    bin_fill: Kernel,
-    band: Kernel,
+    clear: Kernel,
+    band_min: Kernel,
+    band_id: Kernel,
+    seed: Kernel,
     jfa: Kernel,
+    refine: Kernel,
     cross: Kernel,
     wind: Kernel,
     finish: Kernel,
@@ -110,7 +113,7 @@ pub fn build_options() -> String {
 ///
 /// # Errors
 ///
-/// Those of [`prepare`] and [`PreparedMesh::bin_entries`], device errors,
+/// Those of [`prepare`] and [`PreparedMesh::band_work`], device errors,
 /// and a buffer larger than the device allows.
 pub fn mesh_to_sdf(
     gpu: Arc<Gpu>,
@@ -126,15 +129,16 @@ pub fn mesh_to_sdf(
 }
 
 impl MeshSdf {
-    /// Builds `kernels/mesh_sdf.cl` (cached per device) and the scan.
+    /// Builds `kernels/mesh_sdf.cl` (cached per device).
     pub fn new(gpu: Arc<Gpu>) -> Result<MeshSdf> {
         let p = gpu.program(&KERNELS, &build_options())?;
         Ok(MeshSdf {
-            scan: Scan::new(gpu.clone())?,
-            bin_count: gpu.kernel(&p, "msdf_bin_count")?,
-            bin_fill: gpu.kernel(&p, "msdf_bin_fill")?,
-            band: gpu.kernel(&p, "msdf_band")?,
+            clear: gpu.kernel(&p, "msdf_clear")?,
+            band_min: gpu.kernel(&p, "msdf_band_min")?,
+            band_id: gpu.kernel(&p, "msdf_band_id")?,
+            seed: gpu.kernel(&p, "msdf_seed")?,
             jfa: gpu.kernel(&p, "msdf_jfa")?,
+            refine: gpu.kernel(&p, "msdf_refine")?,
             cross: gpu.kernel(&p, "msdf_cross")?,
             wind: gpu.kernel(&p, "msdf_wind")?,
             finish: gpu.kernel(&p, "msdf_finish")?,
@@ -166,9 +170,7 @@ impl MeshSdf {
         let grid = prep.grid;
         let n = grid.voxels();
         let ntri = prep.triangles.len();
-        let cd = grid.cell_dims();
-        let cells = cd[0] * cd[1] * cd[2];
-        let entries = prep.bin_entries()?;
+        let work = prep.band_work()?;
         if n > u32::MAX as usize {
             return Err(Error::InvalidArgument(format!(
                 "mesh signed distance: {n} voxels exceed the u32 index range"
@@ -181,15 +183,10 @@ impl MeshSdf {
             voxels: n,
             triangles: ntri,
             degenerate_faces: prep.degenerate,
-            bin_entries: entries,
+            band_work: work,
             ..Default::default()
         };
-        st.device_bytes = 28 * n as u64
-            + 12 * cells as u64
-            + 4 * entries.max(1)
-            + 24 * prep.grid_pos.len() as u64
-            + 12 * ntri as u64
-            + self.scan.scratch_bytes();
+        st.device_bytes = 48 * n as u64 + 24 * prep.grid_pos.len() as u64 + 24 * ntri as u64;
 
         // Inputs.
         let nv = prep.grid_pos.len();
@@ -199,108 +196,82 @@ impl MeshSdf {
         g.write(&mut fix, prep.fixed.as_flattened())?;
         let mut tris = g.buffer_flags::<u32>(3 * ntri, CL_MEM_READ_ONLY)?;
         g.write(&mut tris, prep.triangles.as_flattened())?;
+        let mut adj = g.buffer_flags::<u32>(3 * ntri, CL_MEM_READ_ONLY)?;
+        g.write(&mut adj, prep.adjacent.as_flattened())?;
 
-        // Spatial grid of triangles.
-        let (cx, cy, cz) = (cd[0] as i32, cd[1] as i32, cd[2] as i32);
-        let cell = CELL_VOXELS as f32;
-        let mut counts = g.buffer::<u32>(cells)?;
-        let offsets = g.buffer::<u32>(cells)?;
-        let mut cursor = g.buffer::<u32>(cells)?;
-        let list = g.buffer::<u32>(entries as usize)?;
-        g.zero(&mut counts, cells)?;
-        g.zero(&mut cursor, cells)?;
-        let mut ev: Vec<Event> = Vec::new();
-        let bin_args = |extra: &[Arg]| {
-            let mut a = vec![
-                Arg::U32(ntri as u32),
-                buf(&tris),
-                buf(&pos),
-                Arg::F32(BAND_VOXELS),
-                Arg::F32(cell),
-                Arg::I32(cx),
-                Arg::I32(cy),
-                Arg::I32(cz),
-            ];
-            a.extend_from_slice(extra);
-            a
-        };
-        ev.extend(launch(
-            g,
-            &self.bin_count,
-            ntri,
-            &bin_args(&[buf(&counts)]),
-        )?);
-        let total = self.scan.exclusive(&counts, &offsets, cells)?;
-        if total != entries {
-            return Err(Error::InvalidArgument(format!(
-                "mesh signed distance: the device counted {total} grid entries, the host {entries}"
-            )));
-        }
-        ev.extend(launch(
-            g,
-            &self.bin_fill,
-            ntri,
-            &bin_args(&[buf(&offsets), buf(&cursor), buf(&list)]),
-        )?);
-        st.bin_ms = wait_all(&mut ev)? + self.scan.last_ms();
-
-        // Distances: band, then flooding (ping-pong).
+        // Band: exact nearest triangle within BAND_VOXELS.
         let [nx, ny, nz] = grid.dims.map(|d| d as i32);
-        let d2 = [g.buffer::<f32>(n)?, g.buffer::<f32>(n)?];
+        let (nu, ntu) = (Arg::U32(n as u32), Arg::U32(ntri as u32));
+        let dims = [Arg::I32(nx), Arg::I32(ny), Arg::I32(nz)];
+        let d2 = g.buffer::<f32>(n)?;
         let id = [g.buffer::<u32>(n)?, g.buffer::<u32>(n)?];
-        ev.extend(launch(
-            g,
-            &self.band,
-            n,
-            &[
-                Arg::U32(n as u32),
-                Arg::I32(nx),
-                Arg::I32(ny),
-                Arg::I32(CELL_VOXELS as i32),
-                Arg::I32(cx),
-                Arg::I32(cy),
-                buf(&counts),
-                buf(&offsets),
-                buf(&list),
-                buf(&tris),
-                buf(&pos),
-                buf(&d2[0]),
-                buf(&id[0]),
-            ],
-        )?);
+        let q = [g.buffer::<f32>(3 * n)?, g.buffer::<f32>(3 * n)?];
+        let mut ev: Vec<Event> = Vec::new();
+        ev.extend(launch(g, &self.clear, n, &[nu, buf(&d2), buf(&id[0])])?);
+        let mut a = vec![ntu];
+        a.extend_from_slice(&dims);
+        a.extend([Arg::F32(BAND_VOXELS), buf(&tris), buf(&pos), buf(&d2)]);
+        ev.extend(launch(g, &self.band_min, ntri, &a)?);
+        a.push(buf(&id[0]));
+        ev.extend(launch(g, &self.band_id, ntri, &a)?);
         st.band_ms = wait_all(&mut ev)?;
         let mut trace = MeshSdfTrace::default();
         if traced {
-            trace.band = (read_vec(g, &d2[0], n)?, read_vec(g, &id[0], n)?);
+            trace.band = (read_vec(g, &d2, n)?, read_vec(g, &id[0], n)?);
         }
+
+        // Flooding of nearest points (ping-pong), then the exact pass.
+        ev.extend(launch(
+            g,
+            &self.seed,
+            n,
+            &[
+                nu,
+                dims[0],
+                dims[1],
+                buf(&id[0]),
+                buf(&tris),
+                buf(&pos),
+                buf(&q[0]),
+            ],
+        )?);
         let steps = grid.steps();
         st.jfa_passes = steps.len();
         let mut cur = 0;
         for step in steps {
-            ev.extend(launch(
-                g,
-                &self.jfa,
-                n,
-                &[
-                    Arg::U32(n as u32),
-                    Arg::I32(nx),
-                    Arg::I32(ny),
-                    Arg::I32(nz),
-                    Arg::I32(step as i32),
-                    Arg::F32(BAND_VOXELS * BAND_VOXELS),
-                    buf(&d2[cur]),
-                    buf(&id[cur]),
-                    buf(&d2[1 - cur]),
-                    buf(&id[1 - cur]),
-                    buf(&tris),
-                    buf(&pos),
-                ],
-            )?);
+            let mut a = vec![nu];
+            a.extend_from_slice(&dims);
+            a.extend([
+                Arg::I32(step as i32),
+                buf(&q[cur]),
+                buf(&id[cur]),
+                buf(&q[1 - cur]),
+                buf(&id[1 - cur]),
+            ]);
+            ev.extend(launch(g, &self.jfa, n, &a)?);
             cur = 1 - cur;
         }
         st.jfa_ms = wait_all(&mut ev)?;
         if traced {
-            trace.flooded = (read_vec(g, &d2[cur], n)?, read_vec(g, &id[cur], n)?);
+            let flat: Vec<f32> = read_vec(g, &q[cur], 3 * n)?;
+            let pts = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            trace.flooded = (pts, read_vec(g, &id[cur], n)?);
+        }
+        let mut a = vec![nu];
+        a.extend_from_slice(&dims);
+        a.extend([
+            buf(&id[cur]),
+            buf(&tris),
+            buf(&pos),
+            buf(&adj),
+            Arg::U32(MAX_DESCENT),
+            buf(&d2),
+            buf(&id[1 - cur]),
+        ]);
+        ev.extend(launch(g, &self.refine, n, &a)?);
+        st.refine_ms = wait_all(&mut ev)?;
+        if traced {
+            trace.refined = (read_vec(g, &d2, n)?, read_vec(g, &id[1 - cur], n)?);
         }
 
         // Sign: six-ray winding sum, one axis at a time into one crossings buffer.
@@ -339,14 +310,14 @@ impl MeshSdf {
             &[
                 Arg::U32(n as u32),
                 Arg::F32(grid.spacing as f32),
-                buf(&d2[cur]),
+                buf(&d2),
                 buf(&winding),
                 buf(&out),
             ],
         )?);
         st.finish_ms = wait_all(&mut ev)?;
         let values = read_vec(g, &out, n)?;
-        st.kernel_ms = st.bin_ms + st.band_ms + st.jfa_ms + st.sign_ms + st.finish_ms;
+        st.kernel_ms = st.band_ms + st.jfa_ms + st.refine_ms + st.sign_ms + st.finish_ms;
         st.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
             return Err(Error::input(
