@@ -7,9 +7,10 @@
 // of the squared distance, then of the triangle index among the nearest).
 // Beyond it, jump flooding (Rong & Tan 2006) propagates each voxel's
 // nearest surface point and its triangle, comparing plain point distances;
-// a last pass measures, exactly, the triangles of the voxel and of its 26
-// neighbours, then walks to edge-adjacent triangles while they are nearer
-// (adj uint[3T]), which repairs the flooding's wrong candidates.
+// a last pass measures each voxel's candidate triangle exactly and walks to
+// edge-adjacent triangles while they are nearer (adj uint[3T]), which
+// repairs the flooding's wrong candidates (on a sphere mesh the error is
+// then the chordal error, see tests/mesh_sdf.rs).
 // Sign: the generalized winding number (Jacobson et al. 2013) is the mean
 // over ray directions of the signed ray-crossing count; here it is estimated
 // with the six axis directions ±x ±y ±z. Crossings are found per grid line
@@ -25,8 +26,8 @@
 //   msdf_band_id    per triangle  atomic min of its index where it is nearest
 //   msdf_seed       per voxel     nearest point q of the voxel's triangle
 //   msdf_jfa        per voxel     one flooding pass with step `step` on (q, id)
-//   msdf_refine     per voxel     exact distance to own + neighbours' triangles,
-//                                 then descent across edge-adjacent triangles
+//   msdf_refine     per voxel     exact distance to its triangle, then descent
+//                                 across edge-adjacent triangles
 //   msdf_cross      per triangle  +-1 at the first voxel past each crossing
 //   msdf_wind       per grid line prefix sums -> six-ray winding count
 //   msdf_finish     per voxel     sign(winding) * distance * spacing
@@ -237,29 +238,8 @@ __kernel void msdf_refine(uint nvox, int nx, int ny, int nz, __global const uint
     GID_OR_RETURN(nvox);
     const int x = gid % nx, y = (gid / nx) % ny, z = gid / (nx * ny);
     const P3 p = { (float)x, (float)y, (float)z };
-    float bd = INFINITY;
-    uint bt = NO_TRI, last = NO_TRI;
-    for (int dz = -1; dz <= 1; ++dz) {
-        const int qz = z + dz;
-        if (qz < 0 || qz >= nz) continue;
-        for (int dy = -1; dy <= 1; ++dy) {
-            const int qy = y + dy;
-            if (qy < 0 || qy >= ny) continue;
-            for (int dx = -1; dx <= 1; ++dx) {
-                const int qx = x + dx;
-                if (qx < 0 || qx >= nx) continue;
-                const uint t = id[qx + nx * (qy + ny * qz)];
-                // Neighbours mostly share triangles: skip repeats.
-                if (t == NO_TRI || t == bt || t == last) continue;
-                last = t;
-                const float d = p3_d2(p, tri_closest_id(p, tris, pos, t));
-                if (BETTER(d, t, bd, bt)) {
-                    bd = d;
-                    bt = t;
-                }
-            }
-        }
-    }
+    uint bt = id[gid];
+    float bd = bt == NO_TRI ? INFINITY : p3_d2(p, tri_closest_id(p, tris, pos, bt));
     // Descent across edge-adjacent triangles: on a smooth surface the
     // nearest triangle is next to a nearly nearest one.
     for (uint it = 0; it < max_descent && bt != NO_TRI; ++it) {

@@ -4,8 +4,8 @@
 //! Distance: exact point-triangle distance within [`BAND_VOXELS`](crate::spec::mesh_sdf::BAND_VOXELS) of the
 //! surface ([`band`]: each triangle measures the voxels of its grown box),
 //! jump flooding of nearest points beyond it ([`seed`], [`jfa`], Rong & Tan
-//! 2006), and an exact pass over each voxel's own and neighbours' triangles
-//! ([`refine`]). Sign: the generalized winding number (Jacobson et al.
+//! 2006), and an exact pass that descends from each voxel's candidate
+//! across edge-adjacent triangles ([`refine`]). Sign: the generalized winding number (Jacobson et al.
 //! 2013) estimated from the six axis rays, whose signed crossing counts are
 //! found per grid line by exact scan conversion ([`cross`], [`wind`]); see
 //! the kernel file's header for why. The arithmetic is the kernels' `f32`,
@@ -80,6 +80,8 @@ fn d2(a: [f32; 3], b: [f32; 3]) -> f32 {
     dot(d, d)
 }
 
+// max then min, like the kernel's fmax/fmin (not clamp, whose NaN rule differs).
+#[allow(clippy::manual_clamp)]
 fn seg_t(ap: [f32; 3], e: [f32; 3]) -> f32 {
     let ee = dot(e, e);
     if ee > 0.0 {
@@ -259,26 +261,19 @@ pub fn jfa(
     pairs.into_iter().unzip()
 }
 
-/// `msdf_refine`: the exact squared distance (voxels²) to the nearest of
-/// the triangles of the voxel and its 26 neighbours, improved by a descent
-/// across edge-adjacent triangles (at most [`MAX_DESCENT`] steps), and that
-/// triangle.
+/// `msdf_refine`: the exact squared distance (voxels²) to the voxel's
+/// candidate triangle, improved by a descent across edge-adjacent triangles
+/// (at most [`MAX_DESCENT`] steps), and the triangle it ends on.
 pub fn refine(prep: &PreparedMesh, id: &[u32]) -> (Vec<f32>, Vec<u32>) {
     let g = &prep.grid;
     let pairs = par_map(g.voxels(), |i| {
         let p = point(g, i);
-        let (mut bd, mut bt, mut last) = (f32::INFINITY, NO_TRIANGLE, NO_TRIANGLE);
-        neighbours(g, i, 1, |v| {
-            let t = id[v];
-            if t == NO_TRIANGLE || t == bt || t == last {
-                return;
-            }
-            last = t;
-            let d = d2(p, triangle_closest(prep, p, t));
-            if better(d, t, bd, bt) {
-                (bd, bt) = (d, t);
-            }
-        });
+        let mut bt = id[i];
+        let mut bd = if bt == NO_TRIANGLE {
+            f32::INFINITY
+        } else {
+            d2(p, triangle_closest(prep, p, bt))
+        };
         let mut it = 0;
         while it < MAX_DESCENT && bt != NO_TRIANGLE {
             let from = bt;

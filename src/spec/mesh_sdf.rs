@@ -12,7 +12,8 @@
 //! Distances: exact point-triangle distance in a narrow band of
 //! [`BAND_VOXELS`] (each triangle measures the voxels of its grown box),
 //! jump flooding of nearest points beyond it, and a last pass that measures
-//! each voxel's candidate triangles (its own and its 26 neighbours') exactly.
+//! each voxel's candidate triangle exactly and descends across
+//! edge-adjacent triangles while they are nearer.
 //!
 //! The prepared input: vertex positions in grid index units, snapped to a
 //! fixed-point lattice of [`FIX_ONE`] steps per voxel. The sign pass

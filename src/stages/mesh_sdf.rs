@@ -7,8 +7,8 @@
 //! Passes: `msdf_clear` → `msdf_band_min` → `msdf_band_id` (exact nearest
 //! triangle in the narrow band, per triangle with atomics) → `msdf_seed` →
 //! `msdf_jfa` per step (jump flooding of nearest points beyond the band) →
-//! `msdf_refine` (exact distance to each voxel's own and neighbours'
-//! triangles) → per axis `msdf_cross` + `msdf_wind` (six-ray winding
+//! `msdf_refine` (exact distance to each voxel's candidate triangle, with a
+//! descent across edge-adjacent triangles) → per axis `msdf_cross` + `msdf_wind` (six-ray winding
 //! number, Jacobson et al. 2013) → `msdf_finish`. Everything stays on the
 //! device until the field is read.
 //!
