@@ -8,9 +8,9 @@
 //! triangle in the narrow band, per triangle with atomics) → `msdf_seed` →
 //! `msdf_jfa` per step (jump flooding of nearest points beyond the band) →
 //! `msdf_refine` (exact distance to each voxel's candidate triangle, with a
-//! descent across edge-adjacent triangles) → per axis `msdf_cross` + `msdf_wind` (six-ray winding
-//! number, Jacobson et al. 2013) → `msdf_finish`. Everything stays on the
-//! device until the field is read.
+//! descent across edge-adjacent triangles) → per axis `msdf_cross` +
+//! `msdf_wind` (six-ray winding number, Jacobson et al. 2013) →
+//! `msdf_finish`. Everything stays on the device until the field is read.
 //!
 //! Device memory: 48 bytes per voxel (nearest point and triangle twice for
 //! the flooding ping-pong, distance, crossings, winding, output), 24 per
