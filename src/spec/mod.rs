@@ -15,6 +15,7 @@ pub mod edges;
 pub mod feature_lines;
 pub mod limits;
 pub mod marching_cubes;
+pub mod mesh_sdf;
 pub mod radix_sort;
 pub mod scan;
 pub mod sdf_lines;

@@ -7,6 +7,7 @@ pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
 pub mod marching_cubes;
+pub mod mesh_sdf;
 pub mod pipeline;
 pub mod radix_sort;
 pub mod scan;

@@ -7,7 +7,11 @@
 //! for checking curvature estimates on their zero isosurface. The gyroid is
 //! the level-set `sin x cos y + sin y cos z + sin z cos x` (not a distance),
 //! with [`GYROID_PERIODS`] periods across the cube: a large, genus-rich
-//! surface for throughput measurements.
+//! surface for throughput measurements. The ellipsoid (semi-axes
+//! [`ELLIPSOID_A`], [`ELLIPSOID_B`], [`ELLIPSOID_C`]) has no closed-form
+//! distance; it stores a first-order distance whose zero set is exactly the
+//! ellipsoid (see [`ellipsoid_distance`]), with analytic curvature
+//! ([`ellipsoid_curvature`]): the oracle of the curvature-directed strokes.
 
 use std::str::FromStr;
 
@@ -26,6 +30,12 @@ pub const TORUS_TUBE: f64 = 0.25;
 /// 2.54 M marching-cubes triangles (twice the vertex count of a closed
 /// triangulation); `tests/volume.rs` (`gyroid_calibration`) measures it.
 pub const GYROID_PERIODS: f64 = 4.0;
+/// Semi-axis of [`Sdf::Ellipsoid`] along x (the longest).
+pub const ELLIPSOID_A: f64 = 0.8;
+/// Semi-axis of [`Sdf::Ellipsoid`] along y.
+pub const ELLIPSOID_B: f64 = 0.5;
+/// Semi-axis of [`Sdf::Ellipsoid`] along z (the shortest).
+pub const ELLIPSOID_C: f64 = 0.3;
 
 /// A procedural field.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,19 +46,23 @@ pub enum Sdf {
     Torus,
     /// Gyroid with [`GYROID_PERIODS`] periods per axis.
     Gyroid,
+    /// Axis-aligned ellipsoid at the origin with semi-axes [`ELLIPSOID_A`],
+    /// [`ELLIPSOID_B`], [`ELLIPSOID_C`], sampled with [`ellipsoid_distance`].
+    Ellipsoid,
 }
 
 impl FromStr for Sdf {
     type Err = Error;
 
-    /// `sphere`, `torus` or `gyroid` (case-insensitive).
+    /// `sphere`, `torus`, `gyroid` or `ellipsoid` (case-insensitive).
     fn from_str(s: &str) -> Result<Self> {
         match s.to_ascii_lowercase().as_str() {
             "sphere" => Ok(Sdf::Sphere),
             "torus" => Ok(Sdf::Torus),
             "gyroid" => Ok(Sdf::Gyroid),
+            "ellipsoid" => Ok(Sdf::Ellipsoid),
             _ => Err(Error::InvalidArgument(format!(
-                "unknown procedural volume '{s}' (expected sphere, torus or gyroid)"
+                "unknown procedural volume '{s}' (expected sphere, torus, gyroid or ellipsoid)"
             ))),
         }
     }
@@ -81,6 +95,13 @@ pub fn sdf(kind: Sdf, res: usize) -> Volume {
                 }
             }
         }
+        Sdf::Ellipsoid => {
+            for &z in &coord {
+                for &y in &coord {
+                    values.extend(coord.iter().map(|&x| ellipsoid_distance([x, y, z]) as f32));
+                }
+            }
+        }
         Sdf::Gyroid => {
             // sin and cos per axis once: the field is separable per term.
             let w = std::f64::consts::PI * GYROID_PERIODS;
@@ -103,7 +124,7 @@ pub fn sdf(kind: Sdf, res: usize) -> Volume {
     }
 }
 
-/// [`sdf`] by name (`sphere`, `torus`, `gyroid`), checking `res`.
+/// [`sdf`] by name (`sphere`, `torus`, `gyroid`, `ellipsoid`), checking `res`.
 ///
 /// # Errors
 ///
@@ -134,6 +155,38 @@ pub fn sphere_distance(p: [f64; 3]) -> f64 {
 pub fn torus_distance(p: [f64; 3]) -> f64 {
     let q = (p[0] * p[0] + p[1] * p[1]).sqrt() - TORUS_R;
     (q * q + p[2] * p[2]).sqrt() - TORUS_TUBE
+}
+
+/// First-order signed distance to the ellipsoid (negative inside):
+/// `f = (k0 - 1) · k0 / k1` with `k0 = |p / (a,b,c)|` and
+/// `k1 = |p / (a²,b²,c²)|`.
+///
+/// The exact distance to an ellipsoid needs a root of a sixth-degree
+/// polynomial. This field has the same zero set exactly (`k0 = 1`), the
+/// right sign (`k0 < 1` inside), and a gradient of length exactly 1 on the
+/// surface (there `∇f = ∇k0 / k1` and `|∇k0| = k1`), so near the surface it
+/// agrees with the true distance to first order, which the simpler
+/// `(k0 - 1)·min(a,b,c)` does not (its gradient length varies from
+/// `c/a` to 1 over the surface). Away from the surface it is a distance
+/// estimate, not a distance. At the centre, where `k0/k1` has no limit,
+/// it returns the true distance `-min(a,b,c)`.
+pub fn ellipsoid_distance(p: [f64; 3]) -> f64 {
+    let (a, b, c) = (ELLIPSOID_A, ELLIPSOID_B, ELLIPSOID_C);
+    let k0 = ((p[0] / a).powi(2) + (p[1] / b).powi(2) + (p[2] / c).powi(2)).sqrt();
+    let k1 =
+        ((p[0] / (a * a)).powi(2) + (p[1] / (b * b)).powi(2) + (p[2] / (c * c)).powi(2)).sqrt();
+    if k1 == 0.0 {
+        return -a.min(b).min(c);
+    }
+    (k0 - 1.0) * k0 / k1
+}
+
+/// Principal curvatures `(k1, k2)`, `k1 >= k2`, of the ellipsoid of
+/// [`Sdf::Ellipsoid`] at a point on it; positive = convex with respect to
+/// the outward normal (at `(a, 0, 0)`: `a/c²` and `a/b²`). Same formula as
+/// [`crate::mesh::ellipsoid_curvature`].
+pub fn ellipsoid_curvature(p: [f64; 3]) -> (f64, f64) {
+    crate::mesh::ellipsoid_curvature(ELLIPSOID_A, ELLIPSOID_B, ELLIPSOID_C, p)
 }
 
 /// Principal curvatures `(k1, k2)`, `k1 >= k2`, of the sphere at a point on

@@ -1,0 +1,347 @@
+//! Host wiring of `kernels/mesh_sdf.cl`: a triangle mesh to a signed
+//! distance field (negative inside, world units, on the grid of
+//! [`crate::spec::mesh_sdf::prepare`]), the input the curvature-directed
+//! strokes need when they are given a mesh. CPU twin:
+//! [`crate::cpu::mesh_sdf`], which matches it bit for bit.
+//!
+//! Passes: `msdf_clear` → `msdf_band_min` → `msdf_band_id` (exact nearest
+//! triangle in the narrow band, per triangle with atomics) → `msdf_seed` →
+//! `msdf_jfa` per step (jump flooding of nearest points beyond the band) →
+//! `msdf_refine` (exact distance to each voxel's candidate triangle, with a
+//! descent across edge-adjacent triangles) → per axis `msdf_cross` +
+//! `msdf_wind` (six-ray winding number, Jacobson et al. 2013) →
+//! `msdf_finish`. Everything stays on the device until the field is read.
+//!
+//! Device memory: 48 bytes per voxel (nearest point and triangle twice for
+//! the flooding ping-pong, distance, crossings, winding, output), 24 per
+//! vertex, 24 per triangle (corners and edge neighbours).
+
+use crate::error::{Error, Result};
+use crate::gpu::{Arg, COMMON_HEADERS, Gpu, KernelFile, buf, event_ms, launch};
+use crate::mesh::Mesh;
+use crate::spec::mesh_sdf::{
+    BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh, prepare,
+};
+use crate::volume::Volume;
+use opencl3::event::Event;
+use opencl3::kernel::Kernel;
+use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The kernel file of this family.
+pub const KERNELS: KernelFile = KernelFile {
+    name: "kernels/mesh_sdf.cl",
+    source: include_str!("../../kernels/mesh_sdf.cl"),
+    headers: COMMON_HEADERS,
+};
+
+/// What one conversion did and how long each pass took.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct MeshSdfStats {
+    /// Samples along x, y, z.
+    pub dims: [usize; 3],
+    /// Isotropic spacing (world units).
+    pub spacing: f64,
+    /// World position of sample (0, 0, 0).
+    pub origin: [f64; 3],
+    /// Voxels.
+    pub voxels: usize,
+    /// Triangles used (faces minus degenerate ones).
+    pub triangles: usize,
+    /// Faces skipped because their (snapped) corners are collinear.
+    pub degenerate_faces: usize,
+    /// Point-triangle distances of the band pass.
+    pub band_work: u64,
+    /// Jump-flooding passes (steps).
+    pub jfa_passes: usize,
+    /// Kernel ms: msdf_clear, msdf_band_min, msdf_band_id.
+    pub band_ms: f64,
+    /// Kernel ms: msdf_seed and all msdf_jfa passes.
+    pub jfa_ms: f64,
+    /// Kernel ms: msdf_refine.
+    pub refine_ms: f64,
+    /// Kernel ms: msdf_cross and msdf_wind over the three axes.
+    pub sign_ms: f64,
+    /// Kernel ms: msdf_finish.
+    pub finish_ms: f64,
+    /// Sum of the kernel times.
+    pub kernel_ms: f64,
+    /// Wall ms from the upload to the field read back (program build excluded).
+    pub wall_ms: f64,
+    /// Device bytes allocated.
+    pub device_bytes: u64,
+}
+
+/// Intermediate results read back for step-by-step comparison with the CPU
+/// twin ([`MeshSdf::run_traced`]).
+#[derive(Clone, Debug, Default)]
+pub struct MeshSdfTrace {
+    /// `msdf_band_id`: squared distance (voxels²) and triangle per voxel.
+    pub band: (Vec<f32>, Vec<u32>),
+    /// After the last `msdf_jfa` pass: nearest point (grid units) and triangle.
+    pub flooded: (Vec<[f32; 3]>, Vec<u32>),
+    /// `msdf_refine`: squared distance (voxels²) and triangle.
+    pub refined: (Vec<f32>, Vec<u32>),
+    /// Six-ray winding sum per voxel.
+    pub winding: Vec<i32>,
+}
+
+/// The program and kernels of the family on one device (built once).
+pub struct MeshSdf {
+    gpu: Arc<Gpu>,
+    clear: Kernel,
+    band_min: Kernel,
+    band_id: Kernel,
+    seed: Kernel,
+    jfa: Kernel,
+    refine: Kernel,
+    cross: Kernel,
+    wind: Kernel,
+    finish: Kernel,
+}
+
+/// The options the kernels are built with: correctly rounded `f32` division
+/// and square root (as in the CPU twin) and the fixed-point bits.
+pub fn build_options() -> String {
+    format!("-cl-fp32-correctly-rounded-divide-sqrt -DSC_FIX_BITS={FIX_BITS}")
+}
+
+/// Front door: prepares `mesh` ([`prepare`]), converts it on `gpu` and
+/// returns the field as a [`Volume`] in the mesh's world coordinates
+/// (negative inside) with the stats.
+///
+/// # Errors
+///
+/// Those of [`prepare`] and [`PreparedMesh::band_work`], device errors,
+/// and a buffer larger than the device allows.
+pub fn mesh_to_sdf(
+    gpu: Arc<Gpu>,
+    mesh: &Mesh,
+    opts: &MeshSdfOptions,
+) -> Result<(Volume, MeshSdfStats)> {
+    let prep = prepare(mesh, opts, "mesh")?;
+    let (values, stats) = MeshSdf::new(gpu)?.run(&prep)?;
+    let g = prep.grid;
+    let vol = Volume::new(g.dims, values, "mesh signed distance")?
+        .with_geometry([g.spacing; 3], g.origin)?;
+    Ok((vol, stats))
+}
+
+impl MeshSdf {
+    /// Builds `kernels/mesh_sdf.cl` (cached per device).
+    pub fn new(gpu: Arc<Gpu>) -> Result<MeshSdf> {
+        let p = gpu.program(&KERNELS, &build_options())?;
+        Ok(MeshSdf {
+            clear: gpu.kernel(&p, "msdf_clear")?,
+            band_min: gpu.kernel(&p, "msdf_band_min")?,
+            band_id: gpu.kernel(&p, "msdf_band_id")?,
+            seed: gpu.kernel(&p, "msdf_seed")?,
+            jfa: gpu.kernel(&p, "msdf_jfa")?,
+            refine: gpu.kernel(&p, "msdf_refine")?,
+            cross: gpu.kernel(&p, "msdf_cross")?,
+            wind: gpu.kernel(&p, "msdf_wind")?,
+            finish: gpu.kernel(&p, "msdf_finish")?,
+            gpu,
+        })
+    }
+
+    /// Converts a prepared mesh: the field's samples (x fastest) and stats.
+    pub fn run(&mut self, prep: &PreparedMesh) -> Result<(Vec<f32>, MeshSdfStats)> {
+        let (v, s, _) = self.run_inner(prep, false)?;
+        Ok((v, s))
+    }
+
+    /// [`MeshSdf::run`] that also reads back the intermediate buffers.
+    pub fn run_traced(
+        &mut self,
+        prep: &PreparedMesh,
+    ) -> Result<(Vec<f32>, MeshSdfStats, MeshSdfTrace)> {
+        self.run_inner(prep, true)
+    }
+
+    fn run_inner(
+        &mut self,
+        prep: &PreparedMesh,
+        traced: bool,
+    ) -> Result<(Vec<f32>, MeshSdfStats, MeshSdfTrace)> {
+        let t0 = Instant::now();
+        let g = &*self.gpu.clone();
+        let grid = prep.grid;
+        let n = grid.voxels();
+        let ntri = prep.triangles.len();
+        let work = prep.band_work()?;
+        if n > u32::MAX as usize {
+            return Err(Error::InvalidArgument(format!(
+                "mesh signed distance: {n} voxels exceed the u32 index range"
+            )));
+        }
+        let mut st = MeshSdfStats {
+            dims: grid.dims,
+            spacing: grid.spacing,
+            origin: grid.origin,
+            voxels: n,
+            triangles: ntri,
+            degenerate_faces: prep.degenerate,
+            band_work: work,
+            ..Default::default()
+        };
+        st.device_bytes = 48 * n as u64 + 24 * prep.grid_pos.len() as u64 + 24 * ntri as u64;
+
+        // Inputs.
+        let nv = prep.grid_pos.len();
+        let mut pos = g.buffer_flags::<f32>(3 * nv, CL_MEM_READ_ONLY)?;
+        g.write(&mut pos, prep.grid_pos.as_flattened())?;
+        let mut fix = g.buffer_flags::<i32>(3 * nv, CL_MEM_READ_ONLY)?;
+        g.write(&mut fix, prep.fixed.as_flattened())?;
+        let mut tris = g.buffer_flags::<u32>(3 * ntri, CL_MEM_READ_ONLY)?;
+        g.write(&mut tris, prep.triangles.as_flattened())?;
+        let mut adj = g.buffer_flags::<u32>(3 * ntri, CL_MEM_READ_ONLY)?;
+        g.write(&mut adj, prep.adjacent.as_flattened())?;
+
+        // Band: exact nearest triangle within BAND_VOXELS.
+        let [nx, ny, nz] = grid.dims.map(|d| d as i32);
+        let (nu, ntu) = (Arg::U32(n as u32), Arg::U32(ntri as u32));
+        let dims = [Arg::I32(nx), Arg::I32(ny), Arg::I32(nz)];
+        let d2 = g.buffer::<f32>(n)?;
+        let id = [g.buffer::<u32>(n)?, g.buffer::<u32>(n)?];
+        let q = [g.buffer::<f32>(3 * n)?, g.buffer::<f32>(3 * n)?];
+        let mut ev: Vec<Event> = Vec::new();
+        ev.extend(launch(g, &self.clear, n, &[nu, buf(&d2), buf(&id[0])])?);
+        let mut a = vec![ntu];
+        a.extend_from_slice(&dims);
+        a.extend([Arg::F32(BAND_VOXELS), buf(&tris), buf(&pos), buf(&d2)]);
+        ev.extend(launch(g, &self.band_min, ntri, &a)?);
+        a.push(buf(&id[0]));
+        ev.extend(launch(g, &self.band_id, ntri, &a)?);
+        st.band_ms = wait_all(&mut ev)?;
+        let mut trace = MeshSdfTrace::default();
+        if traced {
+            trace.band = (read_vec(g, &d2, n)?, read_vec(g, &id[0], n)?);
+        }
+
+        // Flooding of nearest points (ping-pong), then the exact pass.
+        ev.extend(launch(
+            g,
+            &self.seed,
+            n,
+            &[
+                nu,
+                dims[0],
+                dims[1],
+                buf(&id[0]),
+                buf(&tris),
+                buf(&pos),
+                buf(&q[0]),
+            ],
+        )?);
+        let steps = grid.steps();
+        st.jfa_passes = steps.len();
+        let mut cur = 0;
+        for step in steps {
+            let mut a = vec![nu];
+            a.extend_from_slice(&dims);
+            a.extend([
+                Arg::I32(step as i32),
+                buf(&q[cur]),
+                buf(&id[cur]),
+                buf(&q[1 - cur]),
+                buf(&id[1 - cur]),
+            ]);
+            ev.extend(launch(g, &self.jfa, n, &a)?);
+            cur = 1 - cur;
+        }
+        st.jfa_ms = wait_all(&mut ev)?;
+        if traced {
+            let flat: Vec<f32> = read_vec(g, &q[cur], 3 * n)?;
+            let pts = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            trace.flooded = (pts, read_vec(g, &id[cur], n)?);
+        }
+        let mut a = vec![nu];
+        a.extend_from_slice(&dims);
+        a.extend([
+            buf(&id[cur]),
+            buf(&tris),
+            buf(&pos),
+            buf(&adj),
+            Arg::U32(MAX_DESCENT),
+            buf(&d2),
+            buf(&id[1 - cur]),
+        ]);
+        ev.extend(launch(g, &self.refine, n, &a)?);
+        st.refine_ms = wait_all(&mut ev)?;
+        if traced {
+            trace.refined = (read_vec(g, &d2, n)?, read_vec(g, &id[1 - cur], n)?);
+        }
+
+        // Sign: six-ray winding sum, one axis at a time into one crossings buffer.
+        let mut diff = g.buffer::<i32>(n)?;
+        let mut winding = g.buffer::<i32>(n)?;
+        g.zero(&mut winding, n)?;
+        for axis in 0..3 {
+            let (ku, kv) = ((axis + 1) % 3, (axis + 2) % 3);
+            let lines = grid.dims[ku] * grid.dims[kv];
+            g.zero(&mut diff, n)?;
+            let dims = [
+                Arg::I32(axis as i32),
+                Arg::I32(nx),
+                Arg::I32(ny),
+                Arg::I32(nz),
+            ];
+            let mut a = vec![Arg::U32(ntri as u32)];
+            a.extend_from_slice(&dims);
+            a.extend([buf(&tris), buf(&fix), buf(&diff)]);
+            ev.extend(launch(g, &self.cross, ntri, &a)?);
+            let mut a = vec![Arg::U32(lines as u32)];
+            a.extend_from_slice(&dims);
+            a.extend([buf(&diff), buf(&winding)]);
+            ev.extend(launch(g, &self.wind, lines, &a)?);
+        }
+        st.sign_ms = wait_all(&mut ev)?;
+        if traced {
+            trace.winding = read_vec(g, &winding, n)?;
+        }
+
+        let out = g.buffer::<f32>(n)?;
+        ev.extend(launch(
+            g,
+            &self.finish,
+            n,
+            &[
+                Arg::U32(n as u32),
+                Arg::F32(grid.spacing as f32),
+                buf(&d2),
+                buf(&winding),
+                buf(&out),
+            ],
+        )?);
+        st.finish_ms = wait_all(&mut ev)?;
+        let values = read_vec(g, &out, n)?;
+        st.kernel_ms = st.band_ms + st.jfa_ms + st.refine_ms + st.sign_ms + st.finish_ms;
+        st.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::input(
+                "mesh",
+                format!("voxel {i}"),
+                "no triangle reached this sample (non-finite distance)",
+            ));
+        }
+        Ok((values, st, trace))
+    }
+}
+
+/// Waits for `ev` (in order) and returns their summed kernel ms.
+fn wait_all(ev: &mut Vec<Event>) -> Result<f64> {
+    let mut ms = 0.0;
+    for e in ev.drain(..) {
+        e.wait().map_err(|e| Error::cl("clWaitForEvents", e))?;
+        ms += event_ms(&e);
+    }
+    Ok(ms)
+}
+
+fn read_vec<T: Copy + Default>(g: &Gpu, b: &Buffer<T>, n: usize) -> Result<Vec<T>> {
+    let mut v = vec![T::default(); n];
+    g.read(b, &mut v)?;
+    Ok(v)
+}
