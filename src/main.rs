@@ -454,7 +454,8 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         counts.vertices_without_curvature
     );
     if let Some(out) = &a.output {
-        shapecue::export::ply::write_ply(out, &mesh, Some(&field))?;
+        let written = shapecue::export::ply::write_ply(out, &mesh, Some(&field))?;
+        note_double(out, &written);
         println!("wrote {}", out.display());
     }
     if let Some(path) = &a.stats {
@@ -469,6 +470,16 @@ fn curvature(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         write_json(path, &s)?;
     }
     Ok(())
+}
+
+/// Says when a PLY file's properties were written as double.
+fn note_double(out: &Path, w: &shapecue::export::ply::PlyWritten) {
+    if let Some(why) = &w.double {
+        eprintln!(
+            "note: {} has double-precision vertex properties: {why}",
+            out.display()
+        );
+    }
 }
 
 fn minmax(v: &[f64]) -> (f64, f64) {
@@ -586,17 +597,18 @@ fn isosurface(device: Option<&str>, a: IsoArgs) -> Result<()> {
         let normals = a
             .normals
             .then(|| shapecue::cpu::marching_cubes::gradient_normals(&vol, &ipos));
-        match (&field, normals) {
+        let written = match (&field, normals) {
             (Some(f), n) => {
                 let mut f = f.clone();
                 if let Some(n) = n {
                     f.normals = n;
                 }
-                shapecue::export::ply::write_ply(out, &mesh, Some(&f))?;
+                shapecue::export::ply::write_ply(out, &mesh, Some(&f))?
             }
             (None, Some(n)) => shapecue::export::ply::write_ply_with_normals(out, &mesh, &n)?,
             (None, None) => shapecue::export::ply::write_ply(out, &mesh, None)?,
-        }
+        };
+        note_double(out, &written);
         println!("wrote {}", out.display());
     }
     if let Some(path) = &a.stats {

@@ -53,7 +53,7 @@ fn write_sequence(dir: &Path, n: usize, ext: &str) -> Vec<Mesh> {
             let path = dir.join(format!("frame_{f}.{ext}"));
             match ext {
                 "obj" => write_obj(&path, &m),
-                _ => write_ply(&path, &m, None).expect("write PLY"),
+                _ => drop(write_ply(&path, &m, None).expect("write PLY")),
             }
             m
         })

@@ -815,3 +815,45 @@ fn writer_without_field_and_errors() {
     ));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Values a float cannot hold (a sphere scaled by 1e30 has areas of ~1e60,
+/// one scaled by 1e-40 curvatures of ~1e40) make the writer use double for
+/// the vertex properties, and say why; a non-finite value is an error naming
+/// the property and the vertex, never a silent `inf` in the file.
+#[test]
+fn ply_values_outside_float_range_are_written_as_double() {
+    let dir = scratch("ply-double");
+    let m = shapecue::mesh::icosphere(1.0, 1);
+    let mut f = field_for(&m);
+    let p = dir.join("plain.ply");
+    assert_eq!(write_ply(&p, &m, Some(&f)).unwrap().double, None);
+    assert!(
+        std::fs::read(&p)
+            .unwrap()
+            .starts_with(b"ply\nformat binary_little_endian 1.0\n")
+    );
+
+    f.areas[3] = 1e60;
+    let p = dir.join("huge.ply");
+    let w = write_ply(&p, &m, Some(&f)).unwrap();
+    let why = w.double.expect("written as double");
+    assert!(why.contains("'area'") && why.contains("vertex 3"), "{why}");
+    let bytes = std::fs::read(&p).unwrap();
+    let text = String::from_utf8_lossy(&bytes);
+    assert!(text.contains("property double area") && !text.contains("property float"));
+    // The value is in the file as the f64 it was.
+    let needle = 1e60f64.to_le_bytes();
+    assert!(bytes.windows(8).any(|w| w == needle));
+
+    f.areas[3] = 1.0;
+    f.k1[5] = 1e-40;
+    let w = write_ply(&dir.join("tiny.ply"), &m, Some(&f)).unwrap();
+    assert!(w.double.unwrap().contains("'k1'"));
+
+    f.k1[5] = f64::INFINITY;
+    let e = write_ply(&dir.join("inf.ply"), &m, Some(&f))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'k1'") && e.contains("vertex 5"), "{e}");
+    assert!(!dir.join("inf.ply").exists(), "nothing written on error");
+}

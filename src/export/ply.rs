@@ -26,15 +26,27 @@ pub const FIELD_PROPERTIES: [&str; 16] = [
     "dk2", "dk3",
 ];
 
+/// What [`write_ply`] wrote.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlyWritten {
+    /// `Some(why)` when the vertex properties were written as `double`
+    /// because a value lies outside the range of `float` (it would have
+    /// become infinite or zero); names the property, the vertex and the value.
+    pub double: Option<String>,
+}
+
 /// Writes `mesh` (and `field`, when given) to `path` as a binary
-/// little-endian PLY file with `float` vertex properties.
+/// little-endian PLY file with `float` vertex properties, or `double` ones
+/// when a value does not fit a `float` (see [`PlyWritten`]): a value is
+/// never written as infinity or flushed to zero.
 ///
 /// # Errors
 ///
 /// [`Error::InvalidArgument`] when the field's arrays do not all have one
-/// entry per vertex or a face index does not fit a PLY `int`;
+/// entry per vertex, a face index does not fit a PLY `int`, or a value is
+/// not finite (named with its property and vertex);
 /// [`Error::Write`] when the file cannot be created or written.
-pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Result<()> {
+pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Result<PlyWritten> {
     let n = mesh.n_vertices();
     if let Some(f) = field {
         let lens = [
@@ -60,13 +72,13 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
         .collect();
     write_rows(path, mesh, &names, |i, row| {
         if let Some(f) = field {
-            row.extend(f.normals[i].iter().map(|&c| c as f32));
-            row.push(f.areas[i] as f32);
-            row.push(f.k1[i] as f32);
-            row.push(f.k2[i] as f32);
-            row.extend(f.d1[i].iter().map(|&c| c as f32));
-            row.extend(f.d2[i].iter().map(|&c| c as f32));
-            row.extend(f.dk[i].iter().map(|&c| c as f32));
+            row.extend(f.normals[i]);
+            row.push(f.areas[i]);
+            row.push(f.k1[i]);
+            row.push(f.k2[i]);
+            row.extend(f.d1[i]);
+            row.extend(f.d2[i]);
+            row.extend(f.dk[i]);
         }
     })
 }
@@ -77,7 +89,11 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
 /// # Errors
 ///
 /// As [`write_ply`]; also when `normals` does not have one entry per vertex.
-pub fn write_ply_with_normals(path: &Path, mesh: &Mesh, normals: &[[f64; 3]]) -> Result<()> {
+pub fn write_ply_with_normals(
+    path: &Path,
+    mesh: &Mesh,
+    normals: &[[f64; 3]],
+) -> Result<PlyWritten> {
     if normals.len() != mesh.n_vertices() {
         return Err(Error::InvalidArgument(format!(
             "{} normals for a mesh of {} vertices",
@@ -87,7 +103,7 @@ pub fn write_ply_with_normals(path: &Path, mesh: &Mesh, normals: &[[f64; 3]]) ->
     }
     check_face_indices(mesh)?;
     write_rows(path, mesh, &["x", "y", "z", "nx", "ny", "nz"], |i, row| {
-        row.extend(normals[i].iter().map(|&c| c as f32));
+        row.extend(normals[i]);
     })
 }
 
@@ -105,19 +121,54 @@ fn check_face_indices(mesh: &Mesh) -> Result<()> {
     Ok(())
 }
 
-/// Writes the header, one row of float properties per vertex (position
-/// first, then what `extra` appends) and the faces.
+/// True when `x` (finite) would not survive as an `f32`: it would become
+/// infinite, or a non-zero value would become zero or lose precision as a
+/// subnormal.
+fn outside_f32(x: f64) -> bool {
+    let a = x.abs();
+    a > f64::from(f32::MAX) || (a != 0.0 && a < f64::from(f32::MIN_POSITIVE))
+}
+
+/// Writes the header, one row of properties per vertex (position first,
+/// then what `extra` appends) and the faces; `float` unless a value needs
+/// `double`.
 fn write_rows(
     path: &Path,
     mesh: &Mesh,
     names: &[&str],
-    extra: impl Fn(usize, &mut Vec<f32>),
-) -> Result<()> {
+    extra: impl Fn(usize, &mut Vec<f64>),
+) -> Result<PlyWritten> {
+    let mut row: Vec<f64> = Vec::with_capacity(names.len());
+    let mut written = PlyWritten::default();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        row.clear();
+        row.extend(p);
+        extra(i, &mut row);
+        for (k, &x) in row.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: property '{}' of vertex {i} is {x}: not written",
+                    path.display(),
+                    names[k]
+                )));
+            }
+            if written.double.is_none() && outside_f32(x) {
+                written.double = Some(format!(
+                    "property '{}' of vertex {i} is {x:e}, outside the range of float                      (about 1.2e-38 to 3.4e38)",
+                    names[k]
+                ));
+            }
+        }
+    }
+    let double = written.double.is_some();
     let write_err = |source| Error::Write {
         path: path.to_path_buf(),
         source,
     };
-    super::output::write_atomic(path, |w| write_body(w, mesh, names, &extra, write_err))
+    super::output::write_atomic(path, |w| {
+        write_body(w, mesh, names, &extra, double, write_err)
+    })?;
+    Ok(written)
 }
 
 /// The bytes of [`write_rows`], into a writer.
@@ -125,29 +176,35 @@ fn write_body(
     w: &mut BufWriter<File>,
     mesh: &Mesh,
     names: &[&str],
-    extra: &impl Fn(usize, &mut Vec<f32>),
+    extra: &impl Fn(usize, &mut Vec<f64>),
+    double: bool,
     write_err: impl Fn(std::io::Error) -> Error,
 ) -> Result<()> {
     let n = mesh.n_vertices();
+    let ty = if double { "double" } else { "float" };
     let mut header = String::new();
     header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
     header.push_str(&format!("element vertex {n}\n"));
     for name in names {
-        header.push_str(&format!("property float {name}\n"));
+        header.push_str(&format!("property {ty} {name}\n"));
     }
     header.push_str(&format!("element face {}\n", mesh.n_faces()));
     header.push_str("property list uchar int vertex_indices\nend_header\n");
     w.write_all(header.as_bytes()).map_err(&write_err)?;
 
-    let mut row: Vec<f32> = Vec::with_capacity(names.len());
-    let mut bytes: Vec<u8> = Vec::with_capacity(4 * row.capacity());
+    let mut row: Vec<f64> = Vec::with_capacity(names.len());
+    let mut bytes: Vec<u8> = Vec::with_capacity(8 * row.capacity());
     for (i, p) in mesh.positions.iter().enumerate() {
         row.clear();
-        row.extend(p.iter().map(|&c| c as f32));
+        row.extend(p);
         extra(i, &mut row);
         bytes.clear();
-        for v in &row {
-            bytes.extend_from_slice(&v.to_le_bytes());
+        for &v in &row {
+            if double {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            } else {
+                bytes.extend_from_slice(&(v as f32).to_le_bytes());
+            }
         }
         w.write_all(&bytes).map_err(&write_err)?;
     }
