@@ -3,7 +3,8 @@
 # OpenCL devices, computes curvature of a torus and an ellipsoid to PLY + JSON
 # stats in out/, prints the accuracy/time table of every variant, then extracts
 # isosurfaces of procedural fields (with curvature) and prints their report,
-# and renders the two bundled scenes (torus, gyroid).
+# renders the bundled scenes (torus, gyroid, strokes), and draws curvature-
+# directed strokes on a torus SDF.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -21,4 +22,8 @@ $bin isosurface --sdf gyroid --resolution 128 --fusion hash -o out/gyroid-iso.pl
 $bin isosurface --report --max-resolution 256 --runs 3
 # Scenes: only the passes each scene's cues need run; images, SVG line
 # drawings and a JSON report of the passes that ran go to out/scenes/.
-$bin render scenes/torus.toml scenes/gyroid.toml --out out/scenes --force
+$bin render scenes/torus.toml scenes/gyroid.toml scenes/strokes.toml --out out/scenes --force
+# Curvature-directed strokes on a signed distance field (every step on the
+# device): PNG over the shaded surface, SVG outlines, PLY strips, stats.
+$bin strokes --sdf torus --resolution 128 -o out/torus-strokes.png --svg out/torus-strokes.svg \
+  --geometry out/torus-strokes.ply --stats out/torus-strokes.json --force

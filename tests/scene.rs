@@ -35,6 +35,10 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
             ]
         }
         Cue::FeatureEdges => vec![EdgeBuffer, CapBuffer, FaceNormals, Edges, Caps, Render],
+        // Traced on the field itself; a volume's frame still draws its
+        // isosurface (shaded, or flat to hide the strokes behind it).
+        Cue::CurvatureStrokes if input == Input::Volume => vec![SdfLines, Isosurface, Render],
+        Cue::CurvatureStrokes => vec![SdfLines, Render],
     };
     let needs_geometry = v.iter().any(|p| {
         matches!(
@@ -155,4 +159,43 @@ fn the_cap_variant_decides_the_cap_passes() {
             .collect();
         assert_eq!(diff, vec![Pass::CapBuffer, Pass::Caps]);
     }
+}
+
+#[test]
+fn curvature_strokes_plan_per_input_kind() {
+    use Pass::*;
+    // The table for every input kind: which accept the cue, and what the
+    // strokes alone plan (no mesh curvature pass on a volume).
+    let table: [(Input, bool, Vec<Pass>); 4] = [
+        (Input::Static, false, vec![SdfLines, Render]),
+        (Input::Skinned, false, vec![SdfLines, Render]),
+        (Input::Flipbook, false, vec![SdfLines, Render]),
+        (Input::Volume, true, vec![Isosurface, SdfLines, Render]),
+    ];
+    for (input, accepted, passes) in table {
+        assert_eq!(Cue::CurvatureStrokes.accepts(input), accepted, "{input:?}");
+        let p = plan(&[Cue::CurvatureStrokes], input);
+        assert_eq!(p.passes, passes, "{input:?}");
+        for c in Cue::ALL.iter().filter(|&&c| c != Cue::CurvatureStrokes) {
+            assert!(c.accepts(input), "{c:?} on {input:?}");
+        }
+    }
+    let v = plan(&[Cue::CurvatureStrokes], Input::Volume);
+    for p in [OneRings, VertexNormals, Curvature, Dcurv, Ao] {
+        assert!(!v.contains(p), "{p:?} planned for strokes alone");
+    }
+    assert_eq!(SdfLines.lifetime(Input::Volume), Lifetime::Pose);
+    assert_eq!(v.runs(SdfLines, 3, 2), 3, "once per pose, not per view");
+    // Over shading: the normals of the shading, still no curvature.
+    let s = plan(&[Cue::CurvatureStrokes, Cue::Shading], Input::Volume);
+    assert_eq!(s.passes, vec![Isosurface, VertexNormals, SdfLines, Render]);
+    // Its kernels are the sdf_lines steps, joined to the timing by id.
+    assert!(
+        SdfLines
+            .kernels()
+            .iter()
+            .all(|k| k.kernel().starts_with("sdfl_"))
+    );
+    let text = v.explain(1, 2);
+    assert!(text.contains("SdfLines"), "{text}");
 }

@@ -380,3 +380,48 @@ fn the_inside_of_a_volume_decides_convex_or_concave() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn curvature_strokes_on_a_volume_run_their_pass_and_draw() {
+    // Strokes alone (the isosurface flat, hiding the far side) and over
+    // shading, two views: the strokes pass runs once per pose, no mesh
+    // curvature pass runs, the PNGs are written.
+    for (fx, with_shading) in [
+        ("curvature_strokes = {}\n", false),
+        (
+            "shading = {}\ncurvature_strokes = { color = [0.6, 0.1, 0.1] }\n",
+            true,
+        ),
+    ] {
+        let dir = scratch("strokes");
+        let s = scene(
+            &dir,
+            &format!(
+                "[input]\nsdf = \"torus\"\nresolution = 48\n[[camera]]\norbit = 2\n\
+                 [effects]\n{fx}[output]\nsize = [96, 96]\n"
+            ),
+        );
+        let Some(r) = run(&s, &dir, false) else {
+            return;
+        };
+        let r = r.unwrap();
+        check_minimal(&r, fx);
+        assert!(r.plan.contains(Pass::SdfLines) && r.plan.contains(Pass::Isosurface));
+        assert!(!r.plan.contains(Pass::Curvature) && !r.plan.contains(Pass::OneRings));
+        assert_eq!(r.plan.contains(Pass::VertexNormals), with_shading);
+        let rec = r.passes.iter().find(|p| p.pass == Pass::SdfLines).unwrap();
+        assert_eq!((rec.runs, rec.clock), (1, "kernel"), "{rec:?}");
+        assert!(r.strokes > 0, "a torus has strokes");
+        assert_eq!(r.outputs.len(), 2);
+        for p in &r.outputs {
+            let img = image::open(p).unwrap().to_rgb8();
+            // Some dark stroke pixels on a white background.
+            let dark = img
+                .pixels()
+                .filter(|q| q.0.iter().all(|&c| c < 160))
+                .count();
+            assert!(dark > 20, "{}: {dark} dark pixels", p.display());
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

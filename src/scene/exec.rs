@@ -154,6 +154,7 @@ pub fn run(
         view_ms_median: crate::report::median(&mut view_ms),
         render_ms_median: crate::report::median(&mut render_ms),
         segments: ex.segments,
+        strokes: ex.stroke_count,
         notes,
         outputs: std::mem::take(&mut ex.outputs),
         wall_ms: ms_since(t_all),

@@ -28,6 +28,8 @@
 //! contours = { width = 2 }
 //! suggestive_contours = { threshold = 0.05, fade = 0.2 }
 //! feature_edges = { crease = 30, caps = "adjacency" }
+//! curvature_strokes = { spacing = 0.05, sampling = "auto", color = [0.1, 0.1, 0.2], width = 0.01 }
+//!                              # volume and sdf inputs only
 //!
 //! [output]
 //! dir = "out/brainstem"        # `--out DIR` on the command line overrides it
@@ -50,7 +52,7 @@ use toml::Spanned;
 mod raw;
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
-    LineSpec, OutputSpec, SceneFile, ShadingSpec, SuggestiveSpec,
+    LineSpec, OutputSpec, SamplingSpec, SceneFile, ShadingSpec, StrokeSpec, SuggestiveSpec,
 };
 
 /// Where a scene's geometry comes from, resolved.
@@ -146,6 +148,22 @@ pub struct Effects {
     pub edge_contours: bool,
     /// Edge boundaries.
     pub edge_boundaries: bool,
+    /// Curvature-directed strokes.
+    pub strokes: StrokeEffect,
+}
+
+/// The `curvature_strokes` cue's parameters (world units; `None`: the
+/// `sdf_lines` default, a multiple of the sampling distance).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrokeEffect {
+    /// Poisson-disk seed spacing.
+    pub spacing: Option<f64>,
+    /// Hessian sampling distance (`None`: automatic).
+    pub sampling: Option<f64>,
+    /// RGB.
+    pub color: [f32; 3],
+    /// Stroke width at the largest κ1.
+    pub width: Option<f64>,
 }
 
 /// A checked scene.
@@ -593,12 +611,59 @@ impl Scene {
                 .parse()
                 .map_err(|x: Error| ck.err(c.span(), x.to_string()))?,
         };
+        let st = fx.curvature_strokes.clone().unwrap_or_default();
+        if fx.curvature_strokes.is_some() {
+            cues.push(Cue::CurvatureStrokes);
+        }
+        let world = |v: Option<f64>, what: &str| -> std::result::Result<Option<f64>, String> {
+            match v {
+                Some(x) if !(x.is_finite() && x > 0.0) => Err(format!(
+                    "curvature_strokes.{what} {x} must be a positive number of world units"
+                )),
+                _ => Ok(v),
+            }
+        };
+        let sampling = match &st.sampling {
+            None => None,
+            Some(s) => match s.get_ref() {
+                SamplingSpec::Word(w) if w == "auto" => None,
+                SamplingSpec::Distance(h) if h.is_finite() && *h > 0.0 => Some(*h),
+                other => {
+                    return Err(ck.err(
+                        s.span(),
+                        format!(
+                            "curvature_strokes.sampling {}: expected \"auto\" or a positive \
+                             distance in world units",
+                            match other {
+                                SamplingSpec::Word(w) => format!("{w:?}"),
+                                SamplingSpec::Distance(h) => h.to_string(),
+                            }
+                        ),
+                    ));
+                }
+            },
+        };
+        let strokes = StrokeEffect {
+            spacing: world(st.spacing, "spacing").map_err(e)?,
+            sampling,
+            color: color(st.color, [0.05, 0.05, 0.1], "curvature_strokes.color").map_err(e)?,
+            width: world(st.width, "width").map_err(e)?,
+        };
         if cues.is_empty() {
             return Err(e(
                 "[effects] asks for no cue: add shading, curvature_colors, ao, contours, \
-                 suggestive_contours or feature_edges"
+                 suggestive_contours, feature_edges or curvature_strokes"
                     .into(),
             ));
+        }
+        let input = source.input();
+        if let Some(c) = cues.iter().find(|c| !c.accepts(input)) {
+            return Err(e(format!(
+                "{}: curvature-directed strokes are traced on a signed distance field; they \
+                 need a volume or sdf input, not a {} input",
+                c.key(),
+                given[0]
+            )));
         }
         let effects = Effects {
             cues,
@@ -616,6 +681,7 @@ impl Scene {
             caps,
             edge_contours: fe.contours.unwrap_or(true),
             edge_boundaries: fe.boundaries.unwrap_or(true),
+            strokes,
         };
 
         // Output.

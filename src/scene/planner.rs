@@ -31,18 +31,48 @@ pub enum Cue {
     SuggestiveContours,
     /// Feature edges (contour, crease, boundary, marked) with caps.
     FeatureEdges,
+    /// Curvature-directed strokes on a signed distance field (Interrante's
+    /// strokes, curvature from the Hessian after Kindlmann et al. 2003):
+    /// volume inputs only ([`Cue::accepts`]).
+    CurvatureStrokes,
 }
 
 impl Cue {
     /// Every cue.
-    pub const ALL: [Cue; 6] = [
+    pub const ALL: [Cue; 7] = [
         Cue::Shading,
         Cue::CurvatureColors,
         Cue::AmbientOcclusion,
         Cue::Contours,
         Cue::SuggestiveContours,
         Cue::FeatureEdges,
+        Cue::CurvatureStrokes,
     ];
+
+    /// Whether the cue can be drawn on an input kind: curvature-directed
+    /// strokes are traced on a scalar field, so they need a volume input
+    /// (a volume file or a procedural SDF); every other cue works on any.
+    /// The scene file refuses a cue on an input it does not accept before
+    /// anything runs.
+    pub fn accepts(self, input: Input) -> bool {
+        match self {
+            Cue::CurvatureStrokes => input == Input::Volume,
+            _ => true,
+        }
+    }
+
+    /// The cue's name in scene files (`[effects]` keys).
+    pub fn key(self) -> &'static str {
+        match self {
+            Cue::Shading => "shading",
+            Cue::CurvatureColors => "curvature_colors",
+            Cue::AmbientOcclusion => "ao",
+            Cue::Contours => "contours",
+            Cue::SuggestiveContours => "suggestive_contours",
+            Cue::FeatureEdges => "feature_edges",
+            Cue::CurvatureStrokes => "curvature_strokes",
+        }
+    }
 
     /// The passes this cue reads directly.
     pub fn needs(self) -> &'static [Pass] {
@@ -53,6 +83,7 @@ impl Cue {
             Cue::Contours => &[Pass::Contours, Pass::Render],
             Cue::SuggestiveContours => &[Pass::SuggestiveContours, Pass::Render],
             Cue::FeatureEdges => &[Pass::Edges, Pass::Caps, Pass::Render],
+            Cue::CurvatureStrokes => &[Pass::SdfLines, Pass::Render],
         }
     }
 }
@@ -109,6 +140,10 @@ pub enum Pass {
     Dcurv,
     /// Ambient occlusion from curvature.
     Ao,
+    /// Curvature-directed strokes traced on the volume itself (family
+    /// `sdf_lines`): dense samples, Poisson-disk seeds, curvature from the
+    /// Hessian, RK4 tracing along d1, tapered strips. Reads no mesh pass.
+    SdfLines,
     /// Occluding contours (zero crossings of n·v).
     Contours,
     /// Suggestive contours (zero crossings of radial curvature, with dk).
@@ -156,6 +191,16 @@ impl Pass {
             Pass::Curvature => &[CurvTensor, CurvPrincipal],
             Pass::Dcurv => &[CurvDcurv],
             Pass::Ao => &[AoVertex],
+            Pass::SdfLines => &[
+                SdflDense,
+                SdflGradient,
+                SdflSweep,
+                SdflThin,
+                SdflCurvature,
+                SdflRange,
+                SdflTrace,
+                SdflStrips,
+            ],
             Pass::Contours | Pass::SuggestiveContours => &[LinesVertex, LinesFace],
             Pass::Edges => &[EdgesDetect],
             Pass::Caps => &[CapsMh, CapsAdjacency],
@@ -195,6 +240,11 @@ impl Pass {
             Pass::SuggestiveContours => vec![Pass::Dcurv, Pass::VertexNormals],
             Pass::Edges => vec![Pass::EdgeBuffer, Pass::FaceNormals],
             Pass::Caps => vec![Pass::Edges, Pass::CapBuffer],
+            // The strokes are traced on the field, not on the isosurface.
+            Pass::SdfLines => vec![],
+            // A volume's frame draws its isosurface (shaded, or flat in the
+            // background colour to hide the strokes and lines behind it).
+            Pass::Render if input == Input::Volume => vec![Pass::Isosurface],
             Pass::Render => vec![],
         };
         v.sort();

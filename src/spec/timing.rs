@@ -33,6 +33,8 @@ pub enum Family {
     FeatureLines,
     /// `kernels/ao.cl`.
     Ao,
+    /// `kernels/sdf_lines.cl` (curvature-directed strokes on a field).
+    SdfLines,
 }
 
 /// A step of a stage: a kernel entry point `<prefix>_<step>` of
@@ -102,6 +104,27 @@ pub enum Step {
     LinesFace,
     /// `ao_vertex`: ambient occlusion from (k1, k2).
     AoVertex,
+    /// `sdfl_dense`: sign changes between neighbouring voxels (the
+    /// marching-cubes edge rule), appended with a counter.
+    SdflDense,
+    /// `sdfl_thin_phase`: Poisson-disk thinning in 27 conflict-free phases
+    /// (`sdfl_cell_count`, `sdfl_cell_fill`, `sdfl_thin_flags`,
+    /// `sdfl_thin_compact` and their scans counted in it).
+    SdflThin,
+    /// `sdfl_gradient`: central differences per voxel.
+    SdflGradient,
+    /// `sdfl_curvature`: principal curvatures and direction at the seeds
+    /// (Kindlmann et al. 2003).
+    SdflCurvature,
+    /// `sdfl_range`: κ1 min and max over the seeds (atomics).
+    SdflRange,
+    /// `sdfl_trace`: RK4 along d1 both ways, projected onto the surface.
+    SdflTrace,
+    /// `sdfl_strips` (+ the vertex-count scan): tapered triangle strips.
+    SdflStrips,
+    /// The automatic sampling sweep (host entry `sdfl_sweep`): a
+    /// provisional thinning and one `sdfl_curvature` per candidate distance.
+    SdflSweep,
 }
 
 impl Step {
@@ -136,6 +159,14 @@ impl Step {
             Step::LinesVertex => "lines_vertex",
             Step::LinesFace => "lines_face",
             Step::AoVertex => "ao_vertex",
+            Step::SdflDense => "sdfl_dense",
+            Step::SdflThin => "sdfl_thin_phase",
+            Step::SdflGradient => "sdfl_gradient",
+            Step::SdflCurvature => "sdfl_curvature",
+            Step::SdflRange => "sdfl_range",
+            Step::SdflTrace => "sdfl_trace",
+            Step::SdflStrips => "sdfl_strips",
+            Step::SdflSweep => "sdfl_sweep",
         }
     }
 
@@ -151,6 +182,7 @@ impl Step {
             Family::Skinning => &k["skin_".len()..],
             Family::FeatureLines => &k["lines_".len()..],
             Family::Ao => &k["ao_".len()..],
+            Family::SdfLines => &k["sdfl_".len()..],
             Family::Scan | Family::RadixSort | Family::Edges => k,
         }
     }
@@ -170,6 +202,8 @@ impl Step {
             SkinLbs => Family::Skinning,
             LinesVertex | LinesFace => Family::FeatureLines,
             AoVertex => Family::Ao,
+            SdflDense | SdflThin | SdflGradient | SdflCurvature | SdflRange | SdflTrace
+            | SdflStrips | SdflSweep => Family::SdfLines,
         }
     }
 }

@@ -9,6 +9,7 @@ use crate::render::edges::draw_edges;
 use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
 use crate::scene::file::{CameraKind, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
+use crate::spec::sdf_lines::Stroke;
 use crate::stages::edges::EdgeOutput;
 use std::path::PathBuf;
 
@@ -108,6 +109,10 @@ pub(super) struct ViewLines<'a> {
     pub(super) segments: &'a [Segment],
     /// The edge stage's outputs, when feature edges are planned.
     pub(super) edges: Option<&'a EdgeOutput>,
+    /// Curvature-directed strokes (scene frame).
+    pub(super) strokes: &'a [Stroke],
+    /// Lift of the strokes towards the eye (world units).
+    pub(super) stroke_lift: f32,
 }
 
 /// Draws one view (mesh, line quads, edge quads), reads it back and writes
@@ -184,6 +189,16 @@ pub(super) fn draw_view(
         let [r, g, b] = fx.edge.1;
         draw_edges(renderer, eo, [r, g, b, 1.0])?;
         line_quads.extend_from_slice(&eo.edge_out);
+    }
+    if plan.contains(Pass::SdfLines) {
+        // Strips over the surface (drawn first, so it hides the far side).
+        let [r, g, b] = fx.strokes.color;
+        let style = crate::render::strokes::StrokeStyle {
+            color: [r, g, b, 1.0],
+            width_scale: 1.0,
+            lift: lines.stroke_lift,
+        };
+        crate::render::strokes::draw(renderer, cam, lines.strokes, &style)?;
     }
     let image: Frame = renderer.finish()?;
     for path in paths {

@@ -8,7 +8,9 @@
 //! [`PosePipeline`] (built with only the stages the plan needs); the other
 //! inputs hold their curvature estimator per topology (an isosurface's on
 //! the device, from the fusion kernels) and one [`AoStage`]. The feature
-//! lines and the edge stage are per topology for every input.
+//! lines and the edge stage are per topology for every input. A volume's
+//! curvature-directed strokes ([`SdfLines`]) are traced on the volume
+//! itself, uploaded once for the run, and need no mesh pass.
 
 use super::draw::{self, PoseData, ViewLines};
 use super::load::Loaded;
@@ -23,6 +25,7 @@ use crate::render::colormap::curvature_scale;
 use crate::render::{Camera, Renderer};
 use crate::scene::file::Scene;
 use crate::scene::planner::{Pass, Plan};
+use crate::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, Stroke};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
@@ -30,6 +33,7 @@ use crate::stages::edges::{EdgeOutput, EdgeParams, EdgeStage};
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use crate::stages::marching_cubes::{IsoNormals, Isosurfacer};
 use crate::stages::pipeline::{PipelineOptions, PipelineStages, PosePipeline};
+use crate::stages::sdf_lines::SdfLines;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -93,6 +97,12 @@ pub(super) struct Executor<'s, 'g> {
     iso: Option<Isosurfacer>,
     /// AO of an unskinned input.
     ao: Option<AoStage>,
+    /// Curvature-directed strokes of a volume input, and its voxel size.
+    sdf_lines: Option<(SdfLines, f64)>,
+    /// This pose: the strokes (world units).
+    strokes: Vec<Stroke>,
+    /// Strokes over all poses.
+    pub(super) stroke_count: usize,
     topo: Option<Topology>,
     framing: Option<Framing>,
     color_scale: Option<f32>,
@@ -162,6 +172,25 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             _ => None,
         };
+        let sdf_lines = match &loaded {
+            Loaded::Volume(v, iso, _) if has(Pass::SdfLines) => {
+                let st = &fx.strokes;
+                // The loader negated an `above` volume: inside is below iso.
+                let opts = SdfLineOptions {
+                    iso: *iso,
+                    inside: Inside::Below,
+                    sampling: st
+                        .sampling
+                        .map_or(Sampling::Auto(Vec::new()), Sampling::Fixed),
+                    spacing: st.spacing,
+                    width: st.width,
+                    ..SdfLineOptions::default()
+                };
+                let voxel = crate::spec::sdf_lines::voxel_size(v.spacing);
+                Some((SdfLines::new(gpu.clone(), v, &opts)?, voxel))
+            }
+            _ => None,
+        };
         let ao = match (&pipe, has(Pass::Ao)) {
             (None, true) => Some(AoStage::new(gpu.clone())?),
             _ => None,
@@ -178,6 +207,9 @@ impl<'s, 'g> Executor<'s, 'g> {
             pipe,
             iso,
             ao,
+            sdf_lines,
+            strokes: Vec::new(),
+            stroke_count: 0,
             topo: None,
             framing: None,
             color_scale: fx.curvature_scale,
@@ -414,6 +446,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 self.rec.kernels(pass, &t, "dcurv");
             }
             Pass::Ao => self.ao(frame)?,
+            Pass::SdfLines => self.sdf_lines()?,
             Pass::Contours | Pass::SuggestiveContours | Pass::Edges | Pass::Caps | Pass::Render => {
                 unreachable!("{pass:?} is a view pass")
             }
@@ -553,6 +586,47 @@ impl<'s, 'g> Executor<'s, 'g> {
         Ok(())
     }
 
+    /// Curvature-directed strokes of this pose, traced on the volume.
+    fn sdf_lines(&mut self) -> Result<()> {
+        let (stage, _) = self.sdf_lines.as_mut().expect("built for the strokes pass");
+        let out = stage.run()?;
+        let st = &out.stats;
+        let t = st.ms.timing(st.wall_ms);
+        let h = st.params.map_or(0.0, |p| p.sampling);
+        let r = st.params.map_or(0.0, |p| p.spacing);
+        let how = format!(
+            "{} surface samples → {} Poisson-disk seeds (r = {r:.4}), {} strokes, {} segments; \
+             Hessian sampling distance {h:.4} ({})",
+            st.dense,
+            st.seeds,
+            st.strokes,
+            st.segments,
+            if st.sweep.is_empty() {
+                "fixed"
+            } else {
+                "automatic: coefficient of variation of κ1 closest to 1"
+            }
+        );
+        self.rec.kernels(Pass::SdfLines, &t, &how);
+        self.stroke_count += out.strokes.len();
+        self.strokes = out.strokes;
+        Ok(())
+    }
+
+    /// The strokes in the scene frame (world minus the scene origin).
+    fn scene_strokes(&self) -> Vec<Stroke> {
+        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
+        self.strokes
+            .iter()
+            .map(|s| Stroke {
+                points: s.points.iter().map(local).collect(),
+                strip: s.strip.iter().map(local).collect(),
+                ..s.clone()
+            })
+            .collect()
+    }
+
     /// Starts a view.
     pub(super) fn begin_view(&mut self) {
         self.segs.clear();
@@ -619,10 +693,15 @@ impl<'s, 'g> Executor<'s, 'g> {
                     &self.pose,
                     self.color_scale.unwrap_or(1.0),
                 );
+                let strokes = self.scene_strokes();
                 let t = self.topo.as_ref().expect("a pose ran");
                 let lines = ViewLines {
                     segments: &self.segs,
                     edges: self.edges_ran.as_ref().map(|e| &e.1),
+                    strokes: &strokes,
+                    // Half a voxel towards the eye: the strokes lie on the
+                    // interpolated surface, which marching cubes cuts as chords.
+                    stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
                 };
                 let drawn = draw::draw_view(
                     &mut self.renderer,
@@ -638,7 +717,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 self.rec.wall(
                     pass,
                     ms_since(t0),
-                    "draw mesh, line quads and edge quads; read back",
+                    "draw mesh, line quads, edge quads and stroke strips; read back",
                 );
                 self.segments[0] += drawn[0];
                 self.segments[1] += drawn[1];

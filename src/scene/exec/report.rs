@@ -56,6 +56,8 @@ pub struct RunReport {
     pub render_ms_median: f64,
     /// Contour and suggestive-contour segments over all views.
     pub segments: [usize; 2],
+    /// Curvature-directed strokes over all poses (traced once per pose).
+    pub strokes: usize,
     /// Notes (e.g. what skinning weights were dropped).
     pub notes: Vec<String>,
     /// Files written (images; the report itself is written last).

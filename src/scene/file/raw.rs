@@ -146,6 +146,8 @@ pub struct EffectsSpec {
     pub suggestive_contours: Option<SuggestiveSpec>,
     /// Feature edges with caps.
     pub feature_edges: Option<EdgeSpec>,
+    /// Curvature-directed strokes (volume inputs only).
+    pub curvature_strokes: Option<StrokeSpec>,
 }
 
 /// `[effects.shading]`.
@@ -217,6 +219,34 @@ pub struct EdgeSpec {
     pub contours: Option<bool>,
     /// Draw boundary edges (default true).
     pub boundaries: Option<bool>,
+}
+
+/// `[effects.curvature_strokes]`: Interrante-style strokes along the first
+/// principal direction of a volume's isosurface. Lengths are world units;
+/// the defaults are multiples of the Hessian sampling distance h
+/// (`crate::spec::sdf_lines`).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrokeSpec {
+    /// Poisson-disk seed spacing r (default 1.5 h).
+    pub spacing: Option<f64>,
+    /// Hessian sampling distance: `"auto"` (default: the candidate whose
+    /// coefficient of variation of κ1 is closest to 1) or a distance.
+    pub sampling: Option<Spanned<SamplingSpec>>,
+    /// RGB (default near black).
+    pub color: Option<[f32; 3]>,
+    /// Stroke width at the largest κ1 (default 0.4 h).
+    pub width: Option<f64>,
+}
+
+/// `sampling = "auto"` or `sampling = 0.03`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum SamplingSpec {
+    /// A distance in world units.
+    Distance(f64),
+    /// A word (only `auto` is accepted).
+    Word(String),
 }
 
 /// `[output]`.

@@ -139,3 +139,39 @@ fn effects_resolve_cues_and_parameters() {
     assert!(!s.png && s.svg);
     assert_eq!(s.source.input(), Input::Volume);
 }
+
+#[test]
+fn curvature_strokes_resolve_and_need_a_volume() {
+    let s = parse(
+        "[input]\nsdf = \"torus\"\n[effects]\nshading = {}\ncurvature_strokes = { spacing = 0.05, sampling = 0.03, color = [1, 0, 0], width = 0.01 }\n",
+    )
+    .unwrap();
+    assert_eq!(s.effects.cues, vec![Cue::Shading, Cue::CurvatureStrokes]);
+    let st = &s.effects.strokes;
+    assert_eq!(
+        (st.spacing, st.sampling, st.color, st.width),
+        (Some(0.05), Some(0.03), [1.0, 0.0, 0.0], Some(0.01))
+    );
+    let s =
+        parse("[input]\nsdf = \"torus\"\n[effects]\ncurvature_strokes = { sampling = \"auto\" }\n")
+            .unwrap();
+    assert_eq!(s.effects.strokes.sampling, None);
+    let e =
+        err("[input]\nsdf = \"torus\"\n[effects]\ncurvature_strokes = { sampling = \"often\" }\n");
+    assert!(
+        e.contains("test.toml") && e.contains("line 4") && e.contains("auto"),
+        "{e}"
+    );
+    let e = err("[input]\nsdf = \"torus\"\n[effects]\ncurvature_strokes = { spacing = -1 }\n");
+    assert!(e.contains("spacing"), "{e}");
+    // A mesh input: refused when the file is read, naming the file and the cue.
+    for input in ["generate = \"torus\"", "flipbook = \"f_*.obj\""] {
+        let e = err(&format!(
+            "[input]\n{input}\n[effects]\nshading = {{}}\ncurvature_strokes = {{}}\n"
+        ));
+        assert!(
+            e.contains("test.toml") && e.contains("curvature_strokes") && e.contains("volume"),
+            "{e}"
+        );
+    }
+}

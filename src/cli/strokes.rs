@@ -1,0 +1,462 @@
+//! `shapecue strokes`: curvature-directed strokes (Interrante's strokes on a
+//! signed distance field, principal curvature from the Hessian after
+//! Kindlmann et al. 2003) drawn over the shaded isosurface, to PNG, with the
+//! strokes also as SVG outlines, a PLY of the strips and a stats JSON.
+//!
+//! Thin: parses, calls the library (`stages::sdf_lines` for the strokes,
+//! `stages::marching_cubes` for the surface under them, `render` and
+//! `export`), prints one summary line. `--report` prints the accuracy/time
+//! table against the analytic torus instead.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use shapecue::export::output::{check_outputs, write_bytes_atomic};
+use shapecue::gpu::Gpu;
+use shapecue::render::strokes::{StrokeStyle, draw};
+use shapecue::render::{MeshStyle, Placement, RenderOptions, Renderer, framed};
+use shapecue::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, SdfLinesOutput, Stroke};
+use shapecue::stages::sdf_lines::SdfLines;
+use shapecue::volume::{self, RawSpec, ScalarType, Volume};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Direction (centre → eye) of the fitted camera when `--eye` is not given.
+const FIT_DIRECTION: [f32; 3] = [0.3, -1.0, 0.9];
+
+/// Options of `shapecue strokes`.
+#[derive(Args, Debug)]
+pub struct StrokesArgs {
+    /// Input: a volume (.nrrd/.nhdr, .mhd/.mha, .vtk, .vti, .slc, or raw
+    /// data with --dims and --type) or a triangle mesh (.obj, .ply, .off).
+    #[arg(required_unless_present_any = ["sdf", "report"])]
+    pub input: Option<PathBuf>,
+    /// Use a procedural signed distance field instead: sphere, torus or gyroid.
+    #[arg(long, conflicts_with = "input")]
+    pub sdf: Option<String>,
+    /// Grid points per axis of a procedural field.
+    #[arg(long, default_value_t = 128)]
+    pub resolution: usize,
+    /// Raw input: voxels per axis, e.g. 32,32,32.
+    #[arg(long, value_delimiter = ',')]
+    pub dims: Option<Vec<usize>>,
+    /// Raw input: voxel type (u8, i8, u16, i16, u32, i32, f32, f64).
+    #[arg(long = "type")]
+    pub scalar: Option<String>,
+    /// Raw input: world units per voxel step, e.g. 1,1,2.5.
+    #[arg(long, value_delimiter = ',')]
+    pub spacing: Option<Vec<f64>>,
+    /// Raw input: big-endian data.
+    #[arg(long)]
+    pub big_endian: bool,
+    /// Raw input: bytes to skip before the data.
+    #[arg(long, default_value_t = 0)]
+    pub header_bytes: usize,
+    /// Iso value of the surface (default 0 for procedural fields; required
+    /// for volume files).
+    #[arg(long, allow_negative_numbers = true)]
+    pub iso: Option<f32>,
+    /// Which side of the iso value is inside the object: below (distance
+    /// fields; the default for --sdf) or above (density data such as CT;
+    /// the default for volume files). Normals point out, convex is positive.
+    #[arg(long)]
+    pub inside: Option<String>,
+    /// Poisson-disk seed spacing r in world units (default: 1.5 × the
+    /// Hessian sampling distance).
+    #[arg(long, allow_negative_numbers = true)]
+    pub seed_spacing: Option<f64>,
+    /// Hessian sampling distance: auto (the candidate whose coefficient of
+    /// variation of κ1 over the seeds is closest to 1) or a distance in
+    /// world units.
+    #[arg(long, default_value = "auto")]
+    pub sampling: String,
+    /// Output PNG.
+    #[arg(short, long, required_unless_present = "report")]
+    pub output: Option<PathBuf>,
+    /// Also write the strokes facing the eye as SVG (each a filled
+    /// variable-width outline).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Also write the strips as a PLY triangle mesh (vertices on the surface).
+    #[arg(long)]
+    pub geometry: Option<PathBuf>,
+    /// Write statistics (seeds before/after thinning, strokes, segments,
+    /// the sampling sweep, per-step kernel ms) as JSON.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// Eye position in world units, e.g. 0.5,-2,1.8 (default: a fitted view).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub eye: Option<Vec<f32>>,
+    /// Image size, e.g. 800x800.
+    #[arg(long, default_value = "800x800")]
+    pub size: String,
+    /// Strokes without the shaded surface: the surface is drawn in the
+    /// background colour, so that it still hides the strokes behind it.
+    #[arg(long)]
+    pub no_surface: bool,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+    /// Print the accuracy/time table (κ1 and direction error against the
+    /// analytic torus per grid resolution and sampling distance, beside the
+    /// kernel time) instead; no input needed.
+    #[arg(long)]
+    pub report: bool,
+}
+
+/// Runs `shapecue strokes`.
+///
+/// # Errors
+///
+/// Bad arguments, an unreadable input, a mesh input (it needs the
+/// mesh-to-distance-field stage), outputs that exist without `--force` or
+/// are the input, and any library error.
+pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
+    if a.report {
+        let gpu = Arc::new(Gpu::new(device)?);
+        print!("{}", torus_report(gpu)?);
+        return Ok(());
+    }
+    let (w, h) = size_arg(&a.size)?;
+    let output = a.output.clone().expect("clap requires -o without --report");
+    let (name, mut vol, procedural) = load_input(&a)?;
+    let iso = match (a.iso, procedural) {
+        (Some(v), _) => v,
+        (None, true) => 0.0,
+        (None, false) => bail!("give --iso (the volume's values span {:?})", vol.range()),
+    };
+    if !iso.is_finite() {
+        bail!("--iso {iso} must be finite");
+    }
+    let inside: Inside = match &a.inside {
+        Some(s) => s.parse()?,
+        None if procedural => Inside::Below,
+        None => Inside::Above,
+    };
+    let sampling = match a.sampling.as_str() {
+        "auto" => Sampling::Auto(Vec::new()),
+        s => match s.parse::<f64>() {
+            Ok(d) if d.is_finite() && d > 0.0 => Sampling::Fixed(d),
+            _ => bail!("--sampling {s:?}: expected auto or a positive distance in world units"),
+        },
+    };
+    let eye = match &a.eye {
+        None => None,
+        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+            Some(glam::Vec3::new(v[0], v[1], v[2]))
+        }
+        Some(v) => bail!("--eye needs three finite numbers X,Y,Z, got {v:?}"),
+    };
+    let outputs: Vec<&Path> = [
+        Some(&output),
+        a.svg.as_ref(),
+        a.geometry.as_ref(),
+        a.stats.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path)
+    .collect();
+    let inputs: Vec<&Path> = a.input.iter().map(PathBuf::as_path).collect();
+    check_outputs(&inputs, &outputs, a.force)?;
+
+    // Marching cubes orients its triangles out of the region below iso:
+    // for an object above iso, negate the values and iso (exact in f32), so
+    // both the surface and the strokes see the object below.
+    let iso_below = if inside == Inside::Above {
+        vol.values.iter_mut().for_each(|x| *x = -*x);
+        -iso
+    } else {
+        iso
+    };
+    let opts = SdfLineOptions {
+        iso: iso_below,
+        inside: Inside::Below,
+        sampling,
+        spacing: a.seed_spacing,
+        ..SdfLineOptions::default()
+    };
+    let gpu = Arc::new(Gpu::new(device)?);
+    let out = SdfLines::new(gpu.clone(), &vol, &opts)
+        .with_context(|| format!("uploading {name}"))?
+        .run()
+        .with_context(|| format!("tracing the strokes of {name}"))?;
+    let st = &out.stats;
+
+    // The surface under the strokes.
+    let mut ex = shapecue::stages::marching_cubes::Isosurfacer::new(gpu.clone(), &vol)?;
+    ex.extract(iso_below, shapecue::cpu::vertex_fusion::Fusion::Edge)?;
+    let (ipos, faces) = ex.read_index_space()?;
+    let mesh = ex.world_mesh(&ipos, faces);
+    if mesh.n_faces() == 0 {
+        bail!(
+            "{name}: the isosurface at iso {iso} is empty (the values span {:?})",
+            vol.range()
+        );
+    }
+    let normals = shapecue::cpu::marching_cubes::gradient_normals(&vol, &ipos);
+
+    // Draw in a frame centred on the surface (f32 precision far from 0).
+    let bounds = mesh.bounds();
+    let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (bounds.0[i] + bounds.1[i]));
+    let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - c[i]) };
+    let lb = (local(&bounds.0), local(&bounds.1));
+    let placement = match eye {
+        Some(e) => Placement::At(e - glam::DVec3::from(c).as_vec3()),
+        None => Placement::Fit(glam::Vec3::from(FIT_DIRECTION)),
+    };
+    let cam = framed(placement, None, None, 35.0, false, lb, w as f32 / h as f32)?;
+    let strokes: Vec<Stroke> = out
+        .strokes
+        .iter()
+        .map(|s| Stroke {
+            points: s.points.iter().map(local).collect(),
+            strip: s.strip.iter().map(local).collect(),
+            ..s.clone()
+        })
+        .collect();
+    let pos: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| local(p).map(|x| x as f32))
+        .collect();
+    let nrm: Vec<[f32; 3]> = normals.iter().map(|n| n.map(|x| x as f32)).collect();
+    let mut r = Renderer::new(RenderOptions {
+        width: w,
+        height: h,
+        ..RenderOptions::default()
+    })?;
+    let style = if a.no_surface {
+        MeshStyle {
+            ambient: 1.0,
+            color: [1.0; 3],
+            ..MeshStyle::default()
+        }
+    } else {
+        MeshStyle::default()
+    };
+    let voxel = shapecue::spec::sdf_lines::voxel_size(vol.spacing);
+    r.begin(&cam)?;
+    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, style)?;
+    draw(
+        &mut r,
+        &cam,
+        &strokes,
+        &StrokeStyle {
+            lift: (0.5 * voxel) as f32,
+            ..StrokeStyle::default()
+        },
+    )?;
+    r.finish()?.save_png(&output)?;
+
+    let ms = st.ms.total;
+    println!(
+        "{name}: {} surface samples → {} seeds after Poisson-disk thinning (r = {:.4}); {} strokes, \
+         {} segments; sampling distance {:.4} ({}); kernels {ms:.1} ms; wrote {}",
+        st.dense,
+        st.seeds,
+        st.params.map_or(0.0, |p| p.spacing),
+        st.strokes,
+        st.segments,
+        st.params.map_or(0.0, |p| p.sampling),
+        if st.sweep.is_empty() {
+            "fixed"
+        } else {
+            "automatic: coefficient of variation of κ1 closest to 1"
+        },
+        output.display()
+    );
+    if let Some(p) = &a.svg {
+        let e = cam.eye;
+        let facing: Vec<Stroke> = strokes
+            .iter()
+            .filter(|s| facing_eye(s, e))
+            .cloned()
+            .collect();
+        shapecue::export::strokes::write_svg(p, &facing, &cam, [w, h])?;
+        println!(
+            "wrote {} ({} strokes facing the eye)",
+            p.display(),
+            facing.len()
+        );
+    }
+    if let Some(p) = &a.geometry {
+        shapecue::export::strokes::write_ply(p, &out.strokes)?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.stats {
+        write_stats(p, &name, &gpu, &vol, &out)?;
+    }
+    Ok(())
+}
+
+/// Whether a stroke's outward normal at its seed faces the eye (local frame).
+fn facing_eye(s: &Stroke, eye: glam::Vec3) -> bool {
+    let (Some(p), Some(n)) = (s.points.get(s.centre), s.normals.get(s.centre)) else {
+        return false;
+    };
+    let d: [f64; 3] = std::array::from_fn(|i| f64::from(eye[i]) - p[i]);
+    d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0
+}
+
+fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutput) -> Result<()> {
+    let st = &out.stats;
+    let s = serde_json::json!({
+        "input": name,
+        "device": gpu.info,
+        "dims": vol.dims,
+        "spacing": vol.spacing,
+        "origin": vol.origin,
+        "dense_samples": st.dense,
+        "seeds": st.seeds,
+        "strokes": st.strokes,
+        "segments": st.segments,
+        "strip_vertices": st.strip_vertices,
+        "sampling_distance": st.params.map(|p| p.sampling),
+        "params": st.params,
+        "sweep": st.sweep,
+        "k1_min": st.k1_min,
+        "k1_max": st.k1_max,
+        "kernel_ms": st.ms,
+        "passes": st.ms.timing(st.wall_ms),
+        "wall_ms": st.wall_ms,
+    });
+    write_bytes_atomic(p, (serde_json::to_string_pretty(&s)? + "\n").as_bytes())?;
+    println!("wrote {}", p.display());
+    Ok(())
+}
+
+/// The input as a volume: a procedural field, a volume file, or a refusal
+/// for a mesh. Returns (name, volume, procedural).
+fn load_input(a: &StrokesArgs) -> Result<(String, Volume, bool)> {
+    if let Some(kind) = &a.sdf {
+        let v = volume::sdf::sdf_by_name(kind, a.resolution)?;
+        return Ok((format!("{kind} SDF {}³", a.resolution), v, true));
+    }
+    let path = a.input.as_ref().expect("clap requires INPUT or --sdf");
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if matches!(ext.as_str(), "obj" | "ply" | "off") {
+        bail!(
+            "{}: a triangle mesh must first be turned into a signed distance field, and this \
+             build has no mesh-to-distance-field stage yet; give a volume file or --sdf",
+            path.display()
+        );
+    }
+    let raw = match (&a.dims, &a.scalar) {
+        (Some(d), Some(t)) => {
+            if d.len() != 3 {
+                bail!("--dims needs three values X,Y,Z, got {}", d.len());
+            }
+            let scalar: ScalarType = t.parse()?;
+            let mut spec = RawSpec::new([d[0], d[1], d[2]], scalar);
+            spec.big_endian = a.big_endian;
+            spec.header_bytes = a.header_bytes;
+            if let Some(sp) = &a.spacing {
+                if sp.len() != 3 {
+                    bail!("--spacing needs three values, got {}", sp.len());
+                }
+                spec.spacing = [sp[0], sp[1], sp[2]];
+            }
+            Some(spec)
+        }
+        (None, None) => None,
+        _ => bail!("raw input needs both --dims and --type"),
+    };
+    let v = volume::load(path, raw.as_ref())?;
+    Ok((path.display().to_string(), v, false))
+}
+
+fn size_arg(s: &str) -> Result<(u32, u32)> {
+    let parsed = s
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => Ok((w, h)),
+        _ => bail!("--size {s:?}: expected WIDTHxHEIGHT with both in 1..=16384, e.g. 800x800"),
+    }
+}
+
+/// The accuracy/time table: on the torus SDF (tube radius r, κ1 = 1/r with
+/// d1 around the tube), per grid resolution and sampling distance, the
+/// relative κ1 error and the angle between d1 and the tube's cross-section
+/// direction at the seeds (median and 95th percentile), beside the kernel
+/// ms of the whole run (seed spacing fixed at 0.05 so the seed counts
+/// compare).
+fn torus_report(gpu: Arc<Gpu>) -> Result<String> {
+    use shapecue::volume::sdf::{Sdf, TORUS_TUBE, sdf, torus_curvature};
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "torus SDF (R 0.6, r {TORUS_TUBE}: κ1 = 1/r = {:.1}, d1 around the tube); seed spacing 0.05",
+        1.0 / TORUS_TUBE
+    );
+    let _ = writeln!(
+        s,
+        "{:>4} {:>8} {:>8} {:>6} {:>11} {:>11} {:>10} {:>10} {:>9}",
+        "res",
+        "h/voxel",
+        "h",
+        "seeds",
+        "κ1 err med",
+        "κ1 err p95",
+        "d1 ° med",
+        "d1 ° p95",
+        "kernel ms"
+    );
+    for res in [32usize, 64, 128, 256] {
+        let vol = sdf(Sdf::Torus, res);
+        let voxel = vol.spacing[0];
+        for hv in [1.0, 2.0, 4.0] {
+            let opts = SdfLineOptions {
+                sampling: Sampling::Fixed(hv * voxel),
+                spacing: Some(0.05),
+                ..SdfLineOptions::default()
+            };
+            let out = SdfLines::new(gpu.clone(), &vol, &opts)?.run()?;
+            let mut ke = Vec::new();
+            let mut de = Vec::new();
+            for sd in out.seeds.iter().filter(|s| s.valid) {
+                let (k1, _) = torus_curvature(sd.p);
+                ke.push(((sd.k1 - k1) / k1).abs());
+                // Tube direction: normal × ring tangent (ring tangent ∝ (−y, x, 0)).
+                let [x, y, _] = sd.p;
+                let t = [-y, x, 0.0];
+                let n = sd.n;
+                let d = [
+                    n[1] * t[2] - n[2] * t[1],
+                    n[2] * t[0] - n[0] * t[2],
+                    n[0] * t[1] - n[1] * t[0],
+                ];
+                let dl = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let dot = (d[0] * sd.d1[0] + d[1] * sd.d1[1] + d[2] * sd.d1[2]).abs() / dl;
+                de.push(dot.clamp(0.0, 1.0).acos().to_degrees());
+            }
+            let q = |v: &mut Vec<f64>, f: f64| -> f64 {
+                if v.is_empty() {
+                    return f64::NAN;
+                }
+                v.sort_by(f64::total_cmp);
+                v[((v.len() - 1) as f64 * f).round() as usize]
+            };
+            let _ = writeln!(
+                s,
+                "{res:>4} {hv:>8.1} {:>8.4} {:>6} {:>11.2e} {:>11.2e} {:>10.3} {:>10.3} {:>9.2}",
+                hv * voxel,
+                ke.len(),
+                q(&mut ke, 0.5),
+                q(&mut ke, 0.95),
+                q(&mut de, 0.5),
+                q(&mut de, 0.95),
+                out.stats.ms.total
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "(errors at the thinned seeds; kernel ms from OpenCL profiling events, sweep excluded: fixed h)"
+    );
+    Ok(s)
+}
