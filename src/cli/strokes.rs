@@ -33,7 +33,8 @@ pub struct StrokesArgs {
     /// Use a procedural signed distance field instead: sphere, torus or gyroid.
     #[arg(long, conflicts_with = "input")]
     pub sdf: Option<String>,
-    /// Grid points per axis of a procedural field.
+    /// Grid points per axis of a procedural field; for a mesh input, samples
+    /// along the mesh's longest axis of its signed distance field.
     #[arg(long, default_value_t = 128)]
     pub resolution: usize,
     /// Raw input: voxels per axis, e.g. 32,32,32.
@@ -107,8 +108,8 @@ pub struct StrokesArgs {
 ///
 /// # Errors
 ///
-/// Bad arguments, an unreadable input, a mesh input (it needs the
-/// mesh-to-distance-field stage), outputs that exist without `--force` or
+/// Bad arguments, an unreadable input, a mesh whose distance field cannot be
+/// built (no faces, non-finite vertices), outputs that exist without `--force` or
 /// are the input, and any library error.
 pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     if a.report {
@@ -118,7 +119,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     }
     let (w, h) = size_arg(&a.size)?;
     let output = a.output.clone().expect("clap requires -o without --report");
-    let (name, mut vol, procedural) = load_input(&a)?;
+    let (name, mut vol, procedural) = load_input(&a, device)?;
     let iso = match (a.iso, procedural) {
         (Some(v), _) => v,
         (None, true) => 0.0,
@@ -184,7 +185,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
 
     // The surface under the strokes.
     let mut ex = shapecue::stages::marching_cubes::Isosurfacer::new(gpu.clone(), &vol)?;
-    ex.extract(iso_below, shapecue::cpu::vertex_fusion::Fusion::Edge)?;
+    ex.extract(iso_below, shapecue::spec::vertex_fusion::Fusion::Edge)?;
     let (ipos, faces) = ex.read_index_space()?;
     let mesh = ex.world_mesh(&ipos, faces);
     if mesh.n_faces() == 0 {
@@ -327,7 +328,7 @@ fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutp
 
 /// The input as a volume: a procedural field, a volume file, or a refusal
 /// for a mesh. Returns (name, volume, procedural).
-fn load_input(a: &StrokesArgs) -> Result<(String, Volume, bool)> {
+fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, bool)> {
     if let Some(kind) = &a.sdf {
         let v = volume::sdf::sdf_by_name(kind, a.resolution)?;
         return Ok((format!("{kind} SDF {}³", a.resolution), v, true));
@@ -338,11 +339,26 @@ fn load_input(a: &StrokesArgs) -> Result<(String, Volume, bool)> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if matches!(ext.as_str(), "obj" | "ply" | "off") {
-        bail!(
-            "{}: a triangle mesh must first be turned into a signed distance field, and this \
-             build has no mesh-to-distance-field stage yet; give a volume file or --sdf",
-            path.display()
+        // A triangle mesh becomes a signed distance field first (negative
+        // inside, sign from the winding number), on the device.
+        let mesh = shapecue::mesh::load(path, &Default::default())?;
+        let gpu = Arc::new(Gpu::new(device)?);
+        let opts = shapecue::spec::mesh_sdf::MeshSdfOptions {
+            resolution: a.resolution,
+        };
+        let (v, st) = shapecue::stages::mesh_sdf::mesh_to_sdf(gpu, &mesh, &opts)
+            .with_context(|| format!("turning {} into a signed distance field", path.display()))?;
+        println!(
+            "{}: signed distance field {}x{}x{} (spacing {:.4}), {:.1} ms kernels, {:.1} ms wall",
+            path.display(),
+            st.dims[0],
+            st.dims[1],
+            st.dims[2],
+            st.spacing,
+            st.kernel_ms,
+            st.wall_ms
         );
+        return Ok((path.display().to_string(), v, true));
     }
     let raw = match (&a.dims, &a.scalar) {
         (Some(d), Some(t)) => {
