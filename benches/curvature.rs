@@ -21,9 +21,9 @@ use criterion::{
     measurement::WallTime,
 };
 use shapecue::Mesh;
-use shapecue::field::CurvatureOptions;
 use shapecue::gpu::Gpu;
 use shapecue::mesh;
+use shapecue::spec::curvature::CurvatureOptions;
 use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -157,9 +157,9 @@ fn curvature_benches(c: &mut Criterion) {
         return;
     };
     // the report's variants, so the README table and the bench cover the same set
-    let variants: Vec<(String, _)> = shapecue::report::variants()
+    let variants: Vec<(String, _)> = shapecue::metrics::variants()
         .into_iter()
-        .map(|o| (shapecue::report::label(&o).replace(' ', "-"), o))
+        .map(|o| (shapecue::metrics::label(&o).replace(' ', "-"), o))
         .collect();
     let mut cpu_input: Option<Mesh> = None;
 

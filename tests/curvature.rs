@@ -8,11 +8,11 @@ mod common;
 use common::{gpu, shared_mesh};
 
 use shapecue::cpu::curvature as cpu;
-use shapecue::field::{
+use shapecue::mesh::{self, Mesh};
+use shapecue::metrics::{analytic_rms, nrmse, rmse};
+use shapecue::spec::curvature::{
     Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
 };
-use shapecue::mesh::{self, Mesh};
-use shapecue::report::{analytic_rms, nrmse, rmse};
 use shapecue::stages::curvature::{self as stage, CurvatureEstimator, Pass};
 
 const F64: CurvatureOptions = CurvatureOptions {

@@ -285,8 +285,8 @@ fn tri_set_orientation() {
 
 #[test]
 fn curvature_on_the_device_resident_isosurface() {
-    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
-    use shapecue::report::analytic_rms;
+    use shapecue::metrics::analytic_rms;
+    use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
     use shapecue::stages::marching_cubes::{IsoNormals, curvature};
     use shapecue::volume::sdf::{SPHERE_RADIUS, TORUS_TUBE, sphere_curvature, torus_curvature};
     let opts = CurvatureOptions {
@@ -308,7 +308,7 @@ fn curvature_on_the_device_resident_isosurface() {
             let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts)
                 .unwrap()
                 .field;
-            let d = shapecue::report::rmse(&f.k1, &host.k1);
+            let d = shapecue::metrics::rmse(&f.k1, &host.k1);
             assert!(
                 d < 1e-9,
                 "{kind:?} {res}: device-resident vs host path k1 rmse {d}"
@@ -347,7 +347,7 @@ fn curvature_on_the_device_resident_isosurface() {
 
 #[test]
 fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
-    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
     use shapecue::stages::marching_cubes::{IsoNormals, curvature};
     use shapecue::volume::sdf::SPHERE_RADIUS;
     let opts = CurvatureOptions {
