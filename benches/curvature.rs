@@ -24,7 +24,8 @@ use shapecue::Mesh;
 use shapecue::gpu::Gpu;
 use shapecue::mesh;
 use shapecue::spec::curvature::CurvatureOptions;
-use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
+use shapecue::spec::timing::Timing;
+use shapecue::stages::curvature::CurvatureEstimator;
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
@@ -143,7 +144,7 @@ fn ready(
 }
 
 /// Runs `iters` times and returns the sum of `pick(timing)` (milliseconds) as a duration.
-fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&RunTiming) -> f64) -> Duration {
+fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&Timing) -> f64) -> Duration {
     let mut ms = 0.0;
     for _ in 0..iters {
         let t = est.run().expect("curvature run failed");

@@ -616,7 +616,7 @@ fn memory_stays_within_budget() {
     let m = mesh::torus(1.0, 0.4, 200, 100);
     for acc in [Accumulate::Atomic, Accumulate::Gather] {
         let o = with(CurvatureOptions::default(), acc, Precision::F32);
-        let b = stage::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
+        let b = shapecue::spec::curvature::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
         let budget = 192 * m.n_vertices() as u64 + 32 * m.n_faces() as u64;
         assert!(b <= budget, "{acc:?}: {b} > {budget}");
     }

@@ -10,12 +10,12 @@ mod common;
 
 use common::{LineArrays, gpu, max_abs_diff, model_path, to_f32};
 
-use shapecue::cpu::ao::AoMode;
-use shapecue::cpu::feature_lines::{Segment, View};
 use shapecue::cpu::skinning::skin_lbs;
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::mesh::{self, Mesh};
+use shapecue::spec::ao::AoMode;
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use shapecue::spec::feature_lines::{EyeView as View, Segment};
 use shapecue::stages::ao::AoStage;
 use shapecue::stages::curvature::{CurvatureEstimator, Pass};
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};

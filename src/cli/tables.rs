@@ -135,8 +135,8 @@ pub(crate) fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<S
 /// the device, no host round trip) and the RMS error of k1, k2 against the
 /// analytic values, relative to 1/r (resolution is an accuracy/time trade-off).
 pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<String> {
-    use shapecue::cpu::vertex_fusion::Fusion;
     use shapecue::spec::curvature::{Accumulate, Compat, Precision};
+    use shapecue::spec::vertex_fusion::Fusion;
     use shapecue::stages::marching_cubes::{self as mcs, Isosurfacer};
     use shapecue::volume::sdf::{self, Sdf};
     use std::fmt::Write as _;
@@ -265,9 +265,18 @@ pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> R
                 st.faces
             );
             for (precision, normals) in [
-                (Precision::F32, mcs::IsoNormals::Mesh),
-                (Precision::F32, mcs::IsoNormals::Gradient),
-                (Precision::F64, mcs::IsoNormals::Gradient),
+                (
+                    Precision::F32,
+                    shapecue::spec::marching_cubes::IsoNormals::Mesh,
+                ),
+                (
+                    Precision::F32,
+                    shapecue::spec::marching_cubes::IsoNormals::Gradient,
+                ),
+                (
+                    Precision::F64,
+                    shapecue::spec::marching_cubes::IsoNormals::Gradient,
+                ),
             ] {
                 let opts = CurvatureOptions {
                     accumulate: Accumulate::Atomic,
@@ -321,7 +330,7 @@ pub(crate) fn pipeline_report(
     frames: usize,
     runs: usize,
 ) -> Result<String> {
-    use shapecue::cpu::ao::AoMode;
+    use shapecue::spec::ao::AoMode;
     use shapecue::spec::timing::Family;
     use shapecue::stages::feature_lines::LineOptions;
     use shapecue::stages::pipeline::{PipelineOptions, PosePipeline, clip_poses};

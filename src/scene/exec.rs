@@ -193,13 +193,13 @@ fn run_with(
 fn refuse_overwrite(
     scene: &Scene,
     images: &[(usize, usize, PathBuf)],
-    report: &PathBuf,
+    report: &std::path::Path,
     force: bool,
 ) -> Result<()> {
     let outputs: Vec<&std::path::Path> = images
         .iter()
         .map(|i| i.2.as_path())
-        .chain([report.as_path()])
+        .chain([report])
         .collect();
     crate::export::output::check_outputs(&[scene.path.as_path()], &outputs, force)
 }

@@ -74,9 +74,6 @@ impl Pass {
     }
 }
 
-/// Timing of one [`CurvatureEstimator::run`]: one step per pass.
-pub type RunTiming = Timing; // compat re-export
-
 /// Device state after a partial run, for pass-by-pass comparison with the
 /// CPU reference. All values in normalized coordinates.
 #[derive(Clone, Debug, Default)]
@@ -178,8 +175,6 @@ struct GatherBufs {
     corner: Buffer<u8>,
     status: Buffer<u8>,
 }
-
-pub use crate::spec::curvature::device_bytes_bound; // compat re-export
 
 /// Build options of `kernels/curvature.cl` for a variant.
 pub fn build_options(opts: &CurvatureOptions) -> String {
