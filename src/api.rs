@@ -25,7 +25,6 @@ use crate::spec::edges::{CapMode, EdgeOptions, EdgeOutput};
 use crate::spec::marching_cubes::{Inside, IsoNormals};
 use crate::spec::vertex_fusion::Fusion;
 use crate::spec::view::View;
-use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::edges::EdgeStage;
 use crate::stages::marching_cubes::{self as mcs, IsoStats, Isosurfacer};
 use crate::volume::Volume;
@@ -42,7 +41,7 @@ fn default_gpu() -> Result<Arc<Gpu>> {
 /// principal curvatures and directions and (with `opts.dcurv`) the
 /// derivative tensor, with skip counts and timing (Griffin et al. 2012,
 /// after Rusinkiewicz 2004). For many poses of one topology, build a
-/// [`CurvatureEstimator`] once instead.
+/// [`crate::stages::curvature::CurvatureEstimator`] once instead.
 ///
 /// ```
 /// use shapecue::{mesh::Generated, spec::curvature::CurvatureOptions};
@@ -62,16 +61,7 @@ pub fn curvature(mesh: &Mesh, opts: CurvatureOptions) -> Result<Curvature> {
 
 /// [`curvature`] on a given device.
 pub fn curvature_on(gpu: &Arc<Gpu>, mesh: &Mesh, opts: CurvatureOptions) -> Result<Curvature> {
-    let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, opts)?;
-    est.set_positions(&mesh.positions)?;
-    let timing = est.run()?;
-    Ok(Curvature {
-        field: est.read()?,
-        counts: est.counts()?,
-        timing,
-        topology_ms: est.topology_ms(),
-        device_bytes: est.device_bytes(),
-    })
+    crate::stages::curvature::estimate(gpu.clone(), mesh, opts)
 }
 
 /// How [`isosurface`] extracts and what it computes on the result.

@@ -30,7 +30,7 @@ fn with(o: CurvatureOptions, acc: Accumulate, prec: Precision) -> CurvatureOptio
     }
 }
 
-fn device(m: &Mesh, o: CurvatureOptions) -> stage::Estimate {
+fn device(m: &Mesh, o: CurvatureOptions) -> shapecue::Curvature {
     stage::estimate(gpu(), m, o).expect("device estimate")
 }
 
@@ -372,7 +372,7 @@ fn flat_plane_has_zero_curvature_and_orthonormal_frames() {
 
 // ---------------------------------------------------------------- hard cases
 
-fn check_hard(m: &Mesh, what: &str) -> (stage::Estimate, CurvatureField) {
+fn check_hard(m: &Mesh, what: &str) -> (shapecue::Curvature, CurvatureField) {
     let (r, rc) = cpu::estimate(m, &CurvatureOptions::default());
     assert!(r.all_finite(), "{what}: CPU reference not finite");
     for acc in [Accumulate::Atomic, Accumulate::Gather] {

@@ -695,28 +695,21 @@ impl CurvatureEstimator {
     }
 }
 
-/// Result of [`estimate`]: the field, what was skipped and how long it took.
-#[derive(Clone, Debug)]
-pub struct Estimate {
-    /// Per-vertex outputs.
-    pub field: CurvatureField,
-    /// Skip counters.
-    pub counts: CurvatureCounts,
-    /// Timing of the run.
-    pub timing: Timing,
-    /// Device bytes allocated.
-    pub device_bytes: u64,
-}
-
-/// One-shot estimation: allocate, upload, run every pass, read back.
-pub fn estimate(gpu: Arc<Gpu>, mesh: &crate::Mesh, opts: CurvatureOptions) -> Result<Estimate> {
+/// One-shot estimation: allocate, upload, run every pass, read back (the
+/// front door's `shapecue::curvature_on`).
+pub fn estimate(
+    gpu: Arc<Gpu>,
+    mesh: &crate::Mesh,
+    opts: CurvatureOptions,
+) -> Result<crate::spec::curvature::Curvature> {
     let mut est = CurvatureEstimator::new(gpu, mesh.n_vertices(), &mesh.faces, opts)?;
     est.set_positions(&mesh.positions)?;
     let timing = est.run()?;
-    Ok(Estimate {
+    Ok(crate::spec::curvature::Curvature {
         field: est.read()?,
         counts: est.counts()?,
         timing,
+        topology_ms: est.topology_ms(),
         device_bytes: est.device_bytes(),
     })
 }
