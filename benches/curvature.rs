@@ -21,10 +21,11 @@ use criterion::{
     measurement::WallTime,
 };
 use shapecue::Mesh;
-use shapecue::field::CurvatureOptions;
 use shapecue::gpu::Gpu;
 use shapecue::mesh;
-use shapecue::stages::curvature::{CurvatureEstimator, RunTiming};
+use shapecue::spec::curvature::CurvatureOptions;
+use shapecue::spec::timing::Timing;
+use shapecue::stages::curvature::CurvatureEstimator;
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
@@ -143,7 +144,7 @@ fn ready(
 }
 
 /// Runs `iters` times and returns the sum of `pick(timing)` (milliseconds) as a duration.
-fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&RunTiming) -> f64) -> Duration {
+fn timed(est: &mut CurvatureEstimator, iters: u64, pick: fn(&Timing) -> f64) -> Duration {
     let mut ms = 0.0;
     for _ in 0..iters {
         let t = est.run().expect("curvature run failed");
@@ -157,9 +158,9 @@ fn curvature_benches(c: &mut Criterion) {
         return;
     };
     // the report's variants, so the README table and the bench cover the same set
-    let variants: Vec<(String, _)> = shapecue::report::variants()
+    let variants: Vec<(String, _)> = shapecue::metrics::variants()
         .into_iter()
-        .map(|o| (shapecue::report::label(&o).replace(' ', "-"), o))
+        .map(|o| (shapecue::metrics::label(&o).replace(' ', "-"), o))
         .collect();
     let mut cpu_input: Option<Mesh> = None;
 

@@ -22,10 +22,11 @@ mod common;
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::Mesh;
-use shapecue::mesh::{self, edges::EdgeTopology, edges::vertex_normals};
+use shapecue::mesh::{self, edges::EdgeTopology, topology::vertex_normals};
 use shapecue::render::edges::draw_edges;
 use shapecue::render::{MeshStyle, Placement, RenderOptions, Renderer, framed};
-use shapecue::stages::edges::{CapMode, EdgeParams, EdgeStage};
+use shapecue::spec::edges::{CapMode, EdgeParams};
+use shapecue::stages::edges::EdgeStage;
 use std::time::{Duration, Instant};
 
 const SIZE: (u32, u32) = (800, 600);

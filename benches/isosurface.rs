@@ -9,8 +9,8 @@
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shapecue::cpu::vertex_fusion::Fusion;
-use shapecue::report::median;
+use shapecue::metrics::median;
+use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::sdf::{Sdf, sdf};
 use shapecue::volume::{self, RawSpec, ScalarType, Volume};

@@ -8,9 +8,9 @@
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shapecue::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
-use shapecue::report::median;
+use shapecue::metrics::median;
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::skinning::Skinner;
 use std::time::Duration;

@@ -1,29 +1,52 @@
 //! shapecue: shape cues (curvature, isosurfaces, feature edges, curvature-based
 //! lines and ambient occlusion) computed by OpenCL kernels, each with a plain
-//! Rust reference implementation.
+//! Rust reference implementation (its CPU twin).
 //!
-//! Data flow (one name per stage, used for the kernel file, the host module,
-//! the CPU reference, the test and the bench):
+//! Data flow (one name per stage family, used for the kernel file, the host
+//! module, the CPU twin, the test, the bench group, the planner pass and the
+//! stats keys; see `ARCHITECTURE.md`):
 //!
 //! ```text
-//! mesh ─► positions ─► [curvature] ─► normals, areas, k1 k2 d1 d2 dk ─► export (PLY, JSON)
-//! mesh ─► [edges] ─► edge-out + cap-out (House & Li) ─► render, SVG
-//! all outputs ─► render (headless OpenGL: shaded mesh, clip-space edge quads ─► PNG)
+//! mesh file ─► mesh::load ─┐                     (topology once: mesh::topology, mesh::edges)
+//! glTF / libigl / frames ──┴─► [skinning] ─► positions ─┬─► [curvature] ─► k1 k2 d1 d2 dk ─┬─► [feature_lines]
+//!                                                       │                                  └─► [ao]
+//!                                                       └─► [edges] ─► edge-out + cap-out
+//! volume file / SDF ─► volume::load ─► [marching_cubes] ─► [vertex_fusion: radix_sort, scan] ─► mesh ─► (above)
+//!                                   └─► [sdf_lines] ─► strokes
+//! mesh ─► [mesh_sdf] ─► volume ─► (above)
+//! all outputs ─► render/ (headless GL, PNG)   export/ (PLY, SVG, JSON; written whole or not at all)
+//! scene file ─► scene::planner (cues → passes, pure data) ─► scene::exec (runs exactly those passes)
 //! ```
+//!
+//! The front door is one call per task ([`curvature()`], [`isosurface()`],
+//! [`feature_edges()`], [`render_scene()`], each with an `_on` form taking a
+//! device; defined in [`api`]), beside the stateful per-topology types for
+//! deforming meshes ([`stages::curvature::CurvatureEstimator`],
+//! [`stages::marching_cubes::Isosurfacer`], [`stages::edges::EdgeStage`],
+//! [`stages::pipeline::PosePipeline`], ...). The CPU twins of the calls have
+//! the same signatures ([`cpu::curvature::curvature`],
+//! [`cpu::edges::feature_edges`]).
 #![warn(missing_docs)]
 
+pub mod api;
 pub mod cpu;
 pub mod error;
 pub mod export;
-pub mod field;
 pub mod gpu;
 pub mod mesh;
+pub mod metrics;
 pub mod render;
-pub mod report;
 pub mod scene;
 pub mod spec;
 pub mod stages;
 pub mod volume;
 
+pub use api::{
+    IsoOptions, Isosurface, curvature, curvature_on, feature_edges, feature_edges_on, isosurface,
+    isosurface_on, render_scene, render_scene_on,
+};
 pub use error::{Error, Result};
 pub use mesh::Mesh;
+pub use spec::curvature::{Curvature, CurvatureOptions};
+pub use spec::edges::{EdgeOptions, EdgeOutput};
+pub use spec::marching_cubes::Inside;

@@ -6,9 +6,11 @@ mod common;
 
 use common::gpu;
 
-use shapecue::cpu::ao::{AoMode, LUT_N, ao_reference, ao_vertex};
+use shapecue::cpu::ao::ao_vertex;
 use shapecue::mesh::splitmix;
-use shapecue::stages::ao::{AoStage, lut};
+use shapecue::spec::ao::lut;
+use shapecue::spec::ao::{AoMode, LUT_N, ao_reference};
+use shapecue::stages::ao::AoStage;
 
 #[test]
 fn reference_closed_forms() {

@@ -295,3 +295,122 @@ fn render_explains_plans_and_names_scene_errors() {
     let out = run_cli(["render", "no/such/scene.toml"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scene.toml"));
 }
+
+#[test]
+fn a_hard_link_to_the_input_is_refused_even_with_force() {
+    let d = scratch("hardlink");
+    let obj = d.join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let link = d.join("hard.ply");
+    std::fs::hard_link(&obj, &link).unwrap();
+    let out = cli()
+        .arg("curvature")
+        .arg(&obj)
+        .arg("-o")
+        .arg(&link)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("input file") && e.contains("another name"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_to_string(&obj).unwrap(), TETRA);
+}
+
+#[test]
+fn stats_equal_to_the_output_is_refused() {
+    let d = scratch("stats-is-output");
+    let ply = d.join("o.ply");
+    let out = cli()
+        .args([
+            "curvature",
+            "--generate",
+            "plane",
+            "--resolution",
+            "100",
+            "-o",
+        ])
+        .arg(&ply)
+        .arg("--stats")
+        .arg(&ply)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("same output file"), "{e}");
+    assert!(!ply.exists());
+}
+
+#[test]
+fn a_volume_data_file_is_an_input() {
+    let d = scratch("nhdr-data");
+    let raw = d.join("v.raw");
+    std::fs::write(&raw, (0..64u8).collect::<Vec<_>>()).unwrap();
+    let nhdr = d.join("v.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: v.raw\n",
+    )
+    .unwrap();
+    let out = cli()
+        .arg("isosurface")
+        .arg(&nhdr)
+        .args(["--iso", "30", "-o"])
+        .arg(&raw)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("input file"), "{e}");
+    assert_eq!(std::fs::read(&raw).unwrap().len(), 64);
+}
+
+/// Runs the CLI with its standard output closed before it writes (as
+/// `| head -1` closes it after a line) and returns the exit status and stderr.
+fn with_closed_stdout(args: &[&str]) -> (std::process::ExitStatus, String) {
+    use std::io::Read;
+    let mut child = cli()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (child.wait().unwrap(), err)
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly_with_status_0() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/torus.toml");
+    for args in [
+        vec!["render", scene, "--explain"],
+        vec!["edges", "--memory-table"],
+        vec!["devices"],
+    ] {
+        let (status, err) = with_closed_stdout(&args);
+        assert_eq!(status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn a_missing_input_is_named_once_with_the_os_message_once() {
+    let out = run_cli(["curvature", "/nonexistent/x.ply"]);
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(e.matches("/nonexistent/x.ply").count(), 1, "{e}");
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+}

@@ -8,11 +8,11 @@ mod common;
 use common::{gpu, shared_mesh};
 
 use shapecue::cpu::curvature as cpu;
-use shapecue::field::{
+use shapecue::mesh::{self, Mesh};
+use shapecue::metrics::{analytic_rms, nrmse, rmse};
+use shapecue::spec::curvature::{
     Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
 };
-use shapecue::mesh::{self, Mesh};
-use shapecue::report::{analytic_rms, nrmse, rmse};
 use shapecue::stages::curvature::{self as stage, CurvatureEstimator, Pass};
 
 const F64: CurvatureOptions = CurvatureOptions {
@@ -30,7 +30,7 @@ fn with(o: CurvatureOptions, acc: Accumulate, prec: Precision) -> CurvatureOptio
     }
 }
 
-fn device(m: &Mesh, o: CurvatureOptions) -> stage::Estimate {
+fn device(m: &Mesh, o: CurvatureOptions) -> shapecue::Curvature {
     stage::estimate(gpu(), m, o).expect("device estimate")
 }
 
@@ -372,7 +372,7 @@ fn flat_plane_has_zero_curvature_and_orthonormal_frames() {
 
 // ---------------------------------------------------------------- hard cases
 
-fn check_hard(m: &Mesh, what: &str) -> (stage::Estimate, CurvatureField) {
+fn check_hard(m: &Mesh, what: &str) -> (shapecue::Curvature, CurvatureField) {
     let (r, _) = cpu::estimate(m, &CurvatureOptions::default());
     assert!(r.all_finite(), "{what}: CPU reference not finite");
     for acc in [Accumulate::Atomic, Accumulate::Gather] {
@@ -620,7 +620,7 @@ fn memory_stays_within_budget() {
     let m = mesh::torus(1.0, 0.4, 200, 100);
     for acc in [Accumulate::Atomic, Accumulate::Gather] {
         let o = with(CurvatureOptions::default(), acc, Precision::F32);
-        let b = stage::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
+        let b = shapecue::spec::curvature::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
         let budget = 192 * m.n_vertices() as u64 + 32 * m.n_faces() as u64;
         assert!(b <= budget, "{acc:?}: {b} > {budget}");
     }

@@ -14,13 +14,15 @@ use common::{cli, cli_gl_missing, gpu, run_cli, scratch, shared_mesh, to_f32};
 use glam::Vec3;
 use shapecue::Error;
 use shapecue::cpu::edges as cpu;
-use shapecue::mesh::edges::{EdgeTopology, parse_marked, vertex_normals};
+use shapecue::mesh::edges::{EdgeTopology, parse_marked};
+use shapecue::mesh::topology::vertex_normals;
 use shapecue::mesh::{self, Mesh};
 use shapecue::render::Camera;
-use shapecue::stages::edges::{
-    CapMode, EdgeOutput, EdgeParams, EdgeStage, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
-    KIND_CREASE, KIND_DRAWN, decide_interop, memory_use,
+use shapecue::spec::edges::{
+    CapMode, EdgeOutput, EdgeParams, InteropMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
+    KIND_DRAWN, decide_interop, memory_use,
 };
+use shapecue::stages::edges::EdgeStage;
 fn camera(eye: [f32; 3], target: [f32; 3]) -> Camera {
     let mut cam = Camera::look_at(Vec3::from(eye), Vec3::from(target));
     cam.fov_y_deg = 40.0;

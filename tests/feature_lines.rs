@@ -7,9 +7,10 @@ mod common;
 
 use common::{LineArrays, gpu, to_f32};
 
-use shapecue::cpu::feature_lines::{LineInputs, Segment, View, lines_face, lines_vertex};
-use shapecue::field::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use shapecue::cpu::feature_lines::{lines_face, lines_vertex};
 use shapecue::mesh::{self, Mesh};
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use shapecue::spec::feature_lines::{EyeView as View, LineInputs, Segment};
 use shapecue::stages::curvature::estimate;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 

@@ -5,9 +5,11 @@ mod common;
 
 use common::gpu;
 
-use shapecue::cpu::marching_cubes::{self as mc, END, table};
-use shapecue::cpu::vertex_fusion::{Fused, Fusion, fuse};
+use shapecue::cpu::marching_cubes as mc;
+use shapecue::cpu::vertex_fusion::{Fused, fuse};
 use shapecue::mesh::quality;
+use shapecue::spec::marching_cubes::{END, table};
+use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::Volume;
 use shapecue::volume::sdf::{Sdf, sdf};
@@ -220,7 +222,7 @@ fn table_is_complementary_in_counts_and_closed() {
             used[e as usize] = true;
         }
         for (e, &u) in used.iter().enumerate() {
-            let (a, b) = mc::edge_corners(e);
+            let (a, b) = shapecue::spec::marching_cubes::edge_corners(e);
             let crossing = (case >> a & 1) != (case >> b & 1);
             assert_eq!(u, crossing, "case {case} edge {e}");
         }
@@ -285,9 +287,10 @@ fn tri_set_orientation() {
 
 #[test]
 fn curvature_on_the_device_resident_isosurface() {
-    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
-    use shapecue::report::analytic_rms;
-    use shapecue::stages::marching_cubes::{IsoNormals, curvature};
+    use shapecue::metrics::analytic_rms;
+    use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::spec::marching_cubes::IsoNormals;
+    use shapecue::stages::marching_cubes::curvature;
     use shapecue::volume::sdf::{SPHERE_RADIUS, TORUS_TUBE, sphere_curvature, torus_curvature};
     let opts = CurvatureOptions {
         accumulate: Accumulate::Atomic,
@@ -308,7 +311,7 @@ fn curvature_on_the_device_resident_isosurface() {
             let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts)
                 .unwrap()
                 .field;
-            let d = shapecue::report::rmse(&f.k1, &host.k1);
+            let d = shapecue::metrics::rmse(&f.k1, &host.k1);
             assert!(
                 d < 1e-9,
                 "{kind:?} {res}: device-resident vs host path k1 rmse {d}"
@@ -347,8 +350,9 @@ fn curvature_on_the_device_resident_isosurface() {
 
 #[test]
 fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
-    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
-    use shapecue::stages::marching_cubes::{IsoNormals, curvature};
+    use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::spec::marching_cubes::IsoNormals;
+    use shapecue::stages::marching_cubes::curvature;
     use shapecue::volume::sdf::SPHERE_RADIUS;
     let opts = CurvatureOptions {
         accumulate: Accumulate::Atomic,

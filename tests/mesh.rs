@@ -11,8 +11,8 @@ use std::path::Path;
 
 use shapecue::Error;
 use shapecue::export::ply::{FIELD_PROPERTIES, read_ply_properties, write_ply};
-use shapecue::field::CurvatureField;
 use shapecue::mesh::{LoadOptions, Mesh, load};
+use shapecue::spec::curvature::CurvatureField;
 
 fn plain() -> LoadOptions {
     LoadOptions::default()

@@ -491,10 +491,11 @@ fn ellipsoid_curvature_at_the_axes() {
 
 #[test]
 fn ellipsoid_curvature_matches_the_isosurface_estimate() {
-    use shapecue::cpu::vertex_fusion::Fusion;
-    use shapecue::field::{Accumulate, Compat, CurvatureOptions, Precision};
-    use shapecue::report::analytic_rms;
-    use shapecue::stages::marching_cubes::{IsoNormals, Isosurfacer, curvature};
+    use shapecue::metrics::analytic_rms;
+    use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+    use shapecue::spec::marching_cubes::IsoNormals;
+    use shapecue::spec::vertex_fusion::Fusion;
+    use shapecue::stages::marching_cubes::{Isosurfacer, curvature};
     let o = CurvatureOptions {
         accumulate: Accumulate::Atomic,
         precision: Precision::F32,

@@ -10,12 +10,12 @@ mod common;
 
 use common::{LineArrays, gpu, max_abs_diff, model_path, to_f32};
 
-use shapecue::cpu::ao::AoMode;
-use shapecue::cpu::feature_lines::{Segment, View};
 use shapecue::cpu::skinning::skin_lbs;
-use shapecue::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::mesh::{self, Mesh};
+use shapecue::spec::ao::AoMode;
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use shapecue::spec::feature_lines::{EyeView as View, Segment};
 use shapecue::stages::ao::AoStage;
 use shapecue::stages::curvature::{CurvatureEstimator, Pass};
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
@@ -447,7 +447,17 @@ fn pose_pipeline_runs_frames_and_reports() {
         ..Default::default()
     };
     assert!(PosePipeline::new(gpu(), &m, bad).is_err());
-    let r = shapecue::report::pipeline_report(gpu(), &path, 2, 1).unwrap();
+    let out = common::cli()
+        .args(["render", "--report", "--frames", "2", "--runs", "1"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = String::from_utf8(out.stdout).unwrap();
     eprintln!("{r}");
     for row in [
         "| skin |",

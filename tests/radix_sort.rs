@@ -12,7 +12,8 @@ use common::{download, gpu, random, upload};
 
 use shapecue::Error;
 use shapecue::cpu::radix_sort as cpu;
-use shapecue::stages::radix_sort::{MAX_BLOCKS, MIN_BLOCK, RadixSort, Strategy, blocking, digits};
+use shapecue::spec::radix_sort::{MAX_BLOCKS, MIN_BLOCK, Strategy, blocking, digits};
+use shapecue::stages::radix_sort::RadixSort;
 
 /// `n` deterministic 32-bit keys.
 fn random_keys(n: usize, seed: u64) -> Vec<u32> {

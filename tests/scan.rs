@@ -8,7 +8,8 @@ use common::{download, gpu, random, upload};
 
 use shapecue::Error;
 use shapecue::cpu::scan as cpu;
-use shapecue::stages::scan::{MAX_CHUNKS, MIN_CHUNK, Scan, chunking};
+use shapecue::spec::scan::{MAX_CHUNKS, MIN_CHUNK, chunking};
+use shapecue::stages::scan::Scan;
 
 /// Scans `data` on the device out of place and in place and checks both
 /// against the CPU reference.

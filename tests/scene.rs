@@ -109,7 +109,7 @@ fn run_counts_follow_the_lifetimes() {
     // topology once.
     let p = plan(&all, Input::Skinned);
     assert_eq!(p.runs(Pass::EdgeBuffer, 10, 4), 1);
-    assert_eq!(p.runs(Pass::Skin, 10, 4), 10);
+    assert_eq!(p.runs(Pass::Skinning, 10, 4), 10);
     assert_eq!(p.runs(Pass::Curvature, 10, 4), 10);
     assert_eq!(p.runs(Pass::Render, 10, 4), 40);
     // Static mesh: curvature once over all frames and cameras.
@@ -137,7 +137,7 @@ fn run_counts_follow_the_lifetimes() {
 #[test]
 fn the_cap_variant_decides_the_cap_passes() {
     use shapecue::scene::planner::plan_with;
-    use shapecue::stages::edges::CapMode;
+    use shapecue::spec::edges::CapMode;
     for input in INPUTS {
         let adj = plan_with(&[Cue::FeatureEdges], input, CapMode::Adjacency);
         assert_eq!(adj, plan(&[Cue::FeatureEdges], input));
@@ -147,7 +147,7 @@ fn the_cap_variant_decides_the_cap_passes() {
         assert!(mh.contains(Pass::VertexNormals) && !adj.contains(Pass::VertexNormals));
         let none = plan_with(&[Cue::FeatureEdges], input, CapMode::None);
         assert!(!none.contains(Pass::Caps) && !none.contains(Pass::CapBuffer));
-        assert!(none.contains(Pass::EdgeDetect) && none.contains(Pass::EdgeBuffer));
+        assert!(none.contains(Pass::Edges) && none.contains(Pass::EdgeBuffer));
         // Other cues are unaffected.
         let all = plan_with(&Cue::ALL, input, CapMode::None);
         let full = plan(&Cue::ALL, input);

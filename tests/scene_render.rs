@@ -211,7 +211,7 @@ fn a_skinned_scene_runs_pose_passes_per_frame_and_topology_once() {
     check_minimal(&r, "skinned");
     assert_eq!(r.frames, vec![0, 2, 4]);
     let runs = |p: Pass| r.passes.iter().find(|x| x.pass == p).map(|x| x.runs);
-    assert_eq!(runs(Pass::Skin), Some(3));
+    assert_eq!(runs(Pass::Skinning), Some(3));
     assert_eq!(runs(Pass::OneRings), Some(1));
     assert_eq!(runs(Pass::Dcurv), Some(3));
     assert_eq!(runs(Pass::Contours), Some(6));

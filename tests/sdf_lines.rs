@@ -696,9 +696,10 @@ fn automatic_sampling_follows_the_cv_rule() {
 /// to `/tmp/sdf-<name>*.png`, plus SVG and PLY; skipped without headless GL.
 fn picture(name: &str, vol: &Volume, opts: &SdfLineOptions, eye: [f32; 3]) {
     use shapecue::cpu::marching_cubes::{gradient_normals, mc_triangles};
-    use shapecue::cpu::vertex_fusion::{Fusion, fuse};
+    use shapecue::cpu::vertex_fusion::fuse;
     use shapecue::render::strokes::{StrokeStyle, draw};
     use shapecue::render::{Camera, MeshStyle, RenderOptions, Renderer};
+    use shapecue::spec::vertex_fusion::Fusion;
     let out = SdfLines::new(gpu(), vol, opts).unwrap().run().unwrap();
     eprintln!("{name}: {:?}", out.stats);
     let mesh = fuse(&mc_triangles(vol, opts.iso), Fusion::Edge);

@@ -6,7 +6,7 @@
 
 use crate::spec::ao::{AO_SAMPLES, dirs};
 
-pub use crate::spec::ao::{AoMode, LUT_N, ao_reference, build_lut}; // compat re-export
+use crate::spec::ao::AoMode;
 
 fn lut_coord(x: f32, n: usize) -> f32 {
     let t = x / (1.0 + x.abs());

@@ -517,3 +517,39 @@ pub fn estimate(mesh: &Mesh, opts: &CurvatureOptions) -> (CurvatureField, Curvat
     }
     (s.field(&norm, opts.dcurv), s.counts)
 }
+
+/// The front door's CPU twin: [`estimate`] with the signature of
+/// `shapecue::curvature`, timed as a whole (`timing.wall_ms`; no kernel
+/// steps, no device bytes).
+///
+/// ```
+/// use shapecue::mesh::Generated;
+/// use shapecue::spec::curvature::CurvatureOptions;
+/// let (_, mesh) = Generated::Torus.mesh(2000);
+/// let c = shapecue::cpu::curvature::curvature(&mesh, CurvatureOptions::default())?;
+/// assert_eq!(c.field.len(), mesh.n_vertices());
+/// assert_eq!(c.counts.degenerate_faces, 0);
+/// # Ok::<(), shapecue::Error>(())
+/// ```
+///
+/// # Errors
+/// None today (the reference cannot fail on a loaded mesh); the `Result`
+/// keeps the device form's signature.
+pub fn curvature(
+    mesh: &Mesh,
+    opts: CurvatureOptions,
+) -> crate::Result<crate::spec::curvature::Curvature> {
+    let t = std::time::Instant::now();
+    let (field, counts) = estimate(mesh, &opts);
+    let timing = crate::spec::timing::Timing {
+        wall_ms: t.elapsed().as_secs_f64() * 1e3,
+        ..Default::default()
+    };
+    Ok(crate::spec::curvature::Curvature {
+        field,
+        counts,
+        timing,
+        topology_ms: 0.0,
+        device_bytes: 0,
+    })
+}

@@ -293,3 +293,56 @@ pub fn caps_adjacency(
     }
     out
 }
+
+/// The front door's CPU twin of `shapecue::feature_edges`: builds the
+/// topology (the cap buffer only for adjacency caps), packs the parameters
+/// and runs [`edges_detect`] and the caps of `opts.caps`, returning what the
+/// device stage's `read` returns.
+///
+/// ```
+/// use shapecue::mesh::Generated;
+/// use shapecue::render::{Placement, framed};
+/// use shapecue::spec::edges::{EdgeOptions, KIND_DRAWN};
+/// let (_, mesh) = Generated::Torus.mesh(2000);
+/// let eye = Placement::At(glam::Vec3::splat(5.0));
+/// let view = framed(eye, None, None, 40.0, false, mesh.bounds(), 4.0 / 3.0)?.view(400, 300);
+/// let out = shapecue::cpu::edges::feature_edges(&mesh, &view, &EdgeOptions::default())?;
+/// assert!(out.count(KIND_DRAWN) > 0);
+/// # Ok::<(), shapecue::Error>(())
+/// ```
+///
+/// # Errors
+/// Bad parameters ([`crate::spec::edges::EdgeParams::pack`]), a marked edge
+/// naming a vertex out of range.
+pub fn feature_edges(
+    mesh: &crate::mesh::Mesh,
+    view: &crate::spec::view::View,
+    opts: &crate::spec::edges::EdgeOptions,
+) -> crate::Result<crate::spec::edges::EdgeOutput> {
+    use crate::mesh::edges::EdgeTopology;
+    use crate::spec::edges::CapMode;
+    let packed = opts.params(*view)?.pack()?;
+    let topo = if opts.caps == CapMode::Adjacency {
+        EdgeTopology::new(mesh, &opts.marked, "mesh")?
+    } else {
+        EdgeTopology::without_caps(mesh, &opts.marked, "mesh")?
+    };
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+    let nrm = crate::mesh::topology::vertex_normals(mesh);
+    let (edge_out, kind) = edges_detect(&packed, &pos, &nrm, &topo.edges);
+    let mut out = crate::spec::edges::EdgeOutput {
+        edge_out,
+        kind,
+        ..Default::default()
+    };
+    match opts.caps {
+        CapMode::None => {}
+        CapMode::Mh => {
+            (out.cap_mh0, out.cap_mh1) = caps_mh(&packed, &pos, &nrm, &topo.edges, &out.edge_out);
+        }
+        CapMode::Adjacency => {
+            out.cap_adj = caps_adjacency(&packed, &topo.edges, &topo.caps, &out.edge_out);
+        }
+    }
+    Ok(out)
+}

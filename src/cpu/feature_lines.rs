@@ -3,10 +3,9 @@
 //! face order; the device's order is that of its atomic counter, so tests
 //! compare canonically sorted segment lists.
 
-pub use crate::spec::feature_lines::EyeView as View; // compat re-export
-pub use crate::spec::feature_lines::LineInputs; // compat re-export
+use crate::spec::feature_lines::LineInputs;
 use crate::spec::feature_lines::LineView;
-pub use crate::spec::feature_lines::Segment; // compat re-export
+use crate::spec::feature_lines::Segment;
 
 /// Per-vertex values of `lines_vertex`: n·v, κr·sin²θ and the suggestive test.
 pub struct VertexTerms {

@@ -22,7 +22,7 @@
 use crate::spec::marching_cubes::cell_rows;
 use crate::volume::Volume;
 
-pub use crate::spec::marching_cubes::{END, edge_corners, table}; // compat re-export
+use crate::spec::marching_cubes::{END, edge_corners, table};
 
 /// One vertex of the triangle soup: its position in index space (voxel
 /// units; world = origin + spacing × p) and its exact key: `4g + axis` for a

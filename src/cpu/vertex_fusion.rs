@@ -12,7 +12,7 @@
 
 use super::marching_cubes::SoupVertex;
 
-pub use crate::spec::vertex_fusion::Fusion; // compat re-export
+use crate::spec::vertex_fusion::Fusion;
 
 /// The 32-bit position hash (same integer mix as the kernel's `fuse_hash`).
 pub fn fuse_hash(p: [f32; 3]) -> u32 {

@@ -13,8 +13,8 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, PropertyType};
 
 use crate::error::{Error, Result};
-use crate::field::CurvatureField;
 use crate::mesh::Mesh;
+use crate::spec::curvature::CurvatureField;
 
 /// Names of the vertex position properties, first in every file.
 pub const POSITION_PROPERTIES: [&str; 3] = ["x", "y", "z"];

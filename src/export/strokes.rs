@@ -9,16 +9,9 @@ use std::path::Path;
 
 use glam::{Vec3, Vec4};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::render::Camera;
 use crate::spec::sdf_lines::Stroke;
-
-fn write_err(path: &Path, e: std::io::Error) -> Error {
-    Error::Write {
-        path: path.to_path_buf(),
-        source: e,
-    }
-}
 
 /// The SVG text: a `<path>` per stroke, the closed outline of its strip
 /// (left side forward, right side back), in pixels of a `size` image seen
@@ -65,7 +58,7 @@ pub fn svg_string(strokes: &[Stroke], camera: &Camera, size: [u32; 2], color: &s
 ///
 /// [`Error::Write`] naming the file.
 pub fn write_svg(path: &Path, strokes: &[Stroke], camera: &Camera, size: [u32; 2]) -> Result<()> {
-    std::fs::write(path, svg_string(strokes, camera, size, "#111")).map_err(|e| write_err(path, e))
+    super::output::write_bytes_atomic(path, svg_string(strokes, camera, size, "#111").as_bytes())
 }
 
 /// Writes the strips as a binary little-endian PLY triangle mesh: vertices
@@ -115,5 +108,5 @@ pub fn write_ply(path: &Path, strokes: &[Stroke]) -> Result<()> {
             b.extend_from_slice(&i.to_le_bytes());
         }
     }
-    std::fs::write(path, b).map_err(|e| write_err(path, e))
+    super::output::write_bytes_atomic(path, &b)
 }

@@ -18,7 +18,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::render::Frame;
 
 /// Default depth bias (window depth units) of [`visible_polylines`].
@@ -167,10 +167,8 @@ pub fn write_svg(
     height: u32,
     stroke_width: f32,
 ) -> Result<()> {
-    std::fs::write(path, svg_text(polylines, width, height, stroke_width)).map_err(|source| {
-        Error::Write {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
+    super::output::write_bytes_atomic(
+        path,
+        svg_text(polylines, width, height, stroke_width).as_bytes(),
+    )
 }

@@ -278,5 +278,3 @@ pub fn read_marked(path: &Path) -> Result<Vec<[u32; 2]>> {
     })?;
     parse_marked(&text, &path.display().to_string())
 }
-
-pub use super::topology::vertex_normals; // compat re-export

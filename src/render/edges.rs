@@ -19,12 +19,14 @@ use crate::error::Result;
 use crate::export::svg::{DEFAULT_BIAS, visible_polylines};
 use crate::gpu::{DeviceInfo, Gpu};
 use crate::mesh::Mesh;
-use crate::mesh::edges::{EdgeTopology, read_marked, vertex_normals};
+use crate::mesh::edges::{EdgeTopology, read_marked};
+use crate::mesh::topology::vertex_normals;
 use crate::spec::edges::{
     CapMode, EdgeOutput, EdgeParams, InteropDecision, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
     KIND_DRAWN, MemoryUse, crease_from_degrees, memory_use,
 };
-use crate::stages::edges::{EdgeStage, RunTiming};
+use crate::spec::timing::Timing;
+use crate::stages::edges::EdgeStage;
 
 /// Draws the edge quads of `out` and the caps it holds (those of the last
 /// run's mode) with flat `color` into the frame in progress.
@@ -109,7 +111,7 @@ pub struct EdgeDrawing {
     /// Mesh faces.
     pub faces: usize,
     /// Kernel and wall times of the stage's run.
-    pub timing: RunTiming,
+    pub timing: Timing,
     /// Building the topology, ms.
     pub topology_ms: f64,
     /// The stage, its run and read-back, and the whole GL frame, ms.

@@ -49,14 +49,17 @@ impl Frame {
 
     /// Writes the colour as an 8-bit RGBA PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        self.to_image()
-            .save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| Error::Write {
-                path: path.to_path_buf(),
-                source: match e {
-                    image::ImageError::IoError(io) => io,
-                    other => std::io::Error::other(other),
-                },
-            })
+        let image = self.to_image();
+        crate::export::output::write_atomic(path, |w| {
+            image
+                .write_to(w, image::ImageFormat::Png)
+                .map_err(|e| Error::Write {
+                    path: path.to_path_buf(),
+                    source: match e {
+                        image::ImageError::IoError(io) => io,
+                        other => std::io::Error::other(other),
+                    },
+                })
+        })
     }
 }

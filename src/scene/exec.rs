@@ -65,6 +65,25 @@ pub fn run(
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport> {
+    run_with(None, scene, opts, progress)
+}
+
+/// [`run`] on a device the caller holds (`opts.device` is ignored).
+pub fn run_on(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    opts: &ExecOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<RunReport> {
+    run_with(Some(gpu), scene, opts, progress)
+}
+
+fn run_with(
+    gpu: Option<&Arc<Gpu>>,
+    scene: &Scene,
+    opts: &ExecOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<RunReport> {
     let t_all = Instant::now();
     let mut notes = Vec::new();
     let loaded = load(scene, &mut notes)?;
@@ -74,7 +93,7 @@ pub fn run(
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
     let (images, report_path) = output_paths(scene, &frames, &out_dir);
-    refuse_overwrite(&images, &report_path, opts.force)?;
+    refuse_overwrite(scene, &images, &report_path, opts.force)?;
     std::fs::create_dir_all(&out_dir).map_err(|source| Error::Write {
         path: out_dir.clone(),
         source,
@@ -83,7 +102,10 @@ pub fn run(
     let fx = &scene.effects;
     let input = scene.source.input();
     let plan = plan_with(&fx.cues, input, fx.caps);
-    let gpu = Arc::new(Gpu::new(opts.device.as_deref())?);
+    let gpu = match gpu {
+        Some(g) => g.clone(),
+        None => Arc::new(Gpu::new(opts.device.as_deref())?),
+    };
     let [w, h] = scene.size;
     let [br, bg, bb] = scene.background;
     let renderer = Renderer::new(RenderOptions {
@@ -150,9 +172,9 @@ pub fn run(
         vertices,
         faces,
         passes: ex.rec.in_plan_order(&plan),
-        pose_ms_median: crate::report::median(&mut pose_ms),
-        view_ms_median: crate::report::median(&mut view_ms),
-        render_ms_median: crate::report::median(&mut render_ms),
+        pose_ms_median: crate::metrics::median(&mut pose_ms),
+        view_ms_median: crate::metrics::median(&mut view_ms),
+        render_ms_median: crate::metrics::median(&mut render_ms),
         segments: ex.segments,
         strokes: ex.stroke_count,
         notes,
@@ -167,24 +189,20 @@ pub fn run(
     Ok(report)
 }
 
-/// Refuses before any work: nothing the user has is overwritten.
+/// Refuses outputs that exist (without `force`), that are the scene file,
+/// or that name one file twice ([`crate::export::output::check_outputs`]).
 fn refuse_overwrite(
+    scene: &Scene,
     images: &[(usize, usize, PathBuf)],
-    report: &PathBuf,
+    report: &std::path::Path,
     force: bool,
 ) -> Result<()> {
-    if force {
-        return Ok(());
-    }
-    for p in images.iter().map(|i| &i.2).chain([report]) {
-        if p.exists() {
-            return Err(Error::InvalidArgument(format!(
-                "{} exists; pass --force to overwrite it",
-                p.display()
-            )));
-        }
-    }
-    Ok(())
+    let outputs: Vec<&std::path::Path> = images
+        .iter()
+        .map(|i| i.2.as_path())
+        .chain([report])
+        .collect();
+    crate::export::output::check_outputs(&[scene.path.as_path()], &outputs, force)
 }
 
 /// The plan of a scene and the frames it would render, as `--explain` prints

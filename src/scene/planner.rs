@@ -157,13 +157,6 @@ pub enum Pass {
 }
 
 impl Pass {
-    /// Old name of [`Pass::Skinning`].
-    #[allow(non_upper_case_globals)]
-    pub const Skin: Pass = Pass::Skinning; // compat re-export
-    /// Old name of [`Pass::Edges`].
-    #[allow(non_upper_case_globals)]
-    pub const EdgeDetect: Pass = Pass::Edges; // compat re-export
-
     /// The device steps this pass launches (empty for host passes), by
     /// which the executor joins a stage's [`crate::spec::timing::Timing`]
     /// to the plan. Contours and suggestive contours share one

@@ -288,6 +288,24 @@ impl CurvatureCounts {
     }
 }
 
+/// What one curvature run gives (the front door's `shapecue::curvature` and
+/// its CPU twin `cpu::curvature::curvature`): the field, what was skipped,
+/// and how long it took.
+#[derive(Clone, Debug)]
+pub struct Curvature {
+    /// Per-vertex outputs.
+    pub field: CurvatureField,
+    /// Skip counters.
+    pub counts: CurvatureCounts,
+    /// Kernel ms per step and the run's wall ms (mesh already on the
+    /// device); for the CPU twin, the wall ms of the whole reference run.
+    pub timing: crate::spec::timing::Timing,
+    /// Building the topology (one-rings, owning faces), ms; 0 for the twin.
+    pub topology_ms: f64,
+    /// Device bytes allocated; 0 for the twin.
+    pub device_bytes: u64,
+}
+
 /// Relative area threshold of the degenerate-face rule, × Σ edge²
 /// (`DEGEN_AREA_REL` in `kernels/curvature.cl`).
 pub const DEGEN_AREA_REL: f64 = 5e-8;

@@ -187,6 +187,62 @@ pub fn crease_from_degrees(degrees: f32) -> Result<Option<f32>> {
     }
 }
 
+/// What `shapecue::feature_edges` (and its CPU twin `cpu::edges::feature_edges`)
+/// detects and how wide it makes the quads: everything of [`EdgeParams`] but
+/// the view, plus the cap variant and the marked edges.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgeOptions {
+    /// Cap variant.
+    pub caps: CapMode,
+    /// Line width in pixels (> 0).
+    pub line_width: f32,
+    /// Crease angle in degrees; 180 or more finds none ([`crease_from_degrees`]).
+    pub crease_deg: f32,
+    /// Detect contour edges.
+    pub contours: bool,
+    /// Draw boundary and marked edges.
+    pub boundaries: bool,
+    /// Depth scale k of the width factor max(1, k/w); `None`: constant width.
+    pub depth_scale: Option<f32>,
+    /// Contour-only edges as half quads, outward from the silhouette.
+    pub half_contours: bool,
+    /// Marked edges (vertex-index pairs), drawn like boundaries.
+    pub marked: Vec<[u32; 2]>,
+}
+
+impl Default for EdgeOptions {
+    fn default() -> Self {
+        EdgeOptions {
+            caps: CapMode::Adjacency,
+            line_width: 4.0,
+            crease_deg: 30.0,
+            contours: true,
+            boundaries: true,
+            depth_scale: None,
+            half_contours: false,
+            marked: Vec::new(),
+        }
+    }
+}
+
+impl EdgeOptions {
+    /// The per-frame parameters of these options seen through `view`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a crease angle outside (0, 180].
+    pub fn params(&self, view: View) -> Result<EdgeParams> {
+        Ok(EdgeParams {
+            view,
+            line_width: self.line_width,
+            crease_deg: crease_from_degrees(self.crease_deg)?,
+            contours: self.contours,
+            boundaries: self.boundaries,
+            depth_scale: self.depth_scale,
+            half_contours: self.half_contours,
+        })
+    }
+}
+
 /// The per-frame parameter block of `kernels/edges.cl`, mirrored there field
 /// by field by `typedef struct { ... } EdgeParams` (same names, same order,
 /// all 4-byte floats, so no padding on either side). A unit test in

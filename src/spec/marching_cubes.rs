@@ -189,3 +189,19 @@ impl IsoNormals {
 }
 
 super::named_choice!(IsoNormals, "isosurface normals choice");
+
+/// Which side of the iso value is the object. Marching cubes orients its
+/// triangles (and gradient normals) out of the region *below* the iso value;
+/// for density data (CT, MRI: the object has the high values) the values and
+/// the iso value are negated first (exact in f32), so normals point out of
+/// the object and its convex parts get positive curvature. The scene file's
+/// `inside = "above" | "below"`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Inside {
+    /// The object has the values above the iso value (density volumes).
+    Above,
+    /// The object has the values below it (signed distance fields).
+    #[default]
+    Below,
+}

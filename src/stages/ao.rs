@@ -16,8 +16,6 @@ use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::Arc;
 
-pub use crate::spec::ao::lut; // compat re-export
-
 /// Ambient occlusion on the device.
 pub struct AoStage {
     gpu: Arc<Gpu>,

@@ -74,9 +74,6 @@ impl Pass {
     }
 }
 
-/// Timing of one [`CurvatureEstimator::run`]: one step per pass.
-pub type RunTiming = Timing; // compat re-export
-
 /// Device state after a partial run, for pass-by-pass comparison with the
 /// CPU reference. All values in normalized coordinates.
 #[derive(Clone, Debug, Default)]
@@ -178,8 +175,6 @@ struct GatherBufs {
     corner: Buffer<u8>,
     status: Buffer<u8>,
 }
-
-pub use crate::spec::curvature::device_bytes_bound; // compat re-export
 
 /// Build options of `kernels/curvature.cl` for a variant.
 pub fn build_options(opts: &CurvatureOptions) -> String {
@@ -700,28 +695,21 @@ impl CurvatureEstimator {
     }
 }
 
-/// Result of [`estimate`]: the field, what was skipped and how long it took.
-#[derive(Clone, Debug)]
-pub struct Estimate {
-    /// Per-vertex outputs.
-    pub field: CurvatureField,
-    /// Skip counters.
-    pub counts: CurvatureCounts,
-    /// Timing of the run.
-    pub timing: Timing,
-    /// Device bytes allocated.
-    pub device_bytes: u64,
-}
-
-/// One-shot estimation: allocate, upload, run every pass, read back.
-pub fn estimate(gpu: Arc<Gpu>, mesh: &crate::Mesh, opts: CurvatureOptions) -> Result<Estimate> {
+/// One-shot estimation: allocate, upload, run every pass, read back (the
+/// front door's `shapecue::curvature_on`).
+pub fn estimate(
+    gpu: Arc<Gpu>,
+    mesh: &crate::Mesh,
+    opts: CurvatureOptions,
+) -> Result<crate::spec::curvature::Curvature> {
     let mut est = CurvatureEstimator::new(gpu, mesh.n_vertices(), &mesh.faces, opts)?;
     est.set_positions(&mesh.positions)?;
     let timing = est.run()?;
-    Ok(Estimate {
+    Ok(crate::spec::curvature::Curvature {
         field: est.read()?,
         counts: est.counts()?,
         timing,
+        topology_ms: est.topology_ms(),
         device_bytes: est.device_bytes(),
     })
 }

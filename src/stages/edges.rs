@@ -43,7 +43,8 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
-use crate::mesh::edges::{EdgeTopology, vertex_normals};
+use crate::mesh::edges::EdgeTopology;
+use crate::mesh::topology::vertex_normals;
 use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -51,14 +52,7 @@ use opencl3::memory::Buffer;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use crate::spec::edges::{
-    CapMode, EdgeOutput, EdgeParams, InteropDecision, InteropMode, KIND_BOUNDARY, KIND_CONTOUR,
-    KIND_CREASE, KIND_DRAWN, MemoryUse, decide_interop, memory_use,
-}; // compat re-export
-
-/// Kernel and wall times of one [`EdgeStage::run`]: steps `edges_detect`
-/// and `caps_mh` or `caps_adjacency`.
-pub type RunTiming = Timing; // compat re-export
+use crate::spec::edges::{CapMode, EdgeOutput, EdgeParams};
 
 /// Device buffers and kernels of the edges stage for one mesh topology.
 pub struct EdgeStage {

@@ -90,8 +90,6 @@ pub struct Isosurfacer {
     result: Option<(Holder, usize, usize)>,
 }
 
-pub use crate::spec::marching_cubes::device_bytes_bound; // compat re-export
-
 impl Isosurfacer {
     /// Uploads `vol` to the device (once) and builds the kernels. Errors if
     /// the device cannot hold the volume, naming the bytes.
@@ -396,7 +394,7 @@ impl Isosurfacer {
     }
 }
 
-pub use crate::spec::marching_cubes::IsoNormals; // compat re-export
+use crate::spec::marching_cubes::IsoNormals;
 
 /// Curvature of the current isosurface, computed without a host round trip:
 /// the fused faces and positions are copied device to device into a

@@ -6,7 +6,7 @@
 //! up and only the segments (and, on request, the AO values) come back.
 //!
 //! The bench (`benches/pipeline.rs`) and the report
-//! ([`crate::report::pipeline_report`]) both drive a frame through
+//! (`shapecue render --report`) both drive a frame through
 //! [`PosePipeline::frame`], so the bench measures what the report prints.
 //!
 //! Coordinates: the curvature estimator works in the rest pose's normalized
@@ -14,12 +14,12 @@
 //! reduction); the stages map world-unit parameters (AO radius, eye, feature
 //! size) in and segments out.
 
-use crate::cpu::ao::AoMode;
-use crate::cpu::feature_lines::{Segment, View};
 use crate::error::{Error, Result};
-use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use crate::gpu::{Gpu, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
+use crate::spec::ao::AoMode;
+use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use crate::spec::feature_lines::{EyeView as View, Segment};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;

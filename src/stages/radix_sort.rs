@@ -41,9 +41,7 @@ use opencl3::types::CL_BLOCKING;
 use std::ffi::c_void;
 use std::sync::Arc;
 
-pub use crate::spec::radix_sort::{
-    DIGIT_BITS, MAX_BLOCKS, MIN_BLOCK, RADIX, SKEW_LIMIT, Strategy, blocking, digits,
-}; // compat re-export
+use crate::spec::radix_sort::{DIGIT_BITS, RADIX, SKEW_LIMIT, Strategy, blocking, digits};
 
 /// Stable device radix sort of (key, value) pairs; kernels built once,
 /// scratch kept between calls.

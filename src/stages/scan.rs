@@ -23,8 +23,6 @@ use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, ClMem};
 use std::sync::Arc;
 
-pub use crate::spec::scan::{MAX_CHUNKS, MIN_CHUNK, chunking}; // compat re-export
-
 /// Number of `u32` elements a device buffer holds.
 pub(crate) fn len_u32(b: &Buffer<u32>) -> Result<usize> {
     b.size()

@@ -19,10 +19,7 @@ use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
 
-/// Kernel times of one fusion, per step.
-pub type FusionTiming = Timing; // compat re-export
-
-pub use crate::spec::vertex_fusion::FusionCounts; // compat re-export
+use crate::spec::vertex_fusion::FusionCounts;
 
 /// A growable device buffer.
 pub(crate) struct Grow<T> {

@@ -33,7 +33,7 @@ mod vtk;
 
 use std::borrow::Cow;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
@@ -325,8 +325,31 @@ pub fn load(path: &Path, raw: Option<&RawSpec>) -> Result<Volume> {
 // Helpers shared by the loaders
 // ---------------------------------------------------------------------------
 
+/// [`load`], also returning every file it read: the header and, for NRRD
+/// and MetaImage, each detached data file (so that a caller can refuse to
+/// write over any of them).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with_files(path: &Path, raw: Option<&RawSpec>) -> Result<(Volume, Vec<PathBuf>)> {
+    READ.with(|r| *r.borrow_mut() = Some(Vec::new()));
+    let result = load(path, raw);
+    let files = READ.with(|r| r.borrow_mut().take()).unwrap_or_default();
+    Ok((result?, files))
+}
+
+thread_local! {
+    /// The files [`read_file`] read while [`load_with_files`] records them.
+    static READ: std::cell::RefCell<Option<Vec<PathBuf>>> = const { std::cell::RefCell::new(None) };
+}
+
 /// Reads a whole file, naming it in the error.
 fn read_file(path: &Path) -> Result<Vec<u8>> {
+    READ.with(|r| {
+        if let Some(files) = r.borrow_mut().as_mut() {
+            files.push(path.to_path_buf());
+        }
+    });
     std::fs::read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,

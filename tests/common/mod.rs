@@ -15,10 +15,10 @@
 
 use opencl3::memory::Buffer;
 use shapecue::Error;
-use shapecue::cpu::feature_lines::LineInputs;
-use shapecue::field::CurvatureField;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::{self, Mesh, splitmix};
+use shapecue::spec::curvature::CurvatureField;
+use shapecue::spec::feature_lines::LineInputs;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

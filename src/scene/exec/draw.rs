@@ -2,15 +2,15 @@
 //! pose's bounds, the mesh colours and style, the line and edge quads, and
 //! the PNG and SVG files of one view.
 
-use crate::cpu::feature_lines::Segment;
 use crate::error::Result;
 use crate::render::colormap::{curvature_color, with_ao};
 use crate::render::edges::draw_edges;
 use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
 use crate::scene::file::{CameraKind, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
+use crate::spec::edges::EdgeOutput;
+use crate::spec::feature_lines::Segment;
 use crate::spec::sdf_lines::Stroke;
-use crate::stages::edges::EdgeOutput;
 use std::path::PathBuf;
 
 /// Host copies of the pose that the renderer and the host-side passes use,

@@ -15,23 +15,26 @@
 use super::draw::{self, PoseData, ViewLines};
 use super::load::Loaded;
 use super::report::{Recorder, ms_since};
-use crate::cpu::feature_lines::{LineInputs, Segment};
 use crate::error::{Error, Result};
-use crate::field::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
-use crate::mesh::edges::{EdgeTopology, vertex_normals};
+use crate::mesh::edges::EdgeTopology;
+use crate::mesh::topology::vertex_normals;
 use crate::render::colormap::curvature_scale;
 use crate::render::{Camera, Renderer};
 use crate::scene::file::Scene;
 use crate::scene::planner::{Pass, Plan};
+use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use crate::spec::edges::{EdgeOutput, EdgeParams};
+use crate::spec::feature_lines::{LineInputs, Segment};
+use crate::spec::marching_cubes::IsoNormals;
 use crate::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, Stroke};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
-use crate::stages::edges::{EdgeOutput, EdgeParams, EdgeStage};
+use crate::stages::edges::EdgeStage;
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
-use crate::stages::marching_cubes::{IsoNormals, Isosurfacer};
+use crate::stages::marching_cubes::Isosurfacer;
 use crate::stages::pipeline::{PipelineOptions, PipelineStages, PosePipeline};
 use crate::stages::sdf_lines::SdfLines;
 use std::path::PathBuf;
@@ -460,7 +463,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             unreachable!("planned for a volume input")
         };
         let ex = self.iso.as_mut().expect("built for the isosurface pass");
-        let s = ex.extract(*iso_value, crate::cpu::vertex_fusion::Fusion::Edge)?;
+        let s = ex.extract(*iso_value, crate::spec::vertex_fusion::Fusion::Edge)?;
         self.rec.kernels(
             Pass::Isosurface,
             &s.timing,

@@ -1,152 +1,26 @@
-//! What accuracy costs in time: error metrics shared by the tests and the
-//! `shapecue curvature --report` table (so the README's table is produced,
-//! not typed).
+//! The report tables of the command line (`curvature --report`,
+//! `isosurface --report`, `render --report`, `edges --memory-table`,
+//! `edges --cap-quality`): they time the library's stages and print the
+//! library's metrics ([`shapecue::metrics`]) as the README's tables.
 
-use crate::error::Result;
-use crate::field::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
-use crate::gpu::Gpu;
-use crate::mesh::{self, Mesh};
-use crate::stages::curvature::CurvatureEstimator;
+use shapecue::Result;
+use shapecue::gpu::Gpu;
+use shapecue::mesh::{self, LoadOptions, Mesh};
+use shapecue::metrics::{
+    analytic_rms, label, measure, measure_isosurface, median, nrmse, torus_truth, variants,
+};
+use shapecue::spec::curvature::{Compat, CurvatureOptions, Precision};
 use std::fmt::Write;
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// Root-mean-square difference.
-pub fn rmse(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len(), "rmse of slices of different lengths");
-    let n = a.len().max(1) as f64;
-    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / n).sqrt()
-}
-
-/// RMS error normalized by the reference's range; for a (nearly) constant
-/// attribute, whose range says nothing, by its mean magnitude instead
-/// (whichever is larger). Multiply by 100 for percent.
-pub fn nrmse(a: &[f64], reference: &[f64]) -> f64 {
-    let (lo, hi) = reference
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
-            (l.min(x), h.max(x))
-        });
-    let mean_abs = reference.iter().map(|x| x.abs()).sum::<f64>() / reference.len().max(1) as f64;
-    let norm = (hi - lo).max(mean_abs);
-    if norm > 0.0 {
-        rmse(a, reference) / norm
-    } else {
-        rmse(a, reference)
-    }
-}
-
-/// RMS error of (k1, k2) against analytic values at each vertex.
-pub fn analytic_rms(f: &CurvatureField, truth: &[(f64, f64)]) -> (f64, f64) {
-    let t1: Vec<f64> = truth.iter().map(|t| t.0).collect();
-    let t2: Vec<f64> = truth.iter().map(|t| t.1).collect();
-    (rmse(&f.k1, &t1), rmse(&f.k2, &t2))
-}
-
-/// Analytic curvature of the report's torus (R = 1, r = 0.4) at its vertices.
-pub fn torus_truth(m: &Mesh) -> Vec<(f64, f64)> {
-    m.positions
-        .iter()
-        .map(|&p| mesh::torus_curvature(1.0, 0.4, p))
-        .collect()
-}
-
-/// Median of a list of numbers (0 for an empty list).
-pub fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-/// One measured variant: the field of its last run and median times.
-pub struct Measured {
-    /// Output of the last run.
-    pub field: CurvatureField,
-    /// Median kernel time (ms) over the runs, mesh already on the device.
-    pub kernel_ms: f64,
-    /// Median wall time (ms) of a run, upload of positions and read-back excluded.
-    pub wall_ms: f64,
-}
-
-/// Runs a device variant `runs` times on `m` (after one warm-up run that
-/// pays for JIT compilation) and returns medians.
-pub fn measure(gpu: &Arc<Gpu>, m: &Mesh, opts: CurvatureOptions, runs: usize) -> Result<Measured> {
-    let mut est = CurvatureEstimator::new(gpu.clone(), m.n_vertices(), &m.faces, opts)?;
-    est.set_positions(&m.positions)?;
-    est.run()?;
-    let (mut k, mut w) = (Vec::new(), Vec::new());
-    for _ in 0..runs.max(1) {
-        let t = est.run()?;
-        k.push(t.kernel_ms);
-        w.push(t.wall_ms);
-    }
-    Ok(Measured {
-        field: est.read()?,
-        kernel_ms: median(&mut k),
-        wall_ms: median(&mut w),
-    })
-}
-
-/// A variant's name, e.g. `atomic f32 exact` or `gather f64 exact no-dcurv`
-/// (the report's rows; the bench uses it with dashes).
-pub fn label(o: &CurvatureOptions) -> String {
-    format!(
-        "{} {} {}{}",
-        match o.accumulate {
-            Accumulate::Atomic => "atomic",
-            Accumulate::Gather => "gather",
-        },
-        match o.precision {
-            Precision::F32 => "f32",
-            Precision::F64 => "f64",
-        },
-        match o.compat {
-            Compat::Exact => "exact",
-            Compat::Trimesh2 => "trimesh2",
-        },
-        if o.dcurv { "" } else { " no-dcurv" }
-    )
-}
-
-/// The variants the report and the criterion bench compare, default first.
-pub fn variants() -> Vec<CurvatureOptions> {
-    let d = CurvatureOptions::default();
-    vec![
-        d,
-        CurvatureOptions { dcurv: false, ..d },
-        CurvatureOptions {
-            accumulate: Accumulate::Gather,
-            ..d
-        },
-        CurvatureOptions {
-            precision: Precision::F64,
-            ..d
-        },
-        CurvatureOptions {
-            accumulate: Accumulate::Gather,
-            precision: Precision::F64,
-            ..d
-        },
-        CurvatureOptions {
-            compat: Compat::Trimesh2,
-            ..d
-        },
-    ]
-}
 
 /// The full report: every variant on a torus of about `n` vertices (error
 /// against the analytic curvature, error against the f64 CPU reference,
 /// median kernel and wall time), then a refinement sweep showing how the
 /// analytic error falls with resolution for the exact solve and stalls for
 /// the trimesh2-compatible one.
-pub fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<String> {
+pub(crate) fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<String> {
     let mut s = String::new();
     let (nu, nv) = mesh::torus_resolution_for(n);
     let m = mesh::torus(1.0, 0.4, nu, nv);
@@ -175,7 +49,7 @@ pub fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<String> 
             compat,
             ..Default::default()
         };
-        crate::cpu::curvature::estimate(&m, &o).0
+        shapecue::cpu::curvature::estimate(&m, &o).0
     };
     let ref_exact = refs(Compat::Exact);
     let ref_compat = refs(Compat::Trimesh2);
@@ -197,7 +71,7 @@ pub fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<String> 
         );
     }
     let t = Instant::now();
-    let (cf, _) = crate::cpu::curvature::estimate(&m, &CurvatureOptions::default());
+    let (cf, _) = shapecue::cpu::curvature::estimate(&m, &CurvatureOptions::default());
     let cpu_ms = t.elapsed().as_secs_f64() * 1e3;
     let (e1, e2) = analytic_rms(&cf, &truth);
     let _ = writeln!(
@@ -254,35 +128,17 @@ pub fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<String> 
     Ok(s)
 }
 
-/// Median kernel and wall ms of `runs` extractions (after one warm-up that
-/// pays for JIT compilation), and the stats of the last.
-pub fn measure_isosurface(
-    ex: &mut crate::stages::marching_cubes::Isosurfacer,
-    iso: f32,
-    fusion: crate::cpu::vertex_fusion::Fusion,
-    runs: usize,
-) -> Result<(f64, f64, crate::stages::marching_cubes::IsoStats)> {
-    let mut st = ex.extract(iso, fusion)?;
-    let (mut k, mut w) = (Vec::new(), Vec::new());
-    for _ in 0..runs.max(1) {
-        st = ex.extract(iso, fusion)?;
-        k.push(st.timing.kernel_ms);
-        w.push(st.timing.wall_ms);
-    }
-    Ok((median(&mut k), median(&mut w), st))
-}
-
 /// The `shapecue isosurface --report` text: (1) extraction + fusion time of
 /// every fusion variant on the procedural fields at 128³ and 256³ with the
 /// mesh quality each leaves; (2) the resolution sweep 64³ … `max_res`³ of the
 /// sphere and torus SDFs: extraction time, curvature time (f32 and f64, on
 /// the device, no host round trip) and the RMS error of k1, k2 against the
 /// analytic values, relative to 1/r (resolution is an accuracy/time trade-off).
-pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<String> {
-    use crate::cpu::vertex_fusion::Fusion;
-    use crate::field::{Accumulate, Compat, Precision};
-    use crate::stages::marching_cubes::{self as mcs, Isosurfacer};
-    use crate::volume::sdf::{self, Sdf};
+pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<String> {
+    use shapecue::spec::curvature::{Accumulate, Compat, Precision};
+    use shapecue::spec::vertex_fusion::Fusion;
+    use shapecue::stages::marching_cubes::{self as mcs, Isosurfacer};
+    use shapecue::volume::sdf::{self, Sdf};
     use std::fmt::Write as _;
     let mut s = String::new();
     let w = |s: &mut String, t: String| {
@@ -327,7 +183,7 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
         for fusion in [Fusion::None, Fusion::Edge, Fusion::Hash] {
             let (k, wall, st) = measure_isosurface(&mut ex, 0.0, fusion, runs)?;
             let (p, f) = ex.read_index_space()?;
-            let q = crate::mesh::quality(&p, &f);
+            let q = shapecue::mesh::quality(&p, &f);
             w(
                 &mut s,
                 format!(
@@ -409,9 +265,18 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
                 st.faces
             );
             for (precision, normals) in [
-                (Precision::F32, mcs::IsoNormals::Mesh),
-                (Precision::F32, mcs::IsoNormals::Gradient),
-                (Precision::F64, mcs::IsoNormals::Gradient),
+                (
+                    Precision::F32,
+                    shapecue::spec::marching_cubes::IsoNormals::Mesh,
+                ),
+                (
+                    Precision::F32,
+                    shapecue::spec::marching_cubes::IsoNormals::Gradient,
+                ),
+                (
+                    Precision::F64,
+                    shapecue::spec::marching_cubes::IsoNormals::Gradient,
+                ),
             ] {
                 let opts = CurvatureOptions {
                     accumulate: Accumulate::Atomic,
@@ -449,9 +314,9 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
 }
 
 /// The `pipeline` report of an animated glTF model: the default per-frame
-/// device pipeline ([`crate::stages::pipeline::PosePipeline`]: skin,
+/// device pipeline ([`shapecue::stages::pipeline::PosePipeline`]: skin,
 /// curvature + dcurv, AO `lut`, contours + suggestive contours from
-/// [`PosePipeline::front_view`](crate::stages::pipeline::PosePipeline::front_view))
+/// [`PosePipeline::front_view`](shapecue::stages::pipeline::PosePipeline::front_view))
 /// over `frames` poses of the first clip, `runs` times (after one warm-up
 /// frame that pays for JIT compilation). One markdown row per pass with its
 /// median kernel ms; the two other AO levels run on the same curvatures each
@@ -459,17 +324,17 @@ pub fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> Result<S
 /// time (accuracy and cost side by side); then the median total of the
 /// default pipeline (kernel sum and host wall per frame) and whether it meets
 /// the 16 ms frame budget.
-pub fn pipeline_report(
+pub(crate) fn pipeline_report(
     gpu: Arc<Gpu>,
     gltf: &std::path::Path,
     frames: usize,
     runs: usize,
 ) -> Result<String> {
-    use crate::cpu::ao::AoMode;
-    use crate::spec::timing::Family;
-    use crate::stages::feature_lines::LineOptions;
-    use crate::stages::pipeline::{PipelineOptions, PosePipeline, clip_poses};
-    let m = crate::mesh::skinned::load_gltf(gltf)?;
+    use shapecue::spec::ao::AoMode;
+    use shapecue::spec::timing::Family;
+    use shapecue::stages::feature_lines::LineOptions;
+    use shapecue::stages::pipeline::{PipelineOptions, PosePipeline, clip_poses};
+    let m = shapecue::mesh::skinned::load_gltf(gltf)?;
     let opts = PipelineOptions::default();
     let mut p = PosePipeline::new(gpu.clone(), &m, opts)?;
     let poses = clip_poses(&m, frames)?;
@@ -499,7 +364,7 @@ pub fn pipeline_report(
         }
     }
     let rms = |se: f64| (se / n.max(1) as f64).sqrt();
-    let med = |f: &dyn Fn(&crate::stages::pipeline::PassTimes) -> f64| {
+    let med = |f: &dyn Fn(&shapecue::stages::pipeline::PassTimes) -> f64| {
         median(&mut t.iter().map(f).collect::<Vec<_>>())
     };
     let name = gltf.file_name().map_or_else(
@@ -571,4 +436,119 @@ pub fn pipeline_report(
         verdict(wall)
     );
     Ok(s)
+}
+
+/// The meshes of the edges tables (House & Li's comparison): generated
+/// cube, cylinder, cone and icosphere, and the shared teapot and bunny when
+/// present; all unit-sized.
+fn table_meshes() -> Vec<(String, Mesh)> {
+    let mut v = vec![
+        ("cube".to_string(), mesh::cube(1.0)),
+        ("cylinder".to_string(), mesh::capped_cylinder(0.5, 1.0, 32)),
+        ("cone".to_string(), mesh::cone(0.5, 1.0, 32)),
+        ("icosphere".to_string(), mesh::icosphere(0.5, 3)),
+    ];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
+    for (name, file) in [("teapot", "teapot.obj"), ("bunny", "stanford-bunny.obj")] {
+        let p = dir.join(file);
+        match mesh::load(&p, &LoadOptions::default()) {
+            Ok(m) => v.push((name.to_string(), m)),
+            Err(e) => eprintln!("skipping {name}: {e}"),
+        }
+    }
+    v.into_iter()
+        .map(|(n, m)| (n, mesh::unit_sized(&m)))
+        .collect()
+}
+
+/// `shapecue edges --memory-table`: bits per mesh of each cap variant, from
+/// the buffer sizes ([`shapecue::spec::edges::memory_use`]).
+pub(crate) fn edges_memory_table() -> anyhow::Result<()> {
+    use super::out;
+    use shapecue::mesh::edges::EdgeTopology;
+    use shapecue::spec::edges::{CapMode, memory_use};
+    out!(
+        "{:<10} {:>8} {:>9} {:>12} {:>12} {:>12}",
+        "mesh",
+        "edges",
+        "caps",
+        "none bits",
+        "mh bits",
+        "adj bits"
+    );
+    for (name, m) in table_meshes() {
+        let t = EdgeTopology::new(&m, &[], &name)?;
+        let bits = |c| {
+            let u = memory_use(c, t.edges.len(), t.caps.len());
+            u.edge_bits + u.cap_bits
+        };
+        out!(
+            "{name:<10} {:>8} {:>9} {:>12} {:>12} {:>12}",
+            t.edges.len(),
+            t.caps.len(),
+            bits(CapMode::None),
+            bits(CapMode::Mh),
+            bits(CapMode::Adjacency)
+        );
+    }
+    out!(
+        "(bits of the edge buffer, edge-out and kind, plus each variant's cap buffer and cap-out; 32-bit elements)"
+    );
+    Ok(())
+}
+
+/// `shapecue edges --cap-quality`: gap and extra pixels of each cap variant
+/// against the ideal round-joined stroke
+/// ([`shapecue::render::cap_quality::cap_quality`]), seen from (5, 5, 5).
+pub(crate) fn edges_cap_quality(
+    gpu: &Arc<Gpu>,
+    (w, h): (u32, u32),
+    width: f32,
+    crease_deg: f32,
+    fov: f32,
+    ortho: bool,
+) -> anyhow::Result<()> {
+    use super::out;
+    use shapecue::mesh::edges::EdgeTopology;
+    use shapecue::render::{Placement, framed};
+    use shapecue::spec::edges::{EdgeParams, crease_from_degrees};
+    let crease = crease_from_degrees(crease_deg)?;
+    out!(
+        "eye (5,5,5), unit-sized meshes at the origin, {w}x{h}, width {width} px, crease {crease_deg}°"
+    );
+    out!(
+        "{:<10} {:<10} {:>8} {:>9} {:>8} {:>8}",
+        "mesh",
+        "caps",
+        "ideal",
+        "rendered",
+        "gap",
+        "extra"
+    );
+    for (name, m) in table_meshes() {
+        let t = EdgeTopology::new(&m, &[], &name)?;
+        let cam = framed(
+            Placement::At(glam::Vec3::splat(5.0)),
+            Some(glam::Vec3::ZERO),
+            None,
+            fov,
+            ortho,
+            m.bounds(),
+            w as f32 / h as f32,
+        )?;
+        let mut p = EdgeParams::new(cam.view(w, h));
+        p.line_width = width;
+        p.crease_deg = crease;
+        for q in shapecue::render::cap_quality::cap_quality(gpu.clone(), &m, &t, &p)? {
+            out!(
+                "{name:<10} {:<10} {:>8} {:>9} {:>8} {:>8}",
+                q.mode.name(),
+                q.ideal,
+                q.rendered,
+                q.gap,
+                q.extra
+            );
+        }
+    }
+    Ok(())
 }

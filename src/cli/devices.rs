@@ -1,0 +1,44 @@
+//! `shapecue devices`: the OpenCL platforms and devices, as a table or JSON.
+
+use super::out;
+use anyhow::Result;
+use shapecue::gpu::{Gpu, list_devices};
+
+/// Lists the devices; `*` marks the one a command would use by default.
+pub fn run(json: bool) -> Result<()> {
+    let devs = list_devices()?;
+    if json {
+        out!("{}", serde_json::to_string_pretty(&devs)?);
+        return Ok(());
+    }
+    let default = Gpu::new(None).ok().map(|g| g.info.index);
+    out!(
+        "{:>3}  {:<4} {:>3} {:>9} {:>4} {:>10} {:>9}  platform / device",
+        "#",
+        "type",
+        "CUs",
+        "memory",
+        "fp64",
+        "gl_sharing",
+        "int64_atm"
+    );
+    let yn = |b: bool| if b { "yes" } else { "no" };
+    for d in devs {
+        out!(
+            "{:>3}{} {:<4} {:>3} {:>6} MiB {:>4} {:>10} {:>9}  {} / {} ({})",
+            d.index,
+            if Some(d.index) == default { "*" } else { " " },
+            d.kind,
+            d.compute_units,
+            d.global_mem >> 20,
+            yn(d.fp64),
+            yn(d.gl_sharing),
+            yn(d.int64_atomics),
+            d.platform,
+            d.name,
+            d.version
+        );
+    }
+    out!("(* = default; choose with --device <index|name> or SHAPECUE_DEVICE)");
+    Ok(())
+}

@@ -1,0 +1,194 @@
+//! `shapecue edges`: object-space feature edges with caps (House & Li),
+//! drawn over the shaded mesh by [`shapecue::render::edges::draw`] to PNG,
+//! with the visible edges as SVG and JSON stats; `--memory-table` and
+//! `--cap-quality` print the tables of [`super::tables`].
+
+use super::{check_outputs, out, write_json};
+use anyhow::{Result, bail};
+use clap::Args;
+use shapecue::gpu::Gpu;
+use shapecue::mesh::LoadOptions;
+use shapecue::render::edges::{EdgeDrawOptions, draw};
+use shapecue::spec::edges::{
+    CapMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, decide_interop,
+};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The arguments of `shapecue edges`.
+#[derive(Args)]
+pub struct EdgesArgs {
+    /// Input mesh (.obj, .ply, .off).
+    #[arg(required_unless_present_any = ["cap_quality", "memory_table"])]
+    mesh: Option<PathBuf>,
+    /// Eye position, e.g. 5,5,5.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 1,
+        allow_negative_numbers = true
+    )]
+    eye: Option<Vec<f32>>,
+    /// Point looked at (default: the centre of the mesh's bounding box).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    target: Option<Vec<f32>>,
+    /// Up direction (default +Y, or +Z when looking along Y).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    up: Option<Vec<f32>>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 40.0)]
+    fov: f32,
+    /// Orthographic projection (showing the height the perspective view shows at the target).
+    #[arg(long)]
+    ortho: bool,
+    /// Caps filling the gaps between thick edges: none, mh (McGuire-Hughes
+    /// half-caps from vertex normals) or adjacency (House & Li).
+    #[arg(long, default_value = "adjacency")]
+    caps: String,
+    /// Edge width in pixels.
+    #[arg(long, default_value_t = 4.0, allow_negative_numbers = true)]
+    width: f32,
+    /// Crease angle in degrees: edges whose face normals differ by more than
+    /// this are creases (a cube's edges at 90°); 180 or more finds none.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    crease: f32,
+    /// Draw contour-only edges as half quads, outward from the silhouette.
+    #[arg(long)]
+    half_contours: bool,
+    /// Depth-scaled width: width × max(1, K/w), w the clip-space depth.
+    #[arg(long, allow_negative_numbers = true)]
+    depth_scale: Option<f32>,
+    /// Marked edges: a text file with one pair of 0-based vertex indices per line.
+    #[arg(long)]
+    marked: Option<PathBuf>,
+    /// Image size, e.g. 800x600.
+    #[arg(long, default_value = "800x600")]
+    size: String,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also write the visible edges as SVG polylines.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Write statistics (edge counts, timings, memory, interop path) as JSON.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    force: bool,
+    /// CL-GL buffer sharing: auto (share when the device reports
+    /// cl_khr_gl_sharing, else copy through the host), on (require it: exit
+    /// code 3 without the extension), off (host path).
+    #[arg(long, value_enum, default_value = "auto")]
+    interop: shapecue::spec::edges::InteropMode,
+    /// Print the cap-quality table (gap and extra pixels against the ideal
+    /// round-joined stroke) for the standard meshes instead.
+    #[arg(long)]
+    cap_quality: bool,
+    /// Print the memory table (bits per mesh for each cap variant) instead.
+    #[arg(long)]
+    memory_table: bool,
+}
+
+fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
+        }
+        Some(v) => bail!("--{what} needs three finite numbers X,Y,Z, got {v:?}"),
+    }
+}
+
+fn size_arg(s: &str) -> Result<(u32, u32)> {
+    let parsed = s
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => Ok((w, h)),
+        _ => bail!("--size {s:?}: expected WIDTHxHEIGHT with both in 1..=16384, e.g. 800x600"),
+    }
+}
+
+/// Runs `shapecue edges`.
+pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
+    // Parsed here rather than by clap's ValueEnum so that a bad name keeps
+    // the library's message ("unknown cap mode ...") and exit code 1.
+    let mode: CapMode = a.caps.parse()?;
+    let (w, h) = size_arg(&a.size)?;
+    // Checked before any table or drawing: the message names the flag.
+    if !(a.width.is_finite() && a.width > 0.0) {
+        bail!(
+            "--width {}: the edge width must be a positive number of pixels",
+            a.width
+        );
+    }
+    if a.memory_table {
+        return super::tables::edges_memory_table();
+    }
+    let gpu = Arc::new(Gpu::new(device)?);
+    let interop = decide_interop(a.interop, gpu.info.gl_sharing, &gpu.info.name)?;
+    if a.cap_quality {
+        return super::tables::edges_cap_quality(&gpu, (w, h), a.width, a.crease, a.fov, a.ortho);
+    }
+    let path = a.mesh.as_deref().expect("clap requires MESH here");
+    let Some(output) = &a.output else {
+        bail!("give -o OUT.png (or --cap-quality / --memory-table)");
+    };
+    check_outputs(
+        [path].into_iter().chain(a.marked.as_deref()),
+        [Some(output), a.svg.as_ref(), a.stats.as_ref()]
+            .into_iter()
+            .flatten()
+            .map(PathBuf::as_path),
+        a.force,
+    )?;
+    let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
+    let Some(eye) = vec3_arg(&a.eye, "eye")? else {
+        bail!("--eye X,Y,Z is required");
+    };
+    let opts = EdgeDrawOptions {
+        eye,
+        target: vec3_arg(&a.target, "target")?,
+        up: vec3_arg(&a.up, "up")?,
+        fov_deg: a.fov,
+        ortho: a.ortho,
+        width: w,
+        height: h,
+        caps: mode,
+        line_width: a.width,
+        crease_deg: a.crease,
+        depth_scale: a.depth_scale,
+        half_contours: a.half_contours,
+        marked: a.marked.clone(),
+        polylines: a.svg.is_some(),
+    };
+    let d = draw(gpu, &mesh, &path.display().to_string(), &opts)?;
+    d.frame.save_png(output)?;
+    let t = &d.topology;
+    out!(
+        "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
+         (in front of the near plane) of those detected as contour {}, crease {}, \
+         boundary/marked {}; kernels {:.3} ms; wrote {}",
+        path.display(),
+        t.edges.len(),
+        t.boundary,
+        t.non_manifold,
+        t.marked,
+        t.caps.len(),
+        d.count(KIND_DRAWN),
+        d.count(KIND_CONTOUR),
+        d.count(KIND_CREASE),
+        d.count(KIND_BOUNDARY),
+        d.timing.kernel_ms,
+        output.display()
+    );
+    if let (Some(svg), Some(lines)) = (&a.svg, &d.polylines) {
+        shapecue::export::svg::write_svg(svg, lines, w, h, a.width)?;
+        out!("wrote {} ({} polylines)", svg.display(), lines.len());
+    }
+    if let Some(sp) = &a.stats {
+        write_json(sp, &d.stats(&path.display().to_string(), &interop))?;
+    }
+    Ok(())
+}

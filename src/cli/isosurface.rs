@@ -1,0 +1,231 @@
+//! `shapecue isosurface`: the isosurface of a volume file or a procedural
+//! signed distance field ([`shapecue::isosurface`]), optionally with its
+//! curvature, written as PLY with JSON stats; `--report` prints the
+//! fusion and resolution tables.
+
+use super::{check_outputs, out, write_json};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use shapecue::gpu::Gpu;
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::marching_cubes::IsoNormals;
+use shapecue::spec::vertex_fusion::Fusion;
+use shapecue::volume::{self, RawSpec, ScalarType};
+use shapecue::{Inside, IsoOptions};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The arguments of `shapecue isosurface`.
+#[derive(Args)]
+pub struct IsoArgs {
+    /// Input volume: .nrrd/.nhdr, .mhd/.mha, .vtk (STRUCTURED_POINTS), .vti, or
+    /// raw data with --dims and --type.
+    #[arg(required_unless_present_any = ["sdf", "report"])]
+    input: Option<PathBuf>,
+    /// Use a procedural signed distance field instead: sphere, torus or gyroid.
+    #[arg(long, conflicts_with = "input")]
+    sdf: Option<String>,
+    /// Grid points per axis of a procedural field.
+    #[arg(long, default_value_t = 128)]
+    resolution: usize,
+    /// Iso value (default 0 for procedural fields).
+    #[arg(long, allow_negative_numbers = true)]
+    iso: Option<f32>,
+    /// Raw input: voxels per axis, e.g. 32,32,32.
+    #[arg(long, value_delimiter = ',')]
+    dims: Option<Vec<usize>>,
+    /// Raw input: voxel type (u8, i8, u16, i16, u32, i32, f32, f64).
+    #[arg(long = "type")]
+    scalar: Option<String>,
+    /// Raw input: big-endian data.
+    #[arg(long)]
+    big_endian: bool,
+    /// Raw input: world units per voxel step, e.g. 1,1,2.5.
+    #[arg(long, value_delimiter = ',')]
+    spacing: Option<Vec<f64>>,
+    /// Raw input: bytes to skip before the data.
+    #[arg(long, default_value_t = 0)]
+    header_bytes: usize,
+    /// Vertex fusion: hash (the seed's position hash + radix sort), edge
+    /// (exact voxel-edge keys), none (triangle soup).
+    #[arg(long, value_enum, default_value = "hash")]
+    fusion: Fusion,
+    /// Write per-vertex normals from the volume gradient.
+    #[arg(long)]
+    normals: bool,
+    /// Compute curvature on the device right after extraction (no host round trip).
+    #[arg(long)]
+    curvature: bool,
+    /// Curvature precision.
+    #[arg(long, value_enum, default_value = "f32")]
+    precision: Precision,
+    /// Vertex normals of the curvature passes: the volume gradient (accurate
+    /// on marching-cubes meshes) or the mesh's own face normals (the paper's).
+    #[arg(long, value_enum, default_value = "gradient")]
+    curvature_normals: IsoNormals,
+    /// Skip the curvature-derivative pass.
+    #[arg(long)]
+    no_dcurv: bool,
+    /// Output PLY (binary little-endian). Never the input file.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write statistics (passes, counts, quality, bytes) as JSON.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    force: bool,
+    /// Print the isosurface accuracy/time report instead (no input needed).
+    #[arg(long)]
+    report: bool,
+    /// Largest resolution of the report's sweep.
+    #[arg(long, default_value_t = 512)]
+    max_resolution: usize,
+    /// Runs per measurement in the report (median).
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
+}
+
+/// The raw-data description that `--dims`, `--type`, ... give, if any.
+fn raw_spec(a: &IsoArgs) -> Result<Option<RawSpec>> {
+    Ok(match (&a.dims, &a.scalar) {
+        (Some(d), Some(t)) => {
+            if d.len() != 3 {
+                bail!("--dims needs three values X,Y,Z, got {}", d.len());
+            }
+            let scalar: ScalarType = t.parse()?;
+            let mut spec = RawSpec::new([d[0], d[1], d[2]], scalar);
+            spec.big_endian = a.big_endian;
+            spec.header_bytes = a.header_bytes;
+            if let Some(sp) = &a.spacing {
+                if sp.len() != 3 {
+                    bail!("--spacing needs three values, got {}", sp.len());
+                }
+                spec.spacing = [sp[0], sp[1], sp[2]];
+            }
+            Some(spec)
+        }
+        (None, None) => None,
+        _ => bail!("raw input needs both --dims and --type"),
+    })
+}
+
+/// Runs `shapecue isosurface`.
+pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
+    if a.report {
+        let gpu = Arc::new(Gpu::new(device)?);
+        super::print_str(&super::tables::isosurface_report(
+            gpu,
+            a.max_resolution,
+            a.runs,
+        )?)?;
+        return Ok(());
+    }
+    let t_load = Instant::now();
+    let (name, vol, read) = match (&a.input, &a.sdf) {
+        (_, Some(kind)) => (
+            format!("{kind} SDF {}³", a.resolution),
+            volume::sdf::sdf_by_name(kind, a.resolution)?,
+            Vec::new(),
+        ),
+        (Some(path), None) => {
+            let raw = raw_spec(&a)?;
+            let (vol, read) = volume::load_with_files(path, raw.as_ref())?;
+            (path.display().to_string(), vol, read)
+        }
+        (None, None) => bail!("give an input volume, --sdf or --report"),
+    };
+    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    let iso = match (a.iso, &a.sdf) {
+        (Some(v), _) => v,
+        (None, Some(_)) => 0.0,
+        (None, None) => bail!("give --iso (the volume's values span {:?})", vol.range()),
+    };
+    check_outputs(
+        a.input
+            .as_deref()
+            .into_iter()
+            .chain(read.iter().map(PathBuf::as_path)),
+        a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
+        a.force,
+    )?;
+    let gpu = Arc::new(Gpu::new(device)?);
+    let curvature = a.curvature.then_some(CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        precision: a.precision,
+        compat: Compat::Exact,
+        dcurv: !a.no_dcurv,
+    });
+    let opts = IsoOptions {
+        fusion: a.fusion,
+        inside: Inside::Below,
+        curvature,
+        curvature_normals: a.curvature_normals,
+        gradient_normals: a.normals && a.output.is_some(),
+    };
+    let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)
+        .with_context(|| format!("uploading {name}"))?;
+    let st = &s.stats;
+    out!(
+        "{name}: iso {iso}, fusion {}: {} vertices, {} faces ({} soup vertices, {} degenerate \
+         triangles dropped); extraction {:.1} ms kernels, {:.1} ms wall",
+        a.fusion.name(),
+        st.vertices,
+        st.faces,
+        st.soup_vertices,
+        st.degenerate_dropped,
+        st.timing.kernel_ms,
+        st.timing.wall_ms
+    );
+    if let Some(out) = &a.output {
+        write_ply(out, &s)?;
+        out!("wrote {}", out.display());
+    }
+    if let Some(path) = &a.stats {
+        let curv = s.curvature.as_ref().map_or(serde_json::Value::Null, |c| {
+            serde_json::json!({
+                "options": curvature,
+                "normals": a.curvature_normals,
+                "passes": super::curvature::passes(&c.timing),
+                "kernel_ms": c.timing.kernel_ms,
+                "run_wall_ms": c.timing.wall_ms,
+                "counts": c.counts,
+                "device_bytes": c.device_bytes,
+            })
+        });
+        let stats = serde_json::json!({
+            "input": name,
+            "device": gpu.info,
+            "dims": vol.dims,
+            "spacing": vol.spacing,
+            "origin": vol.origin,
+            "load_ms": load_ms,
+            "upload_ms": s.upload_ms,
+            "extraction": st,
+            "quality": shapecue::mesh::quality(&s.mesh.positions, &s.mesh.faces),
+            "curvature": curv,
+        });
+        write_json(path, &stats)?;
+    }
+    Ok(())
+}
+
+/// The PLY of an isosurface: with curvature (gradient normals replacing the
+/// estimator's when `--normals` asked for them), with normals only, or bare.
+fn write_ply(out: &Path, s: &shapecue::Isosurface) -> Result<()> {
+    use shapecue::export::ply;
+    let written = match (&s.curvature, &s.normals) {
+        (Some(c), n) => {
+            let mut f = c.field.clone();
+            if let Some(n) = n {
+                f.normals = n.clone();
+            }
+            ply::write_ply(out, &s.mesh, Some(&f))?
+        }
+        (None, Some(n)) => ply::write_ply_with_normals(out, &s.mesh, n)?,
+        (None, None) => ply::write_ply(out, &s.mesh, None)?,
+    };
+    super::note_double(out, &written);
+    Ok(())
+}

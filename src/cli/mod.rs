@@ -1,0 +1,108 @@
+//! The commands of the `shapecue` binary, one module each, and what they
+//! share: writing to standard output (a closed pipe ends the command
+//! quietly), the outputs check, JSON stats, and the one error report.
+
+pub mod curvature;
+pub mod devices;
+pub mod edges;
+pub mod isosurface;
+pub mod render;
+pub mod strokes;
+pub mod tables;
+
+use anyhow::Result;
+use std::io::Write;
+use std::path::Path;
+
+/// `println!` on a locked standard output that returns the I/O error (a
+/// closed pipe: `shapecue … | head -1`) instead of panicking; [`fail`] turns
+/// a broken pipe into a quiet exit with status 0.
+macro_rules! out {
+    ($($t:tt)*) => {
+        $crate::cli::print(format_args!($($t)*))?
+    };
+}
+pub(crate) use out;
+
+/// Writes one line to standard output (see [`out!`]).
+pub fn print(args: std::fmt::Arguments) -> std::io::Result<()> {
+    let mut o = std::io::stdout().lock();
+    o.write_fmt(args)?;
+    o.write_all(b"\n")
+}
+
+/// Writes text as is to standard output (see [`out!`]).
+pub fn print_str(s: &str) -> std::io::Result<()> {
+    let mut o = std::io::stdout().lock();
+    o.write_all(s.as_bytes())?;
+    o.flush()
+}
+
+/// Checks a run's outputs against every file it reads and against each
+/// other, before any work ([`shapecue::export::output::check_outputs`]:
+/// inputs are compared by inode and are never overwritten, even with
+/// `--force`).
+pub fn check_outputs<'a>(
+    inputs: impl IntoIterator<Item = &'a Path>,
+    outputs: impl IntoIterator<Item = &'a Path>,
+    force: bool,
+) -> Result<()> {
+    let inputs: Vec<&Path> = inputs.into_iter().collect();
+    let outputs: Vec<&Path> = outputs.into_iter().collect();
+    shapecue::export::output::check_outputs(&inputs, &outputs, force)?;
+    Ok(())
+}
+
+/// Writes a stats document as pretty JSON (atomically) and says so.
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    shapecue::export::output::write_bytes_atomic(
+        path,
+        (serde_json::to_string_pretty(value)? + "\n").as_bytes(),
+    )?;
+    out!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Reports a failed command once and returns its exit code: 0 for a closed
+/// standard output (nothing is printed), else the message chain on stderr,
+/// each cause printed only if the message before it does not already say it
+/// (the library's I/O errors include the OS message), and the code the
+/// library's error decides ([`shapecue::Error::exit_code`]: 3 for
+/// `--interop on` without CL-GL sharing), 1 for everything else.
+pub fn fail(e: &anyhow::Error) -> i32 {
+    let broken_pipe = e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    });
+    if broken_pipe {
+        return 0;
+    }
+    let mut msg = String::new();
+    let mut prev = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if prev.contains(&text) {
+            continue;
+        }
+        if !msg.is_empty() {
+            msg.push_str(": ");
+        }
+        msg.push_str(&text);
+        prev = text;
+    }
+    eprintln!("error: {msg}");
+    e.chain()
+        .find_map(|c| c.downcast_ref::<shapecue::Error>())
+        .map_or(1, shapecue::Error::exit_code)
+}
+
+/// Says on stderr when a PLY file's vertex properties had to be written as
+/// double (a value outside float's range).
+pub fn note_double(out: &Path, w: &shapecue::export::ply::PlyWritten) {
+    if let Some(why) = &w.double {
+        eprintln!(
+            "note: {} has double-precision vertex properties: {why}",
+            out.display()
+        );
+    }
+}

@@ -1,0 +1,173 @@
+//! `shapecue render`: scene files through the planner and the executor
+//! ([`shapecue::scene::exec`]), with a progress bar on a terminal and each
+//! scene's report printed; `--explain` prints the plans, `--report` the
+//! per-frame device pipeline table.
+
+use super::out;
+use anyhow::{Result, bail};
+use clap::Args;
+use shapecue::gpu::Gpu;
+use shapecue::scene::exec::{self, ExecOptions, RunReport};
+use shapecue::scene::file::Scene;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The arguments of `shapecue render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene files (with `--report`: glTF files to time the per-frame device
+    /// pipeline on; default ../shared/data/animations/gltf/BrainStem.glb).
+    #[arg(required_unless_present = "report")]
+    scenes: Vec<PathBuf>,
+    /// Print the per-frame device pipeline table (skin, curvature with dcurv,
+    /// AO at each level with its error, contours and suggestive contours) of
+    /// skinned glTF models, timed apart from rendering.
+    #[arg(long)]
+    report: bool,
+    /// Frames of the first clip sampled by `--report`.
+    #[arg(long, default_value_t = 30)]
+    frames: usize,
+    /// Timed runs per frame for `--report` (medians are printed).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Output folder (overrides each scene's `[output] dir`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Overwrite existing images and reports.
+    #[arg(long)]
+    force: bool,
+    /// Print each scene's plan (passes, lifetimes, run counts) and exit
+    /// without computing or writing anything.
+    #[arg(long)]
+    explain: bool,
+}
+
+/// Runs `shapecue render`.
+pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
+    if a.report {
+        return pipeline_tables(device, &a);
+    }
+    let opts = ExecOptions {
+        out_dir: a.out.clone(),
+        force: a.force,
+        device: device.map(str::to_string),
+    };
+    // Check every scene before running any, so a typo in the last one does
+    // not surface after minutes of rendering.
+    let scenes: Vec<Scene> = a
+        .scenes
+        .iter()
+        .map(|p| Scene::load(p))
+        .collect::<shapecue::Result<_>>()?;
+    for scene in &scenes {
+        if a.explain {
+            super::print_str(&exec::explain(scene, &opts)?)?;
+            continue;
+        }
+        let bar = progress_bar(&scene.name);
+        let r = exec::run(scene, &opts, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        })?;
+        bar.finish_and_clear();
+        print_report(&r)?;
+    }
+    Ok(())
+}
+
+/// `--report`: the per-frame device pipeline table of each glTF model.
+fn pipeline_tables(device: Option<&str>, a: &RenderArgs) -> Result<()> {
+    let models = if a.scenes.is_empty() {
+        vec![PathBuf::from(
+            "../shared/data/animations/gltf/BrainStem.glb",
+        )]
+    } else {
+        a.scenes.clone()
+    };
+    let gpu = Arc::new(Gpu::new(device)?);
+    for m in &models {
+        if !m.exists() {
+            bail!(
+                "{}: not found (give the glTF files to time: `shapecue render --report MODEL.glb`)",
+                m.display()
+            );
+        }
+        let t = super::tables::pipeline_report(gpu.clone(), m, a.frames.max(1), a.runs.max(1))?;
+        super::print_str(&t)?;
+    }
+    Ok(())
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal.
+fn progress_bar(name: &str) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use std::io::IsTerminal;
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if !std::io::stderr().is_terminal() {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} views {elapsed} ETA {eta}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(name.to_string());
+    bar
+}
+
+/// A scene's report: counts, one line per pass that ran, medians, notes.
+fn print_report(r: &RunReport) -> Result<()> {
+    out!(
+        "{}: {} frame(s) x {} view(s), {} vertices, {} faces on {}",
+        r.scene,
+        r.frames.len(),
+        r.views,
+        r.vertices,
+        r.faces,
+        r.device
+    );
+    out!(
+        "  {:<20} {:<9} {:>6} {:>10} {:>10}  how",
+        "pass",
+        "lifetime",
+        "runs",
+        "total ms",
+        "ms/run"
+    );
+    for p in &r.passes {
+        out!(
+            "  {:<20} {:<9} {:>6} {:>10.2} {:>10.3}  {} ({})",
+            format!("{:?}", p.pass),
+            format!("{:?}", p.lifetime),
+            p.runs,
+            p.ms,
+            p.ms / p.runs.max(1) as f64,
+            p.how,
+            p.clock
+        );
+    }
+    out!(
+        "  per frame: pose passes {:.2} ms (median); per view: lines/edges {:.2} ms, render {:.1} ms; \
+         segments: {} contour, {} suggestive; wall {:.0} ms",
+        r.pose_ms_median,
+        r.view_ms_median,
+        r.render_ms_median,
+        r.segments[0],
+        r.segments[1],
+        r.wall_ms
+    );
+    for n in &r.notes {
+        out!("  note: {n}");
+    }
+    let dir = r
+        .outputs
+        .first()
+        .and_then(|p| p.parent())
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    out!(
+        "  wrote {} file(s) to {dir} and the report",
+        r.outputs.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,159 @@
+//! What accuracy costs in time: error metrics (RMSE, NRMSE, analytic
+//! errors, medians) and timed runs of the stages, shared by the tests, the
+//! benches and the report tables of the `shapecue` command line (which
+//! print them, so the README's tables are produced, not typed).
+
+use crate::error::Result;
+use crate::gpu::Gpu;
+use crate::mesh::{self, Mesh};
+use crate::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use crate::stages::curvature::CurvatureEstimator;
+use std::sync::Arc;
+
+/// Root-mean-square difference.
+pub fn rmse(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len(), "rmse of slices of different lengths");
+    let n = a.len().max(1) as f64;
+    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / n).sqrt()
+}
+
+/// RMS error normalized by the reference's range; for a (nearly) constant
+/// attribute, whose range says nothing, by its mean magnitude instead
+/// (whichever is larger). Multiply by 100 for percent.
+pub fn nrmse(a: &[f64], reference: &[f64]) -> f64 {
+    let (lo, hi) = reference
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
+    let mean_abs = reference.iter().map(|x| x.abs()).sum::<f64>() / reference.len().max(1) as f64;
+    let norm = (hi - lo).max(mean_abs);
+    if norm > 0.0 {
+        rmse(a, reference) / norm
+    } else {
+        rmse(a, reference)
+    }
+}
+
+/// RMS error of (k1, k2) against analytic values at each vertex.
+pub fn analytic_rms(f: &CurvatureField, truth: &[(f64, f64)]) -> (f64, f64) {
+    let t1: Vec<f64> = truth.iter().map(|t| t.0).collect();
+    let t2: Vec<f64> = truth.iter().map(|t| t.1).collect();
+    (rmse(&f.k1, &t1), rmse(&f.k2, &t2))
+}
+
+/// Analytic curvature of the report's torus (R = 1, r = 0.4) at its vertices.
+pub fn torus_truth(m: &Mesh) -> Vec<(f64, f64)> {
+    m.positions
+        .iter()
+        .map(|&p| mesh::torus_curvature(1.0, 0.4, p))
+        .collect()
+}
+
+/// Median of a list of numbers (0 for an empty list).
+pub fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// One measured variant: the field of its last run and median times.
+pub struct Measured {
+    /// Output of the last run.
+    pub field: CurvatureField,
+    /// Median kernel time (ms) over the runs, mesh already on the device.
+    pub kernel_ms: f64,
+    /// Median wall time (ms) of a run, upload of positions and read-back excluded.
+    pub wall_ms: f64,
+}
+
+/// Runs a device variant `runs` times on `m` (after one warm-up run that
+/// pays for JIT compilation) and returns medians.
+pub fn measure(gpu: &Arc<Gpu>, m: &Mesh, opts: CurvatureOptions, runs: usize) -> Result<Measured> {
+    let mut est = CurvatureEstimator::new(gpu.clone(), m.n_vertices(), &m.faces, opts)?;
+    est.set_positions(&m.positions)?;
+    est.run()?;
+    let (mut k, mut w) = (Vec::new(), Vec::new());
+    for _ in 0..runs.max(1) {
+        let t = est.run()?;
+        k.push(t.kernel_ms);
+        w.push(t.wall_ms);
+    }
+    Ok(Measured {
+        field: est.read()?,
+        kernel_ms: median(&mut k),
+        wall_ms: median(&mut w),
+    })
+}
+
+/// A variant's name, e.g. `atomic f32 exact` or `gather f64 exact no-dcurv`
+/// (the report's rows; the bench uses it with dashes).
+pub fn label(o: &CurvatureOptions) -> String {
+    format!(
+        "{} {} {}{}",
+        match o.accumulate {
+            Accumulate::Atomic => "atomic",
+            Accumulate::Gather => "gather",
+        },
+        match o.precision {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        },
+        match o.compat {
+            Compat::Exact => "exact",
+            Compat::Trimesh2 => "trimesh2",
+        },
+        if o.dcurv { "" } else { " no-dcurv" }
+    )
+}
+
+/// The variants the report and the criterion bench compare, default first.
+pub fn variants() -> Vec<CurvatureOptions> {
+    let d = CurvatureOptions::default();
+    vec![
+        d,
+        CurvatureOptions { dcurv: false, ..d },
+        CurvatureOptions {
+            accumulate: Accumulate::Gather,
+            ..d
+        },
+        CurvatureOptions {
+            precision: Precision::F64,
+            ..d
+        },
+        CurvatureOptions {
+            accumulate: Accumulate::Gather,
+            precision: Precision::F64,
+            ..d
+        },
+        CurvatureOptions {
+            compat: Compat::Trimesh2,
+            ..d
+        },
+    ]
+}
+
+/// Median kernel and wall ms of `runs` extractions (after one warm-up that
+/// pays for JIT compilation), and the stats of the last.
+pub fn measure_isosurface(
+    ex: &mut crate::stages::marching_cubes::Isosurfacer,
+    iso: f32,
+    fusion: crate::spec::vertex_fusion::Fusion,
+    runs: usize,
+) -> Result<(f64, f64, crate::stages::marching_cubes::IsoStats)> {
+    let mut st = ex.extract(iso, fusion)?;
+    let (mut k, mut w) = (Vec::new(), Vec::new());
+    for _ in 0..runs.max(1) {
+        st = ex.extract(iso, fusion)?;
+        k.push(st.timing.kernel_ms);
+        w.push(st.timing.wall_ms);
+    }
+    Ok((median(&mut k), median(&mut w), st))
+}
