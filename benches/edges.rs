@@ -1,5 +1,5 @@
 //! Edges stage benches (`kernels/edges.cl` ↔ `src/stages/edges.rs`), House &
-//! Li's comparison of the McGuire-Hughes and adjacency cap variants (seed 002).
+//! Li's comparison of the McGuire-Hughes and adjacency cap variants (House & Li).
 //!
 //! Groups, per caps variant (`none`, `mh`, `adjacency`) and mesh:
 //! - `edges/<caps>/<mesh>`: `edges_detect` + the variant's cap kernel, from

@@ -1,4 +1,4 @@
-// ao.cl: ambient occlusion from curvature (seed 000 §2.3, equations 10-12):
+// ao.cl: ambient occlusion from curvature (Griffin et al. 2012, §2.3, equations 10-12):
 // the surface near a vertex is the quadric z = ½(κ1x² + κ2y²) along the
 // normal, and AO is the cosine-weighted fraction of the hemisphere of radius R
 // above it that the quadric does not block. Host: src/stages/ao.rs; CPU twin:
@@ -15,7 +15,7 @@
 // 1 on a plane or a convex point, → 0 at the bottom of an ever sharper bowl.
 // The radius is emulated by scaling the curvatures (q uses kR).
 //   ao_vertex   per vertex   one of three accuracy levels (mode):
-//     0 poly   the seed's fit along the table's diagonal, s = (k1 + k2)R:
+//     0 poly   Griffin et al.'s fit along the table's diagonal, s = (k1 + k2)R:
 //              AO = 1.0 − 0.0022s² + 0.0776s + 0.7369 as quoted, clamped to [0, 1]
 //     1 lut    bilinear lookup in an N×N table of the integral over
 //              (t1, t2) = (x/(1+|x|)) of (k1R, k2R), built on the host

@@ -1,5 +1,5 @@
 // edges.cl: object-space feature edges with caps (House & Li, "Real-Time
-// Object-Space Edge Detection using OpenCL", seed 002; McGuire & Hughes 2004).
+// Object-Space Edge Detection using OpenCL"; McGuire & Hughes 2004).
 //
 // Passes (host: src/stages/edges.rs; CPU twin with the same step names:
 // src/cpu/edges.rs):
@@ -168,7 +168,7 @@ __kernel void edges_detect(uint n, __global const EdgeParams* P, __global const 
     const float f0 = hw * depth_factor(P->depth_k, c0w);
     const float f1 = hw * depth_factor(P->depth_k, c1w);
     // Half quads (contour-only edges, when asked): from the edge outward by the full
-    // width, outward = the side the projected vertex normal of i0 points to (seed's
+    // width, outward = the side the projected vertex normal of i0 points to (House & Li's
     // sign(m0·p)). Slots stay in perimeter order: 0 = s0, 1 = s1, 2, 3 outside.
     const int halfq = P->half_contours != 0.0f && k == KIND_CONTOUR;
     const uint j0 = halfq ? i0 : 0u;

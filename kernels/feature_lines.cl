@@ -1,5 +1,5 @@
 // feature_lines.cl: occluding and suggestive contours extracted per face as
-// line segments (DeCarlo et al. 2003, 2004; seed 000 §3.8). Host:
+// line segments (DeCarlo et al. 2003, 2004; Griffin et al. 2012, §3.8). Host:
 // src/stages/feature_lines.rs; CPU twin with the same step names:
 // src/cpu/feature_lines.rs.
 //   lines_vertex   per vertex  n·v, the radial curvature κr·sin²θ = k1u² + k2v²

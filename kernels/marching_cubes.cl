@@ -1,7 +1,7 @@
 // marching_cubes.cl: triangle soup of the isosurface value = iso of a scalar
 // volume, with one key per soup vertex for vertex fusion (vertex_fusion.cl).
 //
-// Seed 000 §3.4 (Griffin et al. 2012): classify, scan, triangles. Host:
+// Griffin et al. 2012, §3.4: classify, scan, triangles. Host:
 // src/stages/marching_cubes.rs; CPU twin with the same step names and the
 // same f32 arithmetic: src/cpu/marching_cubes.rs.
 // Shared with the host (src/spec/marching_cubes.rs): the case table (counts,

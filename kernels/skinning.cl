@@ -1,4 +1,4 @@
-// skinning.cl: linear blend skinning (seed 000: the mesh is deformed on the
+// skinning.cl: linear blend skinning (Griffin et al. 2012: the mesh is deformed on the
 // device each frame from keyframe joint matrices), p' = Σ w_i M_{j_i} p with
 // up to four influences. Host: src/stages/skinning.rs; CPU twin:
 // src/cpu/skinning.rs.

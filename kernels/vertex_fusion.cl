@@ -1,5 +1,5 @@
 // vertex_fusion.cl: marching-cubes triangle soup → indexed mesh with shared
-// vertices (seed 000 §3.4). Host: src/stages/vertex_fusion.rs; CPU twin with
+// vertices (Griffin et al. 2012, §3.4). Host: src/stages/vertex_fusion.rs; CPU twin with
 // the same step names: src/cpu/vertex_fusion.rs.
 // Shared with the host (src/spec/vertex_fusion.rs): the Fusion variant and its
 // mc_triangles mode code, and the bounds of the buffers below.

@@ -13,6 +13,9 @@
 #                        no crate::render, crate::scene
 #   src/scene/planner.rs the plan is data: no crate::gpu, crate::stages,
 #                        crate::render
+#   src/mesh/, src/volume/  data: no crate::gpu, crate::stages, crate::render,
+#                        crate::scene
+#   src/export/          writers: no crate::gpu, crate::stages, crate::scene
 #
 # What counts as a dependency: a `crate::<module>` path anywhere in code
 # (`use crate::stages::…`, `crate::render::Renderer` in a signature), and
@@ -27,6 +30,9 @@ rules=(
     "src/cpu|gpu stages render scene|CPU twins and spec know no device"
     "src/stages|render scene|compute knows no screen"
     "src/scene/planner.rs|gpu stages render|the plan is data, free of the device layer"
+    "src/mesh|gpu stages render scene|data knows no device and no screen"
+    "src/volume|gpu stages render scene|data knows no device and no screen"
+    "src/export|gpu stages scene|writers know no device (they may read the renderer's frames and cameras)"
 )
 
 status=0
@@ -86,4 +92,4 @@ if [ "$status" -ne 0 ]; then
     echo "check-layers: the layering above is broken; see ARCHITECTURE.md (move the shared type into src/spec/, or the drawing into src/render/)" >&2
     exit 1
 fi
-echo "check-layers: ok (spec, cpu, stages and the planner import only what their layer may)"
+echo "check-layers: ok (spec, cpu twins, stages, the planner, data and writers import only what their layer may)"

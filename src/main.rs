@@ -36,7 +36,7 @@ enum Cmd {
     /// Isosurface of a volume (marching cubes with vertex fusion on the
     /// device), optionally with curvature computed on the device right after.
     Isosurface(cli::isosurface::IsoArgs),
-    /// Object-space feature edges with caps (House & Li, seed 002): renders the
+    /// Object-space feature edges with caps (House & Li): renders the
     /// mesh, then contour, crease and boundary/marked edges as thick quads with
     /// caps, to PNG (and SVG). Exit code 3: `--interop on` on a device without
     /// cl_khr_gl_sharing (such as PoCL); 1: any other error.

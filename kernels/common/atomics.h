@@ -1,5 +1,5 @@
 // atomics.h: floating-point atomic add built on compare-and-swap, as the
-// seed's one-ring sums need (OpenCL 1.2 has no float atomics).
+// one-ring sums of Griffin et al. need (OpenCL 1.2 has no float atomics).
 // float: atomic_cmpxchg on the 32-bit pattern (core 1.1+);
 // double: atom_cmpxchg on the 64-bit pattern (cl_khr_int64_base_atomics).
 #ifdef SC_DOUBLE

@@ -1,4 +1,4 @@
-// hash.h: the 32-bit position hash of vertex fusion (seed 000 §3.4), the same
+// hash.h: the 32-bit position hash of vertex fusion (Griffin et al. 2012, §3.4), the same
 // integer mix as src/cpu/vertex_fusion.rs::fuse_hash. Build with
 // -DSC_HASH_COLLIDE=<mask> to keep only the masked bits (tests force
 // collisions this way; fusion must still be exact).

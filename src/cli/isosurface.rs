@@ -47,7 +47,7 @@ pub struct IsoArgs {
     /// Raw input: bytes to skip before the data.
     #[arg(long, default_value_t = 0)]
     header_bytes: usize,
-    /// Vertex fusion: hash (the seed's position hash + radix sort), edge
+    /// Vertex fusion: hash (Griffin et al.'s position hash + radix sort), edge
     /// (exact voxel-edge keys), none (triangle soup).
     #[arg(long, value_enum, default_value = "hash")]
     fusion: Fusion,

@@ -1,4 +1,4 @@
-//! Plain Rust reference of `kernels/edges.cl` (House & Li, seed 002), with
+//! Plain Rust reference of `kernels/edges.cl` (House & Li), with
 //! the same step names: [`edges_detect`], [`caps_mh`], [`caps_adjacency`].
 //!
 //! Inputs are the device's: the packed parameter block

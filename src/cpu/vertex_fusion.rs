@@ -1,6 +1,6 @@
 //! CPU reference of `kernels/vertex_fusion.cl`: turns the marching-cubes
 //! triangle soup into an indexed mesh with shared vertices, with the same
-//! steps as the device (seed 000, §3.4):
+//! steps as the device (Griffin et al. 2012, §3.4):
 //! `fuse_keys` (hash of the position, or the exact edge/point key) →
 //! stable sort of (key, soup index) → `fuse_index` (binary search to the first
 //! equal key, then walk forward comparing positions) → `fuse_triangles`

@@ -1,4 +1,4 @@
-//! SVG export of drawn feature edges (edges stage, seed 002): the visible
+//! SVG export of drawn feature edges (edges stage, House & Li): the visible
 //! part of each edge, found against the rendered depth buffer, with connected
 //! visible pieces joined into polylines.
 //!

@@ -1,4 +1,4 @@
-//! Edge topology for the edges stage (House & Li, seed 002), built once per
+//! Edge topology for the edges stage (House & Li), built once per
 //! mesh topology: the edge buffer, the adjacency cap buffer, marked edges and
 //! per-vertex normals for McGuire-Hughes caps.
 //!
@@ -6,7 +6,7 @@
 //! is the edge as the *first* face using it traverses it (faces in file
 //! order), `i2` is that face's third vertex, `i3` the third vertex of the
 //! second face. Boundary edges (one face) and marked edges have `i3 == i0`,
-//! the seed's "boundary and marked" test.
+//! House & Li's "boundary and marked" test.
 //!
 //! **Non-manifold edges** (3 or more faces): the faces around the edge are
 //! taken in file order and paired, (f0, f1), (f2, f3), ...; the edge is emitted

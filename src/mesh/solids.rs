@@ -81,7 +81,7 @@ pub fn cone(r: f64, h: f64, n: usize) -> Mesh {
 }
 
 /// `mesh` moved and scaled so that its bounding box is centred at the origin
-/// with a largest side of 1 ("unit-sized at the origin", as in seed 002's tables).
+/// with a largest side of 1 ("unit-sized at the origin", as in House & Li's tables).
 pub fn unit_sized(mesh: &Mesh) -> Mesh {
     let (lo, hi) = mesh.bounds();
     let c = [

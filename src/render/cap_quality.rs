@@ -1,4 +1,4 @@
-//! Cap-quality evaluation of the edges stage (seed 002's table): how closely
+//! Cap-quality evaluation of the edges stage (House & Li's table): how closely
 //! each cap variant's rendered stroke matches the ideal round-joined stroke
 //! of the same edges.
 //!

@@ -1,5 +1,5 @@
 //! Per-vertex colours for the scene renderer: the curvature colour map of
-//! seed 000 (Fig. 1 and 7: blue concave, red convex, green saddle) and AO
+//! Griffin et al. 2012 (Fig. 1 and 7: blue concave, red convex, green saddle) and AO
 //! baked into vertex colours, so that the mesh shader's Lambert term times
 //! the colour gives Lambert × AO.
 //!

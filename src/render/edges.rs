@@ -1,4 +1,4 @@
-//! Drawing the edges stage's output (House & Li, seed 002): the edge-out and
+//! Drawing the edges stage's output (House & Li): the edge-out and
 //! cap-out buffers as projection-space quads and triangles
 //! ([`draw_edges`]), and [`draw`], the whole `shapecue edges` picture in one
 //! call: topology, framing, the stage, the shaded mesh with its edges, the

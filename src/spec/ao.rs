@@ -17,7 +17,7 @@ use std::sync::OnceLock;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum AoMode {
-    /// The seed's polynomial along the table's diagonal.
+    /// Griffin et al.'s polynomial along the table's diagonal.
     #[value(help = super::NO_HELP)]
     Poly,
     /// Bilinear lookup in a precomputed table.

@@ -83,7 +83,7 @@ impl CurvatureField {
 #[serde(rename_all = "lowercase")]
 pub enum Accumulate {
     /// One work-item per face adds into its vertices with float atomics
-    /// (compare-and-swap), as in the seed. Summation order varies run to run.
+    /// (compare-and-swap), as in Griffin et al. Summation order varies run to run.
     #[default]
     #[value(help = super::NO_HELP)]
     Atomic,

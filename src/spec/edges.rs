@@ -446,7 +446,7 @@ pub fn cap_adjacency_bound(caps: usize) -> usize {
 }
 
 /// Bits of device memory the edges stage uses for one mesh, from the actual
-/// buffer sizes (seed 002's memory table; inputs already on the GPU for
+/// buffer sizes (House & Li's memory table; inputs already on the GPU for
 /// rendering, positions and normals, are not counted).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct MemoryUse {

@@ -15,7 +15,7 @@
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Fusion {
-    /// The seed's method: 32-bit hash of the position bits, radix sort,
+    /// Griffin et al.'s method: 32-bit hash of the position bits, radix sort,
     /// collisions resolved by comparing positions.
     #[value(help = super::NO_HELP)]
     Hash,

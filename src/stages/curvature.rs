@@ -6,7 +6,7 @@
 //! [`CurvatureEstimator::new`]; [`CurvatureEstimator::set_positions`] uploads a
 //! new pose into the existing buffers and [`CurvatureEstimator::run`] reruns
 //! only the position-dependent passes, so a deforming mesh costs no
-//! reallocation per frame (seed 000, §3.6). The CPU twin is
+//! reallocation per frame (Griffin et al. 2012, §3.6). The CPU twin is
 //! [`crate::cpu::curvature`]; shared types, thresholds and the memory bound:
 //! [`crate::spec::curvature`]; one-ring lists: [`crate::mesh::topology`].
 

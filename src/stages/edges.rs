@@ -26,7 +26,7 @@
 //! - **Crease**: the angle between the two face normals is larger than the
 //!   user angle θ (degrees, in (0, 180]): `na·nb < cos θ |na||nb|`. A flat
 //!   region has 0°, a cube's edges 90°: θ = 30 finds the cube's 12 edges and
-//!   none of its face diagonals. (The seed writes `na·nb < −cos θ'`, i.e.
+//!   none of its face diagonals. (House & Li write `na·nb < −cos θ'`, i.e.
 //!   θ' = 180° − θ is the dihedral angle between the faces.)
 //! - **Boundary and marked**: `i3 == i0`.
 //! - **Half quads** (`half_contours`): contour-only edges extend from the edge
@@ -34,10 +34,10 @@
 //!   centre line, so adjacency caps join them (McGuire-Hughes caps stay
 //!   centred on the edge).
 //! - **Width**: `line_width` pixels across, times max(1, k/w) with depth scale
-//!   k (the seed's appendix; k = 0 or `None`: constant screen width).
+//!   k (House & Li's appendix; k = 0 or `None`: constant screen width).
 //! - **Near plane**: an edge with an end at clip w ≤ near (perspective) is not
 //!   drawn, so an eye inside the mesh gives no screen-spanning quads.
-//! - **Degenerate output** is the seed's marker `(NaN, 0, −1, 1)` on every
+//! - **Degenerate output** is House & Li's marker `(NaN, 0, −1, 1)` on every
 //!   vertex of the quad, triangle or cap.
 
 use crate::error::{Error, Result};

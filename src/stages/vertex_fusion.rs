@@ -1,6 +1,6 @@
 //! Host wiring of `kernels/vertex_fusion.cl`: the marching-cubes soup (one
 //! key per vertex, written by `mc_triangles`) becomes an indexed mesh with
-//! shared vertices, entirely on the device (seed 000 §3.4):
+//! shared vertices, entirely on the device (Griffin et al. 2012, §3.4):
 //! radix sort of (key, soup index) → `fuse_index` → `fuse_triangles` →
 //! twin cancellation (`fuse_candidates`, sort, `fuse_cancel`) → `fuse_mark` →
 //! scans → `fuse_compact_vertices`, `fuse_compact_faces`.

@@ -1,0 +1,318 @@
+use std::io::{BufRead, ErrorKind};
+
+use ply_rs_bw::parser::{ParseError, Parser, Reader};
+use ply_rs_bw::ply::{
+    ElementDef, Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType,
+    ScalarType,
+};
+
+use super::{Error, Mesh, Result, capped, fan, vertex_index};
+
+/// Names accepted for the face index list.
+const FACE_LISTS: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// A vertex: only x, y and z are kept, converted to f64.
+struct Vertex([f64; 3]);
+
+impl PropertyAccess for Vertex {
+    fn new() -> Self {
+        Vertex([0.0; 3])
+    }
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        let k = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.0[k] = match property {
+            Property::Char(v) => v.into(),
+            Property::UChar(v) => v.into(),
+            Property::Short(v) => v.into(),
+            Property::UShort(v) => v.into(),
+            Property::Int(v) => v.into(),
+            Property::UInt(v) => v.into(),
+            Property::Float(v) => v.into(),
+            Property::Double(v) => v,
+            _ => return PropertyAccessResult::UnsupportedType,
+        };
+        PropertyAccessResult::Set
+    }
+}
+
+/// A face: only the index list is kept, widened to i64 so that negative
+/// values can be reported.
+struct Face(Vec<i64>);
+
+impl PropertyAccess for Face {
+    fn new() -> Self {
+        Face(Vec::new())
+    }
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        if !FACE_LISTS.contains(&name) {
+            return PropertyAccessResult::Ignored;
+        }
+        self.0 = match property {
+            Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListInt(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUInt(v) => v.into_iter().map(i64::from).collect(),
+            _ => return PropertyAccessResult::UnsupportedType,
+        };
+        PropertyAccessResult::Set
+    }
+}
+
+/// An element shapecue does not use: parsed (to advance the stream) and dropped.
+struct Skip;
+
+impl PropertyAccess for Skip {
+    fn new() -> Self {
+        Skip
+    }
+}
+
+/// First line of a parser error's message (the rest is a dump of the
+/// parser's state).
+fn first_line(e: &ParseError) -> String {
+    let msg = e.to_string();
+    let line = msg.lines().next().unwrap_or("").trim();
+    line.strip_prefix("Line")
+        .map_or_else(|| line.to_string(), |r| format!("line{r}"))
+}
+
+/// One-line description of a parser error met while reading element
+/// `def`; `ascii_line` is the line number and text of an ASCII element.
+fn describe(e: &ParseError, def: &ElementDef, ascii_line: Option<(usize, &str)>) -> String {
+    match (e.kind(), ascii_line) {
+        (ErrorKind::UnexpectedEof, _) => format!(
+            "unexpected end of file: the header declares {} '{}' elements",
+            def.count, def.name
+        ),
+        (ErrorKind::InvalidInput, Some((ln, text))) => {
+            let props: Vec<&str> = def.properties.keys().map(String::as_str).collect();
+            let text: String = text.trim().chars().take(80).collect();
+            format!(
+                "line {ln}: '{text}' does not match the declared properties ({})",
+                props.join(" ")
+            )
+        }
+        _ => e
+            .to_string()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" "),
+    }
+}
+
+/// The payload stream: the bytes after the header and, for ASCII files,
+/// the number of the next line.
+struct Stream<'a> {
+    reader: Reader<&'a [u8]>,
+    encoding: Encoding,
+    line_no: usize,
+    line: String,
+}
+
+impl Stream<'_> {
+    /// Reads the next element described by `def`.
+    fn element<E: PropertyAccess>(
+        &mut self,
+        parser: &Parser<E>,
+        def: &ElementDef,
+    ) -> std::result::Result<E, ParseError> {
+        match self.encoding {
+            Encoding::BinaryLittleEndian => {
+                parser.read_little_endian_element(self.reader.get_mut(), def)
+            }
+            Encoding::BinaryBigEndian => parser.read_big_endian_element(self.reader.get_mut(), def),
+            Encoding::Ascii => {
+                // One element per line; blank lines are tolerated.
+                loop {
+                    self.line.clear();
+                    self.line_no += 1;
+                    if self.reader.get_mut().read_line(&mut self.line)? == 0 {
+                        return Err(std::io::Error::from(ErrorKind::UnexpectedEof).into());
+                    }
+                    if !self.line.trim().is_empty() {
+                        let e = parser.read_ascii_element(&self.line, def)?;
+                        // The parser ignores values past the declared ones;
+                        // a line with more is a malformed file, not a
+                        // comment.
+                        if extra_values(&self.line, def) {
+                            return Err(std::io::Error::from(ErrorKind::InvalidInput).into());
+                        }
+                        return Ok(e);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reads all `def.count` elements of one kind, passing each to `sink`.
+    fn read_all<E: PropertyAccess>(
+        &mut self,
+        def: &ElementDef,
+        source: &str,
+        mut sink: impl FnMut(usize, E) -> Result<()>,
+    ) -> Result<()> {
+        let parser = Parser::<E>::new();
+        for i in 0..def.count {
+            let e = self.element(&parser, def).map_err(|e| {
+                let ascii = (self.encoding == Encoding::Ascii)
+                    .then_some((self.line_no, self.line.as_str()));
+                Error::input(
+                    source,
+                    format!("{} {i}", def.name),
+                    describe(&e, def, ascii),
+                )
+            })?;
+            sink(i, e)?;
+        }
+        Ok(())
+    }
+}
+
+/// True when an ASCII element line holds more values than `def`
+/// declares (a list property takes its count and that many values).
+fn extra_values(line: &str, def: &ElementDef) -> bool {
+    let tokens: Vec<&str> = line.split_whitespace().collect();
+    let mut used = 0usize;
+    for p in def.properties.values() {
+        match p.data_type {
+            PropertyType::Scalar(_) => used += 1,
+            PropertyType::List(..) => {
+                let n = tokens
+                    .get(used)
+                    .and_then(|t| t.parse::<usize>().ok())
+                    .unwrap_or(0);
+                used = used.saturating_add(1).saturating_add(n);
+            }
+        }
+    }
+    tokens.len() > used
+}
+
+fn is_integer(t: &ScalarType) -> bool {
+    !matches!(t, ScalarType::Float | ScalarType::Double)
+}
+
+/// Checks that the header has what shapecue needs, before reading the payload.
+fn check_header(header: &Header, source: &str) -> Result<()> {
+    let err = |p: String| Error::input(source, "header", p);
+    let Some(vertex) = header.elements.get("vertex") else {
+        return Err(err("no 'vertex' element".into()));
+    };
+    for axis in ["x", "y", "z"] {
+        match vertex.properties.get(axis).map(|p| &p.data_type) {
+            Some(PropertyType::Scalar(_)) => {}
+            Some(PropertyType::List(..)) => {
+                return Err(err(format!(
+                    "property '{axis}' of element 'vertex' is a list, not a number"
+                )));
+            }
+            None => return Err(err(format!("element 'vertex' has no property '{axis}'"))),
+        }
+    }
+    if let Some(face) = header.elements.get("face") {
+        let list = FACE_LISTS
+            .iter()
+            .find_map(|n| face.properties.get(*n).map(|p| (n, &p.data_type)));
+        match list {
+            Some((_, PropertyType::List(count, item))) if is_integer(count) && is_integer(item) => {
+            }
+            Some((n, t)) => {
+                return Err(err(format!(
+                    "property '{n}' of element 'face' must be a list of integers, found {t:?}"
+                )));
+            }
+            None if face.count == 0 => {}
+            None => {
+                return Err(err(
+                    "element 'face' has no 'vertex_indices' (or 'vertex_index') list".into(),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The header is text: a line that is not UTF-8 is named by its number
+/// (the parser would only say that the stream is not valid UTF-8).
+fn check_header_text(bytes: &[u8], source: &str) -> Result<()> {
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if let Err(e) = std::str::from_utf8(line) {
+            let col = e.valid_up_to();
+            return Err(Error::input(
+                source,
+                format!("header line {}", i + 1),
+                format!(
+                    "byte 0x{:02x} at column {} is not text (the header must be ASCII)",
+                    line[col],
+                    col + 1
+                ),
+            ));
+        }
+        if line.strip_suffix(b"\r").unwrap_or(line) == b"end_header" {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// Parses a PLY file (ASCII, binary little- or big-endian).
+pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
+    check_header_text(bytes, source)?;
+    let mut reader = Reader::new(bytes);
+    let header = Parser::<Skip>::new()
+        .read_header(&mut reader)
+        .map_err(|e| Error::input(source, "header", first_line(&e)))?;
+    check_header(&header, source)?;
+    let mut stream = Stream {
+        // `line()` is the number of the first payload line; `element`
+        // increments before reading.
+        line_no: reader.line().saturating_sub(1),
+        reader,
+        encoding: header.encoding,
+        line: String::new(),
+    };
+    let nv = header.elements.get("vertex").map_or(0, |d| d.count);
+
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    let mut poly: Vec<u32> = Vec::new();
+    for (name, def) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                positions.reserve(capped(def.count, bytes.len()));
+                stream.read_all(def, source, |_, v: Vertex| {
+                    positions.push(v.0);
+                    Ok(())
+                })?;
+            }
+            "face" => {
+                faces.reserve(capped(def.count, bytes.len()));
+                stream.read_all(def, source, |i, f: Face| {
+                    let element = || format!("face {i}");
+                    if f.0.len() < 3 {
+                        return Err(Error::input(
+                            source,
+                            element(),
+                            format!("{} vertex indices; a face needs at least 3", f.0.len()),
+                        ));
+                    }
+                    poly.clear();
+                    for &v in &f.0 {
+                        poly.push(vertex_index(v, nv, source, element)?);
+                    }
+                    fan(&poly, &mut faces);
+                    Ok(())
+                })?;
+            }
+            _ => stream.read_all(def, source, |_, _: Skip| Ok(()))?,
+        }
+    }
+    Ok(Mesh { positions, faces })
+}
