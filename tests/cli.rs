@@ -414,3 +414,91 @@ fn a_missing_input_is_named_once_with_the_os_message_once() {
     assert_eq!(e.matches("No such file").count(), 1, "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }
+
+/// Signed volume of a closed triangle mesh (positive when faces point out).
+fn signed_volume(pos: &[Vec<f32>], faces: &[[u32; 3]]) -> f64 {
+    let p = |i: u32| {
+        let v = &pos[i as usize];
+        [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])]
+    };
+    faces
+        .iter()
+        .map(|f| {
+            let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
+/// A density volume (a ball of high values, as CT and MRI data are) gives
+/// outward faces by default (inside = above for volume files), and convex
+/// (positive) mean curvature; `--inside below` turns it inside out. An iso
+/// value outside the data is an error giving the data's range.
+#[test]
+fn density_volumes_are_outward_by_default_and_iso_outside_the_data_is_an_error() {
+    let d = scratch("density-ball");
+    let n = 24usize;
+    let mut bytes = Vec::with_capacity(n * n * n);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let c = |i: usize| i as f64 - 11.5;
+                let r = (c(x).powi(2) + c(y).powi(2) + c(z).powi(2)).sqrt();
+                bytes.push((255.0 * (1.0 - r / 12.0).clamp(0.0, 1.0)) as u8);
+            }
+        }
+    }
+    let raw = d.join("ball.raw");
+    std::fs::write(&raw, &bytes).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let o = cli()
+            .arg("isosurface")
+            .arg(&raw)
+            .args([
+                "--dims",
+                "24,24,24",
+                "--type",
+                "u8",
+                "--iso",
+                "128",
+                "--curvature",
+                "-o",
+            ])
+            .arg(d.join(out))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let (names, rows, faces) =
+            shapecue::export::ply::read_ply_properties(&d.join(out)).unwrap();
+        let k1 = names.iter().position(|n| n == "k1").unwrap();
+        let k2 = names.iter().position(|n| n == "k2").unwrap();
+        let h: f64 = rows
+            .iter()
+            .map(|r| 0.5 * f64::from(r[k1] + r[k2]))
+            .sum::<f64>()
+            / rows.len() as f64;
+        (signed_volume(&rows, &faces), h)
+    };
+    let (vol, h) = run("out.ply", &[]);
+    assert!(vol > 0.0 && h > 0.0, "default: volume {vol}, mean H {h}");
+    let (vol, h) = run("in.ply", &["--inside", "below"]);
+    assert!(
+        vol < 0.0 && h < 0.0,
+        "inside below: volume {vol}, mean H {h}"
+    );
+
+    let o = cli()
+        .arg("isosurface")
+        .arg(&raw)
+        .args(["--dims", "24,24,24", "--type", "u8", "--iso", "300", "-o"])
+        .arg(d.join("none.ply"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("empty") && e.contains("0 to 236"), "{e}");
+    assert!(!d.join("none.ply").exists());
+}

@@ -32,6 +32,12 @@ pub struct IsoArgs {
     /// Iso value (default 0 for procedural fields).
     #[arg(long, allow_negative_numbers = true)]
     iso: Option<f32>,
+    /// Which side of the iso value the object is on, so that faces and
+    /// gradient normals point out and convex parts have positive curvature
+    /// (default: above for volume files such as CT or MRI densities, below
+    /// for the procedural signed distance fields).
+    #[arg(long, value_enum)]
+    inside: Option<Inside>,
     /// Raw input: voxels per axis, e.g. 32,32,32.
     #[arg(long, value_delimiter = ',')]
     dims: Option<Vec<usize>>,
@@ -140,8 +146,14 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     let iso = match (a.iso, &a.sdf) {
         (Some(v), _) => v,
         (None, Some(_)) => 0.0,
-        (None, None) => bail!("give --iso (the volume's values span {:?})", vol.range()),
+        (None, None) => match vol.range() {
+            Some((lo, hi)) => bail!("give --iso (the volume's values span {lo} to {hi})"),
+            None => bail!("give --iso (the volume has no finite values)"),
+        },
     };
+    if !iso.is_finite() {
+        bail!("--iso {iso} must be finite");
+    }
     check_outputs(
         a.input
             .as_deref()
@@ -159,7 +171,11 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     });
     let opts = IsoOptions {
         fusion: a.fusion,
-        inside: Inside::Below,
+        inside: a.inside.unwrap_or(if a.sdf.is_some() {
+            Inside::Below
+        } else {
+            Inside::Above
+        }),
         curvature,
         curvature_normals: a.curvature_normals,
         gradient_normals: a.normals && a.output.is_some(),
@@ -167,6 +183,15 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)
         .with_context(|| format!("uploading {name}"))?;
     let st = &s.stats;
+    if st.faces == 0 {
+        // As in scenes: an empty surface is an error, not an empty file.
+        let span = vol
+            .range()
+            .map_or("no finite values".to_string(), |(lo, hi)| {
+                format!("the values span {lo} to {hi}")
+            });
+        bail!("{name}: the isosurface at iso {iso} is empty ({span})");
+    }
     out!(
         "{name}: iso {iso}, fusion {}: {} vertices, {} faces ({} soup vertices, {} degenerate \
          triangles dropped); extraction {:.1} ms kernels, {:.1} ms wall",

@@ -196,12 +196,29 @@ super::named_choice!(IsoNormals, "isosurface normals choice");
 /// the iso value are negated first (exact in f32), so normals point out of
 /// the object and its convex parts get positive curvature. The scene file's
 /// `inside = "above" | "below"`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Inside {
     /// The object has the values above the iso value (density volumes).
+    #[value(help = super::NO_HELP)]
     Above,
     /// The object has the values below it (signed distance fields).
     #[default]
+    #[value(help = super::NO_HELP)]
     Below,
+}
+
+impl std::str::FromStr for Inside {
+    type Err = crate::error::Error;
+
+    /// `above` or `below` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "below" => Ok(Inside::Below),
+            "above" => Ok(Inside::Above),
+            _ => Err(crate::error::Error::InvalidArgument(format!(
+                "inside = '{s}': expected above or below"
+            ))),
+        }
+    }
 }

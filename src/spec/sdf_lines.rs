@@ -37,32 +37,9 @@ pub const NEWTON_STEPS: u32 = 2;
 /// Marker of an empty Poisson cell / an unset index.
 pub const NONE: u32 = u32::MAX;
 
-/// Which side of the iso value is inside the object (normals point out, so
-/// convex is positive): `Below` for signed distance fields (negative inside),
-/// `Above` for density volumes (CT, MRI).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub enum Inside {
-    /// Values below iso are inside (signed distance fields).
-    #[default]
-    Below,
-    /// Values above iso are inside (density volumes).
-    Above,
-}
-
-impl std::str::FromStr for Inside {
-    type Err = crate::error::Error;
-
-    /// `above` or `below` (case-insensitive).
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "below" => Ok(Inside::Below),
-            "above" => Ok(Inside::Above),
-            _ => Err(crate::error::Error::InvalidArgument(format!(
-                "inside = '{s}': expected above or below"
-            ))),
-        }
-    }
-}
+/// Which side of the iso value is inside the object: the marching-cubes
+/// choice, shared so that the surface and its strokes agree.
+pub use super::marching_cubes::Inside;
 
 /// How the Hessian sampling distance h is chosen.
 #[derive(Clone, Debug, PartialEq)]

@@ -480,8 +480,11 @@ impl<'s, 'g> Executor<'s, 'g> {
                         let (a, b) = (sign * a, sign * b);
                         (a.min(b), a.max(b))
                     });
+                    let span = span.map_or("no finite values".to_string(), |(a, b)| {
+                        format!("the values span {a} to {b}")
+                    });
                     format!(
-                        "the isosurface at iso {} is empty (the values span {span:?})",
+                        "the isosurface at iso {} is empty ({span})",
                         sign * iso_value
                     )
                 },
