@@ -502,3 +502,77 @@ fn density_volumes_are_outward_by_default_and_iso_outside_the_data_is_an_error()
     assert!(e.contains("empty") && e.contains("0 to 236"), "{e}");
     assert!(!d.join("none.ply").exists());
 }
+
+/// Sizes are checked before anything is allocated: the error names the
+/// option, the bytes implied and the limit, at once (these aborted after
+/// trying to allocate, or ran for seconds first).
+#[test]
+fn sizes_are_checked_before_allocating() {
+    let d = scratch("sizes");
+    let run = |args: &[&str]| {
+        let t = std::time::Instant::now();
+        let o = cli().args(args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} should fail");
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{args:?}: a clear error, not an abort"
+        );
+        assert!(
+            t.elapsed().as_secs() < 20,
+            "{args:?} took {:?}",
+            t.elapsed()
+        );
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let out = d.join("o.ply");
+    let o = out.to_str().unwrap();
+    let e = run(&[
+        "isosurface",
+        "--sdf",
+        "sphere",
+        "--resolution",
+        "100000",
+        "-o",
+        o,
+    ]);
+    assert!(
+        e.contains("--resolution") && e.contains("GiB") && e.contains("1024"),
+        "{e}"
+    );
+    let e = run(&[
+        "isosurface",
+        "--sdf",
+        "sphere",
+        "--resolution",
+        "0",
+        "-o",
+        o,
+    ]);
+    assert!(
+        e.contains("--resolution") && e.contains("at least 2"),
+        "{e}"
+    );
+    let e = run(&[
+        "curvature",
+        "--generate",
+        "plane",
+        "--resolution",
+        "100000000000",
+        "-o",
+        o,
+    ]);
+    assert!(e.contains("--resolution") && e.contains("50000000"), "{e}");
+    let e = run(&[
+        "curvature",
+        "--generate",
+        "torus",
+        "--runs",
+        "0",
+        "--report",
+    ]);
+    assert!(e.contains("--runs"), "{e}");
+    let e = run(&["edges", "missing.obj", "--size", "0x10", "-o", o]);
+    assert!(e.contains("--size"), "{e}");
+    assert!(!out.exists());
+}

@@ -67,6 +67,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         compat: a.compat,
         dcurv: !a.no_dcurv,
     };
+    shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         let text = super::tables::curvature_report(gpu, a.resolution, a.runs)?;
@@ -75,7 +76,10 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     }
     let t_load = Instant::now();
     let (name, mesh) = match (&a.input, a.generate) {
-        (_, Some(kind)) => kind.mesh(a.resolution),
+        (_, Some(kind)) => {
+            shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
+            kind.mesh(a.resolution)
+        }
         (Some(path), None) => {
             let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
             (path.display().to_string(), m)

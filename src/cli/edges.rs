@@ -100,22 +100,12 @@ fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
     }
 }
 
-fn size_arg(s: &str) -> Result<(u32, u32)> {
-    let parsed = s
-        .split_once(['x', 'X'])
-        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
-    match parsed {
-        Some((w, h)) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => Ok((w, h)),
-        _ => bail!("--size {s:?}: expected WIDTHxHEIGHT with both in 1..=16384, e.g. 800x600"),
-    }
-}
-
 /// Runs `shapecue edges`.
 pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     // Parsed here rather than by clap's ValueEnum so that a bad name keeps
     // the library's message ("unknown cap mode ...") and exit code 1.
     let mode: CapMode = a.caps.parse()?;
-    let (w, h) = size_arg(&a.size)?;
+    let (w, h) = super::size_arg(&a.size)?;
     // Checked before any table or drawing: the message names the flag.
     if !(a.width.is_finite() && a.width > 0.0) {
         bail!(

@@ -10,7 +10,7 @@ use shapecue::gpu::Gpu;
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use shapecue::spec::marching_cubes::IsoNormals;
 use shapecue::spec::vertex_fusion::Fusion;
-use shapecue::volume::{self, RawSpec, ScalarType};
+use shapecue::volume;
 use shapecue::{Inside, IsoOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -93,32 +93,9 @@ pub struct IsoArgs {
     runs: usize,
 }
 
-/// The raw-data description that `--dims`, `--type`, ... give, if any.
-fn raw_spec(a: &IsoArgs) -> Result<Option<RawSpec>> {
-    Ok(match (&a.dims, &a.scalar) {
-        (Some(d), Some(t)) => {
-            if d.len() != 3 {
-                bail!("--dims needs three values X,Y,Z, got {}", d.len());
-            }
-            let scalar: ScalarType = t.parse()?;
-            let mut spec = RawSpec::new([d[0], d[1], d[2]], scalar);
-            spec.big_endian = a.big_endian;
-            spec.header_bytes = a.header_bytes;
-            if let Some(sp) = &a.spacing {
-                if sp.len() != 3 {
-                    bail!("--spacing needs three values, got {}", sp.len());
-                }
-                spec.spacing = [sp[0], sp[1], sp[2]];
-            }
-            Some(spec)
-        }
-        (None, None) => None,
-        _ => bail!("raw input needs both --dims and --type"),
-    })
-}
-
 /// Runs `shapecue isosurface`.
 pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
+    shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         super::print_str(&super::tables::isosurface_report(
@@ -136,7 +113,13 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             Vec::new(),
         ),
         (Some(path), None) => {
-            let raw = raw_spec(&a)?;
+            let raw = super::raw_spec(
+                a.dims.as_deref(),
+                a.scalar.as_deref(),
+                a.big_endian,
+                a.header_bytes,
+                a.spacing.as_deref(),
+            )?;
             let (vol, read) = volume::load_with_files(path, raw.as_ref())?;
             (path.display().to_string(), vol, read)
         }

@@ -106,3 +106,53 @@ pub fn note_double(out: &Path, w: &shapecue::export::ply::PlyWritten) {
         );
     }
 }
+
+/// Parses `--size WIDTHxHEIGHT` within the shared image limits
+/// ([`shapecue::spec::limits::check_image_size`]).
+pub fn size_arg(s: &str) -> anyhow::Result<(u32, u32)> {
+    let parsed = s
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) => {
+            shapecue::spec::limits::check_image_size("--size", w, h)?;
+            Ok((w, h))
+        }
+        None => anyhow::bail!(
+            "--size {s}: expected WIDTHxHEIGHT with both in 1..={}, e.g. 800x600",
+            shapecue::spec::limits::MAX_IMAGE_SIDE
+        ),
+    }
+}
+
+/// The raw-data description that `--dims`, `--type`, `--big-endian`,
+/// `--header-bytes` and `--spacing` give, if any (volume inputs).
+pub fn raw_spec(
+    dims: Option<&[usize]>,
+    scalar: Option<&str>,
+    big_endian: bool,
+    header_bytes: usize,
+    spacing: Option<&[f64]>,
+) -> anyhow::Result<Option<shapecue::volume::RawSpec>> {
+    use shapecue::volume::{RawSpec, ScalarType};
+    Ok(match (dims, scalar) {
+        (Some(d), Some(t)) => {
+            if d.len() != 3 {
+                anyhow::bail!("--dims needs three values X,Y,Z, got {}", d.len());
+            }
+            let scalar: ScalarType = t.parse()?;
+            let mut spec = RawSpec::new([d[0], d[1], d[2]], scalar);
+            spec.big_endian = big_endian;
+            spec.header_bytes = header_bytes;
+            if let Some(sp) = spacing {
+                if sp.len() != 3 {
+                    anyhow::bail!("--spacing needs three values, got {}", sp.len());
+                }
+                spec.spacing = [sp[0], sp[1], sp[2]];
+            }
+            Some(spec)
+        }
+        (None, None) => None,
+        _ => anyhow::bail!("raw input needs both --dims and --type"),
+    })
+}

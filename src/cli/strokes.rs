@@ -16,7 +16,7 @@ use shapecue::render::strokes::{StrokeStyle, draw};
 use shapecue::render::{MeshStyle, Placement, RenderOptions, Renderer, framed};
 use shapecue::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, SdfLinesOutput, Stroke};
 use shapecue::stages::sdf_lines::SdfLines;
-use shapecue::volume::{self, RawSpec, ScalarType, Volume};
+use shapecue::volume::{self, Volume};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -117,7 +117,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         print!("{}", torus_report(gpu)?);
         return Ok(());
     }
-    let (w, h) = size_arg(&a.size)?;
+    let (w, h) = super::size_arg(&a.size)?;
     let output = a.output.clone().expect("clap requires -o without --report");
     let (name, mut vol, procedural) = load_input(&a, device)?;
     let iso = match (a.iso, procedural) {
@@ -360,38 +360,15 @@ fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, 
         );
         return Ok((path.display().to_string(), v, true));
     }
-    let raw = match (&a.dims, &a.scalar) {
-        (Some(d), Some(t)) => {
-            if d.len() != 3 {
-                bail!("--dims needs three values X,Y,Z, got {}", d.len());
-            }
-            let scalar: ScalarType = t.parse()?;
-            let mut spec = RawSpec::new([d[0], d[1], d[2]], scalar);
-            spec.big_endian = a.big_endian;
-            spec.header_bytes = a.header_bytes;
-            if let Some(sp) = &a.spacing {
-                if sp.len() != 3 {
-                    bail!("--spacing needs three values, got {}", sp.len());
-                }
-                spec.spacing = [sp[0], sp[1], sp[2]];
-            }
-            Some(spec)
-        }
-        (None, None) => None,
-        _ => bail!("raw input needs both --dims and --type"),
-    };
+    let raw = super::raw_spec(
+        a.dims.as_deref(),
+        a.scalar.as_deref(),
+        a.big_endian,
+        a.header_bytes,
+        a.spacing.as_deref(),
+    )?;
     let v = volume::load(path, raw.as_ref())?;
     Ok((path.display().to_string(), v, false))
-}
-
-fn size_arg(s: &str) -> Result<(u32, u32)> {
-    let parsed = s
-        .split_once(['x', 'X'])
-        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
-    match parsed {
-        Some((w, h)) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => Ok((w, h)),
-        _ => bail!("--size {s:?}: expected WIDTHxHEIGHT with both in 1..=16384, e.g. 800x800"),
-    }
 }
 
 /// The accuracy/time table: on the torus SDF (tube radius r, κ1 = 1/r with

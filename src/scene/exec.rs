@@ -182,10 +182,7 @@ fn run_with(
         wall_ms: ms_since(t_all),
     };
     let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
-    std::fs::write(&report_path, json).map_err(|source| Error::Write {
-        path: report_path.clone(),
-        source,
-    })?;
+    crate::export::output::write_bytes_atomic(&report_path, json.as_bytes())?;
     Ok(report)
 }
 

@@ -132,17 +132,9 @@ pub fn sdf(kind: Sdf, res: usize) -> Volume {
 /// large to address.
 pub fn sdf_by_name(name: &str, res: usize) -> Result<Volume> {
     let kind: Sdf = name.parse()?;
-    if res < 2 {
-        return Err(Error::InvalidArgument(format!(
-            "procedural volume resolution {res}: at least 2 samples per axis are needed"
-        )));
-    }
-    res.checked_mul(res)
-        .and_then(|r| r.checked_mul(res))
-        .and_then(|r| r.checked_mul(std::mem::size_of::<f32>()))
-        .ok_or_else(|| {
-            Error::InvalidArgument(format!("procedural volume resolution {res} is too large"))
-        })?;
+    // Checked before allocating: the error names the option, the bytes and
+    // the limit (a typo like 100000 must not abort on allocation).
+    crate::spec::limits::check_volume_resolution("--resolution", res)?;
     Ok(sdf(kind, res))
 }
 
