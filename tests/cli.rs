@@ -576,3 +576,61 @@ fn sizes_are_checked_before_allocating() {
     assert!(e.contains("--size"), "{e}");
     assert!(!out.exists());
 }
+
+/// `shapecue strokes` end to end: a procedural field and a mesh (turned
+/// into a signed distance field first) give a PNG, an SVG, the strip PLY
+/// and stats; a closed stdout stays quiet.
+#[test]
+fn strokes_from_a_field_and_from_a_mesh() {
+    let d = scratch("strokes");
+    let mesh = d.join("ball.ply");
+    let written = shapecue::export::ply::write_ply(&mesh, &shapecue::mesh::icosphere(0.5, 3), None);
+    assert_eq!(written.unwrap().double, None);
+    for (input, tag) in [
+        (vec!["--sdf".to_string(), "torus".to_string()], "torus"),
+        (vec![mesh.display().to_string()], "mesh"),
+    ] {
+        let png = d.join(format!("{tag}.png"));
+        let stats = d.join(format!("{tag}.json"));
+        let o = cli()
+            .arg("strokes")
+            .args(&input)
+            .args([
+                "--resolution",
+                "48",
+                "--size",
+                "200x200",
+                "--seed-spacing",
+                "0.08",
+                "-o",
+            ])
+            .arg(&png)
+            .arg("--svg")
+            .arg(d.join(format!("{tag}.svg")))
+            .arg("--geometry")
+            .arg(d.join(format!("{tag}-strips.ply")))
+            .arg("--stats")
+            .arg(&stats)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{tag}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(png.exists() && d.join(format!("{tag}.svg")).exists());
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert!(s["seeds"].as_u64().unwrap() > 0, "{tag}: {s}");
+    }
+    let (status, err) = with_closed_stdout(&[
+        "strokes",
+        "--sdf",
+        "sphere",
+        "--resolution",
+        "32",
+        "-o",
+        d.join("quiet.png").to_str().unwrap(),
+    ]);
+    assert!(status.success(), "{err}");
+}

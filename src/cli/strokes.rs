@@ -114,7 +114,7 @@ pub struct StrokesArgs {
 pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
-        print!("{}", torus_report(gpu)?);
+        super::print_str(&torus_report(gpu)?)?;
         return Ok(());
     }
     let (w, h) = super::size_arg(&a.size)?;
@@ -123,7 +123,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     let iso = match (a.iso, procedural) {
         (Some(v), _) => v,
         (None, true) => 0.0,
-        (None, false) => bail!("give --iso (the volume's values span {:?})", vol.range()),
+        (None, false) => bail!("give --iso ({})", span(&vol)),
     };
     if !iso.is_finite() {
         bail!("--iso {iso} must be finite");
@@ -190,8 +190,8 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     let mesh = ex.world_mesh(&ipos, faces);
     if mesh.n_faces() == 0 {
         bail!(
-            "{name}: the isosurface at iso {iso} is empty (the values span {:?})",
-            vol.range()
+            "{name}: the isosurface at iso {iso} is empty ({})",
+            span(&vol)
         );
     }
     let normals = shapecue::cpu::marching_cubes::gradient_normals(&vol, &ipos);
@@ -250,7 +250,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     r.finish()?.save_png(&output)?;
 
     let ms = st.ms.total;
-    println!(
+    super::out!(
         "{name}: {} surface samples → {} seeds after Poisson-disk thinning (r = {:.4}); {} strokes, \
          {} segments; sampling distance {:.4} ({}); kernels {ms:.1} ms; wrote {}",
         st.dense,
@@ -274,7 +274,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
             .cloned()
             .collect();
         shapecue::export::strokes::write_svg(p, &facing, &cam, [w, h])?;
-        println!(
+        super::out!(
             "wrote {} ({} strokes facing the eye)",
             p.display(),
             facing.len()
@@ -282,7 +282,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     }
     if let Some(p) = &a.geometry {
         shapecue::export::strokes::write_ply(p, &out.strokes)?;
-        println!("wrote {}", p.display());
+        super::out!("wrote {}", p.display());
     }
     if let Some(p) = &a.stats {
         write_stats(p, &name, &gpu, &vol, &out)?;
@@ -322,12 +322,20 @@ fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutp
         "wall_ms": st.wall_ms,
     });
     write_bytes_atomic(p, (serde_json::to_string_pretty(&s)? + "\n").as_bytes())?;
-    println!("wrote {}", p.display());
+    super::out!("wrote {}", p.display());
     Ok(())
 }
 
 /// The input as a volume: a procedural field, a volume file, or a refusal
 /// for a mesh. Returns (name, volume, procedural).
+/// The range of a volume's values, in words.
+fn span(v: &Volume) -> String {
+    v.range()
+        .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
+            format!("the values span {lo} to {hi}")
+        })
+}
+
 fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, bool)> {
     if let Some(kind) = &a.sdf {
         let v = volume::sdf::sdf_by_name(kind, a.resolution)?;
@@ -348,7 +356,7 @@ fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, 
         };
         let (v, st) = shapecue::stages::mesh_sdf::mesh_to_sdf(gpu, &mesh, &opts)
             .with_context(|| format!("turning {} into a signed distance field", path.display()))?;
-        println!(
+        super::out!(
             "{}: signed distance field {}x{}x{} (spacing {:.4}), {:.1} ms kernels, {:.1} ms wall",
             path.display(),
             st.dims[0],
