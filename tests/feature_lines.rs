@@ -10,7 +10,8 @@ use common::{LineArrays, gpu, to_f32};
 use shapecue::cpu::feature_lines::{lines_face, lines_vertex};
 use shapecue::mesh::{self, Mesh};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
-use shapecue::spec::feature_lines::{EyeView as View, LineInputs, Segment};
+use shapecue::spec::feature_lines::{LineInputs, Segment};
+use shapecue::spec::view::View;
 use shapecue::stages::curvature::estimate;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 
@@ -85,15 +86,7 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
         ..Default::default()
     };
     // Along the axis: the outer and inner equators (radius 1.4 and 0.6, z = 0).
-    let s = device(
-        &m,
-        &x,
-        View {
-            eye: [0.0, 0.0, 1.0],
-            ortho: true,
-        },
-        contours,
-    );
+    let s = device(&m, &x, View::from_eye([0.0, 0.0, 1.0], true), contours);
     assert!(s.len() > 300, "{}", s.len());
     for (a, b, kind, _) in &s {
         assert_eq!(*kind, 0);
@@ -108,15 +101,7 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
     }
     // Across the axis (view along x): n·x = cos v cos u = 0, the circles in
     // the plane x = 0 and the top and bottom circles z = ±0.4.
-    let s = device(
-        &m,
-        &x,
-        View {
-            eye: [1.0, 0.0, 0.0],
-            ortho: true,
-        },
-        contours,
-    );
+    let s = device(&m, &x, View::from_eye([1.0, 0.0, 0.0], true), contours);
     assert!(s.len() > 300);
     for (a, b, _, _) in &s {
         for p in [a, b] {
@@ -152,14 +137,8 @@ fn device_matches_cpu_twin() {
             ..Default::default()
         };
         for view in [
-            View {
-                eye: [c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d],
-                ortho: false,
-            },
-            View {
-                eye: [0.3, 1.0, 0.2],
-                ortho: true,
-            },
+            View::from_eye([c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d], false),
+            View::from_eye([0.3, 1.0, 0.2], true),
         ] {
             let dev = device(&m, &x, view, opts);
             let t = lines_vertex(&li(&x), view);
@@ -177,10 +156,7 @@ fn device_matches_cpu_twin() {
 fn suggestive_contours_respect_the_threshold_and_facing() {
     let m = mesh::torus(1.0, 0.4, 120, 60);
     let x = inputs(&m);
-    let view = View {
-        eye: [3.0, 0.5, 1.5],
-        ortho: false,
-    };
+    let view = View::from_eye([3.0, 0.5, 1.5], false);
     let only_sc = |t: f32| LineOptions {
         contours: false,
         suggestive: true,
@@ -212,7 +188,7 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
     // Eye exactly on a vertex, and inside the sphere.
     for eye in [x.pos[0], [0.1, 0.0, 0.0]] {
         let (s, _) = ex
-            .extract(&li(&x), View { eye, ortho: false }, 1.0, opts)
+            .extract(&li(&x), View::from_eye(eye, false), 1.0, opts)
             .unwrap();
         assert!(
             s.iter()
@@ -222,38 +198,19 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
     assert!(
         ex.extract(
             &li(&x),
-            View {
-                eye: [f32::NAN, 0.0, 0.0],
-                ortho: false
-            },
+            View::from_eye([f32::NAN, 0.0, 0.0], false),
             1.0,
             opts
         )
         .is_err()
     );
     assert!(
-        ex.extract(
-            &li(&x),
-            View {
-                eye: [0.0; 3],
-                ortho: true
-            },
-            1.0,
-            opts
-        )
-        .is_err()
+        ex.extract(&li(&x), View::from_eye([0.0; 3], true), 1.0, opts)
+            .is_err()
     );
     assert!(
-        ex.extract(
-            &li(&x),
-            View {
-                eye: [0.0, 0.0, 5.0],
-                ortho: false
-            },
-            0.0,
-            opts
-        )
-        .is_err()
+        ex.extract(&li(&x), View::from_eye([0.0, 0.0, 5.0], false), 0.0, opts)
+            .is_err()
     );
     let short = LineArrays {
         pos: x.pos[..3].to_vec(),
@@ -262,10 +219,7 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
     assert!(
         ex.extract(
             &li(&short),
-            View {
-                eye: [0.0, 0.0, 5.0],
-                ortho: false
-            },
+            View::from_eye([0.0, 0.0, 5.0], false),
             1.0,
             opts
         )

@@ -15,7 +15,8 @@ use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::mesh::{self, Mesh};
 use shapecue::spec::ao::AoMode;
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
-use shapecue::spec::feature_lines::{EyeView as View, Segment};
+use shapecue::spec::feature_lines::Segment;
+use shapecue::spec::view::View;
 use shapecue::stages::ao::AoStage;
 use shapecue::stages::curvature::{CurvatureEstimator, Pass};
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
@@ -141,14 +142,11 @@ fn chained_lines_equal_lines_of_host_arrays() {
         let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
         let d = size(&m);
         let views = [
-            View {
-                eye: [c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d].map(|x| x as f32),
-                ortho: false,
-            },
-            View {
-                eye: [0.3, 1.0, 0.2],
-                ortho: true,
-            },
+            View::from_eye(
+                [c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d].map(|x| x as f32),
+                false,
+            ),
+            View::from_eye([0.3, 1.0, 0.2], true),
         ];
         // Endpoints within 1e-5 of the mesh size: the world positions of
         // the host path are rounded to f32 (at 1e4 + 1e3 that alone is ~3e-7
@@ -170,14 +168,14 @@ fn chained_lines_equal_lines_of_host_arrays() {
             assert_eq!(unmatched(&got, &want, tol), 0, "{what}: endpoints");
             // Relative to an origin at the mesh centre: the same segments,
             // shifted (eye given relative to the origin too).
-            let local = View {
-                eye: if view.ortho {
-                    view.eye
+            let local = View::from_eye(
+                if view.ortho {
+                    view.eye.to_array()
                 } else {
                     std::array::from_fn(|i| (f64::from(view.eye[i]) - c[i]) as f32)
                 },
-                ortho: view.ortho,
-            };
+                view.ortho,
+            );
             let (rel, _) = ex
                 .extract_device_at(&est, local, 0.3 * d as f32, opts, c)
                 .unwrap();
@@ -196,10 +194,7 @@ fn chained_lines_equal_lines_of_host_arrays() {
             );
         }
         // Same validation as the host path.
-        let bad = View {
-            eye: [f32::NAN, 0.0, 0.0],
-            ortho: false,
-        };
+        let bad = View::from_eye([f32::NAN, 0.0, 0.0], false);
         assert!(
             ex.extract_device(&est, bad, 1.0, LineOptions::default())
                 .is_err()
@@ -208,10 +203,7 @@ fn chained_lines_equal_lines_of_host_arrays() {
             ex.extract_device(&est, views[0], 0.0, LineOptions::default())
                 .is_err()
         );
-        let zero = View {
-            eye: [0.0; 3],
-            ortho: true,
-        };
+        let zero = View::from_eye([0.0; 3], true);
         assert!(
             ex.extract_device(&est, zero, 1.0, LineOptions::default())
                 .is_err()
@@ -241,14 +233,8 @@ fn contours_need_only_the_normals_pass() {
             let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
             let d = size(&m) as f32;
             for view in [
-                View {
-                    eye: [2.0 * d, 0.5 * d, 1.5 * d],
-                    ortho: false,
-                },
-                View {
-                    eye: [0.3, 1.0, 0.2],
-                    ortho: true,
-                },
+                View::from_eye([2.0 * d, 0.5 * d, 1.5 * d], false),
+                View::from_eye([0.3, 1.0, 0.2], true),
             ] {
                 let what = format!("{accumulate:?} {name} {view:?}");
                 let (mut a, _) = ex.extract_device(&full, view, d, contours_only()).unwrap();
@@ -310,10 +296,7 @@ fn f64_estimator_cannot_be_chained() {
     let mut ao = AoStage::new(gpu()).unwrap();
     assert!(ao.run_device(&est, 0.1, AoMode::Lut).is_err());
     let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
-    let view = View {
-        eye: [3.0, 0.0, 1.0],
-        ortho: false,
-    };
+    let view = View::from_eye([3.0, 0.0, 1.0], false);
     assert!(
         ex.extract_device(&est, view, 1.0, LineOptions::default())
             .is_err()
@@ -332,10 +315,7 @@ fn brainstem_frame_chained_on_device_matches_cpu_skinned_host_path() {
     let mats = SkinnedMesh::flatten(&m.joint_matrices(Some(0), 0.37 * clip.duration).unwrap());
     let radius = (0.05 * d) as f32;
     let feature = (0.1 * d) as f32;
-    let view = View {
-        eye: [0.8 * d, 0.6 * d, 2.8 * d].map(|x| x as f32),
-        ortho: false,
-    };
+    let view = View::from_eye([0.8 * d, 0.6 * d, 2.8 * d].map(|x| x as f32), false);
     let opts = LineOptions::default();
 
     // Device: skin → curvature (rest normalization) → AO → lines, chained.

@@ -4,8 +4,8 @@
 //! compare canonically sorted segment lists.
 
 use crate::spec::feature_lines::LineInputs;
-use crate::spec::feature_lines::LineView;
 use crate::spec::feature_lines::Segment;
+use crate::spec::view::View;
 
 /// Per-vertex values of `lines_vertex`: n·v, κr·sin²θ and the suggestive test.
 pub struct VertexTerms {
@@ -23,8 +23,8 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 
 /// `lines_vertex`, seen from `view` (a [`crate::spec::view::View`], or the
 /// eye-only [`View`]).
-pub fn lines_vertex(x: &LineInputs, view: impl LineView) -> VertexTerms {
-    let (eye, ortho) = (view.line_eye(), view.is_ortho());
+pub fn lines_vertex(x: &LineInputs, view: View) -> VertexTerms {
+    let (eye, ortho) = (view.line_eye(), view.ortho);
     let n = x.pos.len();
     let mut t = VertexTerms {
         ndv: Vec::with_capacity(n),

@@ -2,7 +2,7 @@
 //! as plain data. The renderer's camera makes it (`render::Camera::view`);
 //! the edges stage packs it into its parameter block
 //! ([`crate::spec::edges::EdgeParams`]) and the feature-line stage reads its
-//! eye ([`crate::spec::feature_lines::LineView`]). Nothing here knows GL or
+//! eye ([`View::line_eye`]). Nothing here knows GL or
 //! the device: compute takes a view, it never frames or draws one.
 
 use glam::{Mat4, Vec3};
@@ -35,6 +35,34 @@ pub struct View {
 }
 
 impl View {
+    /// A view for line extraction alone, from the eye position (perspective)
+    /// or, when `ortho`, the constant direction towards the viewer: the
+    /// projection is the identity and the viewport 1×1, so it is not for
+    /// drawing or for the edges stage (use `render::Camera::view`).
+    pub fn from_eye(eye: [f32; 3], ortho: bool) -> View {
+        let e = Vec3::from(eye);
+        View {
+            view_proj: Mat4::IDENTITY,
+            eye: e,
+            // −dir is exactly the direction towards the viewer.
+            dir: -e,
+            ortho,
+            near: f32::MIN_POSITIVE,
+            width: 1,
+            height: 1,
+        }
+    }
+
+    /// What line extraction reads: the eye, or the direction towards the
+    /// viewer ([`View::toward_viewer`]) when orthographic.
+    pub fn line_eye(&self) -> [f32; 3] {
+        if self.ortho {
+            self.toward_viewer().to_array()
+        } else {
+            self.eye.to_array()
+        }
+    }
+
     /// The unit view direction (eye towards the point looked at).
     pub fn unit_dir(&self) -> Vec3 {
         self.dir.normalize()

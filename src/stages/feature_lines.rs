@@ -7,13 +7,13 @@
 //! kind), the most a face can emit ([`segments_bound`]), and the kernel still
 //! counts and refuses what does not fit. CPU twin:
 //! [`crate::cpu::feature_lines`]. Views are [`crate::spec::view::View`]s
-//! (made by the renderer's camera) or the eye-only
-//! [`crate::spec::feature_lines::EyeView`], through [`LineView`].
+//! (made by the renderer's camera, or [`View::from_eye`] for lines alone).
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
-use crate::spec::feature_lines::{LineInputs, LineView, Segment, segments_bound};
+use crate::spec::feature_lines::{LineInputs, Segment, segments_bound};
 use crate::spec::timing::{Step, Timing};
+use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -102,7 +102,7 @@ impl LineExtractor {
     pub fn extract(
         &mut self,
         x: &LineInputs,
-        view: impl LineView,
+        view: View,
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
@@ -122,7 +122,7 @@ impl LineExtractor {
                 "feature lines: every per-vertex input needs {n} entries"
             )));
         }
-        let view = (view.line_eye(), view.is_ortho());
+        let view = (view.line_eye(), view.ortho);
         check_view(view, feature_size)?;
         let g = self.gpu.clone();
         g.write(&mut self.inputs[0], x.pos.as_flattened())?;
@@ -149,7 +149,7 @@ impl LineExtractor {
     pub fn extract_device(
         &mut self,
         est: &CurvatureEstimator,
-        view: impl LineView,
+        view: View,
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
@@ -163,12 +163,12 @@ impl LineExtractor {
     pub fn extract_device_at(
         &mut self,
         est: &CurvatureEstimator,
-        view: impl LineView,
+        view: View,
         feature_size: f32,
         opts: LineOptions,
         origin: [f64; 3],
     ) -> Result<(Vec<Segment>, LineStats)> {
-        let (view_eye, ortho) = (view.line_eye(), view.is_ortho());
+        let (view_eye, ortho) = (view.line_eye(), view.ortho);
         check_view((view_eye, ortho), feature_size)?;
         let d = est.device_outputs()?;
         if d.nv != self.nv {

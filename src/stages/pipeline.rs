@@ -19,8 +19,9 @@ use crate::gpu::{Gpu, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
 use crate::spec::ao::AoMode;
 use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
-use crate::spec::feature_lines::{EyeView as View, Segment};
+use crate::spec::feature_lines::Segment;
 use crate::spec::timing::{Step, Timing};
+use crate::spec::view::View;
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines::{LineExtractor, LineOptions, LineStats};
@@ -356,10 +357,7 @@ impl PosePipeline {
     pub fn front_view(&self) -> View {
         let (c, s) = (self.norm.center, self.norm.scale);
         let d = [0.8, 0.6, 2.8];
-        View {
-            eye: std::array::from_fn(|i| (c[i] + s * d[i]) as f32),
-            ortho: false,
-        }
+        View::from_eye(std::array::from_fn(|i| (c[i] + s * d[i]) as f32), false)
     }
 
     /// Feature size for the suggestive-contour threshold: the rest pose's
