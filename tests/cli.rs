@@ -634,3 +634,29 @@ fn strokes_from_a_field_and_from_a_mesh() {
     ]);
     assert!(status.success(), "{err}");
 }
+
+/// An image name that is not `.png` is refused (the bytes would be PNG), a
+/// width past the image is refused, and `--report` refuses an input or an
+/// output it would ignore.
+#[test]
+fn jpeg_names_huge_widths_and_report_with_inputs_are_refused() {
+    let d = scratch("refusals");
+    let run = |args: &[&str]| {
+        let o = cli().args(args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} should fail");
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let jpg = d.join("o.jpg");
+    let j = jpg.to_str().unwrap();
+    let e = run(&["strokes", "--sdf", "sphere", "--resolution", "16", "-o", j]);
+    assert!(e.contains(".png"), "{e}");
+    let e = run(&["edges", "missing.obj", "-o", j]);
+    assert!(e.contains(".png"), "{e}");
+    assert!(!jpg.exists());
+    let e = run(&["edges", "missing.obj", "--width", "1e30", "-o", "x.png"]);
+    assert!(e.contains("--width") && e.contains("at most"), "{e}");
+    let e = run(&["curvature", "some.obj", "--report"]);
+    assert!(e.contains("--report"), "{e}");
+    let e = run(&["isosurface", "--report", "-o", "x.ply"]);
+    assert!(e.contains("--report"), "{e}");
+}

@@ -68,6 +68,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         dcurv: !a.no_dcurv,
     };
     shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
+    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         let text = super::tables::curvature_report(gpu, a.resolution, a.runs)?;

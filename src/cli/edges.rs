@@ -113,6 +113,13 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             a.width
         );
     }
+    let widest = w.max(h) as f32;
+    if a.width > widest {
+        bail!(
+            "--width {}: the edge width must be at most the image's larger side ({widest} pixels)",
+            a.width
+        );
+    }
     if a.memory_table {
         return super::tables::edges_memory_table();
     }
@@ -122,6 +129,9 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         return super::tables::edges_cap_quality(&gpu, (w, h), a.width, a.crease, a.fov, a.ortho);
     }
     let path = a.mesh.as_deref().expect("clap requires MESH here");
+    if let Some(o) = &a.output {
+        super::require_png("-o", o)?;
+    }
     let Some(output) = &a.output else {
         bail!("give -o OUT.png (or --cap-quality / --memory-table)");
     };

@@ -96,6 +96,7 @@ pub struct IsoArgs {
 /// Runs `shapecue isosurface`.
 pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
+    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         super::print_str(&super::tables::isosurface_report(

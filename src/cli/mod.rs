@@ -156,3 +156,33 @@ pub fn raw_spec(
         _ => anyhow::bail!("raw input needs both --dims and --type"),
     })
 }
+
+/// Refuses an image output whose name does not end in `.png` (shapecue
+/// writes PNG only; a `.jpg` name would hold PNG bytes).
+pub fn require_png(option: &str, path: &Path) -> anyhow::Result<()> {
+    let ok = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !ok {
+        anyhow::bail!(
+            "{option} {}: images are written as PNG; give a name ending in .png",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Refuses `--report` together with an input or an output: the report
+/// measures generated shapes and writes nothing, so either would be ignored.
+pub fn report_alone(
+    report: bool,
+    input: Option<&Path>,
+    output: Option<&Path>,
+) -> anyhow::Result<()> {
+    if report && (input.is_some() || output.is_some()) {
+        anyhow::bail!(
+            "--report prints the accuracy/time table of generated shapes and reads no input              nor writes -o; run it without them"
+        );
+    }
+    Ok(())
+}

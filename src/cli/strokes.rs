@@ -112,6 +112,7 @@ pub struct StrokesArgs {
 /// built (no faces, non-finite vertices), outputs that exist without `--force` or
 /// are the input, and any library error.
 pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
+    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         super::print_str(&torus_report(gpu)?)?;
@@ -119,6 +120,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     }
     let (w, h) = super::size_arg(&a.size)?;
     let output = a.output.clone().expect("clap requires -o without --report");
+    super::require_png("-o", &output)?;
     let (name, mut vol, procedural) = load_input(&a, device)?;
     let iso = match (a.iso, procedural) {
         (Some(v), _) => v,
