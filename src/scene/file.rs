@@ -463,6 +463,35 @@ impl Scene {
             if s.up.is_some_and(|u| u == [0.0; 3]) || s.direction.is_some_and(|d| d == [0.0; 3]) {
                 return Err(e("up and direction must be non-zero".into()));
             }
+            // A view direction parallel to `up` has no image orientation;
+            // checked here, with the line, rather than when the camera is
+            // built after earlier scenes have rendered.
+            let parallel = |d: glam::Vec3| {
+                s.up.is_some_and(|u| {
+                    d.normalize_or_zero()
+                        .cross(glam::Vec3::from(u).normalize_or_zero())
+                        .length()
+                        < 1e-4
+                })
+            };
+            if let Some(d) = s.direction
+                && parallel(glam::Vec3::from(d))
+            {
+                return Err(e(format!(
+                    "direction {d:?} is parallel to up {:?}: the image would have no up",
+                    s.up.unwrap_or_default()
+                )));
+            }
+            if let (Some(eye), Some(target)) = (s.eye, s.target)
+                && target != eye
+                && parallel(glam::Vec3::from(target) - glam::Vec3::from(eye))
+            {
+                return Err(e(format!(
+                    "the view from {eye:?} to {target:?} is parallel to up {:?}: the image \
+                     would have no up",
+                    s.up.unwrap_or_default()
+                )));
+            }
             let modes = [s.eye.is_some(), s.direction.is_some(), s.orbit.is_some()];
             if modes.iter().filter(|&&m| m).count() > 1 {
                 return Err(e("a camera has one of eye, direction or orbit".into()));

@@ -175,3 +175,22 @@ fn curvature_strokes_resolve_and_need_a_volume() {
         );
     }
 }
+
+#[test]
+fn a_view_parallel_to_up_is_refused_with_its_line() {
+    let e = err(&format!(
+        "{MIN}[[camera]]\ndirection = [0, 2, 0]\nup = [0, 1, 0]\n"
+    ));
+    assert!(
+        e.contains("test.toml") && e.contains("line 5") && e.contains("parallel"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "{MIN}[[camera]]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nup = [0, 0, 1]\n"
+    ));
+    assert!(e.contains("parallel"), "{e}");
+    parse(&format!(
+        "{MIN}[[camera]]\ndirection = [0, 2, 1]\nup = [0, 1, 0]\n"
+    ))
+    .unwrap();
+}
