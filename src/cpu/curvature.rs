@@ -14,30 +14,8 @@ use crate::spec::curvature::{
     Normalization, Precision, degen_height_ulp,
 };
 
-type V3 = [f64; 3];
+use super::vec3::{V3, add, cross, dot, len, scale, sub};
 
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn len(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
 fn normalize(a: V3) -> V3 {
     scale(a, 1.0 / len(a))
 }

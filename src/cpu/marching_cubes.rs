@@ -124,6 +124,29 @@ pub fn mc_triangles(vol: &Volume, iso: f32) -> Vec<SoupVertex> {
     out
 }
 
+/// The gradient at grid point `g` in world units: central differences,
+/// one-sided at the border, 0 along an axis of one sample. Shared by the
+/// marching-cubes normals and the `sdf_lines` twin.
+pub fn grid_gradient(vol: &Volume, g: [usize; 3]) -> [f64; 3] {
+    let d = vol.dims;
+    let val = |x: usize, y: usize, z: usize| vol.value(x, y, z) as f64;
+    std::array::from_fn(|a| {
+        let mut lo = g;
+        let mut hi = g;
+        if g[a] > 0 {
+            lo[a] -= 1;
+        }
+        if g[a] + 1 < d[a] {
+            hi[a] += 1;
+        }
+        let span = (hi[a] - lo[a]) as f64;
+        if span == 0.0 {
+            return 0.0;
+        }
+        (val(hi[0], hi[1], hi[2]) - val(lo[0], lo[1], lo[2])) / (span * vol.spacing[a])
+    })
+}
+
 /// Unit normals at index-space positions from the volume's gradient
 /// (central differences at the grid points, trilinearly interpolated, scaled
 /// by the spacing into world units), pointing towards increasing values like
@@ -131,24 +154,6 @@ pub fn mc_triangles(vol: &Volume, iso: f32) -> Vec<SoupVertex> {
 /// not finite the normal is (0, 0, 0).
 pub fn gradient_normals(vol: &Volume, positions: &[[f32; 3]]) -> Vec<[f64; 3]> {
     let d = vol.dims;
-    let val = |x: usize, y: usize, z: usize| vol.value(x, y, z) as f64;
-    let grad_at = |g: [usize; 3]| -> [f64; 3] {
-        std::array::from_fn(|a| {
-            let mut lo = g;
-            let mut hi = g;
-            if g[a] > 0 {
-                lo[a] -= 1;
-            }
-            if g[a] + 1 < d[a] {
-                hi[a] += 1;
-            }
-            let span = (hi[a] - lo[a]) as f64;
-            if span == 0.0 {
-                return 0.0;
-            }
-            (val(hi[0], hi[1], hi[2]) - val(lo[0], lo[1], lo[2])) / (span * vol.spacing[a])
-        })
-    };
     positions
         .iter()
         .map(|p| {
@@ -163,7 +168,7 @@ pub fn gradient_normals(vol: &Volume, positions: &[[f32; 3]]) -> Vec<[f64; 3]> {
                 let w: f64 = (0..3)
                     .map(|a| if o[a] == 1 { f[a] } else { 1.0 - f[a] })
                     .product();
-                let gr = grad_at(g);
+                let gr = grid_gradient(vol, g);
                 for a in 0..3 {
                     n[a] += w * gr[a];
                 }

@@ -12,4 +12,5 @@ pub mod radix_sort;
 pub mod scan;
 pub mod sdf_lines;
 pub mod skinning;
+mod vec3;
 pub mod vertex_fusion;

@@ -27,38 +27,16 @@
 //!
 //! [`run`] chains them like the device's `SdfLines::run`.
 
-use crate::cpu::marching_cubes::mc_vertex;
+use crate::cpu::marching_cubes::{grid_gradient, mc_vertex};
 use crate::error::{Error, Result};
 use crate::spec::sdf_lines::*;
 use crate::volume::Volume;
 use std::time::Instant;
 
-type V3 = [f64; 3];
+use super::vec3::{V3, add, cross, dot, len, scale, sub};
 
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
 fn normalize(a: V3) -> Option<V3> {
-    let l = norm(a);
+    let l = len(a);
     (l > 0.0 && l.is_finite()).then(|| scale(a, 1.0 / l))
 }
 fn finite(a: V3) -> bool {
@@ -299,21 +277,7 @@ pub fn gradient(vol: &Volume) -> Vec<V3> {
         for y in 0..d[1] {
             for x in 0..d[0] {
                 let g = [x, y, z];
-                out.push(std::array::from_fn(|a| {
-                    let (mut lo, mut hi) = (g, g);
-                    if g[a] > 0 {
-                        lo[a] -= 1;
-                    }
-                    if g[a] + 1 < d[a] {
-                        hi[a] += 1;
-                    }
-                    let span = (hi[a] - lo[a]) as f64;
-                    if span == 0.0 {
-                        return 0.0;
-                    }
-                    (vol.value(hi[0], hi[1], hi[2]) as f64 - vol.value(lo[0], lo[1], lo[2]) as f64)
-                        / (span * vol.spacing[a])
-                }));
+                out.push(grid_gradient(vol, g));
             }
         }
     }
@@ -479,7 +443,7 @@ pub fn tangent_basis(n: V3) -> (V3, V3) {
 /// (one of them is zero when `b = 0`); both vanish only at an umbilic or a
 /// flat point, where d1 is `u` (defined, never NaN).
 pub fn principal(g: V3, hm: [[f64; 3]; 3]) -> Principal {
-    let len = norm(g);
+    let len = len(g);
     let ok = len > 0.0 && len.is_finite() && hm.iter().flatten().all(|c| c.is_finite());
     if !ok {
         return Principal::default();
