@@ -660,3 +660,32 @@ fn jpeg_names_huge_widths_and_report_with_inputs_are_refused() {
     let e = run(&["isosurface", "--report", "-o", "x.ply"]);
     assert!(e.contains("--report"), "{e}");
 }
+
+/// `shapecue strokes` protects a volume's detached data file like the
+/// isosurface command does, and checks outputs before any conversion.
+#[test]
+fn strokes_never_writes_over_a_volume_data_file() {
+    let d = scratch("strokes-nhdr");
+    let raw = d.join("v.raw");
+    std::fs::write(&raw, (0..64u8).collect::<Vec<_>>()).unwrap();
+    let nhdr = d.join("v.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: v.raw\n",
+    )
+    .unwrap();
+    let out = cli()
+        .arg("strokes")
+        .arg(&nhdr)
+        .args(["--iso", "30", "-o"])
+        .arg(d.join("s.png"))
+        .arg("--stats")
+        .arg(&raw)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("input file"), "{e}");
+    assert_eq!(std::fs::read(&raw).unwrap(), (0..64u8).collect::<Vec<_>>());
+}

@@ -121,7 +121,17 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     let (w, h) = super::size_arg(&a.size)?;
     let output = a.output.clone().expect("clap requires -o without --report");
     super::require_png("-o", &output)?;
-    let (name, mut vol, procedural) = load_input(&a, device)?;
+    let outputs: Vec<&Path> = [
+        Some(&output),
+        a.svg.as_ref(),
+        a.geometry.as_ref(),
+        a.stats.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path)
+    .collect();
+    let (name, mut vol, procedural) = load_input(&a, device, &outputs)?;
     let iso = match (a.iso, procedural) {
         (Some(v), _) => v,
         (None, true) => 0.0,
@@ -149,18 +159,6 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         }
         Some(v) => bail!("--eye needs three finite numbers X,Y,Z, got {v:?}"),
     };
-    let outputs: Vec<&Path> = [
-        Some(&output),
-        a.svg.as_ref(),
-        a.geometry.as_ref(),
-        a.stats.as_ref(),
-    ]
-    .into_iter()
-    .flatten()
-    .map(PathBuf::as_path)
-    .collect();
-    let inputs: Vec<&Path> = a.input.iter().map(PathBuf::as_path).collect();
-    check_outputs(&inputs, &outputs, a.force)?;
 
     // Marching cubes orients its triangles out of the region below iso:
     // for an object above iso, negate the values and iso (exact in f32), so
@@ -338,8 +336,15 @@ fn span(v: &Volume) -> String {
         })
 }
 
-fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, bool)> {
+/// Reads the input and checks the outputs against every file read (a
+/// volume's detached data files included) before any conversion runs.
+fn load_input(
+    a: &StrokesArgs,
+    device: Option<&str>,
+    outputs: &[&Path],
+) -> Result<(String, Volume, bool)> {
     if let Some(kind) = &a.sdf {
+        check_outputs(&[], outputs, a.force)?;
         let v = volume::sdf::sdf_by_name(kind, a.resolution)?;
         return Ok((format!("{kind} SDF {}³", a.resolution), v, true));
     }
@@ -352,6 +357,7 @@ fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, 
         // A triangle mesh becomes a signed distance field first (negative
         // inside, sign from the winding number), on the device.
         let mesh = shapecue::mesh::load(path, &Default::default())?;
+        check_outputs(&[path.as_path()], outputs, a.force)?;
         let gpu = Arc::new(Gpu::new(device)?);
         let opts = shapecue::spec::mesh_sdf::MeshSdfOptions {
             resolution: a.resolution,
@@ -377,7 +383,11 @@ fn load_input(a: &StrokesArgs, device: Option<&str>) -> Result<(String, Volume, 
         a.header_bytes,
         a.spacing.as_deref(),
     )?;
-    let v = volume::load(path, raw.as_ref())?;
+    let (v, read) = volume::load_with_files(path, raw.as_ref())?;
+    let inputs: Vec<&Path> = std::iter::once(path.as_path())
+        .chain(read.iter().map(PathBuf::as_path))
+        .collect();
+    check_outputs(&inputs, outputs, a.force)?;
     Ok((path.display().to_string(), v, false))
 }
 
