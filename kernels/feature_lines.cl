@@ -68,7 +68,7 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
                          __global const float *ndv, __global const float *kr,
                          __global const float *sc, uint want_contours, uint want_suggestive,
                          float sc_thresh, float fade, uint cap, __global float *seg,
-                         volatile __global uint *counter)
+                         __global uint *ends, volatile __global uint *counter)
 {
     GID_OR_RETURN(nf);
     uint v[3];
@@ -112,6 +112,13 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
                 seg[8 * o + i] = p[i];
             seg[8 * o + 6] = (float)kind;
             seg[8 * o + 7] = strength;
+            // The mesh edges the two endpoints lie on, as sorted vertex pairs:
+            // neighbouring faces give the same pair for a shared crossing, so
+            // segments chain into polylines exactly, by edge.
+            ends[4 * o] = min(v[c], v[a]);
+            ends[4 * o + 1] = max(v[c], v[a]);
+            ends[4 * o + 2] = min(v[c], v[b]);
+            ends[4 * o + 3] = max(v[c], v[b]);
         }
     }
 }

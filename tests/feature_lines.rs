@@ -42,8 +42,10 @@ fn device(m: &Mesh, x: &LineArrays, view: View, opts: LineOptions) -> Vec<Segmen
 fn same(dev: Vec<Segment>, cpu: Vec<Segment>, what: &str) {
     let close = |a: &Segment, b: &Segment| {
         let d = |p: [f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-5);
+        // Endpoints and the mesh edges they lie on, in the same order.
         a.2 == b.2
-            && (d(a.0, b.0) && d(a.1, b.1) || d(a.0, b.1) && d(a.1, b.0))
+            && (d(a.0, b.0) && d(a.1, b.1) && a.4 == b.4
+                || d(a.0, b.1) && d(a.1, b.0) && a.4 == [b.4[1], b.4[0]])
             && (a.3 - b.3).abs() < 1e-4
     };
     let key = |s: &Segment| (s.0[0] + s.1[0]) * 0.5;
@@ -88,7 +90,7 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
     // Along the axis: the outer and inner equators (radius 1.4 and 0.6, z = 0).
     let s = device(&m, &x, View::from_eye([0.0, 0.0, 1.0], true), contours);
     assert!(s.len() > 300, "{}", s.len());
-    for (a, b, kind, _) in &s {
+    for (a, b, kind, _, _) in &s {
         assert_eq!(*kind, 0);
         for p in [a, b] {
             let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
@@ -103,7 +105,7 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
     // the plane x = 0 and the top and bottom circles z = ±0.4.
     let s = device(&m, &x, View::from_eye([1.0, 0.0, 0.0], true), contours);
     assert!(s.len() > 300);
-    for (a, b, _, _) in &s {
+    for (a, b, _, _, _) in &s {
         for p in [a, b] {
             assert!(
                 p[0].abs() < 0.01 || (p[2].abs() - 0.4).abs() < 0.01,
@@ -111,6 +113,44 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
             );
         }
     }
+}
+
+#[test]
+fn each_segment_end_lies_on_its_mesh_edge_and_closed_contours_meet_in_pairs() {
+    // On a closed mesh an occluding contour is a set of closed loops: every
+    // mesh edge a contour crosses is shared by exactly two contour segments
+    // (the faces on either side), which is what joins them into polylines.
+    let m = mesh::torus(1.0, 0.4, 120, 60);
+    let x = inputs(&m);
+    let contours = LineOptions {
+        contours: true,
+        suggestive: false,
+        ..Default::default()
+    };
+    let s = device(&m, &x, View::from_eye([0.3, 0.2, 1.0], true), contours);
+    assert!(s.len() > 300, "{}", s.len());
+    let mut count: std::collections::HashMap<[u32; 2], usize> = Default::default();
+    for (a, b, _, _, ends) in &s {
+        for (p, e) in [(a, ends[0]), (b, ends[1])] {
+            assert!(e[0] < e[1], "{e:?} is a sorted vertex pair");
+            // p = v0 + t (v1 − v0) for some t in [0, 1].
+            let (v0, v1) = (x.pos[e[0] as usize], x.pos[e[1] as usize]);
+            let d: [f32; 3] = std::array::from_fn(|i| v1[i] - v0[i]);
+            let len2: f32 = d.iter().map(|c| c * c).sum();
+            let t = (0..3).map(|i| (p[i] - v0[i]) * d[i]).sum::<f32>() / len2;
+            let off: f32 = (0..3)
+                .map(|i| (p[i] - v0[i] - t * d[i]).powi(2))
+                .sum::<f32>()
+                .sqrt();
+            assert!(
+                (-1e-4..=1.0 + 1e-4).contains(&t) && off < 1e-5,
+                "{p:?} off {e:?}"
+            );
+            *count.entry(e).or_default() += 1;
+        }
+    }
+    let odd: Vec<_> = count.iter().filter(|(_, n)| **n != 2).collect();
+    assert!(odd.is_empty(), "edges not shared by two segments: {odd:?}");
 }
 
 #[test]

@@ -183,7 +183,7 @@ fn chained_lines_equal_lines_of_host_arrays() {
                 .iter()
                 .map(|s| {
                     let w = |p: [f32; 3]| std::array::from_fn(|i| (f64::from(p[i]) + c[i]) as f32);
-                    (w(s.0), w(s.1), s.2, s.3)
+                    (w(s.0), w(s.1), s.2, s.3, s.4)
                 })
                 .collect();
             assert_eq!(back.len(), got.len(), "{what}: origin-relative count");

@@ -425,3 +425,51 @@ fn curvature_strokes_on_a_volume_run_their_pass_and_draw() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn svg_contours_are_joined_by_mesh_edge_into_few_polylines_one_group_per_cue() {
+    // An oblique view of a torus: its occluding contour is a few long curves.
+    // Segments used to be written one polyline each (hundreds of two-point
+    // polylines) in an order that varied from run to run.
+    let text = "[input]\ngenerate = \"torus\"\nresolution = 20000\n[[camera]]\n\
+                direction = [0.0, -1.0, -1.2]\n[effects]\ncontours = {}\n\
+                suggestive_contours = {}\nfeature_edges = { crease = 60 }\n[output]\n\
+                size = [240, 180]\nformats = [\"svg\"]\n";
+    let mut texts = Vec::new();
+    for round in 0..2 {
+        let dir = scratch(&format!("svg-join-{round}"));
+        let s = scene(&dir, text);
+        let Some(r) = run(&s, &dir, false) else {
+            return;
+        };
+        let r = r.unwrap();
+        assert!(r.segments[0] > 100, "{:?}", r.segments);
+        texts.push(std::fs::read_to_string(&r.outputs[0]).unwrap());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    assert_eq!(texts[0], texts[1], "the SVG is the same on every run");
+    let t = &texts[0];
+    for id in ["contours", "suggestive-contours", "feature-edges"] {
+        assert!(
+            t.contains(&format!("<g id=\"{id}\" class=\"{id}\"")),
+            "group {id} missing:\n{t}"
+        );
+    }
+    let contours = t
+        .split("<g id=\"contours\"")
+        .nth(1)
+        .and_then(|g| g.split("</g>").next())
+        .unwrap();
+    let lens: Vec<usize> = contours
+        .lines()
+        .filter(|l| l.starts_with("<polyline"))
+        .map(|l| l.matches(',').count())
+        .collect();
+    let segments: usize = lens.iter().map(|n| n - 1).sum();
+    assert!(!lens.is_empty() && lens.iter().all(|&n| n >= 2), "{lens:?}");
+    assert!(
+        lens.len() * 10 < segments,
+        "{} polylines for {segments} visible pieces: {lens:?}",
+        lens.len()
+    );
+}

@@ -115,7 +115,8 @@ pub fn lines_face(
                     1.0
                 };
             }
-            out.push((lerp(ta, a), lerp(tb, b), kind, strength));
+            let edge = |p: usize| [v[c].min(v[p]) as u32, v[c].max(v[p]) as u32];
+            out.push((lerp(ta, a), lerp(tb, b), kind, strength, [edge(a), edge(b)]));
         }
     }
     out

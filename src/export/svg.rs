@@ -1,6 +1,17 @@
-//! SVG export of drawn feature edges (edges stage, House & Li): the visible
-//! part of each edge, found against the rendered depth buffer, with connected
-//! visible pieces joined into polylines.
+//! SVG export of drawn lines: feature edges (House & Li) and occluding and
+//! suggestive contours (DeCarlo et al. 2003). The visible part of each line is
+//! found against the rendered depth buffer, and connected visible pieces are
+//! joined into polylines, one SVG group per cue (its own id, class, colour and
+//! stroke width, so that users can restyle each cue).
+//!
+//! Joining: contour segments come from faces that share mesh edges, and each
+//! endpoint carries the edge it lies on, so two segments are joined exactly
+//! when they end on the same edge, never by comparing floats. Pieces cut by
+//! occlusion, and feature edges (whose ends are mesh vertices, computed the
+//! same way for every edge that meets there), are joined where their pixel
+//! positions agree within 1/64 pixel. Pieces are put in a canonical order
+//! before joining, so the file does not depend on the order in which the
+//! device emitted segments.
 //!
 //! Visibility: each drawn edge (a non-marker quad of the edge-out buffer) is
 //! taken from the midpoints of its quad ends, i.e. the projected edge, and
@@ -18,36 +29,165 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use glam::{Mat4, Vec4};
+
 use crate::error::Result;
 use crate::render::Frame;
+use crate::spec::feature_lines::{Segment, edge_key};
 
 /// Default depth bias (window depth units) of [`visible_polylines`].
 pub const DEFAULT_BIAS: f32 = 1e-3;
+
+/// A line to test for visibility: clip-space ends (OpenGL convention, w > 0),
+/// the mesh edge each end lies on when known, and an opacity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipLine {
+    /// Clip-space ends.
+    pub ends: [[f32; 4]; 2],
+    /// The mesh edge of each end ([`edge_key`]), when the end lies on one.
+    pub edges: [Option<u64>; 2],
+    /// Stroke opacity in [0, 1].
+    pub opacity: f32,
+}
+
+/// How the end of a visible piece is matched with others.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum EndKey {
+    /// The mesh edge it lies on (exact).
+    Edge(u64),
+    /// Its pixel position in 1/64 pixel.
+    Pixel(i64, i64),
+}
+
+/// A visible piece in image pixels (origin top left).
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    ends: [[f32; 2]; 2],
+    keys: [EndKey; 2],
+    opacity: f32,
+}
+
+/// A polyline in image pixels with its opacity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SvgPolyline {
+    /// Points, origin top left.
+    pub points: Vec<[f32; 2]>,
+    /// Stroke opacity in [0, 1] (the mean over its pieces).
+    pub opacity: f32,
+}
+
+/// One cue's group in the SVG file.
+#[derive(Clone, Debug)]
+pub struct SvgLayer {
+    /// Group id and class (`contours`, `suggestive-contours`, `feature-edges`).
+    pub id: &'static str,
+    /// Stroke width in pixels.
+    pub stroke_width: f32,
+    /// Stroke colour, linear 0..1 components written as `#rrggbb`.
+    pub color: [f32; 3],
+    /// The joined visible lines.
+    pub lines: Vec<SvgPolyline>,
+}
+
+fn pixel_key(p: [f32; 2]) -> EndKey {
+    EndKey::Pixel((p[0] * 64.0).round() as i64, (p[1] * 64.0).round() as i64)
+}
+
+/// The drawn edges of `edge_out` (4 clip-space vertices per edge, House & Li
+/// layout) as [`ClipLine`]s: the midpoints of the quad ends, i.e. the
+/// projected edge. Marker quads (NaN) and non-finite quads are skipped.
+pub fn edge_out_lines(edge_out: &[[f32; 4]]) -> Vec<ClipLine> {
+    let mid = |a: [f32; 4], b: [f32; 4]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), a[2], a[3]];
+    edge_out
+        .chunks_exact(4)
+        .filter(|q| !q[0][0].is_nan() && q.iter().flatten().all(|c| c.is_finite()))
+        .map(|q| ClipLine {
+            ends: [mid(q[0], q[3]), mid(q[1], q[2])],
+            edges: [None; 2],
+            opacity: 1.0,
+        })
+        .collect()
+}
+
+/// Contour or suggestive-contour segments of `kind` (0 or 1) projected by
+/// `view_proj`, each end keeping the mesh edge it lies on. A segment crossing
+/// the near plane is cut there (the cut end has no edge); one behind it, or
+/// with a non-finite point, is dropped. `opacity` maps a segment's strength
+/// to its stroke opacity.
+pub fn segment_lines(
+    view_proj: Mat4,
+    segments: &[Segment],
+    kind: u32,
+    opacity: impl Fn(f32) -> f32,
+) -> Vec<ClipLine> {
+    let mut out = Vec::new();
+    for s in segments.iter().filter(|s| s.2 == kind) {
+        let a = view_proj * Vec4::from((glam::Vec3::from(s.0), 1.0));
+        let b = view_proj * Vec4::from((glam::Vec3::from(s.1), 1.0));
+        if !(a.is_finite() && b.is_finite()) {
+            continue;
+        }
+        let mut edges = [Some(edge_key(s.4[0])), Some(edge_key(s.4[1]))];
+        // Inside the near plane when z ≥ −w (OpenGL clip space).
+        let (da, db) = (a.z + a.w, b.z + b.w);
+        if da < 0.0 && db < 0.0 {
+            continue;
+        }
+        let (a, b) = match (da < 0.0, db < 0.0) {
+            (true, _) => {
+                edges[0] = None;
+                (a + (b - a) * (da / (da - db)), b)
+            }
+            (_, true) => {
+                edges[1] = None;
+                (a, a + (b - a) * (da / (da - db)))
+            }
+            _ => (a, b),
+        };
+        if a.w <= 0.0 || b.w <= 0.0 {
+            continue;
+        }
+        out.push(ClipLine {
+            ends: [a.to_array(), b.to_array()],
+            edges,
+            opacity: opacity(s.3),
+        });
+    }
+    out
+}
 
 /// Visible pieces of the drawn edges of `edge_out` (4 clip-space vertices per
 /// edge, House & Li layout), in image pixel coordinates (origin top left),
 /// joined into polylines where pieces share an end point (within 1/64 pixel).
 pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec<Vec<[f32; 2]>> {
+    visible_joined(&edge_out_lines(edge_out), frame, bias)
+        .into_iter()
+        .map(|l| l.points)
+        .collect()
+}
+
+/// Visible parts of `lines` against the depth of `frame`, joined into
+/// polylines (exactly by mesh edge where both ends know theirs, else by pixel
+/// position within 1/64 pixel), in a canonical order.
+pub fn visible_joined(lines: &[ClipLine], frame: &Frame, bias: f32) -> Vec<SvgPolyline> {
     let (w, h) = (frame.width as f32, frame.height as f32);
-    let to_px = |a: [f32; 4], b: [f32; 4]| {
-        // Midpoint of the two quad vertices at one end (same w): the edge end.
-        let (x, y, z, cw) = (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), a[2], a[3]);
+    let to_px = |c: [f32; 4]| {
         [
-            (x / cw * 0.5 + 0.5) * w,
-            (0.5 - y / cw * 0.5) * h,
-            z / cw * 0.5 + 0.5,
+            (c[0] / c[3] * 0.5 + 0.5) * w,
+            (0.5 - c[1] / c[3] * 0.5) * h,
+            c[2] / c[3] * 0.5 + 0.5,
         ]
     };
-    let mut pieces: Vec<[[f32; 2]; 2]> = Vec::new();
-    for q in edge_out.chunks_exact(4) {
-        if q[0][0].is_nan() || !q.iter().flatten().all(|c| c.is_finite()) {
+    let mut pieces: Vec<Piece> = Vec::new();
+    for l in lines {
+        let (s0, s1) = (to_px(l.ends[0]), to_px(l.ends[1]));
+        if !s0.iter().chain(&s1).all(|c| c.is_finite()) {
             continue;
         }
-        let (s0, s1) = (to_px(q[0], q[3]), to_px(q[1], q[2]));
         let len = ((s1[0] - s0[0]).powi(2) + (s1[1] - s0[1]).powi(2)).sqrt();
         let n = (len.ceil() as usize).clamp(1, 1 << 16);
         // The depth buffer holds one (multi)sample per pixel, up to a pixel away
-        // from the sample point: allow the edge's depth change over 1.5 pixels.
+        // from the sample point: allow the line's depth change over 1.5 pixels.
         let bias = bias + 1.5 * (s1[2] - s0[2]).abs() / len.max(1.0);
         let at = |i: usize| {
             let t = i as f32 / n as f32;
@@ -77,6 +217,21 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
             }
             p[2] <= far + bias
         };
+        // A piece end keeps the line's mesh edge only where it is the line's
+        // own end; ends cut by occlusion are matched by position.
+        let mut push = |s: usize, e: usize| {
+            let (a, b) = (at(s), at(e));
+            let (a, b) = ([a[0], a[1]], [b[0], b[1]]);
+            let key = |i: usize, p: [f32; 2], own: Option<u64>| match own {
+                Some(k) if i == 0 || i == n => EndKey::Edge(k),
+                _ => pixel_key(p),
+            };
+            pieces.push(Piece {
+                ends: [a, b],
+                keys: [key(s, a, l.edges[0]), key(e, b, l.edges[1])],
+                opacity: l.opacity,
+            });
+        };
         let mut start: Option<usize> = None;
         for i in 0..=n {
             let v = visible(at(i));
@@ -84,8 +239,7 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
                 (true, None) => start = Some(i),
                 (false, Some(s)) => {
                     if i - 1 > s {
-                        let (a, b) = (at(s), at(i - 1));
-                        pieces.push([[a[0], a[1]], [b[0], b[1]]]);
+                        push(s, i - 1);
                     }
                     start = None;
                 }
@@ -93,40 +247,69 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
             }
         }
         if let Some(s) = start.filter(|&s| s < n) {
-            let (a, b) = (at(s), at(n));
-            pieces.push([[a[0], a[1]], [b[0], b[1]]]);
+            push(s, n);
         }
     }
-    join(&pieces)
+    join(pieces)
 }
 
-/// Joins segments sharing end points into polylines: chains start at points
-/// that are not shared by exactly two segments, then closed loops remain.
-fn join(pieces: &[[[f32; 2]; 2]]) -> Vec<Vec<[f32; 2]>> {
-    let key = |p: [f32; 2]| ((p[0] * 64.0).round() as i64, (p[1] * 64.0).round() as i64);
-    let mut at: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
-    for (i, s) in pieces.iter().enumerate() {
-        at.entry(key(s[0])).or_default().push(i);
-        at.entry(key(s[1])).or_default().push(i);
+/// Joins pieces sharing end keys into polylines: chains start at ends that
+/// are not shared by exactly two pieces, then closed loops remain. The pieces
+/// are first sorted (by keys, then coordinates), so the result does not depend
+/// on their input order.
+fn join(mut pieces: Vec<Piece>) -> Vec<SvgPolyline> {
+    let order = |p: &Piece| {
+        let mut k = p.keys;
+        k.sort();
+        k
+    };
+    pieces.sort_by(|a, b| {
+        order(a).cmp(&order(b)).then_with(|| {
+            let fa = a.ends.as_flattened();
+            let fb = b.ends.as_flattened();
+            fa.iter()
+                .zip(fb)
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+    });
+    let mut at: HashMap<EndKey, Vec<usize>> = HashMap::new();
+    for (i, p) in pieces.iter().enumerate() {
+        at.entry(p.keys[0]).or_default().push(i);
+        at.entry(p.keys[1]).or_default().push(i);
     }
     let mut used = vec![false; pieces.len()];
     let mut lines = Vec::new();
     let walk = |first: usize, from_end: usize, used: &mut Vec<bool>| {
-        let mut line = vec![pieces[first][from_end], pieces[first][1 - from_end]];
+        let p = &pieces[first];
+        let mut points = vec![p.ends[from_end], p.ends[1 - from_end]];
+        let mut tip = p.keys[1 - from_end];
+        let mut opacity = p.opacity;
+        let mut count = 1usize;
         used[first] = true;
+        // Through any end with an unused piece: at a branch (three or more
+        // pieces, as at a corner of feature edges) the chain goes on along the
+        // first in canonical order, and the others start chains of their own.
         loop {
-            let tip = *line.last().expect("non-empty");
-            let next = at[&key(tip)].iter().copied().find(|&j| !used[j]);
+            let next = at[&tip].iter().copied().find(|&j| !used[j]);
             let Some(j) = next else { break };
             used[j] = true;
-            let far = if key(pieces[j][0]) == key(tip) { 1 } else { 0 };
-            line.push(pieces[j][far]);
+            let q = &pieces[j];
+            let far = if q.keys[0] == tip { 1 } else { 0 };
+            points.push(q.ends[far]);
+            tip = q.keys[far];
+            opacity += q.opacity;
+            count += 1;
         }
-        line
+        SvgPolyline {
+            points,
+            opacity: opacity / count as f32,
+        }
     };
     for i in 0..pieces.len() {
         for end in 0..2 {
-            if !used[i] && at[&key(pieces[i][end])].len() != 2 {
+            if !used[i] && at[&pieces[i].keys[end]].len() != 2 {
                 lines.push(walk(i, end, &mut used));
             }
         }
@@ -139,27 +322,82 @@ fn join(pieces: &[[[f32; 2]; 2]]) -> Vec<Vec<[f32; 2]>> {
     lines
 }
 
-/// SVG text of `polylines` on a `width` × `height` canvas, black round-joined
-/// strokes of `stroke_width` pixels.
-pub fn svg_text(polylines: &[Vec<[f32; 2]>], width: u32, height: u32, stroke_width: f32) -> String {
-    let mut s = format!(
+fn hex(c: [f32; 3]) -> String {
+    let b = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    format!("#{:02x}{:02x}{:02x}", b(c[0]), b(c[1]), b(c[2]))
+}
+
+/// Writes one polyline; consecutive points that print the same (pieces of
+/// zero length, where a contour passes through a vertex) are written once.
+fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
+    s.push_str("<polyline points=\"");
+    let mut last = String::new();
+    for p in points {
+        let here = format!("{:.2},{:.2}", p[0], p[1]);
+        if here == last {
+            continue;
+        }
+        if !last.is_empty() {
+            s.push(' ');
+        }
+        s.push_str(&here);
+        last = here;
+    }
+    s.push('"');
+    if let Some(o) = opacity.filter(|&o| o < 0.995) {
+        let _ = write!(s, " stroke-opacity=\"{o:.2}\"");
+    }
+    s.push_str("/>\n");
+}
+
+fn svg_open(width: u32, height: u32) -> String {
+    format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" \
-         viewBox=\"0 0 {width} {height}\">\n<g fill=\"none\" stroke=\"black\" \
-         stroke-width=\"{stroke_width}\" stroke-linecap=\"round\" stroke-linejoin=\"round\">\n"
+         viewBox=\"0 0 {width} {height}\">\n"
+    )
+}
+
+/// SVG text of `polylines` on a `width` × `height` canvas, black round-joined
+/// strokes of `stroke_width` pixels, in one group `feature-edges`.
+pub fn svg_text(polylines: &[Vec<[f32; 2]>], width: u32, height: u32, stroke_width: f32) -> String {
+    let mut s = svg_open(width, height);
+    let _ = writeln!(
+        s,
+        "<g id=\"feature-edges\" class=\"feature-edges\" fill=\"none\" stroke=\"black\" \
+         stroke-width=\"{stroke_width}\" stroke-linecap=\"round\" stroke-linejoin=\"round\">"
     );
     for l in polylines {
-        s.push_str("<polyline points=\"");
-        for (i, p) in l.iter().enumerate() {
-            let sep = if i == 0 { "" } else { " " };
-            let _ = write!(s, "{sep}{:.2},{:.2}", p[0], p[1]);
-        }
-        s.push_str("\"/>\n");
+        push_polyline(&mut s, l, None);
     }
     s.push_str("</g>\n</svg>\n");
     s
 }
 
-/// Writes [`svg_text`] to `path`.
+/// SVG text of `layers` on a `width` × `height` canvas: one group per layer
+/// with its id, class, colour and stroke width; round caps and joins; a
+/// polyline's `stroke-opacity` where it is below 1. Empty layers are kept (as
+/// empty groups), so a stylesheet can rely on every requested cue's group.
+pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
+    let mut s = svg_open(width, height);
+    for layer in layers {
+        let _ = writeln!(
+            s,
+            "<g id=\"{id}\" class=\"{id}\" fill=\"none\" stroke=\"{c}\" stroke-width=\"{w}\" \
+             stroke-linecap=\"round\" stroke-linejoin=\"round\">",
+            id = layer.id,
+            c = hex(layer.color),
+            w = layer.stroke_width
+        );
+        for l in &layer.lines {
+            push_polyline(&mut s, &l.points, Some(l.opacity));
+        }
+        s.push_str("</g>\n");
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// Writes [`svg_text`] to `path` (whole or not at all).
 pub fn write_svg(
     path: &Path,
     polylines: &[Vec<[f32; 2]>],
@@ -171,4 +409,148 @@ pub fn write_svg(
         path,
         svg_text(polylines, width, height, stroke_width).as_bytes(),
     )
+}
+
+/// Writes [`svg_layers_text`] to `path` (whole or not at all).
+pub fn write_svg_layers(path: &Path, layers: &[SvgLayer], width: u32, height: u32) -> Result<()> {
+    super::output::write_bytes_atomic(path, svg_layers_text(layers, width, height).as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn piece(a: [f32; 2], b: [f32; 2], ka: EndKey, kb: EndKey) -> Piece {
+        Piece {
+            ends: [a, b],
+            keys: [ka, kb],
+            opacity: 1.0,
+        }
+    }
+
+    #[test]
+    fn pieces_ending_on_the_same_mesh_edge_join_although_their_floats_differ() {
+        // Three segments of an open contour whose shared crossings differ by
+        // rounding (each face interpolates from its own corner).
+        let e = EndKey::Edge;
+        let ps = vec![
+            piece([2.0, 0.0], [1.0, 0.0], e(2), e(1)),
+            piece([0.0, 0.0], [1.0001, 0.0], e(0), e(1)),
+            piece([2.0002, 0.0], [3.0, 0.0], e(2), e(3)),
+        ];
+        let mut lines = join(ps.clone());
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        let l = lines.pop().unwrap();
+        assert_eq!(l.points.len(), 4);
+        // The same polyline whatever the input order.
+        let mut rev = ps;
+        rev.reverse();
+        assert_eq!(join(rev), vec![l]);
+    }
+
+    #[test]
+    fn pieces_on_different_edges_stay_apart_even_when_their_ends_coincide() {
+        let e = EndKey::Edge;
+        let ps = vec![
+            piece([0.0, 0.0], [1.0, 0.0], e(0), e(1)),
+            piece([1.0, 0.0], [2.0, 0.0], e(2), e(3)),
+        ];
+        assert_eq!(join(ps).len(), 2);
+    }
+
+    #[test]
+    fn a_closed_loop_becomes_one_polyline_and_branches_end_chains() {
+        let e = EndKey::Edge;
+        let sq = vec![
+            piece([0.0, 0.0], [1.0, 0.0], e(0), e(1)),
+            piece([1.0, 0.0], [1.0, 1.0], e(1), e(2)),
+            piece([1.0, 1.0], [0.0, 1.0], e(2), e(3)),
+            piece([0.0, 1.0], [0.0, 0.0], e(3), e(0)),
+        ];
+        let l = join(sq);
+        assert_eq!(l.len(), 1);
+        assert_eq!(l[0].points.len(), 5);
+        assert_eq!(l[0].points.first(), l[0].points.last());
+        // Three pieces meeting at one end: one chain passes it, the third
+        // piece is a polyline of its own.
+        let y = vec![
+            piece([0.0, 0.0], [1.0, 0.0], e(0), e(9)),
+            piece([1.0, 0.0], [2.0, 0.0], e(9), e(1)),
+            piece([1.0, 0.0], [1.0, 1.0], e(9), e(2)),
+        ];
+        let l = join(y);
+        assert_eq!(l.len(), 2, "{l:?}");
+        assert_eq!(l.iter().map(|p| p.points.len()).sum::<usize>(), 5);
+    }
+
+    #[test]
+    fn an_occluder_cuts_a_line_and_only_its_own_ends_keep_their_edges() {
+        // 16×4 image, depth 0.5 everywhere but a near block over columns 6..10.
+        let (w, h) = (16u32, 4u32);
+        let mut depth = vec![0.5f32; (w * h) as usize];
+        for y in 0..h {
+            for x in 6..10 {
+                depth[(y * w + x) as usize] = 0.1;
+            }
+        }
+        let frame = Frame {
+            width: w,
+            height: h,
+            rgba: vec![0; (4 * w * h) as usize],
+            depth,
+        };
+        // A horizontal line across the image at window depth 0.5 (NDC z 0).
+        let line = ClipLine {
+            ends: [[-0.95, 0.0, 0.0, 1.0], [0.95, 0.0, 0.0, 1.0]],
+            edges: [Some(7), Some(8)],
+            opacity: 1.0,
+        };
+        let next = ClipLine {
+            ends: [[0.95, 0.0, 0.0, 1.0], [0.95, 0.9, 0.0, 1.0]],
+            edges: [Some(8), Some(11)],
+            opacity: 1.0,
+        };
+        let l = visible_joined(&[line, next], &frame, DEFAULT_BIAS);
+        // Two visible pieces of the first line; the right one joins the second
+        // line through edge 8.
+        assert_eq!(l.len(), 2, "{l:?}");
+        let lens: Vec<usize> = l.iter().map(|p| p.points.len()).collect();
+        assert!(lens.contains(&2) && lens.contains(&3), "{lens:?}");
+        for p in &l {
+            // Pixels 7 and 8 are hidden (their 3×3 neighbourhoods are all near).
+            assert!(
+                p.points.iter().all(|q| !(q[0] > 7.0 && q[0] < 9.0)),
+                "{p:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn layers_are_groups_with_their_own_id_colour_width_and_opacity() {
+        let layers = [
+            SvgLayer {
+                id: "contours",
+                stroke_width: 2.0,
+                color: [0.0, 0.0, 0.0],
+                lines: vec![SvgPolyline {
+                    points: vec![[0.0, 0.0], [1.0, 1.0]],
+                    opacity: 1.0,
+                }],
+            },
+            SvgLayer {
+                id: "suggestive-contours",
+                stroke_width: 1.5,
+                color: [1.0, 0.5, 0.0],
+                lines: vec![SvgPolyline {
+                    points: vec![[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]],
+                    opacity: 0.5,
+                }],
+            },
+        ];
+        let t = svg_layers_text(&layers, 8, 8);
+        assert!(t.contains("<g id=\"contours\" class=\"contours\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\""));
+        assert!(t.contains("id=\"suggestive-contours\" class=\"suggestive-contours\" fill=\"none\" stroke=\"#ff8000\" stroke-width=\"1.5\""));
+        assert!(t.contains("points=\"0.00,0.00 1.00,1.00 2.00,0.00\" stroke-opacity=\"0.50\""));
+        assert!(t.contains("points=\"0.00,0.00 1.00,1.00\"/>"));
+    }
 }

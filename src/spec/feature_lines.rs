@@ -4,8 +4,16 @@
 //! (`stages::feature_lines`) and the CPU twin
 //! (`cpu::feature_lines`).
 
-/// A segment: endpoints, kind (0 contour, 1 suggestive) and strength.
-pub type Segment = ([f32; 3], [f32; 3], u32, f32);
+/// A segment: endpoints, kind (0 contour, 1 suggestive), strength, and the
+/// mesh edge each endpoint lies on (sorted vertex pairs). The segments of two
+/// faces sharing an edge meet on it, so chaining by these edges is exact
+/// (see [`edge_key`]).
+pub type Segment = ([f32; 3], [f32; 3], u32, f32, [[u32; 2]; 2]);
+
+/// One number per mesh edge (a sorted vertex pair), for chaining segments.
+pub fn edge_key(e: [u32; 2]) -> u64 {
+    (u64::from(e[0]) << 32) | u64::from(e[1])
+}
 
 /// Inputs of the stage, f32 per vertex.
 pub struct LineInputs<'a> {

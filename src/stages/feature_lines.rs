@@ -64,6 +64,7 @@ pub struct LineExtractor {
     inputs: [Buffer<f32>; 6],
     terms: [Buffer<f32>; 3],
     seg: Buffer<f32>,
+    ends: Buffer<u32>,
     counter: Buffer<u32>,
 }
 
@@ -90,6 +91,7 @@ impl LineExtractor {
             ],
             terms: [gpu.buffer(nv)?, gpu.buffer(nv)?, gpu.buffer(nv)?],
             seg: gpu.buffer(8 * segments_bound(faces.len()))?,
+            ends: gpu.buffer(4 * segments_bound(faces.len()))?,
             counter: gpu.buffer(1)?,
             gpu,
             nv,
@@ -245,6 +247,7 @@ impl LineExtractor {
                 Arg::F32(opts.fade),
                 Arg::U32(cap as u32),
                 buf(&self.seg),
+                buf(&self.ends),
                 buf(&self.counter),
             ],
         )?;
@@ -258,9 +261,20 @@ impl LineExtractor {
         }
         let mut raw = vec![0f32; 8 * found];
         g.read(&self.seg, &mut raw)?;
+        let mut ends = vec![0u32; 4 * found];
+        g.read(&self.ends, &mut ends)?;
         let segs = raw
             .chunks_exact(8)
-            .map(|s| ([s[0], s[1], s[2]], [s[3], s[4], s[5]], s[6] as u32, s[7]))
+            .zip(ends.chunks_exact(4))
+            .map(|(s, e)| {
+                (
+                    [s[0], s[1], s[2]],
+                    [s[3], s[4], s[5]],
+                    s[6] as u32,
+                    s[7],
+                    [[e[0], e[1]], [e[2], e[3]]],
+                )
+            })
             .collect();
         let mut timing = Timing::default();
         if let Some(e) = &e1 {

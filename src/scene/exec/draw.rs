@@ -152,7 +152,6 @@ pub(super) fn draw_view(
         }
     };
     renderer.draw_mesh(&pose.pos, &pose.nrm, colors, faces, style)?;
-    let mut line_quads: Vec<[f32; 4]> = Vec::new();
     let mut drawn = [0usize; 2];
     // Contours opaque; suggestive contours in four opacity bins of
     // their n·v fade (DeCarlo et al. fade them out as they approach
@@ -174,21 +173,12 @@ pub(super) fn draw_view(
             let [r, g, b] = color;
             let a = if kind == 0 { 1.0 } else { alpha };
             renderer.draw_lines(&pts, [r, g, b, a], width)?;
-            if scene.svg {
-                line_quads.extend(crate::render::segments_to_clip_quads(
-                    cam.view_proj(w as f32 / h as f32),
-                    [w, h],
-                    &pts,
-                    width,
-                ));
-            }
         }
         drawn[kind as usize] += n;
     }
     if let Some(eo) = lines.edges {
         let [r, g, b] = fx.edge.1;
         draw_edges(renderer, eo, [r, g, b, 1.0])?;
-        line_quads.extend_from_slice(&eo.edge_out);
     }
     if plan.contains(Pass::SdfLines) {
         // Strips over the surface (drawn first, so it hides the far side).
@@ -205,14 +195,60 @@ pub(super) fn draw_view(
         if path.extension().is_some_and(|e| e == "png") {
             image.save_png(path)?;
         } else {
-            let lines = crate::export::svg::visible_polylines(
-                &line_quads,
-                &image,
-                crate::export::svg::DEFAULT_BIAS,
-            );
-            let width = fx.contour.0.max(fx.edge.0);
-            crate::export::svg::write_svg(path, &lines, w, h, width)?;
+            let layers = svg_layers(scene, plan, cam, &lines, &image);
+            crate::export::svg::write_svg_layers(path, &layers, w, h)?;
         }
     }
     Ok(drawn)
+}
+
+/// The SVG groups of one view: one per line cue the scene asks for (contours,
+/// suggestive contours, feature edges), each with the cue's colour and width,
+/// visible parts only (against `image`'s depth), joined into polylines.
+fn svg_layers(
+    scene: &Scene,
+    plan: &Plan,
+    cam: &Camera,
+    lines: &ViewLines<'_>,
+    image: &Frame,
+) -> Vec<crate::export::svg::SvgLayer> {
+    use crate::export::svg::{DEFAULT_BIAS, SvgLayer, segment_lines, visible_joined};
+    let fx = &scene.effects;
+    let [w, h] = scene.size;
+    let vp = cam.view_proj(w as f32 / h as f32);
+    let mut layers = Vec::new();
+    // Suggestive contours fade as in the image (four opacity bins).
+    let alpha = |s: f32| [0.25, 0.5, 0.75, 1.0][strength_bin(s)];
+    for (kind, id, (width, color)) in [
+        (0u32, "contours", fx.contour),
+        (1u32, "suggestive-contours", fx.suggestive),
+    ] {
+        let wanted = if kind == 0 {
+            fx.cues.contains(&Cue::Contours)
+        } else {
+            fx.cues.contains(&Cue::SuggestiveContours)
+        };
+        if !wanted {
+            continue;
+        }
+        let clip = segment_lines(vp, lines.segments, kind, |s| {
+            if kind == 0 { 1.0 } else { alpha(s) }
+        });
+        layers.push(SvgLayer {
+            id,
+            stroke_width: width,
+            color,
+            lines: visible_joined(&clip, image, DEFAULT_BIAS),
+        });
+    }
+    if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
+        let clip = crate::export::svg::edge_out_lines(&eo.edge_out);
+        layers.push(SvgLayer {
+            id: "feature-edges",
+            stroke_width: fx.edge.0,
+            color: fx.edge.1,
+            lines: visible_joined(&clip, image, DEFAULT_BIAS),
+        });
+    }
+    layers
 }
