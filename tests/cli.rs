@@ -273,10 +273,18 @@ fn render_explains_plans_and_names_scene_errors() {
     // Curvature colours + AO + contours + suggestive contours: dcurv runs,
     // feature edges do not; 4 orbit views.
     assert!(
-        s.contains("Dcurv") && s.contains("Ao") && !s.contains("EdgeDetect"),
+        s.contains("dcurv") && s.contains(" ao ") && !s.contains(" edges "),
         "{s}"
     );
     assert!(s.contains("1 frame(s) × 4 view(s)"), "{s}");
+    // Plain words, not the program's internal names.
+    assert!(
+        s.contains("input: static mesh; cues: curvature_colors, ao"),
+        "{s}"
+    );
+    for internal in ["Static", "CurvatureColors", "VertexNormals", "[", "Lut"] {
+        assert!(!s.contains(internal), "{internal} in {s}");
+    }
     let d = scratch("render-bad");
     let bad = d.join("bad.toml");
     std::fs::write(
@@ -688,4 +696,70 @@ fn strokes_never_writes_over_a_volume_data_file() {
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("input file"), "{e}");
     assert_eq!(std::fs::read(&raw).unwrap(), (0..64u8).collect::<Vec<_>>());
+}
+
+#[test]
+fn render_refuses_two_scenes_writing_the_same_files_before_either_runs() {
+    let d = scratch("render-collide");
+    let text = "[input]\ngenerate = \"torus\"\nresolution = 2000\n[[camera]]\norbit = 1\n\
+                [effects]\nshading = {}\n[output]\nname = \"same\"\nsize = [32, 32]\n";
+    let (a, b) = (d.join("a.toml"), d.join("b.toml"));
+    std::fs::write(&a, text).unwrap();
+    std::fs::write(&b, text).unwrap();
+    let out = d.join("out");
+    let r = run_cli([
+        "render",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("a.toml") && err.contains("b.toml") && err.contains("same_report.json"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing ran, nothing was written");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn meshes_too_large_or_small_to_draw_in_single_precision_are_refused_by_name() {
+    // A unit sphere scaled by 1e30 and by 1e-30: curvature works on both (it
+    // normalises); drawing refuses them with the range instead of a camera
+    // of infinities.
+    let d = scratch("undrawable");
+    for (scale, word) in [(1e30, "below"), (1e-30, "at least")] {
+        let m = shapecue::mesh::icosphere(1.0, 2);
+        let mut obj = String::new();
+        for p in &m.positions {
+            obj.push_str(&format!(
+                "v {:e} {:e} {:e}\n",
+                p[0] * scale,
+                p[1] * scale,
+                p[2] * scale
+            ));
+        }
+        for t in &m.faces {
+            obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        }
+        let path = d.join(format!("s{scale:e}.obj"));
+        std::fs::write(&path, obj).unwrap();
+        let png = d.join("x.png");
+        let r = run_cli([
+            "edges",
+            path.to_str().unwrap(),
+            "--eye",
+            &format!("{:e},{:e},{:e}", 3.0 * scale, 2.0 * scale, scale),
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{err}");
+        assert!(err.contains("rescale") && err.contains(word), "{err}");
+        assert!(!err.contains("Vec3") && !err.contains("Camera {"), "{err}");
+        assert!(!png.exists());
+    }
+    let _ = std::fs::remove_dir_all(&d);
 }

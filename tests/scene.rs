@@ -129,7 +129,7 @@ fn run_counts_follow_the_lifetimes() {
     );
     let text = plan(&[Cue::AmbientOcclusion], Input::Skinned).explain(3, 2);
     assert!(
-        text.contains("Ao") && text.contains("Skin") && !text.contains("Dcurv"),
+        text.contains(" ao ") && text.contains("skinning") && !text.contains("dcurv"),
         "{text}"
     );
 }
@@ -197,5 +197,5 @@ fn curvature_strokes_plan_per_input_kind() {
             .all(|k| k.kernel().starts_with("sdfl_"))
     );
     let text = v.explain(1, 2);
-    assert!(text.contains("SdfLines"), "{text}");
+    assert!(text.contains("sdf_lines"), "{text}");
 }

@@ -473,3 +473,69 @@ fn svg_contours_are_joined_by_mesh_edge_into_few_polylines_one_group_per_cue() {
         lens.len()
     );
 }
+
+#[test]
+fn a_scene_that_fails_midway_leaves_no_images_and_no_new_folder() {
+    // Three good frames, then one with another topology: the first frames
+    // render, the fourth fails; the images already written and the output
+    // folders the run created are removed, a file that was there stays.
+    let dir = scratch("fail-midway");
+    let m = shapecue::mesh::torus(1.0, 0.4, 24, 12);
+    let mut obj = String::new();
+    for p in &m.positions {
+        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for t in &m.faces {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    for f in 0..3 {
+        std::fs::write(dir.join(format!("frame_{f}.obj")), &obj).unwrap();
+    }
+    std::fs::write(
+        dir.join("frame_9.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let s = scene(
+        &dir,
+        "[input]\nflipbook = \"frame_*.obj\"\n[effects]\nshading = {}\n[output]\nsize = [32, 32]\n",
+    );
+    let out = dir.join("new/deeper");
+    let opts = ExecOptions {
+        out_dir: Some(out.clone()),
+        force: false,
+        device: None,
+    };
+    let Some(r) = unless_no_gl(exec::run(&s, &opts, &mut |_, _| {})) else {
+        return;
+    };
+    let e = r.expect_err("frame 9 has another topology");
+    assert!(e.to_string().contains("frame_9.obj"), "{e}");
+    let listing: Vec<_> = walk(&dir.join("new"));
+    assert!(
+        !dir.join("new").exists(),
+        "the run's folders are removed: {listing:?}"
+    );
+    // Into an existing folder: the run's own images go, the user's file stays.
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let e = exec::run(&s, &opts, &mut |_, _| {}).expect_err("still fails");
+    assert!(e.to_string().contains("frame_9.obj"), "{e}");
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("notes.txt")]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn walk(d: &Path) -> Vec<std::path::PathBuf> {
+    let mut v = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(d) {
+        for e in rd.flatten() {
+            v.push(e.path());
+            v.extend(walk(&e.path()));
+        }
+    }
+    v
+}

@@ -59,6 +59,9 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
         .iter()
         .map(|p| Scene::load(p))
         .collect::<shapecue::Result<_>>()?;
+    if !a.explain {
+        exec::check_scenes(&scenes, &opts)?;
+    }
     for scene in &scenes {
         if a.explain {
             super::print_str(&exec::explain(scene, &opts)?)?;
@@ -137,8 +140,8 @@ fn print_report(r: &RunReport) -> Result<()> {
     for p in &r.passes {
         out!(
             "  {:<20} {:<9} {:>6} {:>10.2} {:>10.3}  {} ({})",
-            format!("{:?}", p.pass),
-            format!("{:?}", p.lifetime),
+            p.pass.name(),
+            p.lifetime.name(),
             p.runs,
             p.ms,
             p.ms / p.runs.max(1) as f64,

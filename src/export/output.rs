@@ -52,7 +52,8 @@ fn identity(path: &Path) -> Option<Identity> {
 
 /// Where a path that may not exist yet would be: its folder made canonical
 /// (when that folder exists) joined with its file name.
-fn location(path: &Path) -> PathBuf {
+/// Where `path` is: its folder made canonical where it exists, and its name.
+pub(crate) fn location(path: &Path) -> PathBuf {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

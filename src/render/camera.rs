@@ -149,7 +149,12 @@ impl Camera {
             && self.far.is_finite()
             && self.ortho_height.is_none_or(f32::is_finite);
         if !finite {
-            return bad(format!("non-finite value in {self:?}"));
+            return bad(format!(
+                "a value is not finite (eye {}, target {}, up {}, field of view {}°, near {}, \
+                 far {}); a mesh with coordinates beyond the single-precision range (about \
+                 3.4e38) cannot be drawn",
+                self.eye, self.target, self.up, self.fov_y_deg, self.near, self.far
+            ));
         }
         let dir = self.target - self.eye;
         let scale = self.eye.abs().max(self.target.abs()).max_element().max(1.0);
@@ -219,6 +224,14 @@ pub fn framed(
     aspect: f32,
 ) -> Result<Camera> {
     let (lo, hi) = bounds;
+    {
+        let (l, h) = (glam::DVec3::from(lo), glam::DVec3::from(hi));
+        crate::spec::limits::check_drawable(
+            "drawing",
+            0.5 * (h - l).length(),
+            (0.5 * (l + h)).length(),
+        )?;
+    }
     let lo = glam::DVec3::from(lo).as_vec3();
     let hi = glam::DVec3::from(hi).as_vec3();
     let centre = 0.5 * (lo + hi);

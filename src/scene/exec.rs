@@ -93,11 +93,70 @@ fn run_with(
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
     let (images, report_path) = output_paths(scene, &frames, &out_dir);
-    refuse_overwrite(scene, &images, &report_path, opts.force)?;
-    std::fs::create_dir_all(&out_dir).map_err(|source| Error::Write {
-        path: out_dir.clone(),
-        source,
-    })?;
+    // What this run creates (folders, and files that did not exist), to
+    // remove again if it fails: a failed run leaves what it found.
+    let new_dirs: Vec<PathBuf> = out_dir
+        .ancestors()
+        .filter(|d| !d.as_os_str().is_empty() && !d.exists())
+        .map(PathBuf::from)
+        .collect();
+    let new_files: Vec<PathBuf> = images
+        .iter()
+        .map(|i| &i.2)
+        .chain([&report_path])
+        .filter(|p| !p.exists())
+        .cloned()
+        .collect();
+    let result = refuse_overwrite(scene, &images, &report_path, opts.force)
+        .and_then(|()| {
+            std::fs::create_dir_all(&out_dir).map_err(|source| Error::Write {
+                path: out_dir.clone(),
+                source,
+            })
+        })
+        .and_then(|()| {
+            render_all(
+                gpu,
+                scene,
+                opts,
+                progress,
+                loaded,
+                frames,
+                &images,
+                &report_path,
+            )
+        });
+    if result.is_err() {
+        for f in &new_files {
+            let _ = std::fs::remove_file(f);
+        }
+        // Deepest first; only folders left empty go.
+        for d in &new_dirs {
+            let _ = std::fs::remove_dir(d);
+        }
+    }
+    result.map(|mut r| {
+        r.notes.splice(0..0, notes);
+        r.wall_ms = ms_since(t_all);
+        r
+    })
+}
+
+/// The frame loop of [`run_with`] after the outputs are checked and the
+/// folder exists; writes the report last.
+#[allow(clippy::too_many_arguments)]
+fn render_all(
+    gpu: Option<&Arc<Gpu>>,
+    scene: &Scene,
+    opts: &ExecOptions,
+    progress: &mut dyn FnMut(usize, usize),
+    loaded: load::Loaded,
+    frames: Vec<usize>,
+    images: &[(usize, usize, PathBuf)],
+    report_path: &std::path::Path,
+) -> Result<RunReport> {
+    let t_all = Instant::now();
+    let notes = Vec::new();
 
     let fx = &scene.effects;
     let input = scene.source.input();
@@ -182,8 +241,45 @@ fn run_with(
         wall_ms: ms_since(t_all),
     };
     let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
-    crate::export::output::write_bytes_atomic(&report_path, json.as_bytes())?;
+    crate::export::output::write_bytes_atomic(report_path, json.as_bytes())?;
     Ok(report)
+}
+
+/// Checks, before any scene of a run starts, what can be checked without
+/// loading inputs: no two scenes write the same report and images (same
+/// output folder and name), and without `force` no scene's report exists
+/// already. A collision used to surface only after the first scene had
+/// rendered.
+pub fn check_scenes(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
+    use crate::export::output::location;
+    let reports: Vec<(PathBuf, &Scene)> = scenes
+        .iter()
+        .map(|s| {
+            let dir = opts.out_dir.clone().unwrap_or_else(|| s.out_dir.clone());
+            (dir.join(format!("{}_report.json", s.prefix)), s)
+        })
+        .collect();
+    for (i, (a, sa)) in reports.iter().enumerate() {
+        for (b, sb) in &reports[..i] {
+            if location(a) == location(b) {
+                return Err(Error::InvalidArgument(format!(
+                    "{} and {} would both write {} and the same image names: give one of them \
+                     its own [output] name or dir",
+                    sb.path.display(),
+                    sa.path.display(),
+                    a.display()
+                )));
+            }
+        }
+        if !opts.force && a.exists() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: {} exists (from an earlier run); use --force to overwrite it",
+                sa.path.display(),
+                a.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses outputs that exist (without `force`), that are the scene file,
@@ -216,11 +312,12 @@ pub fn explain(scene: &Scene, opts: &ExecOptions) -> Result<String> {
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
     let (images, report) = output_paths(scene, &frames, &out_dir);
+    let shown: Vec<String> = frames.iter().take(8).map(|f| f.to_string()).collect();
     let mut s = format!(
-        "{}: frames {:?}{}\n",
+        "{}: frames {}{}\n",
         scene.path.display(),
-        &frames[..frames.len().min(8)],
-        if frames.len() > 8 { " ..." } else { "" }
+        shown.join(", "),
+        if frames.len() > 8 { ", ..." } else { "" }
     );
     for n in &notes {
         s.push_str(&format!("  note: {n}\n"));

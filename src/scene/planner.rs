@@ -156,7 +156,78 @@ pub enum Pass {
     Render,
 }
 
+impl std::fmt::Display for Cue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
+impl Input {
+    /// The input kind in words (`--explain`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::Static => "static mesh",
+            Input::Skinned => "skinned mesh (glTF)",
+            Input::Flipbook => "mesh sequence",
+            Input::Volume => "volume isosurface",
+        }
+    }
+}
+
+impl std::fmt::Display for Input {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Lifetime {
+    /// How often, in words (`--explain`, the report table).
+    pub fn name(self) -> &'static str {
+        match self {
+            Lifetime::Topology => "topology",
+            Lifetime::Pose => "pose",
+            Lifetime::View => "view",
+        }
+    }
+}
+
+impl std::fmt::Display for Lifetime {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::fmt::Display for Pass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl Pass {
+    /// The pass's name as the report JSON and `--explain` write it (the
+    /// kernel family's name where the pass is one family).
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::Isosurface => "isosurface",
+            Pass::Skinning => "skinning",
+            Pass::LoadFrame => "load_frame",
+            Pass::EdgeBuffer => "edge_buffer",
+            Pass::OneRings => "one_rings",
+            Pass::CapBuffer => "cap_buffer",
+            Pass::VertexNormals => "vertex_normals",
+            Pass::FaceNormals => "face_normals",
+            Pass::Curvature => "curvature",
+            Pass::Dcurv => "dcurv",
+            Pass::Ao => "ao",
+            Pass::SdfLines => "sdf_lines",
+            Pass::Contours => "contours",
+            Pass::SuggestiveContours => "suggestive_contours",
+            Pass::Edges => "edges",
+            Pass::Caps => "caps",
+            Pass::Render => "render",
+        }
+    }
+
     /// The device steps this pass launches (empty for host passes), by
     /// which the executor joins a stage's [`crate::spec::timing::Timing`]
     /// to the plan. Contours and suggestive contours share one
@@ -337,17 +408,30 @@ impl Plan {
 
     /// Human-readable plan (`--explain`).
     pub fn explain(&self, frames: usize, views: usize) -> String {
+        let list = |v: &mut dyn Iterator<Item = String>| {
+            let v: Vec<String> = v.collect();
+            if v.is_empty() {
+                "nothing".to_string()
+            } else {
+                v.join(", ")
+            }
+        };
         let mut s = format!(
-            "input {:?}, cues {:?}; {frames} frame(s) × {views} view(s)\n",
-            self.input, self.cues
+            "input: {}; cues: {}; {frames} frame(s) × {views} view(s)\n",
+            self.input,
+            list(&mut self.cues.iter().map(|c| c.to_string()))
         );
+        s.push_str(&format!(
+            "  {:<20} {:<9} {:>5}  reads\n",
+            "pass", "once per", "runs"
+        ));
         for &p in &self.passes {
             s.push_str(&format!(
-                "  {:<20} {:<9} runs {:>5}  needs {:?}\n",
-                format!("{p:?}"),
-                format!("{:?}", p.lifetime(self.input)),
+                "  {:<20} {:<9} {:>5}  {}\n",
+                p.name(),
+                p.lifetime(self.input).name(),
                 self.runs(p, frames, views),
-                p.needs(self.input)
+                list(&mut p.needs(self.input).iter().map(|n| n.to_string()))
             ));
         }
         s

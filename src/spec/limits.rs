@@ -24,6 +24,37 @@ pub const MAX_MESH_VERTICES: usize = 50_000_000;
 /// triangles of u32 indices per vertex).
 pub const MESH_BYTES_PER_VERTEX: u64 = 24 + 2 * 12;
 
+/// Bounding radii a drawn mesh may have: the renderer works in single
+/// precision, where squared lengths of larger (or smaller) scenes overflow
+/// (or vanish), so a mesh outside this range is refused with the range named
+/// instead of drawing nothing. Curvature, isosurfaces and the other data
+/// outputs have no such limit (they normalise the mesh).
+pub const DRAWABLE_RADIUS: (f64, f64) = (1e-15, 1e15);
+
+/// Checks that a mesh of bounding radius `radius` (world units) and centre
+/// at distance `offset` from the origin can be drawn ([`DRAWABLE_RADIUS`]).
+pub fn check_drawable(what: &str, radius: f64, offset: f64) -> Result<()> {
+    let (lo, hi) = DRAWABLE_RADIUS;
+    if !(radius.is_finite() && offset.is_finite()) {
+        return Err(Error::InvalidArgument(format!(
+            "{what}: the mesh's bounds are not finite; nothing can be drawn"
+        )));
+    }
+    if radius > hi || offset > hi {
+        return Err(Error::InvalidArgument(format!(
+            "{what}: the mesh spans {radius:.3e} (bounding radius), {offset:.3e} from the origin; \
+             drawing works in single precision and needs both below {hi:e}: rescale the mesh"
+        )));
+    }
+    if radius > 0.0 && radius < lo && offset < lo * 1e6 {
+        return Err(Error::InvalidArgument(format!(
+            "{what}: the mesh spans {radius:.3e} (bounding radius); drawing works in single \
+             precision and needs at least {lo:e}: rescale the mesh"
+        )));
+    }
+    Ok(())
+}
+
 fn gib(b: u64) -> String {
     format!("{:.2} GiB", b as f64 / f64::from(1u32 << 30))
 }

@@ -199,6 +199,24 @@ fn is_integer(t: &ScalarType) -> bool {
     !matches!(t, ScalarType::Float | ScalarType::Double)
 }
 
+/// A property type as a PLY header writes it (`float`, `list uchar int`).
+fn ply_type_name(t: &PropertyType) -> String {
+    let scalar = |t: &ScalarType| match t {
+        ScalarType::Char => "char",
+        ScalarType::UChar => "uchar",
+        ScalarType::Short => "short",
+        ScalarType::UShort => "ushort",
+        ScalarType::Int => "int",
+        ScalarType::UInt => "uint",
+        ScalarType::Float => "float",
+        ScalarType::Double => "double",
+    };
+    match t {
+        PropertyType::Scalar(x) => scalar(x).to_string(),
+        PropertyType::List(c, x) => format!("list {} {}", scalar(c), scalar(x)),
+    }
+}
+
 /// Checks that the header has what shapecue needs, before reading the payload.
 fn check_header(header: &Header, source: &str) -> Result<()> {
     let err = |p: String| Error::input(source, "header", p);
@@ -225,7 +243,8 @@ fn check_header(header: &Header, source: &str) -> Result<()> {
             }
             Some((n, t)) => {
                 return Err(err(format!(
-                    "property '{n}' of element 'face' must be a list of integers, found {t:?}"
+                    "property '{n}' of element 'face' must be a list of integers, found {}",
+                    ply_type_name(t)
                 )));
             }
             None if face.count == 0 => {}

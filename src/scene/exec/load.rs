@@ -105,9 +105,16 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
             let a = crate::mesh::libigl::load_elephant_set(p)?;
             let (m, trunc) = a.to_skinned();
             notes.push(format!(
-                "{}: {} bones, weights cut to the 4 largest per vertex: {trunc:?}",
+                "{}: {} bones, weights cut to the 4 largest per vertex ({} vertices had more \
+                 than four, {} more than four above {}; largest dropped weight sum {:.3}, \
+                 mean {:.4})",
                 p.display(),
-                m.joint_nodes.len()
+                m.joint_nodes.len(),
+                trunc.vertices_over_4,
+                trunc.significant_over_4,
+                crate::mesh::libigl::SIGNIFICANT_WEIGHT,
+                trunc.max_dropped,
+                trunc.mean_dropped
             ));
             let frames = a.frames;
             Loaded::Skinned {

@@ -588,7 +588,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
         };
         self.rec
-            .kernels(Pass::Ao, &t, &format!("ao_vertex, level {mode:?}"));
+            .kernels(Pass::Ao, &t, &format!("ao_vertex, level {mode}"));
         Ok(())
     }
 
