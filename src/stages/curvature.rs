@@ -149,6 +149,17 @@ pub struct CurvatureEstimator {
     normal_override: Option<Buffer<f32>>,
     device_bytes: u64,
     topology_ms: f64,
+    build_ms: f64,
+    upload_ms: UploadMs,
+}
+
+/// Host time of the last [`CurvatureEstimator::set_positions`], in ms.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct UploadMs {
+    /// Validating the pose and computing its normalization (centre, scale).
+    pub normalise: f64,
+    /// Converting to the device precision and the blocking write.
+    pub write: f64,
 }
 
 struct Kernels {
@@ -201,6 +212,7 @@ impl CurvatureEstimator {
         crate::mesh::check_faces(n_vertices, faces, "curvature estimator")?;
         let t0 = Instant::now();
         let (k, program) = Self::build(&gpu, &opts)?;
+        let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let flat: &[u32] = bytemuck::cast_slice(faces);
         let mut faces_b = gpu.buffer::<u32>(flat.len())?;
         gpu.write(&mut faces_b, flat)?;
@@ -213,7 +225,7 @@ impl CurvatureEstimator {
             opts,
             k,
             program,
-            t0,
+            (t0, build_ms),
         )
     }
 
@@ -301,8 +313,17 @@ impl CurvatureEstimator {
         }
         let t0 = Instant::now();
         let (k, program) = Self::build(&gpu, &opts)?;
+        let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         Self::with_faces(
-            gpu, n_vertices, faces_b, n_faces, None, opts, k, program, t0,
+            gpu,
+            n_vertices,
+            faces_b,
+            n_faces,
+            None,
+            opts,
+            k,
+            program,
+            (t0, build_ms),
         )
     }
 
@@ -316,7 +337,7 @@ impl CurvatureEstimator {
         opts: CurvatureOptions,
         k: Kernels,
         program: Arc<opencl3::program::Program>,
-        t0: Instant,
+        (t0, build_ms): (Instant, f64),
     ) -> Result<Self> {
         let gather = opts.accumulate == Accumulate::Gather;
         let real = opts.precision.bytes();
@@ -384,6 +405,8 @@ impl CurvatureEstimator {
             owner,
             gather: gather_bufs,
             topology_ms: t0.elapsed().as_secs_f64() * 1e3,
+            build_ms,
+            upload_ms: UploadMs::default(),
         };
         Ok(est)
     }
@@ -404,6 +427,18 @@ impl CurvatureEstimator {
         self.topology_ms
     }
 
+    /// Wall time of getting the program and creating the kernels (part of
+    /// [`CurvatureEstimator::topology_ms`]): a build from source, from
+    /// shapecue's binary cache, or nothing when this `Gpu` built it before.
+    pub fn build_ms(&self) -> f64 {
+        self.build_ms
+    }
+
+    /// Host time of the last [`CurvatureEstimator::set_positions`].
+    pub fn upload_ms(&self) -> UploadMs {
+        self.upload_ms
+    }
+
     /// The device this estimator runs on.
     pub fn gpu(&self) -> &Arc<Gpu> {
         &self.gpu
@@ -420,8 +455,10 @@ impl CurvatureEstimator {
                 self.nv
             )));
         }
+        let t0 = Instant::now();
         crate::mesh::check_positions(positions, "pose")?;
         self.norm = Normalization::of_masked(positions, Some(&self.referenced));
+        let t1 = Instant::now();
         self.staging.clear();
         for (p, &used) in positions.iter().zip(&self.referenced) {
             // Unreferenced vertices are never read; zeros keep them finite in f32.
@@ -433,7 +470,12 @@ impl CurvatureEstimator {
                 }
             }
         }
-        self.gpu.write(&mut self.pos, &self.staging)
+        self.gpu.write(&mut self.pos, &self.staging)?;
+        self.upload_ms = UploadMs {
+            normalise: (t1 - t0).as_secs_f64() * 1e3,
+            write: t1.elapsed().as_secs_f64() * 1e3,
+        };
+        Ok(())
     }
 
     /// Loads positions from a device buffer of `3·n_vertices` floats `p`
