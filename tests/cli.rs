@@ -742,11 +742,17 @@ fn cache_outcome(stats: &serde_json::Value) -> String {
 
 fn cache_entries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let mut v: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
+        .map(|r| r.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
     v.sort();
     v
+}
+
+fn clbin_entries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    cache_entries(dir)
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "clbin"))
+        .collect()
 }
 
 /// The program-binary cache: a miss builds from source and saves one entry,
@@ -757,13 +763,22 @@ fn cache_entries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 fn program_cache_hits_and_survives_corrupt_and_truncated_files() {
     let d = scratch("progcache");
     let cache = d.join("cache");
+    // The first build from source leaves a marker, the second saves the
+    // binary (so the very first process pays nothing for the cache).
     let (s, reference) = curvature_cached(Some(&cache), &d, "first", &[]);
     assert_eq!(cache_outcome(&s), "miss");
+    assert_eq!(s["programs"][0]["saved"], false);
+    assert!(clbin_entries(&cache).is_empty());
+    let (s, ply) = curvature_cached(Some(&cache), &d, "second", &[]);
+    assert_eq!(cache_outcome(&s), "miss");
+    assert_eq!(s["programs"][0]["saved"], true);
+    assert_eq!(ply, reference);
     let entries = cache_entries(&cache);
     assert_eq!(entries.len(), 1, "{entries:?}");
     assert!(entries[0].extension().is_some_and(|e| e == "clbin"));
     let (s, ply) = curvature_cached(Some(&cache), &d, "hit", &[]);
     assert_eq!(cache_outcome(&s), "hit");
+    assert_eq!(s["programs"][0]["saved"], false);
     assert_eq!(ply, reference, "output from the cached binary differs");
 
     let good = std::fs::read(&entries[0]).unwrap();
@@ -846,11 +861,25 @@ fn concurrent_processes_share_the_program_cache() {
     for p in &plys {
         assert_eq!(p, &reference);
     }
+    // Each racer saw no entry; those that found another's marker saved.
+    // Within two more processes the entry is there, one file, no leftovers.
+    let mut outcomes = Vec::new();
+    for i in 0..3 {
+        let (s, ply) = curvature_cached(Some(&cache), &d, &format!("after{i}"), &[]);
+        assert_eq!(ply, reference);
+        outcomes.push(cache_outcome(&s));
+        if outcomes.last().is_some_and(|o| o == "hit") {
+            break;
+        }
+    }
+    assert_eq!(
+        outcomes.last().map(String::as_str),
+        Some("hit"),
+        "{outcomes:?}"
+    );
     let entries = cache_entries(&cache);
     assert_eq!(entries.len(), 1, "{entries:?}");
-    let (s, ply) = curvature_cached(Some(&cache), &d, "after", &[]);
-    assert_eq!(cache_outcome(&s), "hit");
-    assert_eq!(ply, reference);
+    assert_eq!(clbin_entries(&cache), entries);
 }
 
 /// `--runs N`: the output is written once and is the same as without it;

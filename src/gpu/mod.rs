@@ -61,6 +61,9 @@ pub struct ProgramBuild {
     /// (a damaged, foreign or refused cache file; built from source and
     /// saved again).
     pub cache: String,
+    /// Whether [`Gpu::persist_programs`] saved it into the cache (a miss is
+    /// saved at its second build from source, see [`cache`]).
+    pub saved: bool,
     /// Wall ms of getting the program (read + build, or build from source).
     pub ms: f64,
 }
@@ -146,15 +149,14 @@ impl Gpu {
             Some(Ok(p)) => (Arc::new(p), "hit".to_string()),
             other => {
                 let p = Arc::new(program::build_source(&self.context, file, &src, &opts)?);
-                let outcome = match other {
-                    None => "off".to_string(),
-                    Some(Err(why)) if why == cache::Reject::Missing.to_string() => {
-                        "miss".to_string()
+                let (outcome, save) = match (other, &self.cache_dir) {
+                    (Some(Err(why)), Some(dir)) if why == cache::Reject::Missing.to_string() => {
+                        ("miss".to_string(), cache::seen_before(dir, key))
                     }
-                    Some(Err(why)) => format!("rejected: {why}"),
-                    Some(Ok(_)) => unreachable!("handled above"),
+                    (Some(Err(why)), _) => (format!("rejected: {why}"), true),
+                    _ => ("off".to_string(), false),
                 };
-                if self.cache_dir.is_some() {
+                if save {
                     lock(&self.unsaved).push((key, p.clone()));
                 }
                 (p, outcome)
@@ -164,6 +166,7 @@ impl Gpu {
             file: file.name.to_string(),
             options: options.to_string(),
             cache: outcome,
+            saved: false,
             ms: t0.elapsed().as_secs_f64() * 1e3,
         });
         programs.insert(map_key, p.clone());
@@ -175,8 +178,10 @@ impl Gpu {
         lock(&self.builds).clone()
     }
 
-    /// Saves the programs built from source so far into the binary cache
-    /// (best effort: a folder that cannot be written is skipped silently).
+    /// Saves the programs built from source so far that are due (the second
+    /// build of a key, or the replacement of a damaged entry: see [`cache`])
+    /// into the binary cache (best effort: a folder that cannot be written
+    /// is skipped silently).
     /// Called when the `Gpu` is dropped; call it earlier to time it, or
     /// after the kernels have run once so that code the driver compiles at
     /// the first launch is in the saved binary. Returns how many were saved.
@@ -185,12 +190,24 @@ impl Gpu {
             return 0;
         };
         let pending = std::mem::take(&mut *lock(&self.unsaved));
-        pending
-            .iter()
-            .filter(|(key, p)| {
-                program::binary_of(p).is_some_and(|bin| cache::store(dir, *key, &bin).is_ok())
-            })
-            .count()
+        let mut saved = 0;
+        for (key, p) in &pending {
+            if program::binary_of(p).is_some_and(|bin| cache::store(dir, *key, &bin).is_ok()) {
+                saved += 1;
+                let programs = lock(&self.programs);
+                let mut builds = lock(&self.builds);
+                // The build record of this program: same (file, options) entry.
+                if let Some(((file, options), _)) = programs.iter().find(|(_, q)| Arc::ptr_eq(q, p))
+                {
+                    for b in builds.iter_mut() {
+                        if &b.file == file && &b.options == options {
+                            b.saved = true;
+                        }
+                    }
+                }
+            }
+        }
+        saved
     }
 
     /// Creates the kernel `name` from `program`.
