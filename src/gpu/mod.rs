@@ -267,6 +267,31 @@ impl Gpu {
         .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
     }
 
+    /// Reads several buffers with one wait: every read is enqueued without
+    /// blocking, then the queue is finished once (a blocking read per
+    /// buffer waits for the device's worker each time). Each `out` is filled
+    /// from the start of its buffer.
+    pub fn read_many<T>(&self, reads: &mut [(&Buffer<T>, &mut [T])]) -> Result<()> {
+        for (buf, out) in reads.iter_mut() {
+            if out.is_empty() {
+                continue;
+            }
+            // SAFETY: a non-blocking read into a live slice no longer than the
+            // buffer; the slices stay borrowed until `finish` below returns,
+            // and an error from it leaves them borrowed only to this call.
+            unsafe {
+                self.queue
+                    .enqueue_read_buffer(buf, opencl3::types::CL_NON_BLOCKING, 0, out, &[])
+            }
+            .map_err(|e| {
+                // Do not return while earlier reads may still write into `reads`.
+                let _ = self.queue.finish();
+                Error::cl("clEnqueueReadBuffer", e)
+            })?;
+        }
+        self.finish()
+    }
+
     /// Enqueues zeroing the first `len` elements of `buf` without waiting
     /// (the in-order queue runs it before later commands): resetting a
     /// counter this way does not stall the host between passes.
