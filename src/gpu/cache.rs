@@ -8,14 +8,17 @@
 //! kernel cache folder, work-group-size variants included) has it saved too.
 //! Later processes create the program from that binary.
 //!
-//! - **When:** at the *second* build from source of a key (the first leaves
-//!   an empty `<key>.seen` marker), or at once when a damaged entry is
-//!   replaced. Asking PoCL for a program's binary compiles every kernel of
-//!   the program for any work-group size: for `kernels/curvature.cl` (16
-//!   kernels) that took 9 to 19 s on this project's 2-core machine under
-//!   load when PoCL's own cache was cold, against about 0.1 s once PoCL had
-//!   compiled them itself. Deferring the save keeps the very first process
-//!   as fast as without this cache.
+//! - **When:** on PoCL ([`defers_save`]), at the *second* build from source
+//!   of a key (the first leaves an empty `<key>.seen` marker); elsewhere,
+//!   and on PoCL when a damaged entry is replaced, at the first. Asking
+//!   PoCL for a program's binary compiles every kernel of the program for
+//!   any work-group size: for `kernels/curvature.cl` (16 kernels) that took
+//!   7 to 19 s on this project's 2-core machine under load (about 0.1 s
+//!   when PoCL's cache already held those builds), so a process that runs
+//!   once (a CI job, a one-off command) does not pay for it. Intel's CPU
+//!   runtime returns its binary in about 30 ms and has no cache of its own
+//!   (each process compiled the curvature program for 6 to 7 s there), so
+//!   it saves at once.
 //! - **Where:** `$SHAPECUE_CACHE_DIR`, else `$XDG_CACHE_HOME/shapecue`, else
 //!   `~/.cache/shapecue`; `SHAPECUE_NO_CACHE=1` turns the cache off.
 //! - **Key:** a 128-bit FNV-1a hash of the assembled kernel text, the full
@@ -150,6 +153,13 @@ pub fn decode(key: u128, bytes: &[u8]) -> Result<&[u8], Reject> {
     Ok(payload)
 }
 
+/// Whether programs of this platform are saved at their second build from
+/// source rather than the first: PoCL's, whose binary query is costly (see
+/// the module header).
+pub fn defers_save(platform: &str) -> bool {
+    platform.contains("Portable Computing Language") || platform.contains("PoCL")
+}
+
 /// The marker of `key` in `dir` (see the module header: saved at the second build).
 fn seen_path(dir: &Path, key: u128) -> PathBuf {
     dir.join(format!("{key:032x}.seen"))
@@ -223,6 +233,8 @@ mod tests {
         assert_ne!(k, key(&[b"a", b"bc"]));
         assert_ne!(k, key(&[b"ab", b"d"]));
         assert_eq!(k, key(&[b"ab", b"c"]));
+        assert!(defers_save("Portable Computing Language"));
+        assert!(!defers_save("Intel(R) OpenCL"));
     }
 
     #[test]

@@ -151,7 +151,9 @@ impl Gpu {
                 let p = Arc::new(program::build_source(&self.context, file, &src, &opts)?);
                 let (outcome, save) = match (other, &self.cache_dir) {
                     (Some(Err(why)), Some(dir)) if why == cache::Reject::Missing.to_string() => {
-                        ("miss".to_string(), cache::seen_before(dir, key))
+                        let save = !cache::defers_save(&self.info.platform)
+                            || cache::seen_before(dir, key);
+                        ("miss".to_string(), save)
                     }
                     (Some(Err(why)), _) => (format!("rejected: {why}"), true),
                     _ => ("off".to_string(), false),
