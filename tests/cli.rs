@@ -763,3 +763,249 @@ fn meshes_too_large_or_small_to_draw_in_single_precision_are_refused_by_name() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Runs `shapecue curvature` on a small generated sphere (gather variant:
+/// bitwise reproducible) with the program cache in `cache` (or off), and
+/// returns the stats and the PLY bytes.
+fn curvature_cached(
+    cache: Option<&std::path::Path>,
+    out_dir: &std::path::Path,
+    tag: &str,
+    extra: &[&str],
+) -> (serde_json::Value, Vec<u8>) {
+    let (ply, json) = (
+        out_dir.join(format!("{tag}.ply")),
+        out_dir.join(format!("{tag}.json")),
+    );
+    let mut cmd = cli();
+    cmd.args([
+        "curvature",
+        "--generate",
+        "sphere",
+        "--resolution",
+        "800",
+        "--accumulate",
+        "gather",
+        "-o",
+    ])
+    .arg(&ply)
+    .arg("--stats")
+    .arg(&json)
+    .args(extra);
+    match cache {
+        Some(dir) => cmd
+            .env("SHAPECUE_CACHE_DIR", dir)
+            .env("SHAPECUE_CACHE_POCL", "1")
+            .env_remove("SHAPECUE_NO_CACHE"),
+        None => cmd.env("SHAPECUE_NO_CACHE", "1"),
+    };
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{tag}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    (stats, std::fs::read(&ply).unwrap())
+}
+
+fn cache_outcome(stats: &serde_json::Value) -> String {
+    let p = stats["programs"].as_array().expect("stats list programs");
+    assert_eq!(p.len(), 1, "{stats}");
+    p[0]["cache"].as_str().unwrap().to_string()
+}
+
+fn cache_entries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+fn clbin_entries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    cache_entries(dir)
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "clbin"))
+        .collect()
+}
+
+/// The program-binary cache: a miss builds from source and saves one entry,
+/// the next process builds from it; a corrupt or truncated entry is
+/// detected, rebuilt from source and rewritten, never an error; the output
+/// is the same bytes every time; `SHAPECUE_NO_CACHE=1` turns it off.
+#[test]
+fn program_cache_hits_and_survives_corrupt_and_truncated_files() {
+    let d = scratch("progcache");
+    let cache = d.join("cache");
+    // The first build from source saves the binary (on PoCL only with
+    // SHAPECUE_CACHE_POCL=1, which `curvature_cached` sets).
+    let (s, reference) = curvature_cached(Some(&cache), &d, "first", &[]);
+    assert_eq!(cache_outcome(&s), "miss");
+    assert_eq!(s["programs"][0]["saved"], true, "{s}");
+    let entries = cache_entries(&cache);
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    assert!(entries[0].extension().is_some_and(|e| e == "clbin"));
+    let (s, ply) = curvature_cached(Some(&cache), &d, "hit", &[]);
+    assert_eq!(cache_outcome(&s), "hit");
+    assert_eq!(s["programs"][0]["saved"], false);
+    assert_eq!(ply, reference, "output from the cached binary differs");
+
+    let good = std::fs::read(&entries[0]).unwrap();
+    // One flipped byte in the driver's binary: the checksum catches it.
+    let mut bad = good.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0x5a;
+    std::fs::write(&entries[0], &bad).unwrap();
+    let (s, ply) = curvature_cached(Some(&cache), &d, "corrupt", &[]);
+    let why = cache_outcome(&s);
+    assert!(
+        why.starts_with("rejected") && why.contains("checksum"),
+        "{why}"
+    );
+    assert_eq!(ply, reference);
+    assert_eq!(
+        cache_outcome(&curvature_cached(Some(&cache), &d, "rewritten", &[]).0),
+        "hit"
+    );
+
+    // Cut short (a crash mid-write of a cache that did not write atomically).
+    std::fs::write(&entries[0], &good[..good.len() / 3]).unwrap();
+    let (s, ply) = curvature_cached(Some(&cache), &d, "truncated", &[]);
+    let why = cache_outcome(&s);
+    assert!(
+        why.starts_with("rejected") && why.contains("truncated"),
+        "{why}"
+    );
+    assert_eq!(ply, reference);
+    // Shorter than the header, and not a cache file at all.
+    let junk = [
+        &b"SCCL"[..],
+        &b"not a cache file, but long enough to hold a header"[..],
+    ];
+    for (i, junk) in junk.into_iter().enumerate() {
+        std::fs::write(&entries[0], junk).unwrap();
+        let (s, ply) = curvature_cached(Some(&cache), &d, &format!("junk{i}"), &[]);
+        assert!(cache_outcome(&s).starts_with("rejected"), "{s}");
+        assert_eq!(ply, reference);
+    }
+    assert_eq!(
+        cache_outcome(&curvature_cached(Some(&cache), &d, "again", &[]).0),
+        "hit"
+    );
+    assert_eq!(
+        cache_entries(&cache).len(),
+        1,
+        "one entry, no temporary files"
+    );
+
+    let (s, ply) = curvature_cached(None, &d, "off", &[]);
+    assert_eq!(cache_outcome(&s), "off");
+    assert_eq!(ply, reference);
+
+    // A cache folder that cannot be created (a file is in the way): built
+    // from source, no error.
+    let blocked = d.join("a-file");
+    std::fs::write(&blocked, b"x").unwrap();
+    let (s, ply) = curvature_cached(Some(&blocked.join("cache")), &d, "blocked", &[]);
+    assert!(cache_outcome(&s).starts_with("rejected") || cache_outcome(&s) == "miss");
+    assert_eq!(ply, reference);
+}
+
+/// Processes started together on an empty cache all succeed with the same
+/// output, and leave one valid entry that the next process uses.
+#[test]
+fn concurrent_processes_share_the_program_cache() {
+    let d = scratch("progcache-race");
+    let cache = d.join("cache");
+    let (_, reference) = curvature_cached(None, &d, "reference", &[]);
+    let plys: Vec<Vec<u8>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..4)
+            .map(|i| {
+                let (cache, d) = (&cache, &d);
+                s.spawn(move || curvature_cached(Some(cache), d, &format!("racer{i}"), &[]).1)
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for p in &plys {
+        assert_eq!(p, &reference);
+    }
+    // Each racer saw no entry and saved the same bytes (renamed into place).
+    // Within two more processes the entry is there, one file, no leftovers.
+    let mut outcomes = Vec::new();
+    for i in 0..3 {
+        let (s, ply) = curvature_cached(Some(&cache), &d, &format!("after{i}"), &[]);
+        assert_eq!(ply, reference);
+        outcomes.push(cache_outcome(&s));
+        if outcomes.last().is_some_and(|o| o == "hit") {
+            break;
+        }
+    }
+    assert_eq!(
+        outcomes.last().map(String::as_str),
+        Some("hit"),
+        "{outcomes:?}"
+    );
+    let entries = cache_entries(&cache);
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    assert_eq!(clbin_entries(&cache), entries);
+}
+
+/// `--runs N`: the output is written once and is the same as without it;
+/// the stats give the count, kernel and wall medians and one median per
+/// pass, in the order of `passes`; `--runs 0` is refused.
+#[test]
+fn curvature_runs_times_the_device_passes() {
+    let d = scratch("runs");
+    let (plain, reference) = curvature_cached(None, &d, "plain", &[]);
+    for key in ["phases_ms", "command_ms", "programs"] {
+        assert!(plain.get(key).is_some(), "stats lack {key}: {plain}");
+    }
+    for phase in [
+        "load",
+        "device",
+        "program_build",
+        "topology",
+        "normalise",
+        "upload",
+        "first_run",
+        "read_back",
+        "cache_write",
+        "ply_write",
+    ] {
+        assert!(
+            plain["phases_ms"][phase].as_f64().is_some_and(|v| v >= 0.0),
+            "phase {phase}: {plain}"
+        );
+    }
+    assert!(plain.get("kernel_median_ms").is_none());
+    let (s, ply) = curvature_cached(None, &d, "runs", &["--runs", "3"]);
+    assert_eq!(ply, reference, "--runs changed the output");
+    assert_eq!(s["runs"], 3);
+    for key in [
+        "kernel_median_ms",
+        "wall_median_ms",
+        "kernel_min_ms",
+        "wall_min_ms",
+    ] {
+        assert!(s[key].as_f64().is_some_and(|v| v > 0.0), "{key}: {s}");
+    }
+    assert!(s["kernel_min_ms"].as_f64() <= s["kernel_median_ms"].as_f64());
+    let names = |k: &str| -> Vec<String> {
+        s[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["pass"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(names("passes_median"), names("passes"));
+    let out = run_cli(["curvature", "--generate", "sphere", "--runs", "0"]);
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("--runs") && e.contains("1..="), "{e}");
+    // The CPU reference times its runs too.
+    let (s, _) = curvature_cached(None, &d, "cpu", &["--cpu", "--runs", "2"]);
+    assert_eq!(s["runs"], 2);
+    assert!(s["wall_median_ms"].as_f64().is_some_and(|v| v > 0.0), "{s}");
+}

@@ -1,13 +1,21 @@
 //! `shapecue curvature`: per-vertex curvature of a mesh file or a generated
 //! mesh ([`shapecue::curvature`] or its CPU twin), written as PLY with JSON
 //! stats; `--report` prints the accuracy/time table.
+//!
+//! The stats time every phase of the command (`phases_ms`: load = parse and
+//! validation, device, program build, topology, normalisation, upload, the
+//! first run with the driver's compilation at first launch, read-back,
+//! program-cache write, PLY write), and `--runs N` adds N timed runs of the
+//! device passes after the one whose results are written, with medians.
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::{Generated, LoadOptions};
-use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{Accumulate, Compat, Curvature, CurvatureOptions, Precision};
+use shapecue::spec::timing::Timing;
+use shapecue::stages::curvature::CurvatureEstimator;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -54,9 +62,11 @@ pub struct CurvatureArgs {
     /// Print the accuracy/time table of every variant instead (no input needed).
     #[arg(long)]
     report: bool,
-    /// Runs per variant for the report's median times.
-    #[arg(long, default_value_t = 7)]
-    runs: usize,
+    /// With --report: runs per variant for the median times (default 7).
+    /// Otherwise: after the run whose results are written (the warm-up), N
+    /// more timed runs of the device passes; --stats gives their medians.
+    #[arg(long)]
+    runs: Option<usize>,
 }
 
 /// Runs `shapecue curvature`.
@@ -67,11 +77,14 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         compat: a.compat,
         dcurv: !a.no_dcurv,
     };
-    shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
+    let t_start = Instant::now();
+    if let Some(n) = a.runs {
+        shapecue::spec::limits::check_count("--runs", n, 10_000)?;
+    }
     super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
-        let text = super::tables::curvature_report(gpu, a.resolution, a.runs)?;
+        let text = super::tables::curvature_report(gpu, a.resolution, a.runs.unwrap_or(7))?;
         super::print_str(&text)?;
         return Ok(());
     }
@@ -98,6 +111,11 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     }
 
     let t_all = Instant::now();
+    let mut phases = serde_json::Map::new();
+    let mut phase = |name: &str, ms: f64| {
+        phases.insert(name.to_string(), serde_json::json!(ms));
+    };
+    phase("load", load_ms);
     let (c, mut stats) = if a.cpu {
         // The reference computes in f64, so it judges faces by f64 rounding.
         let opts = CurvatureOptions {
@@ -105,16 +123,48 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             ..opts
         };
         let c = shapecue::cpu::curvature::curvature(&mesh, opts)?;
-        let stats = serde_json::json!({
+        let mut stats = serde_json::json!({
             "device": "cpu reference (f64, single thread)",
             "wall_ms": c.timing.wall_ms,
         });
+        if let Some(n) = a.runs {
+            let mut walls = Vec::with_capacity(n);
+            for _ in 0..n {
+                walls.push(
+                    shapecue::cpu::curvature::curvature(&mesh, opts)?
+                        .timing
+                        .wall_ms,
+                );
+            }
+            stats["runs"] = serde_json::json!(n);
+            stats["wall_median_ms"] = serde_json::json!(median(&mut walls));
+        }
+        phase("first_run", c.timing.wall_ms);
         (c, stats)
     } else {
+        let t = Instant::now();
         let gpu = Arc::new(Gpu::new(device)?);
-        let c = shapecue::curvature_on(&gpu, &mesh, opts)
-            .with_context(|| format!("setting up curvature for {name}"))?;
-        let stats = serde_json::json!({
+        phase("device", ms_since(t));
+        let setup = || format!("setting up curvature for {name}");
+        let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, opts)
+            .with_context(setup)?;
+        phase("program_build", est.build_ms());
+        phase("topology", est.topology_ms() - est.build_ms());
+        est.set_positions(&mesh.positions).with_context(setup)?;
+        phase("normalise", est.upload_ms().normalise);
+        phase("upload", est.upload_ms().write);
+        let timing = est.run().with_context(setup)?;
+        phase("first_run", timing.wall_ms);
+        let t = Instant::now();
+        let c = Curvature {
+            field: est.read()?,
+            counts: est.counts()?,
+            timing,
+            topology_ms: est.topology_ms(),
+            device_bytes: est.device_bytes(),
+        };
+        phase("read_back", ms_since(t));
+        let mut stats = serde_json::json!({
             "device": gpu.info,
             "topology_ms": c.topology_ms,
             "passes": passes(&c.timing),
@@ -123,6 +173,19 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             "device_bytes": c.device_bytes,
             "device_bytes_per_vertex": c.device_bytes as f64 / mesh.n_vertices() as f64,
         });
+        if let Some(n) = a.runs {
+            let mut timed = Vec::with_capacity(n);
+            for _ in 0..n {
+                timed.push(est.run()?);
+            }
+            runs_stats(&mut stats, &timed, c.timing.wall_ms);
+        }
+        // After the runs, so that code the driver compiled at the first
+        // launch is in the saved binaries; a no-op when the cache hit.
+        let t = Instant::now();
+        gpu.persist_programs();
+        phase("cache_write", ms_since(t));
+        stats["programs"] = serde_json::to_value(gpu.program_builds())?;
         (c, stats)
     };
     let total_ms = t_all.elapsed().as_secs_f64() * 1e3;
@@ -149,7 +212,9 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         );
     }
     if let Some(out) = &a.output {
+        let t = Instant::now();
         let written = shapecue::export::ply::write_ply(out, &mesh, Some(field))?;
+        phases.insert("ply_write".into(), serde_json::json!(ms_since(t)));
         super::note_double(out, &written);
         out!("wrote {}", out.display());
     }
@@ -162,9 +227,57 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         stats["mostly_degenerate"] = serde_json::json!(mostly_degenerate);
         stats["load_ms"] = serde_json::json!(load_ms);
         stats["total_wall_ms"] = serde_json::json!(total_ms);
+        stats["phases_ms"] = serde_json::Value::Object(phases);
+        // From the start of the command (after argument parsing) to here:
+        // everything but the process start and this file.
+        stats["command_ms"] = serde_json::json!(ms_since(t_start));
         write_json(path, &stats)?;
     }
     Ok(())
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// The median of `v` (the mean of the middle two for an even count; 0 for none).
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// The `--runs` keys of the device stats: the count, kernel and wall
+/// medians and minima, the median of each pass, and an estimate of the
+/// driver's compilation at first launch (first run's wall − median wall).
+fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
+    let mut kernel: Vec<f64> = timed.iter().map(|t| t.kernel_ms).collect();
+    let mut wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
+    let (kmin, wmin) = (
+        kernel.iter().copied().fold(f64::INFINITY, f64::min),
+        wall.iter().copied().fold(f64::INFINITY, f64::min),
+    );
+    let wall_median = median(&mut wall);
+    let per_pass: Vec<serde_json::Value> = timed
+        .first()
+        .map(|t| &t.steps[..])
+        .unwrap_or_default()
+        .iter()
+        .map(|s| {
+            let mut ms: Vec<f64> = timed.iter().map(|t| t.ms(&[s.step])).collect();
+            serde_json::json!({ "pass": s.step.name(), "kernel_ms": median(&mut ms) })
+        })
+        .collect();
+    stats["runs"] = serde_json::json!(timed.len());
+    stats["kernel_median_ms"] = serde_json::json!(median(&mut kernel));
+    stats["kernel_min_ms"] = serde_json::json!(kmin);
+    stats["wall_median_ms"] = serde_json::json!(wall_median);
+    stats["wall_min_ms"] = serde_json::json!(wmin);
+    stats["passes_median"] = serde_json::Value::Array(per_pass);
+    stats["first_launch_compile_ms"] = serde_json::json!((first_wall_ms - wall_median).max(0.0));
 }
 
 fn minmax(v: &[f64]) -> (f64, f64) {

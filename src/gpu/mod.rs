@@ -1,8 +1,10 @@
 //! The OpenCL layer: platform and device discovery, device selection, program
 //! building (kernel sources embedded with `include_str!`, shared headers
 //! prepended with `#line` markers so build logs name the real file), typed
-//! buffers and kernel launches timed with profiling events.
+//! buffers and kernel launches timed with profiling events; built programs
+//! are kept in shapecue's own binary cache ([`cache`]) across processes.
 
+pub mod cache;
 mod device;
 mod program;
 
@@ -18,8 +20,11 @@ use opencl3::kernel::{ExecuteKernel, Kernel};
 use opencl3::memory::{Buffer, CL_MEM_READ_WRITE};
 use opencl3::program::Program;
 use opencl3::types::{CL_BLOCKING, cl_mem_flags};
+use serde::Serialize;
 use std::collections::HashMap;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
+use std::time::Instant;
 
 /// Work-group size used for every 1-D launch. PoCL compiles a new kernel
 /// variant for every distinct local size, so a fixed size (with the global
@@ -27,13 +32,40 @@ use std::sync::{Arc, Mutex};
 pub const LOCAL_SIZE: usize = 64;
 
 /// An OpenCL device with its context, in-order profiling queue and a cache of
-/// built programs (each (file, options) pair is compiled once per `Gpu`).
+/// built programs (each (file, options) pair is compiled once per `Gpu`, and
+/// across processes through [`cache`]).
 pub struct Gpu {
     /// What the device is.
     pub info: DeviceInfo,
     context: Context,
     queue: CommandQueue,
     programs: Mutex<HashMap<(String, String), Arc<Program>>>,
+    /// The binary cache's folder (`None`: off), read once in [`Gpu::new`].
+    cache_dir: Option<PathBuf>,
+    /// Platform, device and driver, as they enter every cache key.
+    cache_tag: String,
+    /// Programs built from source in this `Gpu`, not yet saved: (key, program).
+    unsaved: Mutex<Vec<(u128, Arc<Program>)>>,
+    builds: Mutex<Vec<ProgramBuild>>,
+}
+
+/// How one program of a [`Gpu`] was obtained (for stats).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ProgramBuild {
+    /// Kernel file (`kernels/curvature.cl`).
+    pub file: String,
+    /// Build options given (without `-cl-std`).
+    pub options: String,
+    /// `"hit"` (built from the cached binary), `"miss"` (from source, to be
+    /// saved), `"off"` (cache disabled or no folder) or `"rejected: why"`
+    /// (a damaged, foreign or refused cache file; built from source and
+    /// saved again).
+    pub cache: String,
+    /// Whether [`Gpu::persist_programs`] saved it into the cache (a miss is
+    /// saved at its second build from source, see [`cache`]).
+    pub saved: bool,
+    /// Wall ms of getting the program (read + build, or build from source).
+    pub ms: f64,
 }
 
 impl std::fmt::Debug for Gpu {
@@ -55,11 +87,28 @@ impl Gpu {
         #[allow(deprecated)]
         let queue = CommandQueue::create_default(&context, CL_QUEUE_PROFILING_ENABLE)
             .map_err(|e| Error::cl("clCreateCommandQueue", e))?;
+        let platform_version = device
+            .platform()
+            .ok()
+            .and_then(|p| opencl3::platform::Platform::new(p).version().ok())
+            .unwrap_or_default();
+        let cache_tag = format!(
+            "platform={}\nplatform_version={}\ndevice={}\ndevice_version={}\ndriver={}\n",
+            info.platform,
+            platform_version.trim(),
+            info.name,
+            info.version,
+            device.driver_version().unwrap_or_default().trim()
+        );
         Ok(Gpu {
             info,
             context,
             queue,
             programs: Mutex::new(HashMap::new()),
+            cache_dir: cache::cache_dir(),
+            cache_tag,
+            unsaved: Mutex::new(Vec::new()),
+            builds: Mutex::new(Vec::new()),
         })
     }
 
@@ -74,16 +123,92 @@ impl Gpu {
     }
 
     /// Builds `file` with `options` (e.g. `-DREAL=double`), or returns the
-    /// program built earlier in this process with the same pair.
+    /// program built earlier in this process with the same pair. The build
+    /// starts from shapecue's binary cache where it holds this program for
+    /// this device and driver ([`cache`]), else from source (then saved by
+    /// [`Gpu::persist_programs`]); a cache problem is never an error.
     pub fn program(&self, file: &KernelFile, options: &str) -> Result<Arc<Program>> {
-        let key = (file.name.to_string(), options.to_string());
-        let mut cache = self.programs.lock().unwrap_or_else(|p| p.into_inner());
-        if let Some(p) = cache.get(&key) {
+        let map_key = (file.name.to_string(), options.to_string());
+        let mut programs = self.programs.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(p) = programs.get(&map_key) {
             return Ok(p.clone());
         }
-        let p = Arc::new(program::build(&self.context, file, options)?);
-        cache.insert(key, p.clone());
+        let t0 = Instant::now();
+        let src = program::assemble(file);
+        let opts = program::full_options(options);
+        let key = cache::key(&[src.as_bytes(), opts.as_bytes(), self.cache_tag.as_bytes()]);
+        let from_cache = self.cache_dir.as_deref().map(|dir| {
+            cache::load(dir, key)
+                .map_err(|r| r.to_string())
+                .and_then(|bin| {
+                    program::build_binary(&self.context, self.info.id, &bin, &opts)
+                        .map_err(|e| format!("the driver refused the cached binary ({e})"))
+                })
+        });
+        let (p, outcome) = match from_cache {
+            Some(Ok(p)) => (Arc::new(p), "hit".to_string()),
+            other => {
+                let p = Arc::new(program::build_source(&self.context, file, &src, &opts)?);
+                let saves = cache::saves(&self.info.platform);
+                let (outcome, save) = match (other, &self.cache_dir) {
+                    (Some(Err(why)), Some(_)) if why == cache::Reject::Missing.to_string() => {
+                        ("miss".to_string(), saves)
+                    }
+                    (Some(Err(why)), _) => (format!("rejected: {why}"), saves),
+                    _ => ("off".to_string(), false),
+                };
+                if save {
+                    lock(&self.unsaved).push((key, p.clone()));
+                }
+                (p, outcome)
+            }
+        };
+        lock(&self.builds).push(ProgramBuild {
+            file: file.name.to_string(),
+            options: options.to_string(),
+            cache: outcome,
+            saved: false,
+            ms: t0.elapsed().as_secs_f64() * 1e3,
+        });
+        programs.insert(map_key, p.clone());
         Ok(p)
+    }
+
+    /// How each program of this `Gpu` was obtained, in build order.
+    pub fn program_builds(&self) -> Vec<ProgramBuild> {
+        lock(&self.builds).clone()
+    }
+
+    /// Saves the programs built from source so far that are due (see
+    /// [`cache::saves`])
+    /// into the binary cache (best effort: a folder that cannot be written
+    /// is skipped silently).
+    /// Called when the `Gpu` is dropped; call it earlier to time it, or
+    /// after the kernels have run once so that code the driver compiles at
+    /// the first launch is in the saved binary. Returns how many were saved.
+    pub fn persist_programs(&self) -> usize {
+        let Some(dir) = &self.cache_dir else {
+            return 0;
+        };
+        let pending = std::mem::take(&mut *lock(&self.unsaved));
+        let mut saved = 0;
+        for (key, p) in &pending {
+            if program::binary_of(p).is_some_and(|bin| cache::store(dir, *key, &bin).is_ok()) {
+                saved += 1;
+                let programs = lock(&self.programs);
+                let mut builds = lock(&self.builds);
+                // The build record of this program: same (file, options) entry.
+                if let Some(((file, options), _)) = programs.iter().find(|(_, q)| Arc::ptr_eq(q, p))
+                {
+                    for b in builds.iter_mut() {
+                        if &b.file == file && &b.options == options {
+                            b.saved = true;
+                        }
+                    }
+                }
+            }
+        }
+        saved
     }
 
     /// Creates the kernel `name` from `program`.
@@ -143,6 +268,31 @@ impl Gpu {
         .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
     }
 
+    /// Reads several buffers with one wait: every read is enqueued without
+    /// blocking, then the queue is finished once (a blocking read per
+    /// buffer waits for the device's worker each time). Each `out` is filled
+    /// from the start of its buffer.
+    pub fn read_many<T>(&self, reads: &mut [(&Buffer<T>, &mut [T])]) -> Result<()> {
+        for (buf, out) in reads.iter_mut() {
+            if out.is_empty() {
+                continue;
+            }
+            // SAFETY: a non-blocking read into a live slice no longer than the
+            // buffer; the slices stay borrowed until `finish` below returns,
+            // and an error from it leaves them borrowed only to this call.
+            unsafe {
+                self.queue
+                    .enqueue_read_buffer(buf, opencl3::types::CL_NON_BLOCKING, 0, out, &[])
+            }
+            .map_err(|e| {
+                // Do not return while earlier reads may still write into `reads`.
+                let _ = self.queue.finish();
+                Error::cl("clEnqueueReadBuffer", e)
+            })?;
+        }
+        self.finish()
+    }
+
     /// Enqueues zeroing the first `len` elements of `buf` without waiting
     /// (the in-order queue runs it before later commands): resetting a
     /// counter this way does not stall the host between passes.
@@ -165,6 +315,16 @@ impl Gpu {
     pub fn finish(&self) -> Result<()> {
         self.queue.finish().map_err(|e| Error::cl("clFinish", e))
     }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        self.persist_programs();
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 /// A kernel argument: a buffer or a plain scalar value.

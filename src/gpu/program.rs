@@ -112,13 +112,53 @@ pub(crate) fn driver_lock() -> std::sync::MutexGuard<'static, ()> {
     DRIVER_LOCK.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-pub(crate) fn build(context: &Context, file: &KernelFile, options: &str) -> Result<Program> {
-    let src = assemble(file);
-    let opts = format!("-cl-std=CL1.2 {options}");
+/// The options handed to the compiler for `options` (the OpenCL C version first).
+pub(crate) fn full_options(options: &str) -> String {
+    format!("-cl-std=CL1.2 {options}")
+}
+
+/// Builds `src` (the [`assemble`]d text of `file`) from source with `opts`
+/// (from [`full_options`]); a failure carries the build log.
+pub(crate) fn build_source(
+    context: &Context,
+    file: &KernelFile,
+    src: &str,
+    opts: &str,
+) -> Result<Program> {
     let _guard = driver_lock();
-    Program::create_and_build_from_source(context, &src, &opts).map_err(|log| Error::Build {
+    Program::create_and_build_from_source(context, src, opts).map_err(|log| Error::Build {
         file: file.name.to_string(),
-        options: opts,
+        options: opts.to_string(),
         log,
     })
+}
+
+/// Creates and builds a program from a binary this driver returned earlier
+/// (`CL_PROGRAM_BINARIES`), or says why the driver refused it.
+pub(crate) fn build_binary(
+    context: &Context,
+    device: opencl3::types::cl_device_id,
+    binary: &[u8],
+    opts: &str,
+) -> std::result::Result<Program, String> {
+    let _guard = driver_lock();
+    // SAFETY: one device and one binary, both alive for the call; the driver
+    // checks the binary (PoCL: its magic, version and device hash) and fails
+    // the call or the build on a mismatch, which the caller turns into a
+    // build from source.
+    let mut p = unsafe { Program::create_from_binary(context, &[device], &[binary]) }
+        .map_err(|e| e.to_string())?;
+    p.build(&[device], opts).map_err(|e| e.to_string())?;
+    Ok(p)
+}
+
+/// The binary of a built program for its one device, or `None` when the
+/// driver gives none (empty, or more than one device).
+pub(crate) fn binary_of(program: &Program) -> Option<Vec<u8>> {
+    let _guard = driver_lock();
+    let mut bins = program.get_binaries().ok()?;
+    match bins.len() {
+        1 if !bins[0].is_empty() => bins.pop(),
+        _ => None,
+    }
 }

@@ -149,6 +149,17 @@ pub struct CurvatureEstimator {
     normal_override: Option<Buffer<f32>>,
     device_bytes: u64,
     topology_ms: f64,
+    build_ms: f64,
+    upload_ms: UploadMs,
+}
+
+/// Host time of the last [`CurvatureEstimator::set_positions`], in ms.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct UploadMs {
+    /// Validating the pose and computing its normalization (centre, scale).
+    pub normalise: f64,
+    /// Converting to the device precision and the blocking write.
+    pub write: f64,
 }
 
 struct Kernels {
@@ -201,6 +212,7 @@ impl CurvatureEstimator {
         crate::mesh::check_faces(n_vertices, faces, "curvature estimator")?;
         let t0 = Instant::now();
         let (k, program) = Self::build(&gpu, &opts)?;
+        let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let flat: &[u32] = bytemuck::cast_slice(faces);
         let mut faces_b = gpu.buffer::<u32>(flat.len())?;
         gpu.write(&mut faces_b, flat)?;
@@ -213,7 +225,7 @@ impl CurvatureEstimator {
             opts,
             k,
             program,
-            t0,
+            (t0, build_ms),
         )
     }
 
@@ -301,8 +313,17 @@ impl CurvatureEstimator {
         }
         let t0 = Instant::now();
         let (k, program) = Self::build(&gpu, &opts)?;
+        let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         Self::with_faces(
-            gpu, n_vertices, faces_b, n_faces, None, opts, k, program, t0,
+            gpu,
+            n_vertices,
+            faces_b,
+            n_faces,
+            None,
+            opts,
+            k,
+            program,
+            (t0, build_ms),
         )
     }
 
@@ -316,7 +337,7 @@ impl CurvatureEstimator {
         opts: CurvatureOptions,
         k: Kernels,
         program: Arc<opencl3::program::Program>,
-        t0: Instant,
+        (t0, build_ms): (Instant, f64),
     ) -> Result<Self> {
         let gather = opts.accumulate == Accumulate::Gather;
         let real = opts.precision.bytes();
@@ -338,6 +359,17 @@ impl CurvatureEstimator {
         } else {
             None
         };
+        // Zeroed once: a partial run (normals only, for contours) leaves the
+        // curvature buffers unwritten, and later stages reading them through
+        // [`CurvatureEstimator::device_outputs`] must see finite values.
+        // Fills are enqueued (no host zeros, no wait per buffer); the one
+        // `finish` below waits for them and the owning-face pass together.
+        let rb = |n: usize| -> Result<Buffer<u8>> {
+            let mut b = gpu.buffer::<u8>(n * real)?;
+            gpu.zero(&mut b, n * real)?;
+            Ok(b)
+        };
+        let bufs = [3, 3, 1, 3, 3, 3, 2, 4].map(|n| rb(n * nv));
         launch(
             &gpu,
             &max_face,
@@ -345,23 +377,16 @@ impl CurvatureEstimator {
             &[Arg::U32(nf as u32), buf(&faces_b), buf(&owner)],
         )?;
         gpu.finish()?;
-        // Zeroed once: a partial run (normals only, for contours) leaves the
-        // curvature buffers unwritten, and later stages reading them through
-        // [`CurvatureEstimator::device_outputs`] must see finite values.
-        let rb = |n: usize| -> Result<Buffer<u8>> {
-            let mut b = gpu.buffer::<u8>(n * real)?;
-            gpu.write(&mut b, &vec![0u8; n * real])?;
-            Ok(b)
-        };
+        let [pos, nrm, area, pd1, pd2, tens, kk, dk] = bufs;
         let est = CurvatureEstimator {
-            pos: rb(3 * nv)?,
-            nrm: rb(3 * nv)?,
-            area: rb(nv)?,
-            pd1: rb(3 * nv)?,
-            pd2: rb(3 * nv)?,
-            tens: rb(3 * nv)?,
-            kk: rb(2 * nv)?,
-            dk: rb(4 * nv)?,
+            pos: pos?,
+            nrm: nrm?,
+            area: area?,
+            pd1: pd1?,
+            pd2: pd2?,
+            tens: tens?,
+            kk: kk?,
+            dk: dk?,
             counters: gpu.buffer::<u32>(4)?,
             normal_override: None,
             device_bytes: crate::spec::curvature::device_bytes_bound(nv, nf, &opts),
@@ -384,6 +409,8 @@ impl CurvatureEstimator {
             owner,
             gather: gather_bufs,
             topology_ms: t0.elapsed().as_secs_f64() * 1e3,
+            build_ms,
+            upload_ms: UploadMs::default(),
         };
         Ok(est)
     }
@@ -404,6 +431,18 @@ impl CurvatureEstimator {
         self.topology_ms
     }
 
+    /// Wall time of getting the program and creating the kernels (part of
+    /// [`CurvatureEstimator::topology_ms`]): a build from source, from
+    /// shapecue's binary cache, or nothing when this `Gpu` built it before.
+    pub fn build_ms(&self) -> f64 {
+        self.build_ms
+    }
+
+    /// Host time of the last [`CurvatureEstimator::set_positions`].
+    pub fn upload_ms(&self) -> UploadMs {
+        self.upload_ms
+    }
+
     /// The device this estimator runs on.
     pub fn gpu(&self) -> &Arc<Gpu> {
         &self.gpu
@@ -420,8 +459,10 @@ impl CurvatureEstimator {
                 self.nv
             )));
         }
+        let t0 = Instant::now();
         crate::mesh::check_positions(positions, "pose")?;
         self.norm = Normalization::of_masked(positions, Some(&self.referenced));
+        let t1 = Instant::now();
         self.staging.clear();
         for (p, &used) in positions.iter().zip(&self.referenced) {
             // Unreferenced vertices are never read; zeros keep them finite in f32.
@@ -433,7 +474,12 @@ impl CurvatureEstimator {
                 }
             }
         }
-        self.gpu.write(&mut self.pos, &self.staging)
+        self.gpu.write(&mut self.pos, &self.staging)?;
+        self.upload_ms = UploadMs {
+            normalise: (t1 - t0).as_secs_f64() * 1e3,
+            write: t1.elapsed().as_secs_f64() * 1e3,
+        };
+        Ok(())
     }
 
     /// Loads positions from a device buffer of `3·n_vertices` floats `p`
@@ -640,36 +686,47 @@ impl CurvatureEstimator {
         })
     }
 
-    fn read_real(&self, b: &Buffer<u8>, n: usize) -> Result<Vec<f64>> {
-        let mut bytes = vec![0u8; n * self.real];
-        self.gpu.read(b, &mut bytes)?;
-        Ok(match self.opts.precision {
-            Precision::F32 => bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)
+    /// Device reals (f32 or f64 bytes) as f64.
+    fn to_f64(&self, bytes: &[u8]) -> Vec<f64> {
+        match self.opts.precision {
+            Precision::F32 => bytemuck::pod_collect_to_vec::<u8, f32>(bytes)
                 .into_iter()
                 .map(f64::from)
                 .collect(),
-            Precision::F64 => bytemuck::pod_collect_to_vec::<u8, f64>(&bytes),
-        })
+            Precision::F64 => bytemuck::pod_collect_to_vec::<u8, f64>(bytes),
+        }
     }
 
-    fn read_vec<const N: usize>(&self, b: &Buffer<u8>) -> Result<Vec<[f64; N]>> {
-        let flat = self.read_real(b, N * self.nv)?;
-        Ok(flat
+    fn to_vecs<const N: usize>(&self, bytes: &[u8]) -> Vec<[f64; N]> {
+        self.to_f64(bytes)
             .chunks_exact(N)
             .map(|c| std::array::from_fn(|i| c[i]))
-            .collect())
+            .collect()
     }
 
-    /// Reads the raw device state (normalized coordinates).
+    /// Reads the raw device state (normalized coordinates): the seven
+    /// buffers with one wait ([`Gpu::read_many`]).
     pub fn read_intermediate(&self) -> Result<Intermediate> {
+        let (nv, r) = (self.nv, self.real);
+        let mut bytes: [Vec<u8>; 7] = [3, 1, 3, 3, 3, 2, 4].map(|n| vec![0u8; n * nv * r]);
+        let [nrm, area, pd1, pd2, tens, kk, dk] = &mut bytes;
+        self.gpu.read_many(&mut [
+            (&self.nrm, &mut nrm[..]),
+            (&self.area, &mut area[..]),
+            (&self.pd1, &mut pd1[..]),
+            (&self.pd2, &mut pd2[..]),
+            (&self.tens, &mut tens[..]),
+            (&self.kk, &mut kk[..]),
+            (&self.dk, &mut dk[..]),
+        ])?;
         Ok(Intermediate {
-            normals: self.read_vec::<3>(&self.nrm)?,
-            areas: self.read_real(&self.area, self.nv)?,
-            pd1: self.read_vec::<3>(&self.pd1)?,
-            pd2: self.read_vec::<3>(&self.pd2)?,
-            tensor: self.read_vec::<3>(&self.tens)?,
-            k: self.read_vec::<2>(&self.kk)?,
-            dk: self.read_vec::<4>(&self.dk)?,
+            normals: self.to_vecs::<3>(nrm),
+            areas: self.to_f64(area),
+            pd1: self.to_vecs::<3>(pd1),
+            pd2: self.to_vecs::<3>(pd2),
+            tensor: self.to_vecs::<3>(tens),
+            k: self.to_vecs::<2>(kk),
+            dk: self.to_vecs::<4>(dk),
         })
     }
 
