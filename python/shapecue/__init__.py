@@ -307,9 +307,12 @@ def isosurface(
     given in (x, y, z) order, the order of the returned vertices, which are
     world (x, y, z) positions. So for the same array,
     ``skimage.measure.marching_cubes(vol, iso)[0][:, ::-1]`` lists the same
-    points as these vertices (each once here; scikit-image may keep a
-    duplicate at a grid point, and keeps the zero-area triangles that
-    ``degenerate_dropped`` counts).
+    points as these vertices, and the two surfaces have the same area and
+    volume; a cell's polygon may be split into triangles along the other
+    diagonal (scikit-image uses Lewiner et al.'s tables), and scikit-image's
+    faces, seen in (x, y, z), point the other way. Triangles whose fused
+    corners coincide (an iso value equal to sample values) are dropped and
+    counted in ``degenerate_dropped``.
 
     ``inside``: "below" (signed distance fields, the default) or "above"
     (densities): faces and normals point away from that side.

@@ -64,6 +64,19 @@ fn value_err(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())
 }
 
+/// The array's data as one slice in logical (C) order, when it is laid out
+/// so; `None` for strided and Fortran-ordered arrays (numpy's `as_slice`
+/// also accepts the latter, in memory order).
+fn c_slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+) -> Option<&'a [T]> {
+    if a.is_c_contiguous() {
+        a.as_slice().ok()
+    } else {
+        None
+    }
+}
+
 /// Reads an (N, 3) array of f64 or f32 (any strides) into owned rows.
 fn read_rows3f(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
     fn rows<T: numpy::Element + Copy + Into<f64>>(
@@ -77,7 +90,7 @@ fn read_rows3f(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
                 shape[0], shape[1]
             )));
         }
-        if let Ok(s) = a.as_slice() {
+        if let Some(s) = c_slice(a) {
             return Ok(s
                 .chunks_exact(3)
                 .map(|c| [c[0].into(), c[1].into(), c[2].into()])
@@ -126,7 +139,7 @@ fn read_faces(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
             }
             Ok(out)
         };
-        if let Ok(s) = a.as_slice() {
+        if let Some(s) = c_slice(a) {
             return s
                 .chunks_exact(3)
                 .enumerate()
@@ -441,10 +454,10 @@ fn read_volume(obj: &Bound<'_, PyAny>) -> PyResult<shapecue::volume::Volume> {
     ) -> ([usize; 3], Vec<f32>) {
         let s = a.shape();
         let dims = [s[2], s[1], s[0]];
-        let values = match a.as_slice() {
-            Ok(sl) => sl.iter().map(|v| v.to_f32()).collect(),
+        let values = match c_slice(a) {
+            Some(sl) => sl.iter().map(|v| v.to_f32()).collect(),
             // Standard (logical C) order is x fastest for a (z, y, x) array.
-            Err(_) => a.as_array().iter().map(|v| v.to_f32()).collect(),
+            None => a.as_array().iter().map(|v| v.to_f32()).collect(),
         };
         (dims, values)
     }
