@@ -37,6 +37,7 @@ import json
 import os
 import time
 import traceback
+import uuid
 from typing import Any, Dict, Iterable, List, Optional, Union
 
 import numpy as np
@@ -98,7 +99,9 @@ def _save_npz(path: str, arrays: Dict[str, np.ndarray]) -> None:
     os.replace(tmp, path)
 
 
-def process_one(path: str, task: str, out_dir: str, options: Optional[Dict[str, Any]] = None) -> Dict[str, Any]:
+def process_one(
+    path: str, task: str, out_dir: str, options: Optional[Dict[str, Any]] = None
+) -> Dict[str, Any]:
     """Runs one task on this process (a Dask worker, or the caller) and
     returns its manifest record; never raises for a failure of the input or
     the device, which is recorded as ``status: "error"``."""
@@ -107,7 +110,13 @@ def process_one(path: str, task: str, out_dir: str, options: Optional[Dict[str, 
     options = dict(options or {})
     device = options.pop("device", None) or os.environ.get("SHAPECUE_DEVICE") or None
     out = _output_name(path, task, out_dir)
-    rec: Dict[str, Any] = {"input": path, "output": out, "task": task, "status": "error", "error": None}
+    rec: Dict[str, Any] = {
+        "input": path,
+        "output": out,
+        "task": task,
+        "status": "error",
+        "error": None,
+    }
     try:
         from distributed import get_worker
 
@@ -192,7 +201,9 @@ def run(
     todo = [
         p
         for p in paths
-        if not (last.get(p, {}).get("status") == "ok" and os.path.exists(last[p].get("output", "")))
+        if not (
+            last.get(p, {}).get("status") == "ok" and os.path.exists(last[p].get("output", ""))
+        )
     ]
     if not todo:
         return []
@@ -206,13 +217,27 @@ def run(
 
             client = get_client()
         except ValueError:
-            own = LocalCluster(n_workers=min(2, os.cpu_count() or 1), threads_per_worker=1, dashboard_address=None)
+            own = LocalCluster(
+                n_workers=min(2, os.cpu_count() or 1), threads_per_worker=1, dashboard_address=None
+            )
             client = Client(own)
     records = []
     manifest = os.path.join(out_dir, MANIFEST)
     try:
+        # Keys unique per run: a key the cluster still holds would hand back
+        # that earlier result instead of running the task again.
+        run_id = uuid.uuid4().hex[:8]
         futures = {
-            client.submit(process_one, p, task, out_dir, options, key=f"shapecue-{task}-{i}-{os.path.basename(p)}", resources=resources, pure=False): p
+            client.submit(
+                process_one,
+                p,
+                task,
+                out_dir,
+                options,
+                key=f"shapecue-{task}-{os.path.basename(p)}-{run_id}-{i}",
+                resources=resources,
+                pure=False,
+            ): p
             for i, p in enumerate(todo)
         }
         with open(manifest, "a", encoding="utf-8") as fh:
