@@ -6,10 +6,11 @@ service to install, and the same code runs on a real cluster (``dask
 scheduler`` / ``dask worker``, dask-jobqueue on SLURM/PBS, dask-kubernetes)
 by handing :func:`run` a ``Client`` connected to it.
 
-Each input is one task. A task opens its own OpenCL device (``device=``, or
-the worker's ``SHAPECUE_DEVICE`` environment variable, so one GPU per worker
-is set where the worker starts), reads its input, computes, writes its output
-into ``out_dir`` and returns a record; failures (a broken file, a device
+Each input is one task. A task runs on an OpenCL device opened in its
+worker (``device=``, or the worker's ``SHAPECUE_DEVICE`` environment
+variable, so one GPU per worker is set where the worker starts; a worker
+thread opens it on its first task and reuses it), reads its input,
+computes, writes its output into ``out_dir`` and returns a record; failures (a broken file, a device
 error) are caught in the task and recorded, and the other tasks go on. The
 client appends one JSON line per task to ``out_dir/manifest.jsonl``::
 

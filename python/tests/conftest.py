@@ -86,7 +86,8 @@ def device():
 @pytest.fixture(scope="session")
 def cli():
     """The shapecue command line built by `cargo test --release`."""
-    exe = os.environ.get("SHAPECUE_BIN") or str(REPO / "target" / "release" / "shapecue")
+    target = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
+    exe = os.environ.get("SHAPECUE_BIN") or str(target / "release" / "shapecue")
     if not (os.path.exists(exe) or shutil.which(exe)):
         pytest.skip(f"the shapecue command line is not built ({exe}); run cargo build --release")
     return exe
