@@ -131,6 +131,9 @@ class Curvature:
     topology_ms: float
     device_bytes: int
     device: str  #: the device that computed it
+    #: ms spent in the library call itself (the rest of a call's wall time
+    #: is the binding: reading the arrays, making the result)
+    library_ms: float = 0.0
 
     @property
     def mean(self) -> np.ndarray:

@@ -39,6 +39,7 @@ def test_torus_shapes_dtypes_and_oracle(device):
     np.testing.assert_allclose(np.linalg.norm(c.normals, axis=1), 1, atol=1e-5)
     np.testing.assert_allclose(c.mean, 0.5 * (c.k1 + c.k2))
     assert c.device
+    assert 0 < c.library_ms
 
 
 def test_device_matches_cpu_reference(device):
