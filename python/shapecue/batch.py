@@ -195,6 +195,12 @@ def run(
     out_dir = os.path.abspath(os.fspath(out_dir))
     os.makedirs(out_dir, exist_ok=True)
     paths = _inputs(inputs)
+    outs = {}
+    for p in paths:
+        o = _output_name(p, task, out_dir)
+        if o in outs and outs[o] != p:
+            raise ValueError(f"{outs[o]} and {p} would both write {o}: give inputs distinct names")
+        outs[o] = p
     last = {}
     for r in read_manifest(out_dir):
         if r.get("task") == task:

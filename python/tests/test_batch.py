@@ -86,5 +86,10 @@ def test_isosurface_batch(device, client, tmp_path):
         assert d["vertices"].shape[1] == 3 and len(d["curvature_k1"]) == len(d["vertices"])
     bad = batch.run(paths[:1], tmp_path / "out2", task="isosurface", client=client)
     assert bad[0]["status"] == "error" and "iso" in bad[0]["error"]
+    (tmp_path / "other").mkdir()
+    twin = tmp_path / "other" / "ball0.nrrd"
+    twin.write_bytes(open(paths[0], "rb").read())
+    with pytest.raises(ValueError, match="would both write"):
+        batch.run([paths[0], str(twin)], tmp_path / "out4", task="isosurface", client=client)
     with pytest.raises(ValueError, match="unknown task"):
         batch.run(paths, tmp_path / "out3", task="sculpt", client=client)
