@@ -1,0 +1,462 @@
+"""shapecue from Python: curvature, isosurfaces, feature edges and scene
+rendering computed by OpenCL kernels, on numpy arrays.
+
+Every call takes ``device=``: an index from :func:`devices` or a
+case-insensitive substring of "platform device"; ``None`` uses the
+``SHAPECUE_DEVICE`` environment variable, else the first GPU, else the first
+CPU device (as the ``shapecue`` command line does). The device work runs with
+the GIL released, so Python threads compute in parallel.
+
+Inputs: C-contiguous ``float64``/``float32`` vertices and
+``int32``/``int64``/``uint32`` faces are read where they lie; strided arrays
+of those dtypes are read element by element; anything else (lists, other
+dtypes) is converted with :func:`numpy.asarray` first, which copies. The
+library then holds its own double-precision copy of the mesh, so the arrays
+may change after the call returns.
+
+Errors: bad input raises :class:`ValueError` with a message naming the
+element (``mesh: face 12: vertex index 99 out of range ...``); unreadable
+files :class:`OSError`; device problems :class:`DeviceError` and GL problems
+:class:`RenderError`, both :class:`RuntimeError` subclasses.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from typing import Any, Iterator, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _shapecue
+from ._shapecue import DeviceError, RenderError
+
+__all__ = [
+    "Curvature",
+    "CurvatureEstimator",
+    "DeviceError",
+    "FeatureEdges",
+    "Isosurface",
+    "RenderError",
+    "Volume",
+    "curvature",
+    "devices",
+    "feature_edges",
+    "isosurface",
+    "load_mesh",
+    "load_volume",
+    "render",
+]
+
+_VERTEX_DTYPES = (np.float64, np.float32)
+_FACE_DTYPES = (np.int32, np.int64, np.uint32)
+
+
+def _device(device: Union[int, str, None]) -> Optional[str]:
+    if device is None:
+        return None
+    if isinstance(device, bool) or not isinstance(device, (int, str)):
+        raise TypeError("device: expected an index (int), a name substring (str) or None")
+    return str(device)
+
+
+def _as_array(a: Any, dtypes: tuple, default: type, ndim: int, what: str) -> np.ndarray:
+    """``a`` unchanged when it is an ndarray of an accepted dtype (the
+    extension reads it in place, strided or not); else a converted copy."""
+    if isinstance(a, np.ndarray) and a.dtype.type in dtypes:
+        arr = a
+    else:
+        try:
+            arr = np.asarray(a)
+        except Exception as e:  # ragged lists and the like
+            raise ValueError(f"{what}: cannot be read as an array: {e}") from None
+        if arr.dtype.type not in dtypes:
+            if default in _FACE_DTYPES and arr.size and arr.dtype.kind == "f":
+                if not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
+                    raise ValueError(f"{what}: indices must be whole numbers")
+            if arr.dtype.kind not in "biuf":
+                raise ValueError(f"{what}: expected numbers, got dtype {arr.dtype}")
+            arr = arr.astype(default)
+    if arr.ndim != ndim:
+        raise ValueError(f"{what}: expected a {ndim}-D array, got shape {arr.shape}")
+    return arr
+
+
+def _mesh_arrays(vertices: Any, faces: Any) -> Tuple[np.ndarray, np.ndarray]:
+    if faces is None:
+        if hasattr(vertices, "vertices") and hasattr(vertices, "faces"):
+            vertices, faces = vertices.vertices, vertices.faces
+        else:
+            raise TypeError(
+                "give vertices and faces, or one object with .vertices and .faces "
+                "(such as a trimesh.Trimesh)"
+            )
+    v = _as_array(vertices, _VERTEX_DTYPES, np.float64, 2, "vertices")
+    f = _as_array(faces, _FACE_DTYPES, np.int64, 2, "faces")
+    return v, f
+
+
+def _accumulate(accumulate: str) -> str:
+    # "auto": the command line's default, float atomics (fastest; summation
+    # order varies between runs). "gather" is bitwise reproducible.
+    return "atomic" if accumulate == "auto" else accumulate
+
+
+@dataclass(frozen=True)
+class Curvature:
+    """Per-vertex curvature of a triangle mesh (Rusinkiewicz 2004, as in
+    Griffin et al. 2012), in the mesh's own units.
+
+    ``k1 >= k2`` (signed, positive where convex with outward normals; with
+    ``compat="trimesh2"``, ``|k1| >= |k2|``); ``d1``, ``d2`` unit tangent
+    principal directions with ``d2 = n x d1``; ``dk`` the curvature
+    derivative tensor (C111, C112, C122, C222) in the (d1, d2) frame, zeros
+    when ``dcurv=False``.
+    """
+
+    normals: np.ndarray  #: (V, 3) float64 unit vertex normals
+    area: np.ndarray  #: (V,) float64 Voronoi point areas
+    k1: np.ndarray  #: (V,) float64 maximum principal curvature
+    k2: np.ndarray  #: (V,) float64 minimum principal curvature
+    d1: np.ndarray  #: (V, 3) float64 direction of k1
+    d2: np.ndarray  #: (V, 3) float64 direction of k2
+    dk: np.ndarray  #: (V, 4) float64 derivative tensor
+    degenerate_faces: int  #: faces skipped as degenerate
+    vertices_without_curvature: int  #: vertices no usable face touches
+    tensor_solves_skipped: int
+    dcurv_solves_skipped: int
+    kernel_ms: float  #: summed kernel time (0 for the reference)
+    wall_ms: float  #: wall time of the computation
+    topology_ms: float
+    device_bytes: int
+    device: str  #: the device that computed it
+    #: ms spent in the library call itself (the rest of a call's wall time
+    #: is the binding: reading the arrays, making the result)
+    library_ms: float = 0.0
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Mean curvature (k1 + k2) / 2."""
+        return 0.5 * (self.k1 + self.k2)
+
+    @property
+    def gaussian(self) -> np.ndarray:
+        """Gaussian curvature k1 * k2."""
+        return self.k1 * self.k2
+
+
+def devices() -> list:
+    """The OpenCL devices of every platform, as dicts with ``index``,
+    ``platform``, ``name``, ``type`` ("GPU", "CPU", ...), ``version``,
+    ``compute_units``, ``global_mem``, ``max_alloc``, ``fp64``,
+    ``gl_sharing``, ``int64_atomics`` and ``default`` (the device used
+    without ``device=``). Raises :class:`DeviceError` without any platform."""
+    return _shapecue.devices()
+
+
+def curvature(
+    vertices: Any,
+    faces: Any = None,
+    *,
+    accumulate: str = "auto",
+    precision: str = "f32",
+    compat: Optional[str] = None,
+    dcurv: bool = True,
+    device: Union[int, str, None] = None,
+    reference: bool = False,
+) -> Curvature:
+    """Principal curvatures, directions, normals, point areas and the
+    curvature derivative of a triangle mesh.
+
+    ``vertices`` (V, 3) and ``faces`` (F, 3) arrays, or one object with
+    ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``). Isolated vertices,
+    degenerate and duplicate faces, boundaries and non-manifold edges are
+    handled (counted in the result); NaN coordinates, out-of-range indices and
+    empty meshes raise :class:`ValueError`.
+
+    ``accumulate``: "auto" (= "atomic", float atomics) or "gather"
+    (bitwise reproducible). ``precision``: "f32" or "f64" (needs fp64).
+    ``compat``: None/"exact" or "trimesh2" (trimesh2 2.16's solve and
+    ordering). ``reference=True`` computes with the single-threaded f64 CPU
+    reference instead of the device.
+    """
+    v, f = _mesh_arrays(vertices, faces)
+    d = _shapecue.curvature(
+        v,
+        f,
+        _accumulate(accumulate),
+        precision,
+        compat or "exact",
+        bool(dcurv),
+        _device(device),
+        bool(reference),
+    )
+    return Curvature(**d)
+
+
+class CurvatureEstimator:
+    """Curvature of one mesh topology over many poses (a deforming mesh):
+    the topology (one-rings, device buffers, kernels) is built once, each
+    :meth:`run` uploads new positions and reruns only the per-pose passes.
+
+    >>> est = CurvatureEstimator(faces, len(vertices))
+    >>> for pose in poses:
+    ...     k = est.run(pose)
+
+    Calls on one estimator from several threads are serialised; use one
+    estimator per thread to compute in parallel.
+    """
+
+    def __init__(
+        self,
+        faces: Any,
+        n_vertices: int,
+        *,
+        accumulate: str = "auto",
+        precision: str = "f32",
+        compat: Optional[str] = None,
+        dcurv: bool = True,
+        device: Union[int, str, None] = None,
+    ) -> None:
+        f = _as_array(faces, _FACE_DTYPES, np.int64, 2, "faces")
+        if isinstance(n_vertices, bool) or int(n_vertices) != n_vertices or n_vertices < 0:
+            raise ValueError(f"n_vertices: {n_vertices!r} is not a vertex count")
+        self._inner = _shapecue._CurvatureEstimator(
+            f,
+            int(n_vertices),
+            _accumulate(accumulate),
+            precision,
+            compat or "exact",
+            bool(dcurv),
+            _device(device),
+        )
+
+    def run(self, positions: Any) -> Curvature:
+        """The curvature of the mesh at ``positions`` (V, 3)."""
+        p = _as_array(positions, _VERTEX_DTYPES, np.float64, 2, "positions")
+        return Curvature(**self._inner.run(p))
+
+    @property
+    def n_vertices(self) -> int:
+        return self._inner.n_vertices
+
+    @property
+    def n_faces(self) -> int:
+        return self._inner.n_faces
+
+    @property
+    def device(self) -> str:
+        """The device's name."""
+        return self._inner.device
+
+    @property
+    def topology_ms(self) -> float:
+        """Time spent building the topology, ms."""
+        return self._inner.topology_ms
+
+    @property
+    def device_bytes(self) -> int:
+        return self._inner.device_bytes
+
+
+@dataclass(frozen=True)
+class Volume:
+    """A scalar volume: ``values`` (nz, ny, nx) float32, sample
+    ``values[z, y, x]`` at world ``origin + spacing * (x, y, z)``;
+    ``spacing`` and ``origin`` are in (x, y, z) order."""
+
+    values: np.ndarray
+    spacing: Tuple[float, float, float] = (1.0, 1.0, 1.0)
+    origin: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Isosurface:
+    """An extracted isosurface. Unpacks as ``vertices, faces = ...``."""
+
+    vertices: np.ndarray  #: (V, 3) float64 world (x, y, z)
+    faces: np.ndarray  #: (F, 3) uint32, counter-clockwise seen from outside
+    normals: Optional[np.ndarray]  #: (V, 3) gradient normals, when asked for
+    curvature: Optional[Curvature]  #: when asked for
+    soup_triangles: int  #: triangles before vertex fusion
+    degenerate_dropped: int  #: triangles dropped because fused corners coincide
+    kernel_ms: float
+    wall_ms: float
+    upload_ms: float
+    device: str
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        return iter((self.vertices, self.faces))
+
+
+def isosurface(
+    volume: Any,
+    iso: float,
+    *,
+    spacing: Optional[Sequence[float]] = None,
+    origin: Optional[Sequence[float]] = None,
+    fusion: str = "hash",
+    inside: str = "below",
+    curvature: bool = False,
+    normals: bool = False,
+    device: Union[int, str, None] = None,
+) -> Isosurface:
+    """Marching cubes with vertex fusion on the device (Griffin et al. 2012).
+
+    ``volume``: a 3-D array indexed ``volume[z, y, x]`` (the axis order of
+    scikit-image and of C-ordered medical volumes: x varies fastest), or a
+    :class:`Volume` from :func:`load_volume`. ``spacing`` and ``origin`` are
+    given in (x, y, z) order, the order of the returned vertices, which are
+    world (x, y, z) positions. So for the same array,
+    ``skimage.measure.marching_cubes(vol, iso)[0][:, ::-1]`` lists the same
+    points as these vertices, and the two surfaces have the same area and
+    volume; a cell's polygon may be split into triangles along the other
+    diagonal (scikit-image uses Lewiner et al.'s tables), and scikit-image's
+    faces, seen in (x, y, z), point the other way. Triangles whose fused
+    corners coincide (an iso value equal to sample values) are dropped and
+    counted in ``degenerate_dropped``.
+
+    ``inside``: "below" (signed distance fields, the default) or "above"
+    (densities): faces and normals point away from that side.
+    ``fusion``: "hash" (Griffin et al.), "edge" (exact keys) or "none" (the
+    triangle soup). ``curvature=True`` also computes the curvature of the
+    result on the device; ``normals=True`` adds gradient normals.
+
+    Returns an :class:`Isosurface`, which unpacks as ``vertices, faces``.
+    """
+    if isinstance(volume, Volume):
+        spacing = volume.spacing if spacing is None else spacing
+        origin = volume.origin if origin is None else origin
+        volume = volume.values
+    vol = _as_array(volume, (np.float32, np.float64), np.float32, 3, "volume")
+    sp = tuple(float(x) for x in (spacing if spacing is not None else (1.0, 1.0, 1.0)))
+    org = tuple(float(x) for x in (origin if origin is not None else (0.0, 0.0, 0.0)))
+    if len(sp) != 3 or len(org) != 3:
+        raise ValueError("spacing and origin: expected three numbers each, in (x, y, z) order")
+    d = _shapecue.isosurface(
+        vol, float(iso), sp, org, fusion, inside, bool(curvature), bool(normals), _device(device)
+    )
+    if d["curvature"] is not None:
+        d["curvature"] = Curvature(**d["curvature"])
+    return Isosurface(**d)
+
+
+@dataclass(frozen=True)
+class FeatureEdges:
+    """Object-space feature edges as clip-space quads (House & Li, after
+    McGuire & Hughes 2004), ready to draw; one entry per edge of the mesh."""
+
+    kind: np.ndarray  #: (E,) uint32 bits: 1 contour, 2 crease, 4 boundary, 8 drawn
+    quads: np.ndarray  #: (E, 4, 4) float32 clip-space quad corners per edge
+    cap_adj: np.ndarray  #: (C, 4, 4) adjacency caps (caps="adjacency")
+    cap_mh0: np.ndarray  #: (E, 3, 4) McGuire-Hughes half-caps at one end (caps="mh")
+    cap_mh1: np.ndarray  #: (E, 3, 4) ... and at the other end
+    contour: int  #: edges marked contour
+    crease: int
+    boundary: int
+    drawn: int
+    view_proj: np.ndarray  #: (4, 4) world-to-clip matrix used (column-major)
+    device: str
+
+
+def feature_edges(
+    vertices: Any,
+    faces: Any = None,
+    *,
+    eye: Optional[Sequence[float]] = None,
+    direction: Sequence[float] = (1.0, 1.0, 1.0),
+    target: Optional[Sequence[float]] = None,
+    up: Optional[Sequence[float]] = None,
+    fov: float = 40.0,
+    ortho: bool = False,
+    size: Tuple[int, int] = (640, 480),
+    line_width: float = 4.0,
+    crease: float = 30.0,
+    contours: bool = True,
+    boundaries: bool = True,
+    depth_scale: Optional[float] = None,
+    half_contours: bool = False,
+    caps: str = "adjacency",
+    marked: Any = None,
+    device: Union[int, str, None] = None,
+) -> FeatureEdges:
+    """Contour, crease, boundary and marked edges of a mesh seen from a
+    camera, with their screen-space quads and caps (nothing is drawn).
+
+    The camera: ``eye`` (looking at ``target``, default the centre of the
+    bounds), or, without ``eye``, fitted to the bounds from ``direction``.
+    ``size`` is the image (width, height) in pixels, ``line_width`` in pixels,
+    ``crease`` the crease angle in degrees, ``caps`` "none", "mh" or
+    "adjacency". ``marked``: (M, 2) vertex pairs drawn like boundaries.
+    """
+    v, f = _mesh_arrays(vertices, faces)
+
+    def vec(x, what):
+        if x is None:
+            return None
+        t = tuple(float(c) for c in x)
+        if len(t) != 3:
+            raise ValueError(f"{what}: expected three numbers")
+        return t
+
+    d = _shapecue.feature_edges(
+        v,
+        f,
+        vec(eye, "eye"),
+        vec(direction, "direction"),
+        vec(target, "target"),
+        vec(up, "up"),
+        float(fov),
+        bool(ortho),
+        (int(size[0]), int(size[1])),
+        float(line_width),
+        float(crease),
+        bool(contours),
+        bool(boundaries),
+        None if depth_scale is None else float(depth_scale),
+        bool(half_contours),
+        caps,
+        None if marked is None else np.asarray(marked, dtype=np.int64).tolist(),
+        _device(device),
+    )
+    return FeatureEdges(**d)
+
+
+def render(
+    scene: Union[str, os.PathLike, dict],
+    out_dir: Union[str, os.PathLike, None] = None,
+    *,
+    force: bool = False,
+    device: Union[int, str, None] = None,
+    base_dir: Union[str, os.PathLike, None] = None,
+) -> dict:
+    """Renders a scene (a TOML scene file, or a dict with the same tables:
+    ``{"input": {"generate": "torus"}, "effects": {"shading": {}}, ...}``):
+    runs only the passes its cues need, writes the images and a report into
+    ``out_dir`` (default: the scene's ``[output] dir``) and returns the
+    report as a dict. Existing outputs raise :class:`ValueError` unless
+    ``force``. Relative paths in a dict are relative to ``base_dir``
+    (default: the working directory)."""
+    out = None if out_dir is None else os.fspath(out_dir)
+    if isinstance(scene, dict):
+        anchor = os.path.join(os.fspath(base_dir or os.getcwd()), "scene.toml")
+        text = _shapecue.render_text(json.dumps(scene), anchor, out, bool(force), _device(device))
+    else:
+        text = _shapecue.render_file(os.fspath(scene), out, bool(force), _device(device))
+    return json.loads(text)
+
+
+def load_mesh(path: Union[str, os.PathLike], *, weld: bool = False) -> Tuple[np.ndarray, np.ndarray]:
+    """Reads an .obj, .ply or .off mesh: ``(vertices float64 (V, 3), faces
+    uint32 (F, 3))``, polygons fan-triangulated; ``weld`` merges vertices with
+    bit-identical positions. Malformed files raise :class:`ValueError`
+    naming the file and the element."""
+    return _shapecue.load_mesh(os.fspath(path), bool(weld))
+
+
+def load_volume(path: Union[str, os.PathLike]) -> Volume:
+    """Reads a volume (.nrrd/.nhdr, .mhd/.mha, .vtk, .vti, .slc, ...) as a
+    :class:`Volume` with ``values`` in (z, y, x) order."""
+    values, spacing, origin = _shapecue.load_volume(os.fspath(path))
+    return Volume(values, tuple(spacing), tuple(origin))

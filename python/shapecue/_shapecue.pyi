@@ -1,0 +1,89 @@
+"""Type stubs of the extension module. Call it through the ``shapecue``
+package, whose functions check and convert their arguments and wrap the
+dicts returned here in result objects."""
+
+from typing import Any, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+class DeviceError(RuntimeError):
+    """No OpenCL device, none matching the selection, a device lacking what
+    the variant needs, an OpenCL call or kernel build failure."""
+
+class RenderError(RuntimeError):
+    """No headless OpenGL, or an OpenGL call failed."""
+
+def devices() -> list[dict[str, Any]]: ...
+def curvature(
+    vertices: npt.NDArray[np.floating],
+    faces: npt.NDArray[np.integer],
+    accumulate: str,
+    precision: str,
+    compat: str,
+    dcurv: bool,
+    device: Optional[str],
+    reference: bool,
+) -> dict[str, Any]: ...
+def isosurface(
+    volume: npt.NDArray[np.floating],
+    iso: float,
+    spacing: Tuple[float, float, float],
+    origin: Tuple[float, float, float],
+    fusion: str,
+    inside: str,
+    curvature: bool,
+    normals: bool,
+    device: Optional[str],
+) -> dict[str, Any]: ...
+def feature_edges(
+    vertices: npt.NDArray[np.floating],
+    faces: npt.NDArray[np.integer],
+    eye: Optional[Tuple[float, float, float]],
+    direction: Tuple[float, float, float],
+    target: Optional[Tuple[float, float, float]],
+    up: Optional[Tuple[float, float, float]],
+    fov: float,
+    ortho: bool,
+    size: Tuple[int, int],
+    line_width: float,
+    crease: float,
+    contours: bool,
+    boundaries: bool,
+    depth_scale: Optional[float],
+    half_contours: bool,
+    caps: str,
+    marked: Optional[list[list[int]]],
+    device: Optional[str],
+) -> dict[str, Any]: ...
+def render_file(path: str, out_dir: Optional[str], force: bool, device: Optional[str]) -> str: ...
+def render_text(
+    json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]
+) -> str: ...
+def load_mesh(path: str, weld: bool) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
+def load_volume(
+    path: str,
+) -> Tuple[npt.NDArray[np.float32], Tuple[float, float, float], Tuple[float, float, float]]: ...
+
+class _CurvatureEstimator:
+    def __init__(
+        self,
+        faces: npt.NDArray[np.integer],
+        n_vertices: int,
+        accumulate: str,
+        precision: str,
+        compat: str,
+        dcurv: bool,
+        device: Optional[str],
+    ) -> None: ...
+    def run(self, positions: npt.NDArray[np.floating]) -> dict[str, Any]: ...
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def n_faces(self) -> int: ...
+    @property
+    def device(self) -> str: ...
+    @property
+    def topology_ms(self) -> float: ...
+    @property
+    def device_bytes(self) -> int: ...

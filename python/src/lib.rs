@@ -1,0 +1,767 @@
+//! `shapecue._shapecue`: the Python extension module over shapecue's front
+//! door (`shapecue::curvature`, `shapecue::isosurface`,
+//! `shapecue::feature_edges`, `shapecue::render_scene`), its stateful
+//! per-topology estimator and the mesh and volume loaders.
+//!
+//! What crosses: numpy arrays in, read where they lie (C-contiguous arrays of
+//! the accepted dtypes through their slice, strided ones element by element,
+//! any other dtype converted by the Python layer first) into the library's
+//! owned `Mesh` / `Volume`; results out as numpy arrays that take ownership
+//! of the library's vectors (no copy). Every call that touches the device
+//! runs with the GIL released (`Python::detach`), so Python threads compute
+//! in parallel. Errors become Python exceptions: bad input `ValueError`
+//! (the library's message, naming the element), unreadable files `OSError`,
+//! device problems `DeviceError` (a `RuntimeError`), GL problems
+//! `RenderError` (a `RuntimeError`). The Python package `shapecue` wraps
+//! these functions in typed result objects; call them through it.
+
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use shapecue::gpu::Gpu;
+use shapecue::spec::curvature::{Curvature, CurvatureOptions};
+use shapecue::stages::curvature::CurvatureEstimator as RustEstimator;
+use shapecue::{Error, Mesh};
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+create_exception!(
+    _shapecue,
+    DeviceError,
+    PyRuntimeError,
+    "No OpenCL device, no device matching the selection, a device lacking what \
+     the variant needs (fp64, 64-bit atomics), an OpenCL call or kernel build failure."
+);
+create_exception!(
+    _shapecue,
+    RenderError,
+    PyRuntimeError,
+    "No headless OpenGL (EGL and Mesa missing), or an OpenGL call failed."
+);
+
+/// The library's error as the Python exception a caller can catch.
+fn to_py(e: Error) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        Error::InvalidInput { .. }
+        | Error::InvalidArgument(_)
+        | Error::UnsupportedFormat { .. } => PyValueError::new_err(msg),
+        Error::Io { ref source, .. } if source.kind() == std::io::ErrorKind::NotFound => {
+            PyFileNotFoundError::new_err(msg)
+        }
+        Error::Io { .. } | Error::Write { .. } => PyOSError::new_err(msg),
+        Error::NoGl { .. } | Error::Render { .. } => RenderError::new_err(msg),
+        _ => DeviceError::new_err(msg),
+    }
+}
+
+fn value_err(msg: impl Into<String>) -> PyErr {
+    PyValueError::new_err(msg.into())
+}
+
+/// The array's data as one slice in logical (C) order, when it is laid out
+/// so; `None` for strided and Fortran-ordered arrays (numpy's `as_slice`
+/// also accepts the latter, in memory order).
+fn c_slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+) -> Option<&'a [T]> {
+    if a.is_c_contiguous() {
+        a.as_slice().ok()
+    } else {
+        None
+    }
+}
+
+/// Reads an (N, 3) array of f64 or f32 (any strides) into owned rows.
+fn read_rows3f(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
+    fn rows<T: numpy::Element + Copy + Into<f64>>(
+        a: &PyReadonlyArray2<'_, T>,
+        what: &str,
+    ) -> PyResult<Vec<[f64; 3]>> {
+        let shape = a.shape();
+        if shape[1] != 3 {
+            return Err(value_err(format!(
+                "{what}: expected shape (N, 3), got ({}, {})",
+                shape[0], shape[1]
+            )));
+        }
+        if let Some(s) = c_slice(a) {
+            return Ok(s
+                .chunks_exact(3)
+                .map(|c| [c[0].into(), c[1].into(), c[2].into()])
+                .collect());
+        }
+        let v = a.as_array();
+        Ok(v.rows()
+            .into_iter()
+            .map(|r| [r[0].into(), r[1].into(), r[2].into()])
+            .collect())
+    }
+    if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, f64>>() {
+        rows(&a, what)
+    } else if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, f32>>() {
+        rows(&a, what)
+    } else {
+        Err(value_err(format!(
+            "{what}: expected a 2-D float64 or float32 array of shape (N, 3)"
+        )))
+    }
+}
+
+/// Reads an (F, 3) integer array (int32, int64, uint32; any strides) into
+/// u32 triangles; negative or too large indices are refused naming the face.
+fn read_faces(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
+    fn tris<T: numpy::Element + Copy + TryInto<u32> + std::fmt::Display>(
+        a: &PyReadonlyArray2<'_, T>,
+        what: &str,
+    ) -> PyResult<Vec<[u32; 3]>> {
+        let shape = a.shape();
+        if shape[1] != 3 {
+            return Err(value_err(format!(
+                "{what}: expected shape (F, 3) (triangles), got ({}, {})",
+                shape[0], shape[1]
+            )));
+        }
+        let conv = |i: usize, c: &[T]| -> PyResult<[u32; 3]> {
+            let mut out = [0u32; 3];
+            for k in 0..3 {
+                out[k] = c[k].try_into().map_err(|_| {
+                    value_err(format!(
+                        "{what}: face {i}: vertex index {} out of range",
+                        c[k]
+                    ))
+                })?;
+            }
+            Ok(out)
+        };
+        if let Some(s) = c_slice(a) {
+            return s
+                .chunks_exact(3)
+                .enumerate()
+                .map(|(i, c)| conv(i, c))
+                .collect();
+        }
+        a.as_array()
+            .rows()
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| conv(i, &[r[0], r[1], r[2]]))
+            .collect()
+    }
+    if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, i32>>() {
+        tris(&a, what)
+    } else if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, i64>>() {
+        tris(&a, what)
+    } else if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, u32>>() {
+        tris(&a, what)
+    } else {
+        Err(value_err(format!(
+            "{what}: expected a 2-D int32, int64 or uint32 array of shape (F, 3)"
+        )))
+    }
+}
+
+fn read_mesh(vertices: &Bound<'_, PyAny>, faces: &Bound<'_, PyAny>) -> PyResult<Mesh> {
+    let positions = read_rows3f(vertices, "vertices")?;
+    let faces = read_faces(faces, "faces")?;
+    if positions.is_empty() {
+        return Err(value_err("vertices: the mesh has no vertices"));
+    }
+    Mesh::new(positions, faces, "mesh").map_err(to_py)
+}
+
+/// An owned Vec as a numpy array of shape `shape` (no copy).
+fn array<'py, T: numpy::Element>(
+    py: Python<'py>,
+    v: Vec<T>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = PyArray1::from_vec(py, v);
+    if shape.len() == 1 {
+        return Ok(a.into_any());
+    }
+    Ok(a.reshape(shape)?.into_any())
+}
+
+fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> PyResult<T> {
+    s.parse::<T>().map_err(to_py)
+}
+
+fn options(
+    accumulate: &str,
+    precision: &str,
+    compat: &str,
+    dcurv: bool,
+) -> PyResult<CurvatureOptions> {
+    Ok(CurvatureOptions {
+        accumulate: parse(accumulate)?,
+        precision: parse(precision)?,
+        compat: parse(compat)?,
+        dcurv,
+    })
+}
+
+/// A device selection: `device=` and the `SHAPECUE_DEVICE` it was made under.
+type DeviceKey = (Option<String>, Option<String>);
+
+thread_local! {
+    /// The devices this thread has opened, by (`device=`, `SHAPECUE_DEVICE`):
+    /// opening a context and building the kernels costs far more than a
+    /// call on a small mesh, so each Python thread opens a device once and
+    /// reuses it (its own queue, so threads compute in parallel).
+    static DEVICES: RefCell<HashMap<DeviceKey, Arc<Gpu>>> =
+        RefCell::new(HashMap::new());
+}
+
+/// This thread's device for `device` (see [`DEVICES`]).
+fn open_gpu(device: Option<&str>) -> shapecue::Result<Arc<Gpu>> {
+    let key = (
+        device.map(str::to_string),
+        std::env::var("SHAPECUE_DEVICE").ok(),
+    );
+    if let Some(g) = DEVICES.with(|m| m.borrow().get(&key).cloned()) {
+        return Ok(g);
+    }
+    let g = Arc::new(Gpu::new(device)?);
+    DEVICES.with(|m| m.borrow_mut().insert(key, g.clone()));
+    Ok(g)
+}
+
+/// The curvature result as a dict of numpy arrays, counts and timings.
+fn curvature_dict<'py>(
+    py: Python<'py>,
+    c: Curvature,
+    device: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let n = c.field.len();
+    let f = c.field;
+    d.set_item("normals", array(py, f.normals.into_flattened(), &[n, 3])?)?;
+    d.set_item("area", array(py, f.areas, &[n])?)?;
+    d.set_item("k1", array(py, f.k1, &[n])?)?;
+    d.set_item("k2", array(py, f.k2, &[n])?)?;
+    d.set_item("d1", array(py, f.d1.into_flattened(), &[n, 3])?)?;
+    d.set_item("d2", array(py, f.d2.into_flattened(), &[n, 3])?)?;
+    d.set_item("dk", array(py, f.dk.into_flattened(), &[n, 4])?)?;
+    d.set_item("degenerate_faces", c.counts.degenerate_faces)?;
+    d.set_item(
+        "vertices_without_curvature",
+        c.counts.vertices_without_curvature,
+    )?;
+    d.set_item("tensor_solves_skipped", c.counts.tensor_solves_skipped)?;
+    d.set_item("dcurv_solves_skipped", c.counts.dcurv_solves_skipped)?;
+    d.set_item("kernel_ms", c.timing.kernel_ms)?;
+    d.set_item("wall_ms", c.timing.wall_ms)?;
+    d.set_item("topology_ms", c.topology_ms)?;
+    d.set_item("device_bytes", c.device_bytes)?;
+    d.set_item("device", device)?;
+    Ok(d)
+}
+
+/// devices() -> list[dict]
+///
+/// Every OpenCL device of every platform, with `default` true on the one a
+/// call without `device=` uses.
+#[pyfunction]
+fn devices(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let (all, default) = py
+        .detach(|| {
+            let all = shapecue::gpu::list_devices()?;
+            let default = Gpu::new(None).ok().map(|g| g.info.index);
+            Ok::<_, Error>((all, default))
+        })
+        .map_err(to_py)?;
+    let out = PyList::empty(py);
+    for d in all {
+        let e = PyDict::new(py);
+        e.set_item("index", d.index)?;
+        e.set_item("platform", &d.platform)?;
+        e.set_item("name", &d.name)?;
+        e.set_item("type", &d.kind)?;
+        e.set_item("version", &d.version)?;
+        e.set_item("compute_units", d.compute_units)?;
+        e.set_item("global_mem", d.global_mem)?;
+        e.set_item("max_alloc", d.max_alloc)?;
+        e.set_item("fp64", d.fp64)?;
+        e.set_item("gl_sharing", d.gl_sharing)?;
+        e.set_item("int64_atomics", d.int64_atomics)?;
+        e.set_item("default", Some(d.index) == default)?;
+        out.append(e)?;
+    }
+    Ok(out)
+}
+
+/// curvature(vertices, faces, accumulate, precision, compat, dcurv, device, reference) -> dict
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, accumulate, precision, compat, dcurv, device, reference))]
+#[allow(clippy::too_many_arguments)]
+fn curvature<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+    accumulate: &str,
+    precision: &str,
+    compat: &str,
+    dcurv: bool,
+    device: Option<String>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mesh = read_mesh(vertices, faces)?;
+    let opts = options(accumulate, precision, compat, dcurv)?;
+    let mut library_ms = 0.0;
+    let (c, name) = py
+        .detach(|| {
+            if reference {
+                // The reference computes in f64, so it judges faces by f64
+                // rounding (as the command line's --cpu does).
+                let opts = CurvatureOptions {
+                    precision: shapecue::spec::curvature::Precision::F64,
+                    ..opts
+                };
+                let t = Instant::now();
+                let c = shapecue::cpu::curvature::curvature(&mesh, opts)?;
+                library_ms = t.elapsed().as_secs_f64() * 1e3;
+                Ok::<_, Error>((c, "cpu reference (f64, single thread)".to_string()))
+            } else {
+                let gpu = open_gpu(device.as_deref())?;
+                let t = Instant::now();
+                let c = shapecue::curvature_on(&gpu, &mesh, opts)?;
+                library_ms = t.elapsed().as_secs_f64() * 1e3;
+                Ok((c, gpu.info.name.clone()))
+            }
+        })
+        .map_err(to_py)?;
+    let d = curvature_dict(py, c, &name)?;
+    // The library call alone, so that the binding's own cost (arrays in and
+    // out) is the caller's wall time minus this, measured in one call.
+    d.set_item("library_ms", library_ms)?;
+    Ok(d)
+}
+
+/// A mesh topology's curvature estimator on one device (see the Python
+/// class `shapecue.CurvatureEstimator`).
+#[pyclass(name = "_CurvatureEstimator", module = "shapecue._shapecue")]
+struct PyEstimator {
+    // The library's estimator is Send but not Sync (OpenCL kernels): the
+    // mutex makes the Python object shareable and serialises runs on it.
+    inner: Mutex<RustEstimator>,
+    n_vertices: usize,
+    n_faces: usize,
+    device: String,
+}
+
+#[pymethods]
+impl PyEstimator {
+    #[new]
+    #[pyo3(signature = (faces, n_vertices, accumulate, precision, compat, dcurv, device))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        faces: &Bound<'_, PyAny>,
+        n_vertices: usize,
+        accumulate: &str,
+        precision: &str,
+        compat: &str,
+        dcurv: bool,
+        device: Option<String>,
+    ) -> PyResult<Self> {
+        let faces = read_faces(faces, "faces")?;
+        if n_vertices == 0 {
+            return Err(value_err("n_vertices: the mesh has no vertices"));
+        }
+        shapecue::mesh::check_faces(n_vertices, &faces, "faces").map_err(to_py)?;
+        let opts = options(accumulate, precision, compat, dcurv)?;
+        let n_faces = faces.len();
+        let (est, device) = py
+            .detach(|| {
+                let gpu = open_gpu(device.as_deref())?;
+                let name = gpu.info.name.clone();
+                Ok::<_, Error>((RustEstimator::new(gpu, n_vertices, &faces, opts)?, name))
+            })
+            .map_err(to_py)?;
+        Ok(PyEstimator {
+            inner: Mutex::new(est),
+            n_vertices,
+            n_faces,
+            device,
+        })
+    }
+
+    /// run(positions) -> dict: the curvature of one pose.
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        positions: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pos = read_rows3f(positions, "positions")?;
+        let inner = &self.inner;
+        let c = py
+            .detach(|| {
+                let mut est = inner.lock().unwrap_or_else(|p| p.into_inner());
+                let t = Instant::now();
+                est.set_positions(&pos)?;
+                let mut timing = est.run()?;
+                let field = est.read()?;
+                timing.wall_ms = t.elapsed().as_secs_f64() * 1e3;
+                Ok::<_, Error>(Curvature {
+                    field,
+                    counts: est.counts()?,
+                    timing,
+                    topology_ms: est.topology_ms(),
+                    device_bytes: est.device_bytes(),
+                })
+            })
+            .map_err(to_py)?;
+        let d = curvature_dict(py, c, &self.device)?;
+        d.set_item("library_ms", d.get_item("wall_ms")?)?;
+        Ok(d)
+    }
+
+    #[getter]
+    fn n_vertices(&self) -> usize {
+        self.n_vertices
+    }
+
+    #[getter]
+    fn n_faces(&self) -> usize {
+        self.n_faces
+    }
+
+    #[getter]
+    fn device(&self) -> &str {
+        &self.device
+    }
+
+    #[getter]
+    fn topology_ms(&self) -> f64 {
+        self.inner
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .topology_ms()
+    }
+
+    #[getter]
+    fn device_bytes(&self) -> u64 {
+        self.inner
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .device_bytes()
+    }
+}
+
+/// Reads a (z, y, x) float32 or float64 array into a volume (x fastest).
+fn read_volume(obj: &Bound<'_, PyAny>) -> PyResult<shapecue::volume::Volume> {
+    fn vals<T: numpy::Element + Copy + ToF32>(
+        a: &PyReadonlyArray3<'_, T>,
+    ) -> ([usize; 3], Vec<f32>) {
+        let s = a.shape();
+        let dims = [s[2], s[1], s[0]];
+        let values = match c_slice(a) {
+            Some(sl) => sl.iter().map(|v| v.to_f32()).collect(),
+            // Standard (logical C) order is x fastest for a (z, y, x) array.
+            None => a.as_array().iter().map(|v| v.to_f32()).collect(),
+        };
+        (dims, values)
+    }
+    let (dims, values) = if let Ok(a) = obj.extract::<PyReadonlyArray3<'_, f32>>() {
+        vals(&a)
+    } else if let Ok(a) = obj.extract::<PyReadonlyArray3<'_, f64>>() {
+        vals(&a)
+    } else {
+        return Err(value_err(
+            "volume: expected a 3-D float32 or float64 array in (z, y, x) order",
+        ));
+    };
+    shapecue::volume::Volume::new(dims, values, "volume").map_err(to_py)
+}
+
+trait ToF32 {
+    fn to_f32(self) -> f32;
+}
+impl ToF32 for f32 {
+    fn to_f32(self) -> f32 {
+        self
+    }
+}
+impl ToF32 for f64 {
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+}
+
+/// isosurface(volume, iso, spacing, origin, fusion, inside, curvature, normals, device) -> dict
+#[pyfunction]
+#[pyo3(signature = (volume, iso, spacing, origin, fusion, inside, curvature, normals, device))]
+#[allow(clippy::too_many_arguments)]
+fn isosurface<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyAny>,
+    iso: f32,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    fusion: &str,
+    inside: &str,
+    curvature: bool,
+    normals: bool,
+    device: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !iso.is_finite() {
+        return Err(value_err(format!("iso: {iso} is not a finite number")));
+    }
+    let vol = read_volume(volume)?
+        .with_geometry(spacing, origin)
+        .map_err(to_py)?;
+    let opts = shapecue::IsoOptions {
+        fusion: parse(fusion)?,
+        inside: parse(inside)?,
+        curvature: curvature.then(CurvatureOptions::default),
+        gradient_normals: normals,
+        ..Default::default()
+    };
+    let (s, name) = py
+        .detach(|| {
+            let gpu = open_gpu(device.as_deref())?;
+            let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)?;
+            Ok::<_, Error>((s, gpu.info.name.clone()))
+        })
+        .map_err(to_py)?;
+    let d = PyDict::new(py);
+    let (nv, nf) = (s.mesh.n_vertices(), s.mesh.n_faces());
+    d.set_item(
+        "vertices",
+        array(py, s.mesh.positions.into_flattened(), &[nv, 3])?,
+    )?;
+    d.set_item("faces", array(py, s.mesh.faces.into_flattened(), &[nf, 3])?)?;
+    match s.normals {
+        Some(n) => d.set_item("normals", array(py, n.into_flattened(), &[nv, 3])?)?,
+        None => d.set_item("normals", py.None())?,
+    }
+    match s.curvature {
+        Some(c) => d.set_item("curvature", curvature_dict(py, c, &name)?)?,
+        None => d.set_item("curvature", py.None())?,
+    }
+    d.set_item("soup_triangles", s.stats.soup_triangles)?;
+    d.set_item("degenerate_dropped", s.stats.degenerate_dropped)?;
+    d.set_item("kernel_ms", s.stats.timing.kernel_ms)?;
+    d.set_item("wall_ms", s.stats.timing.wall_ms)?;
+    d.set_item("upload_ms", s.upload_ms)?;
+    d.set_item("device", name)?;
+    Ok(d)
+}
+
+/// feature_edges(vertices, faces, eye, direction, target, up, fov, ortho,
+/// size, line_width, crease, contours, boundaries, depth_scale,
+/// half_contours, caps, marked, device) -> dict
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, eye, direction, target, up, fov, ortho, size,
+    line_width, crease, contours, boundaries, depth_scale, half_contours, caps, marked, device))]
+#[allow(clippy::too_many_arguments)]
+fn feature_edges<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+    eye: Option<[f32; 3]>,
+    direction: [f32; 3],
+    target: Option<[f32; 3]>,
+    up: Option<[f32; 3]>,
+    fov: f32,
+    ortho: bool,
+    size: (u32, u32),
+    line_width: f32,
+    crease: f32,
+    contours: bool,
+    boundaries: bool,
+    depth_scale: Option<f32>,
+    half_contours: bool,
+    caps: &str,
+    marked: Option<&Bound<'py, PyAny>>,
+    device: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use shapecue::render::{Placement, framed};
+    let mesh = read_mesh(vertices, faces)?;
+    let (w, h) = size;
+    if w == 0 || h == 0 {
+        return Err(value_err(format!("size: ({w}, {h}) must be positive")));
+    }
+    let placement = match eye {
+        Some(e) => Placement::At(glam::Vec3::from(e)),
+        None => {
+            if glam::Vec3::from(direction).length_squared() == 0.0 {
+                return Err(value_err("direction: must be a non-zero vector"));
+            }
+            Placement::Fit(glam::Vec3::from(direction))
+        }
+    };
+    let cam = framed(
+        placement,
+        target.map(glam::Vec3::from),
+        up.map(glam::Vec3::from),
+        fov,
+        ortho,
+        mesh.bounds(),
+        w as f32 / h as f32,
+    )
+    .map_err(to_py)?;
+    let view = cam.view(w, h);
+    let marked = match marked {
+        Some(m) => {
+            let rows = m
+                .extract::<Vec<[i64; 2]>>()
+                .map_err(|_| value_err("marked: expected pairs of vertex indices, shape (M, 2)"))?;
+            rows.iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let c = |x: i64| {
+                        u32::try_from(x).map_err(|_| {
+                            value_err(format!("marked: pair {i}: vertex index {x} out of range"))
+                        })
+                    };
+                    Ok([c(p[0])?, c(p[1])?])
+                })
+                .collect::<PyResult<Vec<_>>>()?
+        }
+        None => Vec::new(),
+    };
+    let opts = shapecue::EdgeOptions {
+        caps: parse(caps)?,
+        line_width,
+        crease_deg: crease,
+        contours,
+        boundaries,
+        depth_scale,
+        half_contours,
+        marked,
+    };
+    let (out, name) = py
+        .detach(|| {
+            let gpu = open_gpu(device.as_deref())?;
+            let out = shapecue::feature_edges_on(&gpu, &mesh, &view, &opts)?;
+            Ok::<_, Error>((out, gpu.info.name.clone()))
+        })
+        .map_err(to_py)?;
+    let d = PyDict::new(py);
+    let ne = out.kind.len();
+    let quads = |v: Vec<[f32; 4]>, per: usize| {
+        let n = v.len() / per;
+        array(py, v.into_flattened(), &[n, per, 4])
+    };
+    d.set_item("contour", out.count(shapecue::spec::edges::KIND_CONTOUR))?;
+    d.set_item("crease", out.count(shapecue::spec::edges::KIND_CREASE))?;
+    d.set_item("boundary", out.count(shapecue::spec::edges::KIND_BOUNDARY))?;
+    d.set_item("drawn", out.count(shapecue::spec::edges::KIND_DRAWN))?;
+    d.set_item("kind", array(py, out.kind, &[ne])?)?;
+    d.set_item("quads", quads(out.edge_out, 4)?)?;
+    d.set_item("cap_adj", quads(out.cap_adj, 4)?)?;
+    d.set_item("cap_mh0", quads(out.cap_mh0, 3)?)?;
+    d.set_item("cap_mh1", quads(out.cap_mh1, 3)?)?;
+    d.set_item(
+        "view_proj",
+        array(py, view.view_proj.to_cols_array().to_vec(), &[4, 4])?,
+    )?;
+    d.set_item("device", name)?;
+    Ok(d)
+}
+
+/// render_file(path, out_dir, force, device) -> report JSON text
+#[pyfunction]
+#[pyo3(signature = (path, out_dir, force, device))]
+fn render_file(
+    py: Python<'_>,
+    path: PathBuf,
+    out_dir: Option<PathBuf>,
+    force: bool,
+    device: Option<String>,
+) -> PyResult<String> {
+    let opts = shapecue::scene::exec::ExecOptions {
+        out_dir,
+        force,
+        device: None,
+    };
+    let report = py
+        .detach(|| shapecue::render_scene_on(&open_gpu(device.as_deref())?, &path, &opts))
+        .map_err(to_py)?;
+    serde_json::to_string(&report).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// render_text(json, anchor, out_dir, force, device) -> report JSON text:
+/// a scene given as JSON (from a Python dict), checked as the TOML it
+/// stands for; relative paths are relative to `anchor`'s folder.
+#[pyfunction]
+#[pyo3(signature = (json, anchor, out_dir, force, device))]
+fn render_text(
+    py: Python<'_>,
+    json: &str,
+    anchor: PathBuf,
+    out_dir: Option<PathBuf>,
+    force: bool,
+    device: Option<String>,
+) -> PyResult<String> {
+    let value: serde_json::Value =
+        serde_json::from_str(json).map_err(|e| value_err(format!("scene: {e}")))?;
+    let text = toml::to_string(&value).map_err(|e| value_err(format!("scene: {e}")))?;
+    let scene = shapecue::scene::file::Scene::from_str(&anchor, &text).map_err(to_py)?;
+    let opts = shapecue::scene::exec::ExecOptions {
+        out_dir,
+        force,
+        device: None,
+    };
+    let report = py
+        .detach(|| {
+            let gpu = open_gpu(device.as_deref())?;
+            shapecue::scene::exec::run_on(&gpu, &scene, &opts, &mut |_, _| {})
+        })
+        .map_err(to_py)?;
+    serde_json::to_string(&report).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// load_mesh(path, weld) -> (vertices float64 (V, 3), faces uint32 (F, 3))
+#[pyfunction]
+#[pyo3(signature = (path, weld))]
+fn load_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    weld: bool,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let opts = shapecue::mesh::LoadOptions { weld };
+    let m = py
+        .detach(|| shapecue::mesh::load(Path::new(&path), &opts))
+        .map_err(to_py)?;
+    let (nv, nf) = (m.n_vertices(), m.n_faces());
+    Ok((
+        array(py, m.positions.into_flattened(), &[nv, 3])?,
+        array(py, m.faces.into_flattened(), &[nf, 3])?,
+    ))
+}
+
+/// load_volume(path) -> (values float32 (z, y, x), spacing (x, y, z), origin (x, y, z))
+#[pyfunction]
+fn load_volume(py: Python<'_>, path: PathBuf) -> PyResult<(Bound<'_, PyAny>, [f64; 3], [f64; 3])> {
+    let v = py
+        .detach(|| shapecue::volume::load(Path::new(&path), None))
+        .map_err(to_py)?;
+    let [nx, ny, nz] = v.dims;
+    Ok((array(py, v.values, &[nz, ny, nx])?, v.spacing, v.origin))
+}
+
+/// The extension module.
+#[pymodule]
+fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("DeviceError", py.get_type::<DeviceError>())?;
+    m.add("RenderError", py.get_type::<RenderError>())?;
+    m.add_function(wrap_pyfunction!(devices, m)?)?;
+    m.add_function(wrap_pyfunction!(curvature, m)?)?;
+    m.add_function(wrap_pyfunction!(isosurface, m)?)?;
+    m.add_function(wrap_pyfunction!(feature_edges, m)?)?;
+    m.add_function(wrap_pyfunction!(render_file, m)?)?;
+    m.add_function(wrap_pyfunction!(render_text, m)?)?;
+    m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(load_volume, m)?)?;
+    m.add_class::<PyEstimator>()?;
+    Ok(())
+}

@@ -1,0 +1,95 @@
+"""shapecue.batch on a Dask LocalCluster (two worker processes, no
+service): a few small meshes and one broken file; the failure is recorded
+and the rest finish; a rerun skips what finished."""
+
+import json
+
+import numpy as np
+import pytest
+
+import shapecue
+from conftest import sphere_sdf, torus, write_obj
+
+distributed = pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def test_curvature_batch_records_failures_and_resumes(device, client, tmp_path):
+    from shapecue import batch
+
+    src = tmp_path / "in"
+    src.mkdir()
+    meshes = {}
+    for i in range(3):
+        v, f = torus(16 + 4 * i, 8 + 2 * i)
+        write_obj(src / f"torus{i}.obj", v, f)
+        meshes[f"torus{i}"] = (v, f)
+    (src / "broken.obj").write_text("v 0 0 0\nv 1 0 0\nf 1 2 3\n")  # index 3 of 2 vertices
+    out = tmp_path / "out"
+
+    recs = batch.run(str(src / "*.obj"), out, client=client, options={"accumulate": "gather"})
+    assert len(recs) == 4
+    by = {r["input"].rsplit("/", 1)[-1]: r for r in recs}
+    assert by["broken.obj"]["status"] == "error"
+    assert "broken.obj: face 0" in by["broken.obj"]["error"]
+    assert by["broken.obj"]["error"].startswith("ValueError")
+    for name, (v, f) in meshes.items():
+        r = by[name + ".obj"]
+        assert r["status"] == "ok", r
+        assert r["worker"] and r["timings"]["total_ms"] >= r["timings"]["compute_ms"] > 0
+        data = np.load(r["output"])
+        expect = shapecue.curvature(v, f, accumulate="gather")
+        np.testing.assert_array_equal(data["k1"], expect.k1)
+        np.testing.assert_array_equal(data["faces"], f)
+
+    lines = [json.loads(x) for x in (out / "manifest.jsonl").read_text().splitlines()]
+    assert len(lines) == 4 and {x["status"] for x in lines} == {"ok", "error"}
+    for x in lines:
+        assert set(x) >= {"input", "output", "status", "error", "timings"}
+
+    # A rerun skips the three finished meshes and tries the broken one again.
+    again = batch.run(str(src / "*.obj"), out, client=client, options={"accumulate": "gather"})
+    assert [r["input"].rsplit("/", 1)[-1] for r in again] == ["broken.obj"]
+    assert len(batch.read_manifest(out)) == 5
+    # Once it is fixed, it is run, and then nothing is left.
+    v, f = torus(12, 8)
+    write_obj(src / "broken.obj", v, f)
+    fixed = batch.run(str(src / "*.obj"), out, client=client)
+    assert [r["status"] for r in fixed] == ["ok"], fixed
+    assert batch.run(str(src / "*.obj"), out, client=client) == []
+
+
+def test_isosurface_batch(device, client, tmp_path):
+    from shapecue import batch
+    from test_isosurface import write_nrrd
+
+    paths = []
+    for i, r in enumerate((6.0, 8.0)):
+        p = tmp_path / f"ball{i}.nrrd"
+        write_nrrd(p, sphere_sdf(radius=r), (1.0, 1.0, 1.0))
+        paths.append(str(p))
+    recs = batch.run(paths, tmp_path / "out", task="isosurface", client=client,
+                     options={"iso": 0.0, "curvature": True})
+    assert [r["status"] for r in recs] == ["ok", "ok"], recs
+    for r in recs:
+        d = np.load(r["output"])
+        assert d["vertices"].shape[1] == 3 and len(d["curvature_k1"]) == len(d["vertices"])
+    bad = batch.run(paths[:1], tmp_path / "out2", task="isosurface", client=client)
+    assert bad[0]["status"] == "error" and "iso" in bad[0]["error"]
+    (tmp_path / "other").mkdir()
+    twin = tmp_path / "other" / "ball0.nrrd"
+    twin.write_bytes(open(paths[0], "rb").read())
+    with pytest.raises(ValueError, match="would both write"):
+        batch.run([paths[0], str(twin)], tmp_path / "out4", task="isosurface", client=client)
+    with pytest.raises(ValueError, match="unknown task"):
+        batch.run(paths, tmp_path / "out3", task="sculpt", client=client)

@@ -1,0 +1,88 @@
+"""Devices, mesh loading, feature edges and scene rendering through the
+binding."""
+
+import os
+
+import numpy as np
+import pytest
+
+import shapecue
+from conftest import REPO, torus, write_obj
+
+
+def test_devices(device):
+    assert device and all(isinstance(d, dict) for d in device)
+    for key in ("index", "platform", "name", "type", "fp64", "gl_sharing", "default"):
+        assert key in device[0]
+    assert sum(d["default"] for d in device) == 1
+
+
+def test_load_mesh(tmp_path):
+    v, f = torus(12, 8)
+    p = tmp_path / "t.obj"
+    write_obj(p, v, f)
+    lv, lf = shapecue.load_mesh(p)
+    assert lv.dtype == np.float64 and lf.dtype == np.uint32
+    np.testing.assert_array_equal(lv, v)
+    np.testing.assert_array_equal(lf, f)
+    broken = tmp_path / "broken.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
+    with pytest.raises(ValueError, match=r"broken.obj: face 0"):
+        shapecue.load_mesh(broken)
+    with pytest.raises(FileNotFoundError, match="absent.obj"):
+        shapecue.load_mesh(tmp_path / "absent.obj")
+    with pytest.raises(ValueError, match="unsupported format"):
+        shapecue.load_mesh(tmp_path / "t.xyz")
+
+
+def test_feature_edges(device):
+    v, f = torus(48, 24)
+    e = shapecue.feature_edges(v, f, eye=(0, -4, 2), size=(320, 240), crease=60)
+    n = len(e.kind)
+    assert n > 0 and e.quads.shape == (n, 4, 4) and e.quads.dtype == np.float32
+    assert e.contour > 0 and e.boundary == 0
+    assert e.contour == int(np.count_nonzero(e.kind & 1))
+    assert e.view_proj.shape == (4, 4)
+    fitted = shapecue.feature_edges(v, f, caps="mh")
+    assert fitted.cap_mh0.shape[1:] == (3, 4)
+    with pytest.raises(ValueError, match="crease"):
+        shapecue.feature_edges(v, f, crease=0)
+    with pytest.raises(ValueError, match="marked"):
+        shapecue.feature_edges(v, f, marked=[[0, 999]])
+
+
+def _gl_or_skip(fn):
+    try:
+        return fn()
+    except shapecue.RenderError as e:
+        if os.environ.get("SHAPECUE_REQUIRE_GL"):
+            raise
+        pytest.skip(f"no headless OpenGL: {e}")
+
+
+def test_render_dict_and_file(device, tmp_path):
+    scene = {
+        "input": {"generate": "torus"},
+        "effects": {"shading": {}, "contours": {"width": 2}},
+        "output": {"size": [96, 64], "dir": "out"},
+    }
+    report = _gl_or_skip(lambda: shapecue.render(scene, tmp_path / "a"))
+    pngs = list((tmp_path / "a").glob("*.png"))
+    assert pngs and report["passes"]
+    with pytest.raises(ValueError):
+        shapecue.render(scene, tmp_path / "a")  # outputs exist, no force
+    shapecue.render(scene, tmp_path / "a", force=True)
+    with pytest.raises(ValueError, match="scene.toml"):
+        shapecue.render({"input": {"generate": "torus"}, "bogus": 1}, tmp_path / "b")
+    report = _gl_or_skip(lambda: shapecue.render(REPO / "scenes" / "torus.toml", tmp_path / "c"))
+    assert list((tmp_path / "c").glob("*.png"))
+
+
+def test_readme_python_example(device, tmp_path, monkeypatch):
+    """The README's Python example, run as written."""
+    text = (REPO / "README.md").read_text()
+    start = text.index("## Python")
+    block = text[text.index("```python", start) + len("```python"):]
+    block = block[: block.index("```")]
+    monkeypatch.chdir(REPO)
+    exec(compile(block, "README.md", "exec"), {})
