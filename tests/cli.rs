@@ -1009,3 +1009,92 @@ fn curvature_runs_times_the_device_passes() {
     assert_eq!(s["runs"], 2);
     assert!(s["wall_median_ms"].as_f64().is_some_and(|v| v > 0.0), "{s}");
 }
+
+/// Faults: a write that fails midway (a full disk, simulated with a file
+/// size limit, so the write fails with an OS error after the file was
+/// opened), a device output, an output whose folder cannot exist, and a
+/// device too small for the mesh (`SHAPECUE_DEVICE_MEMORY`): each a clear
+/// error naming the file or the bytes, and nothing left behind.
+#[test]
+fn full_disks_bad_folders_and_small_devices_give_clear_errors_and_leave_nothing() {
+    let d = scratch("faults");
+    let exe = env!("CARGO_BIN_EXE_shapecue");
+    // 16 KiB per file: the PLY of a 10,242-vertex sphere is ~700 KB.
+    let ply = d.join("o.ply");
+    let out = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 16; trap '' XFSZ; exec '{exe}' curvature --generate sphere \
+             --resolution 20000 -o '{}'",
+            ply.display()
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("o.ply") && err.contains("cannot write"),
+        "{err}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&d).unwrap().collect();
+    assert!(left.is_empty(), "nothing left behind: {left:?}");
+
+    let r = run_cli(["curvature", "--generate", "sphere", "-o", "/dev/full"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("/dev/full") && err.contains("not a regular file"),
+        "{err}"
+    );
+
+    let blocker = d.join("a-file");
+    std::fs::write(&blocker, "mine").unwrap();
+    let inside = blocker.join("o.ply");
+    let r = run_cli([
+        "curvature",
+        "--generate",
+        "sphere",
+        "-o",
+        inside.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("a-file") && err.contains("not a folder"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&blocker).unwrap(), "mine");
+
+    let small = cli()
+        .env("SHAPECUE_DEVICE_MEMORY", "1M")
+        .args([
+            "curvature",
+            "--generate",
+            "sphere",
+            "--resolution",
+            "100000",
+            "-o",
+        ])
+        .arg(&ply)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&small.stderr);
+    assert!(!small.status.success());
+    assert!(
+        err.contains("bytes") && err.contains("1048576") && err.contains("SHAPECUE_DEVICE_MEMORY"),
+        "{err}"
+    );
+    assert!(!ply.exists());
+    let bad = cli()
+        .env("SHAPECUE_DEVICE_MEMORY", "lots")
+        .args(["curvature", "--generate", "sphere", "-o"])
+        .arg(&ply)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && err.contains("SHAPECUE_DEVICE_MEMORY"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

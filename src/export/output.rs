@@ -136,6 +136,16 @@ pub fn check_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Result
     }
     for &out in outputs {
         if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if let Some(file) = dir
+                .ancestors()
+                .find(|a| a.exists() && !a.is_dir() && !a.as_os_str().is_empty())
+            {
+                return Err(refuse(format!(
+                    "cannot write {}: {} is a file, not a folder",
+                    out.display(),
+                    file.display()
+                )));
+            }
             std::fs::create_dir_all(dir).map_err(|source| Error::Write {
                 path: dir.to_path_buf(),
                 source,

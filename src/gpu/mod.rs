@@ -47,6 +47,24 @@ pub struct Gpu {
     /// Programs built from source in this `Gpu`, not yet saved: (key, program).
     unsaved: Mutex<Vec<(u128, Arc<Program>)>>,
     builds: Mutex<Vec<ProgramBuild>>,
+    /// `SHAPECUE_DEVICE_MEMORY`: a simulated device memory in bytes, and the
+    /// bytes allocated so far against it (see [`Gpu::buffer_flags`]).
+    budget: Option<(u64, std::sync::atomic::AtomicU64)>,
+}
+
+/// Parses a byte count with an optional binary suffix (`512M`, `2G`, `64KiB`).
+pub fn parse_bytes(s: &str) -> Option<u64> {
+    let s = s.trim();
+    let digits = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+    let n: u64 = s[..digits].parse().ok()?;
+    let shift = match s[digits..].trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 0,
+        "k" | "kib" | "kb" => 10,
+        "m" | "mib" | "mb" => 20,
+        "g" | "gib" | "gb" => 30,
+        _ => return None,
+    };
+    n.checked_mul(1u64 << shift)
 }
 
 /// How one program of a [`Gpu`] was obtained (for stats).
@@ -106,6 +124,18 @@ impl Gpu {
             queue,
             programs: Mutex::new(HashMap::new()),
             cache_dir: cache::cache_dir(),
+            budget: std::env::var("SHAPECUE_DEVICE_MEMORY")
+                .ok()
+                .filter(|v| !v.is_empty())
+                .map(|v| {
+                    parse_bytes(&v).map(|b| (b, 0.into())).ok_or_else(|| {
+                        Error::InvalidArgument(format!(
+                            "SHAPECUE_DEVICE_MEMORY={v:?}: expected a byte count such as \
+                             268435456, 256M or 2G"
+                        ))
+                    })
+                })
+                .transpose()?,
             cache_tag,
             unsaved: Mutex::new(Vec::new()),
             builds: Mutex::new(Vec::new()),
@@ -222,7 +252,13 @@ impl Gpu {
         self.buffer_flags(len, CL_MEM_READ_WRITE)
     }
 
-    /// Allocates a buffer with explicit memory flags.
+    /// Allocates a buffer with explicit memory flags. A buffer larger than the
+    /// device's largest allocation is refused with the bytes named. With
+    /// `SHAPECUE_DEVICE_MEMORY` set (bytes, or with a K/M/G suffix), the
+    /// device is taken to have that much memory: an allocation that would
+    /// bring the bytes allocated through this `Gpu` past it is refused, with
+    /// the bytes named (counted without frees, so an upper bound of what is
+    /// live: meant to test what a run does on a small device).
     pub fn buffer_flags<T>(&self, len: usize, flags: cl_mem_flags) -> Result<Buffer<T>> {
         let bytes = len.max(1) * std::mem::size_of::<T>();
         if bytes as u64 > self.info.max_alloc {
@@ -233,6 +269,19 @@ impl Gpu {
                     self.info.max_alloc
                 ),
             });
+        }
+        if let Some((limit, used)) = &self.budget {
+            use std::sync::atomic::Ordering;
+            let before = used.fetch_add(bytes as u64, Ordering::Relaxed);
+            if before + bytes as u64 > *limit {
+                return Err(Error::DeviceUnsupported {
+                    device: self.info.name.clone(),
+                    what: format!(
+                        "a buffer of {bytes} bytes does not fit: {before} bytes are allocated \
+                         already and the device has {limit} bytes (SHAPECUE_DEVICE_MEMORY)"
+                    ),
+                });
+            }
         }
         // SAFETY: no host pointer is passed; the buffer is written before it is read.
         unsafe { Buffer::<T>::create(&self.context, flags, len.max(1), std::ptr::null_mut()) }
