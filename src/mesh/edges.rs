@@ -68,8 +68,9 @@ impl EdgeTopology {
     /// [`Error::InvalidInput`] for more cap pairs than [`MAX_CAP_PAIRS`].
     pub fn add_caps(&mut self, nv: usize, source: &str) -> Result<()> {
         if self.caps.is_empty() {
-            check_cap_count(nv, &self.edges, source)?;
-            self.caps = cap_pairs(nv, &self.edges);
+            let (off, inc) = incidences(nv, &self.edges);
+            check_cap_count(&off, source)?;
+            self.caps = pairs_of(&off, &inc);
         }
         Ok(())
     }
@@ -210,30 +211,27 @@ fn sides_by_edge(nv: usize, faces: &[[u32; 3]], source: &str) -> Result<(Vec<u32
         off[v + 1] += off[v];
     }
     let mut fill = off.clone();
-    let mut bucket = vec![0u32; off[nv] as usize];
+    // (side, upper vertex) per side, bucketed by lower vertex.
+    let mut bucket = vec![[0u32; 2]; off[nv] as usize];
     for (fi, f) in faces.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (f[k], f[(k + 1) % 3]);
             if a != b {
                 let slot = &mut fill[a.min(b) as usize];
-                bucket[*slot as usize] = (3 * fi + k) as u32;
+                bucket[*slot as usize] = [(3 * fi + k) as u32, a.max(b)];
                 *slot += 1;
             }
         }
     }
     drop(fill);
-    let upper = |h: u32| {
-        let (f, k) = (&faces[h as usize / 3], h as usize % 3);
-        f[k].max(f[(k + 1) % 3])
-    };
     let mut next = vec![NONE; m];
     let mut head = vec![false; m];
     // Per upper vertex: the bucket that last saw it and its last side there.
     let mut seen_in = vec![NONE; nv];
     let mut last = vec![0u32; nv];
     for v in 0..nv {
-        for &h in &bucket[off[v] as usize..off[v + 1] as usize] {
-            let hi = upper(h) as usize;
+        for &[h, hi] in &bucket[off[v] as usize..off[v + 1] as usize] {
+            let hi = hi as usize;
             if seen_in[hi] != v as u32 {
                 seen_in[hi] = v as u32;
                 head[h as usize] = true;
@@ -252,21 +250,17 @@ pub const MAX_CAP_PAIRS: u64 = (u32::MAX / 16) as u64;
 
 /// Rejects meshes whose cap buffer would not fit ([`MAX_CAP_PAIRS`]): the
 /// count grows with the square of vertex degrees (a fan of 100k triangles
-/// around one apex has 5·10⁹ pairs), so it is counted before anything is
-/// allocated, and the error names the vertex of highest degree.
-fn check_cap_count(nv: usize, edges: &[[u32; 4]], source: &str) -> Result<()> {
-    let mut deg = vec![0u64; nv];
-    for e in edges {
-        deg[e[0] as usize] += 1;
-        deg[e[1] as usize] += 1;
-    }
-    let total: u64 = deg.iter().map(|&d| d * d.saturating_sub(1) / 2).sum();
+/// around one apex has 5·10⁹ pairs), so it is counted from the incidence
+/// offsets `off` before anything is allocated, and the error names the
+/// vertex of highest degree.
+fn check_cap_count(off: &[u32], source: &str) -> Result<()> {
+    let deg = |v: usize| u64::from(off[v + 1] - off[v]);
+    let nv = off.len() - 1;
+    let total: u64 = (0..nv).map(|v| deg(v) * deg(v).saturating_sub(1) / 2).sum();
     if total > MAX_CAP_PAIRS {
-        let (v, d) = deg
-            .iter()
-            .enumerate()
-            .max_by_key(|(_, d)| **d)
-            .map(|(v, d)| (v, *d))
+        let (v, d) = (0..nv)
+            .map(|v| (v, deg(v)))
+            .max_by_key(|p| p.1)
             .unwrap_or((0, 0));
         return Err(Error::input(
             source,
@@ -280,22 +274,18 @@ fn check_cap_count(nv: usize, edges: &[[u32; 4]], source: &str) -> Result<()> {
     Ok(())
 }
 
-/// Every pair of edge entries sharing an end vertex (see the module documentation).
-pub fn cap_pairs(nv: usize, edges: &[[u32; 4]]) -> Vec<[u32; 2]> {
-    // CSR of incident edge entries per vertex, each with its other end.
+/// The edge entries at each vertex (CSR: offsets of length V+1), each as
+/// (entry, other end), in entry order.
+fn incidences(nv: usize, edges: &[[u32; 4]]) -> (Vec<u32>, Vec<[u32; 2]>) {
     let mut off = vec![0u32; nv + 1];
     for e in edges {
         off[e[0] as usize + 1] += 1;
         off[e[1] as usize + 1] += 1;
     }
-    let mut n_pairs = 0usize;
     for v in 0..nv {
-        let d = off[v + 1] as usize;
-        n_pairs += d * d.saturating_sub(1) / 2;
         off[v + 1] += off[v];
     }
     let mut fill = off.clone();
-    // (entry, other end) per incidence.
     let mut inc = vec![[0u32; 2]; off[nv] as usize];
     for (i, e) in edges.iter().enumerate() {
         for (v, other) in [(e[0], e[1]), (e[1], e[0])] {
@@ -303,7 +293,23 @@ pub fn cap_pairs(nv: usize, edges: &[[u32; 4]]) -> Vec<[u32; 2]> {
             fill[v as usize] += 1;
         }
     }
-    drop(fill);
+    (off, inc)
+}
+
+/// Every pair of edge entries sharing an end vertex (see the module documentation).
+pub fn cap_pairs(nv: usize, edges: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    let (off, inc) = incidences(nv, edges);
+    pairs_of(&off, &inc)
+}
+
+fn pairs_of(off: &[u32], inc: &[[u32; 2]]) -> Vec<[u32; 2]> {
+    let nv = off.len() - 1;
+    let n_pairs: usize = (0..nv)
+        .map(|v| {
+            let d = (off[v + 1] - off[v]) as usize;
+            d * d.saturating_sub(1) / 2
+        })
+        .sum();
     let mut caps = Vec::with_capacity(n_pairs);
     for v in 0..nv {
         let list = &inc[off[v] as usize..off[v + 1] as usize];

@@ -127,7 +127,9 @@ pub struct EdgePhases {
 pub struct EdgeDrawing {
     /// The picture: the shaded mesh with its edges and caps in black.
     pub frame: Frame,
-    /// The stage's outputs.
+    /// The stage's outputs as drawn: `kind` per edge, and only the edge
+    /// quads and caps that hold geometry, compacted in index order
+    /// ([`EdgeStage::read_drawn`]).
     pub output: EdgeOutput,
     /// The edge and cap buffers (and their counts).
     pub topology: EdgeTopology,
@@ -252,11 +254,15 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
     p.pack()?;
 
     lap();
-    let mut stage = EdgeStage::new(gpu.clone(), mesh, &topo)?;
+    // One f32 copy of the positions and one set of normals, for the stage
+    // and the renderer both.
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
+    let nrm = vertex_normals(mesh);
+    let mut stage = EdgeStage::with_pose(gpu.clone(), &topo, &pos, &nrm)?;
     ph.stage_setup = lap();
     let timing = stage.run(&p, opts.caps)?;
     ph.kernels = lap();
-    let output = stage.read()?;
+    let output = stage.read_drawn()?;
     ph.readback = lap();
     let mut r = Renderer::new(RenderOptions {
         width: w,
@@ -265,14 +271,7 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
     })?;
     ph.gl_context = lap();
     r.begin(&cam)?;
-    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
-    r.draw_mesh(
-        &pos,
-        &vertex_normals(mesh),
-        &[],
-        &mesh.faces,
-        MeshStyle::default(),
-    )?;
+    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, MeshStyle::default())?;
     ph.draw_mesh = lap();
     draw_edges(&mut r, &output, [0.0, 0.0, 0.0, 1.0])?;
     ph.draw_edges = lap();
