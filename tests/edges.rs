@@ -1127,3 +1127,68 @@ fn compact_read_back_case(m: &Mesh) {
         }
     }
 }
+
+#[test]
+fn cli_without_an_eye_frames_the_mesh() {
+    // A cube 0.02 across, far off the origin: with a fixed eye it would be a
+    // few pixels; fitted, it fills most of the image and is not cut off.
+    let d = scratch("framed");
+    let obj = d.join("small.obj");
+    let m = mesh::cube(0.02);
+    let mut s = String::new();
+    for p in &m.positions {
+        s += &format!("v {} {} {}\n", p[0] + 10.0, p[1] - 3.0, p[2]);
+    }
+    for f in &m.faces {
+        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    std::fs::write(&obj, s).unwrap();
+    let png = d.join("small.png");
+    let out = run_cli([
+        "edges",
+        obj.to_str().unwrap(),
+        "--size",
+        "240x200",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    if cli_gl_missing(&out) {
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap().to_rgba8();
+    let (mut lo, mut hi) = ([u32::MAX; 2], [0u32; 2]);
+    for (x, y, p) in img.enumerate_pixels() {
+        if p[0] < 250 || p[1] < 250 || p[2] < 250 {
+            lo = [lo[0].min(x), lo[1].min(y)];
+            hi = [hi[0].max(x), hi[1].max(y)];
+        }
+    }
+    let (w, h) = (
+        hi[0] + 1 - lo[0].min(hi[0] + 1),
+        hi[1] + 1 - lo[1].min(hi[1] + 1),
+    );
+    assert!(
+        h * 10 >= 200 * 6,
+        "drawn {w}x{h} pixels of 240x200 ({lo:?}..{hi:?})"
+    );
+    assert!(
+        lo[0] > 0 && lo[1] > 0 && hi[0] < 239 && hi[1] < 199,
+        "not cut off: {lo:?}..{hi:?}"
+    );
+    // --target alone is refused (the fitted view looks at the centre).
+    let out = run_cli([
+        "edges",
+        obj.to_str().unwrap(),
+        "--target",
+        "0,0,0",
+        "-o",
+        d.join("t.png").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--target needs --eye"));
+}

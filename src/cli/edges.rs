@@ -21,7 +21,8 @@ pub struct EdgesArgs {
     /// Input mesh (.obj, .ply, .off).
     #[arg(required_unless_present_any = ["cap_quality", "memory_table"])]
     mesh: Option<PathBuf>,
-    /// Eye position, e.g. 5,5,5.
+    /// Eye position, e.g. 5,5,5 (default: from direction 1,1,1 off the
+    /// centre of the mesh, far enough that the mesh fills the view).
     #[arg(
         long,
         value_delimiter = ',',
@@ -150,9 +151,10 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let t_load = std::time::Instant::now();
     let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
     let load_ms = ms_since(t_load);
-    let Some(eye) = vec3_arg(&a.eye, "eye")? else {
-        bail!("--eye X,Y,Z is required");
-    };
+    let eye = vec3_arg(&a.eye, "eye")?;
+    if eye.is_none() && a.target.is_some() {
+        bail!("--target needs --eye (without both, the view is fitted around the mesh)");
+    }
     let opts = EdgeDrawOptions {
         eye,
         target: vec3_arg(&a.target, "target")?,

@@ -40,8 +40,10 @@ pub fn draw_edges(r: &mut Renderer, out: &EdgeOutput, color: [f32; 4]) -> Result
 /// What [`draw`] draws and how (the `shapecue edges` options).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EdgeDrawOptions {
-    /// Eye position (world space).
-    pub eye: Vec3,
+    /// Eye position (world space); `None`: framed, from direction (1, 1, 1)
+    /// off the centre of the mesh's bounding box, far enough that the
+    /// bounding sphere fills the view with a 5 % margin ([`Placement::Fit`]).
+    pub eye: Option<Vec3>,
     /// Point looked at; `None`: the centre of the mesh's bounding box.
     pub target: Option<Vec3>,
     /// Up direction; `None`: +Y, or +Z when looking along Y.
@@ -75,7 +77,7 @@ pub struct EdgeDrawOptions {
 impl Default for EdgeDrawOptions {
     fn default() -> Self {
         EdgeDrawOptions {
-            eye: Vec3::splat(5.0),
+            eye: Some(Vec3::splat(5.0)),
             target: None,
             up: None,
             fov_deg: 40.0,
@@ -197,7 +199,7 @@ impl EdgeDrawing {
 /// The edges picture of `mesh` in one call: reads the marked edges, builds
 /// the topology (with the cap buffer only for adjacency caps), frames the
 /// camera ([`framed`]; the default target is the bounding-box centre,
-/// computed in f64), runs the stage once, renders the shaded mesh and the
+/// computed in f64; without an eye the view fits the mesh), runs the stage once, renders the shaded mesh and the
 /// edges and caps in black, and finds the visible polylines when asked.
 /// `name` names the mesh in errors (the marked file names itself).
 ///
@@ -237,8 +239,12 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         (0.5 * (lo[2] + hi[2])) as f32,
     );
     let target = opts.target.unwrap_or(centre);
+    let placement = match opts.eye {
+        Some(eye) => Placement::At(eye),
+        None => Placement::Fit(Vec3::ONE),
+    };
     let cam = framed(
-        Placement::At(opts.eye),
+        placement,
         Some(target),
         opts.up,
         opts.fov_deg,
