@@ -127,7 +127,8 @@ pub struct EdgePhases {
 /// What [`draw`] made.
 #[derive(Clone, Debug)]
 pub struct EdgeDrawing {
-    /// The picture: the shaded mesh with its edges and caps in black.
+    /// The picture: the shaded mesh with its edges and caps in black (its
+    /// depth only when [`EdgeDrawOptions::polylines`] asked for it, else empty).
     pub frame: Frame,
     /// The stage's outputs as drawn: `kind` per edge, and only the edge
     /// quads and caps that hold geometry, compacted in index order
@@ -281,7 +282,12 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
     ph.draw_mesh = lap();
     draw_edges(&mut r, &output, [0.0, 0.0, 0.0, 1.0])?;
     ph.draw_edges = lap();
-    let frame = r.finish()?;
+    // Depth only for the SVG's visibility test.
+    let frame = if opts.polylines {
+        r.finish()?
+    } else {
+        r.finish_color()?
+    };
     ph.image_readback = lap();
     let frame_ms = ph.stage_setup
         + ph.kernels
