@@ -785,18 +785,7 @@ impl Renderer {
                 gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(self.resolve.fbo));
                 // Colour is averaged over samples; depth (NEAREST is required)
                 // takes one sample.
-                gl.blit_framebuffer(
-                    0,
-                    0,
-                    w,
-                    h,
-                    0,
-                    0,
-                    w,
-                    h,
-                    blit,
-                    glow::NEAREST,
-                );
+                gl.blit_framebuffer(0, 0, w, h, 0, 0, w, h, blit, glow::NEAREST);
                 check(gl, "resolving the multisampled frame")?;
             }
             gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.resolve.fbo));

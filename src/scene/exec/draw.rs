@@ -203,7 +203,7 @@ pub(super) fn draw_view(
     // Depth only for an SVG's visibility test.
     let svg = paths
         .iter()
-        .any(|p| !p.extension().is_some_and(|e| e == "png"));
+        .any(|p| p.extension().is_none_or(|e| e != "png"));
     let image: Frame = if svg {
         renderer.finish()?
     } else {
