@@ -5,10 +5,14 @@
 //! - `edges/<caps>/<mesh>`: `edges_detect` + the variant's cap kernel, from
 //!   OpenCL profiling events, topology and positions already on the device,
 //!   after a warm-up run that pays for JIT.
-//! - `edges/<caps>-frame/<mesh>`: host wall time of a whole frame: parameter
-//!   upload, kernels, read-back of edge-out and cap-out, and the GL frame
-//!   (mesh, edges, caps, read-back of colour and depth). Without headless GL:
-//!   kernels + read-back only (a message says so).
+//! - `edges/<caps>/<mesh>/frame`: host wall time of a whole frame: parameter
+//!   upload, kernels, read-back of what was drawn (`EdgeStage::read_drawn`,
+//!   as `shapecue edges` does), and the GL frame (mesh, edges, caps,
+//!   read-back of colour and depth). Without headless GL: kernels +
+//!   read-back only (a message says so).
+//! - `edges/topology/<mesh>`: the host topology, edge buffer and adjacency
+//!   cap pairs (`EdgeTopology::new`), and `edges/topology-edges/<mesh>` the
+//!   edge buffer alone (`EdgeTopology::without_caps`).
 //!
 //! Inputs: generated cube, capped cylinder, cone, icosphere (level 3), the
 //! shared teapot and Stanford bunny (skipped with a message when absent), and a
@@ -73,6 +77,12 @@ fn edges_benches(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
     for (name, m) in inputs() {
+        g.bench_function(format!("topology/{name}"), |b| {
+            b.iter(|| EdgeTopology::new(&m, &[], name).expect("topology"))
+        });
+        g.bench_function(format!("topology-edges/{name}"), |b| {
+            b.iter(|| EdgeTopology::without_caps(&m, &[], name).expect("topology"))
+        });
         let topo = EdgeTopology::new(&m, &[], name).expect("topology");
         let cam = framed(
             Placement::At(Vec3::splat(5.0)),
@@ -105,12 +115,12 @@ fn edges_benches(c: &mut Criterion) {
                     Duration::from_secs_f64(ms * 1e-3)
                 })
             });
-            g.bench_function(format!("{}-frame/{name}", mode.name()), |b| {
+            g.bench_function(format!("{}/{name}/frame", mode.name()), |b| {
                 b.iter_custom(|iters| {
                     let t = Instant::now();
                     for _ in 0..iters {
                         stage.run(&p, mode).expect("run");
-                        let out = stage.read().expect("read");
+                        let out = stage.read_drawn().expect("read");
                         if let Some(r) = renderer.as_mut() {
                             r.begin(&cam).expect("begin");
                             r.draw_mesh(&pos, &nrm, &[], &m.faces, MeshStyle::default())

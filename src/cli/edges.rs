@@ -21,7 +21,8 @@ pub struct EdgesArgs {
     /// Input mesh (.obj, .ply, .off).
     #[arg(required_unless_present_any = ["cap_quality", "memory_table"])]
     mesh: Option<PathBuf>,
-    /// Eye position, e.g. 5,5,5.
+    /// Eye position, e.g. 5,5,5 (default: from direction 1,1,1 off the
+    /// centre of the mesh, far enough that the mesh fills the view).
     #[arg(
         long,
         value_delimiter = ',',
@@ -100,6 +101,10 @@ fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
     }
 }
 
+fn ms_since(t: std::time::Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
 /// Runs `shapecue edges`.
 pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     // Parsed here rather than by clap's ValueEnum so that a bad name keeps
@@ -143,10 +148,13 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             .map(PathBuf::as_path),
         a.force,
     )?;
+    let t_load = std::time::Instant::now();
     let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
-    let Some(eye) = vec3_arg(&a.eye, "eye")? else {
-        bail!("--eye X,Y,Z is required");
-    };
+    let load_ms = ms_since(t_load);
+    let eye = vec3_arg(&a.eye, "eye")?;
+    if eye.is_none() && a.target.is_some() {
+        bail!("--target needs --eye (without both, the view is fitted around the mesh)");
+    }
     let opts = EdgeDrawOptions {
         eye,
         target: vec3_arg(&a.target, "target")?,
@@ -164,7 +172,9 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         polylines: a.svg.is_some(),
     };
     let d = draw(gpu, &mesh, &path.display().to_string(), &opts)?;
+    let t_png = std::time::Instant::now();
     d.frame.save_png(output)?;
+    let png_ms = ms_since(t_png);
     let t = &d.topology;
     out!(
         "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
@@ -183,12 +193,22 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         d.timing.kernel_ms,
         output.display()
     );
+    let mut svg_ms = 0.0;
     if let (Some(svg), Some(lines)) = (&a.svg, &d.polylines) {
+        let t_svg = std::time::Instant::now();
         shapecue::export::svg::write_svg(svg, lines, w, h, a.width)?;
+        svg_ms = ms_since(t_svg);
         out!("wrote {} ({} polylines)", svg.display(), lines.len());
     }
     if let Some(sp) = &a.stats {
-        write_json(sp, &d.stats(&path.display().to_string(), &interop))?;
+        let mut doc = d.stats(&path.display().to_string(), &interop);
+        // The phases outside the library call: loading, PNG, SVG file.
+        if let Some(ph) = doc.get_mut("phases_ms").and_then(|v| v.as_object_mut()) {
+            ph.insert("load".into(), load_ms.into());
+            ph.insert("png_write".into(), png_ms.into());
+            ph.insert("svg_write".into(), svg_ms.into());
+        }
+        write_json(sp, &doc)?;
     }
     Ok(())
 }

@@ -342,6 +342,55 @@ impl Gpu {
         self.finish()
     }
 
+    /// Reads `out.len()` elements of `buf` from element `offset` on. Only
+    /// enqueued: the data is there after [`Gpu::finish`] (or any blocking
+    /// call on the queue), so many small reads cost one wait.
+    ///
+    /// # Safety
+    /// `out` must stay alive and untouched until the queue has finished, and
+    /// `offset + out.len()` must not pass the end of `buf`.
+    pub unsafe fn read_at_async<T>(
+        &self,
+        buf: &Buffer<T>,
+        offset: usize,
+        out: &mut [T],
+    ) -> Result<()> {
+        if out.is_empty() {
+            return Ok(());
+        }
+        // SAFETY: the caller keeps `out` alive until the queue finishes and
+        // keeps the range inside the buffer.
+        unsafe {
+            self.queue.enqueue_read_buffer(
+                buf,
+                opencl3::types::CL_NON_BLOCKING,
+                offset * std::mem::size_of::<T>(),
+                out,
+                &[],
+            )
+        }
+        .map(|_| ())
+        .map_err(|e| Error::cl("clEnqueueReadBuffer", e))
+    }
+
+    /// Enqueues filling the first `len` elements of `buf` with `pattern`
+    /// repeated (`len` a multiple of `pattern.len()`), without waiting: the
+    /// device writes the buffer, no host copy of it is made.
+    pub fn fill<T>(&self, buf: &mut Buffer<T>, pattern: &[T], len: usize) -> Result<()> {
+        if len == 0 {
+            return Ok(());
+        }
+        debug_assert!(len.is_multiple_of(pattern.len()));
+        // SAFETY: the pattern is copied at enqueue time (OpenCL 1.2
+        // clEnqueueFillBuffer); callers size `len` within the buffer.
+        unsafe {
+            self.queue
+                .enqueue_fill_buffer(buf, pattern, 0, len * std::mem::size_of::<T>(), &[])
+        }
+        .map(|_| ())
+        .map_err(|e| Error::cl("clEnqueueFillBuffer", e))
+    }
+
     /// Enqueues zeroing the first `len` elements of `buf` without waiting
     /// (the in-order queue runs it before later commands): resetting a
     /// counter this way does not stall the host between passes.

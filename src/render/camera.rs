@@ -150,9 +150,7 @@ impl Camera {
             && self.ortho_height.is_none_or(f32::is_finite);
         if !finite {
             return bad(format!(
-                "a value is not finite (eye {}, target {}, up {}, field of view {}°, near {}, \
-                 far {}); a mesh with coordinates beyond the single-precision range (about \
-                 3.4e38) cannot be drawn",
+                "non-finite value (eye {}, target {}, up {}, field of view {}°, near {}, far {})",
                 self.eye, self.target, self.up, self.fov_y_deg, self.near, self.far
             ));
         }

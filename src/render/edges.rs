@@ -40,8 +40,10 @@ pub fn draw_edges(r: &mut Renderer, out: &EdgeOutput, color: [f32; 4]) -> Result
 /// What [`draw`] draws and how (the `shapecue edges` options).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EdgeDrawOptions {
-    /// Eye position (world space).
-    pub eye: Vec3,
+    /// Eye position (world space); `None`: framed, from direction (1, 1, 1)
+    /// off the centre of the mesh's bounding box, far enough that the
+    /// bounding sphere fills the view with a 5 % margin ([`Placement::Fit`]).
+    pub eye: Option<Vec3>,
     /// Point looked at; `None`: the centre of the mesh's bounding box.
     pub target: Option<Vec3>,
     /// Up direction; `None`: +Y, or +Z when looking along Y.
@@ -75,7 +77,7 @@ pub struct EdgeDrawOptions {
 impl Default for EdgeDrawOptions {
     fn default() -> Self {
         EdgeDrawOptions {
-            eye: Vec3::splat(5.0),
+            eye: Some(Vec3::splat(5.0)),
             target: None,
             up: None,
             fov_deg: 40.0,
@@ -93,12 +95,44 @@ impl Default for EdgeDrawOptions {
     }
 }
 
+/// Host wall time of each phase of [`draw`], ms: where a frame's time goes.
+/// The CLI adds loading, PNG encoding and the SVG file; the rest is measured
+/// here. `frame_ms` of [`EdgeDrawing`] is the sum of `stage_setup` through
+/// `image_readback`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct EdgePhases {
+    /// The edge buffer (unique edges, their faces, marked edges).
+    pub edge_buffer: f64,
+    /// The adjacency cap pairs (0 without adjacency caps).
+    pub cap_pairs: f64,
+    /// Building the program, allocating and filling the device buffers
+    /// (topology, markers, positions, vertex normals).
+    pub stage_setup: f64,
+    /// The stage's run: parameter upload, kernels, waiting for them.
+    pub kernels: f64,
+    /// Reading back edge-out, kinds and the caps of the variant.
+    pub readback: f64,
+    /// Creating (or reusing) the renderer: GL context, programs, framebuffers.
+    pub gl_context: f64,
+    /// Drawing the shaded mesh (uploads included).
+    pub draw_mesh: f64,
+    /// Drawing the edge and cap quads (compaction and uploads included).
+    pub draw_edges: f64,
+    /// Resolving and reading back the image (and depth when an SVG is asked for).
+    pub image_readback: f64,
+    /// The visible polylines for SVG (0 without).
+    pub svg_visibility: f64,
+}
+
 /// What [`draw`] made.
 #[derive(Clone, Debug)]
 pub struct EdgeDrawing {
-    /// The picture: the shaded mesh with its edges and caps in black.
+    /// The picture: the shaded mesh with its edges and caps in black (its
+    /// depth only when [`EdgeDrawOptions::polylines`] asked for it, else empty).
     pub frame: Frame,
-    /// The stage's outputs.
+    /// The stage's outputs as drawn: `kind` per edge, and only the edge
+    /// quads and caps that hold geometry, compacted in index order
+    /// ([`EdgeStage::read_drawn`]).
     pub output: EdgeOutput,
     /// The edge and cap buffers (and their counts).
     pub topology: EdgeTopology,
@@ -114,6 +148,8 @@ pub struct EdgeDrawing {
     pub timing: Timing,
     /// Building the topology, ms.
     pub topology_ms: f64,
+    /// Wall time of each phase of the call, ms ([`EdgePhases`]).
+    pub phases: EdgePhases,
     /// The stage, its run and read-back, and the whole GL frame, ms.
     pub frame_ms: f64,
     /// Device memory of the variant.
@@ -154,6 +190,7 @@ impl EdgeDrawing {
             "timing": self.timing,
             "topology_ms": self.topology_ms,
             "frame_ms": self.frame_ms,
+            "phases_ms": self.phases,
             "memory_bits": self.memory,
             "svg_polylines": self.polylines.as_ref().map_or(0, Vec::len),
         })
@@ -163,7 +200,7 @@ impl EdgeDrawing {
 /// The edges picture of `mesh` in one call: reads the marked edges, builds
 /// the topology (with the cap buffer only for adjacency caps), frames the
 /// camera ([`framed`]; the default target is the bounding-box centre,
-/// computed in f64), runs the stage once, renders the shaded mesh and the
+/// computed in f64; without an eye the view fits the mesh), runs the stage once, renders the shaded mesh and the
 /// edges and caps in black, and finds the visible polylines when asked.
 /// `name` names the mesh in errors (the marked file names itself).
 ///
@@ -181,13 +218,21 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         .marked
         .as_ref()
         .map_or_else(|| name.to_string(), |m| m.display().to_string());
-    let t_topo = Instant::now();
-    let topo = if opts.caps == CapMode::Adjacency {
-        EdgeTopology::new(mesh, &marked, &source)?
-    } else {
-        EdgeTopology::without_caps(mesh, &marked, &source)?
+    let mut ph = EdgePhases::default();
+    let mut clock = Instant::now();
+    let mut lap = || {
+        let now = Instant::now();
+        let ms = (now - clock).as_secs_f64() * 1e3;
+        clock = now;
+        ms
     };
-    let topology_ms = t_topo.elapsed().as_secs_f64() * 1e3;
+    let mut topo = EdgeTopology::without_caps(mesh, &marked, &source)?;
+    ph.edge_buffer = lap();
+    if opts.caps == CapMode::Adjacency {
+        topo.add_caps(mesh.n_vertices(), &source)?;
+    }
+    ph.cap_pairs = lap();
+    let topology_ms = ph.edge_buffer + ph.cap_pairs;
     let (lo, hi) = mesh.bounds();
     let centre = Vec3::new(
         (0.5 * (lo[0] + hi[0])) as f32,
@@ -195,8 +240,12 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         (0.5 * (lo[2] + hi[2])) as f32,
     );
     let target = opts.target.unwrap_or(centre);
+    let placement = match opts.eye {
+        Some(eye) => Placement::At(eye),
+        None => Placement::Fit(Vec3::ONE),
+    };
     let cam = framed(
-        Placement::At(opts.eye),
+        placement,
         Some(target),
         opts.up,
         opts.fov_deg,
@@ -211,30 +260,46 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
     p.half_contours = opts.half_contours;
     p.pack()?;
 
-    let t_all = Instant::now();
-    let mut stage = EdgeStage::new(gpu.clone(), mesh, &topo)?;
+    lap();
+    // One f32 copy of the positions and one set of normals, for the stage
+    // and the renderer both.
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
+    let nrm = vertex_normals(mesh);
+    let mut stage = EdgeStage::with_pose(gpu.clone(), &topo, &pos, &nrm)?;
+    ph.stage_setup = lap();
     let timing = stage.run(&p, opts.caps)?;
-    let output = stage.read()?;
+    ph.kernels = lap();
+    let output = stage.read_drawn()?;
+    ph.readback = lap();
     let mut r = Renderer::new(RenderOptions {
         width: w,
         height: h,
         ..Default::default()
     })?;
+    ph.gl_context = lap();
     r.begin(&cam)?;
-    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|q| q.map(|c| c as f32)).collect();
-    r.draw_mesh(
-        &pos,
-        &vertex_normals(mesh),
-        &[],
-        &mesh.faces,
-        MeshStyle::default(),
-    )?;
+    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, MeshStyle::default())?;
+    ph.draw_mesh = lap();
     draw_edges(&mut r, &output, [0.0, 0.0, 0.0, 1.0])?;
-    let frame = r.finish()?;
-    let frame_ms = t_all.elapsed().as_secs_f64() * 1e3;
+    ph.draw_edges = lap();
+    // Depth only for the SVG's visibility test.
+    let frame = if opts.polylines {
+        r.finish()?
+    } else {
+        r.finish_color()?
+    };
+    ph.image_readback = lap();
+    let frame_ms = ph.stage_setup
+        + ph.kernels
+        + ph.readback
+        + ph.gl_context
+        + ph.draw_mesh
+        + ph.draw_edges
+        + ph.image_readback;
     let polylines = opts
         .polylines
         .then(|| visible_polylines(&output.edge_out, &frame, DEFAULT_BIAS));
+    ph.svg_visibility = lap();
     Ok(EdgeDrawing {
         memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),
         frame,
@@ -246,6 +311,7 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         faces: mesh.n_faces(),
         timing,
         topology_ms,
+        phases: ph,
         frame_ms,
         polylines,
         device: gpu.info.clone(),

@@ -45,7 +45,9 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
 use crate::mesh::topology::vertex_normals;
-use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
+use crate::spec::edges::{
+    KIND_DRAWN, MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound,
+};
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -70,21 +72,35 @@ pub struct EdgeStage {
     caps: Buffer<u32>,
     edge_out: Buffer<f32>,
     kind: Buffer<u32>,
-    cap_mh0: Buffer<f32>,
-    cap_mh1: Buffer<f32>,
-    cap_adj: Buffer<f32>,
-    cap_drawn: Buffer<u8>,
+    /// The cap outputs, allocated (and filled with markers) by the first run
+    /// of their variant: a stage that never draws adjacency caps never holds
+    /// their buffer (16 floats per cap pair, 1.9 GB for a 2M-vertex torus).
+    cap_mh: Option<[Buffer<f32>; 2]>,
+    cap_adj: Option<(Buffer<f32>, Buffer<u8>)>,
     last_mode: CapMode,
 }
 
 impl EdgeStage {
     /// Builds the program, uploads the topology and the mesh's positions and
-    /// vertex normals, and allocates every output buffer of every cap variant
-    /// (sized by the `*_bound` functions of [`crate::spec::edges`]).
+    /// vertex normals, and allocates the edge outputs (sized by the `*_bound`
+    /// functions of [`crate::spec::edges`]; the cap outputs of a variant are
+    /// allocated by its first run).
     pub fn new(gpu: Arc<Gpu>, mesh: &Mesh, topo: &EdgeTopology) -> Result<EdgeStage> {
+        let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+        Self::with_pose(gpu, topo, &pos, &vertex_normals(mesh))
+    }
+
+    /// [`EdgeStage::new`] with the first pose given as f32 positions and unit
+    /// vertex normals (those a caller already made for drawing the mesh).
+    pub fn with_pose(
+        gpu: Arc<Gpu>,
+        topo: &EdgeTopology,
+        pos: &[[f32; 3]],
+        nrm: &[[f32; 3]],
+    ) -> Result<EdgeStage> {
         let file = kernel_file("edges").expect("kernels/edges.cl is registered");
         let prog = gpu.program(&file, "")?;
-        let (nv, ne, nc) = (mesh.n_vertices(), topo.edges.len(), topo.caps.len());
+        let (nv, ne, nc) = (pos.len(), topo.edges.len(), topo.caps.len());
         if ne >= (u32::MAX / 16) as usize || nc >= (u32::MAX / 16) as usize {
             return Err(Error::input(
                 "mesh",
@@ -92,11 +108,7 @@ impl EdgeStage {
                 format!("{ne} edges / {nc} cap pairs exceed the 32-bit output index range"),
             ));
         }
-        let (n_out, n_mh, n_adj) = (
-            edge_out_bound(ne),
-            cap_mh_bound(ne),
-            cap_adjacency_bound(nc),
-        );
+        let n_out = edge_out_bound(ne);
         let mut s = EdgeStage {
             n_vertices: nv,
             n_edges: ne,
@@ -111,26 +123,46 @@ impl EdgeStage {
             caps: gpu.buffer(2 * nc)?,
             edge_out: gpu.buffer(4 * n_out)?,
             kind: gpu.buffer(ne)?,
-            cap_mh0: gpu.buffer(4 * n_mh)?,
-            cap_mh1: gpu.buffer(4 * n_mh)?,
-            cap_adj: gpu.buffer(4 * n_adj)?,
-            cap_drawn: gpu.buffer(nc)?,
+            cap_mh: None,
+            cap_adj: None,
             last_mode: CapMode::None,
             gpu: gpu.clone(),
         };
         // Outputs persist between runs (undrawn-then-undrawn primitives are not
-        // rewritten): start from markers everywhere.
-        gpu.write(&mut s.edge_out, bytemuck::cast_slice(&vec![MARKER; n_out]))?;
-        gpu.write(&mut s.cap_mh0, bytemuck::cast_slice(&vec![MARKER; n_mh]))?;
-        gpu.write(&mut s.cap_mh1, bytemuck::cast_slice(&vec![MARKER; n_mh]))?;
-        gpu.write(&mut s.cap_adj, bytemuck::cast_slice(&vec![MARKER; n_adj]))?;
-        gpu.write(&mut s.kind, &vec![0u32; ne])?;
-        gpu.write(&mut s.cap_drawn, &vec![0u8; nc])?;
+        // rewritten): start from markers everywhere, filled on the device.
+        gpu.fill(&mut s.edge_out, &MARKER, 4 * n_out)?;
+        gpu.zero(&mut s.kind, ne)?;
         gpu.write(&mut s.edges, bytemuck::cast_slice(&topo.edges))?;
         gpu.write(&mut s.caps, bytemuck::cast_slice(&topo.caps))?;
-        let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-        s.set_positions(&pos, &vertex_normals(mesh))?;
+        s.set_positions(pos, nrm)?;
         Ok(s)
+    }
+
+    /// Allocates the cap outputs of `mode` on its first run, filled with
+    /// markers (and `cap_drawn` with 0), as the kernels expect.
+    fn ensure_caps(&mut self, mode: CapMode) -> Result<()> {
+        let g = &self.gpu;
+        match mode {
+            CapMode::None => {}
+            CapMode::Mh if self.cap_mh.is_none() => {
+                let n = 4 * cap_mh_bound(self.n_edges);
+                let mut b = [g.buffer(n)?, g.buffer(n)?];
+                for b in &mut b {
+                    g.fill(b, &MARKER, n)?;
+                }
+                self.cap_mh = Some(b);
+            }
+            CapMode::Adjacency if self.cap_adj.is_none() => {
+                let n = 4 * cap_adjacency_bound(self.n_caps);
+                let mut out = g.buffer(n)?;
+                g.fill(&mut out, &MARKER, n)?;
+                let mut drawn = g.buffer(self.n_caps)?;
+                g.zero(&mut drawn, self.n_caps)?;
+                self.cap_adj = Some((out, drawn));
+            }
+            _ => {}
+        }
+        Ok(())
     }
 
     /// Number of edge entries.
@@ -169,6 +201,7 @@ impl EdgeStage {
     pub fn run(&mut self, params: &EdgeParams, mode: CapMode) -> Result<Timing> {
         let packed = params.pack()?;
         let t0 = Instant::now();
+        self.ensure_caps(mode)?;
         let g = self.gpu.clone();
         g.write(&mut self.params, packed.as_floats())?;
         let ne = self.n_edges as u32;
@@ -188,36 +221,42 @@ impl EdgeStage {
         )?;
         let ev_c = match mode {
             CapMode::None => None,
-            CapMode::Mh => launch(
-                &g,
-                &self.k_mh,
-                self.n_edges,
-                &[
-                    Arg::U32(ne),
-                    buf(&self.params),
-                    buf(&self.pos),
-                    buf(&self.nrm),
-                    buf(&self.edges),
-                    buf(&self.kind),
-                    buf(&self.cap_mh0),
-                    buf(&self.cap_mh1),
-                ],
-            )?,
-            CapMode::Adjacency => launch(
-                &g,
-                &self.k_adj,
-                self.n_caps,
-                &[
-                    Arg::U32(self.n_caps as u32),
-                    buf(&self.params),
-                    buf(&self.edges),
-                    buf(&self.caps),
-                    buf(&self.kind),
-                    buf(&self.edge_out),
-                    buf(&self.cap_adj),
-                    buf(&self.cap_drawn),
-                ],
-            )?,
+            CapMode::Mh => {
+                let [mh0, mh1] = self.cap_mh.as_ref().expect("allocated above");
+                launch(
+                    &g,
+                    &self.k_mh,
+                    self.n_edges,
+                    &[
+                        Arg::U32(ne),
+                        buf(&self.params),
+                        buf(&self.pos),
+                        buf(&self.nrm),
+                        buf(&self.edges),
+                        buf(&self.kind),
+                        buf(mh0),
+                        buf(mh1),
+                    ],
+                )?
+            }
+            CapMode::Adjacency => {
+                let (adj, drawn) = self.cap_adj.as_ref().expect("allocated above");
+                launch(
+                    &g,
+                    &self.k_adj,
+                    self.n_caps,
+                    &[
+                        Arg::U32(self.n_caps as u32),
+                        buf(&self.params),
+                        buf(&self.edges),
+                        buf(&self.caps),
+                        buf(&self.kind),
+                        buf(&self.edge_out),
+                        buf(adj),
+                        buf(drawn),
+                    ],
+                )?
+            }
         };
         g.finish()?;
         self.last_mode = mode;
@@ -251,18 +290,115 @@ impl EdgeStage {
             kind,
             ..Default::default()
         };
-        match self.last_mode {
-            CapMode::None => {}
-            CapMode::Mh => {
-                out.cap_mh0 = read4(&self.cap_mh0, cap_mh_bound(self.n_edges))?;
-                out.cap_mh1 = read4(&self.cap_mh1, cap_mh_bound(self.n_edges))?;
+        match (self.last_mode, &self.cap_mh, &self.cap_adj) {
+            (CapMode::Mh, Some([mh0, mh1]), _) => {
+                out.cap_mh0 = read4(mh0, cap_mh_bound(self.n_edges))?;
+                out.cap_mh1 = read4(mh1, cap_mh_bound(self.n_edges))?;
             }
-            CapMode::Adjacency => {
-                out.cap_adj = read4(&self.cap_adj, cap_adjacency_bound(self.n_caps))?
+            (CapMode::Adjacency, _, Some((adj, _))) => {
+                out.cap_adj = read4(adj, cap_adjacency_bound(self.n_caps))?
             }
+            _ => {}
         }
         Ok(out)
     }
+
+    /// Reads back what the last run drew, for drawing and SVG: `kind` in
+    /// full, and of edge-out and the caps of the last run's mode only the
+    /// primitives that hold geometry (a drawn edge, `KIND_DRAWN`; a drawn
+    /// adjacency cap, `cap_drawn`), **compacted** in index order. Drawing
+    /// the result draws exactly what drawing [`read`](Self::read)'s would
+    /// (the renderer skips markers and keeps order), from a few percent of
+    /// the bytes: on a 2M-vertex torus seen whole, 5,202 of 6M edges.
+    pub fn read_drawn(&self) -> Result<EdgeOutput> {
+        let g = &self.gpu;
+        let mut kind = vec![0u32; self.n_edges];
+        g.read(&self.kind, &mut kind)?;
+        let edge_runs = runs(kind.iter().map(|k| k & KIND_DRAWN != 0));
+        let mut out = EdgeOutput {
+            edge_out: self.gather(&self.edge_out, &edge_runs, 4, self.n_edges)?,
+            kind,
+            ..Default::default()
+        };
+        match (self.last_mode, &self.cap_mh, &self.cap_adj) {
+            (CapMode::Mh, Some([mh0, mh1]), _) => {
+                out.cap_mh0 = self.gather(mh0, &edge_runs, 3, self.n_edges)?;
+                out.cap_mh1 = self.gather(mh1, &edge_runs, 3, self.n_edges)?;
+            }
+            (CapMode::Adjacency, _, Some((adj, drawn))) => {
+                let mut d = vec![0u8; self.n_caps];
+                g.read(drawn, &mut d)?;
+                let cap_runs = runs(d.iter().map(|&c| c != 0));
+                out.cap_adj = self.gather(adj, &cap_runs, 4, self.n_caps)?;
+            }
+            _ => {}
+        }
+        Ok(out)
+    }
+
+    /// The float4 vertices of the primitives in `runs` (first, count) of a
+    /// buffer of `n` primitives with `per` vertices each, in order. Scattered
+    /// runs are read one by one (enqueued, one wait); when there are many
+    /// (more than 64, and more than one per 4,096 vertices of the buffer) one
+    /// whole read and a host compaction is cheaper than the per-read cost.
+    fn gather(
+        &self,
+        b: &Buffer<f32>,
+        runs: &[(usize, usize)],
+        per: usize,
+        n: usize,
+    ) -> Result<Vec<[f32; 4]>> {
+        let g = &self.gpu;
+        let total: usize = runs.iter().map(|r| r.1).sum::<usize>() * per;
+        let mut v = vec![[0f32; 4]; total];
+        if total == 0 {
+            return Ok(v);
+        }
+        if runs.len() > 64 && runs.len() * 4096 > n * per {
+            let mut all = vec![[0f32; 4]; n * per];
+            g.read(b, bytemuck::cast_slice_mut(&mut all))?;
+            let mut at = 0;
+            for &(first, count) in runs {
+                let src = &all[first * per..(first + count) * per];
+                v[at..at + src.len()].copy_from_slice(src);
+                at += src.len();
+            }
+            return Ok(v);
+        }
+        let mut rest: &mut [[f32; 4]] = &mut v;
+        let mut failed = None;
+        for &(first, count) in runs {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(count * per);
+            rest = tail;
+            // SAFETY: `v` is neither moved nor read until `finish` below, which
+            // also runs on the error path; the range lies inside the buffer
+            // (runs come from per-primitive flags of length `n`).
+            let r = unsafe { g.read_at_async(b, 4 * first * per, bytemuck::cast_slice_mut(head)) };
+            if let Err(e) = r {
+                failed = Some(e);
+                break;
+            }
+        }
+        let done = g.finish();
+        match failed {
+            Some(e) => Err(e),
+            None => done.map(|()| v),
+        }
+    }
+}
+
+/// Maximal runs `(first, count)` of true flags.
+fn runs(flags: impl Iterator<Item = bool>) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for (i, f) in flags.enumerate() {
+        if f {
+            match out.last_mut() {
+                Some((first, count)) if *first + *count == i => *count += 1,
+                _ => out.push((i, 1)),
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -190,7 +190,15 @@ pub(super) fn draw_view(
         };
         crate::render::strokes::draw(renderer, cam, lines.strokes, &style)?;
     }
-    let image: Frame = renderer.finish()?;
+    // Depth only for an SVG's visibility test.
+    let svg = paths
+        .iter()
+        .any(|p| p.extension().is_none_or(|e| e != "png"));
+    let image: Frame = if svg {
+        renderer.finish()?
+    } else {
+        renderer.finish_color()?
+    };
     for path in paths {
         if path.extension().is_some_and(|e| e == "png") {
             image.save_png(path)?;
