@@ -3,8 +3,24 @@
 //! [`Scene::from_str`](super::Scene::from_str). Every table rejects unknown
 //! keys.
 
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 use toml::Spanned;
+
+/// An optional fixed-length array that must have exactly `N` entries:
+/// `size = [64, 64, 64]` is an error at its line, not a silent `[64, 64]`.
+fn exact<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let v: Option<Vec<T>> = Option::deserialize(d)?;
+    v.map(|v| {
+        let n = v.len();
+        <[T; N]>::try_from(v)
+            .map_err(|_| serde::de::Error::custom(format!("expected {N} numbers, found {n}")))
+    })
+    .transpose()
+}
 
 /// The scene file as written (after syntax and type checks, before the
 /// cross-field checks of [`Scene::from_str`](super::Scene::from_str)).
@@ -110,12 +126,16 @@ impl Default for FramesSpec {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     /// Eye position (explicit camera).
+    #[serde(default, deserialize_with = "exact")]
     pub eye: Option<[f32; 3]>,
     /// Look-at point (default: the centre of the first pose's bounds).
+    #[serde(default, deserialize_with = "exact")]
     pub target: Option<[f32; 3]>,
     /// Up vector (default +Y).
+    #[serde(default, deserialize_with = "exact")]
     pub up: Option<[f32; 3]>,
     /// Direction from the centre towards the eye of a fitted camera.
+    #[serde(default, deserialize_with = "exact")]
     pub direction: Option<[f32; 3]>,
     /// Number of fitted views evenly spaced around the up axis.
     pub orbit: Option<usize>,
@@ -155,6 +175,7 @@ pub struct EffectsSpec {
 #[serde(deny_unknown_fields)]
 pub struct ShadingSpec {
     /// Base colour (default light grey).
+    #[serde(default, deserialize_with = "exact")]
     pub color: Option<[f32; 3]>,
     /// Ambient term in [0, 1] (default 0.15).
     pub ambient: Option<f32>,
@@ -186,6 +207,7 @@ pub struct LineSpec {
     /// Line width in pixels (default 2).
     pub width: Option<f32>,
     /// RGB (default black).
+    #[serde(default, deserialize_with = "exact")]
     pub color: Option<[f32; 3]>,
 }
 
@@ -196,6 +218,7 @@ pub struct SuggestiveSpec {
     /// Line width in pixels (default 1.5).
     pub width: Option<f32>,
     /// RGB (default dark grey).
+    #[serde(default, deserialize_with = "exact")]
     pub color: Option<[f32; 3]>,
     /// Dimensionless threshold (default 0.05; see `LineOptions`).
     pub threshold: Option<f32>,
@@ -210,6 +233,7 @@ pub struct EdgeSpec {
     /// Width in pixels (default 3).
     pub width: Option<f32>,
     /// RGB (default black).
+    #[serde(default, deserialize_with = "exact")]
     pub color: Option<[f32; 3]>,
     /// Crease angle in degrees, (0, 180]; 180 turns creases off (default 30).
     pub crease: Option<f32>,
@@ -234,6 +258,7 @@ pub struct StrokeSpec {
     /// coefficient of variation of κ1 is closest to 1) or a distance.
     pub sampling: Option<Spanned<SamplingSpec>>,
     /// RGB (default near black).
+    #[serde(default, deserialize_with = "exact")]
     pub color: Option<[f32; 3]>,
     /// Stroke width at the largest κ1 (default 0.4 h).
     pub width: Option<f64>,
@@ -258,11 +283,13 @@ pub struct OutputSpec {
     /// File name prefix (default: the scene file's stem).
     pub name: Option<String>,
     /// Image size (default 640 × 480).
+    #[serde(default, deserialize_with = "exact")]
     pub size: Option<[u32; 2]>,
     /// `png` and/or `svg` (lines only) (default `["png"]`).
     pub formats: Option<Spanned<Vec<String>>>,
     /// Multisampling: 0, 2, 4 or 8 (default 4).
     pub msaa: Option<u32>,
     /// Background RGB (default white).
+    #[serde(default, deserialize_with = "exact")]
     pub background: Option<[f32; 3]>,
 }

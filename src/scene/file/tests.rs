@@ -194,3 +194,21 @@ fn a_view_parallel_to_up_is_refused_with_its_line() {
     ))
     .unwrap();
 }
+
+#[test]
+fn fixed_length_arrays_need_exactly_their_length() {
+    let e = err(&format!("{MIN}[output]\nsize = [64, 64, 64]\n"));
+    assert!(
+        e.contains("line 6") && e.contains("expected 2 numbers, found 3"),
+        "{e}"
+    );
+    let e = err(&format!("{MIN}[[camera]]\ndirection = [1.0, 0.0]\n"));
+    assert!(
+        e.contains("line 6") && e.contains("expected 3 numbers, found 2"),
+        "{e}"
+    );
+    let e = err(&format!("{MIN}[output]\nbackground = [1, 1, 1, 1]\n"));
+    assert!(e.contains("expected 3 numbers, found 4"), "{e}");
+    let s = parse(&format!("{MIN}[output]\nsize = [64, 48]\n")).unwrap();
+    assert_eq!(s.size, [64, 48]);
+}
