@@ -355,3 +355,47 @@ fn nrrd_pattern_with_far_apart_bounds_is_refused_by_count() {
     let e = within_deadline("nhdr", h.as_bytes().to_vec()).unwrap_err();
     assert!(e.contains("more than the grid has slices (2)"), "{e}");
 }
+
+/// The glTF seed that names `d.bin`, as text.
+fn gltf_seed() -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/gltf/seed-file-buffer.gltf");
+    std::fs::read_to_string(p).expect("the glTF seed")
+}
+
+/// A primitive whose POSITION names a missing accessor panicked inside the
+/// glTF crate's validation.
+#[test]
+fn gltf_position_naming_a_missing_accessor_is_an_error() {
+    let f =
+        r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+    let e = within_deadline("gltf", f.as_bytes().to_vec()).unwrap_err();
+    assert!(
+        e.contains("mesh 0 primitive 0") && e.contains("accessor 0") && e.contains("0 accessors"),
+        "{e}"
+    );
+}
+
+/// An accessor whose type does not fit its role (inverse bind matrices
+/// that are not MAT4, say) made the glTF crate's reader panic.
+#[test]
+fn gltf_accessor_of_the_wrong_type_is_an_error() {
+    let seed = gltf_seed();
+    for (from, to, role) in [
+        ("\"MAT4\"", "\"SCALAR\"", "inverse bind matrices"),
+        (
+            "\"count\": 3, \"type\": \"VEC3\"",
+            "\"count\": 3, \"type\": \"VEC2\"",
+            "POSITION",
+        ),
+        (
+            "\"count\": 2, \"type\": \"VEC4\"",
+            "\"count\": 2, \"type\": \"VEC3\"",
+            "keyframe values",
+        ),
+    ] {
+        assert!(seed.contains(from), "{from}");
+        let f = seed.replacen(from, to, 1);
+        let e = within_deadline("gltf", f.into_bytes()).unwrap_err();
+        assert!(e.contains(role) && e.contains("accessor"), "{role}: {e}");
+    }
+}
