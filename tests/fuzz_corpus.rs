@@ -399,3 +399,24 @@ fn gltf_accessor_of_the_wrong_type_is_an_error() {
         assert!(e.contains(role) && e.contains("accessor"), "{role}: {e}");
     }
 }
+
+/// A GLB header declaring gigabytes made the glTF crate allocate them
+/// before reading the (tiny) file.
+#[test]
+fn glb_header_longer_than_the_file_is_refused_before_allocating() {
+    let ws = harness::Workspace::new();
+    let mut f = b"glTF".to_vec();
+    f.extend(2u32.to_le_bytes());
+    f.extend(0xF000_0000u32.to_le_bytes());
+    f.extend(b"\x10\0\0\0JSON{\"asset\":{}}   ");
+    let (e, peak) = lying("glb", &f, &ws);
+    assert!(
+        e.contains("GLB header") && e.contains("4026531840 bytes"),
+        "{e}"
+    );
+    assert!(
+        peak <= SLACK,
+        "{peak} bytes allocated for a {}-byte file",
+        f.len()
+    );
+}

@@ -258,7 +258,8 @@ fn check_accessors(path: &Path, doc: &gltf::Document) -> Result<()> {
     Ok(())
 }
 
-/// Checks the accessor indices of mesh primitives on the document read
+/// Checks a GLB header's length against the file size, and the accessor
+/// indices of mesh primitives on the document read
 /// without the glTF crate's validation, whose hook for primitives indexes
 /// the accessor list with the POSITION index before checking it (a panic on
 /// a file naming a missing accessor). A file that does not parse passes:
@@ -267,6 +268,24 @@ fn check_before_import(path: &Path) -> Result<()> {
     let Ok(bytes) = std::fs::read(path) else {
         return Ok(());
     };
+    // The memory bound: the glTF crate allocates the length a GLB header
+    // declares before reading, so a header claiming more than the file
+    // holds is refused here.
+    if let Some(h) = bytes.first_chunk::<12>()
+        && h.starts_with(b"glTF")
+    {
+        let declared = u32::from_le_bytes([h[8], h[9], h[10], h[11]]);
+        if declared as usize > bytes.len() {
+            return Err(bad(
+                path,
+                "GLB header",
+                format!(
+                    "declares {declared} bytes, but the file has {}",
+                    bytes.len()
+                ),
+            ));
+        }
+    }
     let Ok(g) = gltf::Gltf::from_slice_without_validation(&bytes) else {
         return Ok(());
     };
