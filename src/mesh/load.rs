@@ -80,10 +80,11 @@ fn fan(poly: &[u32], faces: &mut Vec<[u32; 3]>) {
     }
 }
 
-/// Capacity to reserve for `declared` elements of a file of `len` bytes, so
-/// that a lying header cannot make us allocate more than the file could hold.
-fn capped(declared: usize, len: usize) -> usize {
-    declared.min(len / 2)
+/// Capacity to reserve for `declared` elements of at least `min_bytes` each
+/// in a file of `len` bytes, so that a lying header cannot make us allocate
+/// more than the file could hold.
+fn capped(declared: usize, len: usize, min_bytes: usize) -> usize {
+    declared.min(len / min_bytes.max(1) + 1)
 }
 
 /// Converts a vertex index read from a file, checking it against the number

@@ -246,7 +246,8 @@ fn pattern_files(
     if step == 0 {
         return Err("the step of a data file pattern cannot be 0".into());
     }
-    if (max - min).signum() * step.signum() < 0 {
+    // Compared, not subtracted: `max - min` overflows for far-apart bounds.
+    if max != min && (max > min) != (step > 0) {
         return Err(format!(
             "a data file pattern from {min} to {max} cannot use step {step}"
         ));

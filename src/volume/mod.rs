@@ -487,6 +487,34 @@ enum Compression {
     Zlib,
 }
 
+/// Deflate's largest expansion (one 258-byte match in 2 bits): `n` bytes of
+/// gzip or zlib data never inflate to more than `MAX_INFLATE * n` bytes.
+const MAX_INFLATE: usize = 1032;
+
+/// The memory bound of compressed data: refuses, before anything is
+/// inflated or allocated, a header that asks more bytes (`want`) of `have`
+/// compressed bytes than deflate can produce from them.
+fn check_inflate(have: usize, want: usize, kind: Compression) -> std::result::Result<(), String> {
+    if want > have.saturating_mul(MAX_INFLATE) {
+        return Err(format!(
+            "{have} bytes of {} data cannot hold the {want} bytes the header calls for \
+             (deflate expands at most {MAX_INFLATE}:1)",
+            kind.name()
+        ));
+    }
+    Ok(())
+}
+
+impl Compression {
+    /// The format's name in messages.
+    fn name(self) -> &'static str {
+        match self {
+            Compression::Gzip => "gzip",
+            Compression::Zlib => "zlib",
+        }
+    }
+}
+
 /// Decompresses `data`, reading at most `limit` bytes of output so that a
 /// lying header or a compression bomb cannot exhaust memory; the caller
 /// checks the size it gets.
@@ -628,6 +656,7 @@ impl Payload<'_> {
                     }
                 };
                 let limit = skip.saturating_add(expected).saturating_add(1);
+                check_inflate(data.len(), limit - 1, kind).map_err(|p| Error::input(src, el, p))?;
                 decompressed =
                     decompress(data, kind, limit).map_err(|p| Error::input(src, el, p))?;
                 data = decompressed.get(skip..).unwrap_or_default();

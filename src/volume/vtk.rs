@@ -25,8 +25,9 @@ use base64::Engine as _;
 use quick_xml::events::{BytesStart, Event};
 
 use super::{
-    Compression, ScalarType, Volume, byte_count, convert_into, decompress, diagonal, dims_text,
-    number, numbers, oriented, parse_ascii_into, read_file, scalar_type, size_problem, voxel_count,
+    Compression, MAX_INFLATE, ScalarType, Volume, byte_count, check_inflate, convert_into,
+    decompress, diagonal, dims_text, number, numbers, oriented, parse_ascii_into, read_file,
+    scalar_type, size_problem, voxel_count,
 };
 use crate::error::{Error, Result};
 
@@ -690,8 +691,11 @@ fn binary_array(data: &[u8], x: &Xml, expected: usize) -> std::result::Result<Ve
              {expected}"
         ));
     }
-    let mut out = Vec::with_capacity(expected);
     let mut at = (3 + blocks) * hs;
+    // The memory bound: the blocks are inflated one by one, each checked
+    // against the deflate ratio, so room is reserved only for what the
+    // compressed bytes can hold.
+    let mut out = Vec::with_capacity(expected.min(data.len().saturating_mul(MAX_INFLATE)));
     for b in 0..blocks {
         let size = header(3 + b)?;
         let block = at
@@ -704,6 +708,8 @@ fn binary_array(data: &[u8], x: &Xml, expected: usize) -> std::result::Result<Ve
         } else {
             block_size
         };
+        check_inflate(block.len(), want, Compression::Zlib)
+            .map_err(|e| format!("block {b}: {e}"))?;
         let d = decompress(block, Compression::Zlib, want.saturating_add(1))
             .map_err(|e| format!("block {b}: {e}"))?;
         if d.len() != want {

@@ -54,7 +54,11 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     let nv = count(0, "vertex")?;
     let nf = count(1, "face")?;
 
-    let mut positions = Vec::with_capacity(capped(nv, bytes.len()));
+    // The memory bound: a vertex line takes at least 6 bytes (`0 0 0` and
+    // its newline) and a face line 8 (`3 0 1 2`), so a lying count reserves
+    // no more than the file could hold; the end of the file is reported at
+    // the first element it lacks.
+    let mut positions = Vec::with_capacity(capped(nv, bytes.len(), 6));
     for i in 0..nv {
         let element = || format!("vertex {i}");
         let (ln, l) = lines.next().ok_or_else(|| {
@@ -85,7 +89,7 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         positions.push(p);
     }
 
-    let mut faces = Vec::with_capacity(capped(nf, bytes.len()));
+    let mut faces = Vec::with_capacity(capped(nf, bytes.len(), 8));
     let mut poly: Vec<u32> = Vec::new();
     for j in 0..nf {
         let element = || format!("face {j}");

@@ -6,7 +6,7 @@ use ply_rs_bw::ply::{
     ScalarType,
 };
 
-use super::{Error, Mesh, Result, capped, fan, vertex_index};
+use super::{Error, Mesh, Result, fan, vertex_index};
 
 /// Names accepted for the face index list.
 const FACE_LISTS: [&str; 2] = ["vertex_indices", "vertex_index"];
@@ -158,6 +158,11 @@ impl Stream<'_> {
         source: &str,
         mut sink: impl FnMut(usize, E) -> Result<()>,
     ) -> Result<()> {
+        if def.properties.is_empty() && self.encoding != Encoding::Ascii {
+            // Binary elements without properties take no bytes: there is
+            // nothing to read, however many the header declares.
+            return Ok(());
+        }
         let parser = Parser::<E>::new();
         for i in 0..def.count {
             let e = self.element(&parser, def).map_err(|e| {
@@ -193,6 +198,38 @@ fn extra_values(line: &str, def: &ElementDef) -> bool {
         }
     }
     tokens.len() > used
+}
+
+/// Size in bytes of one binary value of type `t`.
+fn scalar_size(t: &ScalarType) -> usize {
+    match t {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    }
+}
+
+/// The fewest bytes one element of `def` can take: in binary, its scalars
+/// and the counts of its lists (an empty list is only its count); in ASCII,
+/// one character and a separator per scalar or list count.
+fn min_element_bytes(def: &ElementDef, encoding: Encoding) -> usize {
+    def.properties
+        .values()
+        .map(|p| match (encoding, &p.data_type) {
+            (Encoding::Ascii, _) => 2,
+            (_, PropertyType::Scalar(t) | PropertyType::List(t, _)) => scalar_size(t),
+        })
+        .sum()
+}
+
+/// The memory bound: how many elements of `def` to reserve room for when
+/// `payload` bytes follow the header. A lying count cannot make the loader
+/// allocate more than the bytes could hold (at the smallest element size);
+/// a file that really ends early is reported at the element where it ends.
+fn capacity(def: &ElementDef, encoding: Encoding, payload: usize) -> usize {
+    let min = min_element_bytes(def, encoding).max(1);
+    def.count.min(payload / min + 1)
 }
 
 fn is_integer(t: &ScalarType) -> bool {
@@ -289,6 +326,7 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         .read_header(&mut reader)
         .map_err(|e| Error::input(source, "header", first_line(&e)))?;
     check_header(&header, source)?;
+    let payload = reader.get_ref().len();
     let mut stream = Stream {
         // `line()` is the number of the first payload line; `element`
         // increments before reading.
@@ -305,14 +343,14 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     for (name, def) in &header.elements {
         match name.as_str() {
             "vertex" => {
-                positions.reserve(capped(def.count, bytes.len()));
+                positions.reserve(capacity(def, header.encoding, payload));
                 stream.read_all(def, source, |_, v: Vertex| {
                     positions.push(v.0);
                     Ok(())
                 })?;
             }
             "face" => {
-                faces.reserve(capped(def.count, bytes.len()));
+                faces.reserve(capacity(def, header.encoding, payload));
                 stream.read_all(def, source, |i, f: Face| {
                     let element = || format!("face {i}");
                     if f.0.len() < 3 {
