@@ -124,6 +124,8 @@ fn run_with(
                 frames,
                 &images,
                 &report_path,
+                notes,
+                t_all,
             )
         });
     if result.is_err() {
@@ -135,15 +137,12 @@ fn run_with(
             let _ = std::fs::remove_dir(d);
         }
     }
-    result.map(|mut r| {
-        r.notes.splice(0..0, notes);
-        r.wall_ms = ms_since(t_all);
-        r
-    })
+    result
 }
 
 /// The frame loop of [`run_with`] after the outputs are checked and the
-/// folder exists; writes the report last.
+/// folder exists (`t_all`: when the run started; `notes`: what loading the
+/// input said); writes the report last.
 #[allow(clippy::too_many_arguments)]
 fn render_all(
     gpu: Option<&Arc<Gpu>>,
@@ -154,10 +153,9 @@ fn render_all(
     frames: Vec<usize>,
     images: &[(usize, usize, PathBuf)],
     report_path: &std::path::Path,
+    notes: Vec<String>,
+    t_all: Instant,
 ) -> Result<RunReport> {
-    let t_all = Instant::now();
-    let notes = Vec::new();
-
     let fx = &scene.effects;
     let input = scene.source.input();
     let plan = plan_with(&fx.cues, input, fx.caps);
