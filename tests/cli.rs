@@ -732,18 +732,8 @@ fn meshes_too_large_or_small_to_draw_in_single_precision_are_refused_by_name() {
     let d = scratch("undrawable");
     for (scale, word) in [(1e30, "below"), (1e-30, "at least")] {
         let m = shapecue::mesh::icosphere(1.0, 2);
-        let mut obj = String::new();
-        for p in &m.positions {
-            obj.push_str(&format!(
-                "v {:e} {:e} {:e}\n",
-                p[0] * scale,
-                p[1] * scale,
-                p[2] * scale
-            ));
-        }
-        for t in &m.faces {
-            obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-        }
+        let scaled = m.positions.iter().map(|p| p.map(|c| c * scale));
+        let obj = common::obj_text(scaled, &m.faces);
         let path = d.join(format!("s{scale:e}.obj"));
         std::fs::write(&path, obj).unwrap();
         let png = d.join("x.png");

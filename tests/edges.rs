@@ -516,14 +516,7 @@ fn shared_meshes_match_the_cpu() {
 /// A unit cube as OBJ text (8 shared vertices, 12 triangles).
 fn cube_obj() -> String {
     let m = mesh::cube(1.0);
-    let mut s = String::new();
-    for p in &m.positions {
-        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
-    }
-    for f in &m.faces {
-        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
-    }
-    s
+    common::obj_text(m.positions.iter().copied(), &m.faces)
 }
 
 #[test]
@@ -1135,14 +1128,8 @@ fn cli_without_an_eye_frames_the_mesh() {
     let d = scratch("framed");
     let obj = d.join("small.obj");
     let m = mesh::cube(0.02);
-    let mut s = String::new();
-    for p in &m.positions {
-        s += &format!("v {} {} {}\n", p[0] + 10.0, p[1] - 3.0, p[2]);
-    }
-    for f in &m.faces {
-        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
-    }
-    std::fs::write(&obj, s).unwrap();
+    let moved = m.positions.iter().map(|p| [p[0] + 10.0, p[1] - 3.0, p[2]]);
+    std::fs::write(&obj, common::obj_text(moved, &m.faces)).unwrap();
     let png = d.join("small.png");
     let out = run_cli([
         "edges",

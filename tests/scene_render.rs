@@ -260,14 +260,9 @@ fn a_flipbook_scene_loads_every_frame_and_builds_topology_once() {
     let m = shapecue::mesh::torus(1.0, 0.4, 24, 12);
     for f in 0..4 {
         // Frame f: the torus squashed along z by a growing amount.
-        let mut obj = String::new();
-        for p in &m.positions {
-            let s = 1.0 - 0.15 * f as f64;
-            obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2] * s));
-        }
-        for t in &m.faces {
-            obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-        }
+        let s = 1.0 - 0.15 * f as f64;
+        let squashed = m.positions.iter().map(|p| [p[0], p[1], p[2] * s]);
+        let obj = common::obj_text(squashed, &m.faces);
         std::fs::write(dir.join(format!("frame_{f}.obj")), obj).unwrap();
     }
     let s = scene(
@@ -481,13 +476,7 @@ fn a_scene_that_fails_midway_leaves_no_images_and_no_new_folder() {
     // folders the run created are removed, a file that was there stays.
     let dir = scratch("fail-midway");
     let m = shapecue::mesh::torus(1.0, 0.4, 24, 12);
-    let mut obj = String::new();
-    for p in &m.positions {
-        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
-    }
-    for t in &m.faces {
-        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-    }
+    let obj = common::obj_text(m.positions.iter().copied(), &m.faces);
     for f in 0..3 {
         std::fs::write(dir.join(format!("frame_{f}.obj")), &obj).unwrap();
     }

@@ -29,7 +29,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use glam::{Mat4, Vec4};
+use glam::Mat4;
 
 use crate::error::Result;
 use crate::render::Frame;
@@ -122,34 +122,14 @@ pub fn segment_lines(
 ) -> Vec<ClipLine> {
     let mut out = Vec::new();
     for s in segments.iter().filter(|s| s.2 == kind) {
-        let a = view_proj * Vec4::from((glam::Vec3::from(s.0), 1.0));
-        let b = view_proj * Vec4::from((glam::Vec3::from(s.1), 1.0));
-        if !(a.is_finite() && b.is_finite()) {
+        let Some((a, b, cut)) = crate::render::clip_segment(view_proj, s.0, s.1) else {
             continue;
-        }
-        let mut edges = [Some(edge_key(s.4[0])), Some(edge_key(s.4[1]))];
-        // Inside the near plane when z ≥ −w (OpenGL clip space).
-        let (da, db) = (a.z + a.w, b.z + b.w);
-        if da < 0.0 && db < 0.0 {
-            continue;
-        }
-        let (a, b) = match (da < 0.0, db < 0.0) {
-            (true, _) => {
-                edges[0] = None;
-                (a + (b - a) * (da / (da - db)), b)
-            }
-            (_, true) => {
-                edges[1] = None;
-                (a, a + (b - a) * (da / (da - db)))
-            }
-            _ => (a, b),
         };
-        if a.w <= 0.0 || b.w <= 0.0 {
-            continue;
-        }
+        // A cut end no longer lies on its mesh edge.
+        let edge = |i: usize| (!cut[i]).then(|| edge_key(s.4[i]));
         out.push(ClipLine {
             ends: [a.to_array(), b.to_array()],
-            edges,
+            edges: [edge(0), edge(1)],
             opacity: opacity(s.3),
         });
     }

@@ -6,6 +6,29 @@
 
 use glam::{Mat4, Vec2, Vec4};
 
+/// A world-space segment in clip space, cut at the near plane (OpenGL: inside
+/// where z ≥ −w), with which ends were cut. `None` for a segment entirely
+/// behind the near plane, with a non-finite point, or (only with a degenerate
+/// projection) an end at w ≤ 0.
+pub fn clip_segment(view_proj: Mat4, p: [f32; 3], q: [f32; 3]) -> Option<(Vec4, Vec4, [bool; 2])> {
+    let a = view_proj * Vec4::from((glam::Vec3::from(p), 1.0));
+    let b = view_proj * Vec4::from((glam::Vec3::from(q), 1.0));
+    if !(a.is_finite() && b.is_finite()) {
+        return None;
+    }
+    let (da, db) = (a.z + a.w, b.z + b.w);
+    if da < 0.0 && db < 0.0 {
+        return None;
+    }
+    let cut = [da < 0.0, db < 0.0];
+    let (a, b) = match cut {
+        [true, _] => (a + (b - a) * (da / (da - db)), b),
+        [_, true] => (a, a + (b - a) * (da / (da - db))),
+        _ => (a, b),
+    };
+    (a.w > 0.0 && b.w > 0.0).then_some((a, b, cut))
+}
+
 /// Expands segments (consecutive pairs of world-space points; a trailing odd
 /// point is ignored) into clip-space quads, 4 vertices each, in the edge-out
 /// order `s0 − p, s1 − p, s1 + p, s0 + p` where `p` is the screen-space
@@ -26,25 +49,9 @@ pub fn segments_to_clip_quads(
     let hw = 0.5 * width_px.max(0.0);
     let mut out = Vec::with_capacity(segments.len() * 2);
     for seg in segments.chunks_exact(2) {
-        let a = view_proj * Vec4::from((glam::Vec3::from(seg[0]), 1.0));
-        let b = view_proj * Vec4::from((glam::Vec3::from(seg[1]), 1.0));
-        if !(a.is_finite() && b.is_finite()) {
+        let Some((a, b, _)) = clip_segment(view_proj, seg[0], seg[1]) else {
             continue;
-        }
-        // Inside the near plane when z ≥ −w (OpenGL clip space).
-        let (da, db) = (a.z + a.w, b.z + b.w);
-        if da < 0.0 && db < 0.0 {
-            continue;
-        }
-        let (a, b) = match (da < 0.0, db < 0.0) {
-            (true, _) => (a + (b - a) * (da / (da - db)), b),
-            (_, true) => (a, a + (b - a) * (da / (da - db))),
-            _ => (a, b),
         };
-        if a.w <= 0.0 || b.w <= 0.0 {
-            // Only reachable with a degenerate projection; nothing sensible to draw.
-            continue;
-        }
         // Pixel coordinates relative to the viewport centre.
         let sa = a.truncate().truncate() / a.w * half_size;
         let sb = b.truncate().truncate() / b.w * half_size;

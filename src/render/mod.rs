@@ -35,7 +35,7 @@ pub mod strokes;
 
 pub use camera::{Camera, Placement, fit_sphere, framed};
 pub use frame::Frame;
-pub use lines::segments_to_clip_quads;
+pub use lines::{clip_segment, segments_to_clip_quads};
 
 use glam::Vec3;
 use glow::HasContext;

@@ -128,6 +128,19 @@ pub fn scratch(tag: &str) -> PathBuf {
     dir
 }
 
+/// OBJ text of `positions` and 0-based `faces` (positions printed so they
+/// read back exactly).
+pub fn obj_text(positions: impl IntoIterator<Item = [f64; 3]>, faces: &[[u32; 3]]) -> String {
+    let mut s = String::new();
+    for p in positions {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in faces {
+        s += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    s
+}
+
 /// Writes `bytes` to `dir/name` and returns its path.
 pub fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
     let p = dir.join(name);
