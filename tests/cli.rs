@@ -353,9 +353,9 @@ fn stats_equal_to_the_output_is_refused() {
     assert!(!ply.exists());
 }
 
-#[test]
-fn a_volume_data_file_is_an_input() {
-    let d = scratch("nhdr-data");
+/// A 4³ u8 volume as a detached NRRD header `v.nhdr` and its data file
+/// `v.raw` in `d`: (header, data file).
+fn tiny_nhdr(d: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
     let raw = d.join("v.raw");
     std::fs::write(&raw, (0..64u8).collect::<Vec<_>>()).unwrap();
     let nhdr = d.join("v.nhdr");
@@ -364,6 +364,13 @@ fn a_volume_data_file_is_an_input() {
         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: v.raw\n",
     )
     .unwrap();
+    (nhdr, raw)
+}
+
+#[test]
+fn a_volume_data_file_is_an_input() {
+    let d = scratch("nhdr-data");
+    let (nhdr, raw) = tiny_nhdr(&d);
     let out = cli()
         .arg("isosurface")
         .arg(&nhdr)
@@ -674,14 +681,7 @@ fn jpeg_names_huge_widths_and_report_with_inputs_are_refused() {
 #[test]
 fn strokes_never_writes_over_a_volume_data_file() {
     let d = scratch("strokes-nhdr");
-    let raw = d.join("v.raw");
-    std::fs::write(&raw, (0..64u8).collect::<Vec<_>>()).unwrap();
-    let nhdr = d.join("v.nhdr");
-    std::fs::write(
-        &nhdr,
-        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: v.raw\n",
-    )
-    .unwrap();
+    let (nhdr, raw) = tiny_nhdr(&d);
     let out = cli()
         .arg("strokes")
         .arg(&nhdr)
