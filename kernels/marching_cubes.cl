@@ -254,3 +254,457 @@ __kernel void mc_gradient_normals(uint nv, __global const float *pos, __global c
     for (uint a = 0; a < 3; ++a)
         nrm[3 * gid + a] = ok ? n[a] / len : 0.0f;
 }
+
+// ---------------------------------------------------------------------------
+// Direct numbering (Fusion::Direct), after Flying Edges (Schroeder, Maynard
+// and Geveci 2015): no soup, no sort. Each vertex is made once, by the voxel
+// edge it lies on, and numbered by a scan over per-row counts; triangles are
+// written with final indices. CPU twin: cpu::marching_cubes::mc_direct.
+//
+// A grid row is every grid point with the same (y, z): G = ny·nz of them,
+// row r = y + ny·z. Row r owns its x-edges and the y- and z-edges that start
+// on it; its vertices are numbered x-edges first, then y, then z, each in x
+// order, from off[r] on. Cell row (y, z) (y < ny−1, z < nz−1) reads grid rows
+// 00 = (y, z), 10 = (y+1, z), 01 = (y, z+1), 11 = (y+1, z+1).
+//   mc_direct_count      per grid row   rowc[r] vertices inside its edges,
+//                                       rowc[G+r] triangles of cell row r,
+//                                       rowc[2G+r] vertices rounding onto a
+//                                       grid point ("hits"), rowc[3G+r]
+//                                       triangles dropped as twins across a
+//                                       cube face (has_twin); split[2r..] the
+//                                       first y and z vertex of the row;
+//                                       trim[2r..] the x range of its
+//                                       non-uniform chunks (Flying Edges'
+//                                       trimming: the later passes read
+//                                       nothing outside it)
+//   (scan.cl)                           one exclusive scan of rowc[0..4G)
+//   mc_direct_hits       per grid row   only when there are hits: the hit
+//                                       points' grid indices (then sorted)
+//   mc_direct_triangles  per cell row   positions of the vertices the row owns,
+//                                       triangles with final indices (a hit
+//                                       corner: edge_vertices + the first slot
+//                                       of its point in the sorted hits)
+//   mc_direct_points     per hit        positions of the hit slots
+// With no hit and a finite volume that is all: no triangle can collapse
+// (two table corners are distinct edges, each its own vertex), and the only
+// twins (a triangle of the table lying in a cube face, flat[case], and its
+// mirror across the face) are found locally by has_twin. Otherwise the
+// vertex_fusion steps after fuse_index clean up (collapsed triangles, twins,
+// vertex slots no kept triangle uses).
+//
+// Buffers: rowc uint[4G] (scanned in place into off), split uint[2G],
+// trim uint[2G], hit_keys uint[H] (sorted), pos float[3(V+H)], faces
+// uint[3T]; V, T, H the scan's first three partial totals.
+
+#define EV_NONE 0u
+#define EV_IN 1u
+#define EV_LO 2u
+#define EV_HI 3u
+
+// What the edge from value v0 (coordinate a along its axis) to v1 (a + 1)
+// carries: EV_NONE (one side, or an end not finite), EV_IN (a vertex inside
+// the edge, at coordinate *c), EV_LO / EV_HI (the vertex rounds onto the
+// lower / upper grid point). Twin: cpu::marching_cubes::edge_vertex.
+inline uint edge_kind(float v0, float v1, float iso, uint a, float *c)
+{
+    if (!(isfinite(v0) && isfinite(v1)) || ((v0 < iso) == (v1 < iso)))
+        return EV_NONE;
+    const float fa = (float)a;
+    const float cc = fa + mc_edge_t(v0, v1, iso);
+    *c = cc;
+    return cc == fa ? EV_LO : (cc == (float)(a + 1) ? EV_HI : EV_IN);
+}
+
+// Grid row gid; rows past the volume's last y or z alias row 00, so their
+// "edges" join a value to itself and never cross.
+#define GRID_ROW_SETUP                                                              \
+    const uint y = gid % ny, z = gid / ny;                                          \
+    const uint hy = y + 1 < ny, hz = z + 1 < nz;                                    \
+    const ulong b00 = (ulong)nx * (y + (ulong)ny * z);                              \
+    const ulong b10 = b00 + (hy ? nx : 0), b01 = b00 + (hz ? (ulong)nx * ny : 0);   \
+    const ulong b11 = b10 + (b01 - b00);
+
+// True when values x .. nx−1 of the four rows are finite and on one side.
+inline bool tail_uniform(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                         uint x, uint nx, float iso)
+{
+    bool in = true, out = true;
+    for (uint i = x; i < nx; ++i) {
+        const float a = vol[b00 + i], b = vol[b10 + i], c = vol[b01 + i], d = vol[b11 + i];
+        if (!(isfinite(a) && isfinite(b) && isfinite(c) && isfinite(d)))
+            return false;
+        in = in && a < iso && b < iso && c < iso && d < iso;
+        out = out && a >= iso && b >= iso && c >= iso && d >= iso;
+    }
+    return in || out;
+}
+
+// The owned edges at position i of the row: adds their interior vertices to
+// n[axis] and their hits to *hits.
+inline void count_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                        uint nx, uint y, uint z, float iso, uint *n, uint *hits)
+{
+    float c;
+    const float a = vol[b00 + i];
+    uint k;
+    if (i + 1 < nx) {
+        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
+        n[0] += k == EV_IN;
+        *hits += k >= EV_LO;
+    }
+    k = edge_kind(a, vol[b10 + i], iso, y, &c);
+    n[1] += k == EV_IN;
+    *hits += k >= EV_LO;
+    k = edge_kind(a, vol[b01 + i], iso, z, &c);
+    n[2] += k == EV_IN;
+    *hits += k >= EV_LO;
+}
+
+// Lower corner of edge e (table numbering), and the edge along `axis` whose
+// lower corner is c0 (its inverse).
+inline uint edge_lo_corner(uint e)
+{
+    const uint axis = e >> 2, k = e & 3;
+    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+    return ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
+}
+
+inline uint edge_id(uint axis, uint c0)
+{
+    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+    return 4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1);
+}
+
+// True when triangle j of cell (x, y, z) of case cas, flagged as lying in a
+// face of the cube (flat[cas] bit j), has an opposite twin in the cell across
+// that face: the same three voxel edges, the other winding. Both cells drop
+// theirs, as vertex fusion's twin cancellation would. Rare (a fan over a loop
+// through all four edges of an ambiguous face), so it may be slow. Twin:
+// cpu::marching_cubes::has_twin.
+inline bool has_twin(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+                     uint nz, float iso, uint cas, uint j, __constant uchar *counts,
+                     __constant uchar *tris)
+{
+    const uint a0 = tris[16 * cas + 3 * j], a1 = tris[16 * cas + 3 * j + 1],
+               a2 = tris[16 * cas + 3 * j + 2];
+    const uint l0 = edge_lo_corner(a0), l1 = edge_lo_corner(a1), l2 = edge_lo_corner(a2);
+    uint f = 3;
+    for (uint q = 0; q < 3 && f == 3; ++q) {
+        if ((a0 >> 2) != q && (a1 >> 2) != q && (a2 >> 2) != q &&
+            ((l0 >> q) & 1) == ((l1 >> q) & 1) && ((l1 >> q) & 1) == ((l2 >> q) & 1))
+            f = q;
+    }
+    if (f == 3)
+        return false;
+    const uint s = (l0 >> f) & 1;
+    uint p[3] = {x, y, z};
+    const uint dim[3] = {nx, ny, nz};
+    if (s == 0) {
+        if (p[f] == 0)
+            return false;
+        p[f] -= 1;
+    } else {
+        if (p[f] + 2 >= dim[f])
+            return false;
+        p[f] += 1;
+    }
+    const ulong b00 = (ulong)nx * (p[1] + (ulong)ny * p[2]);
+    const ulong b10 = b00 + nx, b01 = b00 + (ulong)nx * ny, b11 = b01 + nx;
+    float v[8];
+    const uint cb = cell_case(vol, b00, b10, b01, b11, p[0], iso, v);
+    if (cb >= 256)
+        return false;
+    for (uint t = 0; t < counts[cb]; ++t) {
+        uint m[3];
+        bool ok = true;
+        for (uint i = 0; i < 3; ++i) {
+            const uint e = tris[16 * cb + 3 * t + i], axis = e >> 2, c0 = edge_lo_corner(e);
+            ok = ok && axis != f && ((c0 >> f) & 1) == 1 - s;
+            m[i] = edge_id(axis, c0 ^ (1u << f));
+        }
+        // The other winding: a rotation of (a0, a2, a1).
+        if (ok && ((m[0] == a0 && m[1] == a2 && m[2] == a1) ||
+                   (m[0] == a2 && m[1] == a1 && m[2] == a0) ||
+                   (m[0] == a1 && m[1] == a0 && m[2] == a2)))
+            return true;
+    }
+    return false;
+}
+
+// Triangles of cell (x, y, z), case cas < 256, dropped as twins.
+inline uint twins_of(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+                     uint nz, float iso, uint cas, __constant uchar *counts,
+                     __constant uchar *tris, __constant uchar *flat)
+{
+    uint n = 0;
+    const uint fl = flat[cas];
+    if (fl != 0) {
+        for (uint j = 0; j < counts[cas]; ++j)
+            n += ((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris);
+    }
+    return n;
+}
+
+__kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
+                              __global const float *vol, float iso, __constant uchar *counts,
+                              __constant uchar *tris, __constant uchar *flat,
+                              __global uint *rowc, __global uint *split, __global uint *trim)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const bool cell = hy && hz;
+    uint n[3] = {0, 0, 0};
+    uint hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
+    float v[8];
+    uint x = 0;
+    for (; x + 16 < nx; x += 16) {
+        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+            continue;
+        lo = min(lo, x);
+        hi = x + 16;
+        for (uint i = x; i < x + 16; ++i) {
+            count_owned(vol, b00, b10, b01, i, nx, y, z, iso, n, &hits);
+            if (cell) {
+                const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+                if (cas < 256) {
+                    const uint tw =
+                        twins_of(vol, i, y, z, nx, ny, nz, iso, cas, counts, tris, flat);
+                    ntri += counts[cas] - tw;
+                    twins += tw;
+                }
+            }
+        }
+    }
+    if (!tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
+        lo = min(lo, x);
+        hi = nx;
+        for (uint i = x; i < nx; ++i) {
+            count_owned(vol, b00, b10, b01, i, nx, y, z, iso, n, &hits);
+            if (cell && i + 1 < nx) {
+                const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+                if (cas < 256) {
+                    const uint tw =
+                        twins_of(vol, i, y, z, nx, ny, nz, iso, cas, counts, tris, flat);
+                    ntri += counts[cas] - tw;
+                    twins += tw;
+                }
+            }
+        }
+    }
+    rowc[gid] = n[0] + n[1] + n[2];
+    rowc[grid_rows + gid] = ntri;
+    rowc[2 * grid_rows + gid] = hits;
+    rowc[3 * grid_rows + gid] = twins;
+    split[2 * gid] = n[0];
+    split[2 * gid + 1] = n[0] + n[1];
+    trim[2 * gid] = lo;
+    trim[2 * gid + 1] = hi;
+}
+
+inline void hit_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                      uint nx, uint ny, uint y, uint z, float iso, __global uint *keys, uint *o)
+{
+    float c;
+    const float a = vol[b00 + i];
+    const uint g = grid_index(i, y, z, nx, ny);
+    uint k;
+    if (i + 1 < nx) {
+        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
+        if (k >= EV_LO)
+            keys[(*o)++] = k == EV_LO ? g : g + 1;
+    }
+    k = edge_kind(a, vol[b10 + i], iso, y, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx;
+    k = edge_kind(a, vol[b01 + i], iso, z, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx * ny;
+}
+
+__kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
+                             __global const float *vol, float iso, __global const uint *off,
+                             __global const uint *trim, uint hit_base, uint hit_end,
+                             __global uint *keys)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    const uint first = off[2 * grid_rows + gid];
+    const uint end = gid + 1 < grid_rows ? off[2 * grid_rows + gid + 1] : hit_end;
+    if (first == end)
+        return;
+    uint o = first - hit_base;
+    uint x = lo;
+    for (; x + 16 < nx && x < hi; x += 16) {
+        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+            continue;
+        for (uint i = x; i < x + 16; ++i)
+            hit_owned(vol, b00, b10, b01, i, nx, ny, y, z, iso, keys, &o);
+    }
+    for (; x < hi; ++x)
+        hit_owned(vol, b00, b10, b01, x, nx, ny, y, z, iso, keys, &o);
+}
+
+// Vertex of a hit: edge_vertices + the first slot of grid point g among the
+// nh sorted hit keys.
+inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
+{
+    uint lo = 0, hi = nh;
+    while (lo < hi) {
+        const uint m = lo + (hi - lo) / 2;
+        if (keys[m] < g)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return edge_vertices + lo;
+}
+
+inline void put3(__global float *pos, uint v, float a, float b, float c)
+{
+    pos[3 * v] = a;
+    pos[3 * v + 1] = b;
+    pos[3 * v + 2] = c;
+}
+
+__kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
+                                  __global const float *vol, float iso,
+                                  __constant uchar *counts, __constant uchar *tris,
+                                  __constant uchar *flat, __global const uint *off,
+                                  __global const uint *split,
+                                  __global const uint *trim, uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
+                                  __global uint *faces)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    if (!(hy && hz))
+        return;
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    if (lo >= hi)
+        return;
+    const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
+    // First vertex of each row's x, y and z edges (those a cell row uses).
+    const uint bx00 = off[gid], by00 = bx00 + split[2 * gid], bz00 = bx00 + split[2 * gid + 1];
+    const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
+    const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
+    const uint bx11 = off[r11];
+    // Interior vertices met so far per (row, axis): x00 y00 z00 x10 z10 x01 y01 x11.
+    uint n00x = 0, n00y = 0, n00z = 0, n10x = 0, n10z = 0, n01x = 0, n01y = 0, n11x = 0;
+    // The last cell row of y (z) also writes the vertices of row 10 (01),
+    // which is not a cell row; the last cell of a row those at x = nx − 1.
+    const bool wy = y + 2 == ny, wz = z + 2 == nz;
+    // The triangles' part of off starts at edge_vertices (the scan of the
+    // vertex counts before it).
+    uint out = 3 * (off[grid_rows + gid] - edge_vertices);
+    const float fy = (float)y, fz = (float)z;
+    float v[8], c[12];
+    uint k[12], id[12];
+    uint x = lo;
+    for (; x < hi && x + 1 < nx; ++x) {
+        // The chunks of mc_direct_count: 16 cells from each multiple of 16
+        // that has 16 more values after it (lo is one of them, or the tail).
+        if ((x & 15) == 0 && x + 16 < nx && chunk_uniform(vol, b00, b10, b01, b11, x, iso)) {
+            x += 15;
+            continue;
+        }
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        // The cell's twelve edges in table order (see the header's edge numbering).
+        k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);
+        k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);
+        k[2] = edge_kind(v[4], v[5], iso, x, &c[2]);
+        k[3] = edge_kind(v[6], v[7], iso, x, &c[3]);
+        k[4] = edge_kind(v[0], v[2], iso, y, &c[4]);
+        k[5] = edge_kind(v[1], v[3], iso, y, &c[5]);
+        k[6] = edge_kind(v[4], v[6], iso, y, &c[6]);
+        k[7] = edge_kind(v[5], v[7], iso, y, &c[7]);
+        k[8] = edge_kind(v[0], v[4], iso, z, &c[8]);
+        k[9] = edge_kind(v[1], v[5], iso, z, &c[9]);
+        k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);
+        k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
+        id[0] = bx00 + n00x;
+        id[1] = bx10 + n10x;
+        id[2] = bx01 + n01x;
+        id[3] = bx11 + n11x;
+        id[4] = by00 + n00y;
+        id[5] = id[4] + (k[4] == EV_IN);
+        id[6] = by01 + n01y;
+        id[7] = id[6] + (k[6] == EV_IN);
+        id[8] = bz00 + n00z;
+        id[9] = id[8] + (k[8] == EV_IN);
+        id[10] = bz10 + n10z;
+        id[11] = id[10] + (k[10] == EV_IN);
+        if (nh != 0) {
+            for (uint e = 0; e < 12; ++e) {
+                if (k[e] >= EV_LO) {
+                    const uint axis = e >> 2, kk = e & 3;
+                    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+                    const uint c0 = ((kk & 1) << lo_axis) | ((kk >> 1) << hi_axis);
+                    const uint cn = k[e] == EV_LO ? c0 : (c0 | (1u << axis));
+                    const uint g = grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2),
+                                              nx, ny);
+                    id[e] = hit_vertex(g, hit_keys, nh, edge_vertices);
+                }
+            }
+        }
+        const float fx = (float)x;
+        if (k[0] == EV_IN)
+            put3(pos, id[0], c[0], fy, fz);
+        if (k[4] == EV_IN)
+            put3(pos, id[4], fx, c[4], fz);
+        if (k[8] == EV_IN)
+            put3(pos, id[8], fx, fy, c[8]);
+        if (wy) {
+            if (k[1] == EV_IN)
+                put3(pos, id[1], c[1], fy + 1.0f, fz);
+            if (k[10] == EV_IN)
+                put3(pos, id[10], fx, fy + 1.0f, c[10]);
+        }
+        if (wz) {
+            if (k[2] == EV_IN)
+                put3(pos, id[2], c[2], fy, fz + 1.0f);
+            if (k[6] == EV_IN)
+                put3(pos, id[6], fx, c[6], fz + 1.0f);
+        }
+        if (wy && wz && k[3] == EV_IN)
+            put3(pos, id[3], c[3], fy + 1.0f, fz + 1.0f);
+        if (x + 2 == nx) {
+            if (k[5] == EV_IN)
+                put3(pos, id[5], fx + 1.0f, c[5], fz);
+            if (k[9] == EV_IN)
+                put3(pos, id[9], fx + 1.0f, fy, c[9]);
+            if (wy && k[11] == EV_IN)
+                put3(pos, id[11], fx + 1.0f, fy + 1.0f, c[11]);
+            if (wz && k[7] == EV_IN)
+                put3(pos, id[7], fx + 1.0f, c[7], fz + 1.0f);
+        }
+        if (cas < 256) {
+            const uint nt = counts[cas], fl = flat[cas];
+            for (uint j = 0; j < nt; ++j) {
+                if (((fl >> j) & 1) &&
+                    has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
+                    continue;
+                faces[out] = id[tris[16 * cas + 3 * j]];
+                faces[out + 1] = id[tris[16 * cas + 3 * j + 1]];
+                faces[out + 2] = id[tris[16 * cas + 3 * j + 2]];
+                out += 3;
+            }
+        }
+        n00x += k[0] == EV_IN;
+        n10x += k[1] == EV_IN;
+        n01x += k[2] == EV_IN;
+        n11x += k[3] == EV_IN;
+        n00y += k[4] == EV_IN;
+        n01y += k[6] == EV_IN;
+        n00z += k[8] == EV_IN;
+        n10z += k[10] == EV_IN;
+    }
+}
+
+__kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,
+                               uint edge_vertices, __global float *pos)
+{
+    GID_OR_RETURN(nh);
+    const uint g = hit_keys[gid];
+    put3(pos, edge_vertices + gid, (float)(g % nx), (float)((g / nx) % ny),
+         (float)(g / (nx * ny)));
+}

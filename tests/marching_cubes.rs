@@ -14,7 +14,7 @@ use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::Volume;
 use shapecue::volume::sdf::{Sdf, sdf};
 
-const ALL: [Fusion; 3] = [Fusion::None, Fusion::Hash, Fusion::Edge];
+const ALL: [Fusion; 4] = Fusion::ALL;
 
 /// Extracts on the device and reads back (index space).
 fn device(vol: &Volume, iso: f32, fusion: Fusion, mask: Option<u32>) -> (Fused, usize) {
@@ -37,7 +37,10 @@ fn device(vol: &Volume, iso: f32, fusion: Fusion, mask: Option<u32>) -> (Fused, 
 fn check_same(vol: &Volume, iso: f32, what: &str) {
     let soup = mc::mc_triangles(vol, iso);
     for fusion in ALL {
-        let cpu = fuse(&soup, fusion);
+        let cpu = match fusion {
+            Fusion::Direct => mc::direct_mesh(vol, iso),
+            _ => fuse(&soup, fusion),
+        };
         let (dev, soup_tris) = device(vol, iso, fusion, None);
         assert_eq!(soup_tris * 3, soup.len(), "{what} {fusion:?}: soup size");
         assert_eq!(
@@ -51,6 +54,91 @@ fn check_same(vol: &Volume, iso: f32, what: &str) {
             "{what} {fusion:?}: device differs from the CPU twin"
         );
     }
+    // Direct numbering makes the same mesh as exact fusion of the soup:
+    // the same triangles in the same order, vertices numbered otherwise.
+    let (d, _) = device(vol, iso, Fusion::Direct, None);
+    let (e, _) = device(vol, iso, Fusion::Edge, None);
+    assert_eq!(d.positions.len(), e.positions.len(), "{what}: vertices");
+    assert_eq!(d.dropped, e.dropped, "{what}: dropped");
+    assert!(
+        corners(&d) == corners(&e),
+        "{what}: direct numbering and edge fusion differ"
+    );
+}
+
+/// Each face as its three corner positions.
+fn corners(m: &Fused) -> Vec<[[f32; 3]; 3]> {
+    m.faces
+        .iter()
+        .map(|f| f.map(|v| m.positions[v as usize]))
+        .collect()
+}
+
+/// A small xorshift generator (deterministic tests).
+fn rng(mut s: u64) -> impl FnMut() -> f32 {
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        ((s >> 40) as f32) / (1u64 << 24) as f32
+    }
+}
+
+#[test]
+fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
+    // Noise (no exact hits, many ambiguous faces), small integers at an
+    // integer iso (hits everywhere), and noise with NaN voxels; odd sizes,
+    // rows longer than one 16-cell chunk.
+    let mut r = rng(7);
+    for trial in 0..24 {
+        let n = [3 + trial % 5 * 9, 2 + trial % 4, 3 + trial % 3];
+        let kind = trial % 3;
+        let vals: Vec<f32> = (0..n[0] * n[1] * n[2])
+            .map(|i| match kind {
+                0 => r() - 0.5,
+                1 => (r() * 4.0).floor(),
+                _ if i % 23 == 0 => f32::NAN,
+                _ => r() - 0.5,
+            })
+            .collect();
+        let vol = Volume::new(n, vals, "random").unwrap();
+        let iso = if kind == 1 { 2.0 } else { 0.0123 };
+        check_same(&vol, iso, &format!("random {n:?} kind {kind}"));
+        if kind == 0 {
+            // No hits, finite: only the direct passes run (twins across
+            // faces are dropped by them), no clean-up of vertex fusion.
+            assert_eq!(mc::mc_direct(&vol, iso).hits, 0);
+            let mut s = Isosurfacer::new(gpu(), &vol).unwrap();
+            let st = s.extract(iso, Fusion::Direct).unwrap();
+            assert_eq!(st.exact_hits, 0);
+            let names: Vec<&str> = st.timing.steps.iter().map(|s| s.step.name()).collect();
+            assert_eq!(names, ["direct_count", "scan_exclusive", "direct_triangles"]);
+        }
+    }
+}
+
+#[test]
+fn the_flat_flags_mark_exactly_the_triangles_in_a_cube_face() {
+    use shapecue::spec::marching_cubes::edge_corners;
+    let t = table();
+    let faces = |e: usize| {
+        let (lo, _) = edge_corners(e);
+        (0..3)
+            .filter(move |&f| f != e / 4)
+            .map(move |f| (f, (lo >> f) & 1))
+            .collect::<Vec<_>>()
+    };
+    let mut flagged = 0;
+    for case in 0..256 {
+        for (j, tri) in t.tris[case].chunks(3).take(t.counts[case] as usize).enumerate() {
+            let [a, b, c] = [tri[0], tri[1], tri[2]].map(|e| faces(e as usize));
+            let in_face = a.iter().any(|f| b.contains(f) && c.contains(f));
+            assert_eq!(t.flat[case] >> j & 1 == 1, in_face, "case {case} triangle {j}");
+            flagged += in_face as usize;
+        }
+        assert_eq!(t.flat[case] >> t.counts[case], 0, "case {case}: flags past the triangles");
+    }
+    assert!(flagged > 0, "the fan triangulation has triangles in faces");
 }
 
 fn bucky() -> Option<Volume> {
@@ -111,6 +199,9 @@ fn hard_cases_at_voxel_values_are_clean() {
         let (m, _) = device(&vol, iso, Fusion::Hash, None);
         let q = quality(&m.positions, &m.faces);
         let (e, _) = device(&vol, iso, Fusion::Edge, None);
+        let (d, _) = device(&vol, iso, Fusion::Direct, None);
+        assert!(corners(&d) == corners(&e), "{name}: direct differs");
+        assert_eq!(d, mc::direct_mesh(&vol, iso), "{name}: direct vs twin");
         eprintln!("{name} {iso}: soup {qs:?}\nfused {q:?}");
         assert!(
             qs.collapsed_faces > 0,

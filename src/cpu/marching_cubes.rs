@@ -66,6 +66,21 @@ pub fn mc_classify(vol: &Volume, iso: f32) -> Vec<u32> {
         .collect()
 }
 
+/// The interpolation parameter of the crossing of `iso` between values `v0`
+/// and `v1`, clamped to [0, 1] (the kernels' `mc_edge_t`). NaN (from ±inf
+/// voxels or overflowing differences) fails the test too: the vertex goes to
+/// the lower end.
+pub fn edge_t(v0: f32, v1: f32, iso: f32) -> f32 {
+    let mut t = (iso - v0) / (v1 - v0);
+    if t.is_nan() || t < 0.0 {
+        t = 0.0;
+    }
+    if t > 1.0 {
+        t = 1.0;
+    }
+    t
+}
+
 /// Interpolates the vertex on edge `e` of cell `(x, y, z)` (the same f32
 /// operations as the kernel's `mc_vertex`).
 pub fn mc_vertex(vol: &Volume, iso: f32, cell: [usize; 3], e: usize) -> SoupVertex {
@@ -80,14 +95,7 @@ pub fn mc_vertex(vol: &Volume, iso: f32, cell: [usize; 3], e: usize) -> SoupVert
     hi[axis] += 1;
     let v0 = vol.value(lo[0], lo[1], lo[2]);
     let v1 = vol.value(hi[0], hi[1], hi[2]);
-    let mut t = (iso - v0) / (v1 - v0);
-    // NaN (from ±inf voxels) fails the test too: the vertex goes to the lower end.
-    if t.is_nan() || t < 0.0 {
-        t = 0.0;
-    }
-    if t > 1.0 {
-        t = 1.0;
-    }
+    let t = edge_t(v0, v1, iso);
     let a = lo[axis] as f32;
     let c = a + t;
     let g = |p: [usize; 3]| (p[0] + vol.dims[0] * (p[1] + vol.dims[1] * p[2])) as u64;
@@ -181,4 +189,291 @@ pub fn gradient_normals(vol: &Volume, positions: &[[f32; 3]]) -> Vec<[f64; 3]> {
             }
         })
         .collect()
+}
+
+// ---------------------------------------------------------------------------
+// Direct numbering (`mc_direct_*`): each vertex created once by the voxel edge
+// that owns it and numbered by a scan over per-row counts, as Flying Edges
+// (Schroeder, Maynard and Geveci 2015) does; triangles written with final
+// indices. Same steps, layout and f32 arithmetic as the kernels.
+
+/// What the voxel edge from value `v0` (coordinate `a` along the edge's axis)
+/// to `v1` (coordinate `a + 1`) carries (the kernels' `edge_kind`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EdgeVertex {
+    /// No vertex: both ends on one side of iso, or an end not finite.
+    None,
+    /// A vertex strictly inside the edge, at this coordinate along its axis.
+    Inside(f32),
+    /// The vertex rounds onto the lower grid point: it *is* that point.
+    Lower,
+    /// The vertex rounds onto the upper grid point.
+    Upper,
+}
+
+/// Classifies the vertex of one voxel edge (see [`EdgeVertex`]).
+pub fn edge_vertex(v0: f32, v1: f32, iso: f32, a: usize) -> EdgeVertex {
+    if !(v0.is_finite() && v1.is_finite()) || (v0 < iso) == (v1 < iso) {
+        return EdgeVertex::None;
+    }
+    let fa = a as f32;
+    let c = fa + edge_t(v0, v1, iso);
+    if c == fa {
+        EdgeVertex::Lower
+    } else if c == (a + 1) as f32 {
+        EdgeVertex::Upper
+    } else {
+        EdgeVertex::Inside(c)
+    }
+}
+
+/// The vertex of the edge along `axis` starting at grid point `g`, or
+/// [`EdgeVertex::None`] when the edge leaves the volume.
+fn grid_edge(vol: &Volume, iso: f32, g: [usize; 3], axis: usize) -> EdgeVertex {
+    let mut h = g;
+    h[axis] += 1;
+    if h[axis] >= vol.dims[axis] {
+        return EdgeVertex::None;
+    }
+    edge_vertex(
+        vol.value(g[0], g[1], g[2]),
+        vol.value(h[0], h[1], h[2]),
+        iso,
+        g[axis],
+    )
+}
+
+/// Edge id (table numbering) of the edge along `axis` whose lower corner
+/// is `c0` (the inverse of [`edge_corners`]).
+fn edge_id(axis: usize, c0: usize) -> usize {
+    let others = [(axis + 1) % 3, (axis + 2) % 3];
+    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
+    4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1)
+}
+
+/// True when triangle `j` of cell `cell` (case `case`), which lies in a face
+/// of the cube ([`crate::spec::marching_cubes::McTable::flat`]), has an
+/// opposite twin in the cell across that face: the same three voxel edges,
+/// the other winding. Both are dropped (the kernels' `has_twin`), as vertex
+/// fusion's twin cancellation would drop them.
+pub fn has_twin(vol: &Volume, iso: f32, cell: [usize; 3], case: usize, j: usize) -> bool {
+    let t = table();
+    let a = [0, 1, 2].map(|i| t.tris[case][3 * j + i] as usize);
+    let side = |e: usize, f: usize| (edge_corners(e).0 >> f) & 1;
+    let Some(f) = (0..3).find(|&f| {
+        a.iter().all(|&e| e / 4 != f) && side(a[0], f) == side(a[1], f) && side(a[1], f) == side(a[2], f)
+    }) else {
+        return false;
+    };
+    let s = side(a[0], f);
+    let mut p = cell;
+    if s == 0 {
+        if p[f] == 0 {
+            return false;
+        }
+        p[f] -= 1;
+    } else {
+        if p[f] + 2 >= vol.dims[f] {
+            return false;
+        }
+        p[f] += 1;
+    }
+    let Some(cb) = cell_case(vol, iso, p[0], p[1], p[2]) else {
+        return false;
+    };
+    t.tris[cb].chunks(3).take(t.counts[cb] as usize).any(|tb| {
+        let m: Option<Vec<usize>> = tb
+            .iter()
+            .map(|&e| {
+                let e = e as usize;
+                (e / 4 != f && side(e, f) == 1 - s)
+                    .then(|| edge_id(e / 4, edge_corners(e).0 ^ (1 << f)))
+            })
+            .collect();
+        m.is_some_and(|m| {
+            let r = [a[0], a[2], a[1]];
+            (0..3).any(|k| (0..3).all(|i| m[i] == r[(i + k) % 3]))
+        })
+    })
+}
+
+/// Triangles of a valid cell's case that direct numbering keeps, in table
+/// order (those with an opposite twin across a face dropped).
+fn kept_triangles(vol: &Volume, iso: f32, cell: [usize; 3], case: usize) -> Vec<usize> {
+    let t = table();
+    (0..t.counts[case] as usize)
+        .filter(|&j| t.flat[case] >> j & 1 == 0 || !has_twin(vol, iso, cell, case, j))
+        .collect()
+}
+
+/// Per grid row `y + ny z` (every row of grid points along x, `ny · nz` of
+/// them), what `mc_direct_count` writes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DirectCounts {
+    /// Vertices inside the edges the row owns (its x-edges, and the y- and
+    /// z-edges that start on it), triangles of the cell row `(y, z)` (0 on
+    /// the last row of y or z) that are kept, vertices of its edges that
+    /// round onto a grid point, and triangles dropped with an opposite twin.
+    pub rows: Vec<[u32; 4]>,
+    /// Within the row: the first y-edge vertex and the first z-edge vertex
+    /// (its x-edge vertices come first, then y, then z, each in x order).
+    pub split: Vec<[u32; 2]>,
+}
+
+/// `mc_direct_count`: the per-row counts.
+pub fn mc_direct_count(vol: &Volume, iso: f32) -> DirectCounts {
+    let [nx, ny, nz] = vol.dims;
+    let t = table();
+    let mut out = DirectCounts::default();
+    for r in 0..ny * nz {
+        let (y, z) = (r % ny, r / ny);
+        let mut c = [0u32; 3];
+        let mut hits = 0;
+        for x in 0..nx {
+            for (axis, n) in c.iter_mut().enumerate() {
+                match grid_edge(vol, iso, [x, y, z], axis) {
+                    EdgeVertex::None => {}
+                    EdgeVertex::Inside(_) => *n += 1,
+                    _ => hits += 1,
+                }
+            }
+        }
+        let (mut tris, mut twins) = (0, 0);
+        if y + 1 < ny && z + 1 < nz {
+            for x in 0..nx - 1 {
+                if let Some(k) = cell_case(vol, iso, x, y, z) {
+                    let kept = kept_triangles(vol, iso, [x, y, z], k).len() as u32;
+                    tris += kept;
+                    twins += t.counts[k] as u32 - kept;
+                }
+            }
+        }
+        out.rows.push([c.iter().sum(), tris, hits, twins]);
+        out.split.push([c[0], c[0] + c[1]]);
+    }
+    out
+}
+
+/// The result of direct numbering before the clean-up of exact hits.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Direct {
+    /// Vertex slots: the edge vertices in row order, then one slot per exact
+    /// hit (the sorted hit points; only the first slot of a point is used).
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles with final indices, cell rows in order, cells in x order,
+    /// triangles in table order (those of exact hits may have collapsed).
+    pub faces: Vec<[u32; 3]>,
+    /// Vertices inside edges (the scan total of the row counts).
+    pub edge_vertices: usize,
+    /// Edge vertices that rounded onto a grid point.
+    pub hits: usize,
+    /// Triangles dropped with an opposite twin across a cube face.
+    pub twins: usize,
+}
+
+/// `mc_direct_hits` (the hit points, sorted), `mc_direct_triangles` and
+/// `mc_direct_points`: the positions and triangles, indices final.
+pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
+    let [nx, ny, nz] = vol.dims;
+    let counts = mc_direct_count(vol, iso);
+    let n = nx * ny * nz;
+    let lin = |g: [usize; 3]| g[0] + nx * (g[1] + ny * g[2]);
+    // Vertex id of every interior edge vertex: rows in order; x, y, z edges.
+    let mut id = vec![u32::MAX; 3 * n];
+    let mut positions = Vec::new();
+    let mut hit_points = Vec::new();
+    for r in 0..ny * nz {
+        let (y, z) = (r % ny, r / ny);
+        for axis in 0..3 {
+            for x in 0..nx {
+                let g = [x, y, z];
+                match grid_edge(vol, iso, g, axis) {
+                    EdgeVertex::None => {}
+                    EdgeVertex::Inside(c) => {
+                        id[3 * lin(g) + axis] = positions.len() as u32;
+                        let mut p = g.map(|v| v as f32);
+                        p[axis] = c;
+                        positions.push(p);
+                    }
+                    EdgeVertex::Lower => hit_points.push(lin(g) as u32),
+                    EdgeVertex::Upper => {
+                        let mut h = g;
+                        h[axis] += 1;
+                        hit_points.push(lin(h) as u32);
+                    }
+                }
+            }
+        }
+    }
+    let edge_vertices = positions.len();
+    debug_assert_eq!(
+        edge_vertices as u64,
+        counts.rows.iter().map(|r| r[0] as u64).sum::<u64>()
+    );
+    hit_points.sort_unstable();
+    for &g in &hit_points {
+        let g = g as usize;
+        positions.push([(g % nx) as f32, (g / nx % ny) as f32, (g / (nx * ny)) as f32]);
+    }
+    let t = table();
+    let mut faces = Vec::new();
+    for z in 0..nz.saturating_sub(1) {
+        for y in 0..ny.saturating_sub(1) {
+            for x in 0..nx - 1 {
+                let Some(case) = cell_case(vol, iso, x, y, z) else {
+                    continue;
+                };
+                let vid = |e: usize| {
+                    let (c0, _) = edge_corners(e);
+                    let g = [x + (c0 & 1), y + (c0 >> 1 & 1), z + (c0 >> 2)];
+                    let axis = e / 4;
+                    match grid_edge(vol, iso, g, axis) {
+                        EdgeVertex::Inside(_) => id[3 * lin(g) + axis],
+                        hit => {
+                            let mut p = g;
+                            if hit == EdgeVertex::Upper {
+                                p[axis] += 1;
+                            }
+                            let k = lin(p) as u32;
+                            (edge_vertices + hit_points.partition_point(|&h| h < k)) as u32
+                        }
+                    }
+                };
+                for j in kept_triangles(vol, iso, [x, y, z], case) {
+                    let tri = &t.tris[case][3 * j..3 * j + 3];
+                    faces.push([
+                        vid(tri[0] as usize),
+                        vid(tri[1] as usize),
+                        vid(tri[2] as usize),
+                    ]);
+                }
+            }
+        }
+    }
+    Direct {
+        positions,
+        faces,
+        edge_vertices,
+        hits: hit_points.len(),
+        twins: counts.rows.iter().map(|r| r[3] as usize).sum(),
+    }
+}
+
+/// Direct numbering, whole: [`mc_direct`] (twins across cube faces already
+/// dropped), then, only when there were exact hits or the volume has
+/// non-finite values, the clean-up of vertex fusion ([`crate::cpu::vertex_fusion::fuse_finish`]: collapsed triangles
+/// and opposite twins dropped, unused vertex slots removed).
+pub fn direct_mesh(vol: &Volume, iso: f32) -> crate::cpu::vertex_fusion::Fused {
+    let d = mc_direct(vol, iso);
+    if d.hits > 0 || vol.values.iter().any(|v| !v.is_finite()) {
+        let mut f = crate::cpu::vertex_fusion::fuse_finish(&d.positions, &d.faces);
+        f.dropped += d.twins;
+        f
+    } else {
+        crate::cpu::vertex_fusion::Fused {
+            positions: d.positions,
+            faces: d.faces,
+            dropped: d.twins,
+        }
+    }
 }

@@ -89,15 +89,29 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
         .collect();
     sorted.sort_by_key(|&(k, _)| k);
     let rep = fuse_index(soup, &keys, &sorted, fusion == Fusion::Hash);
+    let positions: Vec<[f32; 3]> = soup.iter().map(|s| s.p).collect();
+    let faces: Vec<[u32; 3]> = rep
+        .chunks(3)
+        .map(|r| [r[0], r[1], r[2]])
+        .collect();
+    fuse_finish(&positions, &faces)
+}
+
+/// The steps after `fuse_index`, shared with direct numbering: triangles
+/// (`faces`, indices into `positions`) whose corners repeat are dropped,
+/// opposite twins lying in a grid plane cancelled, and the vertices still
+/// used compacted in index order (`fuse_triangles`, `fuse_candidates`,
+/// `fuse_cancel`, `fuse_mark`, `fuse_compact_vertices`, `fuse_compact_faces`).
+pub fn fuse_finish(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Fused {
     // fuse_triangles
-    let nt = soup.len() / 3;
-    let tri = |t: usize| [rep[3 * t], rep[3 * t + 1], rep[3 * t + 2]];
+    let nt = faces.len();
+    let tri = |t: usize| faces[t];
     let mut keep = vec![false; nt];
     let mut cand = Vec::new();
     for (t, kt) in keep.iter_mut().enumerate() {
         let f = tri(t);
         *kt = f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
-        let p = f.map(|v| soup[v as usize].p);
+        let p = f.map(|v| positions[v as usize]);
         if *kt
             && (0..3)
                 .any(|a| p[0][a] == p[1][a] && p[1][a] == p[2][a] && p[0][a] == p[0][a].floor())
@@ -122,7 +136,7 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
         }
     }
     // fuse_mark
-    let mut referenced = vec![false; soup.len()];
+    let mut referenced = vec![false; positions.len()];
     let mut kept = Vec::new();
     for (t, &k) in keep.iter().enumerate() {
         if k {
@@ -134,17 +148,17 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
     }
     let dropped = nt - kept.len();
     // fuse_compact_vertices / fuse_compact_faces
-    let mut new_id = vec![u32::MAX; soup.len()];
-    let mut positions = Vec::new();
+    let mut new_id = vec![u32::MAX; positions.len()];
+    let mut kept_positions = Vec::new();
     for (v, &r) in referenced.iter().enumerate() {
         if r {
-            new_id[v] = positions.len() as u32;
-            positions.push(soup[v].p);
+            new_id[v] = kept_positions.len() as u32;
+            kept_positions.push(positions[v]);
         }
     }
     let faces = kept.iter().map(|f| f.map(|v| new_id[v as usize])).collect();
     Fused {
-        positions,
+        positions: kept_positions,
         faces,
         dropped,
     }

@@ -29,6 +29,11 @@ pub struct McTable {
     pub tris: [[u8; 16]; 256],
     /// Triangles per case.
     pub counts: [u8; 256],
+    /// Bit `j` set when triangle `j` of the case lies in a face of the cube
+    /// (a fan over a loop through all four edges of an ambiguous face). Such
+    /// a triangle can have an opposite twin in the cell across the face: a
+    /// fold of zero thickness that fusion cancels.
+    pub flat: [u8; 256],
 }
 
 /// The two corner ids of edge `e` (lower, upper along the edge's axis).
@@ -53,6 +58,7 @@ fn edge_of(c0: usize, c1: usize) -> usize {
 fn build_table() -> McTable {
     let mut tris = [[END; 16]; 256];
     let mut counts = [0u8; 256];
+    let mut flat = [0u8; 256];
     for case in 0..256usize {
         let inside = |c: usize| case >> c & 1 == 1;
         // next[e] = the edge the surface boundary goes to from edge e.
@@ -112,8 +118,27 @@ fn build_table() -> McTable {
         );
         tris[case][..out.len()].copy_from_slice(&out);
         counts[case] = (out.len() / 3) as u8;
+        for (j, t) in out.chunks(3).enumerate() {
+            if on_one_face(t[0] as usize, t[1] as usize, t[2] as usize) {
+                flat[case] |= 1 << j;
+            }
+        }
     }
-    McTable { tris, counts }
+    McTable { tris, counts, flat }
+}
+
+/// True when edges `a`, `b`, `c` all lie on one face of the cube: a
+/// triangle on them lies in the face's plane (see [`McTable::flat`]).
+pub fn on_one_face(a: usize, b: usize, c: usize) -> bool {
+    // Faces of an edge: (axis, side) for each axis other than the edge's own.
+    let faces = |e: usize| {
+        let (lo, _) = edge_corners(e);
+        let axis = e / 4;
+        (0..3)
+            .filter(move |&f| f != axis)
+            .map(move |f| (f, (lo >> f) & 1))
+    };
+    faces(a).any(|fa| faces(b).any(|fb| fb == fa) && faces(c).any(|fc| fc == fa))
 }
 
 /// The case table (built once per process).

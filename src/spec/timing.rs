@@ -69,6 +69,14 @@ pub enum Step {
     McTriangles,
     /// `mc_iota`: identity faces of an unfused soup.
     McIota,
+    /// `mc_direct_count`: per-row vertex, triangle and hit counts, trimming.
+    McDirectCount,
+    /// `mc_direct_hits`: the grid points that vertices round onto.
+    McDirectHits,
+    /// `mc_direct_triangles`: positions and triangles with final indices.
+    McDirectTriangles,
+    /// `mc_direct_points`: positions of the grid-point vertices.
+    McDirectPoints,
     /// `mc_gradient_normals`: normals from the volume gradient.
     McGradientNormals,
     /// `fuse_index`: representative per sorted key.
@@ -142,6 +150,10 @@ impl Step {
             Step::McClassify => "mc_classify",
             Step::McTriangles => "mc_triangles",
             Step::McIota => "mc_iota",
+            Step::McDirectCount => "mc_direct_count",
+            Step::McDirectHits => "mc_direct_hits",
+            Step::McDirectTriangles => "mc_direct_triangles",
+            Step::McDirectPoints => "mc_direct_points",
             Step::McGradientNormals => "mc_gradient_normals",
             Step::FuseIndex => "fuse_index",
             Step::FuseTriangles => "fuse_triangles",
@@ -193,7 +205,8 @@ impl Step {
         match self {
             CurvMaxFace | CurvClear | CurvNormalsAreas | CurvFrames | CurvTensor
             | CurvPrincipal | CurvDcurv => Family::Curvature,
-            McClassify | McTriangles | McIota | McGradientNormals => Family::MarchingCubes,
+            McClassify | McTriangles | McIota | McGradientNormals | McDirectCount | McDirectHits
+            | McDirectTriangles | McDirectPoints => Family::MarchingCubes,
             FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,

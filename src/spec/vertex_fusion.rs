@@ -11,10 +11,15 @@
 //! [`Fusion::Hash`]; `mc_triangles`' `mode` is [`Fusion::code`]. Scalar
 //! arguments only: no parameter struct crosses.
 
-/// How soup vertices are merged.
+/// How the vertices of an isosurface are shared between its triangles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Fusion {
+    /// Exact and the fastest: no soup; each vertex is made once by the voxel
+    /// edge it lies on and numbered by a scan over per-row counts, as
+    /// Flying Edges (Schroeder, Maynard and Geveci 2015) does.
+    #[value(help = super::NO_HELP)]
+    Direct,
     /// Griffin et al.'s method: 32-bit hash of the position bits, radix sort,
     /// collisions resolved by comparing positions.
     #[value(help = super::NO_HELP)]
@@ -29,11 +34,12 @@ pub enum Fusion {
 
 impl Fusion {
     /// All variants, in the order of the CLI, tables and benches.
-    pub const ALL: [Fusion; 3] = [Fusion::Hash, Fusion::Edge, Fusion::None];
+    pub const ALL: [Fusion; 4] = [Fusion::Direct, Fusion::Edge, Fusion::Hash, Fusion::None];
 
     /// Name used on the command line, in stats and in bench ids.
     pub fn name(self) -> &'static str {
         match self {
+            Fusion::Direct => "direct",
             Fusion::Hash => "hash",
             Fusion::Edge => "edge",
             Fusion::None => "none",
@@ -41,10 +47,11 @@ impl Fusion {
     }
 
     /// `mc_triangles`' `mode` argument: which key it writes per soup vertex
-    /// (0 none, 1 the position hash, 2 the exact edge key).
+    /// (0 none, 1 the position hash, 2 the exact edge key). [`Fusion::Direct`]
+    /// makes no soup and does not run `mc_triangles` (0).
     pub fn code(self) -> u32 {
         match self {
-            Fusion::None => 0,
+            Fusion::None | Fusion::Direct => 0,
             Fusion::Hash => 1,
             Fusion::Edge => 2,
         }
@@ -63,6 +70,31 @@ pub struct FusionCounts {
     /// Triangles dropped: two fused corners were the same vertex, or the
     /// triangle was cancelled with an opposite twin.
     pub dropped: usize,
+}
+
+/// Bytes of device memory direct numbering needs beyond the volume, for
+/// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits
+/// and `triangles` triangles: row counts (4 per row), splits and trims (2
+/// each), hit keys and their sort (3 per hit plus the sort's histograms,
+/// bounded by 4 per hit), positions, faces, and the clean-up of vertex fusion
+/// when there are hits or non-finite voxels (`cleanup`).
+pub fn direct_device_bytes_bound(
+    grid_rows: usize,
+    vertices: usize,
+    hits: usize,
+    triangles: usize,
+    cleanup: bool,
+) -> u64 {
+    let slots = (vertices + hits) as u64;
+    let t = triangles as u64;
+    let mut b = 32 * grid_rows as u64 + 16 * hits as u64 + 12 * slots + 12 * t;
+    if cleanup {
+        // rep is the faces buffer; referenced + vert_id per slot; keep,
+        // face_off, cand, cand_off per triangle; candidate keys and their
+        // sort; the compacted outputs.
+        b += 8 * slots + 16 * t + 16 * t + 12 * slots + 12 * t;
+    }
+    b
 }
 
 /// Soup triangles of `soup_vertices` soup vertices (three each): the length

@@ -18,6 +18,7 @@ use crate::spec::marching_cubes::{cell_rows, edge_key_bits, soup_vertices_bound,
 use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::{Fusion, FusionCounts};
 use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
 use crate::stages::vertex_fusion::{Fuser, Grow, build_options};
 use crate::volume::Volume;
@@ -35,10 +36,15 @@ pub struct IsoStats {
     pub iso: f32,
     /// Voxels in the volume.
     pub voxels: usize,
-    /// Soup triangles (before fusion).
+    /// Triangles emitted by the cells (before fusion drops any): the soup's
+    /// triangles, or those of direct numbering.
     pub soup_triangles: usize,
-    /// Soup vertices (3 per triangle: vertices before fusion).
+    /// Soup vertices (3 per triangle: vertices before fusion); 0 for direct
+    /// numbering, which makes no soup.
     pub soup_vertices: usize,
+    /// Direct numbering: vertices that rounded onto a grid point (iso equal
+    /// to voxel values), which alone make the clean-up passes run.
+    pub exact_hits: usize,
     /// Vertices after fusion.
     pub vertices: usize,
     /// Faces after fusion.
@@ -61,6 +67,7 @@ pub type IndexSpaceMesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
 enum Holder {
     Soup,
     Fused,
+    Direct,
 }
 
 /// Extracts isosurfaces of one volume on the device.
@@ -74,11 +81,17 @@ pub struct Isosurfacer {
     vol: Buffer<f32>,
     counts: Buffer<u8>,
     tris: Buffer<u8>,
+    flat: Buffer<u8>,
     classify: Kernel,
     triangles: Kernel,
     iota: Kernel,
     gradient: Kernel,
+    direct_count: Kernel,
+    direct_hits: Kernel,
+    direct_triangles: Kernel,
+    direct_points: Kernel,
     scan: Scan,
+    sort: RadixSort,
     fuser: Fuser,
     row_tris: Buffer<u32>,
     row_off: Buffer<u32>,
@@ -87,6 +100,17 @@ pub struct Isosurfacer {
     key: Grow<u32>,
     idx: Grow<u32>,
     soup_faces: Grow<u32>,
+    /// Direct numbering: per grid row counts (scanned in place), splits, trims.
+    rowc: Buffer<u32>,
+    split: Buffer<u32>,
+    trim: Buffer<u32>,
+    hit_keys: Grow<u32>,
+    hit_vals: Grow<u32>,
+    dpos: Grow<f32>,
+    dfaces: Grow<u32>,
+    /// The volume has NaN or infinite voxels (known at upload): direct
+    /// numbering then removes the vertices of edges only skipped cells use.
+    nonfinite: bool,
     result: Option<(Holder, usize, usize)>,
 }
 
@@ -127,7 +151,10 @@ impl Isosurfacer {
         gpu.write(&mut counts, &t.counts)?;
         let mut tris = gpu.buffer_flags::<u8>(256 * 16, CL_MEM_READ_ONLY)?;
         gpu.write(&mut tris, t.tris.as_flattened())?;
+        let mut flat = gpu.buffer_flags::<u8>(256, CL_MEM_READ_ONLY)?;
+        gpu.write(&mut flat, &t.flat)?;
         let rows = cell_rows(vol.dims);
+        let grid_rows = vol.dims[1] * vol.dims[2];
         Ok(Isosurfacer {
             dims: vol.dims,
             spacing: vol.spacing,
@@ -135,11 +162,17 @@ impl Isosurfacer {
             vol: volb,
             counts,
             tris,
+            flat,
             classify: gpu.kernel(&p, "mc_classify")?,
             triangles: gpu.kernel(&p, "mc_triangles")?,
             iota: gpu.kernel(&p, "mc_iota")?,
             gradient: gpu.kernel(&p, "mc_gradient_normals")?,
+            direct_count: gpu.kernel(&p, "mc_direct_count")?,
+            direct_hits: gpu.kernel(&p, "mc_direct_hits")?,
+            direct_triangles: gpu.kernel(&p, "mc_direct_triangles")?,
+            direct_points: gpu.kernel(&p, "mc_direct_points")?,
             scan: Scan::new(gpu.clone())?,
+            sort: RadixSort::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
             row_tris: gpu.buffer::<u32>(rows)?,
             row_off: gpu.buffer::<u32>(rows)?,
@@ -148,6 +181,14 @@ impl Isosurfacer {
             key: Grow::new(&gpu)?,
             idx: Grow::new(&gpu)?,
             soup_faces: Grow::new(&gpu)?,
+            rowc: gpu.buffer::<u32>(4 * grid_rows)?,
+            split: gpu.buffer::<u32>(2 * grid_rows)?,
+            trim: gpu.buffer::<u32>(2 * grid_rows)?,
+            hit_keys: Grow::new(&gpu)?,
+            hit_vals: Grow::new(&gpu)?,
+            dpos: Grow::new(&gpu)?,
+            dfaces: Grow::new(&gpu)?,
+            nonfinite: vol.values.iter().any(|v| !v.is_finite()),
             result: None,
             gpu,
         })
@@ -172,6 +213,12 @@ impl Isosurfacer {
             + self.key.bytes()
             + self.idx.bytes()
             + self.soup_faces.bytes()
+            + 32 * (self.dims[1] * self.dims[2]) as u64
+            + self.hit_keys.bytes()
+            + self.hit_vals.bytes()
+            + self.dpos.bytes()
+            + self.dfaces.bytes()
+            + self.sort.scratch_bytes()
             + self.fuser.device_bytes()
     }
 
@@ -203,8 +250,14 @@ impl Isosurfacer {
         if fusion == Fusion::Edge && edge_key_bits(voxels).is_none() {
             return Err(Error::InvalidArgument(format!(
                 "--fusion edge keys vertices by 4 × voxel index in 32 bits: at most 2^30 voxels, \
-                 this volume has {voxels}; use --fusion hash"
+                 this volume has {voxels}; use --fusion direct or hash"
             )));
+        }
+        if fusion == Fusion::Direct {
+            self.extract_direct(iso, &mut st)?;
+            st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+            st.device_bytes = self.device_bytes();
+            return Ok(st);
         }
         let common = [
             Arg::U32(rows as u32),
@@ -320,6 +373,157 @@ impl Isosurfacer {
         Ok(st)
     }
 
+    /// Direct numbering (see `kernels/marching_cubes.cl`): count → one scan
+    /// → [hits → sort] → triangles → [points] → [clean-up], with one host
+    /// round trip (the scan's partial totals, which size the outputs).
+    fn extract_direct(&mut self, iso: f32, st: &mut IsoStats) -> Result<()> {
+        let g = self.gpu.clone();
+        let [nx, ny, nz] = self.dims;
+        let voxels = nx * ny * nz;
+        let gr = ny * nz;
+        let common = [
+            Arg::U32(gr as u32),
+            Arg::U32(nx as u32),
+            Arg::U32(ny as u32),
+            Arg::U32(nz as u32),
+            buf(&self.vol),
+            Arg::F32(iso),
+        ];
+        let mut a = common.to_vec();
+        a.extend([
+            buf(&self.counts),
+            buf(&self.tris),
+            buf(&self.flat),
+            buf(&self.rowc),
+            buf(&self.split),
+            buf(&self.trim),
+        ]);
+        let e_count = launch(&g, &self.direct_count, gr, &a)?;
+        let (total, at) = self
+            .scan
+            .exclusive_at(&self.rowc, &self.rowc, 4 * gr, &[gr, 2 * gr, 3 * gr])
+            .map_err(|e| match e {
+                Error::InvalidInput { .. } => Error::InvalidArgument(format!(
+                    "iso {iso}: the isosurface's vertices and triangles exceed the 32-bit \
+                     indices of the device"
+                )),
+                e => e,
+            })?;
+        if let Some(e) = &e_count {
+            st.timing.add(Step::McDirectCount, event_ms(e));
+        }
+        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
+        let (v, t, h, twins) = (
+            at[0] as usize,
+            (at[1] - at[0]) as usize,
+            (at[2] - at[1]) as usize,
+            (total - at[2] as u64) as usize,
+        );
+        let slots = v + h;
+        if 3 * slots as u64 > u32::MAX as u64 || 3 * t as u64 > u32::MAX as u64 {
+            return Err(Error::InvalidArgument(format!(
+                "iso {iso}: {slots} vertices and {t} triangles exceed the 32-bit indices of \
+                 the device (at most {} of each)",
+                u32::MAX / 3
+            )));
+        }
+        let cleanup = h > 0 || self.nonfinite;
+        let need = 4 * voxels as u64
+            + crate::spec::vertex_fusion::direct_device_bytes_bound(gr, v, h, t, cleanup);
+        if need > g.info.global_mem {
+            return Err(Error::DeviceUnsupported {
+                device: g.info.name.clone(),
+                what: format!(
+                    "iso {iso} gives {t} triangles; extracting them needs about {need} bytes \
+                     of device memory, the device has {}",
+                    g.info.global_mem
+                ),
+            });
+        }
+        st.soup_triangles = t + twins;
+        st.exact_hits = h;
+        if h > 0 {
+            self.hit_keys.reserve(&g, h)?;
+            self.hit_vals.reserve(&g, h)?;
+            let mut a = common.to_vec();
+            a.extend([
+                buf(&self.rowc),
+                buf(&self.trim),
+                Arg::U32(at[1]),
+                Arg::U32(at[2]),
+                buf(&self.hit_keys.buf),
+            ]);
+            let e = launch(&g, &self.direct_hits, gr, &a)?;
+            let bits = 64 - (voxels as u64).saturating_sub(1).leading_zeros();
+            self.sort
+                .sort_pairs(&mut self.hit_keys.buf, &mut self.hit_vals.buf, h, bits)?;
+            if let Some(e) = &e {
+                st.timing.add(Step::McDirectHits, event_ms(e));
+            }
+            st.timing.add(Step::RadixSortPairs, self.sort.last_ms());
+        }
+        self.dpos.reserve(&g, 3 * slots)?;
+        self.dfaces.reserve(&g, 3 * t)?;
+        let mut a = common.to_vec();
+        a.extend([
+            buf(&self.counts),
+            buf(&self.tris),
+            buf(&self.flat),
+            buf(&self.rowc),
+            buf(&self.split),
+            buf(&self.trim),
+            Arg::U32(v as u32),
+            Arg::U32(h as u32),
+            buf(&self.hit_keys.buf),
+            buf(&self.dpos.buf),
+            buf(&self.dfaces.buf),
+        ]);
+        let e_tri = launch(&g, &self.direct_triangles, gr, &a)?;
+        let e_pts = launch(
+            &g,
+            &self.direct_points,
+            h,
+            &[
+                Arg::U32(h as u32),
+                buf(&self.hit_keys.buf),
+                Arg::U32(nx as u32),
+                Arg::U32(ny as u32),
+                Arg::U32(v as u32),
+                buf(&self.dpos.buf),
+            ],
+        )?;
+        if cleanup {
+            let (c, ft) = self.fuser.finish(&self.dfaces.buf, &self.dpos.buf, slots, t)?;
+            st.vertices = c.vertices;
+            st.faces = c.faces;
+            st.degenerate_dropped = twins + c.dropped;
+            self.result = Some((Holder::Fused, c.vertices, c.faces));
+            Self::add_events(st, &e_tri, &e_pts);
+            st.timing.extend(&ft);
+        } else {
+            g.finish()?;
+            st.vertices = v;
+            st.faces = t;
+            st.degenerate_dropped = twins;
+            self.result = Some((Holder::Direct, v, t));
+            Self::add_events(st, &e_tri, &e_pts);
+        }
+        Ok(())
+    }
+
+    fn add_events(
+        st: &mut IsoStats,
+        tri: &Option<opencl3::event::Event>,
+        pts: &Option<opencl3::event::Event>,
+    ) {
+        if let Some(e) = tri {
+            st.timing.add(Step::McDirectTriangles, event_ms(e));
+        }
+        if let Some(e) = pts {
+            st.timing.add(Step::McDirectPoints, event_ms(e));
+        }
+    }
+
     /// The current result on the device: (positions: 3 floats per vertex in
     /// index space, faces: 3 indices each, vertex count, face count).
     pub fn device_mesh(&self) -> Option<(&Buffer<f32>, &Buffer<u32>, usize, usize)> {
@@ -327,6 +531,7 @@ impl Isosurfacer {
         Some(match h {
             Holder::Soup => (&self.pos.buf, &self.soup_faces.buf, nv, nf),
             Holder::Fused => (&self.fuser.out_pos.buf, &self.fuser.out_faces.buf, nv, nf),
+            Holder::Direct => (&self.dpos.buf, &self.dfaces.buf, nv, nf),
         })
     }
 

@@ -114,6 +114,55 @@ impl Scan {
         Ok(total[0])
     }
 
+    /// Like [`Scan::exclusive`], also returning `output[i]` for each `i` of
+    /// `at` (each below `n`), read with the total in one wait: a caller that
+    /// scans several counts laid end to end gets every partial total with
+    /// one round trip.
+    pub fn exclusive_at(
+        &mut self,
+        input: &Buffer<u32>,
+        output: &Buffer<u32>,
+        n: usize,
+        at: &[usize],
+    ) -> Result<(u64, Vec<u32>)> {
+        self.last_ms = 0.0;
+        check_len("exclusive scan", n, &[("input", input), ("output", output)])?;
+        if let Some(&i) = at.iter().find(|&&i| i >= n) {
+            return Err(Error::InvalidArgument(format!(
+                "exclusive scan: element {i} asked of {n}"
+            )));
+        }
+        if n == 0 {
+            return Ok((0, Vec::new()));
+        }
+        let events = self.enqueue(input, output, n)?;
+        let mut total = [0u64; 1];
+        let mut vals = vec![0u32; at.len()];
+        for (&i, v) in at.iter().zip(vals.iter_mut()) {
+            // SAFETY: `vals` lives until the blocking read below has drained
+            // the in-order queue; `i < n` is inside the buffer (checked above).
+            if let Err(e) = unsafe { self.gpu.read_at_async(output, i, std::slice::from_mut(v)) } {
+                // Do not return while earlier reads may still write into `vals`.
+                let _ = self.gpu.finish();
+                return Err(e);
+            }
+        }
+        self.gpu.read(&self.total, &mut total)?;
+        self.last_ms = events.iter().map(event_ms).sum();
+        if total[0] > u64::from(u32::MAX) {
+            return Err(Error::input(
+                "exclusive scan",
+                format!("sum of {n} values"),
+                format!(
+                    "{} exceeds u32::MAX ({}); the output was left unchanged",
+                    total[0],
+                    u32::MAX
+                ),
+            ));
+        }
+        Ok((total[0], vals))
+    }
+
     /// Enqueues the three kernels without waiting and without reading the
     /// total back (for callers that know the total cannot overflow, like the
     /// radix sort's histogram of `n` keys). `n` must be checked by the caller.

@@ -10,9 +10,7 @@
 use crate::error::Result;
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::spec::timing::{Step, Timing};
-use crate::spec::vertex_fusion::{
-    Fusion, cancel_candidates_bound, fused_faces_bound, fused_vertices_bound, soup_triangles,
-};
+use crate::spec::vertex_fusion::{Fusion, soup_triangles};
 use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
 use opencl3::kernel::Kernel;
@@ -163,17 +161,7 @@ impl Fuser {
         }
         self.sort.sort_pairs(keys, idx, n, key_bits)?;
         t.add(Step::RadixSortPairs, self.sort.last_ms());
-        for b in [&mut self.rep, &mut self.referenced, &mut self.vert_id] {
-            b.reserve(&g, n)?;
-        }
-        for b in [
-            &mut self.keep,
-            &mut self.face_off,
-            &mut self.cand,
-            &mut self.cand_off,
-        ] {
-            b.reserve(&g, nt)?;
-        }
+        self.rep.reserve(&g, n)?;
         let n32 = n as u32;
         let compare = u32::from(fusion == Fusion::Hash);
         let e_index = launch(
@@ -189,6 +177,54 @@ impl Fuser {
                 buf(&self.rep.buf),
             ],
         )?;
+        // The event's time is read by `finish_inner` once the queue is done.
+        let (counts, ft) = self.finish_inner(None, pos, n, nt, e_index)?;
+        t.extend(&ft);
+        Ok((counts, t))
+    }
+
+    /// The steps after `fuse_index`, shared with direct numbering
+    /// ([`crate::stages::marching_cubes`]): `rep` holds `nt` triangles (3
+    /// indices each) into `pos` (`nv` vertex slots, 3 floats each).
+    /// Triangles whose corners repeat are dropped, opposite twins in grid
+    /// planes cancelled, and the vertices still used compacted in index
+    /// order into [`Fuser::out_pos`] / [`Fuser::out_faces`].
+    pub(crate) fn finish(
+        &mut self,
+        rep: &Buffer<u32>,
+        pos: &Buffer<f32>,
+        nv: usize,
+        nt: usize,
+    ) -> Result<(FusionCounts, Timing)> {
+        self.finish_inner(Some(rep), pos, nv, nt, None)
+    }
+
+    fn finish_inner(
+        &mut self,
+        rep: Option<&Buffer<u32>>,
+        pos: &Buffer<f32>,
+        n: usize,
+        nt: usize,
+        e_index: Option<opencl3::event::Event>,
+    ) -> Result<(FusionCounts, Timing)> {
+        let g = self.gpu.clone();
+        let mut t = Timing::default();
+        if nt == 0 {
+            return Ok((FusionCounts::default(), t));
+        }
+        for b in [&mut self.referenced, &mut self.vert_id] {
+            b.reserve(&g, n)?;
+        }
+        for b in [
+            &mut self.keep,
+            &mut self.face_off,
+            &mut self.cand,
+            &mut self.cand_off,
+        ] {
+            b.reserve(&g, nt)?;
+        }
+        let rep = rep.unwrap_or(&self.rep.buf);
+        let n32 = n as u32;
         let e_clear = launch(
             &g,
             &self.clear,
@@ -201,7 +237,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
-                buf(&self.rep.buf),
+                buf(rep),
                 buf(pos),
                 buf(&self.keep.buf),
                 buf(&self.cand.buf),
@@ -210,7 +246,7 @@ impl Fuser {
         let n_cand = self
             .scan
             .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
-        debug_assert!(n_cand <= cancel_candidates_bound(n));
+        debug_assert!(n_cand <= nt);
         // Steps in execution order; the kernel events are read once done.
         let cand_scan = self.scan.last_ms();
         let mut cancel = Timing::default();
@@ -223,7 +259,7 @@ impl Fuser {
                 nt,
                 &[
                     Arg::U32(nt as u32),
-                    buf(&self.rep.buf),
+                    buf(rep),
                     buf(&self.cand.buf),
                     buf(&self.cand_off.buf),
                     buf(&self.ckeys.buf),
@@ -241,7 +277,7 @@ impl Fuser {
                     Arg::U32(n_cand as u32),
                     buf(&self.ckeys.buf),
                     buf(&self.cvals.buf),
-                    buf(&self.rep.buf),
+                    buf(rep),
                     buf(&self.keep.buf),
                 ],
             )?;
@@ -260,7 +296,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
-                buf(&self.rep.buf),
+                buf(rep),
                 buf(&self.keep.buf),
                 buf(&self.referenced.buf),
             ],
@@ -288,7 +324,7 @@ impl Fuser {
         t.add(Step::ScanExclusive, face_scan);
         t.add(Step::ScanExclusive, vertex_scan);
         // Sized from the scans, within the bounds the memory check assumed.
-        debug_assert!(vertices <= fused_vertices_bound(n) && faces <= fused_faces_bound(n));
+        debug_assert!(vertices <= n && faces <= nt);
         self.out_pos.reserve(&g, 3 * vertices)?;
         self.out_faces.reserve(&g, 3 * faces)?;
         let e_v = launch(
@@ -309,7 +345,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
-                buf(&self.rep.buf),
+                buf(rep),
                 buf(&self.keep.buf),
                 buf(&self.face_off.buf),
                 buf(&self.vert_id.buf),
