@@ -57,7 +57,7 @@ fn bench(c: &mut Criterion) {
     };
     for (name, vol, iso) in inputs() {
         let mut ex = Isosurfacer::new(gpu.clone(), &vol).expect("upload");
-        for fusion in [Fusion::None, Fusion::Edge, Fusion::Hash] {
+        for fusion in Fusion::ALL {
             let mut g = c.benchmark_group(format!("isosurface/{}", fusion.name()));
             g.sample_size(10).measurement_time(Duration::from_secs(3));
             let mut kernel = Vec::new();

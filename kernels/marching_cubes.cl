@@ -339,25 +339,19 @@ inline bool tail_uniform(__global const float *vol, ulong b00, ulong b10, ulong 
     return in || out;
 }
 
-// The owned edges at position i of the row: adds their interior vertices to
-// n[axis] and their hits to *hits.
-inline void count_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
-                        uint nx, uint y, uint z, float iso, uint *n, uint *hits)
+// The owned edges at position i of the row: their interior vertices along
+// x, y, z in bits 0, 8, 16 and their hits in bits 24.. (scalars, so the
+// counters stay in registers).
+inline uint count_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                        uint nx, uint y, uint z, float iso)
 {
     float c;
     const float a = vol[b00 + i];
-    uint k;
-    if (i + 1 < nx) {
-        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
-        n[0] += k == EV_IN;
-        *hits += k >= EV_LO;
-    }
-    k = edge_kind(a, vol[b10 + i], iso, y, &c);
-    n[1] += k == EV_IN;
-    *hits += k >= EV_LO;
-    k = edge_kind(a, vol[b01 + i], iso, z, &c);
-    n[2] += k == EV_IN;
-    *hits += k >= EV_LO;
+    const uint kx = i + 1 < nx ? edge_kind(a, vol[b00 + i + 1], iso, i, &c) : EV_NONE;
+    const uint ky = edge_kind(a, vol[b10 + i], iso, y, &c);
+    const uint kz = edge_kind(a, vol[b01 + i], iso, z, &c);
+    return (uint)(kx == EV_IN) | ((uint)(ky == EV_IN) << 8) | ((uint)(kz == EV_IN) << 16) |
+           (((uint)(kx >= EV_LO) + (uint)(ky >= EV_LO) + (uint)(kz >= EV_LO)) << 24);
 }
 
 // Lower corner of edge e (table numbering), and the edge along `axis` whose
@@ -381,7 +375,7 @@ inline uint edge_id(uint axis, uint c0)
 // theirs, as vertex fusion's twin cancellation would. Rare (a fan over a loop
 // through all four edges of an ambiguous face), so it may be slow. Twin:
 // cpu::marching_cubes::has_twin.
-inline bool has_twin(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+__attribute__((noinline)) bool has_twin(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
                      uint nz, float iso, uint cas, uint j, __constant uchar *counts,
                      __constant uchar *tris)
 {
@@ -453,8 +447,10 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     GID_OR_RETURN(grid_rows);
     GRID_ROW_SETUP
     const bool cell = hy && hz;
-    uint n[3] = {0, 0, 0};
-    uint hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
+    // Per position at most one owned edge of each kind and three hits: the
+    // packed counts of count_owned add up without carries over a 16-cell
+    // chunk, so they are unpacked once per chunk (and per tail position).
+    uint n0 = 0, n1 = 0, n2 = 0, hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
     float v[8];
     uint x = 0;
     for (; x + 16 < nx; x += 16) {
@@ -462,24 +458,39 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
             continue;
         lo = min(lo, x);
         hi = x + 16;
+        uint packed = 0;
         for (uint i = x; i < x + 16; ++i) {
-            count_owned(vol, b00, b10, b01, i, nx, y, z, iso, n, &hits);
             if (cell) {
                 const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+                // A finite cell with all corners on one side: its edges, the
+                // row's owned edges at i among them, carry nothing.
+                if (cas == 0 || cas == 255)
+                    continue;
+                packed += count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
                 if (cas < 256) {
                     const uint tw =
                         twins_of(vol, i, y, z, nx, ny, nz, iso, cas, counts, tris, flat);
                     ntri += counts[cas] - tw;
                     twins += tw;
                 }
+            } else {
+                packed += count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
             }
         }
+        n0 += packed & 0xFF;
+        n1 += (packed >> 8) & 0xFF;
+        n2 += (packed >> 16) & 0xFF;
+        hits += packed >> 24;
     }
     if (!tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
         lo = min(lo, x);
         hi = nx;
         for (uint i = x; i < nx; ++i) {
-            count_owned(vol, b00, b10, b01, i, nx, y, z, iso, n, &hits);
+            const uint packed = count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
+            n0 += packed & 0xFF;
+            n1 += (packed >> 8) & 0xFF;
+            n2 += (packed >> 16) & 0xFF;
+            hits += packed >> 24;
             if (cell && i + 1 < nx) {
                 const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
                 if (cas < 256) {
@@ -491,12 +502,12 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
             }
         }
     }
-    rowc[gid] = n[0] + n[1] + n[2];
+    rowc[gid] = n0 + n1 + n2;
     rowc[grid_rows + gid] = ntri;
     rowc[2 * grid_rows + gid] = hits;
     rowc[3 * grid_rows + gid] = twins;
-    split[2 * gid] = n[0];
-    split[2 * gid + 1] = n[0] + n[1];
+    split[2 * gid] = n0;
+    split[2 * gid + 1] = n0 + n1;
     trim[2 * gid] = lo;
     trim[2 * gid + 1] = hi;
 }
@@ -608,6 +619,9 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
             continue;
         }
         const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        // All corners finite and on one side: nothing to write or count.
+        if (cas == 0 || cas == 255)
+            continue;
         // The cell's twelve edges in table order (see the header's edge numbering).
         k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);
         k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);

@@ -86,7 +86,7 @@ pub struct IsoOptions {
 impl Default for IsoOptions {
     fn default() -> Self {
         IsoOptions {
-            fusion: Fusion::Hash,
+            fusion: Fusion::Direct,
             inside: Inside::Below,
             curvature: None,
             curvature_normals: IsoNormals::Gradient,

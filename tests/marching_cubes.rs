@@ -112,7 +112,10 @@ fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
             let st = s.extract(iso, Fusion::Direct).unwrap();
             assert_eq!(st.exact_hits, 0);
             let names: Vec<&str> = st.timing.steps.iter().map(|s| s.step.name()).collect();
-            assert_eq!(names, ["direct_count", "scan_exclusive", "direct_triangles"]);
+            assert_eq!(
+                names,
+                ["direct_count", "scan_exclusive", "direct_triangles"]
+            );
         }
     }
 }
@@ -130,13 +133,25 @@ fn the_flat_flags_mark_exactly_the_triangles_in_a_cube_face() {
     };
     let mut flagged = 0;
     for case in 0..256 {
-        for (j, tri) in t.tris[case].chunks(3).take(t.counts[case] as usize).enumerate() {
+        for (j, tri) in t.tris[case]
+            .chunks(3)
+            .take(t.counts[case] as usize)
+            .enumerate()
+        {
             let [a, b, c] = [tri[0], tri[1], tri[2]].map(|e| faces(e as usize));
             let in_face = a.iter().any(|f| b.contains(f) && c.contains(f));
-            assert_eq!(t.flat[case] >> j & 1 == 1, in_face, "case {case} triangle {j}");
+            assert_eq!(
+                t.flat[case] >> j & 1 == 1,
+                in_face,
+                "case {case} triangle {j}"
+            );
             flagged += in_face as usize;
         }
-        assert_eq!(t.flat[case] >> t.counts[case], 0, "case {case}: flags past the triangles");
+        assert_eq!(
+            t.flat[case] >> t.counts[case],
+            0,
+            "case {case}: flags past the triangles"
+        );
     }
     assert!(flagged > 0, "the fan triangulation has triangles in faces");
 }

@@ -296,7 +296,7 @@ def isosurface(
     *,
     spacing: Optional[Sequence[float]] = None,
     origin: Optional[Sequence[float]] = None,
-    fusion: str = "hash",
+    fusion: str = "direct",
     inside: str = "below",
     curvature: bool = False,
     normals: bool = False,
@@ -319,8 +319,10 @@ def isosurface(
 
     ``inside``: "below" (signed distance fields, the default) or "above"
     (densities): faces and normals point away from that side.
-    ``fusion``: "hash" (Griffin et al.), "edge" (exact keys) or "none" (the
-    triangle soup). ``curvature=True`` also computes the curvature of the
+    ``fusion``: "direct" (each vertex made once by its voxel edge, as Flying
+    Edges does: exact and the fastest), "edge" (the soup fused by exact
+    keys), "hash" (Griffin et al.'s position hash) or "none" (the triangle
+    soup). ``curvature=True`` also computes the curvature of the
     result on the device; ``normals=True`` adds gradient normals.
 
     Returns an :class:`Isosurface`, which unpacks as ``vertices, faces``.

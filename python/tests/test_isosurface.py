@@ -34,7 +34,7 @@ def euler(v, f):
 
 
 @pytest.mark.parametrize("iso", [0.0, 0.37])
-@pytest.mark.parametrize("fusion", ["hash", "edge"])
+@pytest.mark.parametrize("fusion", ["direct", "hash", "edge"])
 def test_same_surface_as_scikit_image(device, iso, fusion):
     measure = pytest.importorskip("skimage.measure")
     vol = sphere_sdf()  # (z, y, x), deliberately not a cube

@@ -53,9 +53,12 @@ pub struct IsoArgs {
     /// Raw input: bytes to skip before the data.
     #[arg(long, default_value_t = 0)]
     header_bytes: usize,
-    /// Vertex fusion: hash (Griffin et al.'s position hash + radix sort), edge
-    /// (exact voxel-edge keys), none (triangle soup).
-    #[arg(long, value_enum, default_value = "hash")]
+    /// How triangles share vertices: direct (each vertex made once by its
+    /// voxel edge and numbered by a scan, as Flying Edges does; exact and
+    /// fastest), edge (a triangle soup fused by exact voxel-edge keys), hash
+    /// (the soup fused by Griffin et al.'s position hash + radix sort), none
+    /// (the triangle soup).
+    #[arg(long, value_enum, default_value = "direct")]
     fusion: Fusion,
     /// Write per-vertex normals from the volume gradient.
     #[arg(long)]

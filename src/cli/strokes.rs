@@ -185,7 +185,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
 
     // The surface under the strokes.
     let mut ex = shapecue::stages::marching_cubes::Isosurfacer::new(gpu.clone(), &vol)?;
-    ex.extract(iso_below, shapecue::spec::vertex_fusion::Fusion::Edge)?;
+    ex.extract(iso_below, shapecue::spec::vertex_fusion::Fusion::Direct)?;
     let (ipos, faces) = ex.read_index_space()?;
     let mesh = ex.world_mesh(&ipos, faces);
     if mesh.n_faces() == 0 {

@@ -261,7 +261,9 @@ pub fn has_twin(vol: &Volume, iso: f32, cell: [usize; 3], case: usize, j: usize)
     let a = [0, 1, 2].map(|i| t.tris[case][3 * j + i] as usize);
     let side = |e: usize, f: usize| (edge_corners(e).0 >> f) & 1;
     let Some(f) = (0..3).find(|&f| {
-        a.iter().all(|&e| e / 4 != f) && side(a[0], f) == side(a[1], f) && side(a[1], f) == side(a[2], f)
+        a.iter().all(|&e| e / 4 != f)
+            && side(a[0], f) == side(a[1], f)
+            && side(a[1], f) == side(a[2], f)
     }) else {
         return false;
     };
@@ -413,7 +415,11 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
     hit_points.sort_unstable();
     for &g in &hit_points {
         let g = g as usize;
-        positions.push([(g % nx) as f32, (g / nx % ny) as f32, (g / (nx * ny)) as f32]);
+        positions.push([
+            (g % nx) as f32,
+            (g / nx % ny) as f32,
+            (g / (nx * ny)) as f32,
+        ]);
     }
     let t = table();
     let mut faces = Vec::new();

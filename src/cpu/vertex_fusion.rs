@@ -90,10 +90,7 @@ pub fn fuse(soup: &[SoupVertex], fusion: Fusion) -> Fused {
     sorted.sort_by_key(|&(k, _)| k);
     let rep = fuse_index(soup, &keys, &sorted, fusion == Fusion::Hash);
     let positions: Vec<[f32; 3]> = soup.iter().map(|s| s.p).collect();
-    let faces: Vec<[u32; 3]> = rep
-        .chunks(3)
-        .map(|r| [r[0], r[1], r[2]])
-        .collect();
+    let faces: Vec<[u32; 3]> = rep.chunks(3).map(|r| [r[0], r[1], r[2]]).collect();
     fuse_finish(&positions, &faces)
 }
 

@@ -205,8 +205,8 @@ impl Step {
         match self {
             CurvMaxFace | CurvClear | CurvNormalsAreas | CurvFrames | CurvTensor
             | CurvPrincipal | CurvDcurv => Family::Curvature,
-            McClassify | McTriangles | McIota | McGradientNormals | McDirectCount | McDirectHits
-            | McDirectTriangles | McDirectPoints => Family::MarchingCubes,
+            McClassify | McTriangles | McIota | McGradientNormals | McDirectCount
+            | McDirectHits | McDirectTriangles | McDirectPoints => Family::MarchingCubes,
             FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,

@@ -493,7 +493,9 @@ impl Isosurfacer {
             ],
         )?;
         if cleanup {
-            let (c, ft) = self.fuser.finish(&self.dfaces.buf, &self.dpos.buf, slots, t)?;
+            let (c, ft) = self
+                .fuser
+                .finish(&self.dfaces.buf, &self.dpos.buf, slots, t)?;
             st.vertices = c.vertices;
             st.faces = c.faces;
             st.degenerate_dropped = twins + c.dropped;

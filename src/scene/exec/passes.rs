@@ -463,11 +463,11 @@ impl<'s, 'g> Executor<'s, 'g> {
             unreachable!("planned for a volume input")
         };
         let ex = self.iso.as_mut().expect("built for the isosurface pass");
-        let s = ex.extract(*iso_value, crate::spec::vertex_fusion::Fusion::Edge)?;
+        let s = ex.extract(*iso_value, crate::spec::vertex_fusion::Fusion::Direct)?;
         self.rec.kernels(
             Pass::Isosurface,
             &s.timing,
-            "marching cubes + exact edge-key fusion",
+            "marching cubes with direct vertex numbering",
         );
         let m = ex.read()?;
         if m.n_faces() == 0 {
