@@ -81,6 +81,9 @@ pub struct IsoOptions {
     /// Also compute per-vertex normals from the volume gradient
     /// ([`Isosurface::normals`]).
     pub gradient_normals: bool,
+    /// Timed extractions after the first (which warms the device up), with
+    /// the volume on the device: their timings are [`Isosurface::runs`].
+    pub timed_runs: usize,
 }
 
 impl Default for IsoOptions {
@@ -91,6 +94,7 @@ impl Default for IsoOptions {
             curvature: None,
             curvature_normals: IsoNormals::Gradient,
             gradient_normals: false,
+            timed_runs: 0,
         }
     }
 }
@@ -108,6 +112,8 @@ pub struct Isosurface {
     pub stats: IsoStats,
     /// Uploading the volume and building the programs, ms.
     pub upload_ms: f64,
+    /// Timings of the [`IsoOptions::timed_runs`] extractions.
+    pub runs: Vec<crate::spec::timing::Timing>,
 }
 
 /// The isosurface of `volume` at `iso` on the default device: marching
@@ -147,7 +153,12 @@ pub fn isosurface_on(
     let t_up = Instant::now();
     let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
     let upload_ms = t_up.elapsed().as_secs_f64() * 1e3;
+    // The stats are the first extraction's; the timed runs repeat it.
     let stats = ex.extract(iso, opts.fusion)?;
+    let mut runs = Vec::with_capacity(opts.timed_runs);
+    for _ in 0..opts.timed_runs {
+        runs.push(ex.extract(iso, opts.fusion)?.timing);
+    }
     let curvature = match opts.curvature {
         Some(o) => {
             let o = CurvatureOptions {
@@ -182,6 +193,7 @@ pub fn isosurface_on(
         curvature,
         stats,
         upload_ms,
+        runs,
     })
 }
 

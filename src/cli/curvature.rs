@@ -253,7 +253,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// The `--runs` keys of the device stats: the count, kernel and wall
 /// medians and minima, the median of each pass, and an estimate of the
 /// driver's compilation at first launch (first run's wall − median wall).
-fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
+pub(super) fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
     let mut kernel: Vec<f64> = timed.iter().map(|t| t.kernel_ms).collect();
     let mut wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
     let (kmin, wmin) = (

@@ -91,21 +91,25 @@ pub struct IsoArgs {
     /// Largest resolution of the report's sweep.
     #[arg(long, default_value_t = 512)]
     max_resolution: usize,
-    /// Runs per measurement in the report (median).
-    #[arg(long, default_value_t = 5)]
-    runs: usize,
+    /// Runs per measurement in the report (median, default 5); otherwise one
+    /// warm-up and this many more timed extractions with the volume on the
+    /// device, whose medians --stats gives.
+    #[arg(long)]
+    runs: Option<usize>,
 }
 
 /// Runs `shapecue isosurface`.
 pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
-    shapecue::spec::limits::check_count("--runs", a.runs, 10_000)?;
+    if let Some(n) = a.runs {
+        shapecue::spec::limits::check_count("--runs", n, 10_000)?;
+    }
     super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
     if a.report {
         let gpu = Arc::new(Gpu::new(device)?);
         super::print_str(&super::tables::isosurface_report(
             gpu,
             a.max_resolution,
-            a.runs,
+            a.runs.unwrap_or(5),
         )?)?;
         return Ok(());
     }
@@ -166,6 +170,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         curvature,
         curvature_normals: a.curvature_normals,
         gradient_normals: a.normals && a.output.is_some(),
+        timed_runs: a.runs.unwrap_or(0),
     };
     let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)
         .with_context(|| format!("uploading {name}"))?;
@@ -190,10 +195,21 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         st.timing.kernel_ms,
         st.timing.wall_ms
     );
+    if let Some(n) = a.runs {
+        let mut k: Vec<f64> = s.runs.iter().map(|t| t.kernel_ms).collect();
+        let mut w: Vec<f64> = s.runs.iter().map(|t| t.wall_ms).collect();
+        out!(
+            "{n} timed extractions: median {:.2} ms kernels, {:.2} ms wall",
+            shapecue::metrics::median(&mut k),
+            shapecue::metrics::median(&mut w)
+        );
+    }
+    let t_write = Instant::now();
     if let Some(out) = &a.output {
         write_ply(out, &s)?;
         out!("wrote {}", out.display());
     }
+    let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
     if let Some(path) = &a.stats {
         let curv = s.curvature.as_ref().map_or(serde_json::Value::Null, |c| {
             serde_json::json!({
@@ -206,7 +222,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
                 "device_bytes": c.device_bytes,
             })
         });
-        let stats = serde_json::json!({
+        let mut stats = serde_json::json!({
             "input": name,
             "device": gpu.info,
             "dims": vol.dims,
@@ -217,7 +233,11 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             "extraction": st,
             "quality": shapecue::mesh::quality(&s.mesh.positions, &s.mesh.faces),
             "curvature": curv,
+            "write_ms": write_ms,
         });
+        if !s.runs.is_empty() {
+            super::curvature::runs_stats(&mut stats, &s.runs, st.timing.wall_ms);
+        }
         write_json(path, &stats)?;
     }
     Ok(())
