@@ -142,6 +142,25 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     Ok(Mesh { positions, faces })
 }
 
+/// The vertex and face counts of the OFF header at the start of `head`
+/// (the keyword is optional, the counts may follow it on its line);
+/// `None` when they cannot be read from it.
+pub(super) fn header_counts(head: &[u8]) -> Option<(usize, usize)> {
+    let text = String::from_utf8_lossy(head);
+    let mut lines = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .filter(|l| !l.trim().is_empty());
+    let mut toks: Vec<&str> = lines.next()?.split_whitespace().collect();
+    if toks.first().is_some_and(|t| t.parse::<u64>().is_err()) {
+        toks.remove(0);
+        if toks.is_empty() {
+            toks = lines.next()?.split_whitespace().collect();
+        }
+    }
+    Some((toks.first()?.parse().ok()?, toks.get(1)?.parse().ok()?))
+}
+
 /// Refuses vertex and face counts that the `lines` element lines after
 /// the counts line (of a file of `size` bytes) cannot hold, naming the
 /// first element the file lacks, as the error of a truncated file does.

@@ -388,6 +388,17 @@ fn check_header_text(bytes: &[u8], source: &str) -> Result<()> {
     Ok(())
 }
 
+/// The counts of the `vertex` and `face` elements of the header at the
+/// start of `r` (0 for an element it lacks); `None` when the header
+/// cannot be read. Reads the header only.
+pub(super) fn header_counts(r: impl std::io::BufRead) -> Option<(usize, usize)> {
+    let header = Parser::<Skip>::new()
+        .read_header(&mut Reader::new(r))
+        .ok()?;
+    let count = |name: &str| header.elements.get(name).map_or(0, |d| d.count);
+    Some((count("vertex"), count("face")))
+}
+
 /// Parses a PLY file (ASCII, binary little- or big-endian).
 pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     check_header_text(bytes, source)?;
