@@ -411,9 +411,10 @@ fn detached_raw_data_files_are_sized_before_reading() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A gzip data file that inflates to gigabytes (3000 members of a
-/// megabyte of zeros each, about 3 MB on disk) is read as a stream and
-/// inflated one byte past what the header calls for, then refused.
+/// A gzip (NRRD) or zlib (MetaImage) data file that inflates to
+/// gigabytes (3000 members or flushes of a megabyte of zeros each, about
+/// 3 MB on disk) is read as a stream and inflated one byte past what the
+/// header calls for, then refused.
 #[test]
 fn detached_gzip_bomb_stops_at_the_header_size() {
     let dir = scratch("detached-gzip");
@@ -432,6 +433,35 @@ fn detached_gzip_bomb_stops_at_the_header_size() {
         "{e}"
     );
     let bound = SLACK + 4 * GRID;
+    assert!(peak <= bound, "{peak} bytes held (bound {bound}): {e}");
+    // MetaImage's zlib: one stream of 3000 sync-flushed megabytes of zeros
+    // (each flush after the first compresses to the same bytes).
+    let mut c = flate2::Compress::new(flate2::Compression::best(), true);
+    let mut flushed = || {
+        let zeros = vec![0u8; 1 << 20];
+        let mut out = Vec::with_capacity(1 << 16);
+        let before = c.total_in();
+        c.compress_vec(&zeros, &mut out, flate2::FlushCompress::Sync)
+            .unwrap();
+        assert_eq!(c.total_in() - before, zeros.len() as u64);
+        out
+    };
+    let first = flushed();
+    let next = flushed();
+    assert_eq!(flushed(), next);
+    let mut zbomb = first;
+    for _ in 0..3000 {
+        zbomb.extend_from_slice(&next);
+    }
+    assert!(zbomb.len() > 2 * SLACK, "{} bytes", zbomb.len());
+    std::fs::write(dir.join("bomb.z"), &zbomb).unwrap();
+    let [_, mhd] = detached_headers(&dir, "bomb.z", "", "CompressedData = True\n");
+    let (r, peak) = load_counted(&mhd);
+    let e = r.expect_err("more data than the header calls for");
+    assert!(
+        e.contains("bomb.z") && e.contains(&format!("more than the {GRID} bytes")),
+        "{e}"
+    );
     assert!(peak <= bound, "{peak} bytes held (bound {bound}): {e}");
     // The same data, as many bytes as the header says: loads.
     std::fs::write(dir.join("ok.gz"), gz(&vec![3u8; GRID])).unwrap();

@@ -501,6 +501,38 @@ fn huge_counts_in_tiny_files_are_refused_from_the_header() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The counts a PLY or OFF header declares, read without loading the
+/// file (as a flipbook's large frames are checked); OBJ has no header.
+#[test]
+fn header_counts_read_the_header_only() {
+    use shapecue::mesh::header_counts;
+    let dir = scratch("header-counts");
+    let off = write(
+        &dir,
+        "c.off",
+        "# comment\nOFF\n# another\n2147483648 7 0\n0 0 0\n",
+    );
+    assert_eq!(header_counts(&off).unwrap(), Some((1 << 31, 7)));
+    let inline = write(&dir, "i.off", "OFF 3 1 0\n0 0 0\n");
+    assert_eq!(header_counts(&inline).unwrap(), Some((3, 1)));
+    let ply = write(
+        &dir,
+        "h.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\n\
+         property float x\nproperty float y\nproperty float z\nend_header\n",
+    );
+    assert_eq!(header_counts(&ply).unwrap(), Some((4_294_967_295, 0)));
+    let obj = write(&dir, "o.obj", "v 0 0 0\n");
+    assert_eq!(header_counts(&obj).unwrap(), None);
+    let bad = write(&dir, "b.off", "OFF\nmany 1 0\n");
+    assert_eq!(header_counts(&bad).unwrap(), None);
+    assert!(matches!(
+        header_counts(&dir.join("gone.ply")),
+        Err(Error::Io { .. })
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn index_out_of_range_names_face_and_index() {
     let dir = scratch("out-of-range");
