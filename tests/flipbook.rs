@@ -316,6 +316,35 @@ fn a_bad_third_scene_fails_before_the_first_runs() {
             && e.contains("vertices"),
         "{e}"
     );
+    // A glTF clip's frames (the bundled fuzz seed: a one-second clip, 31
+    // frames at 30 fps) are counted before any scene runs, too.
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/glb/seed-skinned.glb");
+    std::fs::copy(&seed, dir.join("skinned.glb")).unwrap();
+    let clip = |name: &str, end: usize| {
+        scene_file(
+            &dir,
+            name,
+            &format!(
+                "[input]\ngltf = \"skinned.glb\"\n[frames]\nend = {end}\n[effects]\n\
+                 shading = {{}}\n[output]\ndir = \"out\"\nname = \"{name}\"\n"
+            ),
+        )
+    };
+    let scenes = vec![fine("a.toml", "a"), clip("clip.toml", 31)];
+    check_scenes(&scenes, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let scenes = vec![
+        fine("a.toml", "a"),
+        fine("b.toml", "b"),
+        clip("long.toml", 40),
+    ];
+    let e = check_scenes(&scenes, &opts)
+        .err()
+        .expect("past the clip")
+        .to_string();
+    assert!(
+        e.contains("long.toml") && e.contains("[frames]") && e.contains("31 frame"),
+        "{e}"
+    );
     // Frames outside the range are not checked.
     let scenes = vec![book("book.toml", "[frames]\nend = 2\n")];
     check_scenes(&scenes, &opts).unwrap_or_else(|e| panic!("{e}"));
