@@ -1,4 +1,4 @@
-//! The scene executor: runs exactly the passes of a [`Plan`] over a scene's
+//! The scene executor: runs exactly the passes of a [`Plan`](crate::scene::planner::Plan) over a scene's
 //! frames and views, renders, writes the images, and reports which passes
 //! ran, how often and for how long.
 //!
@@ -17,6 +17,12 @@
 //! Timing: device passes report OpenCL kernel time; host passes (loading a
 //! flipbook frame, host normals, building topology, rendering) report wall
 //! time. The report says which, per pass.
+//!
+//! A run of several scenes checks them all first ([`check_scenes`]):
+//! output collisions, frame ranges against each animation, a flipbook's
+//! frames against its first frame's topology; the animated inputs it loads
+//! for that go to [`run_checked`], so nothing is loaded twice and a bad
+//! last scene fails the run before the first writes anything.
 //!
 //! The plan is the program: [`run`] walks the plan's passes in order,
 //! filtered by lifetime (topology passes on a new topology, pose passes per
