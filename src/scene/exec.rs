@@ -1,6 +1,7 @@
-//! The scene executor: runs exactly the passes of a [`Plan`](crate::scene::planner::Plan) over a scene's
-//! frames and views, renders, writes the images, and reports which passes
-//! ran, how often and for how long.
+//! The scene executor: runs exactly the passes of a
+//! [`Plan`](crate::scene::planner::Plan) over a scene's frames and views,
+//! renders, writes the images, and reports which passes ran, how often and
+//! for how long.
 //!
 //! Lifetimes (see [`crate::scene::planner`]):
 //! - *topology* passes run when a topology first appears (once for a static,
