@@ -693,10 +693,14 @@ impl Payload<'_> {
     /// tell how many values they hold.
     fn read_data_file(&self, path: &Path, count: usize, out: &mut Vec<f32>) -> Result<()> {
         let el = format!("data file {}", path.display());
-        if self.encoding == Encoding::Ascii {
-            let data = read_file(path)?;
-            return self.read_chunk(&data, &el, count, out);
-        }
+        let compression = match self.encoding {
+            Encoding::Ascii => {
+                let data = read_file(path)?;
+                return self.read_chunk(&data, &el, count, out);
+            }
+            Encoding::Raw => None,
+            Encoding::Compressed(kind) => Some(kind),
+        };
         let src = self.source;
         let io = |source| Error::Io {
             path: path.to_path_buf(),
@@ -733,9 +737,8 @@ impl Payload<'_> {
                 ),
             )
         };
-        let data = match self.encoding {
-            Encoding::Ascii => unreachable!("read whole above"),
-            Encoding::Raw => {
+        let data = match compression {
+            None => {
                 let (offset, found) = match self.byte_skip {
                     Skip::Bytes(n) => (n as u64, rest.saturating_sub(n as u64)),
                     // The last bytes: a larger file is fine, a smaller one not.
@@ -753,7 +756,7 @@ impl Payload<'_> {
                 r.read_exact(&mut buf).map_err(io)?;
                 buf
             }
-            Encoding::Compressed(kind) => {
+            Some(kind) => {
                 let skip = match self.byte_skip {
                     Skip::Bytes(n) => n,
                     Skip::ToEnd => {
