@@ -19,6 +19,13 @@
 //! that cannot be read, or an [`Error::UnsupportedFormat`] for valid input
 //! that shapecue does not read (a sheared grid, a 64-bit integer type, ...).
 //!
+//! Memory is bounded by the file: a header's sizes are checked against the
+//! bytes before anything is allocated, compressed data are inflated no
+//! further than the header calls for, and the binary detached data files of
+//! NRRD and MetaImage headers are sized from their metadata and read as a
+//! stream (only the bytes to skip and the samples), so a data file much
+//! larger than its header says is refused unread.
+//!
 //! Grids whose axes point the negative way (a negative spacing, or a
 //! direction matrix with `-1` on its diagonal) are flipped on load so that
 //! spacing is always positive and every sample keeps its world position.
