@@ -724,6 +724,89 @@ fn render_refuses_two_scenes_writing_the_same_files_before_either_runs() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// Three scenes whose third is a flipbook with a frame of another
+/// topology: the run fails before the first scene renders, naming the
+/// scene file, the frame and its file, and writes nothing; with the frame
+/// repaired, all three render, the flipbook from the input the check loaded.
+#[test]
+fn render_checks_the_third_scene_s_flipbook_before_the_first_runs() {
+    let d = scratch("render-flipbook-check");
+    let frames = d.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let m = shapecue::mesh::icosphere(1.0, 1);
+    for f in 0..3 {
+        let s = 1.0 + 0.1 * f as f64;
+        let pos = m.positions.iter().map(|p| p.map(|c| c * s));
+        std::fs::write(
+            frames.join(format!("f_{f}.obj")),
+            common::obj_text(pos, &m.faces),
+        )
+        .unwrap();
+    }
+    let fine = |name: &str| {
+        format!(
+            "[input]\ngenerate = \"sphere\"\nresolution = 50\n[effects]\nshading = {{}}\n\
+             [output]\nname = \"{name}\"\nsize = [16, 16]\n"
+        )
+    };
+    let paths: Vec<std::path::PathBuf> = ["a", "b", "c"]
+        .iter()
+        .map(|n| d.join(format!("{n}.toml")))
+        .collect();
+    std::fs::write(&paths[0], fine("a")).unwrap();
+    std::fs::write(&paths[1], fine("b")).unwrap();
+    std::fs::write(
+        &paths[2],
+        "[input]\nflipbook = \"frames/f_*.obj\"\n[effects]\nshading = {}\n\
+         [output]\nname = \"c\"\nsize = [16, 16]\n",
+    )
+    .unwrap();
+    let other = shapecue::mesh::icosphere(1.0, 2);
+    std::fs::write(
+        frames.join("f_2.obj"),
+        common::obj_text(other.positions.iter().copied(), &other.faces),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let args = |extra: &[&str]| {
+        let mut v: Vec<String> = vec!["render".into()];
+        v.extend(paths.iter().map(|p| p.display().to_string()));
+        v.extend(["--out".into(), out.display().to_string()]);
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    let r = run_cli(args(&[]));
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("c.toml")
+            && err.contains("flipbook frame 2")
+            && err.contains("f_2.obj")
+            && err.contains("vertices"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing ran, nothing was written");
+
+    let s = 1.2;
+    let pos = m.positions.iter().map(|p| p.map(|c| c * s));
+    std::fs::write(frames.join("f_2.obj"), common::obj_text(pos, &m.faces)).unwrap();
+    let r = run_cli(args(&[]));
+    if common::cli_gl_missing(&r) {
+        let _ = std::fs::remove_dir_all(&d);
+        return;
+    }
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for f in [
+        "a_report.json",
+        "b_report.json",
+        "c_f0002_v00.png",
+        "c_report.json",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn meshes_too_large_or_small_to_draw_in_single_precision_are_refused_by_name() {
     // A unit sphere scaled by 1e30 and by 1e-30: curvature works on both (it

@@ -235,3 +235,167 @@ fn welding_uses_the_first_frame_map() {
     let fb = Flipbook::open("w_*.obj", &dir, &LoadOptions::default()).unwrap();
     assert_eq!(fb.frame(2).unwrap(), torn.positions);
 }
+
+// ---------------------------------------------------------------------------
+// Checks before a run: frame ranges and topology of every scene up front
+// ---------------------------------------------------------------------------
+
+/// Writes `name` in `dir` and loads it as a scene.
+fn scene_file(dir: &Path, name: &str, text: &str) -> shapecue::scene::file::Scene {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    shapecue::scene::file::Scene::load(&p).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// Three scenes whose third is bad: the run's up-front check refuses it
+/// (naming the scene file, the frame and its file, and the problem) before
+/// the first scene starts, and nothing is written.
+#[test]
+fn a_bad_third_scene_fails_before_the_first_runs() {
+    use shapecue::scene::exec::{ExecOptions, check_scenes};
+    let dir = scratch("check-scenes");
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    write_sequence(&frames, 4, "obj");
+    let out = dir.join("out");
+    let fine = |name: &str, prefix: &str| {
+        scene_file(
+            &dir,
+            name,
+            &format!(
+                "[input]\ngenerate = \"sphere\"\nresolution = 50\n[effects]\nshading = {{}}\n\
+                 [output]\ndir = \"out\"\nname = \"{prefix}\"\nsize = [16, 16]\n"
+            ),
+        )
+    };
+    let book = |name: &str, frames: &str| {
+        scene_file(
+            &dir,
+            name,
+            &format!(
+                "[input]\nflipbook = \"frames/frame_*.obj\"\n{frames}[effects]\nshading = {{}}\n\
+                 [output]\ndir = \"out\"\nname = \"{name}\"\nsize = [16, 16]\n"
+            ),
+        )
+    };
+    let opts = ExecOptions::default();
+    let good = book("book.toml", "[frames]\nstart = 1\n");
+    let scenes = vec![fine("a.toml", "a"), fine("b.toml", "b"), good];
+    let checked = check_scenes(&scenes, &opts).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(checked.len(), 3);
+
+    // A frame range past the flipbook's 4 frames.
+    let scenes = vec![
+        fine("a.toml", "a"),
+        fine("b.toml", "b"),
+        book("range.toml", "[frames]\nend = 6\n"),
+    ];
+    let e = check_scenes(&scenes, &opts)
+        .err()
+        .expect("a bad range")
+        .to_string();
+    assert!(
+        e.contains("range.toml") && e.contains("[frames]") && e.contains("4 frame"),
+        "{e}"
+    );
+    // Frame 2 with another vertex count.
+    write_obj(&frames.join("frame_2.obj"), &icosphere(1.0, 2));
+    let scenes = vec![
+        fine("a.toml", "a"),
+        fine("b.toml", "b"),
+        book("book.toml", ""),
+    ];
+    let e = check_scenes(&scenes, &opts)
+        .err()
+        .expect("a bad frame")
+        .to_string();
+    assert!(
+        e.contains("book.toml")
+            && e.contains("flipbook frame 2")
+            && e.contains("frame_2.obj")
+            && e.contains("vertices"),
+        "{e}"
+    );
+    // A glTF clip's frames (the bundled fuzz seed: a one-second clip, 31
+    // frames at 30 fps) are counted before any scene runs, too.
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/glb/seed-skinned.glb");
+    std::fs::copy(&seed, dir.join("skinned.glb")).unwrap();
+    let clip = |name: &str, end: usize| {
+        scene_file(
+            &dir,
+            name,
+            &format!(
+                "[input]\ngltf = \"skinned.glb\"\n[frames]\nend = {end}\n[effects]\n\
+                 shading = {{}}\n[output]\ndir = \"out\"\nname = \"{name}\"\n"
+            ),
+        )
+    };
+    let scenes = vec![fine("a.toml", "a"), clip("clip.toml", 31)];
+    check_scenes(&scenes, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let scenes = vec![
+        fine("a.toml", "a"),
+        fine("b.toml", "b"),
+        clip("long.toml", 40),
+    ];
+    let e = check_scenes(&scenes, &opts)
+        .err()
+        .expect("past the clip")
+        .to_string();
+    assert!(
+        e.contains("long.toml") && e.contains("[frames]") && e.contains("31 frame"),
+        "{e}"
+    );
+    // Frames outside the range are not checked.
+    let scenes = vec![book("book.toml", "[frames]\nend = 2\n")];
+    check_scenes(&scenes, &opts).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!out.exists(), "the checks write nothing");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Sequences too large to load twice are checked from their PLY headers:
+/// a frame declaring another vertex count is refused without parsing it.
+#[test]
+fn large_sequences_are_checked_from_their_headers() {
+    use shapecue::mesh::flipbook::FULL_CHECK_BYTES;
+    let dir = scratch("check-headers");
+    write_sequence(&dir, 3, "ply");
+    // Frame 2 claims another vertex count; its body is left as it was (a
+    // full load would report the mismatch differently).
+    let p2 = dir.join("frame_2.ply");
+    let bytes = std::fs::read(&p2).unwrap();
+    let nv = base().positions.len();
+    let text = String::from_utf8_lossy(&bytes);
+    let from = format!("element vertex {nv}\n");
+    assert!(text.contains(&from));
+    let mut patched = bytes.clone();
+    let at = text.find(&from).unwrap();
+    let to = format!("element vertex {}\n", nv + 1);
+    assert_eq!(to.len(), from.len(), "same length: the body stays in place");
+    patched[at..at + to.len()].copy_from_slice(to.as_bytes());
+    std::fs::write(&p2, &patched).unwrap();
+    // Past the full-check size: sparse padding after the data (every frame,
+    // so that the total is large; the loader ignores bytes past the faces).
+    for f in 0..3 {
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .open(dir.join(format!("frame_{f}.ply")))
+            .unwrap();
+        file.set_len(FULL_CHECK_BYTES / 2).unwrap();
+    }
+    assert_eq!(
+        shapecue::mesh::header_counts(&p2).unwrap(),
+        Some((nv + 1, base().faces.len()))
+    );
+    let fb = Flipbook::open("frame_*.ply", &dir, &LoadOptions::default()).unwrap();
+    assert!(fb.check_frames(&[0, 1]).is_ok());
+    let (i, e) = fb.check_frames(&[0, 1, 2]).unwrap_err();
+    let e = e.to_string();
+    assert_eq!(i, 2);
+    assert!(
+        e.contains("frame_2.ply")
+            && e.contains(&format!("{} vertices", nv + 1))
+            && e.contains("frame_0.ply"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

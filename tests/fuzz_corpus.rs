@@ -313,6 +313,164 @@ fn lying_headers_allocate_no_more_than_the_file_justifies() {
 /// Deflate's largest expansion, as the loaders assume it.
 const MAX_DEFLATE: usize = 1032;
 
+/// A scratch folder of its own for one test.
+fn scratch(tag: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("shapecue-fuzz-corpus-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Loads `header` with the allocation counter on: the result (the error's
+/// text) and the peak bytes held while loading.
+fn load_counted(header: &Path) -> (Result<shapecue::volume::Volume, String>, usize) {
+    let base = counting::now();
+    counting::reset();
+    let r = shapecue::volume::load(header, None).map_err(|e| e.to_string());
+    (r, counting::peak_since(base))
+}
+
+/// Samples of the 64×64×64 uchar grid of the headers below, one byte each.
+const GRID: usize = 64 * 64 * 64;
+
+/// NRRD and MetaImage headers of a 64×64×64 uchar grid in `data`, with
+/// `extra` header lines (a byte skip, a compression).
+fn detached_headers(dir: &Path, data: &str, nrrd_extra: &str, mhd_extra: &str) -> [PathBuf; 2] {
+    let nhdr = dir.join("v.nhdr");
+    std::fs::write(
+        &nhdr,
+        format!(
+            "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 64 64 64\n{nrrd_extra}\
+             data file: {data}\n"
+        ),
+    )
+    .unwrap();
+    let mhd = dir.join("v.mhd");
+    std::fs::write(
+        &mhd,
+        format!(
+            "NDims = 3\nDimSize = 64 64 64\nElementType = MET_UCHAR\n{mhd_extra}\
+             ElementDataFile = {data}\n"
+        ),
+    )
+    .unwrap();
+    [nhdr, mhd]
+}
+
+/// A detached raw data file is sized from its metadata before it is read:
+/// one ten times larger than the header says is refused unread (or, with
+/// the data at the end of the file, only its last bytes are read); a
+/// smaller one is refused naming the file, the bytes expected and its size.
+#[test]
+fn detached_raw_data_files_are_sized_before_reading() {
+    let dir = scratch("detached-raw");
+    let big = dir.join("big.raw");
+    std::fs::write(&big, vec![7u8; 10 * GRID]).unwrap();
+    let small = dir.join("small.raw");
+    std::fs::write(&small, vec![7u8; 1000]).unwrap();
+    for header in detached_headers(&dir, "big.raw", "encoding: raw\n", "") {
+        let (r, peak) = load_counted(&header);
+        let e = r.expect_err("a data file ten times too large");
+        for needle in [
+            big.display().to_string(),
+            format!("expected {GRID} bytes"),
+            format!("found {}", 10 * GRID),
+        ] {
+            assert!(e.contains(&needle), "{needle:?} not in {e}");
+        }
+        assert!(peak <= SLACK, "{peak} bytes held to refuse it: {e}");
+    }
+    for header in detached_headers(&dir, "small.raw", "encoding: raw\n", "") {
+        let (r, _) = load_counted(&header);
+        let e = r.expect_err("a data file too small");
+        for needle in [
+            small.display().to_string(),
+            format!("expected {GRID} bytes"),
+            "found 1000".into(),
+            "the file has 1000 bytes".into(),
+        ] {
+            assert!(e.contains(&needle), "{needle:?} not in {e}");
+        }
+    }
+    // The data at the end: only the last bytes are read. The bound holds
+    // the samples once as bytes and once as f32 values.
+    for header in detached_headers(
+        &dir,
+        "big.raw",
+        "encoding: raw\nbyte skip: -1\n",
+        "HeaderSize = -1\n",
+    ) {
+        let (r, peak) = load_counted(&header);
+        let v = r.unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(v.values.len(), GRID);
+        assert!(v.values.iter().all(|&x| x == 7.0));
+        let bound = SLACK + 5 * GRID;
+        assert!(peak <= bound, "{peak} bytes held (bound {bound})");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A gzip (NRRD) or zlib (MetaImage) data file that inflates to
+/// gigabytes (3000 members or flushes of a megabyte of zeros each, about
+/// 3 MB on disk) is read as a stream and inflated one byte past what the
+/// header calls for, then refused.
+#[test]
+fn detached_gzip_bomb_stops_at_the_header_size() {
+    let dir = scratch("detached-gzip");
+    let member = gz(&vec![0u8; 1 << 20]);
+    let bomb: Vec<u8> = std::iter::repeat_n(member.as_slice(), 3000)
+        .flatten()
+        .copied()
+        .collect();
+    assert!(bomb.len() > 2 * SLACK, "{} bytes", bomb.len());
+    std::fs::write(dir.join("bomb.gz"), &bomb).unwrap();
+    let [nhdr, _] = detached_headers(&dir, "bomb.gz", "encoding: gzip\n", "");
+    let (r, peak) = load_counted(&nhdr);
+    let e = r.expect_err("more data than the header calls for");
+    assert!(
+        e.contains("bomb.gz") && e.contains(&format!("more than the {GRID} bytes")),
+        "{e}"
+    );
+    let bound = SLACK + 4 * GRID;
+    assert!(peak <= bound, "{peak} bytes held (bound {bound}): {e}");
+    // MetaImage's zlib: one stream of 3000 sync-flushed megabytes of zeros
+    // (each flush after the first compresses to the same bytes).
+    let mut c = flate2::Compress::new(flate2::Compression::best(), true);
+    let mut flushed = || {
+        let zeros = vec![0u8; 1 << 20];
+        let mut out = Vec::with_capacity(1 << 16);
+        let before = c.total_in();
+        c.compress_vec(&zeros, &mut out, flate2::FlushCompress::Sync)
+            .unwrap();
+        assert_eq!(c.total_in() - before, zeros.len() as u64);
+        out
+    };
+    let first = flushed();
+    let next = flushed();
+    assert_eq!(flushed(), next);
+    let mut zbomb = first;
+    for _ in 0..3000 {
+        zbomb.extend_from_slice(&next);
+    }
+    assert!(zbomb.len() > 2 * SLACK, "{} bytes", zbomb.len());
+    std::fs::write(dir.join("bomb.z"), &zbomb).unwrap();
+    let [_, mhd] = detached_headers(&dir, "bomb.z", "", "CompressedData = True\n");
+    let (r, peak) = load_counted(&mhd);
+    let e = r.expect_err("more data than the header calls for");
+    assert!(
+        e.contains("bomb.z") && e.contains(&format!("more than the {GRID} bytes")),
+        "{e}"
+    );
+    assert!(peak <= bound, "{peak} bytes held (bound {bound}): {e}");
+    // The same data, as many bytes as the header says: loads.
+    std::fs::write(dir.join("ok.gz"), gz(&vec![3u8; GRID])).unwrap();
+    let [nhdr, _] = detached_headers(&dir, "ok.gz", "encoding: gzip\n", "");
+    let v = shapecue::volume::load(&nhdr, None).unwrap();
+    assert!(v.values.iter().all(|&x| x == 3.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 // ---------------------------------------------------------------------------
 // Inputs the fuzzer (or reading for it) found, one test each
 // ---------------------------------------------------------------------------

@@ -412,6 +412,127 @@ fn truncated_binary_ply_names_the_element() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Headers claiming 2^31 vertices (or faces) in files of about a hundred
+/// bytes are refused before any element is read: the message names the
+/// file, the element, the declared count and how many the bytes can hold
+/// (element lines in ASCII, bytes per element in binary).
+#[test]
+fn huge_counts_in_tiny_files_are_refused_from_the_header() {
+    let dir = scratch("huge-counts");
+    let xyz = "property float x\nproperty float y\nproperty float z\n";
+    let face = "property list uchar int vertex_indices\n";
+    let tri_le: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    let binary = |order: &str, nv: u64, nf: u64, body: &[u8]| {
+        let mut b = format!(
+            "ply\nformat binary_{order}_endian 1.0\nelement vertex {nv}\n{xyz}\
+             element face {nf}\n{face}end_header\n"
+        )
+        .into_bytes();
+        b.extend_from_slice(body);
+        b
+    };
+    let ascii = |nv: u64, nf: u64| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex {nv}\n{xyz}element face {nf}\n{face}\
+             end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+        )
+        .into_bytes()
+    };
+    let cases: Vec<(&str, Vec<u8>, &[&str])> = vec![
+        (
+            "v.off",
+            b"OFF\n2147483648 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
+            &[
+                "vertex 4",
+                "declares 2147483648 vertices",
+                "holds only 4 lines",
+            ],
+        ),
+        (
+            "f.off",
+            b"OFF\n3 2147483648 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
+            &["face 1", "3 vertices and 2147483648 faces", "only 4 lines"],
+        ),
+        (
+            "v-ascii.ply",
+            ascii(1 << 31, 1),
+            &["vertex 4", "2147483648 'vertex' elements", "hold 4 lines"],
+        ),
+        (
+            "f-ascii.ply",
+            ascii(3, 1 << 31),
+            &["face 1", "2147483648 'face' elements", "1 of them left"],
+        ),
+        (
+            "v-le.ply",
+            binary("little", 1 << 31, 0, &tri_le),
+            &[
+                "vertex 3",
+                "2147483648 'vertex' elements of 12 bytes each",
+                "the 36 bytes after the header hold at most 3",
+            ],
+        ),
+        (
+            "v-be.ply",
+            binary("big", 1 << 31, 0, &[0; 40]),
+            &["vertex 3", "of 12 bytes each", "hold at most 3"],
+        ),
+        (
+            "f-le.ply",
+            binary("little", 3, 1 << 31, &tri_le),
+            &[
+                "face 0",
+                "2147483648 'face' elements of at least 1 bytes each",
+                "besides the 36 bytes",
+            ],
+        ),
+    ];
+    for (name, bytes, needles) in cases {
+        assert!(bytes.len() < 300, "{name}: {} bytes", bytes.len());
+        let msg = load_err(&write(&dir, name, &bytes));
+        for n in needles {
+            assert!(msg.contains(n), "{name}: {n:?} not in {msg}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The counts a PLY or OFF header declares, read without loading the
+/// file (as a flipbook's large frames are checked); OBJ has no header.
+#[test]
+fn header_counts_read_the_header_only() {
+    use shapecue::mesh::header_counts;
+    let dir = scratch("header-counts");
+    let off = write(
+        &dir,
+        "c.off",
+        "# comment\nOFF\n# another\n2147483648 7 0\n0 0 0\n",
+    );
+    assert_eq!(header_counts(&off).unwrap(), Some((1 << 31, 7)));
+    let inline = write(&dir, "i.off", "OFF 3 1 0\n0 0 0\n");
+    assert_eq!(header_counts(&inline).unwrap(), Some((3, 1)));
+    let ply = write(
+        &dir,
+        "h.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\n\
+         property float x\nproperty float y\nproperty float z\nend_header\n",
+    );
+    assert_eq!(header_counts(&ply).unwrap(), Some((4_294_967_295, 0)));
+    let obj = write(&dir, "o.obj", "v 0 0 0\n");
+    assert_eq!(header_counts(&obj).unwrap(), None);
+    let bad = write(&dir, "b.off", "OFF\nmany 1 0\n");
+    assert_eq!(header_counts(&bad).unwrap(), None);
+    assert!(matches!(
+        header_counts(&dir.join("gone.ply")),
+        Err(Error::Io { .. })
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn index_out_of_range_names_face_and_index() {
     let dir = scratch("out-of-range");

@@ -59,16 +59,18 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
         .iter()
         .map(|p| Scene::load(p))
         .collect::<shapecue::Result<_>>()?;
-    if !a.explain {
-        exec::check_scenes(&scenes, &opts)?;
-    }
-    for scene in &scenes {
-        if a.explain {
+    if a.explain {
+        for scene in &scenes {
             super::print_str(&exec::explain(scene, &opts)?)?;
-            continue;
         }
+        return Ok(());
+    }
+    // Outputs, frame ranges and flipbook topology of every scene; the
+    // animated inputs loaded for it are handed to their runs.
+    let checked = exec::check_scenes(&scenes, &opts)?;
+    for (scene, checked) in scenes.iter().zip(checked) {
         let bar = progress_bar(&scene.name);
-        let r = exec::run(scene, &opts, &mut |done, total| {
+        let r = exec::run_checked(scene, checked, &opts, &mut |done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })?;

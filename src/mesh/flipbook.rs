@@ -9,6 +9,10 @@
 //! count and the same faces as the first; a mismatch is an error naming the
 //! file and the first differing element, never a silently wrong pose.
 //!
+//! [`Flipbook::check_frames`] runs those checks on the frames a scene will
+//! render before any is rendered (in full for small sequences, from the
+//! file headers for large ones), so that a bad frame fails a run at once.
+//!
 //! With [`LoadOptions::weld`], the weld map of the first frame is applied to
 //! every frame (welding each frame on its own could merge different vertices
 //! when two of them touch in one pose); a frame in which two vertices welded
@@ -17,7 +21,7 @@
 use std::cmp::Ordering;
 use std::path::{Path, PathBuf};
 
-use super::{LoadOptions, Mesh, load};
+use super::{LoadOptions, Mesh, header_counts, load};
 use crate::error::{Error, Result};
 
 /// A sequence of mesh files with one topology, loaded frame by frame.
@@ -202,6 +206,91 @@ impl Flipbook {
             .collect())
     }
 
+    /// Checks, before anything is rendered, that frames `indices` have the
+    /// topology of the first frame, so that a run fails at once rather
+    /// than at the bad frame.
+    ///
+    /// Kept cheap: when the frame files to check total at most
+    /// [`FULL_CHECK_BYTES`], each is loaded and compared in full (vertex
+    /// and face counts, every face, the weld map) as [`Flipbook::frame`]
+    /// does; parsing such small files once more when they are rendered
+    /// costs a fraction of a second, and holding the positions of every
+    /// frame instead would defeat loading one frame at a time. Larger
+    /// sequences compare the vertex and face counts that each PLY or OFF
+    /// header declares with the first frame's, reading headers only; their
+    /// faces (and OBJ frames, which have no header) are compared when each
+    /// frame is loaded for rendering.
+    ///
+    /// # Errors
+    ///
+    /// The index of the first bad frame with its error: as
+    /// [`Flipbook::frame`], or [`Error::Io`] when its file cannot be read.
+    pub fn check_frames(&self, indices: &[usize]) -> std::result::Result<(), (usize, Error)> {
+        let mut total = 0u64;
+        for &i in indices {
+            let path = self.frames.get(i).ok_or_else(|| {
+                let e = Error::InvalidArgument(format!(
+                    "frame {i}: the sequence '{}' has {} frames",
+                    self.pattern,
+                    self.frames.len()
+                ));
+                (i, e)
+            })?;
+            let len = std::fs::metadata(path)
+                .map_err(|source| {
+                    let e = Error::Io {
+                        path: path.clone(),
+                        source,
+                    };
+                    (i, e)
+                })?
+                .len();
+            total = total.saturating_add(len);
+        }
+        if total <= FULL_CHECK_BYTES {
+            // Frame 0 is the first frame itself.
+            for &i in indices.iter().filter(|&&i| i != 0) {
+                self.frame(i).map_err(|e| (i, e))?;
+            }
+            return Ok(());
+        }
+        let first_path = &self.frames[0];
+        let Some((nv0, nf0)) = header_counts(first_path).map_err(|e| (0, e))? else {
+            return Ok(());
+        };
+        let ext = |p: &Path| p.extension().map(|e| e.to_ascii_lowercase());
+        for &i in indices.iter().filter(|&&i| i != 0) {
+            let path = &self.frames[i];
+            if ext(path) != ext(first_path) {
+                continue;
+            }
+            let Some((nv, nf)) = header_counts(path).map_err(|e| (i, e))? else {
+                continue;
+            };
+            let first = first_path.display();
+            let (element, problem) = if nv != nv0 {
+                (
+                    "vertices",
+                    format!("{nv} vertices, but the first frame ({first}) has {nv0}"),
+                )
+            } else if nf != nf0 {
+                (
+                    "faces",
+                    format!("{nf} faces, but the first frame ({first}) has {nf0}"),
+                )
+            } else {
+                continue;
+            };
+            let e = Error::input(
+                path.display().to_string(),
+                element,
+                format!("{problem} (frames must share one topology)"),
+            );
+            return Err((i, e));
+        }
+        Ok(())
+    }
+
     /// Frame `i` as a mesh (the positions of [`Flipbook::frame`] with the
     /// shared faces).
     ///
@@ -215,6 +304,11 @@ impl Flipbook {
         })
     }
 }
+
+/// The most bytes of frame files that [`Flipbook::check_frames`] loads in
+/// full to compare them with the first frame (32 MiB: a few tenths of a
+/// second of parsing); larger sequences are checked from their headers.
+pub const FULL_CHECK_BYTES: u64 = 32 << 20;
 
 /// Natural order of two strings: runs of ASCII digits compare as numbers
 /// (`frame_2` < `frame_10`), everything else character by character. Numbers

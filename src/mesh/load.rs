@@ -71,6 +71,46 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Mesh> {
     Ok(mesh)
 }
 
+/// The vertex and face (polygon) counts that a PLY or OFF file's header
+/// declares, read from the header alone: a cheap check of a file's size
+/// before it is loaded (a flipbook's frames against its first). `None` for
+/// OBJ, which has no header, and for a header these counts cannot be read
+/// from (loading the file reports what is wrong with it).
+///
+/// # Errors
+///
+/// [`Error::Io`] when the file cannot be opened or read.
+pub fn header_counts(path: &Path) -> Result<Option<(usize, usize)>> {
+    use std::io::Read;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let open = || {
+        std::fs::File::open(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    };
+    match ext.as_deref() {
+        Some("ply") => Ok(ply::header_counts(std::io::BufReader::new(open()?))),
+        Some("off") => {
+            // The counts are on the first lines after comments; 64 KiB
+            // holds them in any file whose comments are not a book.
+            let mut head = Vec::new();
+            open()?
+                .take(64 << 10)
+                .read_to_end(&mut head)
+                .map_err(|source| Error::Io {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+            Ok(off::header_counts(&head))
+        }
+        _ => Ok(None),
+    }
+}
+
 /// Appends the fan triangulation of `poly` (at least three indices) to `faces`.
 fn fan(poly: &[u32], faces: &mut Vec<[u32; 3]>) {
     if let Some((&first, rest)) = poly.split_first() {

@@ -17,7 +17,7 @@ mod solids;
 pub mod topology;
 
 pub use generate::*;
-pub use load::{LoadOptions, load};
+pub use load::{LoadOptions, header_counts, load};
 pub use quality::{MeshQuality, quality};
 pub use solids::*;
 

@@ -1,6 +1,7 @@
-//! The scene executor: runs exactly the passes of a [`Plan`] over a scene's
-//! frames and views, renders, writes the images, and reports which passes
-//! ran, how often and for how long.
+//! The scene executor: runs exactly the passes of a
+//! [`Plan`](crate::scene::planner::Plan) over a scene's frames and views,
+//! renders, writes the images, and reports which passes ran, how often and
+//! for how long.
 //!
 //! Lifetimes (see [`crate::scene::planner`]):
 //! - *topology* passes run when a topology first appears (once for a static,
@@ -17,6 +18,12 @@
 //! Timing: device passes report OpenCL kernel time; host passes (loading a
 //! flipbook frame, host normals, building topology, rendering) report wall
 //! time. The report says which, per pass.
+//!
+//! A run of several scenes checks them all first ([`check_scenes`]):
+//! output collisions, frame ranges against each animation, a flipbook's
+//! frames against its first frame's topology; the animated inputs it loads
+//! for that go to [`run_checked`], so nothing is loaded twice and a bad
+//! last scene fails the run before the first writes anything.
 //!
 //! The plan is the program: [`run`] walks the plan's passes in order,
 //! filtered by lifetime (topology passes on a new topology, pose passes per
@@ -36,7 +43,7 @@ pub use report::{PassRecord, RunReport};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::scene::file::Scene;
+use crate::scene::file::{Scene, Source};
 use crate::scene::planner::{Input, Lifetime, Pass, plan_with};
 use load::load;
 use passes::Executor;
@@ -78,15 +85,45 @@ pub fn run_on(
     run_with(Some(gpu), scene, opts, progress)
 }
 
+/// [`run`] with the input that [`check_scenes`] loaded for `scene` (see
+/// [`Checked`]), so that it is not loaded twice. A `checked` of another
+/// scene is ignored and the input loaded again.
+pub fn run_checked(
+    scene: &Scene,
+    checked: Checked,
+    opts: &ExecOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<RunReport> {
+    let pre = checked.input.filter(|_| checked.scene == scene.path);
+    run_loaded(None, scene, pre, opts, progress)
+}
+
 fn run_with(
     gpu: Option<&Arc<Gpu>>,
     scene: &Scene,
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport> {
+    run_loaded(gpu, scene, None, opts, progress)
+}
+
+/// [`run_with`] on an input already loaded (`pre`: the input and what
+/// loading it said), or loading it when `pre` is `None`.
+fn run_loaded(
+    gpu: Option<&Arc<Gpu>>,
+    scene: &Scene,
+    pre: Option<(load::Loaded, Vec<String>)>,
+    opts: &ExecOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<RunReport> {
     let t_all = Instant::now();
-    let mut notes = Vec::new();
-    let loaded = load(scene, &mut notes)?;
+    let (loaded, notes) = match pre {
+        Some(p) => p,
+        None => {
+            let mut notes = Vec::new();
+            (load(scene, &mut notes)?, notes)
+        }
+    };
     let frames = frame_indices(scene, loaded.frames())?;
     let out_dir = opts
         .out_dir
@@ -243,12 +280,85 @@ fn render_all(
     Ok(report)
 }
 
-/// Checks, before any scene of a run starts, what can be checked without
-/// loading inputs: no two scenes write the same report and images (same
-/// output folder and name), and without `force` no scene's report exists
-/// already. A collision used to surface only after the first scene had
-/// rendered.
-pub fn check_scenes(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
+/// What [`check_scenes`] learnt of one scene: the input it loaded to check
+/// the scene's frames (animated inputs only), for [`run_checked`] to use
+/// instead of loading it again.
+pub struct Checked {
+    /// The scene file it belongs to.
+    scene: PathBuf,
+    /// The loaded input and what loading it said.
+    input: Option<(load::Loaded, Vec<String>)>,
+}
+
+/// Checks, before any scene of a run starts, everything that can be
+/// checked before rendering, so that a run fails at once (writing nothing)
+/// rather than after its first scenes have rendered:
+///
+/// - no two scenes write the same report and images (same output folder
+///   and name), and without `force` no scene's report exists already;
+/// - every scene's `[frames]` range lies within its input's frames: one
+///   frame for a static mesh, a volume or an SDF (nothing is loaded); the
+///   clip's sampled frames of a glTF model, the animation's frames of an
+///   LBS set, the files of a flipbook;
+/// - a flipbook's frames in that range have its first frame's topology
+///   ([`Flipbook::check_frames`](crate::mesh::flipbook::Flipbook::check_frames):
+///   in full for small sequences, from the file headers for large ones).
+///
+/// Counting an animated input's frames needs the input (a glTF clip's
+/// duration comes from its keyframes, an LBS set's frame count from its
+/// animation file, a flipbook's topology from its first frame), so those
+/// inputs are loaded here, once: the returned [`Checked`] (one per scene,
+/// in order) hands each to [`run_checked`]. They are held until their
+/// scene runs, one mesh (and its animation) per animated scene.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] naming both scene files for a collision and
+/// the scene file for an existing report; the errors of loading an
+/// animated input; [`Error::InvalidInput`] naming the scene file and its
+/// `[frames]` for a range outside the input; for a flipbook frame of
+/// another topology, an error naming the scene file, the frame and the
+/// frame's file with the difference.
+pub fn check_scenes(scenes: &[Scene], opts: &ExecOptions) -> Result<Vec<Checked>> {
+    check_outputs_across(scenes, opts)?;
+    scenes.iter().map(check_input).collect()
+}
+
+/// The frames check of [`check_scenes`] for one scene.
+fn check_input(scene: &Scene) -> Result<Checked> {
+    let animated = matches!(
+        scene.source,
+        Source::Gltf(..) | Source::Lbs(_) | Source::Flipbook(_)
+    );
+    if !animated {
+        frame_indices(scene, 1)?;
+        return Ok(Checked {
+            scene: scene.path.clone(),
+            input: None,
+        });
+    }
+    let mut notes = Vec::new();
+    let loaded = load(scene, &mut notes)?;
+    let frames = frame_indices(scene, loaded.frames())?;
+    if let load::Loaded::Flipbook(book) = &loaded {
+        book.check_frames(&frames).map_err(|(i, e)| {
+            Error::input(
+                scene.path.display().to_string(),
+                format!("flipbook frame {i}"),
+                e.to_string(),
+            )
+        })?;
+    }
+    Ok(Checked {
+        scene: scene.path.clone(),
+        input: Some((loaded, notes)),
+    })
+}
+
+/// The output check of [`check_scenes`]: no collisions across scenes, no
+/// existing report without `force`. A collision used to surface only
+/// after the first scene had rendered.
+fn check_outputs_across(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
     use crate::export::output::location;
     let reports: Vec<(PathBuf, &Scene)> = scenes
         .iter()

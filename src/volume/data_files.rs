@@ -9,7 +9,7 @@
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
-use super::{Payload, dims_text, number, read_file};
+use super::{Payload, dims_text, number};
 use crate::error::{Error, Result};
 
 /// Where the samples are.
@@ -212,7 +212,9 @@ impl DataFiles {
     }
 
     /// Decodes the samples: attached ones from `header` (the header file's
-    /// bytes), detached ones from their files, in order.
+    /// bytes), detached ones from their files, in order, each file's size
+    /// checked before it is read and only the bytes needed read
+    /// ([`Payload::read_files`]).
     pub(super) fn read(
         &self,
         syntax: &Syntax,
@@ -224,10 +226,7 @@ impl DataFiles {
                 let attached = header.get(*offset..).unwrap_or_default();
                 payload.read([Ok((Cow::Borrowed(attached), syntax.attached.to_string()))])
             }
-            DataFiles::Detached { files, .. } => payload.read(files.iter().map(|f| {
-                let data = read_file(f)?;
-                Ok((Cow::Owned(data), format!("data file {}", f.display())))
-            })),
+            DataFiles::Detached { files, .. } => payload.read_files(files),
         }
     }
 }

@@ -19,6 +19,13 @@
 //! that cannot be read, or an [`Error::UnsupportedFormat`] for valid input
 //! that shapecue does not read (a sheared grid, a 64-bit integer type, ...).
 //!
+//! Memory is bounded by the file: a header's sizes are checked against the
+//! bytes before anything is allocated, compressed data are inflated no
+//! further than the header calls for, and the binary detached data files of
+//! NRRD and MetaImage headers are sized from their metadata and read as a
+//! stream (only the bytes to skip and the samples), so a data file much
+//! larger than its header says is refused unread.
+//!
 //! Grids whose axes point the negative way (a negative spacing, or a
 //! direction matrix with `-1` on its diagonal) are flipped on load so that
 //! spacing is always positive and every sample keeps its world position.
@@ -345,15 +352,56 @@ thread_local! {
 
 /// Reads a whole file, naming it in the error.
 fn read_file(path: &Path) -> Result<Vec<u8>> {
+    record_read(path);
+    std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Notes `path` as read while [`load_with_files`] records.
+fn record_read(path: &Path) {
     READ.with(|r| {
         if let Some(files) = r.borrow_mut().as_mut() {
             files.push(path.to_path_buf());
         }
     });
-    std::fs::read(path).map_err(|source| Error::Io {
+}
+
+/// Opens a file to read part of it, naming it in the error; returns the
+/// reader and the file's size (from its metadata, before reading).
+fn open_file(path: &Path) -> Result<(std::io::BufReader<std::fs::File>, u64)> {
+    record_read(path);
+    let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let size = file.metadata().map_err(io)?.len();
+    Ok((std::io::BufReader::new(file), size))
+}
+
+/// Reads past one newline-terminated line of `r`, keeping nothing; the
+/// bytes it took, or `None` when the stream ends first.
+fn skip_line(r: &mut impl std::io::BufRead) -> std::io::Result<Option<u64>> {
+    let mut taken = 0u64;
+    loop {
+        let buf = r.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(None);
+        }
+        match buf.iter().position(|&b| b == b'\n') {
+            Some(i) => {
+                r.consume(i + 1);
+                return Ok(Some(taken + i as u64 + 1));
+            }
+            None => {
+                let n = buf.len();
+                r.consume(n);
+                taken += n as u64;
+            }
+        }
+    }
 }
 
 /// `X×Y×Z` for messages.
@@ -519,7 +567,7 @@ impl Compression {
 /// lying header or a compression bomb cannot exhaust memory; the caller
 /// checks the size it gets.
 fn decompress(
-    data: &[u8],
+    data: impl Read,
     kind: Compression,
     limit: usize,
 ) -> std::result::Result<Vec<u8>, String> {
@@ -619,6 +667,144 @@ impl Payload<'_> {
             ));
         }
         Ok(values)
+    }
+
+    /// Decodes detached data files, in order, into the samples of the whole
+    /// grid (see [`Payload::read_data_file`]).
+    fn read_files(&self, files: &[PathBuf]) -> Result<Vec<f32>> {
+        let total = voxel_count(self.dims, self.source, "sizes")?;
+        let per_chunk: usize = self.chunk_shape.iter().product();
+        let mut values = Vec::new();
+        for f in files {
+            self.read_data_file(f, per_chunk, &mut values)?;
+        }
+        if values.len() != total {
+            // As in `read`: a guard, not an expected path.
+            return Err(Error::input(
+                self.source,
+                "data",
+                format!("{} samples read for a grid of {total}", values.len()),
+            ));
+        }
+        Ok(values)
+    }
+
+    /// Decodes one detached data file of `count` samples, appending them
+    /// to `out`. Binary data are streamed: the file's size is checked with
+    /// its metadata before anything is read, and only the lines to skip,
+    /// the bytes to skip and the samples are read (a raw file of the wrong
+    /// size is refused unread; with a byte skip of -1 only its last bytes
+    /// are read); compressed data are inflated one byte past what the
+    /// header calls for and no further, so a compression bomb cannot
+    /// exhaust memory. ASCII data are read whole: their length does not
+    /// tell how many values they hold.
+    fn read_data_file(&self, path: &Path, count: usize, out: &mut Vec<f32>) -> Result<()> {
+        let el = format!("data file {}", path.display());
+        let compression = match self.encoding {
+            Encoding::Ascii => {
+                let data = read_file(path)?;
+                return self.read_chunk(&data, &el, count, out);
+            }
+            Encoding::Raw => None,
+            Encoding::Compressed(kind) => Some(kind),
+        };
+        let src = self.source;
+        let io = |source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let (mut r, size) = open_file(path)?;
+        let mut skipped = 0u64;
+        for _ in 0..self.line_skip {
+            skipped += skip_line(&mut r).map_err(io)?.ok_or_else(|| {
+                Error::input(
+                    src,
+                    &el,
+                    format!(
+                        "file ends before the {} lines to skip ('line skip')",
+                        self.line_skip
+                    ),
+                )
+            })?;
+        }
+        let rest = size.saturating_sub(skipped);
+        let expected = byte_count(count, self.scalar, src, &el)?;
+        let wrong_size = |found: u64| {
+            let lines = if skipped > 0 {
+                format!(", {skipped} of them in skipped lines")
+            } else {
+                String::new()
+            };
+            Error::input(
+                src,
+                &el,
+                format!(
+                    "{} (the file has {size} bytes{lines})",
+                    size_problem(&self.chunk_shape, self.scalar, found as usize)
+                ),
+            )
+        };
+        let data = match compression {
+            None => {
+                let (offset, found) = match self.byte_skip {
+                    Skip::Bytes(n) => (n as u64, rest.saturating_sub(n as u64)),
+                    // The last bytes: a larger file is fine, a smaller one not.
+                    Skip::ToEnd => (
+                        rest.saturating_sub(expected as u64),
+                        rest.min(expected as u64),
+                    ),
+                };
+                if found != expected as u64 {
+                    return Err(wrong_size(found));
+                }
+                // `offset` is at most the file's size: it fits in an i64.
+                r.seek_relative(offset as i64).map_err(io)?;
+                let mut buf = vec![0u8; expected];
+                r.read_exact(&mut buf).map_err(io)?;
+                buf
+            }
+            Some(kind) => {
+                let skip = match self.byte_skip {
+                    Skip::Bytes(n) => n,
+                    Skip::ToEnd => {
+                        return Err(Error::input(
+                            src,
+                            &el,
+                            "a byte skip of -1 (data at the end of the file) cannot be used \
+                             with compressed data",
+                        ));
+                    }
+                };
+                let limit = skip.saturating_add(expected).saturating_add(1);
+                let have = usize::try_from(rest).unwrap_or(usize::MAX);
+                check_inflate(have, limit - 1, kind).map_err(|p| Error::input(src, &el, p))?;
+                let mut d = decompress(r, kind, limit).map_err(|p| Error::input(src, &el, p))?;
+                let want = skip.saturating_add(expected);
+                if d.len() > want {
+                    return Err(Error::input(
+                        src,
+                        &el,
+                        format!(
+                            "the {} data inflate to more than the {want} bytes the header calls \
+                             for (decompression stopped there)",
+                            kind.name()
+                        ),
+                    ));
+                }
+                if d.len() < want {
+                    let found = d.len().saturating_sub(skip);
+                    return Err(Error::input(
+                        src,
+                        &el,
+                        size_problem(&self.chunk_shape, self.scalar, found),
+                    ));
+                }
+                d.drain(..skip);
+                d
+            }
+        };
+        convert_into(&data, self.scalar, self.big_endian, out);
+        Ok(())
     }
 
     /// Decodes one chunk of `count` samples, appending them to `out`.

@@ -54,10 +54,13 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     let nv = count(0, "vertex")?;
     let nf = count(1, "face")?;
 
-    // The memory bound: a vertex line takes at least 6 bytes (`0 0 0` and
-    // its newline) and a face line 8 (`3 0 1 2`), so a lying count reserves
-    // no more than the file could hold; the end of the file is reported at
-    // the first element it lacks.
+    // The memory bound: one line per element, so counts that the lines
+    // after the counts line cannot hold are refused before anything is
+    // reserved or parsed (counting lines allocates nothing). Every element
+    // line takes at least two bytes, a vertex line at least six (`0 0 0`)
+    // and a face line eight (`3 0 1 2`), so the reservations below are
+    // also bounded by the file size.
+    check_counts(nv, nf, lines.clone().count(), bytes.len(), source)?;
     let mut positions = Vec::with_capacity(capped(nv, bytes.len(), 6));
     for i in 0..nv {
         let element = || format!("vertex {i}");
@@ -137,6 +140,49 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         fan(&poly, &mut faces);
     }
     Ok(Mesh { positions, faces })
+}
+
+/// The vertex and face counts of the OFF header at the start of `head`
+/// (the keyword is optional, the counts may follow it on its line);
+/// `None` when they cannot be read from it.
+pub(super) fn header_counts(head: &[u8]) -> Option<(usize, usize)> {
+    let text = String::from_utf8_lossy(head);
+    let mut lines = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .filter(|l| !l.trim().is_empty());
+    let mut toks: Vec<&str> = lines.next()?.split_whitespace().collect();
+    if toks.first().is_some_and(|t| t.parse::<u64>().is_err()) {
+        toks.remove(0);
+        if toks.is_empty() {
+            toks = lines.next()?.split_whitespace().collect();
+        }
+    }
+    Some((toks.first()?.parse().ok()?, toks.get(1)?.parse().ok()?))
+}
+
+/// Refuses vertex and face counts that the `lines` element lines after
+/// the counts line (of a file of `size` bytes) cannot hold, naming the
+/// first element the file lacks, as the error of a truncated file does.
+fn check_counts(nv: usize, nf: usize, lines: usize, size: usize, source: &str) -> Result<()> {
+    let (element, declared) = if nv > lines {
+        (format!("vertex {lines}"), format!("{nv} vertices"))
+    } else if nf > lines - nv {
+        (
+            format!("face {}", lines - nv),
+            format!("{nv} vertices and {nf} faces"),
+        )
+    } else {
+        return Ok(());
+    };
+    Err(Error::input(
+        source,
+        element,
+        format!(
+            "unexpected end of file: the header declares {declared} (one line each), but \
+             the {size}-byte file holds only {lines} lines after the counts"
+        ),
+    ))
 }
 
 /// Accepts `[ST][C][N]OFF` (texture coordinates, colours, normals);

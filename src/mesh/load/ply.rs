@@ -232,6 +232,76 @@ fn capacity(def: &ElementDef, encoding: Encoding, payload: usize) -> usize {
     def.count.min(payload / min + 1)
 }
 
+/// Refuses, before anything is reserved or parsed, element counts that the
+/// `body` (the bytes after the header) cannot hold: in binary, each element
+/// takes exactly the bytes of its scalars (and at least the count of each
+/// list); in ASCII, one non-blank line (so at least two bytes). The error
+/// names the first element that cannot be in the
+/// file, as a truncated file's does, with the count and what the bytes hold.
+fn check_counts(header: &Header, body: &[u8], source: &str) -> Result<()> {
+    let payload = body.len();
+    let ascii = header.encoding == Encoding::Ascii;
+    if ascii {
+        // One non-blank line per element (blank lines are skipped), at
+        // least two bytes each: counting them is exact and allocates nothing.
+        let lines = body
+            .split(|&b| b == b'\n')
+            .filter(|l| !l.trim_ascii().is_empty())
+            .count();
+        let mut room = lines;
+        for (name, def) in &header.elements {
+            if def.count > room {
+                return Err(Error::input(
+                    source,
+                    format!("{name} {}", room),
+                    format!(
+                        "unexpected end of file: the header declares {} '{name}' elements (one \
+                         line each), but the {payload} bytes after the header hold {lines} \
+                         lines, {room} of them left for '{name}'",
+                        def.count
+                    ),
+                ));
+            }
+            room -= def.count;
+        }
+        return Ok(());
+    }
+    let mut room = payload as u128;
+    for (name, def) in &header.elements {
+        let min = min_element_bytes(def, header.encoding) as u128;
+        if min == 0 {
+            // Elements without properties take no bytes.
+            continue;
+        }
+        let fit = room / min;
+        if def.count as u128 > fit {
+            let exact = def
+                .properties
+                .values()
+                .all(|p| matches!(p.data_type, PropertyType::Scalar(_)));
+            let each = if exact { "" } else { "at least " };
+            let used = payload as u128 - room;
+            let before = if used > 0 {
+                format!(" besides the {used} bytes the elements before it take at least")
+            } else {
+                String::new()
+            };
+            return Err(Error::input(
+                source,
+                format!("{name} {fit}"),
+                format!(
+                    "unexpected end of file: the header declares {} '{name}' elements of \
+                     {each}{min} bytes each, but the {payload} bytes after the header hold at \
+                     most {fit}{before}",
+                    def.count
+                ),
+            ));
+        }
+        room -= def.count as u128 * min;
+    }
+    Ok(())
+}
+
 fn is_integer(t: &ScalarType) -> bool {
     !matches!(t, ScalarType::Float | ScalarType::Double)
 }
@@ -318,6 +388,17 @@ fn check_header_text(bytes: &[u8], source: &str) -> Result<()> {
     Ok(())
 }
 
+/// The counts of the `vertex` and `face` elements of the header at the
+/// start of `r` (0 for an element it lacks); `None` when the header
+/// cannot be read. Reads the header only.
+pub(super) fn header_counts(r: impl std::io::BufRead) -> Option<(usize, usize)> {
+    let header = Parser::<Skip>::new()
+        .read_header(&mut Reader::new(r))
+        .ok()?;
+    let count = |name: &str| header.elements.get(name).map_or(0, |d| d.count);
+    Some((count("vertex"), count("face")))
+}
+
 /// Parses a PLY file (ASCII, binary little- or big-endian).
 pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     check_header_text(bytes, source)?;
@@ -327,6 +408,7 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         .map_err(|e| Error::input(source, "header", first_line(&e)))?;
     check_header(&header, source)?;
     let payload = reader.get_ref().len();
+    check_counts(&header, reader.get_ref(), source)?;
     let mut stream = Stream {
         // `line()` is the number of the first payload line; `element`
         // increments before reading.
