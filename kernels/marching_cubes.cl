@@ -369,6 +369,57 @@ inline uint edge_id(uint axis, uint c0)
     return 4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1);
 }
 
+// Cases of the 16 cells x .. x+15 of a cell row (bit c set when corner c is
+// inside), from float16 loads of the values x .. x+16 of the four rows; the
+// corner values come back in a[8] (corner c's value of each lane). *finite
+// is false when one of them is not finite (then the cases are not used).
+inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                          uint x, float iso, float16 *a, bool *finite)
+{
+    a[0] = vload16(0, vol + b00 + x);
+    a[1] = vload16(0, vol + b00 + x + 1);
+    a[2] = vload16(0, vol + b10 + x);
+    a[3] = vload16(0, vol + b10 + x + 1);
+    a[4] = vload16(0, vol + b01 + x);
+    a[5] = vload16(0, vol + b01 + x + 1);
+    a[6] = vload16(0, vol + b11 + x);
+    a[7] = vload16(0, vol + b11 + x + 1);
+    const float16 i16 = (float16)(iso);
+    int16 fin = isfinite(a[0]);
+    uint16 cas = (uint16)(0);
+    for (uint c = 0; c < 8; ++c) {
+        fin &= isfinite(a[c]);
+        cas |= as_uint16(isless(a[c], i16)) & (uint16)(1u << c);
+    }
+    *finite = all(fin);
+    return cas;
+}
+
+// Lanes set in a mask of a relational built-in (−1 = true).
+inline uint lanes_set(int16 m)
+{
+    const int8 s8 = m.lo + m.hi;
+    const int4 s4 = s8.lo + s8.hi;
+    const int2 s2 = s4.lo + s4.hi;
+    return (uint)(-(s2.x + s2.y));
+}
+
+// edge_kind for 16 edges at once, all ends finite: *inside gets the lanes
+// with a vertex inside the edge, the return value the lanes that round onto
+// an end. fa is the edges' lower coordinate along their axis.
+inline int16 edge_kinds16(float16 v0, float16 v1, float iso, float16 fa, int16 *inside)
+{
+    const float16 i16 = (float16)(iso);
+    const int16 cross = isless(v0, i16) ^ isless(v1, i16);
+    float16 t = (i16 - v0) / (v1 - v0);
+    t = select((float16)(0.0f), t, isgreaterequal(t, (float16)(0.0f)));
+    t = select(t, (float16)(1.0f), isgreater(t, (float16)(1.0f)));
+    const float16 c = fa + t;
+    const int16 hit = cross & ((c == fa) | (c == fa + 1.0f));
+    *inside = cross & ~hit;
+    return hit;
+}
+
 // True when triangle j of cell (x, y, z) of case cas, flagged as lying in a
 // face of the cube (flat[cas] bit j), has an opposite twin in the cell across
 // that face: the same three voxel edges, the other winding. Both cells drop
@@ -452,12 +503,44 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     // chunk, so they are unpacked once per chunk (and per tail position).
     uint n0 = 0, n1 = 0, n2 = 0, hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
     float v[8];
+    float16 a[8];
+    const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     uint x = 0;
     for (; x + 16 < nx; x += 16) {
-        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+        bool fin;
+        const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
+        if (fin && all((cv == (uint16)(0)) | (cv == (uint16)(255))))
             continue;
         lo = min(lo, x);
         hi = x + 16;
+        if (fin) {
+            // All finite: the owned edges 16 at a time (corner 0 to 1, 2, 4).
+            int16 in;
+            hits += lanes_set(edge_kinds16(a[0], a[1], iso, (float16)((float)x) + lane, &in));
+            n0 += lanes_set(in);
+            hits += lanes_set(edge_kinds16(a[0], a[2], iso, (float16)((float)y), &in));
+            n1 += lanes_set(in);
+            hits += lanes_set(edge_kinds16(a[0], a[4], iso, (float16)((float)z), &in));
+            n2 += lanes_set(in);
+            if (cell) {
+                uint cs[16];
+                vstore16(cv, 0, cs);
+                uint fl = 0;
+                for (uint i = 0; i < 16; ++i) {
+                    ntri += counts[cs[i]];
+                    fl |= flat[cs[i]];
+                }
+                if (fl != 0) {
+                    for (uint i = 0; i < 16; ++i) {
+                        const uint tw = twins_of(vol, x + i, y, z, nx, ny, nz, iso, cs[i],
+                                                 counts, tris, flat);
+                        ntri -= tw;
+                        twins += tw;
+                    }
+                }
+            }
+            continue;
+        }
         uint packed = 0;
         for (uint i = x; i < x + 16; ++i) {
             if (cell) {
@@ -610,14 +693,35 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     const float fy = (float)y, fz = (float)z;
     float v[8], c[12];
     uint k[12], id[12];
+    float16 a[8];
+    // Cells of the current chunk known (from its vector cases) to be finite
+    // with all corners on one side: bit x − base.
+    uint skip = 0, base = lo;
     uint x = lo;
     for (; x < hi && x + 1 < nx; ++x) {
         // The chunks of mc_direct_count: 16 cells from each multiple of 16
         // that has 16 more values after it (lo is one of them, or the tail).
-        if ((x & 15) == 0 && x + 16 < nx && chunk_uniform(vol, b00, b10, b01, b11, x, iso)) {
-            x += 15;
-            continue;
+        if ((x & 15) == 0) {
+            skip = 0;
+            base = x;
+            if (x + 16 < nx) {
+                bool fin;
+                const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
+                if (fin) {
+                    const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
+                    if (all(triv)) {
+                        x += 15;
+                        continue;
+                    }
+                    int tv[16];
+                    vstore16(triv, 0, tv);
+                    for (uint i = 0; i < 16; ++i)
+                        skip |= (uint)(tv[i] & 1) << i;
+                }
+            }
         }
+        if ((skip >> (x - base)) & 1)
+            continue;
         const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
         // All corners finite and on one side: nothing to write or count.
         if (cas == 0 || cas == 255)
