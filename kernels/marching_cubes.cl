@@ -282,15 +282,19 @@ __kernel void mc_gradient_normals(uint nv, __global const float *pos, __global c
 //                                       points' grid indices (then sorted)
 //   mc_direct_triangles  per cell row   positions of the vertices the row owns,
 //                                       triangles with final indices (a hit
-//                                       corner: edge_vertices + the first slot
-//                                       of its point in the sorted hits)
+//                                       corner: edge_vertices + the rank of its
+//                                       point among the sorted, unique hit
+//                                       points); triangles with a hit corner
+//                                       also listed in `side`
 //   mc_direct_points     per hit        positions of the hit slots
 // With no hit and a finite volume that is all: no triangle can collapse
 // (two table corners are distinct edges, each its own vertex), and the only
 // twins (a triangle of the table lying in a cube face, flat[case], and its
-// mirror across the face) are found locally by has_twin. Otherwise the
-// vertex_fusion steps after fuse_index clean up (collapsed triangles, twins,
-// vertex slots no kept triangle uses).
+// mirror across the face) are found locally by has_twin. With hits, only the
+// listed triangles (those with a corner on a grid point) can collapse or
+// have a twin; the host checks them, and only when one does (or the volume
+// has non-finite voxels, whose skipped cells can leave vertices unused) the
+// vertex_fusion steps after fuse_index clean up.
 //
 // Buffers: rowc uint[4G] (scanned in place into off), split uint[2G],
 // trim uint[2G], hit_keys uint[H] (sorted), pos float[3(V+H)], faces
@@ -639,8 +643,8 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
         hit_owned(vol, b00, b10, b01, x, nx, ny, y, z, iso, keys, &o);
 }
 
-// Vertex of a hit: edge_vertices + the first slot of grid point g among the
-// nh sorted hit keys.
+// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
+// sorted, unique hit points.
 inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
 {
     uint lo = 0, hi = nh;
@@ -654,6 +658,17 @@ inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_ver
     return edge_vertices + lo;
 }
 
+// Coordinate q of the vertex of edge e of cell (x, y, z), of kind k (not
+// EV_NONE) and, for EV_IN, coordinate cc along the edge.
+inline float corner_coord(uint e, uint k, float cc, uint x, uint y, uint z, uint q)
+{
+    const uint axis = e >> 2, c0 = edge_lo_corner(e);
+    const uint g = (q == 0 ? x : (q == 1 ? y : z)) + ((c0 >> q) & 1);
+    if (q != axis)
+        return (float)g;
+    return k == EV_IN ? cc : (float)(k == EV_HI ? g + 1 : g);
+}
+
 inline void put3(__global float *pos, uint v, float a, float b, float c)
 {
     pos[3 * v] = a;
@@ -661,13 +676,98 @@ inline void put3(__global float *pos, uint v, float a, float b, float c)
     pos[3 * v + 2] = c;
 }
 
+// The kinds k[12] and coordinates c[12] of the twelve edges of cell (x, y,
+// z) in table order (see the header's edge numbering), from its values v[8].
+#define CELL_EDGES                                                                  \
+    k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);                                    \
+    k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);                                    \
+    k[2] = edge_kind(v[4], v[5], iso, x, &c[2]);                                    \
+    k[3] = edge_kind(v[6], v[7], iso, x, &c[3]);                                    \
+    k[4] = edge_kind(v[0], v[2], iso, y, &c[4]);                                    \
+    k[5] = edge_kind(v[1], v[3], iso, y, &c[5]);                                    \
+    k[6] = edge_kind(v[4], v[6], iso, y, &c[6]);                                    \
+    k[7] = edge_kind(v[5], v[7], iso, y, &c[7]);                                    \
+    k[8] = edge_kind(v[0], v[4], iso, z, &c[8]);                                    \
+    k[9] = edge_kind(v[1], v[5], iso, z, &c[9]);                                    \
+    k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);                                  \
+    k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
+
+// Grid index of the point that the vertex of edge e (kind EV_LO or EV_HI) of
+// cell (x, y, z) rounds onto.
+inline uint hit_point(uint e, uint kind, uint x, uint y, uint z, uint nx, uint ny)
+{
+    const uint c0 = edge_lo_corner(e);
+    const uint cn = kind == EV_LO ? c0 : (c0 | (1u << (e >> 2)));
+    return grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2), nx, ny);
+}
+
+// True when two corners of the triangle on edges ea, eb, ec of cell (x, y, z)
+// round onto the same grid point (the triangle collapses: dropped).
+inline bool collapses(uint ea, uint eb, uint ec, const uint *k, uint x, uint y, uint z,
+                      uint nx, uint ny)
+{
+    const uint ka = k[ea], kb = k[eb], kc = k[ec];
+    const uint none = 0xFFFFFFFFu;
+    const uint pa = ka >= EV_LO ? hit_point(ea, ka, x, y, z, nx, ny) : none;
+    const uint pb = kb >= EV_LO ? hit_point(eb, kb, x, y, z, nx, ny) : none - 1;
+    const uint pc = kc >= EV_LO ? hit_point(ec, kc, x, y, z, nx, ny) : none - 2;
+    return pa == pb || pb == pc || pa == pc;
+}
+
+// Only where there are hits: the triangles of each cell row that are kept
+// (twins across faces and collapsing triangles dropped) into tcount[r]; rows
+// whose four grid rows have no hit keep their count from the first scan.
+__kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
+                                __global const float *vol, float iso, __constant uchar *counts,
+                                __constant uchar *tris, __constant uchar *flat,
+                                __global const uint *off, __global const uint *trim,
+                                __global uint *tcount)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const uint G = grid_rows;
+    if (!(hy && hz)) {
+        tcount[gid] = 0;
+        return;
+    }
+    const uint rows[4] = {gid, gid + 1, gid + ny, gid + ny + 1};
+    uint rh = 0;
+    for (uint i = 0; i < 4; ++i)
+        rh += off[2 * G + rows[i] + 1] - off[2 * G + rows[i]];
+    const uint before = off[G + gid + 1] - off[G + gid];
+    if (rh == 0) {
+        tcount[gid] = before;
+        return;
+    }
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    float v[8], c[12];
+    uint k[12];
+    uint n = 0;
+    for (uint x = lo; x < hi && x + 1 < nx; ++x) {
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        if (cas == 0 || cas >= 255)
+            continue;
+        CELL_EDGES
+        const uint nt = counts[cas], fl = flat[cas];
+        for (uint j = 0; j < nt; ++j) {
+            if (((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
+                continue;
+            n += !collapses(tris[16 * cas + 3 * j], tris[16 * cas + 3 * j + 1],
+                            tris[16 * cas + 3 * j + 2], k, x, y, z, nx, ny);
+        }
+    }
+    tcount[gid] = n;
+}
+
 __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
                                   __global const float *vol, float iso,
                                   __constant uchar *counts, __constant uchar *tris,
                                   __constant uchar *flat, __global const uint *off,
-                                  __global const uint *split,
-                                  __global const uint *trim, uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
-                                  __global uint *faces)
+                                  __global const uint *split, __global const uint *trim,
+                                  __global const uint *toff, uint tshift, uint tbase,
+                                  uint edge_vertices, uint nh, __global const uint *hit_keys,
+                                  __global float *pos, __global uint *faces, uint side_cap,
+                                  __global uint *side, volatile __global uint *side_n)
 {
     GID_OR_RETURN(grid_rows);
     GRID_ROW_SETUP
@@ -687,9 +787,10 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     // The last cell row of y (z) also writes the vertices of row 10 (01),
     // which is not a cell row; the last cell of a row those at x = nx − 1.
     const bool wy = y + 2 == ny, wz = z + 2 == nz;
-    // The triangles' part of off starts at edge_vertices (the scan of the
-    // vertex counts before it).
-    uint out = 3 * (off[grid_rows + gid] - edge_vertices);
+    // First triangle of the row: toff[tshift + r] − tbase (the triangles'
+    // part of off, which starts at edge_vertices, or the scan of the
+    // recount where there are hits).
+    uint out = 3 * (toff[tshift + gid] - tbase);
     const float fy = (float)y, fz = (float)z;
     float v[8], c[12];
     uint k[12], id[12];
@@ -726,19 +827,7 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
         // All corners finite and on one side: nothing to write or count.
         if (cas == 0 || cas == 255)
             continue;
-        // The cell's twelve edges in table order (see the header's edge numbering).
-        k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);
-        k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);
-        k[2] = edge_kind(v[4], v[5], iso, x, &c[2]);
-        k[3] = edge_kind(v[6], v[7], iso, x, &c[3]);
-        k[4] = edge_kind(v[0], v[2], iso, y, &c[4]);
-        k[5] = edge_kind(v[1], v[3], iso, y, &c[5]);
-        k[6] = edge_kind(v[4], v[6], iso, y, &c[6]);
-        k[7] = edge_kind(v[5], v[7], iso, y, &c[7]);
-        k[8] = edge_kind(v[0], v[4], iso, z, &c[8]);
-        k[9] = edge_kind(v[1], v[5], iso, z, &c[9]);
-        k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);
-        k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
+        CELL_EDGES
         id[0] = bx00 + n00x;
         id[1] = bx10 + n10x;
         id[2] = bx01 + n01x;
@@ -751,16 +840,14 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
         id[9] = id[8] + (k[8] == EV_IN);
         id[10] = bz10 + n10z;
         id[11] = id[10] + (k[10] == EV_IN);
+        // Corners of this cell on grid points (collapses need two).
+        uint ch = 0;
         if (nh != 0) {
             for (uint e = 0; e < 12; ++e) {
                 if (k[e] >= EV_LO) {
-                    const uint axis = e >> 2, kk = e & 3;
-                    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
-                    const uint c0 = ((kk & 1) << lo_axis) | ((kk >> 1) << hi_axis);
-                    const uint cn = k[e] == EV_LO ? c0 : (c0 | (1u << axis));
-                    const uint g = grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2),
-                                              nx, ny);
-                    id[e] = hit_vertex(g, hit_keys, nh, edge_vertices);
+                    id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
+                                       edge_vertices);
+                    ++ch;
                 }
             }
         }
@@ -801,9 +888,33 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
                 if (((fl >> j) & 1) &&
                     has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
                     continue;
-                faces[out] = id[tris[16 * cas + 3 * j]];
-                faces[out + 1] = id[tris[16 * cas + 3 * j + 1]];
-                faces[out + 2] = id[tris[16 * cas + 3 * j + 2]];
+                const uint ea = tris[16 * cas + 3 * j], eb = tris[16 * cas + 3 * j + 1],
+                           ec = tris[16 * cas + 3 * j + 2];
+                if (ch >= 2 && collapses(ea, eb, ec, k, x, y, z, nx, ny))
+                    continue;
+                faces[out] = id[ea];
+                faces[out + 1] = id[eb];
+                faces[out + 2] = id[ec];
+                // A triangle with a corner on a grid point may have a twin:
+                // listed (face, corners, in a grid plane) for the host to
+                // decide whether the clean-up must run.
+                if (ch != 0 && (k[ea] >= EV_LO || k[eb] >= EV_LO || k[ec] >= EV_LO)) {
+                    uint plane = 0;
+                    for (uint q = 0; q < 3; ++q) {
+                        const float pa = corner_coord(ea, k[ea], c[ea], x, y, z, q);
+                        const float pb = corner_coord(eb, k[eb], c[eb], x, y, z, q);
+                        const float pc = corner_coord(ec, k[ec], c[ec], x, y, z, q);
+                        plane |= pa == pb && pb == pc && pa == floor(pa);
+                    }
+                    const uint o = atomic_inc(&side_n[0]);
+                    if (o < side_cap) {
+                        side[5 * o] = out / 3;
+                        side[5 * o + 1] = id[ea];
+                        side[5 * o + 2] = id[eb];
+                        side[5 * o + 3] = id[ec];
+                        side[5 * o + 4] = plane;
+                    }
+                }
                 out += 3;
             }
         }

@@ -359,8 +359,8 @@ pub fn mc_direct_count(vol: &Volume, iso: f32) -> DirectCounts {
 /// The result of direct numbering before the clean-up of exact hits.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Direct {
-    /// Vertex slots: the edge vertices in row order, then one slot per exact
-    /// hit (the sorted hit points; only the first slot of a point is used).
+    /// Vertices: the edge vertices in row order, then the grid points that
+    /// vertices rounded onto, sorted and unique.
     pub positions: Vec<[f32; 3]>,
     /// Triangles with final indices, cell rows in order, cells in x order,
     /// triangles in table order (those of exact hits may have collapsed).
@@ -412,7 +412,9 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
         edge_vertices as u64,
         counts.rows.iter().map(|r| r[0] as u64).sum::<u64>()
     );
+    let hits = hit_points.len();
     hit_points.sort_unstable();
+    hit_points.dedup();
     for &g in &hit_points {
         let g = g as usize;
         positions.push([
@@ -460,26 +462,19 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
         positions,
         faces,
         edge_vertices,
-        hits: hit_points.len(),
+        hits,
         twins: counts.rows.iter().map(|r| r[3] as usize).sum(),
     }
 }
 
 /// Direct numbering, whole: [`mc_direct`] (twins across cube faces already
-/// dropped), then, only when there were exact hits or the volume has
-/// non-finite values, the clean-up of vertex fusion ([`crate::cpu::vertex_fusion::fuse_finish`]: collapsed triangles
+/// dropped), then the clean-up of vertex fusion (which the device runs only
+/// where it changes something) ([`crate::cpu::vertex_fusion::fuse_finish`]: collapsed triangles
 /// and opposite twins dropped, unused vertex slots removed).
 pub fn direct_mesh(vol: &Volume, iso: f32) -> crate::cpu::vertex_fusion::Fused {
+    // The device skips the clean-up where it would change nothing.
     let d = mc_direct(vol, iso);
-    if d.hits > 0 || vol.values.iter().any(|v| !v.is_finite()) {
-        let mut f = crate::cpu::vertex_fusion::fuse_finish(&d.positions, &d.faces);
-        f.dropped += d.twins;
-        f
-    } else {
-        crate::cpu::vertex_fusion::Fused {
-            positions: d.positions,
-            faces: d.faces,
-            dropped: d.twins,
-        }
-    }
+    let mut f = crate::cpu::vertex_fusion::fuse_finish(&d.positions, &d.faces);
+    f.dropped += d.twins;
+    f
 }

@@ -77,6 +77,8 @@ pub enum Step {
     McDirectTriangles,
     /// `mc_direct_points`: positions of the grid-point vertices.
     McDirectPoints,
+    /// `mc_direct_recount`: kept triangles of the rows with hits.
+    McDirectRecount,
     /// `mc_gradient_normals`: normals from the volume gradient.
     McGradientNormals,
     /// `fuse_index`: representative per sorted key.
@@ -154,6 +156,7 @@ impl Step {
             Step::McDirectHits => "mc_direct_hits",
             Step::McDirectTriangles => "mc_direct_triangles",
             Step::McDirectPoints => "mc_direct_points",
+            Step::McDirectRecount => "mc_direct_recount",
             Step::McGradientNormals => "mc_gradient_normals",
             Step::FuseIndex => "fuse_index",
             Step::FuseTriangles => "fuse_triangles",
@@ -206,7 +209,9 @@ impl Step {
             CurvMaxFace | CurvClear | CurvNormalsAreas | CurvFrames | CurvTensor
             | CurvPrincipal | CurvDcurv => Family::Curvature,
             McClassify | McTriangles | McIota | McGradientNormals | McDirectCount
-            | McDirectHits | McDirectTriangles | McDirectPoints => Family::MarchingCubes,
+            | McDirectHits | McDirectTriangles | McDirectPoints | McDirectRecount => {
+                Family::MarchingCubes
+            }
             FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,

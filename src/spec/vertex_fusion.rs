@@ -75,9 +75,11 @@ pub struct FusionCounts {
 /// Bytes of device memory direct numbering needs beyond the volume, for
 /// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits
 /// and `triangles` triangles: row counts (4 per row), splits and trims (2
-/// each), hit keys and their sort (3 per hit plus the sort's histograms,
-/// bounded by 4 per hit), positions, faces, and the clean-up of vertex fusion
-/// when there are hits or non-finite voxels (`cleanup`).
+/// each), the recount where there are hits (1), hit keys and their sort (3
+/// per hit plus the sort's histograms, bounded by 4 per hit), the list of
+/// triangles with a hit corner (20 records of 5 per hit), positions, faces,
+/// and the clean-up of vertex fusion when there are hits or non-finite
+/// voxels (`cleanup`).
 pub fn direct_device_bytes_bound(
     grid_rows: usize,
     vertices: usize,
@@ -87,7 +89,7 @@ pub fn direct_device_bytes_bound(
 ) -> u64 {
     let slots = (vertices + hits) as u64;
     let t = triangles as u64;
-    let mut b = 32 * grid_rows as u64 + 16 * hits as u64 + 12 * slots + 12 * t;
+    let mut b = 36 * grid_rows as u64 + 416 * hits as u64 + 12 * slots + 12 * t;
     if cleanup {
         // rep is the faces buffer; referenced + vert_id per slot; keep,
         // face_off, cand, cand_off per triangle; candidate keys and their

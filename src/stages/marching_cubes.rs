@@ -90,6 +90,7 @@ pub struct Isosurfacer {
     direct_hits: Kernel,
     direct_triangles: Kernel,
     direct_points: Kernel,
+    direct_recount: Kernel,
     scan: Scan,
     sort: RadixSort,
     fuser: Fuser,
@@ -106,6 +107,11 @@ pub struct Isosurfacer {
     trim: Buffer<u32>,
     hit_keys: Grow<u32>,
     hit_vals: Grow<u32>,
+    /// Kept triangles per cell row where there are hits (scanned in place).
+    tcount: Buffer<u32>,
+    /// Triangles with a corner on a grid point: (face, a, b, c, in a grid plane).
+    side: Grow<u32>,
+    side_n: Buffer<u32>,
     dpos: Grow<f32>,
     dfaces: Grow<u32>,
     /// The volume has NaN or infinite voxels (known at upload): direct
@@ -171,6 +177,7 @@ impl Isosurfacer {
             direct_hits: gpu.kernel(&p, "mc_direct_hits")?,
             direct_triangles: gpu.kernel(&p, "mc_direct_triangles")?,
             direct_points: gpu.kernel(&p, "mc_direct_points")?,
+            direct_recount: gpu.kernel(&p, "mc_direct_recount")?,
             scan: Scan::new(gpu.clone())?,
             sort: RadixSort::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
@@ -186,6 +193,9 @@ impl Isosurfacer {
             trim: gpu.buffer::<u32>(2 * grid_rows)?,
             hit_keys: Grow::new(&gpu)?,
             hit_vals: Grow::new(&gpu)?,
+            tcount: gpu.buffer::<u32>(grid_rows)?,
+            side: Grow::new(&gpu)?,
+            side_n: gpu.buffer::<u32>(1)?,
             dpos: Grow::new(&gpu)?,
             dfaces: Grow::new(&gpu)?,
             nonfinite: vol.values.iter().any(|v| !v.is_finite()),
@@ -213,7 +223,8 @@ impl Isosurfacer {
             + self.key.bytes()
             + self.idx.bytes()
             + self.soup_faces.bytes()
-            + 32 * (self.dims[1] * self.dims[2]) as u64
+            + 36 * (self.dims[1] * self.dims[2]) as u64
+            + self.side.bytes()
             + self.hit_keys.bytes()
             + self.hit_vals.bytes()
             + self.dpos.bytes()
@@ -442,6 +453,10 @@ impl Isosurfacer {
         }
         st.soup_triangles = t + twins;
         st.exact_hits = h;
+        // Hits: their grid points sorted and made unique (the vertices after
+        // the edge vertices), and the triangles that collapse onto them
+        // recounted where rows have hits.
+        let (mut u, mut tk, mut collapsed) = (0, t, 0);
         if h > 0 {
             self.hit_keys.reserve(&g, h)?;
             self.hit_vals.reserve(&g, h)?;
@@ -457,13 +472,45 @@ impl Isosurfacer {
             let bits = 64 - (voxels as u64).saturating_sub(1).leading_zeros();
             self.sort
                 .sort_pairs(&mut self.hit_keys.buf, &mut self.hit_vals.buf, h, bits)?;
+            let mut keys = vec![0u32; h];
+            g.read(&self.hit_keys.buf, &mut keys)?;
+            keys.dedup();
+            u = keys.len();
+            g.write(&mut self.hit_keys.buf, &keys)?;
             if let Some(e) = &e {
                 st.timing.add(Step::McDirectHits, event_ms(e));
             }
             st.timing.add(Step::RadixSortPairs, self.sort.last_ms());
+            let mut a = common.to_vec();
+            a.extend([
+                buf(&self.counts),
+                buf(&self.tris),
+                buf(&self.flat),
+                buf(&self.rowc),
+                buf(&self.trim),
+                buf(&self.tcount),
+            ]);
+            let e = launch(&g, &self.direct_recount, gr, &a)?;
+            tk = self.scan.exclusive(&self.tcount, &self.tcount, gr)? as usize;
+            if let Some(e) = &e {
+                st.timing.add(Step::McDirectRecount, event_ms(e));
+            }
+            st.timing.add(Step::ScanExclusive, self.scan.last_ms());
+            collapsed = t - tk;
         }
-        self.dpos.reserve(&g, 3 * slots)?;
-        self.dfaces.reserve(&g, 3 * t)?;
+        let nv = v + u;
+        self.dpos.reserve(&g, 3 * nv)?;
+        self.dfaces.reserve(&g, 3 * tk)?;
+        // Triangles with a hit corner, for the twin check: at most 5 per
+        // cell, 4 cells per hit edge.
+        let side_cap = 20 * h;
+        self.side.reserve(&g, 5 * side_cap)?;
+        g.write(&mut self.side_n, &[0])?;
+        let (toff, tshift, tbase) = if h > 0 {
+            (&self.tcount, 0, 0)
+        } else {
+            (&self.rowc, gr as u32, v as u32)
+        };
         let mut a = common.to_vec();
         a.extend([
             buf(&self.counts),
@@ -472,19 +519,25 @@ impl Isosurfacer {
             buf(&self.rowc),
             buf(&self.split),
             buf(&self.trim),
+            buf(toff),
+            Arg::U32(tshift),
+            Arg::U32(tbase),
             Arg::U32(v as u32),
-            Arg::U32(h as u32),
+            Arg::U32(u as u32),
             buf(&self.hit_keys.buf),
             buf(&self.dpos.buf),
             buf(&self.dfaces.buf),
+            Arg::U32(side_cap as u32),
+            buf(&self.side.buf),
+            buf(&self.side_n),
         ]);
         let e_tri = launch(&g, &self.direct_triangles, gr, &a)?;
         let e_pts = launch(
             &g,
             &self.direct_points,
-            h,
+            u,
             &[
-                Arg::U32(h as u32),
+                Arg::U32(u as u32),
                 buf(&self.hit_keys.buf),
                 Arg::U32(nx as u32),
                 Arg::U32(ny as u32),
@@ -492,22 +545,39 @@ impl Isosurfacer {
                 buf(&self.dpos.buf),
             ],
         )?;
-        if cleanup {
+        // Does anything remain for vertex fusion's clean-up to do?
+        let mut full = self.nonfinite;
+        if h > 0 && !full {
+            let mut n = [0u32];
+            g.read(&self.side_n, &mut n)?;
+            let n = n[0] as usize;
+            full = n > side_cap || {
+                let mut rec = vec![0u32; 5 * n];
+                g.read(&self.side.buf, &mut rec)?;
+                hit_twins(&rec)
+            };
+        }
+        if !full && (collapsed > 0 || twins > 0) {
+            // Dropped triangles may have been a vertex's only ones.
+            full = self.fuser.count_referenced(&self.dfaces.buf, nv, tk)? < nv;
+        }
+        let dropped = twins + collapsed;
+        if full {
             let (c, ft) = self
                 .fuser
-                .finish(&self.dfaces.buf, &self.dpos.buf, slots, t)?;
+                .finish(&self.dfaces.buf, &self.dpos.buf, nv, tk)?;
             st.vertices = c.vertices;
             st.faces = c.faces;
-            st.degenerate_dropped = twins + c.dropped;
+            st.degenerate_dropped = dropped + c.dropped;
             self.result = Some((Holder::Fused, c.vertices, c.faces));
             Self::add_events(st, &e_tri, &e_pts);
             st.timing.extend(&ft);
         } else {
             g.finish()?;
-            st.vertices = v;
-            st.faces = t;
-            st.degenerate_dropped = twins;
-            self.result = Some((Holder::Direct, v, t));
+            st.vertices = nv;
+            st.faces = tk;
+            st.degenerate_dropped = dropped;
+            self.result = Some((Holder::Direct, nv, tk));
             Self::add_events(st, &e_tri, &e_pts);
         }
         Ok(())
@@ -636,4 +706,39 @@ pub fn curvature(
     }
     let timing = est.run()?;
     Ok((est, timing))
+}
+
+/// True when triangles with a corner on a grid point (records of
+/// `mc_direct_triangles`: face, three corners, 1 if in a grid plane) include
+/// an opposite twin pair: the same three vertices, both windings.
+fn hit_twins(rec: &[u32]) -> bool {
+    let mut seen: std::collections::HashMap<[u32; 3], u8> = Default::default();
+    for r in rec.chunks_exact(5).filter(|r| r[4] != 0) {
+        let f = [r[1], r[2], r[3]];
+        let mut set = f;
+        set.sort_unstable();
+        // Even permutation of the sorted set: one winding; odd: the other.
+        let even = (f[0] == set[0] && f[1] == set[1])
+            || (f[1] == set[0] && f[2] == set[1])
+            || (f[2] == set[0] && f[0] == set[1]);
+        let w = seen.entry(set).or_default();
+        *w |= if even { 1 } else { 2 };
+        if *w == 3 {
+            return true;
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn hit_twins_finds_opposite_windings_in_grid_planes_only() {
+        use super::hit_twins;
+        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 1]));
+        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 2, 1, 3, 0, 7, 1, 3, 2, 1]));
+        // Same winding (rotations), or not in a grid plane: no twins.
+        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 2, 3, 1, 1]));
+        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 0]));
+    }
 }

@@ -183,6 +183,45 @@ impl Fuser {
         Ok((counts, t))
     }
 
+    /// How many of the `nv` vertices the `nt` triangles of `faces` use
+    /// (`fuse_clear`, `fuse_mark` with every triangle kept, scan): direct
+    /// numbering's check that dropping triangles left no vertex unused.
+    pub(crate) fn count_referenced(
+        &mut self,
+        faces: &Buffer<u32>,
+        nv: usize,
+        nt: usize,
+    ) -> Result<usize> {
+        let g = self.gpu.clone();
+        if nt == 0 {
+            return Ok(0);
+        }
+        self.referenced.reserve(&g, nv)?;
+        self.vert_id.reserve(&g, nv)?;
+        self.keep.reserve(&g, nt)?;
+        g.fill(&mut self.keep.buf, &[1u32], nt)?;
+        launch(
+            &g,
+            &self.clear,
+            nv,
+            &[Arg::U32(nv as u32), buf(&self.referenced.buf)],
+        )?;
+        launch(
+            &g,
+            &self.mark,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                buf(faces),
+                buf(&self.keep.buf),
+                buf(&self.referenced.buf),
+            ],
+        )?;
+        Ok(self
+            .scan
+            .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)? as usize)
+    }
+
     /// The steps after `fuse_index`, shared with direct numbering
     /// ([`crate::stages::marching_cubes`]): `rep` holds `nt` triangles (3
     /// indices each) into `pos` (`nv` vertex slots, 3 floats each).
