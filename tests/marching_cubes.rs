@@ -121,6 +121,61 @@ fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
 }
 
 #[test]
+fn a_few_exact_hits_cost_no_fusion_clean_up() {
+    // A sphere SDF with a handful of voxels next to the surface set exactly
+    // to the iso value: every crossing edge there rounds onto the grid
+    // point, some triangles collapse. Direct numbering drops them where it
+    // makes them and skips vertex fusion's clean-up, giving the same mesh
+    // as its twin and as exact fusion of the soup.
+    let mut vol = sdf(Sdf::Sphere, 40);
+    let [nx, ny, nz] = vol.dims;
+    // Outside voxels with at least three inside neighbours, a few apart.
+    let mut picked: Vec<[usize; 3]> = Vec::new();
+    for z in 1..nz - 1 {
+        for y in 1..ny - 1 {
+            for x in 1..nx - 1 {
+                let inside = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+                    .iter()
+                    .flat_map(|d| {
+                        [
+                            [x + d[0], y + d[1], z + d[2]],
+                            [x - d[0], y - d[1], z - d[2]],
+                        ]
+                    })
+                    .filter(|g| vol.value(g[0], g[1], g[2]) < 0.0)
+                    .count();
+                let far = picked
+                    .iter()
+                    .all(|p| p[0].abs_diff(x) + p[1].abs_diff(y) + p[2].abs_diff(z) > 6);
+                if vol.value(x, y, z) > 0.0 && inside >= 3 && far && picked.len() < 6 {
+                    picked.push([x, y, z]);
+                }
+            }
+        }
+    }
+    assert_eq!(picked.len(), 6);
+    for g in &picked {
+        vol.values[g[0] + nx * (g[1] + ny * g[2])] = 0.0;
+    }
+    check_same(&vol, 0.0, "sphere with voxels at iso");
+    let mut s = Isosurfacer::new(gpu(), &vol).unwrap();
+    let st = s.extract(0.0, Fusion::Direct).unwrap();
+    assert!(st.exact_hits >= 18 && st.degenerate_dropped > 0, "{st:?}");
+    let names: Vec<&str> = st.timing.steps.iter().map(|s| s.step.name()).collect();
+    assert!(!names.contains(&"compact_faces"), "{names:?}");
+    let (p, f) = s.read_index_space().unwrap();
+    let q = quality(&p, &f);
+    assert_eq!(
+        (q.boundary_edges, q.nonmanifold_edges, q.collapsed_faces),
+        (0, 0, 0)
+    );
+    assert_eq!(
+        (q.unique_positions, q.unreferenced_vertices),
+        (q.vertices, 0)
+    );
+}
+
+#[test]
 fn the_flat_flags_mark_exactly_the_triangles_in_a_cube_face() {
     use shapecue::spec::marching_cubes::edge_corners;
     let t = table();
