@@ -154,7 +154,8 @@ fn write_rows(
             }
             if written.double.is_none() && outside_f32(x) {
                 written.double = Some(format!(
-                    "property '{}' of vertex {i} is {x:e}, outside the range of float                      (about 1.2e-38 to 3.4e38)",
+                    "property '{}' of vertex {i} is {x:e}, outside the range of float \
+                     (about 1.2e-38 to 3.4e38)",
                     names[k]
                 ));
             }
