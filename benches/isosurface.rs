@@ -1,5 +1,6 @@
-//! Criterion groups `isosurface/<fusion>/<volume>`: marching cubes + vertex
-//! fusion with the volume already on the device (wall time of one
+//! Criterion groups `isosurface/<fusion>/<volume>` (fusion: direct, edge,
+//! hash, none): marching cubes + vertex fusion with the volume already on the
+//! device (wall time of one
 //! extraction, which ends with the counts read back), for the procedural
 //! SDFs at 128³ and 256³ and the real volumes of `../shared/data/volumes`
 //! (skipped with a message when absent). Kernel-only medians are printed
@@ -69,10 +70,22 @@ fn bench(c: &mut Criterion) {
             });
             g.finish();
             let st = ex.extract(iso, fusion).expect("extract");
+            let k = median(&mut kernel);
+            // VTK's vtkFlyingEdges3D, 2 threads, same volume (the 2-core
+            // machine's figures; re-measure them with the bench's machine).
+            let fe = match name.as_str() {
+                "sphere-256" => Some(18.2),
+                "gyroid-256" => Some(61.7),
+                "Bucky.raw" => Some(0.33),
+                "ironProt.vtk" => Some(0.62),
+                _ => None,
+            };
+            let ratio = fe.map_or(String::new(), |fe: f64| {
+                format!(" ({:.2}× Flying Edges' {fe} ms)", k / fe)
+            });
             eprintln!(
-                "isosurface/{}/{name}: kernel median {:.2} ms; {} soup vertices → {} vertices, {} faces, {} dropped",
+                "isosurface/{}/{name}: kernel median {k:.2} ms{ratio}; {} soup vertices → {} vertices, {} faces, {} dropped",
                 fusion.name(),
-                median(&mut kernel),
                 st.soup_vertices,
                 st.vertices,
                 st.faces,

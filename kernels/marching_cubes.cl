@@ -1,5 +1,7 @@
-// marching_cubes.cl: triangle soup of the isosurface value = iso of a scalar
-// volume, with one key per soup vertex for vertex fusion (vertex_fusion.cl).
+// marching_cubes.cl: the isosurface value = iso of a scalar volume, two ways:
+// a triangle soup with one key per soup vertex for vertex fusion
+// (vertex_fusion.cl; Fusion hash, edge, none), and direct numbering (Fusion
+// direct, the second half of this file: no soup, after Flying Edges).
 //
 // Griffin et al. 2012, §3.4: classify, scan, triangles. Host:
 // src/stages/marching_cubes.rs; CPU twin with the same step names and the
@@ -35,8 +37,10 @@
 // all vertices at a grid point whose value equals iso.
 
 // True when the 16 cells x .. x+15 of a row are all inside or all outside
-// (and finite): they emit nothing. Explicit float16 code (PoCL turns it into
-// AVX-512; its work-item vectoriser gives up on the row loop), so a row is
+// (and finite): they emit nothing. Explicit float16 code (PoCL compiles it
+// for the host CPU, two 8-wide AVX2 halves here, where its work-item loop
+// vectoriser gives up on the row loop: the build log's "AVX vector ... changes
+// the ABI" warnings are about these float16 helpers), so a row is
 // skimmed 16 cells at a time and only mixed chunks go through the per-cell
 // path. Reads the 17 values x .. x+16 of the four rows.
 inline bool chunk_uniform(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,

@@ -460,10 +460,10 @@ fn curvature_on_the_device_resident_isosurface() {
         dcurv: true,
     };
     let mut errs = Vec::new();
-    for res in [48, 96] {
+    for (res, fusion) in [(48, Fusion::Edge), (96, Fusion::Direct)] {
         for kind in [Sdf::Sphere, Sdf::Torus] {
             let mut ex = Isosurfacer::new(gpu(), &sdf(kind, res)).unwrap();
-            ex.extract(0.0, Fusion::Edge).unwrap();
+            ex.extract(0.0, fusion).unwrap();
             let (est, _) = curvature(&ex, opts, IsoNormals::Mesh).unwrap();
             let f = est.read().unwrap();
             assert!(f.all_finite());

@@ -6,9 +6,11 @@
 //! normals choice of isosurface curvature ([`IsoNormals`]) and the bounds
 //! that size the soup and the device memory.
 //!
-//! Mirrors in `kernels/marching_cubes.cl`: the `counts uchar[256]` and
-//! `tris uchar[256·16]` buffers are [`McTable`] (uploaded as is; `0xFF` =
-//! [`END`] ends a row, at most [`MAX_CELL_TRIANGLES`] triangles per case);
+//! Mirrors in `kernels/marching_cubes.cl`: the `counts uchar[256]`,
+//! `tris uchar[256·16]` and `flat uchar[256]` buffers are [`McTable`]
+//! (uploaded as is; `0xFF` = [`END`] ends a row, at most
+//! [`MAX_CELL_TRIANGLES`] triangles per case; `flat` marks the triangles
+//! lying in a cube face, which direct numbering checks for twins);
 //! the corner and edge numbering of [`edge_corners`] is the kernel's
 //! (see its header); one work-item per cell row, [`cell_rows`] of them;
 //! `mc_triangles`' `mode` is [`crate::spec::vertex_fusion::Fusion::code`].

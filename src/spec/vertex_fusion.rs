@@ -20,13 +20,13 @@ pub enum Fusion {
     /// Flying Edges (Schroeder, Maynard and Geveci 2015) does.
     #[value(help = super::NO_HELP)]
     Direct,
+    /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
+    #[value(help = super::NO_HELP)]
+    Edge,
     /// Griffin et al.'s method: 32-bit hash of the position bits, radix sort,
     /// collisions resolved by comparing positions.
     #[value(help = super::NO_HELP)]
     Hash,
-    /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
-    #[value(help = super::NO_HELP)]
-    Edge,
     /// No fusion: the triangle soup, three vertices per triangle.
     #[value(help = super::NO_HELP)]
     None,
