@@ -283,7 +283,11 @@ __kernel void mc_gradient_normals(uint nv, __global const float *pos, __global c
 //                                       nothing outside it)
 //   (scan.cl)                           one exclusive scan of rowc[0..4G)
 //   mc_direct_hits       per grid row   only when there are hits: the hit
-//                                       points' grid indices (then sorted)
+//                                       points' grid indices (then sorted and
+//                                       made unique on the host)
+//   mc_direct_recount    per cell row   only then: kept triangles of the rows
+//                                       with hits (collapsing ones dropped),
+//                                       scanned into tcount
 //   mc_direct_triangles  per cell row   positions of the vertices the row owns,
 //                                       triangles with final indices (a hit
 //                                       corner: edge_vertices + the rank of its
@@ -301,8 +305,9 @@ __kernel void mc_gradient_normals(uint nv, __global const float *pos, __global c
 // vertex_fusion steps after fuse_index clean up.
 //
 // Buffers: rowc uint[4G] (scanned in place into off), split uint[2G],
-// trim uint[2G], hit_keys uint[H] (sorted), pos float[3(V+H)], faces
-// uint[3T]; V, T, H the scan's first three partial totals.
+// trim uint[2G], tcount uint[G], hit_keys uint[H] (sorted, unique: U),
+// pos float[3(V+U)], faces uint[3T], side uint[5·20H]; V, T, H the scan's
+// first three partial totals.
 
 #define EV_NONE 0u
 #define EV_IN 1u

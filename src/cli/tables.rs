@@ -156,9 +156,10 @@ pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> R
     );
     w(
         &mut s,
-        "VTK's vtkFlyingEdges3D with 2 threads on the same volumes, measured on the 2-core \
-         machine these defaults were tuned on (\"FE 2t\"; \"× FE\" = kernel / FE): sphere \
-         256³ 18.2 ms, gyroid 256³ 61.7, gyroid 512³ 448, ironProt 0.62, Bucky 0.33."
+        "× FE: kernel ms over VTK's vtkFlyingEdges3D with 2 threads on the same volume, as \
+         measured once on a 2-core machine of this kind (sphere 256³ 18.2 ms, gyroid 256³ \
+         61.7, gyroid 512³ 448, Bucky 0.33). The same machine type has run up to 3× slower \
+         on other days: for a fair ratio, time Flying Edges in the same session."
             .into(),
     );
     w(
@@ -333,7 +334,7 @@ pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> R
     w(
         &mut s,
         "\n(k errors: RMS of k − k_analytic over the vertices, × r (sphere r = 0.8, torus tube \
-         r = 0.25); extraction uses --fusion edge; curvature kernel ms include dcurv and, for gradient \
+         r = 0.25); extraction uses --fusion direct; curvature kernel ms include dcurv and, for gradient \
          normals, the override pass)"
             .into(),
     );

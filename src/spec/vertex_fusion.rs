@@ -75,8 +75,8 @@ pub struct FusionCounts {
 /// Bytes of device memory direct numbering needs beyond the volume, for
 /// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits
 /// and `triangles` triangles: row counts (4 per row), splits and trims (2
-/// each), the recount where there are hits (1), hit keys and their sort (3
-/// per hit plus the sort's histograms, bounded by 4 per hit), the list of
+/// each), the recount where there are hits (1), hit keys (4 bytes per hit,
+/// bounded here by 16), the list of
 /// triangles with a hit corner (20 records of 5 per hit), positions, faces,
 /// and the clean-up of vertex fusion when there are hits or non-finite
 /// voxels (`cleanup`).

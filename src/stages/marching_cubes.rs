@@ -18,7 +18,6 @@ use crate::spec::marching_cubes::{cell_rows, edge_key_bits, soup_vertices_bound,
 use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::{Fusion, FusionCounts};
 use crate::stages::curvature::CurvatureEstimator;
-use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
 use crate::stages::vertex_fusion::{Fuser, Grow, build_options};
 use crate::volume::Volume;
@@ -92,7 +91,6 @@ pub struct Isosurfacer {
     direct_points: Kernel,
     direct_recount: Kernel,
     scan: Scan,
-    sort: RadixSort,
     fuser: Fuser,
     row_tris: Buffer<u32>,
     row_off: Buffer<u32>,
@@ -106,7 +104,6 @@ pub struct Isosurfacer {
     split: Buffer<u32>,
     trim: Buffer<u32>,
     hit_keys: Grow<u32>,
-    hit_vals: Grow<u32>,
     /// Kept triangles per cell row where there are hits (scanned in place).
     tcount: Buffer<u32>,
     /// Triangles with a corner on a grid point: (face, a, b, c, in a grid plane).
@@ -179,7 +176,6 @@ impl Isosurfacer {
             direct_points: gpu.kernel(&p, "mc_direct_points")?,
             direct_recount: gpu.kernel(&p, "mc_direct_recount")?,
             scan: Scan::new(gpu.clone())?,
-            sort: RadixSort::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
             row_tris: gpu.buffer::<u32>(rows)?,
             row_off: gpu.buffer::<u32>(rows)?,
@@ -192,7 +188,6 @@ impl Isosurfacer {
             split: gpu.buffer::<u32>(2 * grid_rows)?,
             trim: gpu.buffer::<u32>(2 * grid_rows)?,
             hit_keys: Grow::new(&gpu)?,
-            hit_vals: Grow::new(&gpu)?,
             tcount: gpu.buffer::<u32>(grid_rows)?,
             side: Grow::new(&gpu)?,
             side_n: gpu.buffer::<u32>(1)?,
@@ -226,10 +221,8 @@ impl Isosurfacer {
             + 36 * (self.dims[1] * self.dims[2]) as u64
             + self.side.bytes()
             + self.hit_keys.bytes()
-            + self.hit_vals.bytes()
             + self.dpos.bytes()
             + self.dfaces.bytes()
-            + self.sort.scratch_bytes()
             + self.fuser.device_bytes()
     }
 
@@ -385,8 +378,10 @@ impl Isosurfacer {
     }
 
     /// Direct numbering (see `kernels/marching_cubes.cl`): count → one scan
-    /// → [hits → sort] → triangles → [points] → [clean-up], with one host
-    /// round trip (the scan's partial totals, which size the outputs).
+    /// → triangles, with one host round trip (the scan's partial totals,
+    /// which size the outputs); where vertices land on grid points also
+    /// hits → (host sort) → recount → scan → points, the twin check of the
+    /// listed triangles, and the clean-up only if it would change the mesh.
     fn extract_direct(&mut self, iso: f32, st: &mut IsoStats) -> Result<()> {
         let g = self.gpu.clone();
         let [nx, ny, nz] = self.dims;
@@ -459,7 +454,6 @@ impl Isosurfacer {
         let (mut u, mut tk, mut collapsed) = (0, t, 0);
         if h > 0 {
             self.hit_keys.reserve(&g, h)?;
-            self.hit_vals.reserve(&g, h)?;
             let mut a = common.to_vec();
             a.extend([
                 buf(&self.rowc),
@@ -469,18 +463,17 @@ impl Isosurfacer {
                 buf(&self.hit_keys.buf),
             ]);
             let e = launch(&g, &self.direct_hits, gr, &a)?;
-            let bits = 64 - (voxels as u64).saturating_sub(1).leading_zeros();
-            self.sort
-                .sort_pairs(&mut self.hit_keys.buf, &mut self.hit_vals.buf, h, bits)?;
+            // Sorted and made unique on the host: the keys come back anyway
+            // to size the vertices, and a device sort is a dozen launches.
             let mut keys = vec![0u32; h];
             g.read(&self.hit_keys.buf, &mut keys)?;
+            keys.sort_unstable();
             keys.dedup();
             u = keys.len();
             g.write(&mut self.hit_keys.buf, &keys)?;
             if let Some(e) = &e {
                 st.timing.add(Step::McDirectHits, event_ms(e));
             }
-            st.timing.add(Step::RadixSortPairs, self.sort.last_ms());
             let mut a = common.to_vec();
             a.extend([
                 buf(&self.counts),
