@@ -270,7 +270,11 @@ __kernel void mc_gradient_normals(uint nv, __global const float *pos, __global c
 // on it; its vertices are numbered x-edges first, then y, then z, each in x
 // order, from off[r] on. Cell row (y, z) (y < ny−1, z < nz−1) reads grid rows
 // 00 = (y, z), 10 = (y+1, z), 01 = (y, z+1), 11 = (y+1, z+1).
-//   mc_direct_count      per grid row   rowc[r] vertices inside its edges,
+//   mc_direct_rows       per grid row   each row read once: where its x-edges
+//                                       cross, the side of its ends (info)
+//   mc_direct_count      per grid row   from info, the x range where its four
+//                                       rows can differ (none: nothing read);
+//                                       there, rowc[r] vertices inside its edges,
 //                                       rowc[G+r] triangles of cell row r,
 //                                       rowc[2G+r] vertices rounding onto a
 //                                       grid point ("hits"), rowc[3G+r]
@@ -503,14 +507,78 @@ inline uint twins_of(__global const float *vol, uint x, uint y, uint z, uint nx,
     return n;
 }
 
+// Per grid row, read once (Flying Edges' first pass): info[4r..] = the first
+// cell whose x-edge crosses iso or touches a non-finite value (nx if none),
+// one past the last such cell (0 if none), and the side of the row's first
+// and last value (0 below iso, 1 not below, 2 not finite). Outside
+// [first, last + 1) a row is finite and on one side.
+__kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol, float iso,
+                             __global uint *info)
+{
+    GID_OR_RETURN(grid_rows);
+    const ulong b = (ulong)nx * gid;
+    const float16 i16 = (float16)(iso);
+    uint xl = nx, xr = 0, x = 0, last = nx;
+    int m[16];
+    for (; x + 16 < nx; x += 16) {
+        const float16 a = vload16(0, vol + b + x), c = vload16(0, vol + b + x + 1);
+        const int16 bad = ~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16));
+        if (any(bad)) {
+            if (xl == nx) {
+                vstore16(bad, 0, m);
+                uint i = 0;
+                while (!m[i])
+                    ++i;
+                xl = x + i;
+            }
+            last = x;
+        }
+    }
+    if (last != nx) {
+        // The last lane of the last chunk that crosses.
+        const float16 a = vload16(0, vol + b + last), c = vload16(0, vol + b + last + 1);
+        vstore16(~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16)), 0, m);
+        uint i = 15;
+        while (!m[i])
+            --i;
+        xr = last + i + 1;
+    }
+    for (; x + 1 < nx; ++x) {
+        const float a = vol[b + x], c = vol[b + x + 1];
+        if (!(isfinite(a) && isfinite(c)) || ((a < iso) != (c < iso))) {
+            xl = min(xl, x);
+            xr = x + 1;
+        }
+    }
+    const float f = vol[b], l = vol[b + nx - 1];
+    info[4 * gid] = xl;
+    info[4 * gid + 1] = xr;
+    info[4 * gid + 2] = isfinite(f) ? (f < iso ? 0u : 1u) : 2u;
+    info[4 * gid + 3] = isfinite(l) ? (l < iso ? 0u : 1u) : 2u;
+}
+
 __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
                               __global const float *vol, float iso, __constant uchar *counts,
                               __constant uchar *tris, __constant uchar *flat,
-                              __global uint *rowc, __global uint *split, __global uint *trim)
+                              __global const uint *info, __global uint *rowc,
+                              __global uint *split, __global uint *trim)
 {
     GID_OR_RETURN(grid_rows);
     GRID_ROW_SETUP
     const bool cell = hy && hz;
+    // The x range where the four rows (aliased as b00..b11) can differ: left
+    // of every row's first crossing they are uniform, and alike if their
+    // first values are on one side; likewise right of the last crossing.
+    const uint r10 = gid + hy, r01 = gid + (hz ? ny : 0), r11 = r10 + (r01 - gid);
+    const uint L = min(min(info[4 * gid], info[4 * r10]), min(info[4 * r01], info[4 * r11]));
+    const uint Rx = max(max(info[4 * gid + 1], info[4 * r10 + 1]),
+                        max(info[4 * r01 + 1], info[4 * r11 + 1]));
+    const uint sl = info[4 * gid + 2], sr = info[4 * gid + 3];
+    const bool left = sl != 2 && info[4 * r10 + 2] == sl && info[4 * r01 + 2] == sl &&
+                      info[4 * r11 + 2] == sl;
+    const bool right = sr != 2 && info[4 * r10 + 3] == sr && info[4 * r01 + 3] == sr &&
+                       info[4 * r11 + 3] == sr;
+    const uint start = left ? L : 0, pend = right ? Rx : nx;
     // Per position at most one owned edge of each kind and three hits: the
     // packed counts of count_owned add up without carries over a 16-cell
     // chunk, so they are unpacked once per chunk (and per tail position).
@@ -518,8 +586,9 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     float v[8];
     float16 a[8];
     const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    uint x = 0;
-    for (; x + 16 < nx; x += 16) {
+    // The chunks of the other passes, from the one holding `start` on.
+    uint x = start >= pend ? nx : start & ~15u;
+    for (; x + 16 < nx && x < pend; x += 16) {
         bool fin;
         const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
         if (fin && all((cv == (uint16)(0)) | (cv == (uint16)(255))))
@@ -578,7 +647,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
         n2 += (packed >> 16) & 0xFF;
         hits += packed >> 24;
     }
-    if (!tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
+    if (x < pend && !tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
         lo = min(lo, x);
         hi = nx;
         for (uint i = x; i < nx; ++i) {

@@ -114,7 +114,12 @@ fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
             let names: Vec<&str> = st.timing.steps.iter().map(|s| s.step.name()).collect();
             assert_eq!(
                 names,
-                ["direct_count", "scan_exclusive", "direct_triangles"]
+                [
+                    "direct_rows",
+                    "direct_count",
+                    "scan_exclusive",
+                    "direct_triangles"
+                ]
             );
         }
     }

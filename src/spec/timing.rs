@@ -69,6 +69,8 @@ pub enum Step {
     McTriangles,
     /// `mc_iota`: identity faces of an unfused soup.
     McIota,
+    /// `mc_direct_rows`: each grid row read once, where it crosses.
+    McDirectRows,
     /// `mc_direct_count`: per-row vertex, triangle and hit counts, trimming.
     McDirectCount,
     /// `mc_direct_hits`: the grid points that vertices round onto.
@@ -152,6 +154,7 @@ impl Step {
             Step::McClassify => "mc_classify",
             Step::McTriangles => "mc_triangles",
             Step::McIota => "mc_iota",
+            Step::McDirectRows => "mc_direct_rows",
             Step::McDirectCount => "mc_direct_count",
             Step::McDirectHits => "mc_direct_hits",
             Step::McDirectTriangles => "mc_direct_triangles",
@@ -208,10 +211,9 @@ impl Step {
         match self {
             CurvMaxFace | CurvClear | CurvNormalsAreas | CurvFrames | CurvTensor
             | CurvPrincipal | CurvDcurv => Family::Curvature,
-            McClassify | McTriangles | McIota | McGradientNormals | McDirectCount
-            | McDirectHits | McDirectTriangles | McDirectPoints | McDirectRecount => {
-                Family::MarchingCubes
-            }
+            McClassify | McTriangles | McIota | McGradientNormals | McDirectRows
+            | McDirectCount | McDirectHits | McDirectTriangles | McDirectPoints
+            | McDirectRecount => Family::MarchingCubes,
             FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,

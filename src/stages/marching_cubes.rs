@@ -85,6 +85,7 @@ pub struct Isosurfacer {
     triangles: Kernel,
     iota: Kernel,
     gradient: Kernel,
+    direct_rows: Kernel,
     direct_count: Kernel,
     direct_hits: Kernel,
     direct_triangles: Kernel,
@@ -101,6 +102,7 @@ pub struct Isosurfacer {
     soup_faces: Grow<u32>,
     /// Direct numbering: per grid row counts (scanned in place), splits, trims.
     rowc: Buffer<u32>,
+    info: Buffer<u32>,
     split: Buffer<u32>,
     trim: Buffer<u32>,
     hit_keys: Grow<u32>,
@@ -170,6 +172,7 @@ impl Isosurfacer {
             triangles: gpu.kernel(&p, "mc_triangles")?,
             iota: gpu.kernel(&p, "mc_iota")?,
             gradient: gpu.kernel(&p, "mc_gradient_normals")?,
+            direct_rows: gpu.kernel(&p, "mc_direct_rows")?,
             direct_count: gpu.kernel(&p, "mc_direct_count")?,
             direct_hits: gpu.kernel(&p, "mc_direct_hits")?,
             direct_triangles: gpu.kernel(&p, "mc_direct_triangles")?,
@@ -185,6 +188,7 @@ impl Isosurfacer {
             idx: Grow::new(&gpu)?,
             soup_faces: Grow::new(&gpu)?,
             rowc: gpu.buffer::<u32>(4 * grid_rows)?,
+            info: gpu.buffer::<u32>(4 * grid_rows)?,
             split: gpu.buffer::<u32>(2 * grid_rows)?,
             trim: gpu.buffer::<u32>(2 * grid_rows)?,
             hit_keys: Grow::new(&gpu)?,
@@ -218,7 +222,7 @@ impl Isosurfacer {
             + self.key.bytes()
             + self.idx.bytes()
             + self.soup_faces.bytes()
-            + 36 * (self.dims[1] * self.dims[2]) as u64
+            + 52 * (self.dims[1] * self.dims[2]) as u64
             + self.side.bytes()
             + self.hit_keys.bytes()
             + self.dpos.bytes()
@@ -395,11 +399,24 @@ impl Isosurfacer {
             buf(&self.vol),
             Arg::F32(iso),
         ];
+        let e_rows = launch(
+            &g,
+            &self.direct_rows,
+            gr,
+            &[
+                Arg::U32(gr as u32),
+                Arg::U32(nx as u32),
+                buf(&self.vol),
+                Arg::F32(iso),
+                buf(&self.info),
+            ],
+        )?;
         let mut a = common.to_vec();
         a.extend([
             buf(&self.counts),
             buf(&self.tris),
             buf(&self.flat),
+            buf(&self.info),
             buf(&self.rowc),
             buf(&self.split),
             buf(&self.trim),
@@ -415,6 +432,9 @@ impl Isosurfacer {
                 )),
                 e => e,
             })?;
+        if let Some(e) = &e_rows {
+            st.timing.add(Step::McDirectRows, event_ms(e));
+        }
         if let Some(e) = &e_count {
             st.timing.add(Step::McDirectCount, event_ms(e));
         }
