@@ -73,23 +73,24 @@ pub struct FusionCounts {
 }
 
 /// Bytes of device memory direct numbering needs beyond the volume, for
-/// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits
-/// and `triangles` triangles: row summaries and counts (4 each per row), splits
-/// and trims (2 each), the recount where there are hits (1), hit keys (4 bytes per hit,
-/// bounded here by 16), the list of
-/// triangles with a hit corner (20 records of 5 per hit), positions, faces,
-/// and the clean-up of vertex fusion when there are hits or non-finite
-/// voxels (`cleanup`).
+/// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits,
+/// `triangles` triangles and room for `side_records` triangles with a hit
+/// corner: row summaries and counts (4 each per row), splits and trims (2
+/// each), the recount (1), hit keys (4 bytes per hit), the list (5 words per
+/// record), positions, faces, and the clean-up of vertex fusion when there
+/// are hits or non-finite voxels (`cleanup`).
 pub fn direct_device_bytes_bound(
     grid_rows: usize,
     vertices: usize,
     hits: usize,
     triangles: usize,
+    side_records: usize,
     cleanup: bool,
 ) -> u64 {
     let slots = (vertices + hits) as u64;
     let t = triangles as u64;
-    let mut b = 52 * grid_rows as u64 + 416 * hits as u64 + 12 * slots + 12 * t;
+    let mut b =
+        52 * grid_rows as u64 + 4 * hits as u64 + 20 * side_records as u64 + 12 * slots + 12 * t;
     if cleanup {
         // rep is the faces buffer; referenced + vert_id per slot; keep,
         // face_off, cand, cand_off per triangle; candidate keys and their

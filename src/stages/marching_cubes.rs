@@ -454,8 +454,9 @@ impl Isosurfacer {
             )));
         }
         let cleanup = h > 0 || self.nonfinite;
+        let side_cap = side_records(h, t);
         let need = 4 * voxels as u64
-            + crate::spec::vertex_fusion::direct_device_bytes_bound(gr, v, h, t, cleanup);
+            + crate::spec::vertex_fusion::direct_device_bytes_bound(gr, v, h, t, side_cap, cleanup);
         if need > g.info.global_mem {
             return Err(Error::DeviceUnsupported {
                 device: g.info.name.clone(),
@@ -514,9 +515,6 @@ impl Isosurfacer {
         let nv = v + u;
         self.dpos.reserve(&g, 3 * nv)?;
         self.dfaces.reserve(&g, 3 * tk)?;
-        // Triangles with a hit corner, for the twin check: at most 5 per
-        // cell, 4 cells per hit edge.
-        let side_cap = 20 * h;
         self.side.reserve(&g, 5 * side_cap)?;
         g.write(&mut self.side_n, &[0])?;
         let (toff, tshift, tbase) = if h > 0 {
@@ -754,4 +752,13 @@ mod tests {
         assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 2, 3, 1, 1]));
         assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 0]));
     }
+}
+
+/// Room for the list of triangles with a corner on a grid point, which the
+/// host checks for twins: at most 5 per cell and 4 cells per hit edge, and
+/// at most every triangle; capped at 2^21 records (40 MB), past which the
+/// list overflows and the fusion clean-up runs instead (volumes with that
+/// many hits, such as integer data at a voxel value, need it anyway).
+fn side_records(hits: usize, triangles: usize) -> usize {
+    (20 * hits).min(triangles).min(1 << 21)
 }
