@@ -741,6 +741,15 @@ fn hit_twins(rec: &[u32]) -> bool {
     false
 }
 
+/// Room for the list of triangles with a corner on a grid point, which the
+/// host checks for twins: at most 5 per cell and 4 cells per hit edge, and
+/// at most every triangle; capped at 2^21 records (40 MB), past which the
+/// list overflows and the fusion clean-up runs instead (volumes with that
+/// many hits, such as integer data at a voxel value, need it anyway).
+fn side_records(hits: usize, triangles: usize) -> usize {
+    (20 * hits).min(triangles).min(1 << 21)
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -752,13 +761,4 @@ mod tests {
         assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 2, 3, 1, 1]));
         assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 0]));
     }
-}
-
-/// Room for the list of triangles with a corner on a grid point, which the
-/// host checks for twins: at most 5 per cell and 4 cells per hit edge, and
-/// at most every triangle; capped at 2^21 records (40 MB), past which the
-/// list overflows and the fusion clean-up runs instead (volumes with that
-/// many hits, such as integer data at a voxel value, need it anyway).
-fn side_records(hits: usize, triangles: usize) -> usize {
-    (20 * hits).min(triangles).min(1 << 21)
 }
