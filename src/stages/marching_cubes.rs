@@ -515,8 +515,12 @@ impl Isosurfacer {
         let nv = v + u;
         self.dpos.reserve(&g, 3 * nv)?;
         self.dfaces.reserve(&g, 3 * tk)?;
-        self.side.reserve(&g, 5 * side_cap)?;
-        g.write(&mut self.side_n, &[0])?;
+        if h > 0 {
+            // Only written where there are hits (a blocking write otherwise
+            // would be a second wait of the extraction).
+            self.side.reserve(&g, 5 * side_cap)?;
+            g.write(&mut self.side_n, &[0])?;
+        }
         let (toff, tshift, tbase) = if h > 0 {
             (&self.tcount, 0, 0)
         } else {
