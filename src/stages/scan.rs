@@ -90,28 +90,8 @@ impl Scan {
         output: &Buffer<u32>,
         n: usize,
     ) -> Result<u64> {
-        self.last_ms = 0.0;
-        check_len("exclusive scan", n, &[("input", input), ("output", output)])?;
-        if n == 0 {
-            return Ok(0);
-        }
-        let events = self.enqueue(input, output, n)?;
-        let mut total = [0u64; 1];
-        // Blocking read on the in-order queue: the three kernels are done after it.
-        self.gpu.read(&self.total, &mut total)?;
-        self.last_ms = events.iter().map(event_ms).sum();
-        if total[0] > u64::from(u32::MAX) {
-            return Err(Error::input(
-                "exclusive scan",
-                format!("sum of {n} values"),
-                format!(
-                    "{} exceeds u32::MAX ({}); the output was left unchanged",
-                    total[0],
-                    u32::MAX
-                ),
-            ));
-        }
-        Ok(total[0])
+        self.exclusive_at(input, output, n, &[])
+            .map(|(total, _)| total)
     }
 
     /// Like [`Scan::exclusive`], also returning `output[i]` for each `i` of
@@ -147,6 +127,8 @@ impl Scan {
                 return Err(e);
             }
         }
+        // Blocking read on the in-order queue: the three kernels (and the
+        // reads of `at`) are done after it.
         self.gpu.read(&self.total, &mut total)?;
         self.last_ms = events.iter().map(event_ms).sum();
         if total[0] > u64::from(u32::MAX) {
