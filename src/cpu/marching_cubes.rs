@@ -22,7 +22,7 @@
 use crate::spec::marching_cubes::cell_rows;
 use crate::volume::Volume;
 
-use crate::spec::marching_cubes::{END, edge_corners, table};
+use crate::spec::marching_cubes::{END, common_face, edge_corners, edge_of, table};
 
 /// One vertex of the triangle soup: its position in index space (voxel
 /// units; world = origin + spacing × p) and its exact key: `4g + axis` for a
@@ -243,14 +243,6 @@ fn grid_edge(vol: &Volume, iso: f32, g: [usize; 3], axis: usize) -> EdgeVertex {
     )
 }
 
-/// Edge id (table numbering) of the edge along `axis` whose lower corner
-/// is `c0` (the inverse of [`edge_corners`]).
-fn edge_id(axis: usize, c0: usize) -> usize {
-    let others = [(axis + 1) % 3, (axis + 2) % 3];
-    let (lo_axis, hi_axis) = (others[0].min(others[1]), others[0].max(others[1]));
-    4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1)
-}
-
 /// True when triangle `j` of cell `cell` (case `case`), which lies in a face
 /// of the cube ([`crate::spec::marching_cubes::McTable::flat`]), has an
 /// opposite twin in the cell across that face: the same three voxel edges,
@@ -259,15 +251,10 @@ fn edge_id(axis: usize, c0: usize) -> usize {
 pub fn has_twin(vol: &Volume, iso: f32, cell: [usize; 3], case: usize, j: usize) -> bool {
     let t = table();
     let a = [0, 1, 2].map(|i| t.tris[case][3 * j + i] as usize);
-    let side = |e: usize, f: usize| (edge_corners(e).0 >> f) & 1;
-    let Some(f) = (0..3).find(|&f| {
-        a.iter().all(|&e| e / 4 != f)
-            && side(a[0], f) == side(a[1], f)
-            && side(a[1], f) == side(a[2], f)
-    }) else {
+    let Some((f, s)) = common_face(a[0], a[1], a[2]) else {
         return false;
     };
-    let s = side(a[0], f);
+    let side = |e: usize| (edge_corners(e).0 >> f) & 1;
     let mut p = cell;
     if s == 0 {
         if p[f] == 0 {
@@ -288,8 +275,9 @@ pub fn has_twin(vol: &Volume, iso: f32, cell: [usize; 3], case: usize, j: usize)
             .iter()
             .map(|&e| {
                 let e = e as usize;
-                (e / 4 != f && side(e, f) == 1 - s)
-                    .then(|| edge_id(e / 4, edge_corners(e).0 ^ (1 << f)))
+                // The same physical edge in this cell's numbering.
+                let (c0, c1) = edge_corners(e);
+                (e / 4 != f && side(e) == 1 - s).then(|| edge_of(c0 ^ (1 << f), c1 ^ (1 << f)))
             })
             .collect();
         m.is_some_and(|m| {

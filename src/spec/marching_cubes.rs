@@ -48,7 +48,9 @@ pub fn edge_corners(e: usize) -> (usize, usize) {
     (lo, lo | (1 << axis))
 }
 
-fn edge_of(c0: usize, c1: usize) -> usize {
+/// The edge (table numbering) joining corners `c0` and `c1`, which differ
+/// along one axis (the inverse of [`edge_corners`]).
+pub fn edge_of(c0: usize, c1: usize) -> usize {
     let d = c0 ^ c1;
     let axis = d.trailing_zeros() as usize;
     let lo = c0 & !d;
@@ -121,7 +123,7 @@ fn build_table() -> McTable {
         tris[case][..out.len()].copy_from_slice(&out);
         counts[case] = (out.len() / 3) as u8;
         for (j, t) in out.chunks(3).enumerate() {
-            if on_one_face(t[0] as usize, t[1] as usize, t[2] as usize) {
+            if common_face(t[0] as usize, t[1] as usize, t[2] as usize).is_some() {
                 flat[case] |= 1 << j;
             }
         }
@@ -129,18 +131,18 @@ fn build_table() -> McTable {
     McTable { tris, counts, flat }
 }
 
-/// True when edges `a`, `b`, `c` all lie on one face of the cube: a
-/// triangle on them lies in the face's plane (see [`McTable::flat`]).
-pub fn on_one_face(a: usize, b: usize, c: usize) -> bool {
-    // Faces of an edge: (axis, side) for each axis other than the edge's own.
-    let faces = |e: usize| {
-        let (lo, _) = edge_corners(e);
-        let axis = e / 4;
-        (0..3)
-            .filter(move |&f| f != axis)
-            .map(move |f| (f, (lo >> f) & 1))
-    };
-    faces(a).any(|fa| faces(b).any(|fb| fb == fa) && faces(c).any(|fc| fc == fa))
+/// The face of the cube, `(axis, side)`, that edges `a`, `b`, `c` all lie on,
+/// if any: a triangle on them lies in that face's plane (see
+/// [`McTable::flat`]).
+pub fn common_face(a: usize, b: usize, c: usize) -> Option<(usize, usize)> {
+    let side = |e: usize, f: usize| (edge_corners(e).0 >> f) & 1;
+    (0..3)
+        .find(|&f| {
+            [a, b, c].iter().all(|&e| e / 4 != f)
+                && side(a, f) == side(b, f)
+                && side(b, f) == side(c, f)
+        })
+        .map(|f| (f, side(a, f)))
 }
 
 /// The case table (built once per process).

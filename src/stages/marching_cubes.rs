@@ -729,13 +729,7 @@ pub fn curvature(
 fn hit_twins(rec: &[u32]) -> bool {
     let mut seen: std::collections::HashMap<[u32; 3], u8> = Default::default();
     for r in rec.chunks_exact(5).filter(|r| r[4] != 0) {
-        let f = [r[1], r[2], r[3]];
-        let mut set = f;
-        set.sort_unstable();
-        // Even permutation of the sorted set: one winding; odd: the other.
-        let even = (f[0] == set[0] && f[1] == set[1])
-            || (f[1] == set[0] && f[2] == set[1])
-            || (f[2] == set[0] && f[0] == set[1]);
+        let (set, even) = crate::cpu::vertex_fusion::tri_set([r[1], r[2], r[3]]);
         let w = seen.entry(set).or_default();
         *w |= if even { 1 } else { 2 };
         if *w == 3 {
