@@ -117,6 +117,21 @@ inline uint grid_index(uint x, uint y, uint z, uint nx, uint ny)
     return x + nx * (y + ny * z);
 }
 
+// Lower corner of edge e (table numbering), and the edge along `axis` whose
+// lower corner is c0 (its inverse).
+inline uint edge_lo_corner(uint e)
+{
+    const uint axis = e >> 2, k = e & 3;
+    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+    return ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
+}
+
+inline uint edge_id(uint axis, uint c0)
+{
+    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
+    return 4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1);
+}
+
 // Writes the triangles of cell (x, y, z) of case `cas` at soup slot `out`
 // onward; returns the next free slot.
 inline uint emit_cell(uint x, uint y, uint z, uint nx, uint ny, float iso, uint cas,
@@ -127,11 +142,7 @@ inline uint emit_cell(uint x, uint y, uint z, uint nx, uint ny, float iso, uint 
     const uint nt = counts[cas];
     for (uint i = 0; i < 3 * nt; ++i) {
         const uint e = tris[16 * cas + i];
-        const uint axis = e >> 2, k = e & 3;
-        // Lower corner of the edge: offsets on the two other axes from k.
-        const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
-        const uint c0 = ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
-        const uint c1 = c0 | (1u << axis);
+        const uint axis = e >> 2, c0 = edge_lo_corner(e), c1 = c0 | (1u << axis);
         uint g[3];
         g[0] = x + (c0 & 1);
         g[1] = y + ((c0 >> 1) & 1);
@@ -369,21 +380,6 @@ inline uint count_owned(__global const float *vol, ulong b00, ulong b10, ulong b
     const uint kz = edge_kind(a, vol[b01 + i], iso, z, &c);
     return (uint)(kx == EV_IN) | ((uint)(ky == EV_IN) << 8) | ((uint)(kz == EV_IN) << 16) |
            (((uint)(kx >= EV_LO) + (uint)(ky >= EV_LO) + (uint)(kz >= EV_LO)) << 24);
-}
-
-// Lower corner of edge e (table numbering), and the edge along `axis` whose
-// lower corner is c0 (its inverse).
-inline uint edge_lo_corner(uint e)
-{
-    const uint axis = e >> 2, k = e & 3;
-    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
-    return ((k & 1) << lo_axis) | ((k >> 1) << hi_axis);
-}
-
-inline uint edge_id(uint axis, uint c0)
-{
-    const uint lo_axis = axis == 0 ? 1 : 0, hi_axis = axis == 2 ? 1 : 2;
-    return 4 * axis + ((c0 >> lo_axis) & 1) + 2 * ((c0 >> hi_axis) & 1);
 }
 
 // Cases of the 16 cells x .. x+15 of a cell row (bit c set when corner c is

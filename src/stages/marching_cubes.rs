@@ -399,6 +399,8 @@ impl Isosurfacer {
             buf(&self.vol),
             Arg::F32(iso),
         ];
+        // The case table as the direct kernels take it: counts, tris, flat.
+        let tables = [buf(&self.counts), buf(&self.tris), buf(&self.flat)];
         let e_rows = launch(
             &g,
             &self.direct_rows,
@@ -411,11 +413,8 @@ impl Isosurfacer {
                 buf(&self.info),
             ],
         )?;
-        let mut a = common.to_vec();
+        let mut a = [&common[..], &tables[..]].concat();
         a.extend([
-            buf(&self.counts),
-            buf(&self.tris),
-            buf(&self.flat),
             buf(&self.info),
             buf(&self.rowc),
             buf(&self.split),
@@ -495,15 +494,8 @@ impl Isosurfacer {
             if let Some(e) = &e {
                 st.timing.add(Step::McDirectHits, event_ms(e));
             }
-            let mut a = common.to_vec();
-            a.extend([
-                buf(&self.counts),
-                buf(&self.tris),
-                buf(&self.flat),
-                buf(&self.rowc),
-                buf(&self.trim),
-                buf(&self.tcount),
-            ]);
+            let mut a = [&common[..], &tables[..]].concat();
+            a.extend([buf(&self.rowc), buf(&self.trim), buf(&self.tcount)]);
             let e = launch(&g, &self.direct_recount, gr, &a)?;
             tk = self.scan.exclusive(&self.tcount, &self.tcount, gr)? as usize;
             if let Some(e) = &e {
@@ -526,11 +518,8 @@ impl Isosurfacer {
         } else {
             (&self.rowc, gr as u32, v as u32)
         };
-        let mut a = common.to_vec();
+        let mut a = [&common[..], &tables[..]].concat();
         a.extend([
-            buf(&self.counts),
-            buf(&self.tris),
-            buf(&self.flat),
             buf(&self.rowc),
             buf(&self.split),
             buf(&self.trim),
