@@ -650,36 +650,34 @@ impl Payload<'_> {
         &self,
         chunks: impl IntoIterator<Item = Result<(Cow<'c, [u8]>, String)>>,
     ) -> Result<Vec<f32>> {
-        let total = voxel_count(self.dims, self.source, "sizes")?;
-        let per_chunk: usize = self.chunk_shape.iter().product();
-        let mut values = Vec::new();
-        for chunk in chunks {
-            let (bytes, element) = chunk?;
-            self.read_chunk(&bytes, &element, per_chunk, &mut values)?;
-        }
-        if values.len() != total {
-            // The callers size the chunk list from the header; this is a
-            // guard, not an expected path.
-            return Err(Error::input(
-                self.source,
-                "data",
-                format!("{} samples read for a grid of {total}", values.len()),
-            ));
-        }
-        Ok(values)
+        self.gather(|per_chunk, values| {
+            for chunk in chunks {
+                let (bytes, element) = chunk?;
+                self.read_chunk(&bytes, &element, per_chunk, values)?;
+            }
+            Ok(())
+        })
     }
 
     /// Decodes detached data files, in order, into the samples of the whole
     /// grid (see [`Payload::read_data_file`]).
     fn read_files(&self, files: &[PathBuf]) -> Result<Vec<f32>> {
+        self.gather(|per_chunk, values| {
+            files
+                .iter()
+                .try_for_each(|f| self.read_data_file(f, per_chunk, values))
+        })
+    }
+
+    /// The samples of the whole grid, appended by `fill` (given the samples
+    /// per chunk), checked to be exactly the grid's count.
+    fn gather(&self, fill: impl FnOnce(usize, &mut Vec<f32>) -> Result<()>) -> Result<Vec<f32>> {
         let total = voxel_count(self.dims, self.source, "sizes")?;
-        let per_chunk: usize = self.chunk_shape.iter().product();
         let mut values = Vec::new();
-        for f in files {
-            self.read_data_file(f, per_chunk, &mut values)?;
-        }
+        fill(self.chunk_shape.iter().product(), &mut values)?;
         if values.len() != total {
-            // As in `read`: a guard, not an expected path.
+            // The callers size the chunks and files from the header; this is
+            // a guard, not an expected path.
             return Err(Error::input(
                 self.source,
                 "data",
