@@ -325,3 +325,41 @@ __kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global cons
     WRITE_SCREEN(o, 2, smx, smy, mz, mw, hvw, hvh);
     WRITE_SCREEN(o, 3, smx + p1x * hw, smy + p1y * hw, mz, mw, hvw, hvh);
 }
+
+// Read-back of what was drawn, compacted on the device (EdgeStage::read_drawn;
+// CPU twin: cpu::edges::compact_drawn). drawn_flags writes, for E edge entries
+// then C cap pairs, 1 where the last run drew the primitive (kind bit 3;
+// cap_drawn) and 0 elsewhere; the host scans the flags in place (scan.cl), so
+// that slot[i] is primitive i's place among the drawn ones, and the
+// compact_* kernels copy each drawn primitive's `per` vertices there: index
+// order is kept, and only drawn geometry crosses to the host.
+__kernel void drawn_flags(uint ne, uint nc, __global const uint* kind,
+                          __global const uchar* cap_drawn, __global uint* flags) {
+    GID_OR_RETURN(ne + nc)
+    flags[gid] = gid < ne ? ((kind[gid] & KIND_DRAWN) != 0u ? 1u : 0u)
+                          : (cap_drawn[gid - ne] != 0 ? 1u : 0u);
+}
+
+// Edge entries' primitives (edge-out quads, per = 4; McGuire-Hughes half-caps,
+// per = 3) into dst from vertex `at` on.
+__kernel void compact_edges(uint n, uint per, __global const float4* src,
+                            __global const uint* kind, __global const uint* slot,
+                            uint at, __global float4* dst) {
+    GID_OR_RETURN(n)
+    if ((kind[gid] & KIND_DRAWN) == 0u) return;
+    __global const float4* s = src + per * gid;
+    __global float4* d = dst + at + per * slot[gid];
+    for (uint k = 0; k < per; k++) d[k] = s[k];
+}
+
+// Adjacency caps (4 vertices each); their slots follow the ne edge entries'
+// in `slot`, counted on from the `base` drawn edges.
+__kernel void compact_caps(uint n, __global const float4* src, __global const uchar* cap_drawn,
+                           __global const uint* slot, uint ne, uint base, uint at,
+                           __global float4* dst) {
+    GID_OR_RETURN(n)
+    if (cap_drawn[gid] == 0) return;
+    __global const float4* s = src + 4 * gid;
+    __global float4* d = dst + at + 4 * (slot[ne + gid] - base);
+    for (uint k = 0; k < 4; k++) d[k] = s[k];
+}

@@ -1090,6 +1090,27 @@ fn compact_read_back_case(m: &Mesh) {
             s.run(&p, mode).unwrap();
             let (full, drawn) = (s.read().unwrap(), s.read_drawn().unwrap());
             let what = format!("{} from {eye:?}", mode.name());
+            // The device's compaction equals its CPU twin's, bit for bit.
+            let twin = shapecue::cpu::edges::compact_drawn(&full);
+            let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|c| c.to_bits()).collect::<Vec<_>>();
+            for (d, t, name) in [
+                (&drawn.edge_out, &twin.edge_out, "edge-out"),
+                (&drawn.cap_mh0, &twin.cap_mh0, "cap_mh0"),
+                (&drawn.cap_mh1, &twin.cap_mh1, "cap_mh1"),
+                (&drawn.cap_adj, &twin.cap_adj, "cap_adj"),
+            ] {
+                assert!(
+                    bits(d) == bits(t),
+                    "{what}: {name} compacted on the device vs the twin"
+                );
+            }
+            assert!(
+                s.compact_timing()
+                    .steps
+                    .iter()
+                    .any(|st| st.step.kernel() == "edges_compact"),
+                "{what}: the compaction is timed"
+            );
             assert_eq!(drawn.kind, full.kind, "{what}");
             assert!(
                 count(&full.kind, KIND_DRAWN) > 0,

@@ -519,3 +519,81 @@ fn renderers_run_one_after_another_side_by_side_and_on_many_threads() {
         h.join().unwrap();
     }
 }
+
+#[test]
+fn a_reconfigured_renderer_draws_what_a_new_one_draws() {
+    let Some(mut r) = renderer(opts(40, 30, 4)) else {
+        return;
+    };
+    let cam = camera();
+    let first = draw_cube(&mut r, &cam, MeshStyle::default());
+    for o in [
+        opts(64, 48, 0),
+        opts(40, 30, 4),
+        opts(33, 17, 2),
+        opts(33, 17, 2),
+    ] {
+        r.reconfigure(o).unwrap();
+        let mut fresh = Renderer::new(o).unwrap();
+        let a = draw_cube(&mut r, &cam, MeshStyle::default());
+        let b = draw_cube(&mut fresh, &cam, MeshStyle::default());
+        assert_eq!((a.width, a.height), (o.width, o.height));
+        assert!(a == b, "{o:?}: reconfigured vs new renderer");
+    }
+    r.reconfigure(opts(40, 30, 4)).unwrap();
+    assert!(draw_cube(&mut r, &cam, MeshStyle::default()) == first);
+    // Bad options are refused and the renderer keeps its old ones.
+    for (w, h, msaa) in [(0, 8, 0), (8, 8, 3), (8, 8, 16), (1 << 20, 8, 0)] {
+        assert!(
+            matches!(
+                r.reconfigure(opts(w, h, msaa)),
+                Err(Error::InvalidArgument(_))
+            ),
+            "{w}x{h} msaa {msaa}"
+        );
+        assert_eq!(r.options(), opts(40, 30, 4));
+    }
+    assert!(draw_cube(&mut r, &cam, MeshStyle::default()) == first);
+}
+
+#[test]
+fn an_uploaded_mesh_is_drawn_in_every_view_without_uploading_again() {
+    let Some(mut r) = renderer(opts(48, 48, 0)) else {
+        return;
+    };
+    let (p, n, f) = cube();
+    // Nothing uploaded yet: a clear error, not an empty picture.
+    r.begin(&camera()).unwrap();
+    let e = r.draw_uploaded(MeshStyle::default()).unwrap_err();
+    assert!(e.to_string().contains("no mesh uploaded"), "{e}");
+    r.finish().unwrap();
+    r.upload_topology(&f).unwrap();
+    r.upload_pose(&p, &n, &[]).unwrap();
+    let eyes = [
+        Vec3::new(3.0, 2.0, 4.0),
+        Vec3::new(-3.0, 1.0, 2.0),
+        Vec3::new(0.5, -4.0, 1.0),
+    ];
+    for eye in eyes {
+        let cam = Camera::look_at(eye, Vec3::ZERO);
+        r.begin(&cam).unwrap();
+        r.draw_uploaded(MeshStyle::default()).unwrap();
+        let a = r.finish().unwrap();
+        assert!(a == draw_cube(&mut r, &cam, MeshStyle::default()), "{eye}");
+    }
+    // Three draw_mesh calls upload three times; the uploaded views none.
+    assert_eq!(r.uploads().topology, 1 + 3);
+    assert_eq!(r.uploads().pose, 1 + 3);
+    // Faces past the pose's vertices and bad poses are refused by name.
+    r.upload_pose(&p[..10], &n[..10], &[]).unwrap();
+    r.begin(&camera()).unwrap();
+    let e = r.draw_uploaded(MeshStyle::default()).unwrap_err();
+    assert!(e.to_string().contains("past the 10 vertices"), "{e}");
+    r.finish().unwrap();
+    let mut bad = p.clone();
+    bad[7][1] = f32::NAN;
+    let e = r.upload_pose(&bad, &n, &[]).unwrap_err();
+    assert!(e.to_string().contains("vertex 7"), "{e}");
+    let e = r.upload_pose(&p, &n[..3], &[]).unwrap_err();
+    assert!(e.to_string().contains("normals"), "{e}");
+}

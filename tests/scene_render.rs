@@ -13,7 +13,7 @@ use common::{SHARED_DATA, model_path, scratch, unless_no_gl};
 use shapecue::Error;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
-use shapecue::scene::planner::{Cue, Pass, plan_with};
+use shapecue::scene::planner::{Cue, Input, Pass, plan_with};
 use std::path::Path;
 
 /// Writes a scene next to its outputs and parses it.
@@ -47,6 +47,15 @@ fn check_minimal(r: &RunReport, what: &str) {
         );
         assert!(p.ms.is_finite() && p.ms >= 0.0, "{what}: {p:?}");
     }
+    // The mesh goes to GL once per topology and once per pose, not per view.
+    let frames = r.frames.len() as u64;
+    let topologies = if r.plan.input == Input::Volume {
+        frames
+    } else {
+        1
+    };
+    assert_eq!(r.gl_uploads.topology, topologies, "{what}: face uploads");
+    assert_eq!(r.gl_uploads.pose, frames, "{what}: pose uploads");
 }
 
 const CUES: [(&str, Cue); 6] = [
@@ -527,4 +536,72 @@ fn walk(d: &Path) -> Vec<std::path::PathBuf> {
         }
     }
     v
+}
+
+#[test]
+fn scenes_in_one_session_share_the_device_and_the_gl_context_and_draw_the_same() {
+    // Three scenes of other sizes and antialiasing, run one after another
+    // in one session (one renderer, reconfigured) and each on its own: the
+    // images are the same bytes.
+    let dir = scratch("session");
+    let text = |size: [u32; 2], msaa: u32, cues: &str| {
+        format!(
+            "[input]\ngenerate = \"torus\"\nresolution = 3000\n[[camera]]\norbit = 2\n\
+             [effects]\n{cues}\n[output]\nsize = [{}, {}]\nmsaa = {msaa}\nformats = [\"png\"]\n",
+            size[0], size[1]
+        )
+    };
+    let specs = [
+        ([96, 72], 4, "shading = {}\ncontours = {}"),
+        (
+            [64, 64],
+            0,
+            "curvature_colors = {}\nfeature_edges = { crease = 20 }",
+        ),
+        ([96, 72], 2, "ao = {}\nsuggestive_contours = {}"),
+    ];
+    let mut scenes = Vec::new();
+    for (i, (size, msaa, cues)) in specs.iter().enumerate() {
+        let p = dir.join(format!("s{i}.toml"));
+        std::fs::write(&p, text(*size, *msaa, cues)).unwrap();
+        scenes.push(Scene::load(&p).unwrap());
+    }
+    let opts = |sub: &str| ExecOptions {
+        out_dir: Some(dir.join(sub)),
+        force: false,
+        device: None,
+    };
+    let mut session = exec::Session::new();
+    for s in &scenes {
+        let Some(r) = unless_no_gl(session.run(s, &opts("together"), &mut |_, _| {})) else {
+            return;
+        };
+        check_minimal(&r.unwrap(), "in one session");
+    }
+    for s in &scenes {
+        exec::run(s, &opts("alone"), &mut |_, _| {}).unwrap();
+    }
+    let pngs = |sub: &str| {
+        let mut v: Vec<_> = walk(&dir.join(sub))
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "png"))
+            .collect();
+        v.sort();
+        v
+    };
+    let (together, alone) = (pngs("together"), pngs("alone"));
+    assert_eq!(
+        together.len(),
+        3 * 2,
+        "two views of three scenes: {together:?}"
+    );
+    assert_eq!(together.len(), alone.len());
+    for (a, b) in together.iter().zip(&alone) {
+        assert_eq!(a.file_name(), b.file_name());
+        assert!(
+            std::fs::read(a).unwrap() == std::fs::read(b).unwrap(),
+            "{} differs between the session and a run of its own",
+            a.display()
+        );
+    }
 }

@@ -89,6 +89,12 @@ pub struct EdgesArgs {
     /// Print the memory table (bits per mesh for each cap variant) instead.
     #[arg(long)]
     memory_table: bool,
+    /// After the first frame, this many more timed frames of the same view
+    /// with the topology, device buffers, GL context and uploaded mesh kept
+    /// (as a batch of views reuses them); --stats gives their medians
+    /// (frame_median_ms, phases_median_ms). The image is the first frame's.
+    #[arg(long)]
+    runs: Option<usize>,
 }
 
 fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
@@ -124,6 +130,9 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             "--width {}: the edge width must be at most the image's larger side ({widest} pixels)",
             a.width
         );
+    }
+    if let Some(n) = a.runs {
+        shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
     if a.memory_table {
         return super::tables::edges_memory_table();
@@ -170,6 +179,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         half_contours: a.half_contours,
         marked: a.marked.clone(),
         polylines: a.svg.is_some(),
+        timed_runs: a.runs.unwrap_or(0),
     };
     let d = draw(gpu, &mesh, &path.display().to_string(), &opts)?;
     let t_png = std::time::Instant::now();
@@ -193,6 +203,14 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         d.timing.kernel_ms,
         output.display()
     );
+    if let Some(r) = &d.runs {
+        out!(
+            "{} timed frames: median {:.2} ms per frame, {:.3} ms kernels",
+            r.runs,
+            r.frame_median_ms,
+            r.kernel_median_ms
+        );
+    }
     let mut svg_ms = 0.0;
     if let (Some(svg), Some(lines)) = (&a.svg, &d.polylines) {
         let t_svg = std::time::Instant::now();

@@ -68,9 +68,11 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
     // Outputs, frame ranges and flipbook topology of every scene; the
     // animated inputs loaded for it are handed to their runs.
     let checked = exec::check_scenes(&scenes, &opts)?;
+    // One device and one GL context for all the scenes.
+    let mut session = exec::Session::new();
     for (scene, checked) in scenes.iter().zip(checked) {
         let bar = progress_bar(&scene.name);
-        let r = exec::run_checked(scene, checked, &opts, &mut |done, total| {
+        let r = session.run_checked(scene, checked, &opts, &mut |done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })?;

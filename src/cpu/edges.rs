@@ -9,7 +9,7 @@
 //! classification can differ only for ties (a face seen exactly edge-on).
 
 use crate::spec::edges::{
-    EdgeParamBlock, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, MARKER,
+    EdgeOutput, EdgeParamBlock, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, MARKER,
 };
 
 type P = EdgeParamBlock;
@@ -292,6 +292,34 @@ pub fn caps_adjacency(
         out.push(screen(p, sm[0] + p1[0] * hw, sm[1] + p1[1] * hw, z, w));
     }
     out
+}
+
+/// The read-back compaction (`drawn_flags`, one scan, `compact_edges`,
+/// `compact_caps`; the device stage's `read_drawn`): of a full output, the
+/// edge-out quads and McGuire-Hughes half-caps of the drawn edges
+/// (`KIND_DRAWN`) and the adjacency caps that hold geometry (not the
+/// marker), each in index order; `kind` in full.
+pub fn compact_drawn(full: &EdgeOutput) -> EdgeOutput {
+    let drawn = |e: usize| full.kind.get(e).is_some_and(|k| k & KIND_DRAWN != 0);
+    let of_edges = |b: &[[f32; 4]], per: usize| -> Vec<[f32; 4]> {
+        b.chunks_exact(per)
+            .enumerate()
+            .filter(|(e, _)| drawn(*e))
+            .flat_map(|(_, q)| q.iter().copied())
+            .collect()
+    };
+    EdgeOutput {
+        edge_out: of_edges(&full.edge_out, 4),
+        kind: full.kind.clone(),
+        cap_mh0: of_edges(&full.cap_mh0, 3),
+        cap_mh1: of_edges(&full.cap_mh1, 3),
+        cap_adj: full
+            .cap_adj
+            .chunks_exact(4)
+            .filter(|q| !q[0][0].is_nan())
+            .flat_map(|q| q.iter().copied())
+            .collect(),
+    }
 }
 
 /// The front door's CPU twin of `shapecue::feature_edges`: builds the

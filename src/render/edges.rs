@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, framed};
+use super::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, Uploads, framed};
 use crate::error::Result;
 use crate::export::svg::{DEFAULT_BIAS, visible_polylines};
 use crate::gpu::{DeviceInfo, Gpu};
@@ -72,6 +72,11 @@ pub struct EdgeDrawOptions {
     pub marked: Option<PathBuf>,
     /// Also find the visible edges as polylines (for SVG).
     pub polylines: bool,
+    /// Timed frames after the first (0: none): each reruns the stage, its
+    /// read-back and the GL frame with the topology, the device buffers, the
+    /// renderer and the uploaded mesh kept, as a batch of views does
+    /// ([`EdgeDrawing::runs`]).
+    pub timed_runs: usize,
 }
 
 impl Default for EdgeDrawOptions {
@@ -91,6 +96,7 @@ impl Default for EdgeDrawOptions {
             half_contours: false,
             marked: None,
             polylines: false,
+            timed_runs: 0,
         }
     }
 }
@@ -122,6 +128,20 @@ pub struct EdgePhases {
     pub image_readback: f64,
     /// The visible polylines for SVG (0 without).
     pub svg_visibility: f64,
+}
+
+/// Medians over the timed frames of [`EdgeDrawOptions::timed_runs`], ms.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct EdgeRuns {
+    /// Timed frames.
+    pub runs: usize,
+    /// Median of the whole frame: kernels, read-back, drawing, image read-back.
+    pub frame_median_ms: f64,
+    /// Median kernel time of the stage (OpenCL profiling events).
+    pub kernel_median_ms: f64,
+    /// Median of each phase a frame has (the topology, stage setup and GL
+    /// context phases are 0: a frame reuses them).
+    pub phases_median: EdgePhases,
 }
 
 /// What [`draw`] made.
@@ -159,6 +179,10 @@ pub struct EdgeDrawing {
     pub polylines: Option<Vec<Vec<[f32; 2]>>>,
     /// The device that ran the stage.
     pub device: DeviceInfo,
+    /// Medians of the timed frames after the first, when asked for.
+    pub runs: Option<EdgeRuns>,
+    /// Mesh data uploads to GL over all frames (one topology and one pose).
+    pub uploads: Uploads,
 }
 
 impl EdgeDrawing {
@@ -193,6 +217,11 @@ impl EdgeDrawing {
             "phases_ms": self.phases,
             "memory_bits": self.memory,
             "svg_polylines": self.polylines.as_ref().map_or(0, Vec::len),
+            "runs": self.runs.map(|r| r.runs),
+            "frame_median_ms": self.runs.map(|r| r.frame_median_ms),
+            "kernel_median_ms": self.runs.map(|r| r.kernel_median_ms),
+            "phases_median_ms": self.runs.map(|r| r.phases_median),
+            "gl_uploads": self.uploads,
         })
     }
 }
@@ -277,29 +306,51 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         ..Default::default()
     })?;
     ph.gl_context = lap();
-    r.begin(&cam)?;
-    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, MeshStyle::default())?;
-    ph.draw_mesh = lap();
-    draw_edges(&mut r, &output, [0.0, 0.0, 0.0, 1.0])?;
-    ph.draw_edges = lap();
-    // Depth only for the SVG's visibility test.
-    let frame = if opts.polylines {
-        r.finish()?
-    } else {
-        r.finish_color()?
+    r.upload_topology(&mesh.faces)?;
+    r.upload_pose(&pos, &nrm, &[])?;
+    let mut frame_run = |ph: &mut EdgePhases, lap: &mut dyn FnMut() -> f64, output: &EdgeOutput| {
+        r.begin(&cam)?;
+        r.draw_uploaded(MeshStyle::default())?;
+        ph.draw_mesh = lap();
+        draw_edges(&mut r, output, [0.0, 0.0, 0.0, 1.0])?;
+        ph.draw_edges = lap();
+        // Depth only for the SVG's visibility test.
+        let frame = if opts.polylines {
+            r.finish()?
+        } else {
+            r.finish_color()?
+        };
+        ph.image_readback = lap();
+        Ok::<_, crate::error::Error>(frame)
     };
-    ph.image_readback = lap();
-    let frame_ms = ph.stage_setup
-        + ph.kernels
-        + ph.readback
-        + ph.gl_context
-        + ph.draw_mesh
-        + ph.draw_edges
-        + ph.image_readback;
+    let frame = frame_run(&mut ph, &mut lap, &output)?;
+    let frame_ms = frame_sum(&ph);
     let polylines = opts
         .polylines
         .then(|| visible_polylines(&output.edge_out, &frame, DEFAULT_BIAS));
     ph.svg_visibility = lap();
+
+    let runs = if opts.timed_runs > 0 {
+        let mut each: Vec<(EdgePhases, f64)> = Vec::with_capacity(opts.timed_runs);
+        for _ in 0..opts.timed_runs {
+            let mut q = EdgePhases::default();
+            lap();
+            let t = stage.run(&p, opts.caps)?;
+            q.kernels = lap();
+            let out = stage.read_drawn()?;
+            q.readback = lap();
+            let f = frame_run(&mut q, &mut lap, &out)?;
+            if opts.polylines {
+                std::hint::black_box(visible_polylines(&out.edge_out, &f, DEFAULT_BIAS));
+                q.svg_visibility = lap();
+            }
+            each.push((q, t.kernel_ms));
+        }
+        Some(runs_summary(&each))
+    } else {
+        None
+    };
+    let uploads = r.uploads();
     Ok(EdgeDrawing {
         memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),
         frame,
@@ -315,5 +366,40 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
         frame_ms,
         polylines,
         device: gpu.info.clone(),
+        runs,
+        uploads,
     })
+}
+
+/// The whole frame of `ph`: everything after the topology but the SVG.
+fn frame_sum(ph: &EdgePhases) -> f64 {
+    ph.stage_setup
+        + ph.kernels
+        + ph.readback
+        + ph.gl_context
+        + ph.draw_mesh
+        + ph.draw_edges
+        + ph.image_readback
+}
+
+/// Medians of timed frames (their phases and kernel times).
+fn runs_summary(each: &[(EdgePhases, f64)]) -> EdgeRuns {
+    use crate::metrics::median;
+    let of = |f: &dyn Fn(&EdgePhases) -> f64| {
+        median(&mut each.iter().map(|e| f(&e.0)).collect::<Vec<_>>())
+    };
+    EdgeRuns {
+        runs: each.len(),
+        frame_median_ms: of(&frame_sum),
+        kernel_median_ms: median(&mut each.iter().map(|e| e.1).collect::<Vec<_>>()),
+        phases_median: EdgePhases {
+            kernels: of(&|p| p.kernels),
+            readback: of(&|p| p.readback),
+            draw_mesh: of(&|p| p.draw_mesh),
+            draw_edges: of(&|p| p.draw_edges),
+            image_readback: of(&|p| p.image_readback),
+            svg_visibility: of(&|p| p.svg_visibility),
+            ..EdgePhases::default()
+        },
+    }
 }

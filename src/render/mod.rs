@@ -157,6 +157,44 @@ void main() { o_color = u_color; }
 /// A framebuffer object with a colour and a depth renderbuffer.
 struct Target {
     fbo: glow::NativeFramebuffer,
+    renderbuffers: [glow::NativeRenderbuffer; 2],
+}
+
+impl Target {
+    /// Frees the framebuffer and its renderbuffers.
+    ///
+    /// # Safety
+    /// The context of `gl` (the one that made the target) must be current.
+    unsafe fn delete(self, gl: &glow::Context) {
+        unsafe {
+            gl.delete_framebuffer(self.fbo);
+            for rb in self.renderbuffers {
+                gl.delete_renderbuffer(rb);
+            }
+        }
+    }
+}
+
+/// What the mesh buffers of a [`Renderer`] hold (see
+/// [`Renderer::upload_topology`] and [`Renderer::upload_pose`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct HeldMesh {
+    /// Faces in the index buffer, and the largest index they use.
+    faces: Option<(usize, Option<u32>)>,
+    /// Vertices in the position and normal buffers, and whether the colour
+    /// buffer holds one colour per vertex.
+    pose: Option<(usize, bool)>,
+}
+
+/// How often a [`Renderer`] has uploaded mesh data to GL since it was made:
+/// a caller that draws many views of one mesh uploads its faces once per
+/// topology and its positions once per pose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Uploads {
+    /// Index-buffer uploads ([`Renderer::upload_topology`]).
+    pub topology: u64,
+    /// Position, normal and colour uploads ([`Renderer::upload_pose`]).
+    pub pose: u64,
 }
 
 /// Uniform locations of the mesh program.
@@ -190,14 +228,27 @@ pub struct Renderer {
     /// Positions, normals, colours, indices.
     mesh_bufs: [glow::NativeBuffer; 4],
     clip_vao: glow::NativeVertexArray,
-    /// Vertices, indices.
+    /// Vertices, and the quad index pattern (0 1 2 0 2 3 per quad).
     clip_bufs: [glow::NativeBuffer; 2],
+    /// Quads the pattern in `clip_bufs[1]` covers.
+    quad_pattern: usize,
     /// Multisampled target, when `msaa > 0`.
     ms: Option<Target>,
     /// Single-sampled target that `finish` reads (the draw target when `msaa == 0`).
     resolve: Target,
     frame: Option<FrameState>,
+    /// `GL_RENDERER`, and the driver's `GL_MAX_SAMPLES` and
+    /// `GL_MAX_RENDERBUFFER_SIZE` (the limits of [`Renderer::reconfigure`]).
+    driver: String,
+    max_samples: i32,
+    max_size: i32,
+    /// `GL_RENDERER`, `GL_VERSION` and the EGL platform; the MSAA part of
+    /// [`Renderer::gl_info`] is added from the current targets.
     info: String,
+    /// Samples per pixel the driver gave the multisampled target.
+    samples: i32,
+    held: HeldMesh,
+    uploads: Uploads,
     // Dropped last: destroying the context frees every GL object above, so
     // Renderer needs no Drop of its own (and a failed `new` leaks nothing).
     ctx: GlContext,
@@ -289,6 +340,7 @@ unsafe fn target(gl: &glow::Context, w: i32, h: i32, samples: i32) -> Result<Tar
             .create_framebuffer()
             .map_err(|e| Error::render("glGenFramebuffers", e))?;
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        let mut renderbuffers = Vec::with_capacity(2);
         for (format, attachment) in [
             (glow::RGBA8, glow::COLOR_ATTACHMENT0),
             (glow::DEPTH_COMPONENT32F, glow::DEPTH_ATTACHMENT),
@@ -308,19 +360,98 @@ unsafe fn target(gl: &glow::Context, w: i32, h: i32, samples: i32) -> Result<Tar
                 glow::RENDERBUFFER,
                 Some(rb),
             );
+            renderbuffers.push(rb);
         }
-        check(
+        let renderbuffers = [renderbuffers[0], renderbuffers[1]];
+        let made = Target { fbo, renderbuffers };
+        if let Err(e) = check(
             gl,
             &format!("allocating a {w}x{h} framebuffer with {samples} samples"),
-        )?;
+        ) {
+            made.delete(gl);
+            return Err(e);
+        }
         let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
         if status != glow::FRAMEBUFFER_COMPLETE {
+            made.delete(gl);
             return Err(Error::render(
                 format!("framebuffer {w}x{h}, {samples} samples"),
                 format!("incomplete (status 0x{status:04X})"),
             ));
         }
-        Ok(Target { fbo })
+        Ok(made)
+    }
+}
+
+/// Checks `opts` against the driver's sample and size limits.
+fn check_limits(opts: &RenderOptions, driver: &str, max_samples: i32, max_size: i32) -> Result<()> {
+    if opts.msaa as i32 > max_samples {
+        return Err(Error::InvalidArgument(format!(
+            "msaa {} exceeds the {max_samples} samples '{driver}' supports",
+            opts.msaa
+        )));
+    }
+    if opts.width as i64 > max_size as i64 || opts.height as i64 > max_size as i64 {
+        return Err(Error::InvalidArgument(format!(
+            "render size {}x{} exceeds the {max_size}x{max_size} '{driver}' supports",
+            opts.width, opts.height
+        )));
+    }
+    Ok(())
+}
+
+/// Checks what [`Renderer::new`] and [`Renderer::reconfigure`] can check
+/// before touching GL.
+fn check_options(opts: &RenderOptions) -> Result<()> {
+    if opts.width == 0 || opts.height == 0 {
+        return Err(Error::InvalidArgument(format!(
+            "render size {}x{} must be at least 1x1",
+            opts.width, opts.height
+        )));
+    }
+    if ![0, 2, 4, 8].contains(&opts.msaa) {
+        return Err(Error::InvalidArgument(format!(
+            "msaa {} must be 0, 2, 4 or 8",
+            opts.msaa
+        )));
+    }
+    Ok(())
+}
+
+/// The multisampled (when `msaa > 0`) and resolve targets of `opts`, and the
+/// samples the driver gave the first (drivers may round up: llvmpipe 2 → 4).
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn targets(
+    gl: &glow::Context,
+    opts: &RenderOptions,
+) -> Result<(Option<Target>, Target, i32)> {
+    let (w, h) = (opts.width as i32, opts.height as i32);
+    unsafe {
+        let ms = if opts.msaa > 0 {
+            Some(target(gl, w, h, opts.msaa as i32)?)
+        } else {
+            None
+        };
+        let resolve = match target(gl, w, h, 0) {
+            Ok(t) => t,
+            Err(e) => {
+                if let Some(t) = ms {
+                    t.delete(gl);
+                }
+                return Err(e);
+            }
+        };
+        let samples = match &ms {
+            Some(t) => {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(t.fbo));
+                gl.get_parameter_i32(glow::SAMPLES)
+            }
+            None => 0,
+        };
+        gl.viewport(0, 0, w, h);
+        Ok((ms, resolve, samples))
     }
 }
 
@@ -329,45 +460,21 @@ impl Renderer {
     /// [`Error::NoGl`] (naming the apt packages) when libEGL or Mesa is missing,
     /// and with [`Error::InvalidArgument`] for a zero size, an `msaa` other than
     /// 0/2/4/8, or more samples or pixels than the driver supports.
+    ///
+    /// A context, its programs and its framebuffers cost tens of
+    /// milliseconds on llvmpipe: a caller drawing images of several sizes
+    /// keeps one renderer and calls [`reconfigure`](Self::reconfigure).
     pub fn new(opts: RenderOptions) -> Result<Renderer> {
-        if opts.width == 0 || opts.height == 0 {
-            return Err(Error::InvalidArgument(format!(
-                "render size {}x{} must be at least 1x1",
-                opts.width, opts.height
-            )));
-        }
-        if ![0, 2, 4, 8].contains(&opts.msaa) {
-            return Err(Error::InvalidArgument(format!(
-                "msaa {} must be 0, 2, 4 or 8",
-                opts.msaa
-            )));
-        }
+        check_options(&opts)?;
         let (ctx, gl) = GlContext::new()?;
         // SAFETY: `GlContext::new` made the context current on this thread.
         unsafe {
-            let renderer = gl.get_parameter_string(glow::RENDERER);
+            let driver = gl.get_parameter_string(glow::RENDERER);
             let version = gl.get_parameter_string(glow::VERSION);
             let max_samples = gl.get_parameter_i32(glow::MAX_SAMPLES);
             let max_size = gl.get_parameter_i32(glow::MAX_RENDERBUFFER_SIZE);
-            if opts.msaa as i32 > max_samples {
-                return Err(Error::InvalidArgument(format!(
-                    "msaa {} exceeds the {max_samples} samples '{renderer}' supports",
-                    opts.msaa
-                )));
-            }
-            if opts.width as i64 > max_size as i64 || opts.height as i64 > max_size as i64 {
-                return Err(Error::InvalidArgument(format!(
-                    "render size {}x{} exceeds the {max_size}x{max_size} '{renderer}' supports",
-                    opts.width, opts.height
-                )));
-            }
-            let (w, h) = (opts.width as i32, opts.height as i32);
-            let ms = if opts.msaa > 0 {
-                Some(target(&gl, w, h, opts.msaa as i32)?)
-            } else {
-                None
-            };
-            let resolve = target(&gl, w, h, 0)?;
+            check_limits(&opts, &driver, max_samples, max_size)?;
+            let (ms, resolve, samples) = targets(&gl, &opts)?;
 
             let mesh_prog = program(&gl, "mesh", MESH_VS, MESH_FS)?;
             let u = |name: &str| gl.get_uniform_location(mesh_prog, name);
@@ -412,7 +519,6 @@ impl Renderer {
             gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(clip_bufs[1]));
             gl.bind_vertex_array(None);
 
-            gl.viewport(0, 0, w, h);
             gl.enable(glow::DEPTH_TEST);
             gl.disable(glow::CULL_FACE); // edge quads have either winding
             gl.polygon_offset(1.0, 1.0);
@@ -425,19 +531,7 @@ impl Renderer {
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             check(&gl, "setting up the renderer")?;
 
-            // Drivers may round the sample count up (llvmpipe: 2 → 4); report what we got.
-            let samples = match &ms {
-                Some(t) => {
-                    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(t.fbo));
-                    gl.get_parameter_i32(glow::SAMPLES)
-                }
-                None => 0,
-            };
-            let info = format!(
-                "{renderer}; OpenGL {version}; {}; MSAA {} ({samples} samples)",
-                ctx.describe(),
-                opts.msaa
-            );
+            let info = format!("{driver}; OpenGL {version}; {}", ctx.describe());
             Ok(Renderer {
                 gl,
                 opts,
@@ -449,13 +543,47 @@ impl Renderer {
                 mesh_bufs,
                 clip_vao,
                 clip_bufs,
+                quad_pattern: 0,
                 ms,
                 resolve,
                 frame: None,
+                driver,
+                max_samples,
+                max_size,
                 info,
+                samples,
+                held: HeldMesh::default(),
+                uploads: Uploads::default(),
                 ctx,
             })
         }
+    }
+
+    /// Changes the image size, antialiasing and background, keeping the
+    /// context, its programs and the uploaded mesh. The framebuffers are
+    /// made anew only when the size or `msaa` changes. Errors as for
+    /// [`new`](Self::new); after an error the renderer keeps its old options.
+    pub fn reconfigure(&mut self, opts: RenderOptions) -> Result<()> {
+        check_options(&opts)?;
+        check_limits(&opts, &self.driver, self.max_samples, self.max_size)?;
+        self.frame = None;
+        let same = (opts.width, opts.height, opts.msaa)
+            == (self.opts.width, self.opts.height, self.opts.msaa);
+        if !same {
+            self.ctx.make_current()?;
+            // SAFETY: the context is current (above); the old targets were
+            // made by it and nothing refers to them once replaced.
+            unsafe {
+                let (ms, resolve, samples) = targets(&self.gl, &opts)?;
+                if let Some(t) = std::mem::replace(&mut self.ms, ms) {
+                    t.delete(&self.gl);
+                }
+                std::mem::replace(&mut self.resolve, resolve).delete(&self.gl);
+                self.samples = samples;
+            }
+        }
+        self.opts = opts;
+        Ok(())
     }
 
     /// The options the renderer was created with.
@@ -465,7 +593,15 @@ impl Renderer {
 
     /// `GL_RENDERER`, `GL_VERSION`, the EGL platform and the MSAA setting, for stats.
     pub fn gl_info(&self) -> String {
-        self.info.clone()
+        format!(
+            "{}; MSAA {} ({} samples)",
+            self.info, self.opts.msaa, self.samples
+        )
+    }
+
+    /// How often mesh data went to GL since the renderer was made.
+    pub fn uploads(&self) -> Uploads {
+        self.uploads
     }
 
     /// Width / height of the images.
@@ -526,6 +662,14 @@ impl Renderer {
     /// empty to use `style.color`. Faces may have either orientation (no
     /// culling, two-sided lighting). The mesh is drawn with a polygon offset so
     /// that edges and lines drawn on it afterwards stay visible.
+    ///
+    /// This uploads the faces and the pose on every call; a caller drawing
+    /// one mesh in many views uploads them once ([`upload_topology`],
+    /// [`upload_pose`]) and calls [`draw_uploaded`] per view.
+    ///
+    /// [`upload_topology`]: Self::upload_topology
+    /// [`upload_pose`]: Self::upload_pose
+    /// [`draw_uploaded`]: Self::draw_uploaded
     pub fn draw_mesh(
         &mut self,
         positions: &[[f32; 3]],
@@ -533,6 +677,59 @@ impl Renderer {
         colors: &[[f32; 3]],
         faces: &[[u32; 3]],
         style: MeshStyle,
+    ) -> Result<()> {
+        self.frame("draw_mesh")?;
+        self.upload_pose(positions, normals, colors)?;
+        self.upload_topology(faces)?;
+        self.draw_uploaded(style)
+    }
+
+    /// Uploads a mesh's faces (the index buffer), kept until the next call:
+    /// once per topology. Needs no frame in progress. Indices are checked
+    /// against the pose when drawing.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for more faces than one draw can take.
+    pub fn upload_topology(&mut self, faces: &[[u32; 3]]) -> Result<()> {
+        if i32::try_from(faces.len() * 3).is_err() {
+            return Err(Error::InvalidArgument(format!(
+                "draw_mesh: {} faces are too many for one draw",
+                faces.len()
+            )));
+        }
+        let max_index = faces.iter().flatten().copied().max();
+        self.ctx.make_current()?;
+        self.held.faces = None;
+        let gl = &self.gl;
+        // SAFETY: the context is current (above); the index buffer is the
+        // mesh VAO's element buffer, bound with the VAO.
+        unsafe {
+            gl.bind_vertex_array(Some(self.mesh_vao));
+            gl.buffer_data_u8_slice(
+                glow::ELEMENT_ARRAY_BUFFER,
+                bytemuck::cast_slice(faces),
+                glow::STATIC_DRAW,
+            );
+            gl.bind_vertex_array(None);
+        }
+        check(gl, &format!("uploading {} faces", faces.len()))?;
+        self.held.faces = Some((faces.len(), max_index));
+        self.uploads.topology += 1;
+        Ok(())
+    }
+
+    /// Uploads a pose: positions, one normal per position, and one colour
+    /// per position or none (the style's flat colour); kept until the next
+    /// call: once per pose. Needs no frame in progress.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for mismatched lengths or a non-finite
+    /// position (named by its index).
+    pub fn upload_pose(
+        &mut self,
+        positions: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        colors: &[[f32; 3]],
     ) -> Result<()> {
         let n = positions.len();
         if normals.len() != n || !(colors.is_empty() || colors.len() == n) {
@@ -546,37 +743,64 @@ impl Renderer {
             .iter()
             .position(|p| !p.iter().all(|c| c.is_finite()))
         {
+            let [x, y, z] = positions[i];
             return Err(Error::InvalidArgument(format!(
-                "draw_mesh: vertex {i} has a non-finite position {:?}",
-                positions[i]
+                "draw_mesh: vertex {i} has a non-finite position ({x}, {y}, {z})"
             )));
         }
-        if let Some(f) = faces
-            .iter()
-            .position(|f| f.iter().any(|&v| v as usize >= n))
-        {
+        self.ctx.make_current()?;
+        self.held.pose = None;
+        let gl = &self.gl;
+        let data: [&[u8]; 3] = [
+            bytemuck::cast_slice(positions),
+            bytemuck::cast_slice(normals),
+            bytemuck::cast_slice(colors),
+        ];
+        // SAFETY: the context is current (above); the buffers are the mesh
+        // VAO's attribute buffers.
+        unsafe {
+            for (b, d) in self.mesh_bufs[..3].iter().zip(data) {
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(*b));
+                gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, d, glow::DYNAMIC_DRAW);
+            }
+            gl.bind_buffer(glow::ARRAY_BUFFER, None);
+        }
+        check(gl, &format!("uploading a pose of {n} vertices"))?;
+        self.held.pose = Some((n, !colors.is_empty()));
+        self.uploads.pose += 1;
+        Ok(())
+    }
+
+    /// Draws the mesh last uploaded ([`upload_topology`](Self::upload_topology),
+    /// [`upload_pose`](Self::upload_pose)) into the frame in progress, shaded
+    /// as [`draw_mesh`](Self::draw_mesh) describes.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] outside a frame, with nothing uploaded, or
+    /// when a face indexes past the uploaded vertices.
+    pub fn draw_uploaded(&mut self, style: MeshStyle) -> Result<()> {
+        let f = self.frame("draw_mesh")?;
+        let (Some((faces, max_index)), Some((n, colored))) = (self.held.faces, self.held.pose)
+        else {
+            return Err(Error::InvalidArgument(
+                "draw_mesh: no mesh uploaded (faces and a pose)".into(),
+            ));
+        };
+        if let Some(m) = max_index.filter(|&m| m as usize >= n) {
             return Err(Error::InvalidArgument(format!(
-                "draw_mesh: face {f} {:?} indexes past the {n} vertices",
-                faces[f]
+                "draw_mesh: a face uses vertex {m}, past the {n} vertices"
             )));
         }
-        let count = i32::try_from(faces.len() * 3).map_err(|_| {
-            Error::InvalidArgument(format!(
-                "draw_mesh: {} faces are too many for one draw",
-                faces.len()
-            ))
-        })?;
         let (light_dir, headlight) = match style.light {
             Light::Headlight => (Vec3::Z, true),
             Light::Directional(d) => (d.try_normalize().unwrap_or(Vec3::Z), false),
         };
-        let f = self.frame("draw_mesh")?;
         let cam = &f.view;
         let view_dir = cam.unit_dir();
         let gl = &self.gl;
         let u = &self.mesh_u;
-        // SAFETY: the context is current (`frame`); the buffers uploaded below
-        // hold `n` vertices and every index is < n (checked above).
+        // SAFETY: the context is current (`frame`); the buffers hold `n`
+        // vertices and every index is < n (checked above).
         unsafe {
             gl.use_program(Some(self.mesh_prog));
             gl.uniform_matrix_4_f32_slice(
@@ -590,41 +814,24 @@ impl Renderer {
             gl.uniform_1_i32(u.headlight.as_ref(), headlight as i32);
             gl.uniform_3_f32(u.light_dir.as_ref(), light_dir.x, light_dir.y, light_dir.z);
             gl.uniform_1_f32(u.ambient.as_ref(), style.ambient.clamp(0.0, 1.0));
-            gl.uniform_1_i32(u.vertex_color.as_ref(), !colors.is_empty() as i32);
+            gl.uniform_1_i32(u.vertex_color.as_ref(), colored as i32);
             let [r, g, b] = style.color;
             gl.uniform_3_f32(u.color.as_ref(), r, g, b);
 
             gl.bind_vertex_array(Some(self.mesh_vao));
-            let data: [&[u8]; 3] = [
-                bytemuck::cast_slice(positions),
-                bytemuck::cast_slice(normals),
-                bytemuck::cast_slice(colors),
-            ];
-            for (b, d) in self.mesh_bufs[..3].iter().zip(data) {
-                gl.bind_buffer(glow::ARRAY_BUFFER, Some(*b));
-                gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, d, glow::STREAM_DRAW);
-            }
-            if colors.is_empty() {
-                gl.disable_vertex_attrib_array(2);
-            } else {
+            if colored {
                 gl.enable_vertex_attrib_array(2);
+            } else {
+                gl.disable_vertex_attrib_array(2);
             }
-            gl.buffer_data_u8_slice(
-                glow::ELEMENT_ARRAY_BUFFER,
-                bytemuck::cast_slice(faces),
-                glow::STREAM_DRAW,
-            );
             gl.enable(glow::POLYGON_OFFSET_FILL);
             gl.disable(glow::BLEND);
             gl.depth_func(glow::LESS);
-            gl.draw_elements(glow::TRIANGLES, count, glow::UNSIGNED_INT, 0);
+            gl.draw_elements(glow::TRIANGLES, (faces * 3) as i32, glow::UNSIGNED_INT, 0);
             gl.disable(glow::POLYGON_OFFSET_FILL);
             gl.bind_vertex_array(None);
         }
-        check(
-            gl,
-            &format!("draw_mesh ({n} vertices, {} faces)", faces.len()),
-        )
+        check(gl, &format!("draw_mesh ({n} vertices, {faces} faces)"))
     }
 
     /// Draws clip-space quads, 4 vertices each, in House & Li's edge-out order:
@@ -693,35 +900,40 @@ impl Renderer {
             )));
         }
         self.frame(what)?;
-        // Compact the drawable primitives so that the marker vertices never reach
-        // the GPU: what llvmpipe (or any driver) does with NaN positions is undefined.
-        let mut kept: Vec<[f32; 4]> = Vec::with_capacity(verts.len());
-        for prim in verts.chunks_exact(per) {
-            let drawable = !prim[0][0].is_nan() && prim.iter().flatten().all(|c| c.is_finite());
-            if drawable {
-                kept.extend_from_slice(prim);
-            }
-        }
+        // Compact the drawable primitives so that the marker vertices never
+        // reach the GPU: what llvmpipe (or any driver) does with NaN positions
+        // is undefined. Buffers that hold only drawable primitives (the edge
+        // stage's compacted read-back) go to GL as they are.
+        let drawable = |prim: &[[f32; 4]]| {
+            !prim[0][0].is_nan() && prim.iter().flatten().all(|c| c.is_finite())
+        };
+        let compacted: Vec<[f32; 4]>;
+        let kept: &[[f32; 4]] = if verts.chunks_exact(per).all(drawable) {
+            verts
+        } else {
+            compacted = verts
+                .chunks_exact(per)
+                .filter(|p| drawable(p))
+                .flatten()
+                .copied()
+                .collect();
+            &compacted
+        };
         if kept.is_empty() {
             return Ok(());
         }
         let prims = kept.len() / per;
-        let pattern: &[u32] = if per == 4 {
-            &[0, 1, 2, 0, 2, 3]
-        } else {
-            &[0, 1, 2]
-        };
-        let index_count = prims * pattern.len();
+        // Quads are drawn as two triangles through the shared index pattern
+        // 0 1 2 0 2 3 (grown when needed), triangles as they are.
+        let index_count = if per == 4 { prims * 6 } else { prims * 3 };
         if u32::try_from(kept.len()).is_err() || i32::try_from(index_count).is_err() {
             return Err(Error::InvalidArgument(format!(
                 "{what}: {prims} primitives are too many for one draw"
             )));
         }
-        let indices: Vec<u32> = (0..prims as u32)
-            .flat_map(|q| pattern.iter().map(move |&k| q * per as u32 + k))
-            .collect();
         let gl = &self.gl;
-        // SAFETY: the context is current (`frame`); every index is < kept.len().
+        // SAFETY: the context is current (`frame`); every index of the
+        // pattern's first `index_count` is < 4 * prims = kept.len().
         unsafe {
             gl.use_program(Some(self.clip_prog));
             let [r, g, b, a] = color;
@@ -730,21 +942,33 @@ impl Renderer {
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.clip_bufs[0]));
             gl.buffer_data_u8_slice(
                 glow::ARRAY_BUFFER,
-                bytemuck::cast_slice(&kept),
+                bytemuck::cast_slice(kept),
                 glow::STREAM_DRAW,
             );
-            gl.buffer_data_u8_slice(
-                glow::ELEMENT_ARRAY_BUFFER,
-                bytemuck::cast_slice(&indices),
-                glow::STREAM_DRAW,
-            );
+            if per == 4 && prims > self.quad_pattern {
+                // Doubling keeps the uploads of a growing edge count rare.
+                let quads = prims.max(2 * self.quad_pattern).min(u32::MAX as usize / 4);
+                let pattern: Vec<u32> = (0..quads as u32)
+                    .flat_map(|q| [0, 1, 2, 0, 2, 3].map(|k| 4 * q + k))
+                    .collect();
+                gl.buffer_data_u8_slice(
+                    glow::ELEMENT_ARRAY_BUFFER,
+                    bytemuck::cast_slice(&pattern),
+                    glow::STATIC_DRAW,
+                );
+                self.quad_pattern = quads;
+            }
             if a < 1.0 {
                 gl.enable(glow::BLEND);
             } else {
                 gl.disable(glow::BLEND);
             }
             gl.depth_func(glow::LEQUAL);
-            gl.draw_elements(glow::TRIANGLES, index_count as i32, glow::UNSIGNED_INT, 0);
+            if per == 4 {
+                gl.draw_elements(glow::TRIANGLES, index_count as i32, glow::UNSIGNED_INT, 0);
+            } else {
+                gl.draw_arrays(glow::TRIANGLES, 0, index_count as i32);
+            }
             gl.bind_vertex_array(None);
         }
         check(gl, &format!("{what} ({prims} primitives)"))

@@ -25,6 +25,12 @@
 //! for that go to [`run_checked`], so nothing is loaded twice and a bad
 //! last scene fails the run before the first writes anything.
 //!
+//! One process, one device and one GL context: a [`Session`] holds the
+//! OpenCL device (its programs built once) and the renderer across the
+//! scenes it runs, resizing the renderer's framebuffers when a scene's image
+//! size differs. Within a scene the mesh goes to GL once per topology (its
+//! faces) and once per pose (positions, normals, colours), not once per view.
+//!
 //! The plan is the program: [`run`] walks the plan's passes in order,
 //! filtered by lifetime (topology passes on a new topology, pose passes per
 //! pose, view passes per camera), one arm per pass
@@ -63,16 +69,87 @@ pub struct ExecOptions {
     pub device: Option<String>,
 }
 
+/// What the scene runs of one process share: the OpenCL device and one
+/// renderer (one GL context with its programs), made by the first scene that
+/// needs them and reconfigured for each scene's image size and antialiasing.
+/// A renderer is tied to its thread: so is a `Session`.
+#[derive(Default)]
+pub struct Session {
+    gpu: Option<Arc<Gpu>>,
+    renderer: Option<Renderer>,
+}
+
+impl Session {
+    /// A session that opens the device of the first scene's options.
+    pub fn new() -> Session {
+        Session::default()
+    }
+
+    /// A session on a device the caller holds (`ExecOptions::device` is
+    /// then ignored).
+    pub fn on(gpu: Arc<Gpu>) -> Session {
+        Session {
+            gpu: Some(gpu),
+            renderer: None,
+        }
+    }
+
+    /// [`run`] in this session.
+    pub fn run(
+        &mut self,
+        scene: &Scene,
+        opts: &ExecOptions,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<RunReport> {
+        run_loaded(self, scene, None, opts, progress)
+    }
+
+    /// [`run_checked`] in this session.
+    pub fn run_checked(
+        &mut self,
+        scene: &Scene,
+        checked: Checked,
+        opts: &ExecOptions,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<RunReport> {
+        let pre = checked.input.filter(|_| checked.scene == scene.path);
+        run_loaded(self, scene, pre, opts, progress)
+    }
+
+    /// The session's device, opened on first use.
+    fn gpu(&mut self, opts: &ExecOptions) -> Result<Arc<Gpu>> {
+        if let Some(g) = &self.gpu {
+            return Ok(g.clone());
+        }
+        let g = Arc::new(Gpu::new(opts.device.as_deref())?);
+        self.gpu = Some(g.clone());
+        Ok(g)
+    }
+
+    /// The session's renderer set to `opts`: made on first use, its
+    /// framebuffers made anew when the size or antialiasing changes.
+    fn renderer(&mut self, opts: RenderOptions) -> Result<Renderer> {
+        match self.renderer.take() {
+            Some(mut r) => {
+                r.reconfigure(opts)?;
+                Ok(r)
+            }
+            None => Renderer::new(opts),
+        }
+    }
+}
+
 /// Runs a scene: loads the input, plans, refuses to overwrite outputs
 /// (unless `force`), then walks the plan frame by frame and view by view,
 /// calling `progress(done, total)` after each view. Returns the report,
-/// which is also written next to the images.
+/// which is also written next to the images. Several scenes in a row share
+/// a device and a GL context through a [`Session`].
 pub fn run(
     scene: &Scene,
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport> {
-    run_with(None, scene, opts, progress)
+    Session::new().run(scene, opts, progress)
 }
 
 /// [`run`] on a device the caller holds (`opts.device` is ignored).
@@ -82,7 +159,7 @@ pub fn run_on(
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport> {
-    run_with(Some(gpu), scene, opts, progress)
+    Session::on(gpu.clone()).run(scene, opts, progress)
 }
 
 /// [`run`] with the input that [`check_scenes`] loaded for `scene` (see
@@ -94,23 +171,13 @@ pub fn run_checked(
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport> {
-    let pre = checked.input.filter(|_| checked.scene == scene.path);
-    run_loaded(None, scene, pre, opts, progress)
+    Session::new().run_checked(scene, checked, opts, progress)
 }
 
-fn run_with(
-    gpu: Option<&Arc<Gpu>>,
-    scene: &Scene,
-    opts: &ExecOptions,
-    progress: &mut dyn FnMut(usize, usize),
-) -> Result<RunReport> {
-    run_loaded(gpu, scene, None, opts, progress)
-}
-
-/// [`run_with`] on an input already loaded (`pre`: the input and what
+/// A scene run in `session` on an input already loaded (`pre`: the input and what
 /// loading it said), or loading it when `pre` is `None`.
 fn run_loaded(
-    gpu: Option<&Arc<Gpu>>,
+    session: &mut Session,
     scene: &Scene,
     pre: Option<(load::Loaded, Vec<String>)>,
     opts: &ExecOptions,
@@ -153,7 +220,7 @@ fn run_loaded(
         })
         .and_then(|()| {
             render_all(
-                gpu,
+                session,
                 scene,
                 opts,
                 progress,
@@ -177,12 +244,12 @@ fn run_loaded(
     result
 }
 
-/// The frame loop of [`run_with`] after the outputs are checked and the
+/// The frame loop of [`run_loaded`] after the outputs are checked and the
 /// folder exists (`t_all`: when the run started; `notes`: what loading the
 /// input said); writes the report last.
 #[allow(clippy::too_many_arguments)]
 fn render_all(
-    gpu: Option<&Arc<Gpu>>,
+    session: &mut Session,
     scene: &Scene,
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
@@ -196,18 +263,16 @@ fn render_all(
     let fx = &scene.effects;
     let input = scene.source.input();
     let plan = plan_with(&fx.cues, input, fx.caps);
-    let gpu = match gpu {
-        Some(g) => g.clone(),
-        None => Arc::new(Gpu::new(opts.device.as_deref())?),
-    };
+    let gpu = session.gpu(opts)?;
     let [w, h] = scene.size;
     let [br, bg, bb] = scene.background;
-    let renderer = Renderer::new(RenderOptions {
+    let renderer = session.renderer(RenderOptions {
         width: w,
         height: h,
         msaa: scene.msaa,
         background: [br, bg, bb, 1.0],
     })?;
+    let uploads_before = renderer.uploads();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
 
     // The plan's passes by lifetime, each list in plan order.
@@ -269,12 +334,21 @@ fn render_all(
         pose_ms_median: crate::metrics::median(&mut pose_ms),
         view_ms_median: crate::metrics::median(&mut view_ms),
         render_ms_median: crate::metrics::median(&mut render_ms),
+        gl_uploads: {
+            let now = ex.uploads();
+            crate::render::Uploads {
+                topology: now.topology - uploads_before.topology,
+                pose: now.pose - uploads_before.pose,
+            }
+        },
         segments: ex.segments,
         strokes: ex.stroke_count,
         notes,
         outputs: std::mem::take(&mut ex.outputs),
         wall_ms: ms_since(t_all),
     };
+    // The next scene of the session draws with the same GL context.
+    session.renderer = Some(ex.into_renderer());
     let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
     crate::export::output::write_bytes_atomic(report_path, json.as_bytes())?;
     Ok(report)

@@ -108,6 +108,9 @@ pub enum Step {
     CapsMh,
     /// `caps_adjacency`: House & Li adjacency caps.
     CapsAdjacency,
+    /// The drawn primitives compacted for read-back (`drawn_flags`, one
+    /// exclusive scan, `compact_edges`, `compact_caps`).
+    EdgesCompact,
     /// `skin_lbs`: linear blend skinning.
     SkinLbs,
     /// `lines_vertex`: per-vertex n·v and radial curvature.
@@ -173,6 +176,7 @@ impl Step {
             Step::EdgesDetect => "edges_detect",
             Step::CapsMh => "caps_mh",
             Step::CapsAdjacency => "caps_adjacency",
+            Step::EdgesCompact => "edges_compact",
             Step::SkinLbs => "skin_lbs",
             Step::LinesVertex => "lines_vertex",
             Step::LinesFace => "lines_face",
@@ -218,7 +222,7 @@ impl Step {
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,
             RadixSortPairs => Family::RadixSort,
-            EdgesDetect | CapsMh | CapsAdjacency => Family::Edges,
+            EdgesDetect | CapsMh | CapsAdjacency | EdgesCompact => Family::Edges,
             SkinLbs => Family::Skinning,
             LinesVertex | LinesFace => Family::FeatureLines,
             AoVertex => Family::Ao,

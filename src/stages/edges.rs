@@ -45,10 +45,9 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
 use crate::mesh::topology::vertex_normals;
-use crate::spec::edges::{
-    KIND_DRAWN, MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound,
-};
+use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
 use crate::spec::timing::{Step, Timing};
+use crate::stages::scan::Scan;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -78,6 +77,24 @@ pub struct EdgeStage {
     cap_mh: Option<[Buffer<f32>; 2]>,
     cap_adj: Option<(Buffer<f32>, Buffer<u8>)>,
     last_mode: CapMode,
+    /// The read-back compaction, made by the first [`EdgeStage::read_drawn`].
+    compact: Option<Compactor>,
+}
+
+/// Kernels and buffers of [`EdgeStage::read_drawn`]'s compaction.
+struct Compactor {
+    k_flags: Kernel,
+    k_edges: Kernel,
+    k_caps: Kernel,
+    scan: Scan,
+    /// Flags, then slots after the scan: E edge entries, then C cap pairs.
+    slots: Buffer<u32>,
+    /// The compacted vertices: edge-out, then the caps; grown as needed.
+    dst: Buffer<f32>,
+    /// float4 vertices `dst` holds.
+    dst_len: usize,
+    /// Kernel time of the last compaction, ms.
+    last_ms: f64,
 }
 
 impl EdgeStage {
@@ -126,6 +143,7 @@ impl EdgeStage {
             cap_mh: None,
             cap_adj: None,
             last_mode: CapMode::None,
+            compact: None,
             gpu: gpu.clone(),
         };
         // Outputs persist between runs (undrawn-then-undrawn primitives are not
@@ -306,99 +324,177 @@ impl EdgeStage {
     /// Reads back what the last run drew, for drawing and SVG: `kind` in
     /// full, and of edge-out and the caps of the last run's mode only the
     /// primitives that hold geometry (a drawn edge, `KIND_DRAWN`; a drawn
-    /// adjacency cap, `cap_drawn`), **compacted** in index order. Drawing
-    /// the result draws exactly what drawing [`read`](Self::read)'s would
-    /// (the renderer skips markers and keeps order), from a few percent of
-    /// the bytes: on a 2M-vertex torus seen whole, 5,202 of 6M edges.
-    pub fn read_drawn(&self) -> Result<EdgeOutput> {
-        let g = &self.gpu;
-        let mut kind = vec![0u32; self.n_edges];
-        g.read(&self.kind, &mut kind)?;
-        let edge_runs = runs(kind.iter().map(|k| k & KIND_DRAWN != 0));
-        let mut out = EdgeOutput {
-            edge_out: self.gather(&self.edge_out, &edge_runs, 4, self.n_edges)?,
-            kind,
-            ..Default::default()
+    /// adjacency cap, `cap_drawn`), **compacted** in index order on the
+    /// device (`drawn_flags`, one scan, `compact_edges`, `compact_caps`;
+    /// CPU twin [`crate::cpu::edges::compact_drawn`]). Drawing the result
+    /// draws exactly what drawing [`read`](Self::read)'s would (the renderer
+    /// skips markers and keeps order), from a few percent of the bytes: on a
+    /// 2M-vertex torus seen whole, 5,202 of 6M edges. Two waits: the scan's
+    /// totals, then the reads.
+    pub fn read_drawn(&mut self) -> Result<EdgeOutput> {
+        let g = self.gpu.clone();
+        let (ne, nc) = (self.n_edges, self.n_caps);
+        let adj = match (self.last_mode, &self.cap_adj) {
+            (CapMode::Adjacency, Some((out, drawn))) => Some((out, drawn)),
+            _ => None,
         };
-        match (self.last_mode, &self.cap_mh, &self.cap_adj) {
-            (CapMode::Mh, Some([mh0, mh1]), _) => {
-                out.cap_mh0 = self.gather(mh0, &edge_runs, 3, self.n_edges)?;
-                out.cap_mh1 = self.gather(mh1, &edge_runs, 3, self.n_edges)?;
+        let caps_n = if adj.is_some() { nc } else { 0 };
+        if self.compact.is_none() {
+            let file = kernel_file("edges").expect("kernels/edges.cl is registered");
+            let prog = g.program(&file, "")?;
+            self.compact = Some(Compactor {
+                k_flags: g.kernel(&prog, "drawn_flags")?,
+                k_edges: g.kernel(&prog, "compact_edges")?,
+                k_caps: g.kernel(&prog, "compact_caps")?,
+                scan: Scan::new(g.clone())?,
+                slots: g.buffer((ne + nc).max(1))?,
+                dst: g.buffer(4)?,
+                dst_len: 1,
+                last_ms: 0.0,
+            });
+        }
+        let c = self.compact.as_mut().expect("made above");
+        let n = ne + caps_n;
+        let mut kind = vec![0u32; ne];
+        let mut out = EdgeOutput::default();
+        if n == 0 {
+            out.kind = kind;
+            return Ok(out);
+        }
+        // With no adjacency caps, the kind buffer stands in for the unread
+        // cap flags (any buffer will do: no work-item reads it).
+        let cap_flags = adj.map_or_else(|| buf(&self.kind), |(_, d)| buf(d));
+        let mut events = Vec::new();
+        events.extend(launch(
+            &g,
+            &c.k_flags,
+            n,
+            &[
+                Arg::U32(ne as u32),
+                Arg::U32(caps_n as u32),
+                buf(&self.kind),
+                cap_flags,
+                buf(&c.slots),
+            ],
+        )?);
+        let at: &[usize] = if caps_n > 0 && ne > 0 { &[ne] } else { &[] };
+        let (total, before) = c.scan.exclusive_at(&c.slots, &c.slots, n, at)?;
+        let mut ms = c.scan.last_ms();
+        let total = total as usize;
+        let drawn_edges = match (caps_n, ne) {
+            (0, _) => total,
+            (_, 0) => 0,
+            _ => before[0] as usize,
+        };
+        let drawn_caps = total - drawn_edges;
+        let mh = match (self.last_mode, &self.cap_mh) {
+            (CapMode::Mh, Some([m0, m1])) => Some((m0, m1)),
+            _ => None,
+        };
+        // Vertices: edge-out (4 per edge), the half-caps (3 + 3), the caps (4).
+        let per_edge = if mh.is_some() { 10 } else { 4 };
+        let need = per_edge * drawn_edges + 4 * drawn_caps;
+        if need > c.dst_len {
+            // Grown by half again, so that a view drawing a few more edges
+            // than the last does not reallocate every frame.
+            let len = need.max(c.dst_len + c.dst_len / 2);
+            c.dst = g.buffer(4 * len)?;
+            c.dst_len = len;
+        }
+        let mut at_v = 0usize;
+        let mut parts: Vec<(usize, usize)> = Vec::new();
+        if drawn_edges > 0 {
+            let mut srcs: Vec<(&Buffer<f32>, u32)> = vec![(&self.edge_out, 4)];
+            if let Some((m0, m1)) = mh {
+                srcs.push((m0, 3));
+                srcs.push((m1, 3));
             }
-            (CapMode::Adjacency, _, Some((adj, drawn))) => {
-                let mut d = vec![0u8; self.n_caps];
-                g.read(drawn, &mut d)?;
-                let cap_runs = runs(d.iter().map(|&c| c != 0));
-                out.cap_adj = self.gather(adj, &cap_runs, 4, self.n_caps)?;
+            for (src, per) in srcs {
+                events.extend(launch(
+                    &g,
+                    &c.k_edges,
+                    ne,
+                    &[
+                        Arg::U32(ne as u32),
+                        Arg::U32(per),
+                        buf(src),
+                        buf(&self.kind),
+                        buf(&c.slots),
+                        Arg::U32(at_v as u32),
+                        buf(&c.dst),
+                    ],
+                )?);
+                parts.push((at_v, per as usize * drawn_edges));
+                at_v += per as usize * drawn_edges;
             }
-            _ => {}
+        }
+        if let Some((src, drawn)) = adj.filter(|_| drawn_caps > 0) {
+            events.extend(launch(
+                &g,
+                &c.k_caps,
+                nc,
+                &[
+                    Arg::U32(nc as u32),
+                    buf(src),
+                    buf(drawn),
+                    buf(&c.slots),
+                    Arg::U32(ne as u32),
+                    Arg::U32(drawn_edges as u32),
+                    Arg::U32(at_v as u32),
+                    buf(&c.dst),
+                ],
+            )?);
+            parts.push((at_v, 4 * drawn_caps));
+        }
+        let mut vecs: Vec<Vec<[f32; 4]>> = parts.iter().map(|p| vec![[0f32; 4]; p.1]).collect();
+        let mut failed = None;
+        // SAFETY: `kind` and `vecs` are neither moved nor read until `finish`
+        // below, which also runs on the error path; the ranges lie inside
+        // the buffers (parts are within `need` ≤ dst_len vertices).
+        unsafe {
+            if let Err(e) = g.read_at_async(&self.kind, 0, &mut kind) {
+                failed = Some(e);
+            }
+            for (v, p) in vecs.iter_mut().zip(&parts) {
+                if failed.is_some() {
+                    break;
+                }
+                if let Err(e) = g.read_at_async(&c.dst, 4 * p.0, bytemuck::cast_slice_mut(v)) {
+                    failed = Some(e);
+                }
+            }
+        }
+        let done = g.finish();
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        done?;
+        ms += events.iter().map(event_ms).sum::<f64>();
+        c.last_ms = ms;
+        let mut vecs = vecs.into_iter();
+        out.kind = kind;
+        if drawn_edges > 0 {
+            out.edge_out = vecs.next().unwrap_or_default();
+            if mh.is_some() {
+                out.cap_mh0 = vecs.next().unwrap_or_default();
+                out.cap_mh1 = vecs.next().unwrap_or_default();
+            }
+        }
+        if drawn_caps > 0 {
+            out.cap_adj = vecs.next().unwrap_or_default();
         }
         Ok(out)
     }
 
-    /// The float4 vertices of the primitives in `runs` (first, count) of a
-    /// buffer of `n` primitives with `per` vertices each, in order. Scattered
-    /// runs are read one by one (enqueued, one wait); when there are many
-    /// (more than 64, and more than one per 4,096 vertices of the buffer) one
-    /// whole read and a host compaction is cheaper than the per-read cost.
-    fn gather(
-        &self,
-        b: &Buffer<f32>,
-        runs: &[(usize, usize)],
-        per: usize,
-        n: usize,
-    ) -> Result<Vec<[f32; 4]>> {
-        let g = &self.gpu;
-        let total: usize = runs.iter().map(|r| r.1).sum::<usize>() * per;
-        let mut v = vec![[0f32; 4]; total];
-        if total == 0 {
-            return Ok(v);
+    /// Kernel time of the last [`read_drawn`](Self::read_drawn)'s
+    /// compaction ([`Step::EdgesCompact`]).
+    pub fn compact_timing(&self) -> Timing {
+        let mut t = Timing::default();
+        if let Some(c) = &self.compact {
+            t.add(Step::EdgesCompact, c.last_ms);
         }
-        if runs.len() > 64 && runs.len() * 4096 > n * per {
-            let mut all = vec![[0f32; 4]; n * per];
-            g.read(b, bytemuck::cast_slice_mut(&mut all))?;
-            let mut at = 0;
-            for &(first, count) in runs {
-                let src = &all[first * per..(first + count) * per];
-                v[at..at + src.len()].copy_from_slice(src);
-                at += src.len();
-            }
-            return Ok(v);
-        }
-        let mut rest: &mut [[f32; 4]] = &mut v;
-        let mut failed = None;
-        for &(first, count) in runs {
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(count * per);
-            rest = tail;
-            // SAFETY: `v` is neither moved nor read until `finish` below, which
-            // also runs on the error path; the range lies inside the buffer
-            // (runs come from per-primitive flags of length `n`).
-            let r = unsafe { g.read_at_async(b, 4 * first * per, bytemuck::cast_slice_mut(head)) };
-            if let Err(e) = r {
-                failed = Some(e);
-                break;
-            }
-        }
-        let done = g.finish();
-        match failed {
-            Some(e) => Err(e),
-            None => done.map(|()| v),
-        }
+        t
     }
-}
-
-/// Maximal runs `(first, count)` of true flags.
-fn runs(flags: impl Iterator<Item = bool>) -> Vec<(usize, usize)> {
-    let mut out: Vec<(usize, usize)> = Vec::new();
-    for (i, f) in flags.enumerate() {
-        if f {
-            match out.last_mut() {
-                Some((first, count)) if *first + *count == i => *count += 1,
-                _ => out.push((i, 1)),
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]

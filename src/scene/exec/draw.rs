@@ -115,18 +115,14 @@ pub(super) struct ViewLines<'a> {
     pub(super) stroke_lift: f32,
 }
 
-/// Draws one view (mesh, line quads, edge quads), reads it back and writes
-/// its images to `paths`. Returns the contour and suggestive-contour
-/// segments drawn.
-#[allow(clippy::too_many_arguments)]
+/// Draws one view (the mesh the renderer holds, line quads, edge quads),
+/// reads it back and writes its images to `paths`. Returns the contour and
+/// suggestive-contour segments drawn.
 pub(super) fn draw_view(
     renderer: &mut Renderer,
     scene: &Scene,
     plan: &Plan,
     cam: &Camera,
-    pose: &PoseData,
-    colors: &[[f32; 3]],
-    faces: &[[u32; 3]],
     lines: ViewLines<'_>,
     paths: &[&PathBuf],
 ) -> Result<[usize; 2]> {
@@ -151,7 +147,7 @@ pub(super) fn draw_view(
             ..MeshStyle::default()
         }
     };
-    renderer.draw_mesh(&pose.pos, &pose.nrm, colors, faces, style)?;
+    renderer.draw_uploaded(style)?;
     let mut drawn = [0usize; 2];
     // Contours opaque; suggestive contours in four opacity bins of
     // their n·v fade (DeCarlo et al. fade them out as they approach

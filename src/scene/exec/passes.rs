@@ -116,6 +116,10 @@ pub(super) struct Executor<'s, 'g> {
     curv: Option<Timing>,
     /// This pose: whether the host copies are made.
     pose_ready: bool,
+    /// Whether the renderer holds this topology's faces, and this pose's
+    /// positions, normals and colours (uploaded by the first view).
+    gl_topology: bool,
+    gl_pose: bool,
     /// This view: the lines and the edge stage's run and outputs.
     segs: Vec<Segment>,
     lines_ran: Option<Timing>,
@@ -220,6 +224,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             frame_pos: None,
             curv: None,
             pose_ready: false,
+            gl_topology: false,
+            gl_pose: false,
             segs: Vec::new(),
             lines_ran: None,
             edges_ran: None,
@@ -231,6 +237,16 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// The renderer's GL description.
     pub(super) fn gl_info(&self) -> String {
         self.renderer.gl_info()
+    }
+
+    /// The renderer's mesh uploads so far.
+    pub(super) fn uploads(&self) -> crate::render::Uploads {
+        self.renderer.uploads()
+    }
+
+    /// The renderer, for the next scene of the session.
+    pub(super) fn into_renderer(self) -> Renderer {
+        self.renderer
     }
 
     /// Vertices and faces of the current topology.
@@ -261,6 +277,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         self.frame_pos = None;
         self.curv = None;
         self.pose_ready = false;
+        self.gl_pose = false;
     }
 
     /// Ends a pose: host copies made (if no pass needed them), the colour
@@ -296,6 +313,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 }
             };
             self.topo = Some(Topology::new(mesh));
+            self.gl_topology = false;
         }
         Ok(self.topo.as_mut().expect("made above"))
     }
@@ -491,6 +509,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             ));
         }
         self.topo = Some(Topology::new(m));
+        self.gl_topology = false;
         Ok(())
     }
 
@@ -678,7 +697,8 @@ impl<'s, 'g> Executor<'s, 'g> {
                 let t = self.topo.as_mut().expect("a pose ran");
                 let es = t.edges.as_mut().expect("planned with the edge buffer");
                 let timing = es.run(&p, fx.caps)?;
-                let out = es.read()?;
+                // Only what was drawn comes back, compacted on the device.
+                let out = es.read_drawn()?;
                 self.rec.kernels(
                     pass,
                     &timing,
@@ -693,14 +713,25 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             Pass::Render => {
                 let t0 = Instant::now();
-                let colors = draw::mesh_colors(
-                    self.scene,
-                    self.plan,
-                    &self.pose,
-                    self.color_scale.unwrap_or(1.0),
-                );
-                let strokes = self.scene_strokes();
                 let t = self.topo.as_ref().expect("a pose ran");
+                // The mesh goes to GL once per topology (faces) and once per
+                // pose (positions, normals, colours), not once per view.
+                if !self.gl_topology {
+                    self.renderer.upload_topology(&t.mesh.faces)?;
+                    self.gl_topology = true;
+                }
+                if !self.gl_pose {
+                    let colors = draw::mesh_colors(
+                        self.scene,
+                        self.plan,
+                        &self.pose,
+                        self.color_scale.unwrap_or(1.0),
+                    );
+                    self.renderer
+                        .upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
+                    self.gl_pose = true;
+                }
+                let strokes = self.scene_strokes();
                 let lines = ViewLines {
                     segments: &self.segs,
                     edges: self.edges_ran.as_ref().map(|e| &e.1),
@@ -709,17 +740,8 @@ impl<'s, 'g> Executor<'s, 'g> {
                     // interpolated surface, which marching cubes cuts as chords.
                     stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
                 };
-                let drawn = draw::draw_view(
-                    &mut self.renderer,
-                    self.scene,
-                    self.plan,
-                    cam,
-                    &self.pose,
-                    &colors,
-                    &t.mesh.faces,
-                    lines,
-                    paths,
-                )?;
+                let drawn =
+                    draw::draw_view(&mut self.renderer, self.scene, self.plan, cam, lines, paths)?;
                 self.rec.wall(
                     pass,
                     ms_since(t0),

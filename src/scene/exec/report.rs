@@ -54,6 +54,9 @@ pub struct RunReport {
     pub view_ms_median: f64,
     /// Median per-view render time (draw + read back), ms.
     pub render_ms_median: f64,
+    /// Mesh uploads to GL in this run: one per topology (faces) and one per
+    /// pose (positions, normals, colours), however many views.
+    pub gl_uploads: crate::render::Uploads,
     /// Contour and suggestive-contour segments over all views.
     pub segments: [usize; 2],
     /// Curvature-directed strokes over all poses (traced once per pose).
