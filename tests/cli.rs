@@ -37,6 +37,8 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
         .arg(&ply)
         .arg("--stats")
         .arg(&json)
+        // The paper's scheme, whose passes are listed below.
+        .args(["--accumulate", "atomic"])
         .output()
         .unwrap();
     assert!(
@@ -165,6 +167,51 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
+}
+
+#[test]
+fn curvature_defaults_to_the_faster_exact_scheme_of_the_device() {
+    // PoCL and Intel's runtime are CPU devices: gather, whose output is the
+    // same bytes as --accumulate gather; --accumulate atomic still runs.
+    let d = scratch("default-accumulate");
+    let run = |extra: &[&str], name: &str| {
+        let (ply, json) = (
+            d.join(format!("{name}.ply")),
+            d.join(format!("{name}.json")),
+        );
+        let out = cli()
+            .args([
+                "curvature",
+                "--generate",
+                "torus",
+                "--resolution",
+                "3000",
+                "-o",
+            ])
+            .arg(&ply)
+            .arg("--stats")
+            .arg(&json)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (std::fs::read(&ply).unwrap(), stats)
+    };
+    let (auto, stats) = run(&[], "auto");
+    let kind = stats["device"]["kind"].as_str().unwrap().to_string();
+    let want = if kind == "CPU" { "gather" } else { "atomic" };
+    assert_eq!(stats["accumulate"], want, "on a {kind} device");
+    if kind == "CPU" {
+        assert!(auto == run(&["--accumulate", "gather"], "gather").0);
+    }
+    let (_, atomic) = run(&["--accumulate", "atomic"], "atomic");
+    assert_eq!(atomic["accumulate"], "atomic");
 }
 
 #[test]

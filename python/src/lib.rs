@@ -192,6 +192,8 @@ fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> PyResult<T> {
     s.parse::<T>().map_err(to_py)
 }
 
+/// The options of a call; `accumulate = "auto"` is resolved for the device
+/// by [`device_options`] (the command line's rule).
 fn options(
     accumulate: &str,
     precision: &str,
@@ -199,11 +201,28 @@ fn options(
     dcurv: bool,
 ) -> PyResult<CurvatureOptions> {
     Ok(CurvatureOptions {
-        accumulate: parse(accumulate)?,
+        accumulate: if accumulate == "auto" {
+            shapecue::spec::curvature::Accumulate::Gather
+        } else {
+            parse(accumulate)?
+        },
         precision: parse(precision)?,
         compat: parse(compat)?,
         dcurv,
     })
+}
+
+/// `opts` with an `accumulate = "auto"` resolved for `gpu`: gather on CPU
+/// devices, atomic elsewhere (`Accumulate::default_for`).
+fn device_options(opts: CurvatureOptions, accumulate: &str, gpu: &Gpu) -> CurvatureOptions {
+    if accumulate == "auto" {
+        CurvatureOptions {
+            accumulate: shapecue::spec::curvature::Accumulate::default_for(&gpu.info.kind),
+            ..opts
+        }
+    } else {
+        opts
+    }
 }
 
 /// A device selection: `device=` and the `SHAPECUE_DEVICE` it was made under.
@@ -329,6 +348,7 @@ fn curvature<'py>(
                 Ok::<_, Error>((c, "cpu reference (f64, single thread)".to_string()))
             } else {
                 let gpu = open_gpu(device.as_deref())?;
+                let opts = device_options(opts, accumulate, &gpu);
                 let t = Instant::now();
                 let c = shapecue::curvature_on(&gpu, &mesh, opts)?;
                 library_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -380,6 +400,7 @@ impl PyEstimator {
         let (est, device) = py
             .detach(|| {
                 let gpu = open_gpu(device.as_deref())?;
+                let opts = device_options(opts, accumulate, &gpu);
                 let name = gpu.info.name.clone();
                 Ok::<_, Error>((RustEstimator::new(gpu, n_vertices, &faces, opts)?, name))
             })

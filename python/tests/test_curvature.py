@@ -112,6 +112,19 @@ def test_trimesh_object(device):
     assert e.contour > 0
 
 
+def test_auto_accumulation_is_gather_on_cpu_devices_and_atomic_elsewhere(device):
+    v, f = torus(24, 12)
+    auto = shapecue.curvature(v, f)
+    kind = next(d["type"] for d in device if d["default"])
+    if kind == "CPU":
+        same(auto, shapecue.curvature(v, f, accumulate="gather"))
+        same(shapecue.CurvatureEstimator(f, len(v)).run(v), auto)
+    else:
+        # Atomic sums vary in their last bits between runs.
+        np.testing.assert_allclose(auto.k1, shapecue.curvature(v, f, accumulate="atomic").k1,
+                                   rtol=1e-4, atol=1e-5)
+
+
 def test_isolated_vertices_and_degenerate_faces_are_counted(device):
     v, f = torus(24, 12)
     v = np.vstack([v, [[5.0, 5.0, 5.0]]])  # an unreferenced vertex

@@ -38,9 +38,11 @@ pub struct CurvatureArgs {
     /// Merge vertices with bit-identical positions before computing.
     #[arg(long)]
     weld: bool,
-    /// One-ring accumulation: float atomics per face, or per-vertex gather (deterministic).
-    #[arg(long, value_enum, default_value = "atomic")]
-    accumulate: Accumulate,
+    /// One-ring accumulation: float atomics per face (Griffin et al.), or
+    /// per-vertex gather (bitwise reproducible). Default: gather on CPU
+    /// devices, atomic on GPUs (the faster exact scheme of each).
+    #[arg(long, value_enum)]
+    accumulate: Option<Accumulate>,
     /// Device precision.
     #[arg(long, value_enum, default_value = "f32")]
     precision: Precision,
@@ -71,8 +73,8 @@ pub struct CurvatureArgs {
 
 /// Runs `shapecue curvature`.
 pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
-    let opts = CurvatureOptions {
-        accumulate: a.accumulate,
+    let mut opts = CurvatureOptions {
+        accumulate: a.accumulate.unwrap_or(Accumulate::Gather),
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,
@@ -145,6 +147,9 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         let t = Instant::now();
         let gpu = Arc::new(Gpu::new(device)?);
         phase("device", ms_since(t));
+        opts.accumulate = a
+            .accumulate
+            .unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
         let setup = || format!("setting up curvature for {name}");
         let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, opts)
             .with_context(setup)?;
@@ -166,6 +171,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         phase("read_back", ms_since(t));
         let mut stats = serde_json::json!({
             "device": gpu.info,
+            "accumulate": opts.accumulate.name(),
             "topology_ms": c.topology_ms,
             "passes": passes(&c.timing),
             "kernel_ms": c.timing.kernel_ms,

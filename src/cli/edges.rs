@@ -65,6 +65,11 @@ pub struct EdgesArgs {
     /// Image size, e.g. 800x600.
     #[arg(long, default_value = "800x600")]
     size: String,
+    /// Multisample antialiasing: 0 (off), 2, 4 or 8 samples per pixel. On
+    /// Mesa's software rasteriser (llvmpipe) 4 samples cost about twice the
+    /// time of none at 1024x1024.
+    #[arg(long, default_value_t = 4)]
+    msaa: u32,
     /// Output PNG.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -172,6 +177,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         ortho: a.ortho,
         width: w,
         height: h,
+        msaa: a.msaa,
         caps: mode,
         line_width: a.width,
         crease_deg: a.crease,

@@ -56,6 +56,8 @@ pub struct EdgeDrawOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel (0, 2, 4 or 8; see [`RenderOptions::msaa`]).
+    pub msaa: u32,
     /// Cap variant.
     pub caps: CapMode,
     /// Edge width in pixels.
@@ -89,6 +91,7 @@ impl Default for EdgeDrawOptions {
             ortho: false,
             width: 800,
             height: 600,
+            msaa: RenderOptions::default().msaa,
             caps: CapMode::Adjacency,
             line_width: 4.0,
             crease_deg: 30.0,
@@ -303,6 +306,7 @@ pub fn draw(gpu: Arc<Gpu>, mesh: &Mesh, name: &str, opts: &EdgeDrawOptions) -> R
     let mut r = Renderer::new(RenderOptions {
         width: w,
         height: h,
+        msaa: opts.msaa,
         ..Default::default()
     })?;
     ph.gl_context = lap();
