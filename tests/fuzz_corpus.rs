@@ -578,3 +578,31 @@ fn glb_header_longer_than_the_file_is_refused_before_allocating() {
         f.len()
     );
 }
+
+/// A GLB header declaring less than its own 12 bytes made the glTF crate
+/// subtract past zero (a panic where overflow checks are on, as in debug
+/// builds; found by fuzzing a `.gltf` file that holds GLB bytes).
+#[test]
+fn glb_header_shorter_than_itself_is_refused() {
+    let crash = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/gltf/crash-05c2f3a58e6fd23d203c88b640cdcb60ab19a3cb"),
+    )
+    .unwrap();
+    for (target, bytes) in [
+        ("gltf", crash),
+        ("glb", {
+            let mut f = b"glTF".to_vec();
+            f.extend(2u32.to_le_bytes());
+            f.extend(7u32.to_le_bytes());
+            f.extend(b"\x10\0\0\0JSON{\"asset\":{}}   ");
+            f
+        }),
+    ] {
+        let e = within_deadline(target, bytes).unwrap_err();
+        assert!(
+            e.contains("GLB header") && e.contains("less than its own 12"),
+            "{target}: {e}"
+        );
+    }
+}

@@ -270,11 +270,19 @@ fn check_before_import(path: &Path) -> Result<()> {
     };
     // The memory bound: the glTF crate allocates the length a GLB header
     // declares before reading, so a header claiming more than the file
-    // holds is refused here.
+    // holds is refused here; so is one claiming less than the header itself,
+    // which the crate subtracts the header's size from unchecked.
     if let Some(h) = bytes.first_chunk::<12>()
         && h.starts_with(b"glTF")
     {
         let declared = u32::from_le_bytes([h[8], h[9], h[10], h[11]]);
+        if declared < 12 {
+            return Err(bad(
+                path,
+                "GLB header",
+                format!("declares {declared} bytes, less than its own 12"),
+            ));
+        }
         if declared as usize > bytes.len() {
             return Err(bad(
                 path,
