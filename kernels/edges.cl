@@ -8,8 +8,11 @@
 //                             or the degenerate quad (NaN, 0, −1, 1) ×4
 //   caps_mh         per edge  McGuire-Hughes half-caps: one triangle at each end, from
 //                             the projected vertex normal, into cap_mh0 / cap_mh1
-//   caps_adjacency  per cap   House & Li adjacency cap: for a pair of edges sharing a
-//                             vertex, both drawn, a quad (middle vector, p0, sM, p1)
+//   caps_adjacency_flags, caps_adjacency
+//                   per cap   House & Li adjacency cap: for a pair of edges sharing a
+//                             vertex, both drawn, a quad (middle vector, p0, sM, p1);
+//                             the flags are scanned into slots, and only drawn caps
+//                             are written, compacted in pair order
 //
 // Buffers (V vertices, E edge entries, C cap pairs):
 //   params   EdgeParams per frame, see below (packed by EdgeParams::pack)
@@ -23,11 +26,12 @@
 //                       caps join them; McGuire-Hughes caps stay centred on the edge.
 //   kind     uint[E]    bit 0 contour, 1 crease, 2 boundary/marked, 3 drawn
 //   cap_mh0, cap_mh1 float[12E]  half-cap triangles (s, s + p·sign(m·p), s + m)
-//   cap_adj  float[16C] cap quads (sM + mv, sM + p0, sM, sM + p1)
-//   cap_drawn uchar[C]  1 where the last run wrote a cap (not the marker)
-// Outputs persist between runs: an edge or cap that is undrawn now and was
+//   cap_slot uint[C]    flags, then (scanned) each cap pair's slot among the drawn caps
+//   cap_adj  float[16K] the K drawn caps' quads (sM + mv, sM + p0, sM, sM + p1),
+//                       in pair order (grown by the host when a view draws more)
+// Edge outputs persist between runs: an edge that is undrawn now and was
 // undrawn in the previous run keeps its marker and is not rewritten (the host
-// fills edge-out and cap-out with markers, kind and cap_drawn with 0, once).
+// fills edge-out with markers and kind with 0, once).
 //
 // Conventions (documented in src/stages/edges.rs): clip space is OpenGL's; the
 // screen is measured in pixels from the viewport centre (x · W/2, y · H/2 after
@@ -249,29 +253,19 @@ __kernel void caps_mh(uint n, __global const EdgeParams* P, __global const float
     WRITE_SCREEN(o1, 2, s1x + m1x * f1, s1y + m1y * f1, c1z, c1w, hvw, hvh);
 }
 
-__kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global const uint* edges,
-                             __global const uint* caps, __global const uint* kind,
-                             __global const float* edge_out, __global float* cap_out,
-                             __global uchar* cap_drawn) {
-    GID_OR_RETURN(n)
-    __global float* o = cap_out + 16 * gid;
+// House & Li's adjacency cap of pair gid: 1 when the pair draws one (both
+// edges drawn, not collinear), and then, when o is not null, its quad
+// (sM + mv, sM + p0, sM, sM + p1) written to o; 0 otherwise.
+inline int cap_quad(uint gid, __global const EdgeParams* P, __global const uint* edges,
+                    __global const uint* caps, __global const uint* kind,
+                    __global const float* edge_out, __global float* o) {
     const uint e0 = caps[2 * gid], e1 = caps[2 * gid + 1];
+    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per
+    // edge, cache-resident, where edge-out's first x costs a cache line per
+    // edge) before any other read.
+    if (((kind[e0] & kind[e1]) & KIND_DRAWN) == 0u) return 0;
     __global const float* q0 = edge_out + 16 * e0;
     __global const float* q1 = edge_out + 16 * e1;
-    // Most pairs have an undrawn edge: decide from the kind bits (4 bytes per edge,
-    // cache-resident, where edge-out's first x costs a cache line per edge) before
-    // any other read; and rewrite the marker only if the previous run drew a cap
-    // here (cap_drawn, one byte per pair; cap-out starts as markers).
-    if (((kind[e0] & kind[e1]) & KIND_DRAWN) == 0u) {
-        if (cap_drawn[gid] != 0) {
-            cap_drawn[gid] = 0;
-            WRITE_MARKER(o, 0);
-            WRITE_MARKER(o, 1);
-            WRITE_MARKER(o, 2);
-            WRITE_MARKER(o, 3);
-        }
-        return;
-    }
     const float hvw = P->half_vw, hvh = P->half_vh;
     int ok = 1;
     const uint a0 = edges[4 * e0], b0 = edges[4 * e1], b1 = edges[4 * e1 + 1];
@@ -303,14 +297,7 @@ __kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global cons
     const float ls = sqrt(sx * sx + sy * sy);
     // Collinear edges (straight continuation) leave no gap: no cap.
     ok = ok && ls > 1e-4f;
-    cap_drawn[gid] = ok ? 1 : 0;
-    if (!ok) {
-        WRITE_MARKER(o, 0);
-        WRITE_MARKER(o, 1);
-        WRITE_MARKER(o, 2);
-        WRITE_MARKER(o, 3);
-        return;
-    }
+    if (!ok || o == 0) return ok;
     const float mvx = -sx / ls, mvy = -sy / ls;
     float p0x = -uly, p0y = ulx;
     const float g0 = (p0x * mvx + p0y * mvy) >= 0.0f ? 1.0f : -1.0f;
@@ -324,20 +311,43 @@ __kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global cons
     WRITE_SCREEN(o, 1, smx + p0x * hw, smy + p0y * hw, mz, mw, hvw, hvh);
     WRITE_SCREEN(o, 2, smx, smy, mz, mw, hvw, hvh);
     WRITE_SCREEN(o, 3, smx + p1x * hw, smy + p1y * hw, mz, mw, hvw, hvh);
+    return 1;
+}
+
+// Which cap pairs draw a cap (1/0 into flags); the host scans the flags in
+// place (scan.cl) into each drawn cap's slot.
+__kernel void caps_adjacency_flags(uint n, __global const EdgeParams* P,
+                                   __global const uint* edges, __global const uint* caps,
+                                   __global const uint* kind, __global const float* edge_out,
+                                   __global uint* flags) {
+    GID_OR_RETURN(n)
+    flags[gid] = (uint)cap_quad(gid, P, edges, caps, kind, edge_out, (__global float*)0);
+}
+
+// The drawn caps' quads, each at its slot: cap-out holds only drawn caps, in
+// pair order (`total` of them; a pair draws one where the next slot is
+// larger).
+__kernel void caps_adjacency(uint n, __global const EdgeParams* P, __global const uint* edges,
+                             __global const uint* caps, __global const uint* kind,
+                             __global const float* edge_out, __global const uint* slot,
+                             uint total, __global float* cap_out) {
+    GID_OR_RETURN(n)
+    const uint s = slot[gid];
+    const uint next = gid + 1u < n ? slot[gid + 1u] : total;
+    if (next == s) return;
+    cap_quad(gid, P, edges, caps, kind, edge_out, cap_out + 16 * s);
 }
 
 // Read-back of what was drawn, compacted on the device (EdgeStage::read_drawn;
-// CPU twin: cpu::edges::compact_drawn). drawn_flags writes, for E edge entries
-// then C cap pairs, 1 where the last run drew the primitive (kind bit 3;
-// cap_drawn) and 0 elsewhere; the host scans the flags in place (scan.cl), so
-// that slot[i] is primitive i's place among the drawn ones, and the
-// compact_* kernels copy each drawn primitive's `per` vertices there: index
-// order is kept, and only drawn geometry crosses to the host.
-__kernel void drawn_flags(uint ne, uint nc, __global const uint* kind,
-                          __global const uchar* cap_drawn, __global uint* flags) {
-    GID_OR_RETURN(ne + nc)
-    flags[gid] = gid < ne ? ((kind[gid] & KIND_DRAWN) != 0u ? 1u : 0u)
-                          : (cap_drawn[gid - ne] != 0 ? 1u : 0u);
+// CPU twin: cpu::edges::compact_drawn). drawn_flags writes 1 per edge entry
+// the last run drew (kind bit 3) and 0 elsewhere; the host scans the flags in
+// place (scan.cl), so that slot[i] is edge i's place among the drawn ones, and
+// compact_edges copies each drawn edge's `per` vertices there: index order is
+// kept, and only drawn geometry crosses to the host. (Adjacency caps are
+// written compacted by caps_adjacency already.)
+__kernel void drawn_flags(uint ne, __global const uint* kind, __global uint* flags) {
+    GID_OR_RETURN(ne)
+    flags[gid] = (kind[gid] & KIND_DRAWN) != 0u ? 1u : 0u;
 }
 
 // Edge entries' primitives (edge-out quads, per = 4; McGuire-Hughes half-caps,
@@ -350,16 +360,4 @@ __kernel void compact_edges(uint n, uint per, __global const float4* src,
     __global const float4* s = src + per * gid;
     __global float4* d = dst + at + per * slot[gid];
     for (uint k = 0; k < per; k++) d[k] = s[k];
-}
-
-// Adjacency caps (4 vertices each); their slots follow the ne edge entries'
-// in `slot`, counted on from the `base` drawn edges.
-__kernel void compact_caps(uint n, __global const float4* src, __global const uchar* cap_drawn,
-                           __global const uint* slot, uint ne, uint base, uint at,
-                           __global float4* dst) {
-    GID_OR_RETURN(n)
-    if (cap_drawn[gid] == 0) return;
-    __global const float4* s = src + 4 * gid;
-    __global float4* d = dst + at + 4 * (slot[ne + gid] - base);
-    for (uint k = 0; k < 4; k++) d[k] = s[k];
 }

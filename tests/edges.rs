@@ -493,7 +493,7 @@ fn interop_decision_uses_only_the_extension_flag() {
 fn memory_use_counts_the_buffers() {
     let m = memory_use(CapMode::Adjacency, 10, 7);
     assert_eq!(m.edge_bits, 10 * 21 * 32);
-    assert_eq!(m.cap_bits, 7 * 18 * 32 + 7 * 8);
+    assert_eq!(m.cap_bits, 7 * 19 * 32);
     assert_eq!(memory_use(CapMode::Mh, 10, 7).cap_bits, 10 * 24 * 32);
     assert_eq!(memory_use(CapMode::None, 10, 7).cap_bits, 0);
 }

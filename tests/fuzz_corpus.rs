@@ -606,3 +606,20 @@ fn glb_header_shorter_than_itself_is_refused() {
         );
     }
 }
+
+/// Keyframe times that do not increase (here out of order) made sampling
+/// index before the first keyframe (an overflow, then an index past the
+/// end); found by fuzzing. They are refused at load, naming the keyframe.
+#[test]
+fn glb_keyframe_times_out_of_order_are_refused() {
+    let crash = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/glb/crash-cd2c750fd97f431336a35a5b7a4da73f14aa937f"),
+    )
+    .unwrap();
+    let e = within_deadline("glb", crash).unwrap_err();
+    assert!(
+        e.contains("keyframe") && e.contains("previous keyframe"),
+        "{e}"
+    );
+}

@@ -500,6 +500,19 @@ pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
                     "keyframe count mismatch",
                 ));
             }
+            // glTF keyframe times increase strictly; sampling bisects them.
+            if let Some(k) = (0..times.len())
+                .find(|&k| !times[k].is_finite() || (k > 0 && !(times[k] > times[k - 1])))
+            {
+                return Err(bad(
+                    path,
+                    format!("animation {} channel, keyframe {k}", anim.index()),
+                    format!(
+                        "time {} is not finite or not after the previous keyframe's",
+                        times[k]
+                    ),
+                ));
+            }
             clip.duration = clip.duration.max(*times.last().unwrap_or(&0.0));
             clip.channels.push(Channel {
                 node: ch.target().node().index(),
@@ -528,7 +541,9 @@ fn sample(ch: &Channel, t: f32) -> [f32; 4] {
     if t >= ch.times[n - 1] {
         return val(n - 1);
     }
-    let k = ch.times.partition_point(|&x| x <= t) - 1;
+    // times[0] < t < times[n - 1] (loaded times increase strictly), so
+    // 1 ≤ partition point ≤ n - 1; clamped all the same.
+    let k = (ch.times.partition_point(|&x| x <= t).max(1) - 1).min(n - 2);
     let (t0, t1) = (ch.times[k], ch.times[k + 1]);
     let dt = t1 - t0;
     let u = if dt > 0.0 { (t - t0) / dt } else { 0.0 };

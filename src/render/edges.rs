@@ -213,6 +213,8 @@ impl EdgeDrawing {
             "crease": self.count(KIND_CREASE),
             "boundary_or_marked": self.count(KIND_BOUNDARY),
             "caps": self.caps,
+            // Adjacency caps drawn (the device holds only these).
+            "drawn_caps": self.output.cap_adj.len() / 4,
             "interop": interop,
             "timing": self.timing,
             "topology_ms": self.topology_ms,

@@ -439,8 +439,10 @@ pub fn cap_mh_bound(edges: usize) -> usize {
     3 * edges
 }
 
-/// Vertices (float4) of the adjacency cap-out buffer for `caps` cap pairs:
-/// one quad per pair.
+/// Vertices (float4) of the adjacency cap-out for `caps` cap pairs when
+/// every pair draws a cap: one quad per pair. The device holds only the caps
+/// a view draws (in pair order); [`EdgeOutput`] from a full read has this
+/// many, undrawn pairs as the marker.
 pub fn cap_adjacency_bound(caps: usize) -> usize {
     4 * caps
 }
@@ -456,8 +458,9 @@ pub struct MemoryUse {
     pub caps: usize,
     /// Edge buffer + edge-out + kind bits.
     pub edge_bits: u64,
-    /// Cap-related bits of the variant (cap buffer + cap-out, and the
-    /// adjacency variant's one byte of state per cap pair).
+    /// Cap-related bits of the variant: the half-cap buffers; or the cap
+    /// buffer, the slot per cap pair and the cap-out of the drawn caps, here
+    /// at its bound (every pair drawn; a view draws far fewer).
     pub cap_bits: u64,
 }
 
@@ -470,8 +473,8 @@ pub fn memory_use(mode: CapMode, edges: usize, caps: usize) -> MemoryUse {
     let cap_bits = match mode {
         CapMode::None => 0,
         CapMode::Mh => 32 * (2 * f4(cap_mh_bound(edges))),
-        // caps uint[2C], cap_adj float[16C], cap_drawn uchar[C]
-        CapMode::Adjacency => 32 * (2 * c + f4(cap_adjacency_bound(caps))) + 8 * c,
+        // caps uint[2C], cap_slot uint[C], cap_adj float[16K] with K ≤ C
+        CapMode::Adjacency => 32 * (3 * c + f4(cap_adjacency_bound(caps))),
     };
     MemoryUse {
         edges,

@@ -8,13 +8,19 @@
 //! [`EdgeStage::set_positions`]); `params` (per frame, one
 //! [`crate::spec::edges::EdgeParamBlock`] from [`EdgeParams::pack`], mirrored
 //! by `EdgeParams` in the kernel); outputs `edge_out float4[4E]`, `kind uint[E]`,
-//! `cap_mh0`, `cap_mh1 float4[3E]` and `cap_adj float4[4C]`. One work-item
+//! `cap_mh0`, `cap_mh1 float4[3E]`, and for adjacency caps `cap_slot uint[C]`
+//! and `cap_adj float4[4K]` for the K caps a view draws. One work-item
 //! handles one edge (`edges_detect`, `caps_mh`) or one cap pair
-//! (`caps_adjacency`). Outputs are indexed by edge or cap, never appended, so
-//! device and CPU ([`crate::cpu::edges`]) results compare element by element.
-//! Outputs persist between runs: a primitive undrawn in this run and the last
-//! one keeps its marker and is not rewritten (`kind` and `cap_drawn uchar[C]`
-//! remember what the last run drew), which removes most of the output traffic.
+//! (`caps_adjacency_flags`, `caps_adjacency`). Edge outputs are indexed by
+//! edge, never appended; adjacency caps are flagged, the flags scanned into
+//! slots, and only the drawn caps written, in pair order, so that a mesh's
+//! cap-out takes 4 bytes per pair plus the caps drawn instead of House & Li's
+//! 64 bytes per pair (1.5 GB on a 2M-vertex torus). [`EdgeStage::read`]
+//! gives every output indexed by edge or cap pair (undrawn caps as the
+//! marker), so device and CPU ([`crate::cpu::edges`]) results compare
+//! element by element. Edge outputs persist between runs: an edge undrawn in
+//! this run and the last one keeps its marker and is not rewritten (`kind`
+//! remembers what the last run drew), which removes most of the output traffic.
 //! The stage takes a [`crate::spec::view::View`] (inside [`EdgeParams`]) and
 //! knows no screen: framing, drawing and the cap-quality evaluation live in
 //! `render::{camera, edges, cap_quality}`.
@@ -63,6 +69,7 @@ pub struct EdgeStage {
     n_caps: usize,
     k_detect: Kernel,
     k_mh: Kernel,
+    k_adj_flags: Kernel,
     k_adj: Kernel,
     params: Buffer<f32>,
     pos: Buffer<f32>,
@@ -71,30 +78,48 @@ pub struct EdgeStage {
     caps: Buffer<u32>,
     edge_out: Buffer<f32>,
     kind: Buffer<u32>,
-    /// The cap outputs, allocated (and filled with markers) by the first run
-    /// of their variant: a stage that never draws adjacency caps never holds
-    /// their buffer (16 floats per cap pair, 1.9 GB for a 2M-vertex torus).
+    /// The cap outputs, allocated by the first run of their variant: a
+    /// stage that never draws McGuire-Hughes caps never holds their buffers.
     cap_mh: Option<[Buffer<f32>; 2]>,
-    cap_adj: Option<(Buffer<f32>, Buffer<u8>)>,
+    cap_adj: Option<AdjacencyCaps>,
     last_mode: CapMode,
+    /// The scan of the adjacency cap flags and of the read-back compaction.
+    scan: Option<Scan>,
     /// The read-back compaction, made by the first [`EdgeStage::read_drawn`].
     compact: Option<Compactor>,
+}
+
+/// The adjacency caps: a slot per cap pair, and the quads of the drawn ones.
+struct AdjacencyCaps {
+    /// Flags, then (scanned) each pair's slot among the drawn caps.
+    slots: Buffer<u32>,
+    /// The drawn caps' quads, in pair order; grown as needed.
+    out: Buffer<f32>,
+    /// Caps `out` holds room for.
+    room: usize,
+    /// Caps the last run drew.
+    drawn: usize,
 }
 
 /// Kernels and buffers of [`EdgeStage::read_drawn`]'s compaction.
 struct Compactor {
     k_flags: Kernel,
     k_edges: Kernel,
-    k_caps: Kernel,
-    scan: Scan,
-    /// Flags, then slots after the scan: E edge entries, then C cap pairs.
+    /// Flags, then slots after the scan, per edge entry.
     slots: Buffer<u32>,
-    /// The compacted vertices: edge-out, then the caps; grown as needed.
+    /// The compacted vertices: edge-out, then the half-caps; grown as needed.
     dst: Buffer<f32>,
     /// float4 vertices `dst` holds.
     dst_len: usize,
     /// Kernel time of the last compaction, ms.
     last_ms: f64,
+}
+
+/// Room for `need` elements in a buffer that holds `room`: `need` grown by
+/// half again over `room`, so that a view drawing a few more than the last
+/// does not reallocate every frame.
+fn grown(need: usize, room: usize) -> usize {
+    need.max(room + room / 2)
 }
 
 impl EdgeStage {
@@ -132,6 +157,7 @@ impl EdgeStage {
             n_caps: nc,
             k_detect: gpu.kernel(&prog, "edges_detect")?,
             k_mh: gpu.kernel(&prog, "caps_mh")?,
+            k_adj_flags: gpu.kernel(&prog, "caps_adjacency_flags")?,
             k_adj: gpu.kernel(&prog, "caps_adjacency")?,
             params: gpu.buffer(PARAMS_LEN)?,
             pos: gpu.buffer(3 * nv)?,
@@ -143,10 +169,11 @@ impl EdgeStage {
             cap_mh: None,
             cap_adj: None,
             last_mode: CapMode::None,
+            scan: None,
             compact: None,
             gpu: gpu.clone(),
         };
-        // Outputs persist between runs (undrawn-then-undrawn primitives are not
+        // Edge outputs persist between runs (undrawn-then-undrawn edges are not
         // rewritten): start from markers everywhere, filled on the device.
         gpu.fill(&mut s.edge_out, &MARKER, 4 * n_out)?;
         gpu.zero(&mut s.kind, ne)?;
@@ -156,8 +183,9 @@ impl EdgeStage {
         Ok(s)
     }
 
-    /// Allocates the cap outputs of `mode` on its first run, filled with
-    /// markers (and `cap_drawn` with 0), as the kernels expect.
+    /// Allocates the cap outputs of `mode` on its first run: the half-cap
+    /// buffers filled with markers, as `caps_mh` expects; the adjacency
+    /// cap slots and room for one cap (grown by the runs).
     fn ensure_caps(&mut self, mode: CapMode) -> Result<()> {
         let g = &self.gpu;
         match mode {
@@ -171,14 +199,17 @@ impl EdgeStage {
                 self.cap_mh = Some(b);
             }
             CapMode::Adjacency if self.cap_adj.is_none() => {
-                let n = 4 * cap_adjacency_bound(self.n_caps);
-                let mut out = g.buffer(n)?;
-                g.fill(&mut out, &MARKER, n)?;
-                let mut drawn = g.buffer(self.n_caps)?;
-                g.zero(&mut drawn, self.n_caps)?;
-                self.cap_adj = Some((out, drawn));
+                self.cap_adj = Some(AdjacencyCaps {
+                    slots: g.buffer(self.n_caps.max(1))?,
+                    out: g.buffer(16)?,
+                    room: 1,
+                    drawn: 0,
+                });
             }
             _ => {}
+        }
+        if self.scan.is_none() && mode == CapMode::Adjacency {
+            self.scan = Some(Scan::new(g.clone())?);
         }
         Ok(())
     }
@@ -237,11 +268,12 @@ impl EdgeStage {
                 buf(&self.kind),
             ],
         )?;
-        let ev_c = match mode {
-            CapMode::None => None,
+        let mut cap_ms = 0.0;
+        match mode {
+            CapMode::None => {}
             CapMode::Mh => {
                 let [mh0, mh1] = self.cap_mh.as_ref().expect("allocated above");
-                launch(
+                let ev = launch(
                     &g,
                     &self.k_mh,
                     self.n_edges,
@@ -255,39 +287,60 @@ impl EdgeStage {
                         buf(mh0),
                         buf(mh1),
                     ],
-                )?
+                )?;
+                g.finish()?;
+                cap_ms = ev.as_ref().map_or(0.0, event_ms);
             }
             CapMode::Adjacency => {
-                let (adj, drawn) = self.cap_adj.as_ref().expect("allocated above");
-                launch(
-                    &g,
-                    &self.k_adj,
-                    self.n_caps,
-                    &[
-                        Arg::U32(self.n_caps as u32),
-                        buf(&self.params),
-                        buf(&self.edges),
-                        buf(&self.caps),
-                        buf(&self.kind),
-                        buf(&self.edge_out),
-                        buf(adj),
-                        buf(drawn),
-                    ],
-                )?
+                let nc = self.n_caps;
+                let caps = self.cap_adj.as_mut().expect("allocated above");
+                let scan = self.scan.as_mut().expect("made with the caps");
+                let common = [
+                    Arg::U32(nc as u32),
+                    buf(&self.params),
+                    buf(&self.edges),
+                    buf(&self.caps),
+                    buf(&self.kind),
+                    buf(&self.edge_out),
+                ];
+                let mut args = common.to_vec();
+                args.push(buf(&caps.slots));
+                let ev_f = launch(&g, &self.k_adj_flags, nc, &args)?;
+                // The scan's total read is the one wait before the caps.
+                let (total, _) = scan.exclusive_at(&caps.slots, &caps.slots, nc, &[])?;
+                let total = total as usize;
+                if total > caps.room {
+                    let room = grown(total, caps.room);
+                    caps.out = g.buffer(16 * room)?;
+                    caps.room = room;
+                }
+                caps.drawn = total;
+                let mut args = common.to_vec();
+                args.extend([buf(&caps.slots), Arg::U32(total as u32), buf(&caps.out)]);
+                let ev_c = if total > 0 {
+                    launch(&g, &self.k_adj, nc, &args)?
+                } else {
+                    None
+                };
+                g.finish()?;
+                cap_ms = ev_f.as_ref().map_or(0.0, event_ms)
+                    + scan.last_ms()
+                    + ev_c.as_ref().map_or(0.0, event_ms);
             }
-        };
-        g.finish()?;
+        }
+        if mode == CapMode::None {
+            g.finish()?;
+        }
         self.last_mode = mode;
         let mut t = Timing::default();
         if let Some(e) = &ev_d {
             t.add(Step::EdgesDetect, event_ms(e));
         }
-        if let Some(e) = &ev_c {
-            let step = match mode {
-                CapMode::Mh => Step::CapsMh,
-                _ => Step::CapsAdjacency,
-            };
-            t.add(step, event_ms(e));
+        match mode {
+            CapMode::None => {}
+            CapMode::Mh => t.add(Step::CapsMh, cap_ms),
+            // The flags, their scan and the drawn caps.
+            CapMode::Adjacency => t.add(Step::CapsAdjacency, cap_ms),
         }
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(t)
@@ -313,8 +366,24 @@ impl EdgeStage {
                 out.cap_mh0 = read4(mh0, cap_mh_bound(self.n_edges))?;
                 out.cap_mh1 = read4(mh1, cap_mh_bound(self.n_edges))?;
             }
-            (CapMode::Adjacency, _, Some((adj, _))) => {
-                out.cap_adj = read4(adj, cap_adjacency_bound(self.n_caps))?
+            (CapMode::Adjacency, _, Some(c)) => {
+                // Back to one quad per cap pair: the drawn ones at their
+                // slots, the marker elsewhere.
+                let nc = self.n_caps;
+                let mut slots = vec![0u32; nc];
+                g.read(&c.slots, &mut slots)?;
+                let drawn = read4(&c.out, 4 * c.drawn)?;
+                let mut all = vec![MARKER; cap_adjacency_bound(nc)];
+                for i in 0..nc {
+                    let (s, next) = (
+                        slots[i] as usize,
+                        slots.get(i + 1).map_or(c.drawn, |&n| n as usize),
+                    );
+                    if next > s {
+                        all[4 * i..4 * i + 4].copy_from_slice(&drawn[4 * s..4 * s + 4]);
+                    }
+                }
+                out.cap_adj = all;
             }
             _ => {}
         }
@@ -324,84 +393,64 @@ impl EdgeStage {
     /// Reads back what the last run drew, for drawing and SVG: `kind` in
     /// full, and of edge-out and the caps of the last run's mode only the
     /// primitives that hold geometry (a drawn edge, `KIND_DRAWN`; a drawn
-    /// adjacency cap, `cap_drawn`), **compacted** in index order on the
-    /// device (`drawn_flags`, one scan, `compact_edges`, `compact_caps`;
-    /// CPU twin [`crate::cpu::edges::compact_drawn`]). Drawing the result
-    /// draws exactly what drawing [`read`](Self::read)'s would (the renderer
-    /// skips markers and keeps order), from a few percent of the bytes: on a
+    /// adjacency cap), **compacted** in index order on the device
+    /// (`drawn_flags`, one scan, `compact_edges`; adjacency caps are written
+    /// compacted by their kernel already; CPU twin
+    /// [`crate::cpu::edges::compact_drawn`]). Drawing the result draws
+    /// exactly what drawing [`read`](Self::read)'s would (the renderer skips
+    /// markers and keeps order), from a few percent of the bytes: on a
     /// 2M-vertex torus seen whole, 5,202 of 6M edges. Two waits: the scan's
-    /// totals, then the reads.
+    /// total, then the reads.
     pub fn read_drawn(&mut self) -> Result<EdgeOutput> {
         let g = self.gpu.clone();
-        let (ne, nc) = (self.n_edges, self.n_caps);
-        let adj = match (self.last_mode, &self.cap_adj) {
-            (CapMode::Adjacency, Some((out, drawn))) => Some((out, drawn)),
-            _ => None,
-        };
-        let caps_n = if adj.is_some() { nc } else { 0 };
+        let ne = self.n_edges;
         if self.compact.is_none() {
             let file = kernel_file("edges").expect("kernels/edges.cl is registered");
             let prog = g.program(&file, "")?;
             self.compact = Some(Compactor {
                 k_flags: g.kernel(&prog, "drawn_flags")?,
                 k_edges: g.kernel(&prog, "compact_edges")?,
-                k_caps: g.kernel(&prog, "compact_caps")?,
-                scan: Scan::new(g.clone())?,
-                slots: g.buffer((ne + nc).max(1))?,
+                slots: g.buffer(ne.max(1))?,
                 dst: g.buffer(4)?,
                 dst_len: 1,
                 last_ms: 0.0,
             });
         }
-        let c = self.compact.as_mut().expect("made above");
-        let n = ne + caps_n;
-        let mut kind = vec![0u32; ne];
-        let mut out = EdgeOutput::default();
-        if n == 0 {
-            out.kind = kind;
-            return Ok(out);
+        if self.scan.is_none() {
+            self.scan = Some(Scan::new(g.clone())?);
         }
-        // With no adjacency caps, the kind buffer stands in for the unread
-        // cap flags (any buffer will do: no work-item reads it).
-        let cap_flags = adj.map_or_else(|| buf(&self.kind), |(_, d)| buf(d));
+        let c = self.compact.as_mut().expect("made above");
+        let scan = self.scan.as_mut().expect("made above");
+        let mut kind = vec![0u32; ne];
         let mut events = Vec::new();
-        events.extend(launch(
-            &g,
-            &c.k_flags,
-            n,
-            &[
-                Arg::U32(ne as u32),
-                Arg::U32(caps_n as u32),
-                buf(&self.kind),
-                cap_flags,
-                buf(&c.slots),
-            ],
-        )?);
-        let at: &[usize] = if caps_n > 0 && ne > 0 { &[ne] } else { &[] };
-        let (total, before) = c.scan.exclusive_at(&c.slots, &c.slots, n, at)?;
-        let mut ms = c.scan.last_ms();
-        let total = total as usize;
-        let drawn_edges = match (caps_n, ne) {
-            (0, _) => total,
-            (_, 0) => 0,
-            _ => before[0] as usize,
-        };
-        let drawn_caps = total - drawn_edges;
+        let mut ms = 0.0;
+        let mut drawn_edges = 0;
+        if ne > 0 {
+            events.extend(launch(
+                &g,
+                &c.k_flags,
+                ne,
+                &[Arg::U32(ne as u32), buf(&self.kind), buf(&c.slots)],
+            )?);
+            drawn_edges = scan.exclusive_at(&c.slots, &c.slots, ne, &[])?.0 as usize;
+            ms += scan.last_ms();
+        }
         let mh = match (self.last_mode, &self.cap_mh) {
             (CapMode::Mh, Some([m0, m1])) => Some((m0, m1)),
             _ => None,
         };
-        // Vertices: edge-out (4 per edge), the half-caps (3 + 3), the caps (4).
+        let adj = match (self.last_mode, &self.cap_adj) {
+            (CapMode::Adjacency, Some(a)) => Some(a),
+            _ => None,
+        };
+        // Vertices: edge-out (4 per edge) and the half-caps (3 + 3).
         let per_edge = if mh.is_some() { 10 } else { 4 };
-        let need = per_edge * drawn_edges + 4 * drawn_caps;
+        let need = per_edge * drawn_edges;
         if need > c.dst_len {
-            // Grown by half again, so that a view drawing a few more edges
-            // than the last does not reallocate every frame.
-            let len = need.max(c.dst_len + c.dst_len / 2);
+            let len = grown(need, c.dst_len);
             c.dst = g.buffer(4 * len)?;
             c.dst_len = len;
         }
-        let mut at_v = 0usize;
         let mut parts: Vec<(usize, usize)> = Vec::new();
         if drawn_edges > 0 {
             let mut srcs: Vec<(&Buffer<f32>, u32)> = vec![(&self.edge_out, 4)];
@@ -409,6 +458,7 @@ impl EdgeStage {
                 srcs.push((m0, 3));
                 srcs.push((m1, 3));
             }
+            let mut at_v = 0usize;
             for (src, per) in srcs {
                 events.extend(launch(
                     &g,
@@ -428,42 +478,22 @@ impl EdgeStage {
                 at_v += per as usize * drawn_edges;
             }
         }
-        if let Some((src, drawn)) = adj.filter(|_| drawn_caps > 0) {
-            events.extend(launch(
-                &g,
-                &c.k_caps,
-                nc,
-                &[
-                    Arg::U32(nc as u32),
-                    buf(src),
-                    buf(drawn),
-                    buf(&c.slots),
-                    Arg::U32(ne as u32),
-                    Arg::U32(drawn_edges as u32),
-                    Arg::U32(at_v as u32),
-                    buf(&c.dst),
-                ],
-            )?);
-            parts.push((at_v, 4 * drawn_caps));
-        }
         let mut vecs: Vec<Vec<[f32; 4]>> = parts.iter().map(|p| vec![[0f32; 4]; p.1]).collect();
-        let mut failed = None;
-        // SAFETY: `kind` and `vecs` are neither moved nor read until `finish`
-        // below, which also runs on the error path; the ranges lie inside
-        // the buffers (parts are within `need` ≤ dst_len vertices).
-        unsafe {
-            if let Err(e) = g.read_at_async(&self.kind, 0, &mut kind) {
-                failed = Some(e);
-            }
+        let mut caps = vec![[0f32; 4]; adj.map_or(0, |a| 4 * a.drawn)];
+        // SAFETY: `kind`, `vecs` and `caps` are neither moved nor read until
+        // `finish` below, which also runs on the error path; the ranges lie
+        // inside the buffers (parts are within `need` ≤ dst_len vertices, the
+        // caps within the drawn caps' room).
+        let failed = unsafe {
+            let mut reads = vec![g.read_at_async(&self.kind, 0, &mut kind)];
             for (v, p) in vecs.iter_mut().zip(&parts) {
-                if failed.is_some() {
-                    break;
-                }
-                if let Err(e) = g.read_at_async(&c.dst, 4 * p.0, bytemuck::cast_slice_mut(v)) {
-                    failed = Some(e);
-                }
+                reads.push(g.read_at_async(&c.dst, 4 * p.0, bytemuck::cast_slice_mut(v)));
             }
-        }
+            if let Some(a) = adj {
+                reads.push(g.read_at_async(&a.out, 0, bytemuck::cast_slice_mut(&mut caps)));
+            }
+            reads.into_iter().find_map(|r| r.err())
+        };
         let done = g.finish();
         if let Some(e) = failed {
             return Err(e);
@@ -472,16 +502,17 @@ impl EdgeStage {
         ms += events.iter().map(event_ms).sum::<f64>();
         c.last_ms = ms;
         let mut vecs = vecs.into_iter();
-        out.kind = kind;
+        let mut out = EdgeOutput {
+            kind,
+            cap_adj: caps,
+            ..EdgeOutput::default()
+        };
         if drawn_edges > 0 {
             out.edge_out = vecs.next().unwrap_or_default();
             if mh.is_some() {
                 out.cap_mh0 = vecs.next().unwrap_or_default();
                 out.cap_mh1 = vecs.next().unwrap_or_default();
             }
-        }
-        if drawn_caps > 0 {
-            out.cap_adj = vecs.next().unwrap_or_default();
         }
         Ok(out)
     }
