@@ -623,3 +623,17 @@ fn glb_keyframe_times_out_of_order_are_refused() {
         "{e}"
     );
 }
+
+/// An animation channel with an unknown target path made the glTF crate
+/// unwrap an invalid value (a panic in release builds too); found by
+/// fuzzing. Channels are checked before the import, naming the channel.
+#[test]
+fn gltf_channel_with_an_invalid_target_path_is_refused() {
+    let crash = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/gltf/crash-ad027746a4b599dd95ef4de9821ce8d7d444e9eb"),
+    )
+    .unwrap();
+    let e = within_deadline("gltf", crash).unwrap_err();
+    assert!(e.contains("animation") && e.contains("channel"), "{e}");
+}

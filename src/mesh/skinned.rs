@@ -312,6 +312,45 @@ fn check_before_import(path: &Path) -> Result<()> {
             }
         }
     }
+    // Animation channels: the glTF crate unwraps their target path and
+    // indexes their node and sampler unchecked.
+    let nodes = root.nodes.len();
+    for (i, anim) in root.animations.iter().enumerate() {
+        let samplers = anim.samplers.len();
+        for (j, ch) in anim.channels.iter().enumerate() {
+            let what = format!("animation {i} channel {j}");
+            let problem = if matches!(ch.target.path, gltf::json::validation::Checked::Invalid) {
+                Some("has no valid target path (translation, rotation, scale or weights)".into())
+            } else if ch.target.node.value() >= nodes {
+                Some(format!(
+                    "targets node {}, but the file has {nodes} nodes",
+                    ch.target.node.value()
+                ))
+            } else if ch.sampler.value() >= samplers {
+                Some(format!(
+                    "uses sampler {}, but the animation has {samplers} samplers",
+                    ch.sampler.value()
+                ))
+            } else {
+                None
+            };
+            if let Some(p) = problem {
+                return Err(bad(path, what, p));
+            }
+        }
+        for (j, s) in anim.samplers.iter().enumerate() {
+            if let Some(a) = [s.input.value(), s.output.value()]
+                .into_iter()
+                .find(|&a| a >= n)
+            {
+                return Err(bad(
+                    path,
+                    format!("animation {i} sampler {j}"),
+                    format!("refers to accessor {a}, but the file has {n} accessors"),
+                ));
+            }
+        }
+    }
     Ok(())
 }
 
@@ -502,7 +541,7 @@ pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
             }
             // glTF keyframe times increase strictly; sampling bisects them.
             if let Some(k) = (0..times.len())
-                .find(|&k| !times[k].is_finite() || (k > 0 && !(times[k] > times[k - 1])))
+                .find(|&k| !times[k].is_finite() || (k > 0 && times[k] <= times[k - 1]))
             {
                 return Err(bad(
                     path,
