@@ -113,7 +113,8 @@ def main():
               f"per view {r['view_ms_median']:.1f} ms passes + {r['render_ms_median']:.1f} ms "
               f"drawing and files = {per_view:.1f} ms ({1e3 / per_view:.1f} views/s; Blender "
               f"Line Art + Workbench: 755 ms per view, 1.3 views/s); process {total:.0f} ms; "
-              f"GL uploads {r['gl_uploads']}")
+              f"mesh uploads to GL: {r['gl_uploads']['topology']} of the faces, "
+              f"{r['gl_uploads']['pose']} of the pose")
 
 
 if __name__ == "__main__":
