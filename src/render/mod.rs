@@ -16,6 +16,13 @@
 //!   already in clip space, flat colour, depth-tested (≤) against the mesh.
 //! - [`Renderer::draw_lines`]: world-space segments as screen-aligned quads.
 //!
+//! A mesh drawn in many views is uploaded once: [`Renderer::upload_topology`]
+//! (faces, once per topology) and [`Renderer::upload_pose`] (positions,
+//! normals, colours, once per pose), outside any frame, then
+//! [`Renderer::draw_uploaded`] in each frame; [`Renderer::uploads`] counts
+//! the uploads. [`Renderer::reconfigure`] changes the image size and
+//! antialiasing while keeping the context, its programs and the mesh.
+//!
 //! Clip space is OpenGL's (z in [−w, w]), as produced by
 //! [`Camera::view_proj`]. All drawing goes to the renderer's own framebuffer
 //! objects (multisampled when `msaa > 0`, resolved in `finish`).
