@@ -3,7 +3,9 @@
 //! Groups:
 //! - `curvature/<variant>/<input>`: kernel time from OpenCL profiling events
 //!   (the sum of the pass times of one [`CurvatureEstimator::run`]), mesh
-//!   already on the device, after one warm-up run that pays for JIT.
+//!   already on the device, after one warm-up run that pays for JIT; the
+//!   median is also printed with its ratio to trimesh2's single-threaded
+//!   time on the same mesh.
 //! - `curvature/<variant>-wall/<input>`: host wall time of one run (first
 //!   enqueue to end of the last kernel), default variant only.
 //! - `curvature/cpu-reference/bunny`: wall time of the f64 CPU reference,
@@ -53,6 +55,17 @@ const SMALL: Sampling = Sampling {
     flat: false,
     measure_s: 8,
 };
+
+/// trimesh2 2.16, one thread, curvature + derivatives of the same meshes on
+/// this kind of 2-core machine, ms (the ratio the bench prints).
+fn trimesh2_ms(input: &str) -> Option<f64> {
+    match input {
+        "bunny" => Some(19.7),
+        "torus-500k" => Some(253.0),
+        "torus-2m" => Some(1014.0),
+        _ => None,
+    }
+}
 
 fn torus_of(n: usize) -> Mesh {
     let (nu, nv) = mesh::torus_resolution_for(n);
@@ -182,9 +195,25 @@ fn curvature_benches(c: &mut Criterion) {
             let Some(mut est) = ready(&gpu, &m, &id, opts) else {
                 continue;
             };
+            let mut each = Vec::new();
             g.bench_function(&id, |b| {
-                b.iter_custom(|iters| timed(&mut est, iters, |t| t.kernel_ms))
+                b.iter_custom(|iters| {
+                    let mut ms = 0.0;
+                    for _ in 0..iters {
+                        let t = est.run().expect("curvature run failed").kernel_ms;
+                        each.push(t);
+                        ms += t;
+                    }
+                    Duration::from_secs_f64(ms * 1e-3)
+                })
             });
+            if let Some(t2) = trimesh2_ms(input.name) {
+                let k = shapecue::metrics::median(&mut each);
+                eprintln!(
+                    "curvature/{id}: kernel median {k:.2} ms, {:.1}× faster than trimesh2's {t2} ms",
+                    t2 / k
+                );
+            }
         }
         g.finish();
 
