@@ -18,11 +18,21 @@ use std::time::{Duration, Instant};
 /// millisecond; the bound is loose for debug builds and busy machines).
 const PER_INPUT: Duration = Duration::from_secs(5);
 
-fn inputs(root: &str, target: &str) -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+/// `fuzz/<root>/<target>/`: a target's corpus or regression inputs.
+fn folder(root: &str, target: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fuzz")
         .join(root)
-        .join(target);
+        .join(target)
+}
+
+/// The bytes of the crash input `name` of `target` (`fuzz/regressions/`).
+fn regression(target: &str, name: &str) -> Vec<u8> {
+    std::fs::read(folder("regressions", target).join(name)).expect("read a regression input")
+}
+
+fn inputs(root: &str, target: &str) -> Vec<PathBuf> {
+    let dir = folder(root, target);
     let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
         Ok(rd) => rd
             .map(|e| e.expect("read the corpus folder").path())
@@ -584,11 +594,7 @@ fn glb_header_longer_than_the_file_is_refused_before_allocating() {
 /// builds; found by fuzzing a `.gltf` file that holds GLB bytes).
 #[test]
 fn glb_header_shorter_than_itself_is_refused() {
-    let crash = std::fs::read(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("fuzz/regressions/gltf/crash-05c2f3a58e6fd23d203c88b640cdcb60ab19a3cb"),
-    )
-    .unwrap();
+    let crash = regression("gltf", "crash-05c2f3a58e6fd23d203c88b640cdcb60ab19a3cb");
     for (target, bytes) in [
         ("gltf", crash),
         ("glb", {
@@ -612,11 +618,7 @@ fn glb_header_shorter_than_itself_is_refused() {
 /// end); found by fuzzing. They are refused at load, naming the keyframe.
 #[test]
 fn glb_keyframe_times_out_of_order_are_refused() {
-    let crash = std::fs::read(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("fuzz/regressions/glb/crash-cd2c750fd97f431336a35a5b7a4da73f14aa937f"),
-    )
-    .unwrap();
+    let crash = regression("glb", "crash-cd2c750fd97f431336a35a5b7a4da73f14aa937f");
     let e = within_deadline("glb", crash).unwrap_err();
     assert!(
         e.contains("keyframe") && e.contains("previous keyframe"),
@@ -629,11 +631,7 @@ fn glb_keyframe_times_out_of_order_are_refused() {
 /// fuzzing. Channels are checked before the import, naming the channel.
 #[test]
 fn gltf_channel_with_an_invalid_target_path_is_refused() {
-    let crash = std::fs::read(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("fuzz/regressions/gltf/crash-ad027746a4b599dd95ef4de9821ce8d7d444e9eb"),
-    )
-    .unwrap();
+    let crash = regression("gltf", "crash-ad027746a4b599dd95ef4de9821ce8d7d444e9eb");
     let e = within_deadline("gltf", crash).unwrap_err();
     assert!(e.contains("animation") && e.contains("channel"), "{e}");
 }
