@@ -208,8 +208,17 @@ impl EdgeStage {
             }
             _ => {}
         }
-        if self.scan.is_none() && mode == CapMode::Adjacency {
-            self.scan = Some(Scan::new(g.clone())?);
+        if mode == CapMode::Adjacency {
+            self.ensure_scan()?;
+        }
+        Ok(())
+    }
+
+    /// Makes the scan of the adjacency cap flags and of the read-back
+    /// compaction on first use.
+    fn ensure_scan(&mut self) -> Result<()> {
+        if self.scan.is_none() {
+            self.scan = Some(Scan::new(self.gpu.clone())?);
         }
         Ok(())
     }
@@ -268,9 +277,9 @@ impl EdgeStage {
                 buf(&self.kind),
             ],
         )?;
-        let mut cap_ms = 0.0;
-        match mode {
-            CapMode::None => {}
+        // The cap kernels' events, and the scan's kernel time (adjacency).
+        let (cap_events, scan_ms) = match mode {
+            CapMode::None => (Vec::new(), 0.0),
             CapMode::Mh => {
                 let [mh0, mh1] = self.cap_mh.as_ref().expect("allocated above");
                 let ev = launch(
@@ -288,8 +297,7 @@ impl EdgeStage {
                         buf(mh1),
                     ],
                 )?;
-                g.finish()?;
-                cap_ms = ev.as_ref().map_or(0.0, event_ms);
+                (ev.into_iter().collect(), 0.0)
             }
             CapMode::Adjacency => {
                 let nc = self.n_caps;
@@ -305,7 +313,9 @@ impl EdgeStage {
                 ];
                 let mut args = common.to_vec();
                 args.push(buf(&caps.slots));
-                let ev_f = launch(&g, &self.k_adj_flags, nc, &args)?;
+                let mut events: Vec<_> = launch(&g, &self.k_adj_flags, nc, &args)?
+                    .into_iter()
+                    .collect();
                 // The scan's total read is the one wait before the caps.
                 let (total, _) = scan.exclusive_at(&caps.slots, &caps.slots, nc, &[])?;
                 let total = total as usize;
@@ -315,22 +325,17 @@ impl EdgeStage {
                     caps.room = room;
                 }
                 caps.drawn = total;
-                let mut args = common.to_vec();
-                args.extend([buf(&caps.slots), Arg::U32(total as u32), buf(&caps.out)]);
-                let ev_c = if total > 0 {
-                    launch(&g, &self.k_adj, nc, &args)?
-                } else {
-                    None
-                };
-                g.finish()?;
-                cap_ms = ev_f.as_ref().map_or(0.0, event_ms)
-                    + scan.last_ms()
-                    + ev_c.as_ref().map_or(0.0, event_ms);
+                if total > 0 {
+                    let mut args = common.to_vec();
+                    args.extend([buf(&caps.slots), Arg::U32(total as u32), buf(&caps.out)]);
+                    events.extend(launch(&g, &self.k_adj, nc, &args)?);
+                }
+                (events, scan.last_ms())
             }
-        }
-        if mode == CapMode::None {
-            g.finish()?;
-        }
+        };
+        g.finish()?;
+        // The flags, their scan and the drawn caps for adjacency caps.
+        let cap_ms = cap_events.iter().map(event_ms).sum::<f64>() + scan_ms;
         self.last_mode = mode;
         let mut t = Timing::default();
         if let Some(e) = &ev_d {
@@ -339,7 +344,6 @@ impl EdgeStage {
         match mode {
             CapMode::None => {}
             CapMode::Mh => t.add(Step::CapsMh, cap_ms),
-            // The flags, their scan and the drawn caps.
             CapMode::Adjacency => t.add(Step::CapsAdjacency, cap_ms),
         }
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -416,9 +420,7 @@ impl EdgeStage {
                 last_ms: 0.0,
             });
         }
-        if self.scan.is_none() {
-            self.scan = Some(Scan::new(g.clone())?);
-        }
+        self.ensure_scan()?;
         let c = self.compact.as_mut().expect("made above");
         let scan = self.scan.as_mut().expect("made above");
         let mut kind = vec![0u32; ne];
