@@ -75,262 +75,176 @@
 #define PREV3(i) ((i) == 0 ? 2 : (i) - 1)
 
 // ---------------------------------------------------------------------------
-// Scalar vectors.
+// Types. The geometry of kernels/common/curvature_face.h is instantiated on
+// scalars for every kernel and, with SC_LANES > 1 (CPU devices; the host
+// picks the count), on vectors of SC_LANES lanes for the gather variant's
+// per-face kernels, which then handle SC_LANES consecutive faces per
+// work-item (see the file header).
 
-typedef struct {
-    REAL x, y, z;
-} V3;
-typedef struct {
-    REAL x, y, z, w;
-} V4;
+#ifndef SC_LANES
+#define SC_LANES 1
+#endif
+#if SC_LANES != 1 && SC_LANES != 2 && SC_LANES != 4 && SC_LANES != 8 && SC_LANES != 16
+#error "SC_LANES must be 1, 2, 4, 8 or 16"
+#endif
+#if SC_LANES > 1
+#define SC_OL __attribute__((overloadable))
+// Lanes wider than the target's registers (16 floats without AVX-512) pass
+// vectors differently between functions; every helper is inlined, so the
+// note is moot.
+#pragma clang diagnostic ignored "-Wpsabi"
+#else
+#define SC_OL
+#endif
 
-SC_INLINE V3 v3(REAL x, REAL y, REAL z)
-{
-    V3 r;
-    r.x = x;
-    r.y = y;
-    r.z = z;
-    return r;
-}
-SC_INLINE V4 v4(REAL x, REAL y, REAL z, REAL w)
-{
-    V4 r;
-    r.x = x;
-    r.y = y;
-    r.z = z;
-    r.w = w;
-    return r;
-}
-SC_INLINE V3 ld3(__global const REAL *a, uint i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+SC_OL SC_INLINE REAL ld1(__global const REAL *a, uint i) { return a[i]; }
+SC_OL SC_INLINE uint ldu(__global const uint *a, uint i) { return a[i]; }
+SC_OL SC_INLINE void lst(REAL x, uint slot, __global REAL *a) { a[slot] = x; }
+
+#define GT REAL
+#define GM int
+#define GI uint
+#define GV3 V3
+#define GV4 V4
+#define GTri Tri
+#include "common/curvature_face.h"
+#undef GT
+#undef GM
+#undef GI
+#undef GV3
+#undef GV4
+#undef GTri
+
 SC_INLINE void st3(V3 v, uint i, __global REAL *a)
 {
     a[3 * i] = v.x;
     a[3 * i + 1] = v.y;
     a[3 * i + 2] = v.z;
 }
-SC_INLINE V3 add3(V3 a, V3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
-SC_INLINE V3 sub3(V3 a, V3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
-SC_INLINE V3 mul3(V3 a, REAL s) { return v3(a.x * s, a.y * s, a.z * s); }
-SC_INLINE V3 neg3(V3 a) { return v3(-a.x, -a.y, -a.z); }
-SC_INLINE REAL dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-SC_INLINE V3 cross3(V3 a, V3 b)
+
+// The positions of face f's corners, and their indices.
+SC_INLINE Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f, uint *v0,
+                       uint *v1, uint *v2)
 {
-    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+    *v0 = faces[3 * f];
+    *v1 = faces[3 * f + 1];
+    *v2 = faces[3 * f + 2];
+    return make_tri(ld3(pos, *v0), ld3(pos, *v1), ld3(pos, *v2));
 }
-SC_INLINE REAL len3(V3 a) { return sqrt(dot3(a, a)); }
-SC_INLINE V3 normalize3(V3 a) { return mul3(a, RL(1) / len3(a)); }
-// Component-wise select (a select of a whole struct keeps PoCL from vectorising).
-SC_INLINE V3 sel3(bool c, V3 a, V3 b) { return v3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z); }
-SC_INLINE V4 mul4(V4 a, REAL s) { return v4(a.x * s, a.y * s, a.z * s, a.w * s); }
-
-// ---------------------------------------------------------------------------
-// Per-face geometry, shared by the atomic and gather variants.
-
-typedef struct {
-    uint v0, v1, v2;
-    V3 e0, e1, e2; // e_i is the edge opposite corner i: p[i−1] − p[i+1]
-    REAL psum;     // |p0| + |p1| + |p2| (sums, not maxima: a max keeps PoCL from vectorising)
-} Tri;
-
-SC_INLINE Tri load_tri(__global const REAL *pos, __global const uint *faces, uint f)
-{
-    Tri t;
-    t.v0 = faces[3 * f];
-    t.v1 = faces[3 * f + 1];
-    t.v2 = faces[3 * f + 2];
-    V3 p0 = ld3(pos, t.v0), p1 = ld3(pos, t.v1), p2 = ld3(pos, t.v2);
-    t.e0 = sub3(p2, p1);
-    t.e1 = sub3(p0, p2);
-    t.e2 = sub3(p1, p0);
-    t.psum = len3(p0) + len3(p1) + len3(p2);
-    return t;
-}
-
-SC_INLINE bool tri_degenerate(Tri t)
-{
-    REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
-    REAL twice_area = len3(cross3(t.e0, t.e1));
-    REAL lsum = l0 + l1 + l2;
-    // Written as negated comparisons so NaN counts as degenerate too.
-    // Bitwise & (not &&): short-circuit branches keep PoCL from vectorising.
-    return !((l0 > DEGEN_EDGE2) & (l1 > DEGEN_EDGE2) & (l2 > DEGEN_EDGE2) &
-             (twice_area > DEGEN_AREA_REL * lsum) &
-             (twice_area > DEGEN_HEIGHT_ULP * sqrt(lsum) * t.psum));
-}
-
-// Corner-weighted face normal (trimesh2 / Max 1999): the face's a×b divided by
-// the squared lengths of the two edges at the corner, la (next edge) then lb.
-SC_INLINE V3 corner_normal(V3 fn, REAL la, REAL lb)
-{
-    return mul3(mul3(fn, RL(1) / la), RL(1) / lb); // two steps keep f32 in range
-}
-SC_INLINE V3 face_normal(Tri t) { return cross3(t.e2, t.e0); } // |.| = 2A, outward for CCW
-
-// Voronoi (circumcentric) corner areas with trimesh2's obtuse-triangle rule.
-SC_INLINE V3 corner_areas(Tri t)
-{
-    REAL area = RL(0.5) * len3(cross3(t.e0, t.e1));
-    REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
-    REAL ew0 = l0 * (l1 + l2 - l0), ew1 = l1 * (l2 + l0 - l1), ew2 = l2 * (l0 + l1 - l2);
-    REAL q = RL(-0.25) * area;
-    // obtuse at corner 0, 1 or 2: the other two get the area cut off by the
-    // perpendicular bisector of their edge to it, the obtuse corner the rest
-    REAL o01 = q * l2 / dot3(t.e0, t.e2), o02 = q * l1 / dot3(t.e0, t.e1);
-    REAL o12 = q * l0 / dot3(t.e1, t.e0), o10 = q * l2 / dot3(t.e1, t.e2);
-    REAL o20 = q * l1 / dot3(t.e2, t.e1), o21 = q * l0 / dot3(t.e2, t.e0);
-    REAL s = RL(0.5) * area / (ew0 + ew1 + ew2);
-    V3 acute = v3(s * (ew1 + ew2), s * (ew2 + ew0), s * (ew0 + ew1));
-    V3 obt0 = v3(area - o01 - o02, o01, o02);
-    V3 obt1 = v3(o10, area - o12 - o10, o12);
-    V3 obt2 = v3(o20, o21, area - o20 - o21);
-    return sel3(ew0 <= 0, obt0, sel3(ew1 <= 0, obt1, sel3(ew2 <= 0, obt2, acute)));
-}
-
-// Weight of a face corner in its vertex's one-ring sum (0 when the vertex has no area).
-SC_INLINE REAL corner_weight(REAL ca, REAL a) { return a > 0 ? ca / a : RL(0); }
 
 // Any unit vector perpendicular to n (n unit).
 SC_INLINE V3 any_perp(V3 n)
 {
     REAL ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
-    V3 a = sel3((ax <= ay) & (ax <= az), v3(1, 0, 0), sel3(ay <= az, v3(0, 1, 0), v3(0, 0, 1)));
+    V3 ex = v3(RL(1), RL(0), RL(0)), ey = v3(RL(0), RL(1), RL(0)), ez = v3(RL(0), RL(0), RL(1));
+    V3 a = sel3((ax <= ay) & (ax <= az), ex, sel3(ay <= az, ey, ez));
     return normalize3(cross3(n, a));
 }
 
-// Rotate the frame (u, v) by the minimal rotation taking u×v onto nn.
-SC_INLINE void rot_coord_sys(V3 u, V3 v, V3 nn, V3 *ru, V3 *rv)
-{
-    V3 on = cross3(u, v);
-    REAL ndot = dot3(on, nn);
-    bool flip = ndot <= RL(-1) + RL(1e-6); // opposite normals: a half turn
-    V3 perp_old = sub3(nn, mul3(on, ndot));
-    V3 dperp = mul3(add3(on, nn), RL(1) / (RL(1) + ndot));
-    *ru = sel3(flip, neg3(u), sub3(u, mul3(dperp, dot3(u, perp_old))));
-    *rv = sel3(flip, neg3(v), sub3(v, mul3(dperp, dot3(v, perp_old))));
-}
-
-// Re-express the tensor k = (ku, kuv, kv) given in (ou, ov) in the frame (nu, nv).
-SC_INLINE V3 proj_curv(V3 ou, V3 ov, V3 k, V3 nu, V3 nv)
-{
-    V3 ru, rv;
-    rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
-    REAL u1 = dot3(ru, ou), v1 = dot3(ru, ov), u2 = dot3(rv, ou), v2 = dot3(rv, ov);
-    return v3(k.x * u1 * u1 + k.y * (RL(2) * u1 * v1) + k.z * v1 * v1,
-              k.x * u1 * u2 + k.y * (u1 * v2 + u2 * v1) + k.z * v1 * v2,
-              k.x * u2 * u2 + k.y * (RL(2) * u2 * v2) + k.z * v2 * v2);
-}
-
-// The same for the third-order tensor d = (C111, C112, C122, C222).
-SC_INLINE V4 proj_dcurv(V3 ou, V3 ov, V4 d, V3 nu, V3 nv)
-{
-    V3 ru, rv;
-    rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
-    REAL u1 = dot3(ru, ou), v1 = dot3(ru, ov), u2 = dot3(rv, ou), v2 = dot3(rv, ov);
-    return v4(d.x * u1 * u1 * u1 + d.y * RL(3) * u1 * u1 * v1 + d.z * RL(3) * u1 * v1 * v1 +
-                  d.w * v1 * v1 * v1,
-              d.x * u1 * u1 * u2 + d.y * (u1 * u1 * v2 + RL(2) * u2 * u1 * v1) +
-                  d.z * (u2 * v1 * v1 + RL(2) * u1 * v1 * v2) + d.w * v1 * v1 * v2,
-              d.x * u1 * u2 * u2 + d.y * (u2 * u2 * v1 + RL(2) * u1 * u2 * v2) +
-                  d.z * (u1 * v2 * v2 + RL(2) * u2 * v2 * v1) + d.w * v1 * v2 * v2,
-              d.x * u2 * u2 * u2 + d.y * RL(3) * u2 * u2 * v2 + d.z * RL(3) * u2 * v2 * v2 +
-                  d.w * v2 * v2 * v2);
-}
-
-// Face frame: t along e0, b in the face plane, t × b = face normal.
-SC_INLINE void face_frame(Tri t, V3 *ft, V3 *fb)
-{
-    *ft = normalize3(t.e0);
-    *fb = normalize3(cross3(cross3(t.e0, t.e1), *ft));
-}
-
-// Least-squares second fundamental form of a face from the normal differences
-// along its edges (edge e_i pairs with n[i−1] − n[i+1]). The normal equations
-// [[w00 w01 0] [w01 w00+w22 w01] [0 w01 w22]] are tridiagonal; LDLᵀ unrolled.
-// Returns false when a pivot is not positive or the result is not finite.
-SC_INLINE bool face_tensor(Tri t, V3 ft, V3 fb, V3 n0, V3 n1, V3 n2, V3 *x)
-{
-    REAL w00 = 0, w01 = 0, w22 = 0, m0 = 0, m1 = 0, m2 = 0;
-#define TENSOR_EDGE(e, dn)                                 \
-    {                                                      \
-        REAL u = dot3(e, ft), v = dot3(e, fb);             \
-        REAL dnu = dot3(dn, ft), dnv = dot3(dn, fb);       \
-        w00 += u * u;                                      \
-        w01 += u * v;                                      \
-        w22 += v * v;                                      \
-        m0 += dnu * u;                                     \
-        m1 += dnu * v + dnv * u;                           \
-        m2 += dnv * v;                                     \
-    }
-    TENSOR_EDGE(t.e0, sub3(n2, n1));
-    TENSOR_EDGE(t.e1, sub3(n0, n2));
-    TENSOR_EDGE(t.e2, sub3(n1, n0));
-#undef TENSOR_EDGE
-    REAL w11 = w00 + w22, w12 = w01;
-    REAL d0 = w00;
-    REAL l10 = w01 / d0;
-    REAL d1 = w11 - l10 * w01;
-    REAL l21 = w12 / d1;
-#ifdef SC_COMPAT
-    REAL d2 = w22; // trimesh2 2.16's pivot quirk (reads the lower triangle before filling it)
+#if SC_LANES > 1
+#define SC_CAT_(a, b) a##b
+#define SC_CAT(a, b) SC_CAT_(a, b)
+#ifdef SC_DOUBLE
+typedef SC_CAT(double, SC_LANES) REALN;
+typedef SC_CAT(long, SC_LANES) MASKN;
 #else
-    REAL d2 = w22 - l21 * w12;
+typedef SC_CAT(float, SC_LANES) REALN;
+typedef SC_CAT(int, SC_LANES) MASKN;
 #endif
-    REAL y1 = m1 - l10 * m0;
-    REAL y2 = m2 - l21 * y1;
-    REAL x2 = y2 / d2;
-    REAL x1 = y1 / d1 - l21 * x2;
-    REAL x0 = m0 / d0 - l10 * x1;
-    *x = v3(x0, x1, x2);
-    return (d0 > 0) & (d1 > 0) & (d2 > 0) & isfinite(x0) & isfinite(x1) & isfinite(x2);
-}
+typedef SC_CAT(uint, SC_LANES) UINTN;
+typedef SC_CAT(int, SC_LANES) INTN;
+#define VLOADN SC_CAT(vload, SC_LANES)
+#define VSTOREN SC_CAT(vstore, SC_LANES)
+#define CONVERT_UCHARN SC_CAT(convert_uchar, SC_LANES)
+#define CONVERT_INTN SC_CAT(convert_int, SC_LANES)
 
-// Least-squares curvature derivative of a face from the differences of the
-// vertex tensors (in the face frame) along its edges. The 4×4 normal equations
-// [[a b 0 0] [b 2a+c 2b 0] [0 2b a+2c b] [0 0 b c]] (a = Σu², b = Σuv, c = Σv²)
-// are tridiagonal too.
-SC_INLINE bool face_dcurv(Tri t, V3 ft, V3 fb, V3 f0, V3 f1, V3 f2, V4 *x)
-{
-    REAL a = 0, b = 0, c = 0, m0 = 0, m1 = 0, m2 = 0, m3 = 0;
-#define DCURV_EDGE(e, d)                                   \
-    {                                                      \
-        REAL u = dot3(e, ft), v = dot3(e, fb);             \
-        a += u * u;                                        \
-        b += u * v;                                        \
-        c += v * v;                                        \
-        m0 += u * d.x;                                     \
-        m1 += v * d.x + RL(2) * u * d.y;                   \
-        m2 += RL(2) * v * d.y + u * d.z;                   \
-        m3 += v * d.z;                                     \
-    }
-    DCURV_EDGE(t.e0, sub3(f2, f1));
-    DCURV_EDGE(t.e1, sub3(f0, f2));
-    DCURV_EDGE(t.e2, sub3(f1, f0));
-#undef DCURV_EDGE
-    REAL d0 = a;
-    REAL l10 = b / d0;
-    REAL d1 = RL(2) * a + c - l10 * b;
-    REAL l21 = RL(2) * b / d1;
-    REAL d2 = a + RL(2) * c - l21 * (RL(2) * b);
-    REAL l32 = b / d2;
-    REAL d3 = c - l32 * b;
-    REAL y1 = m1 - l10 * m0;
-    REAL y2 = m2 - l21 * y1;
-    REAL y3 = m3 - l32 * y2;
-    REAL x3 = y3 / d3;
-    REAL x2 = y2 / d2 - l32 * x3;
-    REAL x1 = y1 / d1 - l21 * x2;
-    REAL x0 = m0 / d0 - l10 * x1;
-    *x = v4(x0, x1, x2, x3);
-    return (d0 > 0) & (d1 > 0) & (d2 > 0) & (d3 > 0) & isfinite(x0) & isfinite(x1) &
-           isfinite(x2) & isfinite(x3);
-}
+// One scalar load per lane (the compiler assembles the vector).
+#if SC_LANES == 2
+#define SC_GATHER(T, a, i) ((T)(a[i.s0], a[i.s1]))
+#define SC_IOTA ((UINTN)(0, 1))
+#elif SC_LANES == 4
+#define SC_GATHER(T, a, i) ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3]))
+#define SC_IOTA ((UINTN)(0, 1, 2, 3))
+#elif SC_LANES == 8
+#define SC_GATHER(T, a, i) \
+    ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3], a[i.s4], a[i.s5], a[i.s6], a[i.s7]))
+#define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7))
+#else
+#define SC_GATHER(T, a, i)                                                                    \
+    ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3], a[i.s4], a[i.s5], a[i.s6], a[i.s7], a[i.s8],    \
+         a[i.s9], a[i.sa], a[i.sb], a[i.sc], a[i.sd], a[i.se], a[i.sf]))
+#define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+#endif
 
-// A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame.
-SC_INLINE V3 vertex_curv_in(__global const REAL *pd1, __global const REAL *pd2,
-                         __global const REAL *kk, uint v, V3 ft, V3 fb)
+SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return SC_GATHER(REALN, a, i); }
+SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return SC_GATHER(UINTN, a, i); }
+SC_OL SC_INLINE void lst(REALN x, uint slot, __global REAL *a) { VSTOREN(x, slot, a); }
+
+#define GT REALN
+#define GM MASKN
+#define GI UINTN
+#define GV3 V3N
+#define GV4 V4N
+#define GTri TriN
+#endif // SC_LANES > 1
+
+// The lane instance (empty without lanes: GT is then undefined). The include
+// stays outside the #if so that the #line markers around it always apply.
+#include "common/curvature_face.h"
+#undef GT
+#undef GM
+#undef GI
+#undef GV3
+#undef GV4
+#undef GTri
+
+#if SC_LANES > 1
+// The types of the gather variant's per-face kernels.
+typedef REALN FREAL;
+typedef MASKN FMASK;
+typedef UINTN FIDX;
+typedef V3N FV3;
+typedef V4N FV4;
+typedef TriN FTri;
+
+// Face block b: faces SC_LANES·b … SC_LANES·b + SC_LANES − 1. Lanes past the
+// last face repeat it; their corners and status land in the padding of
+// those buffers (sized for whole blocks) and are never read.
+#define FACE_BLOCK_OR_RETURN(nf)                                  \
+    const uint blk = (uint)get_global_id(0);                      \
+    if (blk >= ((nf) + SC_LANES - 1) / SC_LANES) return;          \
+    const FIDX fid = min((FIDX)(SC_LANES * blk) + SC_IOTA, (FIDX)((nf) - 1));
+
+// Status of a block: bit `a` where mask ma holds, bit `b` where mb holds.
+SC_INLINE void st_status(__global uchar *status, uint blk, FMASK ma, uchar a, FMASK mb, uchar b)
 {
-    return proj_curv(ld3(pd1, v), ld3(pd2, v), v3(kk[2 * v], 0, kk[2 * v + 1]), ft, fb);
+    INTN ia = CONVERT_INTN(ma), ib = CONVERT_INTN(mb);
+    VSTOREN(CONVERT_UCHARN(select((INTN)0, (INTN)a, ia) | select((INTN)0, (INTN)b, ib)), blk,
+            status);
 }
+#else
+typedef REAL FREAL;
+typedef int FMASK;
+typedef uint FIDX;
+typedef V3 FV3;
+typedef V4 FV4;
+typedef Tri FTri;
+
+#define FACE_BLOCK_OR_RETURN(nf)  \
+    GID_OR_RETURN(nf);            \
+    const uint blk = gid;         \
+    const FIDX fid = gid;
+
+SC_INLINE void st_status(__global uchar *status, uint blk, FMASK ma, uchar a, FMASK mb, uchar b)
+{
+    status[blk] = (ma ? a : 0) | (mb ? b : 0);
+}
+#endif
+
+// The corner slot of face f's corner c, component k (see st_corner).
+#define CORNER_SLOT(f, c, k) \
+    ((12 * ((f) / SC_LANES) + 3 * (k) + (c)) * SC_LANES + (f) % SC_LANES)
+
 
 // ---------------------------------------------------------------------------
 // Topology pass (once per mesh).
@@ -354,7 +268,7 @@ __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint
     GID_OR_RETURN(nv);
     V3 n = ld3(nrm, gid);
     REAL len = len3(n);
-    n = sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(0, 0, 1));
+    n = sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(RL(0), RL(0), RL(1)));
     st3(n, gid, nrm);
     int f = owner[gid];
     uint fi = (uint)max(f, 0);
@@ -410,9 +324,9 @@ __kernel void curv_clear(uint nv, __global REAL *nrm, __global REAL *area, __glo
                          __global REAL *dk)
 {
     GID_OR_RETURN(nv);
-    st3(v3(0, 0, 0), gid, nrm);
+    st3(v3(RL(0), RL(0), RL(0)), gid, nrm);
     area[gid] = 0;
-    st3(v3(0, 0, 0), gid, tens);
+    st3(v3(RL(0), RL(0), RL(0)), gid, tens);
     dk[4 * gid] = 0;
     dk[4 * gid + 1] = 0;
     dk[4 * gid + 2] = 0;
@@ -439,26 +353,20 @@ __kernel void curv_normals_areas(uint nf, __global const REAL *pos, __global con
                                  volatile __global uint *counters)
 {
     GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
+    uint v0, v1, v2;
+    Tri t = load_tri(pos, faces, gid, &v0, &v1, &v2);
     if (tri_degenerate(t)) {
         atomic_inc(&counters[0]);
         return;
     }
     V3 ca = corner_areas(t), fn = face_normal(t);
     REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
-    atomic_add3(nrm, t.v0, corner_normal(fn, l1, l2));
-    atomic_add3(nrm, t.v1, corner_normal(fn, l2, l0));
-    atomic_add3(nrm, t.v2, corner_normal(fn, l0, l1));
-    atomic_add_real(&area[t.v0], ca.x);
-    atomic_add_real(&area[t.v1], ca.y);
-    atomic_add_real(&area[t.v2], ca.z);
-}
-
-// The weighted tensor of face (t, ft, fb, x) in vertex v's frame.
-SC_INLINE V3 tensor_at(__global const REAL *pd1, __global const REAL *pd2,
-                    __global const REAL *area, uint v, REAL ca, V3 ft, V3 fb, V3 x)
-{
-    return mul3(proj_curv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, area[v]));
+    atomic_add3(nrm, v0, corner_normal(fn, l1, l2));
+    atomic_add3(nrm, v1, corner_normal(fn, l2, l0));
+    atomic_add3(nrm, v2, corner_normal(fn, l0, l1));
+    atomic_add_real(&area[v0], ca.x);
+    atomic_add_real(&area[v1], ca.y);
+    atomic_add_real(&area[v2], ca.z);
 }
 
 __kernel void curv_tensor(uint nf, __global const REAL *pos, __global const uint *faces,
@@ -467,26 +375,20 @@ __kernel void curv_tensor(uint nf, __global const REAL *pos, __global const uint
                           volatile __global REAL *tens, volatile __global uint *counters)
 {
     GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
+    uint v0, v1, v2;
+    Tri t = load_tri(pos, faces, gid, &v0, &v1, &v2);
     if (tri_degenerate(t))
         return;
     V3 ft, fb, x;
     face_frame(t, &ft, &fb);
-    if (!face_tensor(t, ft, fb, ld3(nrm, t.v0), ld3(nrm, t.v1), ld3(nrm, t.v2), &x)) {
+    if (!face_tensor(t, ft, fb, ld3(nrm, v0), ld3(nrm, v1), ld3(nrm, v2), &x)) {
         atomic_inc(&counters[2]);
         return;
     }
     V3 ca = corner_areas(t);
-    atomic_add3(tens, t.v0, tensor_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x));
-    atomic_add3(tens, t.v1, tensor_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x));
-    atomic_add3(tens, t.v2, tensor_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x));
-}
-
-// The weighted derivative tensor of a face in vertex v's frame.
-SC_INLINE V4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2, __global const REAL *area,
-                   uint v, REAL ca, V3 ft, V3 fb, V4 x)
-{
-    return mul4(proj_dcurv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, area[v]));
+    atomic_add3(tens, v0, tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
+    atomic_add3(tens, v1, tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
+    atomic_add3(tens, v2, tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
 }
 
 __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint *faces,
@@ -495,57 +397,52 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
                          volatile __global REAL *dk, volatile __global uint *counters)
 {
     GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
+    uint v0, v1, v2;
+    Tri t = load_tri(pos, faces, gid, &v0, &v1, &v2);
     if (tri_degenerate(t))
         return;
     V3 ft, fb;
     V4 x;
     face_frame(t, &ft, &fb);
-    if (!face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, t.v0, ft, fb),
-                    vertex_curv_in(pd1, pd2, kk, t.v1, ft, fb),
-                    vertex_curv_in(pd1, pd2, kk, t.v2, ft, fb), &x)) {
+    if (!face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, v0, ft, fb),
+                    vertex_curv_in(pd1, pd2, kk, v1, ft, fb),
+                    vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x)) {
         atomic_inc(&counters[3]);
         return;
     }
     V3 ca = corner_areas(t);
-    atomic_add4(dk, t.v0, dcurv_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x));
-    atomic_add4(dk, t.v1, dcurv_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x));
-    atomic_add4(dk, t.v2, dcurv_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x));
+    atomic_add4(dk, v0, dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
+    atomic_add4(dk, v1, dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
+    atomic_add4(dk, v2, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
 }
 
 // ---------------------------------------------------------------------------
-// Gather variant. Face kernels: no atomics, no inner loops, no arrays; a
-// skipped face writes zeros (selected, never multiplied, so NaN cannot leak)
-// and sets its status bit. Sum kernels: each vertex adds its corners in face
-// order and counts each skipped face once, at the face's corner 0.
+// Gather variant. Face kernels: no atomics, no inner loops, no arrays, and
+// SC_LANES faces per work-item (one face block); a skipped face writes zeros
+// (st_corner) and sets its status bit. Sum kernels: each vertex adds its
+// corners in face order and counts each skipped face once, at the face's
+// corner 0.
 
-// Corner c of face f, component k, lives at corner[12f + 3k + c]: a face's 12
-// stores form one gap-free group (stores with gaps, or into several planes of
-// one buffer, keep PoCL from vectorising).
-SC_INLINE void st_corner(__global REAL *corner, uint f, uint c, bool use, V4 x)
-{
-    uint i = 12 * f + c;
-    corner[i] = use ? x.x : 0;
-    corner[i + 3] = use ? x.y : 0;
-    corner[i + 6] = use ? x.z : 0;
-    corner[i + 9] = use ? x.w : 0;
-}
-
-SC_INLINE V4 ext4(V3 a, REAL w) { return v4(a.x, a.y, a.z, w); }
+// The corner indices and positions of a face block.
+#define LOAD_FACE_BLOCK(pos, faces)                                                \
+    FIDX v0 = ldu(faces, 3 * fid), v1 = ldu(faces, 3 * fid + 1),                   \
+         v2 = ldu(faces, 3 * fid + 2);                                             \
+    FTri t = make_tri(ld3(pos, v0), ld3(pos, v1), ld3(pos, v2));
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          __global const uint *faces, __global REAL *corner,
                                          __global uchar *status)
 {
-    GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
-    bool use = !tri_degenerate(t);
-    V3 ca = corner_areas(t), fn = face_normal(t);
-    REAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
-    st_corner(corner, gid, 0, use, ext4(corner_normal(fn, l1, l2), ca.x));
-    st_corner(corner, gid, 1, use, ext4(corner_normal(fn, l2, l0), ca.y));
-    st_corner(corner, gid, 2, use, ext4(corner_normal(fn, l0, l1), ca.z));
-    status[gid] = use ? 0 : 1;
+    FACE_BLOCK_OR_RETURN(nf);
+    LOAD_FACE_BLOCK(pos, faces);
+    FMASK deg = tri_degenerate(t);
+    FMASK use = !deg;
+    FV3 ca = corner_areas(t), fn = face_normal(t);
+    FREAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
+    st_corner(corner, blk, 0, use, ext4(corner_normal(fn, l1, l2), ca.x));
+    st_corner(corner, blk, 1, use, ext4(corner_normal(fn, l2, l0), ca.y));
+    st_corner(corner, blk, 2, use, ext4(corner_normal(fn, l0, l1), ca.z));
+    st_status(status, blk, deg, 1, (FMASK)0, 0);
 }
 
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
@@ -553,18 +450,18 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
                                   __global const REAL *pd1, __global const REAL *pd2,
                                   __global REAL *corner, __global uchar *status)
 {
-    GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
-    bool deg = tri_degenerate(t);
-    V3 ft, fb, x;
+    FACE_BLOCK_OR_RETURN(nf);
+    LOAD_FACE_BLOCK(pos, faces);
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb, x;
     face_frame(t, &ft, &fb);
-    bool ok = face_tensor(t, ft, fb, ld3(nrm, t.v0), ld3(nrm, t.v1), ld3(nrm, t.v2), &x);
-    bool use = !deg & ok;
-    V3 ca = corner_areas(t);
-    st_corner(corner, gid, 0, use, ext4(tensor_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x), 0));
-    st_corner(corner, gid, 1, use, ext4(tensor_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x), 0));
-    st_corner(corner, gid, 2, use, ext4(tensor_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x), 0));
-    status[gid] = (deg ? 1 : 0) | ((!deg & !ok) ? 2 : 0);
+    FMASK ok = face_tensor(t, ft, fb, ld3(nrm, v0), ld3(nrm, v1), ld3(nrm, v2), &x);
+    FMASK use = (!deg) & ok;
+    FV3 ca = corner_areas(t);
+    st_corner(corner, blk, 0, use, ext4(tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x), (FREAL)RL(0)));
+    st_corner(corner, blk, 1, use, ext4(tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x), (FREAL)RL(0)));
+    st_corner(corner, blk, 2, use, ext4(tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x), (FREAL)RL(0)));
+    st_status(status, blk, deg, 1, (!deg) & (!ok), 2);
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
@@ -572,21 +469,21 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
                                  __global const REAL *pd2, __global const REAL *kk,
                                  __global REAL *corner, __global uchar *status)
 {
-    GID_OR_RETURN(nf);
-    Tri t = load_tri(pos, faces, gid);
-    bool deg = tri_degenerate(t);
-    V3 ft, fb;
-    V4 x;
+    FACE_BLOCK_OR_RETURN(nf);
+    LOAD_FACE_BLOCK(pos, faces);
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb;
+    FV4 x;
     face_frame(t, &ft, &fb);
-    bool ok = face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, t.v0, ft, fb),
-                         vertex_curv_in(pd1, pd2, kk, t.v1, ft, fb),
-                         vertex_curv_in(pd1, pd2, kk, t.v2, ft, fb), &x);
-    bool use = !deg & ok;
-    V3 ca = corner_areas(t);
-    st_corner(corner, gid, 0, use, dcurv_at(pd1, pd2, area, t.v0, ca.x, ft, fb, x));
-    st_corner(corner, gid, 1, use, dcurv_at(pd1, pd2, area, t.v1, ca.y, ft, fb, x));
-    st_corner(corner, gid, 2, use, dcurv_at(pd1, pd2, area, t.v2, ca.z, ft, fb, x));
-    status[gid] = (deg ? 1 : 0) | ((!deg & !ok) ? 4 : 0);
+    FMASK ok = face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, v0, ft, fb),
+                          vertex_curv_in(pd1, pd2, kk, v1, ft, fb),
+                          vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x);
+    FMASK use = (!deg) & ok;
+    FV3 ca = corner_areas(t);
+    st_corner(corner, blk, 0, use, dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
+    st_corner(corner, blk, 1, use, dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
+    st_corner(corner, blk, 2, use, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
+    st_status(status, blk, deg, 1, (!deg) & (!ok), 4);
 }
 
 // Sums the corners of vertex v's one-ring in face order, counting (once per
@@ -595,15 +492,15 @@ SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint
                    __global const REAL *corner, __global const uchar *status, uchar bit,
                    volatile __global uint *counter)
 {
-    V4 s = v4(0, 0, 0, 0);
+    V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-        uint e = ring[r], f = e / 3, i = 12 * f + e % 3;
+        uint e = ring[r], f = e / 3, i = CORNER_SLOT(f, e % 3, 0);
         if (e % 3 == 0 && (status[f] & bit))
             atomic_inc(counter);
         s.x += corner[i];
-        s.y += corner[i + 3];
-        s.z += corner[i + 6];
-        s.w += corner[i + 9];
+        s.y += corner[i + 3 * SC_LANES];
+        s.z += corner[i + 6 * SC_LANES];
+        s.w += corner[i + 9 * SC_LANES];
     }
     return s;
 }

@@ -20,6 +20,7 @@ const F64: CurvatureOptions = CurvatureOptions {
     precision: Precision::F64,
     compat: Compat::Exact,
     dcurv: true,
+    lanes: 0,
 };
 
 fn with(o: CurvatureOptions, acc: Accumulate, prec: Precision) -> CurvatureOptions {
@@ -216,6 +217,78 @@ fn gather_is_bitwise_reproducible_and_agrees_with_atomic() {
     }
     let at = device(&m, CurvatureOptions::default()).field;
     assert_fields_close(&at, &a, 1e-6, "atomic vs gather");
+}
+
+/// The gather variant's per-face kernels give the same bits for every lane
+/// count (faces per work-item): on meshes whose face count is not a multiple
+/// of 16 (lanes past the last face), with degenerate faces and skipped
+/// solves (masked lanes), in both precisions. Counts agree too.
+#[test]
+fn face_lanes_give_bitwise_identical_results() {
+    let mut sliver = mesh::jittered_sphere(1.0, 3, 0.2, 5);
+    // a zero-area face and a repeated vertex: degenerate lanes in a block
+    let v = sliver.faces[7];
+    sliver.faces.push([v[0], v[0], v[1]]);
+    let p = sliver.positions[v[0] as usize];
+    sliver.positions.push(p);
+    let n = sliver.positions.len() as u32 - 1;
+    sliver.faces.push([v[0], n, v[1]]);
+    let mut open_sphere = mesh::jittered_sphere(1.0, 4, 0.3, 3);
+    open_sphere.faces.truncate(open_sphere.faces.len() - 5);
+    let lone = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let meshes = [
+        ("jittered sphere with a hole", open_sphere),
+        (
+            "lone triangle",
+            Mesh::new(lone, vec![[0, 1, 2]], "test").unwrap(),
+        ),
+        ("sphere with degenerate faces", sliver),
+        ("torus", mesh::torus(1.0, 0.4, 37, 19)),
+    ];
+    for (what, m) in &meshes {
+        assert_ne!(m.n_faces() % 16, 0, "{what}: want a partial last block");
+        for prec in [Precision::F32, Precision::F64] {
+            let o = |lanes| CurvatureOptions {
+                lanes,
+                ..with(CurvatureOptions::default(), Accumulate::Gather, prec)
+            };
+            let mut est = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o(1)).unwrap();
+            assert_eq!(est.face_lanes(), 1);
+            est.set_positions(&m.positions).unwrap();
+            est.run().unwrap();
+            let (one, one_counts) = (est.read().unwrap(), est.counts().unwrap());
+            for lanes in [2, 4, 8, 16] {
+                let mut est =
+                    CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o(lanes)).unwrap();
+                assert_eq!(est.face_lanes(), lanes);
+                est.set_positions(&m.positions).unwrap();
+                est.run().unwrap();
+                assert_eq!(
+                    est.read().unwrap(),
+                    one,
+                    "{what} {prec:?}: {lanes} lanes differ from 1"
+                );
+                assert_eq!(
+                    est.counts().unwrap(),
+                    one_counts,
+                    "{what} {prec:?}: {lanes} lanes' counts"
+                );
+            }
+        }
+    }
+    let bad = CurvatureOptions {
+        lanes: 3,
+        ..with(
+            CurvatureOptions::default(),
+            Accumulate::Gather,
+            Precision::F32,
+        )
+    };
+    let m = &meshes[0].1;
+    let err = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, bad)
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("1, 2, 4, 8 or 16"), "{err}");
 }
 
 // ---------------------------------------------------------------- analytic oracles

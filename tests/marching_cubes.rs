@@ -463,6 +463,7 @@ fn curvature_on_the_device_resident_isosurface() {
         precision: Precision::F64,
         compat: Compat::Exact,
         dcurv: true,
+        lanes: 0,
     };
     let mut errs = Vec::new();
     for (res, fusion) in [(48, Fusion::Edge), (96, Fusion::Direct)] {
@@ -525,6 +526,7 @@ fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
+        lanes: 0,
     };
     let mut errs = Vec::new();
     for res in [32, 64, 128] {

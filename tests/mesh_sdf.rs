@@ -501,6 +501,7 @@ fn ellipsoid_curvature_matches_the_isosurface_estimate() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: false,
+        lanes: 0,
     };
     let mut errs = Vec::new();
     for res in [64, 128] {

@@ -29,6 +29,7 @@ fn f32_opts() -> CurvatureOptions {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
+        lanes: 0,
     }
 }
 

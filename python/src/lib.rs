@@ -209,6 +209,8 @@ fn options(
         precision: parse(precision)?,
         compat: parse(compat)?,
         dcurv,
+        // by device type, as on the command line
+        lanes: 0,
     })
 }
 

@@ -43,6 +43,11 @@ pub struct CurvatureArgs {
     /// devices, atomic on GPUs (the faster exact scheme of each).
     #[arg(long, value_enum)]
     accumulate: Option<Accumulate>,
+    /// Faces per work-item of the gather scheme's per-face kernels, computed
+    /// as SIMD lanes: 1, 2, 4, 8 or 16. Default: the device's native vector
+    /// width on CPU devices, 1 on GPUs. The results do not depend on it.
+    #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
+    lanes: Option<String>,
     /// Device precision.
     #[arg(long, value_enum, default_value = "f32")]
     precision: Precision,
@@ -78,6 +83,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,
+        lanes: a.lanes.as_deref().map_or(Ok(0), str::parse)?,
     };
     let t_start = Instant::now();
     if let Some(n) = a.runs {
@@ -172,6 +178,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         let mut stats = serde_json::json!({
             "device": gpu.info,
             "accumulate": opts.accumulate.name(),
+            "face_lanes": est.face_lanes(),
             "topology_ms": c.topology_ms,
             "passes": passes(&c.timing),
             "kernel_ms": c.timing.kernel_ms,

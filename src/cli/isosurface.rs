@@ -159,6 +159,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         precision: a.precision,
         compat: Compat::Exact,
         dcurv: !a.no_dcurv,
+        lanes: 0,
     });
     let opts = IsoOptions {
         fusion: a.fusion,

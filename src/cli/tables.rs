@@ -311,6 +311,7 @@ pub(crate) fn isosurface_report(gpu: Arc<Gpu>, max_res: usize, runs: usize) -> R
                     precision,
                     compat: Compat::Exact,
                     dcurv: true,
+                    lanes: 0,
                 };
                 let mut times = Vec::new();
                 let (mut est, _) = mcs::curvature(&ex, opts, normals)?;

@@ -31,6 +31,10 @@ pub struct DeviceInfo {
     pub gl_sharing: bool,
     /// cl_khr_int64_base_atomics (needed by f64 atomic accumulation).
     pub int64_atomics: bool,
+    /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT`: floats per SIMD register.
+    pub native_float_width: u32,
+    /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE` (0 without double precision).
+    pub native_double_width: u32,
     #[serde(skip)]
     pub(crate) id: cl_device_id,
 }
@@ -83,6 +87,8 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
                 fp64: has("cl_khr_fp64"),
                 gl_sharing: has("cl_khr_gl_sharing"),
                 int64_atomics: has("cl_khr_int64_base_atomics"),
+                native_float_width: d.native_vector_width_float().unwrap_or(1),
+                native_double_width: d.native_vector_width_double().unwrap_or(0),
                 id,
             });
         }
@@ -163,6 +169,8 @@ mod tests {
             fp64: false,
             gl_sharing: false,
             int64_atomics: false,
+            native_float_width: 1,
+            native_double_width: 0,
             id: std::ptr::null_mut(),
         }
     }

@@ -1,6 +1,9 @@
 //! Program building. Kernel files are embedded with `include_str!`; the
 //! shared headers of `kernels/common/` are prepended in order, each preceded
 //! by a `#line` marker so compiler messages point at the right file and line.
+//! A line `#include "common/NAME"` in a kernel file is replaced by that
+//! header's text (see [`INCLUDES`]), as often as it appears: a header written
+//! over type macros can be instantiated more than once.
 
 use crate::error::{Error, Result};
 use opencl3::context::Context;
@@ -25,6 +28,13 @@ pub const COMMON_HEADERS: &[(&str, &str)] = &[
         include_str!("../../kernels/common/atomics.h"),
     ),
 ];
+
+/// Headers a kernel file may `#include` (expanded by [`assemble`]; the
+/// drivers see one text with no include paths).
+pub const INCLUDES: &[(&str, &str)] = &[(
+    "common/curvature_face.h",
+    include_str!("../../kernels/common/curvature_face.h"),
+)];
 
 /// Looks up a kernel family by name (`"curvature"`, ...).
 pub fn kernel_file(name: &str) -> Option<KernelFile> {
@@ -97,7 +107,24 @@ pub fn assemble(file: &KernelFile) -> String {
         s.push('\n');
     }
     s.push_str(&format!("#line 1 \"{}\"\n", file.name));
-    s.push_str(file.source);
+    for (i, line) in file.source.lines().enumerate() {
+        let included = line
+            .trim()
+            .strip_prefix("#include")
+            .map(|r| r.trim().trim_matches('"'))
+            .and_then(|name| INCLUDES.iter().find(|(n, _)| *n == name));
+        match included {
+            Some((name, text)) => {
+                s.push_str(&format!("#line 1 \"kernels/{name}\"\n"));
+                s.push_str(text);
+                s.push_str(&format!("\n#line {} \"{}\"\n", i + 2, file.name));
+            }
+            None => {
+                s.push_str(line);
+                s.push('\n');
+            }
+        }
+    }
     s
 }
 

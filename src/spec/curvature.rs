@@ -207,6 +207,11 @@ pub struct CurvatureOptions {
     pub compat: Compat,
     /// Compute the curvature derivative (the dcurv pass).
     pub dcurv: bool,
+    /// Faces per work-item of the gather variant's per-face kernels, as
+    /// explicit SIMD lanes: 0 picks by device type ([`face_lanes_for`]),
+    /// else 1, 2, 4, 8 or 16. Results do not depend on it; the atomic
+    /// variant ignores it.
+    pub lanes: u32,
 }
 
 impl Default for CurvatureOptions {
@@ -216,6 +221,7 @@ impl Default for CurvatureOptions {
             precision: Precision::F32,
             compat: Compat::Exact,
             dcurv: true,
+            lanes: 0,
         }
     }
 }
@@ -356,10 +362,45 @@ pub fn one_ring_len_bound(nf: usize) -> usize {
     3 * nf
 }
 
+/// The most faces one work-item of the gather variant's per-face kernels
+/// handles (`SC_LANES` in `kernels/curvature.cl`).
+pub const MAX_FACE_LANES: u32 = 16;
+
+/// Faces the gather variant's buffers are sized for: `nf` rounded up to whole
+/// blocks of [`MAX_FACE_LANES`] (a block's lanes past the last face write
+/// into this padding).
+pub fn padded_faces(nf: usize) -> usize {
+    nf.div_ceil(MAX_FACE_LANES as usize) * MAX_FACE_LANES as usize
+}
+
 /// Reals of the gather variant's corner buffer for `nf` faces: 4 per corner
-/// (the widest pass, the derivative tensor), 12 per face.
+/// (the widest pass, the derivative tensor), 12 per face, for
+/// [`padded_faces`] faces.
 pub fn corner_reals_bound(nf: usize) -> usize {
-    12 * nf
+    12 * padded_faces(nf)
+}
+
+/// Faces per work-item of the gather variant's per-face kernels on a device:
+/// `requested` when not 0, else by device type (the rule the estimator uses;
+/// `native_width` is the device's `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT` or
+/// `_DOUBLE` for the precision):
+/// - **CPU devices: the native vector width** (8 floats for AVX2, 16 for
+///   AVX-512), so that each face kernel's arithmetic is SIMD code whatever
+///   the runtime's own work-item vectoriser does (PoCL 3.1 leaves these
+///   kernels scalar; see `kernels/curvature.cl`).
+/// - **Other devices (GPUs): 1**, one face per work-item: a GPU's SIMD runs
+///   across work-items already.
+///
+/// The count is rounded down to a power of two and clamped to
+/// 1..=[`MAX_FACE_LANES`]. The results are the same for every count.
+pub fn face_lanes_for(requested: u32, device_kind: &str, native_width: u32) -> u32 {
+    let n = match requested {
+        0 if device_kind.eq_ignore_ascii_case("CPU") => native_width,
+        0 => 1,
+        n => n,
+    };
+    let n = n.clamp(1, MAX_FACE_LANES);
+    1 << (31 - n.leading_zeros())
 }
 
 /// Bytes of device memory the curvature estimator allocates for a mesh, by
@@ -376,7 +417,7 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
             + corner_reals_bound(nf) as u64 * r
-            + nf as u64;
+            + padded_faces(nf) as u64;
     }
     b
 }

@@ -15,7 +15,7 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::topology::one_rings;
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, corner_reals_bound,
+    Precision, corner_reals_bound, padded_faces,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -177,6 +177,9 @@ struct Kernels {
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
     override_normals: Kernel,
+    /// Faces per work-item of the gather variant's per-face kernels (1 for
+    /// the atomic variant): `SC_LANES` of the build.
+    lanes: u32,
 }
 
 /// Buffers of the gather variant: one-ring lists, corner contributions, face status.
@@ -187,9 +190,13 @@ struct GatherBufs {
     status: Buffer<u8>,
 }
 
-/// Build options of `kernels/curvature.cl` for a variant.
-pub fn build_options(opts: &CurvatureOptions) -> String {
+/// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
+/// per work-item in the gather variant's per-face kernels.
+pub fn build_options(opts: &CurvatureOptions, lanes: u32) -> String {
     let mut s = String::new();
+    if opts.accumulate == Accumulate::Gather && lanes > 1 {
+        s.push_str(&format!("-DSC_LANES={lanes} "));
+    }
     if opts.precision == Precision::F64 {
         s.push_str("-DSC_DOUBLE ");
     }
@@ -249,8 +256,19 @@ impl CurvatureEstimator {
                 });
             }
         }
+        if !matches!(opts.lanes, 0 | 1 | 2 | 4 | 8 | 16) {
+            return Err(Error::InvalidArgument(format!(
+                "face lanes must be 1, 2, 4, 8 or 16 (or 0: by device type), not {}",
+                opts.lanes
+            )));
+        }
+        let native = match opts.precision {
+            Precision::F32 => gpu.info.native_float_width,
+            Precision::F64 => gpu.info.native_double_width,
+        };
+        let lanes = crate::spec::curvature::face_lanes_for(opts.lanes, &gpu.info.kind, native);
         let file = kernel_file("curvature").expect("curvature kernels are embedded");
-        let program = gpu.program(&file, &build_options(opts))?;
+        let program = gpu.program(&file, &build_options(opts, lanes))?;
         let gather = opts.accumulate == Accumulate::Gather;
         let kname = |base: &str| {
             if gather {
@@ -279,6 +297,7 @@ impl CurvatureEstimator {
             sums,
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
             override_normals: gpu.kernel(&program, "curv_override_normals")?,
+            lanes: if gather { lanes } else { 1 },
         };
         Ok((k, program))
     }
@@ -354,7 +373,7 @@ impl CurvatureEstimator {
                 ring_off,
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
-                status: gpu.buffer::<u8>(nf)?,
+                status: gpu.buffer::<u8>(padded_faces(nf))?,
             })
         } else {
             None
@@ -413,6 +432,12 @@ impl CurvatureEstimator {
             upload_ms: UploadMs::default(),
         };
         Ok(est)
+    }
+
+    /// Faces per work-item of the gather variant's per-face kernels as built
+    /// for this device (1 for the atomic variant).
+    pub fn face_lanes(&self) -> u32 {
+        self.k.lanes
     }
 
     /// The variant this estimator runs.
@@ -573,7 +598,9 @@ impl CurvatureEstimator {
                     let mut a = vec![Arg::U32(nf32)];
                     a.extend_from_slice(face_args);
                     a.extend([buf(&gb.corner), buf(&gb.status)]);
-                    evs.extend(launch(g, face_kernel, nf, &a)?.map(|e| (pass, e)));
+                    // One work-item per block of `lanes` faces.
+                    let blocks = nf.div_ceil(self.k.lanes as usize);
+                    evs.extend(launch(g, face_kernel, blocks, &a)?.map(|e| (pass, e)));
                     let mut a = vec![
                         Arg::U32(nv32),
                         buf(&gb.ring_off),

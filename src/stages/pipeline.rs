@@ -54,6 +54,7 @@ impl Default for PipelineOptions {
                 precision: Precision::F32,
                 compat: Compat::Exact,
                 dcurv: true,
+                lanes: 0,
             },
             ao_mode: AoMode::Lut,
             ao_radius: 0.1,

@@ -147,6 +147,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             precision: Precision::F32,
             compat: Compat::Exact,
             dcurv: has(Pass::Dcurv),
+            lanes: 0,
         };
         let line_opts = LineOptions {
             contours: has(Pass::Contours),
