@@ -14,22 +14,41 @@
 //   curv_dcurv           per face   same scheme on curvature differences: C111 C112 C122 C222
 // Gather variant: each one-ring pass is split in two. A per-face kernel
 // (curv_*_corners) writes its three corner contributions to a corner buffer,
-// with no atomics and no inner loops, so PoCL can vectorise it across
-// work-items. A per-vertex kernel (curv_*_sum) then adds the corners of its
-// one-ring (CSR lists built once on the host, in face order). The result is
-// bitwise reproducible.
+// with no inner loops, and counts its skipped faces. A per-vertex kernel
+// (curv_*_sum) then adds the corners of its one-ring (CSR lists built once on
+// the host, in face order). The result is bitwise reproducible.
+//
+// Explicit SIMD lanes (SC_LANES, set by the host: the device's native vector
+// width on CPUs, 1 on GPUs). The gather variant's per-face kernels handle
+// SC_LANES consecutive faces per work-item: their geometry
+// (kernels/common/curvature_face.h) is written once over type macros and
+// instantiated on scalars and on REAL vectors of SC_LANES lanes, with
+// overloaded helper names, so one kernel text serves both. Loads through the
+// face indices are one scalar load per lane; corner stores are whole-vector
+// stores. The arithmetic is the same operation for operation, so every lane
+// count gives the same bits (tests/curvature.rs checks 1 to 16 lanes).
+// Why: PoCL 3.1 leaves these kernels scalar when written one face per
+// work-item. It runs -O3 with the SLP vectoriser on the single work-item
+// kernel before it builds the work-item loops; SLP packs pairs of corners into
+// <2 x float>, and the loop vectoriser then refuses the vector-typed
+// instructions (POCL_VECTORIZER_REMARKS, "instruction return type cannot be
+// vectorized"). Its build options cannot switch SLP off (it accepts only
+// -cl-*, -w, -Werror, -g, -D and -I). Disassembly of PoCL's kernel cache
+// (pthread-haswell, AVX2) with 8 lanes: 717 of curv_normals_areas_corners'
+// 1,819 instructions, 2,263 of curv_tensor_corners' 5,160 and 3,692 of
+// curv_dcurv_corners' 7,300 are packed 8-float (ymm) operations; with one
+// lane there are none (1,831 scalar float operations of 2,876 in
+// curv_tensor_corners). The kernels run 2.5-3x faster (README).
+// Still scalar on that target: the per-vertex passes (curv_frames,
+// curv_principal, curv_*_sum), whose loops or selects the work-item
+// vectoriser does not take; on an AVX-512 target it did vectorise frames and
+// principal. Intel's CPU runtime vectorises across work-items itself; lanes
+// change little there.
 //
 // Vectors are structs of scalars (V3, V4) and per-corner values are named
 // (e0 e1 e2, a0 a1 a2), never float3/vload3 and never private arrays: PoCL's
 // work-item vectoriser gives up on OpenCL vector types, private arrays,
-// selects of whole structs, fmax and atomics, but turns scalar code, even with
-// indexed loads, into AVX-512 code (measured on PoCL 3.1 by disassembling
-// the kernel cache). That holds for the per-vertex passes (frames, principal);
-// the per-face passes stay scalar even without atomics: PoCL runs -O3 with
-// the SLP vectoriser on the single work-item kernel before it builds the
-// work-item loops, SLP packs pairs of corners into <2 x float>, and the loop
-// vectoriser then refuses the vector-typed instructions (POCL_VECTORIZER_REMARKS,
-// "instruction return type cannot be vectorized"). Helpers are SC_INLINE
+// selects of whole structs, fmax and atomics. Helpers are SC_INLINE
 // (always_inline): left to PoCL's inliner, proj_dcurv, tensor_at and
 // vertex_curv_in stay calls returning structs through the stack, which cost
 // ~15 % of curv_dcurv.
@@ -44,9 +63,10 @@
 //   kk    REAL[2V]  (k1, k2)                              dk REAL[4V] derivative tensor
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
 //   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
-//   corner REAL[12F] per-corner contributions: corner c of face f, component k at
-//                    12f + 3k + c (one gap-free store group per face), gather only
-//   status uchar[F]   bit 0 degenerate, bit 1 tensor solve skipped, bit 2 dcurv solve skipped
+//   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
+//                    16): corner c of face f, component k at
+//                    L·(12·(f / L) + 3k + c) + f % L with L = SC_LANES (12f + 3k + c
+//                    for one lane): per block of L faces, 12 whole-vector stores
 //
 // Degenerate faces (an edge shorter than 1e-12 of the mesh's RMS radius,
 // twice the area below 5e-8 × Σ edge², or 2A/√(Σ edge²) below the f32
@@ -157,27 +177,33 @@ typedef SC_CAT(int, SC_LANES) INTN;
 #define VSTOREN SC_CAT(vstore, SC_LANES)
 #define CONVERT_UCHARN SC_CAT(convert_uchar, SC_LANES)
 #define CONVERT_INTN SC_CAT(convert_int, SC_LANES)
+#ifdef SC_DOUBLE
+#define CONVERT_MASKN SC_CAT(convert_long, SC_LANES)
+#else
+#define CONVERT_MASKN SC_CAT(convert_int, SC_LANES)
+#endif
 
-// One scalar load per lane (the compiler assembles the vector).
+// F applied to each lane's component name, as a comma-separated list.
 #if SC_LANES == 2
-#define SC_GATHER(T, a, i) ((T)(a[i.s0], a[i.s1]))
+#define SC_LANE_LIST(F) F(s0), F(s1)
 #define SC_IOTA ((UINTN)(0, 1))
 #elif SC_LANES == 4
-#define SC_GATHER(T, a, i) ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3]))
+#define SC_LANE_LIST(F) F(s0), F(s1), F(s2), F(s3)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3))
 #elif SC_LANES == 8
-#define SC_GATHER(T, a, i) \
-    ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3], a[i.s4], a[i.s5], a[i.s6], a[i.s7]))
+#define SC_LANE_LIST(F) F(s0), F(s1), F(s2), F(s3), F(s4), F(s5), F(s6), F(s7)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7))
 #else
-#define SC_GATHER(T, a, i)                                                                    \
-    ((T)(a[i.s0], a[i.s1], a[i.s2], a[i.s3], a[i.s4], a[i.s5], a[i.s6], a[i.s7], a[i.s8],    \
-         a[i.s9], a[i.sa], a[i.sb], a[i.sc], a[i.sd], a[i.se], a[i.sf]))
+#define SC_LANE_LIST(F)                                                                       \
+    F(s0), F(s1), F(s2), F(s3), F(s4), F(s5), F(s6), F(s7), F(s8), F(s9), F(sa), F(sb), F(sc), \
+        F(sd), F(se), F(sf)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
 #endif
 
-SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return SC_GATHER(REALN, a, i); }
-SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return SC_GATHER(UINTN, a, i); }
+// One scalar load per lane; the compiler assembles the vector.
+#define SC_LD_ONE(l) a[i.l]
+SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return (REALN)(SC_LANE_LIST(SC_LD_ONE)); }
+SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return (UINTN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE void lst(REALN x, uint slot, __global REAL *a) { VSTOREN(x, slot, a); }
 
 #define GT REALN
@@ -208,19 +234,42 @@ typedef V4N FV4;
 typedef TriN FTri;
 
 // Face block b: faces SC_LANES·b … SC_LANES·b + SC_LANES − 1. Lanes past the
-// last face repeat it; their corners and status land in the padding of
-// those buffers (sized for whole blocks) and are never read.
+// last face repeat it (`live` is false there); their corners land in the
+// padding of the corner buffer (sized for whole blocks) and are never read.
 #define FACE_BLOCK_OR_RETURN(nf)                                  \
     const uint blk = (uint)get_global_id(0);                      \
     if (blk >= ((nf) + SC_LANES - 1) / SC_LANES) return;          \
-    const FIDX fid = min((FIDX)(SC_LANES * blk) + SC_IOTA, (FIDX)((nf) - 1));
+    const FIDX fid_ = (FIDX)(SC_LANES * blk) + SC_IOTA;           \
+    const INTN live = fid_ < (FIDX)(nf);                          \
+    const FIDX fid = min(fid_, (FIDX)((nf) - 1));
 
-// Status of a block: bit `a` where mask ma holds, bit `b` where mb holds.
-SC_INLINE void st_status(__global uchar *status, uint blk, FMASK ma, uchar a, FMASK mb, uchar b)
+// Adds to *c the lanes of a block where m holds and a face is (live: not
+// past the last face): one atomic per block, and none when no lane counts.
+// Explicit lanes are SIMD code already, so the atomic costs no vectorisation.
+SC_INLINE int lanes_sum(INTN v)
 {
-    INTN ia = CONVERT_INTN(ma), ib = CONVERT_INTN(mb);
-    VSTOREN(CONVERT_UCHARN(select((INTN)0, (INTN)a, ia) | select((INTN)0, (INTN)b, ib)), blk,
-            status);
+#if SC_LANES == 16
+    int8 v8 = v.lo + v.hi;
+#elif SC_LANES == 8
+    int8 v8 = v;
+#endif
+#if SC_LANES >= 8
+    int4 v4_ = v8.lo + v8.hi;
+#elif SC_LANES == 4
+    int4 v4_ = v;
+#endif
+#if SC_LANES >= 4
+    int2 v2 = v4_.lo + v4_.hi;
+#else
+    int2 v2 = v;
+#endif
+    return v2.x + v2.y;
+}
+SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, INTN live)
+{
+    INTN im = CONVERT_INTN(m) & live;
+    if (any(im))
+        atomic_add(c, (uint)(-lanes_sum(im)));
 }
 #else
 typedef REAL FREAL;
@@ -233,11 +282,13 @@ typedef Tri FTri;
 #define FACE_BLOCK_OR_RETURN(nf)  \
     GID_OR_RETURN(nf);            \
     const uint blk = gid;         \
+    const int live = 1;           \
     const FIDX fid = gid;
 
-SC_INLINE void st_status(__global uchar *status, uint blk, FMASK ma, uchar a, FMASK mb, uchar b)
+SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, int live)
 {
-    status[blk] = (ma ? a : 0) | (mb ? b : 0);
+    if (m & live)
+        atomic_inc(c);
 }
 #endif
 
@@ -431,7 +482,7 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          __global const uint *faces, __global REAL *corner,
-                                         __global uchar *status)
+                                         volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -442,13 +493,13 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
     st_corner(corner, blk, 0, use, ext4(corner_normal(fn, l1, l2), ca.x));
     st_corner(corner, blk, 1, use, ext4(corner_normal(fn, l2, l0), ca.y));
     st_corner(corner, blk, 2, use, ext4(corner_normal(fn, l0, l1), ca.z));
-    st_status(status, blk, deg, 1, (FMASK)0, 0);
+    count_lanes(&counters[0], deg, live);
 }
 
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                   __global const REAL *nrm, __global const REAL *area,
                                   __global const REAL *pd1, __global const REAL *pd2,
-                                  __global REAL *corner, __global uchar *status)
+                                  __global REAL *corner, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -458,16 +509,16 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     FMASK ok = face_tensor(t, ft, fb, ld3(nrm, v0), ld3(nrm, v1), ld3(nrm, v2), &x);
     FMASK use = (!deg) & ok;
     FV3 ca = corner_areas(t);
-    st_corner(corner, blk, 0, use, ext4(tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x), (FREAL)RL(0)));
-    st_corner(corner, blk, 1, use, ext4(tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x), (FREAL)RL(0)));
-    st_corner(corner, blk, 2, use, ext4(tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x), (FREAL)RL(0)));
-    st_status(status, blk, deg, 1, (!deg) & (!ok), 2);
+    st_corner3(corner, blk, 0, use, tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
+    st_corner3(corner, blk, 1, use, tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
+    st_corner3(corner, blk, 2, use, tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
+    count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                  __global const REAL *area, __global const REAL *pd1,
                                  __global const REAL *pd2, __global const REAL *kk,
-                                 __global REAL *corner, __global uchar *status)
+                                 __global REAL *corner, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -483,60 +534,58 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     st_corner(corner, blk, 0, use, dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
     st_corner(corner, blk, 1, use, dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
     st_corner(corner, blk, 2, use, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
-    st_status(status, blk, deg, 1, (!deg) & (!ok), 4);
+    count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 
-// Sums the corners of vertex v's one-ring in face order, counting (once per
-// face, at its corner 0) the faces whose status has `bit`.
+// Sums the corners of vertex v's one-ring in face order (components x, y, z,
+// and w when `four`; a constant after inlining). One vertex per work-item:
+// written with SC_LANES vertices per work-item (rings walked together to the
+// longest, masked) these ran no faster on PoCL 3.1 (4.1 against 4.2 ms for
+// the three on the bunny), so their loads (a ring entry, then its corner),
+// not their few adds, look like the limit.
 SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint *ring,
-                   __global const REAL *corner, __global const uchar *status, uchar bit,
-                   volatile __global uint *counter)
+                      __global const REAL *corner, bool four)
 {
     V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-        uint e = ring[r], f = e / 3, i = CORNER_SLOT(f, e % 3, 0);
-        if (e % 3 == 0 && (status[f] & bit))
-            atomic_inc(counter);
+        uint e = ring[r], i = CORNER_SLOT(e / 3, e % 3, 0);
         s.x += corner[i];
         s.y += corner[i + 3 * SC_LANES];
         s.z += corner[i + 6 * SC_LANES];
-        s.w += corner[i + 9 * SC_LANES];
+        if (four)
+            s.w += corner[i + 9 * SC_LANES];
     }
     return s;
 }
 
 __kernel void curv_normals_areas_sum(uint nv, __global const uint *ring_off,
                                      __global const uint *ring, __global const REAL *corner,
-                                     __global const uchar *status, __global REAL *nrm,
-                                     __global REAL *area, volatile __global uint *counters)
+                                     __global REAL *nrm, __global REAL *area)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, ring, corner, status, 1, &counters[0]);
+    V4 s = sum_ring(gid, ring_off, ring, corner, true);
     st3(v3(s.x, s.y, s.z), gid, nrm);
     area[gid] = s.w;
 }
 
 __kernel void curv_tensor_sum(uint nv, __global const uint *ring_off, __global const uint *ring,
-                              __global const REAL *corner, __global const uchar *status,
-                              __global REAL *tens, volatile __global uint *counters)
+                              __global const REAL *corner, __global REAL *tens)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, ring, corner, status, 2, &counters[2]);
+    V4 s = sum_ring(gid, ring_off, ring, corner, false);
     st3(v3(s.x, s.y, s.z), gid, tens);
 }
 
 __kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off, __global const uint *ring,
-                             __global const REAL *corner, __global const uchar *status,
-                             __global REAL *dk, volatile __global uint *counters)
+                             __global const REAL *corner, __global REAL *dk)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, ring, corner, status, 4, &counters[3]);
+    V4 s = sum_ring(gid, ring_off, ring, corner, true);
     dk[4 * gid] = s.x;
     dk[4 * gid + 1] = s.y;
     dk[4 * gid + 2] = s.z;
     dk[4 * gid + 3] = s.w;
 }
-
 // ---------------------------------------------------------------------------
 // Positions of a device-resident mesh (a fused isosurface, index space):
 // pos = a ⊙ src + b, the host's normalization folded with the volume's

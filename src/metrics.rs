@@ -98,10 +98,7 @@ pub fn measure(gpu: &Arc<Gpu>, m: &Mesh, opts: CurvatureOptions, runs: usize) ->
 pub fn label(o: &CurvatureOptions) -> String {
     format!(
         "{} {} {}{}",
-        match o.accumulate {
-            Accumulate::Atomic => "atomic",
-            Accumulate::Gather => "gather",
-        },
+        o.accumulate.name(),
         match o.precision {
             Precision::F32 => "f32",
             Precision::F64 => "f64",
@@ -111,7 +108,12 @@ pub fn label(o: &CurvatureOptions) -> String {
             Compat::Trimesh2 => "trimesh2",
         },
         if o.dcurv { "" } else { " no-dcurv" }
-    )
+    ) + &match (o.accumulate, o.lanes) {
+        // explicit lane counts of the gather scheme; 0 is the device's default
+        (Accumulate::Gather, 1) => " 1-lane".to_string(),
+        (Accumulate::Gather, n) if n > 1 => format!(" {n}-lanes"),
+        _ => String::new(),
+    }
 }
 
 /// The variants the report and the criterion bench compare, default first.
@@ -122,6 +124,12 @@ pub fn variants() -> Vec<CurvatureOptions> {
         CurvatureOptions { dcurv: false, ..d },
         CurvatureOptions {
             accumulate: Accumulate::Gather,
+            ..d
+        },
+        // the gather scheme one face per work-item: what explicit SIMD lanes gain
+        CurvatureOptions {
+            accumulate: Accumulate::Gather,
+            lanes: 1,
             ..d
         },
         CurvatureOptions {

@@ -291,6 +291,43 @@ fn face_lanes_give_bitwise_identical_results() {
     assert!(err.to_string().contains("1, 2, 4, 8 or 16"), "{err}");
 }
 
+/// `--accumulate atomic-native` (cl_ext_float_atomics) agrees with the
+/// compare-and-swap atomics and the CPU reference where the device offers
+/// native float atomics (Intel's CPU runtime), and is refused with a message
+/// naming the extension where it does not (PoCL 3.1), for each precision.
+#[test]
+fn native_float_atomics_match_compare_and_swap_or_are_refused() {
+    let m = mesh::jittered_sphere(1.0, 4, 0.3, 3);
+    let g = gpu();
+    for prec in [Precision::F32, Precision::F64] {
+        let o = with(CurvatureOptions::default(), Accumulate::AtomicNative, prec);
+        let est = CurvatureEstimator::new(g.clone(), m.n_vertices(), &m.faces, o);
+        match est {
+            Ok(_) => {
+                let native = [g.info.float_atomics, g.info.double_atomics];
+                assert!(
+                    native[prec as usize],
+                    "{prec:?}: ran without native atomics"
+                );
+                let native = device(&m, o);
+                let cas = device(&m, with(o, Accumulate::Atomic, prec));
+                assert_eq!(native.counts, cas.counts);
+                assert_fields_close(&native.field, &cas.field, 1e-6, "native vs CAS atomics");
+                let (r, _) = cpu::estimate(&m, &o);
+                assert_fields_close(&native.field, &r, 2e-4, "native atomics vs CPU reference");
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                let want = format!(
+                    "native {} float atomic adds (cl_ext_float_atomics)",
+                    prec.name()
+                );
+                assert!(msg.contains(&want), "{prec:?}: {msg}");
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------- analytic oracles
 
 /// Mean of the larger and smaller RMS errors against the truth.

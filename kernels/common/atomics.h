@@ -2,7 +2,27 @@
 // one-ring sums of Griffin et al. need (OpenCL 1.2 has no float atomics).
 // float: atomic_cmpxchg on the 32-bit pattern (core 1.1+);
 // double: atom_cmpxchg on the 64-bit pattern (cl_khr_int64_base_atomics).
+// With -DSC_NATIVE_ATOMICS (built as OpenCL C 3.0): the device's own float
+// atomic add (cl_ext_float_atomics), relaxed, device scope. The host checks
+// the device's global-add capability for the precision first
+// (CL_DEVICE_SINGLE/DOUBLE_FP_ATOMIC_CAPABILITIES_EXT); Intel's CPU compiler
+// does not define the extension's __opencl_c_ext_fp*_global_atomic_add
+// feature macros, so they are not tested here.
+#ifdef SC_NATIVE_ATOMICS
 #ifdef SC_DOUBLE
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    atomic_fetch_add_explicit((volatile __global atomic_double *)p, v, memory_order_relaxed,
+                              memory_scope_device);
+}
+#else
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    atomic_fetch_add_explicit((volatile __global atomic_float *)p, v, memory_order_relaxed,
+                              memory_scope_device);
+}
+#endif
+#elif defined(SC_DOUBLE)
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 inline void atomic_add_real(volatile __global REAL *p, REAL v)
 {

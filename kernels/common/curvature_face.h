@@ -294,5 +294,13 @@ SC_OL SC_INLINE void st_corner(__global REAL *corner, uint b, uint c, GM use, GV
     lst(use ? x.z : (GT)RL(0), s + 6, corner);
     lst(use ? x.w : (GT)RL(0), s + 9, corner);
 }
+// The same for three components (the tensor pass; slots 9–11 of the block stay unused).
+SC_OL SC_INLINE void st_corner3(__global REAL *corner, uint b, uint c, GM use, GV3 x)
+{
+    uint s = 12 * b + c;
+    lst(use ? x.x : (GT)RL(0), s, corner);
+    lst(use ? x.y : (GT)RL(0), s + 3, corner);
+    lst(use ? x.z : (GT)RL(0), s + 6, corner);
+}
 
 #endif // GT

@@ -38,9 +38,11 @@ pub struct CurvatureArgs {
     /// Merge vertices with bit-identical positions before computing.
     #[arg(long)]
     weld: bool,
-    /// One-ring accumulation: float atomics per face (Griffin et al.), or
-    /// per-vertex gather (bitwise reproducible). Default: gather on CPU
-    /// devices, atomic on GPUs (the faster exact scheme of each).
+    /// One-ring accumulation: float atomics per face (Griffin et al.; as
+    /// compare-and-swap loops, or atomic-native: the device's own float
+    /// atomic add, cl_ext_float_atomics), or per-vertex gather (bitwise
+    /// reproducible). Default: gather on CPU devices, atomic on GPUs (the
+    /// faster exact scheme of each).
     #[arg(long, value_enum)]
     accumulate: Option<Accumulate>,
     /// Faces per work-item of the gather scheme's per-face kernels, computed

@@ -13,19 +13,21 @@ pub fn run(json: bool) -> Result<()> {
     }
     let default = Gpu::new(None).ok().map(|g| g.info.index);
     out!(
-        "{:>3}  {:<4} {:>3} {:>9} {:>4} {:>10} {:>9}  platform / device",
+        "{:>3}  {:<4} {:>3} {:>9} {:>4} {:>10} {:>9} {:>10} {:>5}  platform / device",
         "#",
         "type",
         "CUs",
         "memory",
         "fp64",
         "gl_sharing",
-        "int64_atm"
+        "int64_atm",
+        "float_atm",
+        "lanes"
     );
     let yn = |b: bool| if b { "yes" } else { "no" };
     for d in devs {
         out!(
-            "{:>3}{} {:<4} {:>3} {:>6} MiB {:>4} {:>10} {:>9}  {} / {} ({})",
+            "{:>3}{} {:<4} {:>3} {:>6} MiB {:>4} {:>10} {:>9} {:>10} {:>5}  {} / {} ({})",
             d.index,
             if Some(d.index) == default { "*" } else { " " },
             d.kind,
@@ -34,6 +36,13 @@ pub fn run(json: bool) -> Result<()> {
             yn(d.fp64),
             yn(d.gl_sharing),
             yn(d.int64_atomics),
+            match (d.float_atomics, d.double_atomics) {
+                (true, true) => "f32 f64",
+                (true, false) => "f32",
+                (false, true) => "f64",
+                (false, false) => "no",
+            },
+            shapecue::spec::curvature::face_lanes_for(0, &d.kind, d.native_float_width),
             d.platform,
             d.name,
             d.version

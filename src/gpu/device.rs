@@ -31,6 +31,11 @@ pub struct DeviceInfo {
     pub gl_sharing: bool,
     /// cl_khr_int64_base_atomics (needed by f64 atomic accumulation).
     pub int64_atomics: bool,
+    /// cl_ext_float_atomics with a global atomic add for f32
+    /// (`CL_DEVICE_SINGLE_FP_ATOMIC_CAPABILITIES_EXT`), for `--accumulate atomic-native`.
+    pub float_atomics: bool,
+    /// The same for f64 (`CL_DEVICE_DOUBLE_FP_ATOMIC_CAPABILITIES_EXT`).
+    pub double_atomics: bool,
     /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT`: floats per SIMD register.
     pub native_float_width: u32,
     /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE` (0 without double precision).
@@ -42,6 +47,22 @@ pub struct DeviceInfo {
 // SAFETY: cl_device_id is an opaque handle that OpenCL allows to be used from any thread.
 unsafe impl Send for DeviceInfo {}
 unsafe impl Sync for DeviceInfo {}
+
+// cl_ext_float_atomics: device queries and the global-add capability bit.
+const CL_DEVICE_SINGLE_FP_ATOMIC_CAPABILITIES_EXT: u32 = 0x4231;
+const CL_DEVICE_DOUBLE_FP_ATOMIC_CAPABILITIES_EXT: u32 = 0x4232;
+const CL_DEVICE_GLOBAL_FP_ATOMIC_ADD_EXT: u64 = 1 << 1;
+
+/// Whether a cl_ext_float_atomics capability query reports a global atomic add.
+fn fp_atomic_add(d: &Device, query: u32) -> bool {
+    match d.get_data(query) {
+        Ok(b) if b.len() == 8 => {
+            let bits = u64::from_ne_bytes(b.try_into().unwrap_or([0; 8]));
+            bits & CL_DEVICE_GLOBAL_FP_ATOMIC_ADD_EXT != 0
+        }
+        _ => false,
+    }
+}
 
 /// Lists every device of every platform. No platform at all is an error that
 /// says how to install PoCL.
@@ -87,6 +108,10 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
                 fp64: has("cl_khr_fp64"),
                 gl_sharing: has("cl_khr_gl_sharing"),
                 int64_atomics: has("cl_khr_int64_base_atomics"),
+                float_atomics: has("cl_ext_float_atomics")
+                    && fp_atomic_add(&d, CL_DEVICE_SINGLE_FP_ATOMIC_CAPABILITIES_EXT),
+                double_atomics: has("cl_ext_float_atomics")
+                    && fp_atomic_add(&d, CL_DEVICE_DOUBLE_FP_ATOMIC_CAPABILITIES_EXT),
                 native_float_width: d.native_vector_width_float().unwrap_or(1),
                 native_double_width: d.native_vector_width_double().unwrap_or(0),
                 id,
@@ -169,6 +194,8 @@ mod tests {
             fp64: false,
             gl_sharing: false,
             int64_atomics: false,
+            float_atomics: false,
+            double_atomics: false,
             native_float_width: 1,
             native_double_width: 0,
             id: std::ptr::null_mut(),

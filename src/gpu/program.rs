@@ -139,9 +139,17 @@ pub(crate) fn driver_lock() -> std::sync::MutexGuard<'static, ()> {
     DRIVER_LOCK.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// The options handed to the compiler for `options` (the OpenCL C version first).
+/// The options handed to the compiler for `options`: the OpenCL C version
+/// first (1.2, unless `options` names one).
 pub(crate) fn full_options(options: &str) -> String {
-    format!("-cl-std=CL1.2 {options}")
+    if options
+        .split_whitespace()
+        .any(|o| o.starts_with("-cl-std="))
+    {
+        options.to_string()
+    } else {
+        format!("-cl-std=CL1.2 {options}")
+    }
 }
 
 /// Builds `src` (the [`assemble`]d text of `file`) from source with `opts`

@@ -87,6 +87,13 @@ pub enum Accumulate {
     #[default]
     #[value(help = super::NO_HELP)]
     Atomic,
+    /// As `Atomic`, with the device's own float atomic add
+    /// (`cl_ext_float_atomics`, OpenCL C 3.0 `atomic_fetch_add_explicit`,
+    /// relaxed) in place of compare-and-swap loops. Summation order varies
+    /// run to run. Only on devices that offer it (Intel's CPU runtime, not
+    /// PoCL 3.1); f64 also needs its 64-bit global add.
+    #[value(help = super::NO_HELP)]
+    AtomicNative,
     /// Per-face kernels write each corner's contribution to a buffer (12
     /// reals per face, no atomics); per-vertex kernels sum their one-ring
     /// (built once) in face order. Bitwise identical from run to run.
@@ -96,7 +103,11 @@ pub enum Accumulate {
 
 impl Accumulate {
     /// Both schemes, in the order of tables and benches.
-    pub const ALL: [Accumulate; 2] = [Accumulate::Atomic, Accumulate::Gather];
+    pub const ALL: [Accumulate; 3] = [
+        Accumulate::Atomic,
+        Accumulate::AtomicNative,
+        Accumulate::Gather,
+    ];
 
     /// The default scheme for an OpenCL device type (`CL_DEVICE_TYPE` as
     /// [`crate::gpu::DeviceInfo::kind`] spells it: "CPU", "GPU", ...), the
@@ -124,8 +135,15 @@ impl Accumulate {
     pub fn name(self) -> &'static str {
         match self {
             Accumulate::Atomic => "atomic",
+            Accumulate::AtomicNative => "atomic-native",
             Accumulate::Gather => "gather",
         }
+    }
+
+    /// Whether the one-ring sums are atomic adds from the face kernels (the
+    /// scatter form, compare-and-swap or native).
+    pub fn scatters(self) -> bool {
+        self != Accumulate::Gather
     }
 }
 
@@ -413,11 +431,10 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 
     let per_face = 12;
     let mut b = nv as u64 * per_vertex + nf as u64 * per_face + 16;
     if opts.accumulate == Accumulate::Gather {
-        // one-ring CSR, 4 reals per face corner, one status byte per face
+        // one-ring CSR, 4 reals per face corner
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
-            + corner_reals_bound(nf) as u64 * r
-            + padded_faces(nf) as u64;
+            + corner_reals_bound(nf) as u64 * r;
     }
     b
 }

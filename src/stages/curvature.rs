@@ -15,7 +15,7 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::topology::one_rings;
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, corner_reals_bound, padded_faces,
+    Precision, corner_reals_bound,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -182,12 +182,11 @@ struct Kernels {
     lanes: u32,
 }
 
-/// Buffers of the gather variant: one-ring lists, corner contributions, face status.
+/// Buffers of the gather variant: one-ring lists and corner contributions.
 struct GatherBufs {
     ring_off: Buffer<u32>,
     ring: Buffer<u32>,
     corner: Buffer<u8>,
-    status: Buffer<u8>,
 }
 
 /// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
@@ -196,6 +195,10 @@ pub fn build_options(opts: &CurvatureOptions, lanes: u32) -> String {
     let mut s = String::new();
     if opts.accumulate == Accumulate::Gather && lanes > 1 {
         s.push_str(&format!("-DSC_LANES={lanes} "));
+    }
+    if opts.accumulate == Accumulate::AtomicNative {
+        // atomic_fetch_add_explicit on atomic_float needs OpenCL C 2.0 or later
+        s.push_str("-cl-std=CL3.0 -DSC_NATIVE_ATOMICS ");
     }
     if opts.precision == Precision::F64 {
         s.push_str("-DSC_DOUBLE ");
@@ -255,6 +258,20 @@ impl CurvatureEstimator {
                         .into(),
                 });
             }
+        }
+        let native = match opts.precision {
+            Precision::F32 => gpu.info.float_atomics,
+            Precision::F64 => gpu.info.double_atomics,
+        };
+        if opts.accumulate == Accumulate::AtomicNative && !native {
+            return Err(Error::DeviceUnsupported {
+                device: gpu.info.name.clone(),
+                what: format!(
+                    "--accumulate atomic-native needs native {} float atomic adds \
+                     (cl_ext_float_atomics); use --accumulate atomic or gather",
+                    opts.precision.name()
+                ),
+            });
         }
         if !matches!(opts.lanes, 0 | 1 | 2 | 4 | 8 | 16) {
             return Err(Error::InvalidArgument(format!(
@@ -373,7 +390,6 @@ impl CurvatureEstimator {
                 ring_off,
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
-                status: gpu.buffer::<u8>(padded_faces(nf))?,
             })
         } else {
             None
@@ -597,7 +613,7 @@ impl CurvatureEstimator {
                 (Some(gb), Some(sums)) => {
                     let mut a = vec![Arg::U32(nf32)];
                     a.extend_from_slice(face_args);
-                    a.extend([buf(&gb.corner), buf(&gb.status)]);
+                    a.extend([buf(&gb.corner), cnt]);
                     // One work-item per block of `lanes` faces.
                     let blocks = nf.div_ceil(self.k.lanes as usize);
                     evs.extend(launch(g, face_kernel, blocks, &a)?.map(|e| (pass, e)));
@@ -606,10 +622,8 @@ impl CurvatureEstimator {
                         buf(&gb.ring_off),
                         buf(&gb.ring),
                         buf(&gb.corner),
-                        buf(&gb.status),
                     ];
                     a.extend_from_slice(outputs);
-                    a.push(cnt);
                     evs.extend(launch(g, &sums[sum], nv, &a)?.map(|e| (pass, e)));
                 }
                 _ => {
