@@ -2,32 +2,50 @@
 """Prints the README's curvature speed tables on each CPU OpenCL runtime
 installed (PoCL; Intel's CPU runtime when scripts/setup-intel-opencl.sh has
 put it in target/intel-opencl): kernel time of every pass with the mesh on
-the device, and a fresh `shapecue curvature IN -o OUT.ply` process end to end,
-beside trimesh2's single-threaded figures measured on this kind of machine.
+the device for each accumulation scheme, and a fresh
+`shapecue curvature IN -o OUT.ply` process end to end, beside trimesh2.
 
     python3 scripts/curvature-table.py [--bin target/release/shapecue] [--runs 7]
+        [--trimesh2-bench CMD] [--trimesh2-process CMD]
 
 Meshes: the Stanford bunny and lucy (from ../shared/data/meshes, skipped when
 absent) and generated tori of 500k and 2M vertices. Per mesh and runtime: one
-process to warm the runtime's kernel cache, then `--runs N --stats`
-(medians of N timed runs of all passes, dcurv included, after the run whose
-results are written), then N fresh processes timed end to end (median). Both
-accumulation schemes are timed; the process column uses the default (gather
-on CPU devices). Nothing else should run on the machine meanwhile.
+process to warm the runtime's kernel cache, then `--runs N --stats` for each
+scheme (medians of N timed runs of all passes, dcurv included, after the run
+whose results are written), then N fresh processes with the default scheme
+timed end to end (median), on PoCL the same with shapecue's own program cache
+switched on (SHAPECUE_CACHE_POCL=1; it is always on with Intel's runtime), and
+on the bunny one process with empty kernel caches (the first run after
+install).
+
+trimesh2 is timed in the same run when you give programs built from it
+(this script does not build trimesh2):
+  --trimesh2-bench CMD    `CMD MESH REPS` prints `kernel_ms median=X ...`: the
+                          median of REPS runs of trimesh2's need_normals,
+                          need_pointareas, need_curvatures and need_dcurv
+  --trimesh2-process CMD  `CMD MESH OUT.ply` reads the mesh, computes the same
+                          and writes the same 19 properties
+Without them the trimesh2 columns are figures measured on another day on this
+kind of machine, marked with *.
+
+Nothing else should run on the machine meanwhile.
 """
 
 import argparse
 import json
 import os
+import re
+import shlex
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
-# trimesh2 2.16, one thread: kernel (curvature + dcurv) and process (read,
-# compute, write), ms, measured on this kind of 2-core machine.
-TRIMESH2 = {
+# trimesh2 2.16, one thread, measured on another day on this kind of 2-core
+# machine: kernel (normals, point areas, curvature, dcurv) and process (read,
+# compute, write), ms.
+TRIMESH2_OTHER_DAY = {
     "bunny": (19.7, 56),
     "lucy": (28.7, 38),
     "torus 500k": (253, None),
@@ -36,7 +54,36 @@ TRIMESH2 = {
 
 
 def run(cmd, env):
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    return subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                          env=env)
+
+
+def timed(cmd, env, n):
+    wall = []
+    for _ in range(n):
+        t = time.perf_counter()
+        run(cmd, env)
+        wall.append((time.perf_counter() - t) * 1e3)
+    return statistics.median(wall)
+
+
+def kernel_median(base, extra, stats, runs, env):
+    """Median kernel ms of `--runs` for one scheme, or None where the device
+    refuses it (native float atomics on a device without them)."""
+    r = subprocess.run(base + extra + ["--runs", str(runs), "--stats", stats],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    if r.returncode != 0:
+        err = r.stderr.decode(errors="replace")
+        if "cl_ext_float_atomics" in err:
+            return None, None
+        raise SystemExit(f"{shlex.join(base + extra)} failed:\n{err}")
+    with open(stats) as f:
+        s = json.load(f)
+    return s["kernel_median_ms"], s.get("face_lanes")
+
+
+def fmt(v, digits=1):
+    return "–" if v is None else f"{v:.{digits}f}"
 
 
 def main():
@@ -45,6 +92,9 @@ def main():
     ap.add_argument("--bin", default=os.path.join(root, "target/release/shapecue"))
     ap.add_argument("--runs", type=int, default=7)
     ap.add_argument("--data", default=os.path.join(root, "../shared/data/meshes"))
+    ap.add_argument("--trimesh2-bench", help="command timing trimesh2's kernels (see above)")
+    ap.add_argument("--trimesh2-process", help="command running trimesh2's whole job (see above)")
+    ap.add_argument("--only", help="comma-separated mesh names to time (bunny,lucy,torus 500k,...)")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="shapecue-curvature-table-")
     base_env = dict(os.environ)
@@ -59,46 +109,101 @@ def main():
     else:
         print("Intel's CPU runtime not installed (scripts/setup-intel-opencl.sh): PoCL only",
               file=sys.stderr)
+    only = set(a.only.split(",")) if a.only else None
     inputs = []
     for name, f in [("bunny", "stanford-bunny.obj"), ("lucy", "lucy.ply")]:
         p = os.path.join(a.data, f)
+        if only and name not in only:
+            continue
         if os.path.exists(p):
             inputs.append((name, p))
         else:
             print(f"skipping {f}: not in {a.data}", file=sys.stderr)
     for name, n in [("torus 500k", 500_000), ("torus 2M", 2_000_000)]:
+        if only and name not in only:
+            continue
         # A binary PLY file of the generated torus (its curvature properties
-        # are read past).
+        # are read past, by shapecue and by trimesh2).
         ply = os.path.join(tmp, name.replace(" ", "") + ".ply")
         run([a.bin, "curvature", "--generate", "torus", "--resolution", str(n), "-o", ply], base_env)
         inputs.append((name, ply))
-    rows = []
+
+    # trimesh2 first, in the same run as shapecue.
+    tm2 = {}
+    for name, path in inputs:
+        kern, proc, star = None, None, False
+        if a.trimesh2_bench:
+            out = subprocess.run(shlex.split(a.trimesh2_bench) + [path, str(a.runs)], check=True,
+                                 capture_output=True).stdout.decode()
+            m = re.search(r"kernel_ms median=([0-9.]+)", out)
+            if not m:
+                raise SystemExit(f"--trimesh2-bench printed no `kernel_ms median=`:\n{out}")
+            kern = float(m.group(1))
+        if a.trimesh2_process:
+            proc = timed(shlex.split(a.trimesh2_process) + [path, os.path.join(tmp, "t.ply")],
+                         base_env, a.runs)
+        if kern is None and proc is None:
+            kern, proc = TRIMESH2_OTHER_DAY.get(name, (None, None))
+            star = True
+        tm2[name] = (kern, proc, star)
+        print(f"trimesh2 {name}: done", file=sys.stderr)
+
+    kernel_rows, process_rows = [], []
     for rt, env in runtimes:
         for name, path in inputs:
             out, stats = os.path.join(tmp, "o.ply"), os.path.join(tmp, "s.json")
             base = [a.bin, "curvature", path, "-o", out, "--force"]
             run(base, env)  # warm the kernel cache
             k = {}
-            for acc in ["atomic", "gather"]:
-                run(base + ["--accumulate", acc, "--runs", str(a.runs), "--stats", stats], env)
-                with open(stats) as f:
-                    k[acc] = json.load(f)["kernel_median_ms"]
-            wall = []
-            for _ in range(a.runs):
-                t = time.perf_counter()
-                run(base, env)
-                wall.append((time.perf_counter() - t) * 1e3)
-            rows.append((rt, name, k, statistics.median(wall)))
+            for key, extra in [("atomic", ["--accumulate", "atomic"]),
+                               ("atomic-native", ["--accumulate", "atomic-native"]),
+                               ("gather 1", ["--accumulate", "gather", "--lanes", "1"]),
+                               ("gather", ["--accumulate", "gather"])]:
+                k[key] = kernel_median(base, extra, stats, a.runs, env)
+            cold = None
+            if name == "bunny":
+                # Empty kernel caches: PoCL's own and shapecue's.
+                fresh = tempfile.mkdtemp(dir=tmp)
+                cold_env = dict(env, POCL_CACHE_DIR=os.path.join(fresh, "pocl"),
+                                SHAPECUE_CACHE_DIR=os.path.join(fresh, "shapecue"))
+                cold = timed(base, cold_env, 1)
+            cached = None
+            if rt == "PoCL":
+                # shapecue's own program cache, which on PoCL is used only
+                # with SHAPECUE_CACHE_POCL=1 (two processes fill it).
+                cache_env = dict(env, SHAPECUE_CACHE_POCL="1",
+                                 SHAPECUE_CACHE_DIR=os.path.join(tmp, "program-cache"))
+                run(base, cache_env)
+                run(base, cache_env)
+                cached = timed(base, cache_env, a.runs)
+            kernel_rows.append((rt, name, k))
+            process_rows.append((rt, name, timed(base, env, a.runs), cached, cold))
             print(f"{rt} {name}: done", file=sys.stderr)
-    print("| runtime | mesh | atomic kernels | gather kernels | trimesh2 kernels ÷ faster scheme | "
-          "process (default) | trimesh2 process |")
-    print("|---|---|---|---|---|---|---|")
-    for rt, name, k, proc in rows:
-        tk, tp = TRIMESH2.get(name, (None, None))
-        best = min(k.values())
-        ratio = f"{tk / best:.2f}" if tk else "–"
-        print(f"| {rt} | {name} | {k['atomic']:.1f} | {k['gather']:.1f} | {ratio} | "
-              f"{proc:.0f} | {tp if tp else '–'} |")
+
+    def tm2_cell(v, star, digits=1):
+        return "–" if v is None else f"{v:.{digits}f}" + ("*" if star else "")
+
+    print("| runtime | mesh | atomic (compare-and-swap) | atomic (native float add) | "
+          "gather, 1 face per work-item | gather, N faces per work-item | "
+          "trimesh2 | trimesh2 ÷ fastest |")
+    print("|---|---|---|---|---|---|---|---|")
+    for rt, name, k in kernel_rows:
+        tk, _, star = tm2[name]
+        lanes = k["gather"][1]
+        best = min(v[0] for v in k.values() if v[0] is not None)
+        ratio = "–" if tk is None else f"{tk / best:.2f}" + ("*" if star else "")
+        print(f"| {rt} | {name} | {fmt(k['atomic'][0])} | {fmt(k['atomic-native'][0])} | "
+              f"{fmt(k['gather 1'][0])} | {fmt(k['gather'][0])} (N = {lanes}) | "
+              f"{tm2_cell(tk, star)} | {ratio} |")
+    print()
+    print("| runtime | mesh | shapecue process | with SHAPECUE_CACHE_POCL=1 | trimesh2 process | "
+          "shapecue first run (empty kernel caches) |")
+    print("|---|---|---|---|---|---|")
+    for rt, name, proc, cached, cold in process_rows:
+        _, tp, star = tm2[name]
+        cached = "(the default)" if cached is None else f"{cached:.0f}"
+        print(f"| {rt} | {name} | {proc:.0f} | {cached} | {tm2_cell(tp, star, 0)}"
+              f" | {fmt(cold, 0)} |")
 
 
 if __name__ == "__main__":

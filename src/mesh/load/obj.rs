@@ -1,3 +1,5 @@
+use std::fmt::Write as _;
+
 use super::{Error, Mesh, Result};
 
 /// Strips an end-of-line comment.
@@ -15,13 +17,17 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         match toks.next() {
             Some("v") => {
                 nv += 1;
-                let rest: Vec<&str> = toks.collect();
-                // x y z [w] are kept; x y z r g b loses its colour.
-                let n = if rest.len() == 4 {
-                    4
-                } else {
-                    rest.len().min(3)
-                };
+                // x y z [w] are kept; x y z r g b loses its colour. No
+                // allocation per line: the first five tokens and the count.
+                let mut rest = [""; 5];
+                let mut len = 0;
+                for t in toks {
+                    if len < rest.len() {
+                        rest[len] = t;
+                    }
+                    len += 1;
+                }
+                let n = if len == 4 { 4 } else { len.min(3) };
                 kept.push('v');
                 for t in &rest[..n] {
                     kept.push(' ');
@@ -54,8 +60,7 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     if skip > 0 {
         input.push('f');
         for k in 1..=nv {
-            input.push(' ');
-            input.push_str(&k.to_string());
+            write!(input, " {k}").expect("writing to a String cannot fail");
         }
         input.push('\n');
     }
