@@ -727,18 +727,18 @@ impl CurvatureEstimator {
         })
     }
 
-    /// Device reals (f32 or f64 bytes, little-endian) as f64, in one pass
+    /// Device reals (f32 or f64 bytes, host byte order) as f64, in one pass
     /// with one allocation (a 2M-vertex read-back is ~300 MB of f64s, and
     /// every intermediate vector costs its page faults).
     fn to_f64(&self, bytes: &[u8]) -> Vec<f64> {
         match self.opts.precision {
             Precision::F32 => bytes
                 .chunks_exact(4)
-                .map(|b| f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))))
+                .map(|b| f64::from(f32::from_ne_bytes(b.try_into().expect("4 bytes"))))
                 .collect(),
             Precision::F64 => bytes
                 .chunks_exact(8)
-                .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
+                .map(|b| f64::from_ne_bytes(b.try_into().expect("8 bytes")))
                 .collect(),
         }
     }
@@ -758,8 +758,8 @@ impl CurvatureEstimator {
                 .collect()
         }
         match self.opts.precision {
-            Precision::F32 => conv::<N, 4>(bytes, |b| f64::from(f32::from_le_bytes(b))),
-            Precision::F64 => conv::<N, 8>(bytes, f64::from_le_bytes),
+            Precision::F32 => conv::<N, 4>(bytes, |b| f64::from(f32::from_ne_bytes(b))),
+            Precision::F64 => conv::<N, 8>(bytes, f64::from_ne_bytes),
         }
     }
 
