@@ -48,8 +48,8 @@
 // curv_principal, curv_*_sum), whose loops or selects the work-item
 // vectoriser does not take; on the AVX-512 target it vectorises frames and
 // principal (about 40 % of their instructions on ymm/zmm registers) but not
-// the ring sums (no vector instruction in curv_tensor_sum). Intel's CPU runtime vectorises across work-items itself; lanes
-// change little there.
+// the ring sums (no vector instruction in curv_tensor_sum). Intel's CPU
+// runtime vectorises across work-items itself; lanes change little there.
 //
 // Vectors are structs of scalars (V3, V4) and per-corner values are named
 // (e0 e1 e2, a0 a1 a2), never float3/vload3 and never private arrays: PoCL's

@@ -727,40 +727,30 @@ impl CurvatureEstimator {
         })
     }
 
-    /// Device reals (f32 or f64 bytes, host byte order) as f64, in one pass
-    /// with one allocation (a 2M-vertex read-back is ~300 MB of f64s, and
-    /// every intermediate vector costs its page faults).
-    fn to_f64(&self, bytes: &[u8]) -> Vec<f64> {
+    /// One device real (f32 or f64 bytes, host byte order) as f64.
+    fn real_at(&self, b: &[u8]) -> f64 {
         match self.opts.precision {
-            Precision::F32 => bytes
-                .chunks_exact(4)
-                .map(|b| f64::from(f32::from_ne_bytes(b.try_into().expect("4 bytes"))))
-                .collect(),
-            Precision::F64 => bytes
-                .chunks_exact(8)
-                .map(|b| f64::from_ne_bytes(b.try_into().expect("8 bytes")))
-                .collect(),
+            Precision::F32 => f64::from(f32::from_ne_bytes(b.try_into().expect("4 bytes"))),
+            Precision::F64 => f64::from_ne_bytes(b.try_into().expect("8 bytes")),
         }
     }
 
+    /// Device reals as f64, in one pass with one allocation (a 2M-vertex
+    /// read-back is ~300 MB of f64s, and every intermediate vector costs its
+    /// page faults).
+    fn to_f64(&self, bytes: &[u8]) -> Vec<f64> {
+        bytes
+            .chunks_exact(self.real)
+            .map(|b| self.real_at(b))
+            .collect()
+    }
+
     fn to_vecs<const N: usize>(&self, bytes: &[u8]) -> Vec<[f64; N]> {
-        fn conv<const N: usize, const R: usize>(
-            bytes: &[u8],
-            real: impl Fn([u8; R]) -> f64,
-        ) -> Vec<[f64; N]> {
-            bytes
-                .chunks_exact(N * R)
-                .map(|c| {
-                    std::array::from_fn(|i| {
-                        real(c[i * R..(i + 1) * R].try_into().expect("R bytes"))
-                    })
-                })
-                .collect()
-        }
-        match self.opts.precision {
-            Precision::F32 => conv::<N, 4>(bytes, |b| f64::from(f32::from_ne_bytes(b))),
-            Precision::F64 => conv::<N, 8>(bytes, f64::from_ne_bytes),
-        }
+        let r = self.real;
+        bytes
+            .chunks_exact(N * r)
+            .map(|c| std::array::from_fn(|i| self.real_at(&c[i * r..(i + 1) * r])))
+            .collect()
     }
 
     /// Reads the raw device state (normalized coordinates): the seven
@@ -784,7 +774,7 @@ impl CurvatureEstimator {
     /// Reads the first `n` reals per vertex of `buf` into `staging`.
     fn fetch<'s>(&self, staging: &'s mut [u8], buf: &Buffer<u8>, n: usize) -> Result<&'s [u8]> {
         let out = &mut staging[..n * self.nv * self.real];
-        self.gpu.read_many(&mut [(buf, &mut out[..])])?;
+        self.gpu.read(buf, out)?;
         Ok(out)
     }
 
