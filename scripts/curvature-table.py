@@ -181,7 +181,7 @@ def main():
             print(f"{rt} {name}: done", file=sys.stderr)
 
     def tm2_cell(v, star, digits=1):
-        return "–" if v is None else f"{v:.{digits}f}" + ("*" if star else "")
+        return fmt(v, digits) + ("*" if star and v is not None else "")
 
     print("| runtime | mesh | atomic (compare-and-swap) | atomic (native float add) | "
           "gather, 1 face per work-item | gather, N faces per work-item | "
