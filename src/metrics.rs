@@ -132,6 +132,11 @@ pub fn variants() -> Vec<CurvatureOptions> {
             lanes: 1,
             ..d
         },
+        // the device's own float atomic add, where it has one
+        CurvatureOptions {
+            accumulate: Accumulate::AtomicNative,
+            ..d
+        },
         CurvatureOptions {
             precision: Precision::F64,
             ..d

@@ -1225,3 +1225,58 @@ fn full_disks_bad_folders_and_small_devices_give_clear_errors_and_leave_nothing(
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `curvature --report` has a row for every variant the library compares,
+/// in order; a variant the device cannot run (native float atomics where the
+/// device has no float atomic add) is a row saying why, and the table goes on.
+#[test]
+fn curvature_report_has_a_row_for_every_variant() {
+    let out = run_cli([
+        "curvature",
+        "--report",
+        "--resolution",
+        "5000",
+        "--runs",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("| variant |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .collect();
+    let variants = shapecue::metrics::variants();
+    assert_eq!(
+        rows.len(),
+        variants.len() + 1,
+        "variants and the CPU reference: {text}"
+    );
+    let info = common::gpu().info.clone();
+    for (row, o) in rows.iter().zip(&variants) {
+        let label = shapecue::metrics::label(o);
+        assert!(row.starts_with(&format!("| {label} |")), "{row}");
+        use shapecue::spec::curvature::{Accumulate, Precision};
+        let f64 = o.precision == Precision::F64;
+        let (native, atomic) = (
+            o.accumulate == Accumulate::AtomicNative,
+            o.accumulate == Accumulate::Atomic,
+        );
+        let expected = (native && !info.float_atomics)
+            || (f64 && !info.fp64)
+            || (f64 && atomic && !info.int64_atomics);
+        assert_eq!(row.contains("not on this device"), expected, "{row}");
+        if native && expected && !f64 {
+            assert!(row.contains("cl_ext_float_atomics"), "{row}");
+        }
+    }
+    assert!(
+        rows.last().unwrap().starts_with("| cpu reference"),
+        "{text}"
+    );
+}

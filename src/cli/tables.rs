@@ -54,7 +54,16 @@ pub(crate) fn curvature_report(gpu: Arc<Gpu>, n: usize, runs: usize) -> Result<S
     let ref_exact = refs(Compat::Exact);
     let ref_compat = refs(Compat::Trimesh2);
     for o in variants() {
-        let r = measure(&gpu, &m, o, runs)?;
+        let r = match measure(&gpu, &m, o, runs) {
+            Ok(r) => r,
+            // a variant the device lacks a feature for (native float
+            // atomics, fp64) is a row saying so, not the end of the table
+            Err(shapecue::Error::DeviceUnsupported { what, .. }) => {
+                let _ = writeln!(s, "| {} | not on this device: {what} | | | | |", label(&o));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         let reference = if o.compat == Compat::Exact {
             &ref_exact
         } else {
