@@ -50,6 +50,18 @@
 // principal (about 40 % of their instructions on ymm/zmm registers) but not
 // the ring sums (no vector instruction in curv_tensor_sum). Intel's CPU
 // runtime vectorises across work-items itself; lanes change little there.
+// Fusing each ring sum with the per-vertex pass after it (normal sum with
+// curv_frames, tensor sum with curv_principal, raw sums left unstored) was
+// measured slower on PoCL 3.1 (bunny, medians of 41 runs: 0.9 ms against
+// 0.48 for the normal sum and frames, 0.6 against 0.4 for the tensor sum and
+// principal): the loop of the sum keeps the fused kernel scalar, and the
+// frames and principal passes lose their vectorisation. They stay apart.
+// Recomputing pd2 = n × pd1 in curv_tensor_corners instead of loading it
+// (three scalar loads per lane fewer) gained nothing measurable (0.78
+// against 0.80 ms), so the loads stay.
+// Memory order matters as much on scanned meshes: the host renumbers a
+// scattered mesh along a Morton curve first (src/mesh/order.rs), which
+// makes the ring sums about 3× faster on the Stanford bunny.
 //
 // Vectors are structs of scalars (V3, V4) and per-corner values are named
 // (e0 e1 e2, a0 a1 a2), never float3/vload3 and never private arrays: PoCL's
@@ -515,9 +527,13 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     FMASK ok = face_tensor(t, ft, fb, ld3(nrm, v0), ld3(nrm, v1), ld3(nrm, v2), &x);
     FMASK use = (!deg) & ok;
     FV3 ca = corner_areas(t);
-    st_corner3(corner, blk, 0, use, tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
-    st_corner3(corner, blk, 1, use, tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
-    st_corner3(corner, blk, 2, use, tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
+    // All three corners before the first store (see curv_dcurv_corners).
+    FV3 c0 = tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x);
+    FV3 c1 = tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x);
+    FV3 c2 = tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x);
+    st_corner3(corner, blk, 0, use, c0);
+    st_corner3(corner, blk, 1, use, c1);
+    st_corner3(corner, blk, 2, use, c2);
     count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
@@ -537,9 +553,16 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
                           vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x);
     FMASK use = (!deg) & ok;
     FV3 ca = corner_areas(t);
-    st_corner(corner, blk, 0, use, dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
-    st_corner(corner, blk, 1, use, dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
-    st_corner(corner, blk, 2, use, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
+    // All three corners before the first store: a store to `corner` may
+    // alias pd1/pd2 for the compiler, so a corner computed after one would
+    // load its vertex's frame again (one scalar load per lane and value)
+    // instead of reusing the loads of vertex_curv_in.
+    FV4 c0 = dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x);
+    FV4 c1 = dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x);
+    FV4 c2 = dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x);
+    st_corner(corner, blk, 0, use, c0);
+    st_corner(corner, blk, 1, use, c1);
+    st_corner(corner, blk, 2, use, c2);
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 

@@ -169,6 +169,67 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
     }
 }
 
+/// `--order`: a generated grid keeps its order under auto; spatial
+/// renumbers it for the device and still writes the input's vertex order,
+/// with the same curvature and directions to rounding.
+#[test]
+fn curvature_order_writes_the_input_order_whatever_order_it_computes_in() {
+    let d = scratch("order");
+    let run = |order: &str| {
+        let (ply, json) = (
+            d.join(format!("{order}.ply")),
+            d.join(format!("{order}.json")),
+        );
+        let out = cli()
+            .args(["curvature", "--generate", "torus", "--resolution", "3000"])
+            .args(["--order", order, "-o"])
+            .arg(&ply)
+            .arg("--stats")
+            .arg(&json)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let (_, values, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
+        (values, faces, stats)
+    };
+    let (auto, auto_faces, auto_stats) = run("auto");
+    let (spatial, spatial_faces, spatial_stats) = run("spatial");
+    assert_eq!(auto_stats["order"], "input", "a generated grid is local");
+    assert_eq!(spatial_stats["order"], "spatial");
+    assert!(spatial_stats["phases_ms"]["reorder"].as_f64().unwrap() >= 0.0);
+    assert_eq!(auto_faces, spatial_faces, "faces are written as given");
+    assert_eq!(auto.len(), spatial.len());
+    for (i, (a, b)) in auto.iter().zip(&spatial).enumerate() {
+        assert_eq!(a[..3], b[..3], "vertex {i}: positions in input order");
+        for k in [7, 8] {
+            assert!(
+                (a[k] - b[k]).abs() < 1e-4 * (1.0 + a[k].abs()),
+                "vertex {i}: k{}",
+                k - 6
+            );
+        }
+        let d1 = a[9] * b[9] + a[10] * b[10] + a[11] * b[11];
+        assert!(
+            d1 > 0.999,
+            "vertex {i}: d1 {:?} vs {:?}",
+            &a[9..12],
+            &b[9..12]
+        );
+    }
+    let out = cli()
+        .args(["curvature", "--generate", "torus", "--order", "sideways"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("auto, input, spatial"));
+}
+
 #[test]
 fn curvature_defaults_to_the_faster_exact_scheme_of_the_device() {
     // PoCL and Intel's runtime are CPU devices: gather, whose output is the

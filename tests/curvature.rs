@@ -207,16 +207,88 @@ fn gather_is_bitwise_reproducible_and_agrees_with_atomic() {
         Accumulate::Gather,
         Precision::F32,
     );
+    // One-shot runs (which compute this mesh in a Morton order) and runs
+    // of one estimator (in the input order) are each reproducible.
     let a = device(&m, o).field;
+    assert_eq!(a, device(&m, o).field, "one-shot gather results differ");
     let mut est = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();
     est.set_positions(&m.positions).unwrap();
+    est.run().unwrap();
+    let first = est.read().unwrap();
     for _ in 0..3 {
         est.run().unwrap();
         let b = est.read().unwrap();
-        assert_eq!(a, b, "gather results differ between runs");
+        assert_eq!(first, b, "gather results differ between runs");
     }
+    assert_fields_close(&a, &first, 1e-6, "Morton vs input order");
     let at = device(&m, CurvatureOptions::default()).field;
     assert_fields_close(&at, &a, 1e-6, "atomic vs gather");
+}
+
+/// A mesh in scattered order (its vertices and faces shuffled, as in scanned
+/// meshes) is computed in a Morton order by the one-shot estimate and the
+/// CLI, and gives the input-order results to rounding: the same curvatures
+/// and, since the frames are seeded from the input's owning faces, the same
+/// principal directions with the same signs, and the same derivative.
+#[test]
+fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
+    use shapecue::mesh::order::{LocalityOrder, MeshOrder};
+    let t = mesh::torus(1.0, 0.4, 96, 48);
+    let nv = t.n_vertices();
+    // A fixed pseudo-random permutation of the vertices and of the faces.
+    let shuffle = |n: usize, seed: u64| {
+        let mut p: Vec<u32> = (0..n as u32).collect();
+        let mut x = seed;
+        for i in (1..n).rev() {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            p.swap(i, (x >> 33) as usize % (i + 1));
+        }
+        p
+    };
+    let (pv, pf) = (shuffle(nv, 7), shuffle(t.n_faces(), 11));
+    let mut positions = vec![[0.0; 3]; nv];
+    for (old, &new) in pv.iter().enumerate() {
+        positions[new as usize] = t.positions[old];
+    }
+    let faces = pf
+        .iter()
+        .map(|&f| t.faces[f as usize].map(|v| pv[v as usize]))
+        .collect();
+    let m = Mesh::new(positions, faces, "shuffled torus").unwrap();
+    assert!(LocalityOrder::scattered(nv, &m.faces));
+    assert!(
+        LocalityOrder::choose(&t, MeshOrder::Auto).is_none(),
+        "the grid is local"
+    );
+    for acc in [Accumulate::Gather, Accumulate::Atomic] {
+        let o = with(CurvatureOptions::default(), acc, Precision::F32);
+        let reordered = device(&m, o).field;
+        let mut est = CurvatureEstimator::new(gpu(), nv, &m.faces, o).unwrap();
+        est.set_positions(&m.positions).unwrap();
+        est.run().unwrap();
+        let input = est.read().unwrap();
+        assert_fields_close(&reordered, &input, 1e-6, "Morton vs input order");
+        for i in 0..nv {
+            for (a, b, what) in [
+                (reordered.d1[i], input.d1[i], "d1"),
+                (reordered.d2[i], input.d2[i], "d2"),
+            ] {
+                assert!(dot(a, b) > 1.0 - 1e-6, "vertex {i}: {what} {a:?} vs {b:?}");
+            }
+        }
+        // The derivative, against its RMS over all four components (some
+        // components are ~0 on a torus, so a per-component NRMSE would
+        // divide rounding by rounding).
+        let (a, b): (Vec<f64>, Vec<f64>) = (0..nv)
+            .flat_map(|i| (0..4).map(move |c| (i, c)))
+            .map(|(i, c)| (reordered.dk[i][c], input.dk[i][c]))
+            .unzip();
+        let e = rmse(&a, &b) / rmse(&a, &vec![0.0; a.len()]);
+        eprintln!("{acc:?}: dk relative RMS difference {e:.2e}");
+        assert!(e < 1e-4, "{acc:?}: dk relative RMS difference {e:.2e}");
+    }
 }
 
 /// The gather variant's per-face kernels give the same bits for every lane

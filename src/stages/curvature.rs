@@ -12,6 +12,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::mesh::order::{LocalityOrder, MeshOrder};
 use crate::mesh::topology::one_rings;
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
@@ -450,6 +451,33 @@ impl CurvatureEstimator {
         Ok(est)
     }
 
+    /// Replaces the owning faces that seed each vertex's initial tangent
+    /// frame (by default the largest face id using the vertex, as in
+    /// trimesh2; −1 for none). A mesh computed in another order passes the
+    /// images of its input's owners ([`LocalityOrder::frame_faces`]), so its
+    /// principal directions keep the signs they have in the input order. A
+    /// face that does not use its vertex only seeds another tangent frame.
+    pub fn set_frame_faces(&mut self, owner: &[i32]) -> Result<()> {
+        if owner.len() != self.nv {
+            return Err(Error::InvalidArgument(format!(
+                "{} frame faces given for {} vertices",
+                owner.len(),
+                self.nv
+            )));
+        }
+        if let Some((v, &f)) = owner
+            .iter()
+            .enumerate()
+            .find(|&(_, &f)| f < -1 || i64::from(f) >= self.nf as i64)
+        {
+            return Err(Error::InvalidArgument(format!(
+                "frame face {f} of vertex {v} is not a face of this mesh ({} faces)",
+                self.nf
+            )));
+        }
+        self.gpu.write(&mut self.owner, owner)
+    }
+
     /// Faces per work-item of the gather variant's per-face kernels as built
     /// for this device (1 for the atomic variant).
     pub fn face_lanes(&self) -> u32 {
@@ -801,20 +829,35 @@ impl CurvatureEstimator {
 }
 
 /// One-shot estimation: allocate, upload, run every pass, read back (the
-/// front door's `shapecue::curvature_on`).
+/// front door's `shapecue::curvature_on`). A mesh whose order is scattered
+/// is computed in a Morton order for cache locality and its results are
+/// mapped back ([`crate::mesh::order`], [`MeshOrder::Auto`]); the time of
+/// reordering counts as topology.
 pub fn estimate(
     gpu: Arc<Gpu>,
     mesh: &crate::Mesh,
     opts: CurvatureOptions,
 ) -> Result<crate::spec::curvature::Curvature> {
-    let mut est = CurvatureEstimator::new(gpu, mesh.n_vertices(), &mesh.faces, opts)?;
-    est.set_positions(&mesh.positions)?;
+    let t0 = Instant::now();
+    let order = LocalityOrder::choose(mesh, MeshOrder::Auto);
+    let reordered = order.as_ref().map(|o| o.apply(mesh));
+    let m = reordered.as_ref().unwrap_or(mesh);
+    let reorder_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let mut est = CurvatureEstimator::new(gpu, m.n_vertices(), &m.faces, opts)?;
+    if let Some(o) = &order {
+        est.set_frame_faces(&o.frame_faces(mesh))?;
+    }
+    est.set_positions(&m.positions)?;
     let timing = est.run()?;
+    let field = est.read()?;
     Ok(crate::spec::curvature::Curvature {
-        field: est.read()?,
+        field: match &order {
+            Some(o) => o.field_to_input(&field),
+            None => field,
+        },
         counts: est.counts()?,
         timing,
-        topology_ms: est.topology_ms(),
+        topology_ms: reorder_ms + est.topology_ms(),
         device_bytes: est.device_bytes(),
     })
 }
