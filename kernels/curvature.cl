@@ -84,7 +84,12 @@
 //   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
 //                    16): corner c of face f, component k at
 //                    L·(12·(f / L) + 3k + c) + f % L with L = SC_LANES (12f + 3k + c
-//                    for one lane): per block of L faces, 12 whole-vector stores
+//                    for one lane): per block of L faces, 12 whole-vector stores.
+//                    Component 3 also carries data between passes: the
+//                    normal pass leaves each corner's area there, the tensor
+//                    pass reads it and leaves the corner's weight (corner
+//                    area ÷ point area), which the dcurv pass reads instead
+//                    of recomputing (4 % on the bunny, mostly divisions)
 //
 // Degenerate faces (an edge shorter than 1e-12 of the mesh's RMS radius,
 // twice the area below 5e-8 × Σ edge², or 2A/√(Σ edge²) below the f32
@@ -251,6 +256,9 @@ typedef V3N FV3;
 typedef V4N FV4;
 typedef TriN FTri;
 
+// The SC_LANES reals from SC_LANES·slot of a (one per lane; see st_corner).
+#define LD_SLOT(a, slot) VLOADN((slot), (a))
+
 // Face block b: faces SC_LANES·b … SC_LANES·b + SC_LANES − 1. Lanes past the
 // last face repeat it (`live` is false there); their corners land in the
 // padding of the corner buffer (sized for whole blocks) and are never read.
@@ -296,6 +304,8 @@ typedef uint FIDX;
 typedef V3 FV3;
 typedef V4 FV4;
 typedef Tri FTri;
+
+#define LD_SLOT(a, slot) ((a)[slot])
 
 #define FACE_BLOCK_OR_RETURN(nf)  \
     GID_OR_RETURN(nf);            \
@@ -526,14 +536,20 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     face_frame(t, &ft, &fb);
     FMASK ok = face_tensor(t, ft, fb, ld3(nrm, v0), ld3(nrm, v1), ld3(nrm, v2), &x);
     FMASK use = (!deg) & ok;
-    FV3 ca = corner_areas(t);
+    // The corner areas the normal pass stored (component 3 of each corner;
+    // zero for degenerate faces), read back instead of recomputed, and each
+    // corner's weight in its vertex's sum, stored there in their place for
+    // curv_dcurv_corners. The same values as computing them here.
+    FREAL w0 = corner_weight(LD_SLOT(corner, 12 * blk + 9), ld1(area, v0));
+    FREAL w1 = corner_weight(LD_SLOT(corner, 12 * blk + 10), ld1(area, v1));
+    FREAL w2 = corner_weight(LD_SLOT(corner, 12 * blk + 11), ld1(area, v2));
     // All three corners before the first store (see curv_dcurv_corners).
-    FV3 c0 = tensor_at(pd1, pd2, area, v0, ca.x, ft, fb, x);
-    FV3 c1 = tensor_at(pd1, pd2, area, v1, ca.y, ft, fb, x);
-    FV3 c2 = tensor_at(pd1, pd2, area, v2, ca.z, ft, fb, x);
-    st_corner3(corner, blk, 0, use, c0);
-    st_corner3(corner, blk, 1, use, c1);
-    st_corner3(corner, blk, 2, use, c2);
+    FV3 c0 = tensor_w(pd1, pd2, v0, w0, ft, fb, x);
+    FV3 c1 = tensor_w(pd1, pd2, v1, w1, ft, fb, x);
+    FV3 c2 = tensor_w(pd1, pd2, v2, w2, ft, fb, x);
+    st_corner3w(corner, blk, 0, use, c0, !deg, w0);
+    st_corner3w(corner, blk, 1, use, c1, !deg, w1);
+    st_corner3w(corner, blk, 2, use, c2, !deg, w2);
     count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
@@ -552,14 +568,16 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
                           vertex_curv_in(pd1, pd2, kk, v1, ft, fb),
                           vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x);
     FMASK use = (!deg) & ok;
-    FV3 ca = corner_areas(t);
+    // The corner weights curv_tensor_corners stored (`area` is not read).
+    FREAL w0 = LD_SLOT(corner, 12 * blk + 9), w1 = LD_SLOT(corner, 12 * blk + 10),
+          w2 = LD_SLOT(corner, 12 * blk + 11);
     // All three corners before the first store: a store to `corner` may
     // alias pd1/pd2 for the compiler, so a corner computed after one would
     // load its vertex's frame again (one scalar load per lane and value)
     // instead of reusing the loads of vertex_curv_in.
-    FV4 c0 = dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x);
-    FV4 c1 = dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x);
-    FV4 c2 = dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x);
+    FV4 c0 = dcurv_w(pd1, pd2, v0, w0, ft, fb, x);
+    FV4 c1 = dcurv_w(pd1, pd2, v1, w1, ft, fb, x);
+    FV4 c2 = dcurv_w(pd1, pd2, v2, w2, ft, fb, x);
     st_corner(corner, blk, 0, use, c0);
     st_corner(corner, blk, 1, use, c1);
     st_corner(corner, blk, 2, use, c2);

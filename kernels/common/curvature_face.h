@@ -266,18 +266,30 @@ SC_OL SC_INLINE GV3 vertex_curv_in(__global const REAL *pd1, __global const REAL
                      ft, fb);
 }
 
-// The weighted tensor of face (ft, fb, x) in vertex v's frame (corner area ca).
+// The tensor of face (ft, fb, x) in vertex v's frame, times the corner's
+// weight w in v's one-ring sum.
+SC_OL SC_INLINE GV3 tensor_w(__global const REAL *pd1, __global const REAL *pd2, GI v, GT w,
+                             GV3 ft, GV3 fb, GV3 x)
+{
+    return mul3(proj_curv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), w);
+}
+// The same with the weight from the corner area ca and v's point area.
 SC_OL SC_INLINE GV3 tensor_at(__global const REAL *pd1, __global const REAL *pd2,
                               __global const REAL *area, GI v, GT ca, GV3 ft, GV3 fb, GV3 x)
 {
-    return mul3(proj_curv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, ld1(area, v)));
+    return tensor_w(pd1, pd2, v, corner_weight(ca, ld1(area, v)), ft, fb, x);
 }
 
 // The weighted derivative tensor of a face in vertex v's frame.
+SC_OL SC_INLINE GV4 dcurv_w(__global const REAL *pd1, __global const REAL *pd2, GI v, GT w,
+                            GV3 ft, GV3 fb, GV4 x)
+{
+    return mul4(proj_dcurv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), w);
+}
 SC_OL SC_INLINE GV4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2,
                              __global const REAL *area, GI v, GT ca, GV3 ft, GV3 fb, GV4 x)
 {
-    return mul4(proj_dcurv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), corner_weight(ca, ld1(area, v)));
+    return dcurv_w(pd1, pd2, v, corner_weight(ca, ld1(area, v)), ft, fb, x);
 }
 
 // Corner c of face block b (SC_LANES faces, one per lane), component k lives
@@ -294,13 +306,17 @@ SC_OL SC_INLINE void st_corner(__global REAL *corner, uint b, uint c, GM use, GV
     lst(use ? x.z : (GT)RL(0), s + 6, corner);
     lst(use ? x.w : (GT)RL(0), s + 9, corner);
 }
-// The same for three components (the tensor pass; slots 9–11 of the block stay unused).
-SC_OL SC_INLINE void st_corner3(__global REAL *corner, uint b, uint c, GM use, GV3 x)
+// The tensor pass: three components under `use`, and in the fourth (where
+// the normal pass left the corner area) the corner's weight under `keep`,
+// for the derivative pass.
+SC_OL SC_INLINE void st_corner3w(__global REAL *corner, uint b, uint c, GM use, GV3 x, GM keep,
+                                 GT w)
 {
     uint s = 12 * b + c;
     lst(use ? x.x : (GT)RL(0), s, corner);
     lst(use ? x.y : (GT)RL(0), s + 3, corner);
     lst(use ? x.z : (GT)RL(0), s + 6, corner);
+    lst(keep ? w : (GT)RL(0), s + 9, corner);
 }
 
 #endif // GT
