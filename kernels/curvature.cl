@@ -59,6 +59,12 @@
 // Recomputing pd2 = n × pd1 in curv_tensor_corners instead of loading it
 // (three scalar loads per lane fewer) gained nothing measurable (0.78
 // against 0.80 ms), so the loads stay.
+// Storing each corner at its vertex's one-ring position instead (a slot
+// map built with the rings, so that each vertex sums a contiguous run, with
+// no ring index to load) made the three ring sums 3× faster (torus 2M:
+// 19 against 59 ms) but the per-face kernels slower by as much, their whole-
+// vector stores becoming one scattered store per lane (tensor corners 71
+// against 41 ms): no gain in total, so the corners stay in face order.
 // Memory order matters as much on scanned meshes: the host renumbers a
 // scattered mesh along a Morton curve first (src/mesh/order.rs), which
 // makes the ring sums about 3× faster on the Stanford bunny.
