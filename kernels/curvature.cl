@@ -86,7 +86,9 @@
 //   tens  REAL[3V]  curvature tensor (ku, kuv, kv) in the initial frame
 //   kk    REAL[2V]  (k1, k2)                              dk REAL[4V] derivative tensor
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
-//   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
+//   ring_off uint[V+1], ring uint[3F] one-ring, gather variant only: for each
+//                    corner of the ring, its slot CORNER_SLOT(f, c, 0) in
+//                    `corner` (computed by the host for the build's lanes)
 //   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
 //                    16): corner c of face f, component k at
 //                    L·(12·(f / L) + 3k + c) + f % L with L = SC_LANES (12f + 3k + c
@@ -601,7 +603,7 @@ SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint
 {
     V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-        uint e = ring[r], i = CORNER_SLOT(e / 3, e % 3, 0);
+        uint i = ring[r];
         s.x += corner[i];
         s.y += corner[i + 3 * SC_LANES];
         s.z += corner[i + 6 * SC_LANES];
