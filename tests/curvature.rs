@@ -794,6 +794,26 @@ fn wrong_pose_sizes_and_non_finite_poses_are_errors() {
         .unwrap()
         .to_string();
     assert!(e.contains("face 0"), "{e}");
+    // Frame faces: one per vertex, each −1 or a face of the mesh.
+    let e = est.set_frame_faces(&[0; 3]).unwrap_err().to_string();
+    assert!(e.contains("3 frame faces") && e.contains("vertices"), "{e}");
+    let mut owner = vec![0i32; m.n_vertices()];
+    owner[5] = m.n_faces() as i32;
+    let e = est.set_frame_faces(&owner).unwrap_err().to_string();
+    assert!(e.contains("vertex 5") && e.contains("not a face"), "{e}");
+    owner[5] = -2;
+    assert!(est.set_frame_faces(&owner).is_err());
+    // A face that does not use its vertex only seeds another frame: the
+    // curvature is the same and everything stays finite.
+    est.set_positions(&m.positions).unwrap();
+    est.run().unwrap();
+    let own = est.read().unwrap();
+    owner[5] = -1;
+    est.set_frame_faces(&owner).unwrap();
+    est.run().unwrap();
+    let other = est.read().unwrap();
+    assert!(other.all_finite());
+    assert_fields_close(&own, &other, 1e-5, "other frame faces");
 }
 
 #[test]
