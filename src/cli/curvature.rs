@@ -243,7 +243,9 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let mostly_degenerate = counts.mostly_degenerate(mesh.n_faces());
     if mostly_degenerate {
         eprintln!(
-            "warning: {name}: {} of {} faces were skipped as degenerate, so most curvature              values are zero. Faces are judged against the rounding of the precision computed              in: for a mesh far from the origin or finely detailed, try --precision f64",
+            "warning: {name}: {} of {} faces were skipped as degenerate, so most curvature \
+                 values are zero. Faces are judged against the rounding of the precision computed \
+                 in: for a mesh far from the origin or finely detailed, try --precision f64",
             counts.degenerate_faces,
             mesh.n_faces()
         );

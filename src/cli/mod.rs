@@ -181,7 +181,8 @@ pub fn report_alone(
 ) -> anyhow::Result<()> {
     if report && (input.is_some() || output.is_some()) {
         anyhow::bail!(
-            "--report prints the accuracy/time table of generated shapes and reads no input              nor writes -o; run it without them"
+            "--report prints the accuracy/time table of generated shapes and reads no input \
+                 nor writes -o; run it without them"
         );
     }
     Ok(())

@@ -383,7 +383,8 @@ impl CurvatureEstimator {
         gpu.write(&mut owner, &vec![-1i32; nv])?;
         if gather && corner_reals_bound(nf) > u32::MAX as usize {
             return Err(Error::InvalidArgument(format!(
-                "{nf} faces are more than the gather scheme's 32-bit corner slots address                  ({} at most); use --accumulate atomic",
+                "{nf} faces are more than the gather scheme's 32-bit corner slots address \
+                 ({} at most); use --accumulate atomic",
                 u32::MAX as usize / 12 - crate::spec::curvature::MAX_FACE_LANES as usize
             )));
         }
