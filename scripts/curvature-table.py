@@ -5,7 +5,7 @@ put it in target/intel-opencl): kernel time of every pass with the mesh on
 the device for each accumulation scheme, and a fresh
 `shapecue curvature IN -o OUT.ply` process end to end, beside trimesh2.
 
-    python3 scripts/curvature-table.py [--bin target/release/shapecue] [--runs 7]
+    python3 scripts/curvature-table.py [--bin target/release/shapecue] [--runs 7] [--rounds 3]
         [--trimesh2-bench CMD] [--trimesh2-process CMD]
 
 Meshes: the Stanford bunny and lucy (from ../shared/data/meshes, skipped when
@@ -13,7 +13,9 @@ absent) and generated tori of 500k and 2M vertices. Per mesh and runtime: one
 process to warm the runtime's kernel cache, then `--runs N --stats` for each
 scheme (medians of N timed runs of all passes, dcurv included, after the run
 whose results are written; in the memory order shapecue picks, and for the
-gather scheme also in the file's own order, `--order input`), then N fresh processes with the default scheme
+gather scheme also in the file's own order, `--order input`; `--rounds R`
+processes per scheme, every scheme in turn, and the median of their
+medians), then N fresh processes with the default scheme
 timed end to end (median), on PoCL the same with shapecue's own program cache
 switched on (SHAPECUE_CACHE_POCL=1; it is always on with Intel's runtime), and
 on the bunny one process with empty kernel caches (the first run after
@@ -92,6 +94,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default=os.path.join(root, "target/release/shapecue"))
     ap.add_argument("--runs", type=int, default=7)
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="processes per scheme, taken in turn (median of their medians)")
     ap.add_argument("--data", default=os.path.join(root, "../shared/data/meshes"))
     ap.add_argument("--trimesh2-bench", help="command timing trimesh2's kernels (see above)")
     ap.add_argument("--trimesh2-process", help="command running trimesh2's whole job (see above)")
@@ -155,13 +159,22 @@ def main():
             out, stats = os.path.join(tmp, "o.ply"), os.path.join(tmp, "s.json")
             base = [a.bin, "curvature", path, "-o", out, "--force"]
             run(base, env)  # warm the kernel cache
+            schemes = [("atomic", ["--accumulate", "atomic"]),
+                       ("atomic-native", ["--accumulate", "atomic-native"]),
+                       ("gather 1", ["--accumulate", "gather", "--lanes", "1"]),
+                       ("gather", ["--accumulate", "gather"]),
+                       ("gather input", ["--accumulate", "gather", "--order", "input"])]
+            # Rounds through every scheme in turn, so that a slow spell of
+            # the machine does not fall on one scheme: the median over the
+            # rounds of each process's median.
+            got = {key: [] for key, _ in schemes}
+            for _ in range(a.rounds):
+                for key, extra in schemes:
+                    got[key].append(kernel_median(base, extra, stats, a.runs, env))
             k = {}
-            for key, extra in [("atomic", ["--accumulate", "atomic"]),
-                               ("atomic-native", ["--accumulate", "atomic-native"]),
-                               ("gather 1", ["--accumulate", "gather", "--lanes", "1"]),
-                               ("gather", ["--accumulate", "gather"]),
-                               ("gather input", ["--accumulate", "gather", "--order", "input"])]:
-                k[key] = kernel_median(base, extra, stats, a.runs, env)
+            for key, vals in got.items():
+                ms = [v[0] for v in vals if v[0] is not None]
+                k[key] = (statistics.median(ms) if ms else None, vals[0][1])
             cold = None
             if name == "bunny":
                 # Empty kernel caches: PoCL's own and shapecue's.
