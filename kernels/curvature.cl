@@ -65,6 +65,11 @@
 // 19 against 59 ms) but the per-face kernels slower by as much, their whole-
 // vector stores becoming one scattered store per lane (tensor corners 71
 // against 41 ms): no gain in total, so the corners stay in face order.
+// Ring entries holding the corner slots themselves (computed by the host,
+// no index arithmetic in the sums) made PoCL 5–8 % faster in total but
+// Intel's CPU runtime 2.7× slower in the sums (torus 500k: 15.7 against
+// 5.9 ms for the normal sum, also with pointer offsets), so the sums
+// compute the slot from face·3 + corner.
 // Memory order matters on scanned meshes too: the host renumbers a
 // scattered mesh along a Morton curve first (src/mesh/order.rs). On the
 // Stanford bunny (PoCL, medians of 41 runs per kernel) that makes the ring
@@ -87,9 +92,7 @@
 //   tens  REAL[3V]  curvature tensor (ku, kuv, kv) in the initial frame
 //   kk    REAL[2V]  (k1, k2)                              dk REAL[4V] derivative tensor
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
-//   ring_off uint[V+1], ring uint[3F] one-ring, gather variant only: for each
-//                    corner of the ring, its slot CORNER_SLOT(f, c, 0) in
-//                    `corner` (computed by the host for the build's lanes)
+//   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
 //   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
 //                    16): corner c of face f, component k at
 //                    L·(12·(f / L) + 3k + c) + f % L with L = SC_LANES (12f + 3k + c
@@ -604,7 +607,7 @@ SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint
 {
     V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-        uint i = ring[r];
+        uint e = ring[r], i = CORNER_SLOT(e / 3, e % 3, 0);
         s.x += corner[i];
         s.y += corner[i + 3 * SC_LANES];
         s.z += corner[i + 6 * SC_LANES];

@@ -389,11 +389,7 @@ impl CurvatureEstimator {
             )));
         }
         let gather_bufs = if gather {
-            let (off, mut ring) = one_rings(nv, faces.unwrap_or(&[]));
-            // Entries as corner-buffer slots, so the sums load no index math.
-            for e in &mut ring {
-                *e = corner_slot(*e / 3, *e % 3, k.lanes);
-            }
+            let (off, ring) = one_rings(nv, faces.unwrap_or(&[]));
             let mut ring_off = gpu.buffer::<u32>(off.len())?;
             gpu.write(&mut ring_off, &off)?;
             let mut ring_b = gpu.buffer::<u32>(ring.len())?;
@@ -837,13 +833,6 @@ impl CurvatureEstimator {
         self.norm.unapply(&mut f);
         Ok(f)
     }
-}
-
-/// The slot in the gather variant's corner buffer of component 0 of face
-/// `f`'s corner `c`, for `lanes` faces per work-item: `CORNER_SLOT` of
-/// `kernels/curvature.cl`.
-fn corner_slot(f: u32, c: u32, lanes: u32) -> u32 {
-    (12 * (f / lanes) + c) * lanes + f % lanes
 }
 
 /// One-shot estimation: allocate, upload, run every pass, read back (the
