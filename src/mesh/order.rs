@@ -179,7 +179,17 @@ impl LocalityOrder {
 
     /// The mesh in this order: positions permuted, faces permuted and
     /// renumbered (each face keeps its corner order, so its orientation).
+    ///
+    /// # Panics
+    ///
+    /// If `mesh` is not the mesh this order was made for (other vertex or
+    /// face counts); the same holds for [`LocalityOrder::frame_faces`] and,
+    /// for the length of `values`, [`LocalityOrder::to_input`].
     pub fn apply(&self, mesh: &Mesh) -> Mesh {
+        assert!(
+            mesh.n_vertices() == self.input_vertex.len() && mesh.n_faces() == self.input_face.len(),
+            "LocalityOrder::apply: the order was made for another mesh"
+        );
         let mut new_of = vec![0u32; mesh.n_vertices()];
         for (new, &old) in self.input_vertex.iter().enumerate() {
             new_of[old as usize] = new as u32;
@@ -204,6 +214,11 @@ impl LocalityOrder {
     /// mesh's principal directions keep their input-order signs. `input` is
     /// the mesh this order was made for.
     pub fn frame_faces(&self, input: &Mesh) -> Vec<i32> {
+        assert!(
+            input.n_vertices() == self.input_vertex.len()
+                && input.n_faces() == self.input_face.len(),
+            "LocalityOrder::frame_faces: the order was made for another mesh"
+        );
         let owner = super::topology::max_face(input.n_vertices(), &input.faces);
         let mut new_face = vec![0i32; self.input_face.len()];
         for (new, &old) in self.input_face.iter().enumerate() {
@@ -221,6 +236,11 @@ impl LocalityOrder {
     /// Per-vertex values computed on the reordered mesh, back in the
     /// input's vertex order.
     pub fn to_input<T: Copy + Default>(&self, values: &[T]) -> Vec<T> {
+        assert_eq!(
+            values.len(),
+            self.input_vertex.len(),
+            "LocalityOrder::to_input: one value per vertex"
+        );
         let mut out = vec![T::default(); values.len()];
         for (new, &old) in self.input_vertex.iter().enumerate() {
             out[old as usize] = values[new];
