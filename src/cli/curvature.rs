@@ -3,10 +3,12 @@
 //! stats; `--report` prints the accuracy/time table.
 //!
 //! The stats time every phase of the command (`phases_ms`: load = parse and
-//! validation, device, program build, topology, normalisation, upload, the
-//! first run with the driver's compilation at first launch, read-back,
-//! program-cache write, PLY write), and `--runs N` adds N timed runs of the
-//! device passes after the one whose results are written, with medians.
+//! validation, device, reorder (the memory order of `--order`), program
+//! build, topology, normalisation, upload, the first run with the driver's
+//! compilation at first launch, read-back (with the mapping back to the
+//! input's order), program-cache write, PLY write), and `--runs N` adds N
+//! timed runs of the device passes after the one whose results are written,
+//! with medians.
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
