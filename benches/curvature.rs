@@ -28,10 +28,10 @@ use criterion::{
 use shapecue::Mesh;
 use shapecue::gpu::Gpu;
 use shapecue::mesh;
-use shapecue::mesh::order::{LocalityOrder, MeshOrder};
+use shapecue::mesh::order::MeshOrder;
 use shapecue::spec::curvature::CurvatureOptions;
 use shapecue::spec::timing::Timing;
-use shapecue::stages::curvature::CurvatureEstimator;
+use shapecue::stages::curvature::{CurvatureEstimator, OrderedEstimator};
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
@@ -76,18 +76,10 @@ fn torus_of(n: usize) -> Mesh {
     mesh::torus(1.0, 0.4, nu, nv)
 }
 
-/// `m` in the order the CLI and the one-shot estimate compute it in.
-fn as_computed(m: Mesh) -> Mesh {
-    match LocalityOrder::choose(&m, MeshOrder::Auto) {
-        Some(o) => o.apply(&m),
-        None => m,
-    }
-}
-
 fn inputs() -> Vec<Input> {
     let mut v = vec![Input {
         name: "bunny",
-        make: || common::shared_mesh("curvature", "stanford-bunny.obj").map(as_computed),
+        make: || common::shared_mesh("curvature", "stanford-bunny.obj"),
         sampling: SMALL,
     }];
     if common::quick() {
@@ -95,7 +87,7 @@ fn inputs() -> Vec<Input> {
     } else {
         v.push(Input {
             name: "torus-500k",
-            make: || Some(as_computed(torus_of(500_000))),
+            make: || Some(torus_of(500_000)),
             sampling: Sampling {
                 samples: 10,
                 flat: true,
@@ -104,7 +96,7 @@ fn inputs() -> Vec<Input> {
         });
         v.push(Input {
             name: "torus-2m",
-            make: || Some(as_computed(torus_of(2_000_000))),
+            make: || Some(torus_of(2_000_000)),
             sampling: Sampling {
                 samples: 10,
                 flat: true,
@@ -134,18 +126,16 @@ fn ready(
     name: &str,
     opts: CurvatureOptions,
 ) -> Option<CurvatureEstimator> {
-    let mut est = match CurvatureEstimator::new(gpu.clone(), m.n_vertices(), &m.faces, opts) {
-        Ok(e) => e,
+    // In the memory order the CLI computes in, pose uploaded.
+    let mut est = match OrderedEstimator::new(gpu.clone(), m, opts, MeshOrder::Auto) {
+        Ok(o) => o.est,
         Err(e) => {
             eprintln!("curvature bench: skipping {name}: {e}");
             return None;
         }
     };
     // The first run pays for JIT compilation; the second is printed.
-    let warm = est
-        .set_positions(&m.positions)
-        .and_then(|()| est.run())
-        .and_then(|_| est.run());
+    let warm = est.run().and_then(|_| est.run());
     match warm {
         Ok(t) => {
             let passes: Vec<String> = t

@@ -41,11 +41,7 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
         .args(["--accumulate", "atomic"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let (names, values, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
     assert_eq!(
         names.join(" "),
@@ -169,6 +165,38 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
     }
 }
 
+/// Runs `shapecue curvature` on a generated torus of about 3,000 vertices
+/// with `extra` arguments, writing `<name>.ply` and `<name>.json` in `d`;
+/// checks it succeeded and returns the PLY's path and the stats.
+fn curvature_torus_3000(
+    d: &std::path::Path,
+    name: &str,
+    extra: &[&str],
+) -> (std::path::PathBuf, serde_json::Value) {
+    let (ply, json) = (
+        d.join(format!("{name}.ply")),
+        d.join(format!("{name}.json")),
+    );
+    let out = cli()
+        .args([
+            "curvature",
+            "--generate",
+            "torus",
+            "--resolution",
+            "3000",
+            "-o",
+        ])
+        .arg(&ply)
+        .arg("--stats")
+        .arg(&json)
+        .args(extra)
+        .output()
+        .unwrap();
+    common::assert_succeeded(&out);
+    let stats = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    (ply, stats)
+}
+
 /// `--order`: a generated grid keeps its order under auto; spatial
 /// renumbers it for the device and still writes the input's vertex order,
 /// with the same curvature and directions to rounding.
@@ -176,25 +204,7 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
 fn curvature_order_writes_the_input_order_whatever_order_it_computes_in() {
     let d = scratch("order");
     let run = |order: &str| {
-        let (ply, json) = (
-            d.join(format!("{order}.ply")),
-            d.join(format!("{order}.json")),
-        );
-        let out = cli()
-            .args(["curvature", "--generate", "torus", "--resolution", "3000"])
-            .args(["--order", order, "-o"])
-            .arg(&ply)
-            .arg("--stats")
-            .arg(&json)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let stats: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let (ply, stats) = curvature_torus_3000(&d, order, &["--order", order]);
         let (_, values, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
         (values, faces, stats)
     };
@@ -236,32 +246,7 @@ fn curvature_defaults_to_the_faster_exact_scheme_of_the_device() {
     // same bytes as --accumulate gather; --accumulate atomic still runs.
     let d = scratch("default-accumulate");
     let run = |extra: &[&str], name: &str| {
-        let (ply, json) = (
-            d.join(format!("{name}.ply")),
-            d.join(format!("{name}.json")),
-        );
-        let out = cli()
-            .args([
-                "curvature",
-                "--generate",
-                "torus",
-                "--resolution",
-                "3000",
-                "-o",
-            ])
-            .arg(&ply)
-            .arg("--stats")
-            .arg(&json)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let stats: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let (ply, stats) = curvature_torus_3000(&d, name, extra);
         (std::fs::read(&ply).unwrap(), stats)
     };
     let (auto, stats) = run(&[], "auto");
@@ -296,11 +281,7 @@ fn isosurface_writes_ply_with_curvature_normals_and_stats() {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let (names, rows, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
     assert_eq!(names.len(), 19);
     assert!(!faces.is_empty());
@@ -375,11 +356,7 @@ fn isosurface_bad_input_is_a_clear_error() {
 fn render_explains_plans_and_names_scene_errors() {
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/torus.toml");
     let out = run_cli(["render", scene, "--explain"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let s = String::from_utf8_lossy(&out.stdout);
     // Curvature colours + AO + contours + suggestive contours: dcurv runs,
     // feature edges do not; 4 orbit views.
@@ -1301,11 +1278,7 @@ fn curvature_report_has_a_row_for_every_variant() {
         "1",
     ]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let rows: Vec<&str> = text
         .lines()
         .skip_while(|l| !l.starts_with("| variant |"))

@@ -550,11 +550,7 @@ fn cli_renders_png_svg_and_stats() {
     if cli_gl_missing(&out) {
         return;
     }
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let img = image::open(&png).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (200, 150));
     assert!(
@@ -1163,11 +1159,7 @@ fn cli_without_an_eye_frames_the_mesh() {
     if cli_gl_missing(&out) {
         return;
     }
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let img = image::open(&png).unwrap().to_rgba8();
     let (mut lo, mut hi) = ([u32::MAX; 2], [0u32; 2]);
     for (x, y, p) in img.enumerate_pixels() {

@@ -433,11 +433,7 @@ fn pose_pipeline_runs_frames_and_reports() {
         .arg(&path)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_succeeded(&out);
     let r = String::from_utf8(out.stdout).unwrap();
     eprintln!("{r}");
     for row in [

@@ -14,11 +14,11 @@ use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shapecue::gpu::Gpu;
-use shapecue::mesh::order::{LocalityOrder, MeshOrder};
+use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
 use shapecue::spec::curvature::{Accumulate, Compat, Curvature, CurvatureOptions, Precision};
 use shapecue::spec::timing::Timing;
-use shapecue::stages::curvature::CurvatureEstimator;
+use shapecue::stages::curvature::OrderedEstimator;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -168,43 +168,29 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         opts.accumulate = a
             .accumulate
             .unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
-        let t = Instant::now();
-        let order = LocalityOrder::choose(&mesh, a.order);
-        let reordered = order.as_ref().map(|o| o.apply(&mesh));
-        let m = reordered.as_ref().unwrap_or(&mesh);
-        phase("reorder", ms_since(t));
         let setup = || format!("setting up curvature for {name}");
-        let mut est = CurvatureEstimator::new(gpu.clone(), m.n_vertices(), &m.faces, opts)
-            .with_context(setup)?;
-        if let Some(o) = &order {
-            est.set_frame_faces(&o.frame_faces(&mesh))
-                .with_context(setup)?;
-        }
-        phase("program_build", est.build_ms());
-        phase("topology", est.topology_ms() - est.build_ms());
-        est.set_positions(&m.positions).with_context(setup)?;
-        phase("normalise", est.upload_ms().normalise);
-        phase("upload", est.upload_ms().write);
-        let timing = est.run().with_context(setup)?;
+        let mut o = OrderedEstimator::new(gpu.clone(), &mesh, opts, a.order).with_context(setup)?;
+        phase("reorder", o.reorder_ms);
+        phase("program_build", o.est.build_ms());
+        phase("topology", o.est.topology_ms() - o.est.build_ms());
+        phase("normalise", o.est.upload_ms().normalise);
+        phase("upload", o.est.upload_ms().write);
+        let timing = o.est.run().with_context(setup)?;
         phase("first_run", timing.wall_ms);
         let t = Instant::now();
-        let field = est.read()?;
         let c = Curvature {
-            field: match &order {
-                Some(o) => o.field_to_input(&field),
-                None => field,
-            },
-            counts: est.counts()?,
+            field: o.read()?,
+            counts: o.est.counts()?,
             timing,
-            topology_ms: est.topology_ms(),
-            device_bytes: est.device_bytes(),
+            topology_ms: o.est.topology_ms(),
+            device_bytes: o.est.device_bytes(),
         };
         phase("read_back", ms_since(t));
         let mut stats = serde_json::json!({
             "device": gpu.info,
             "accumulate": opts.accumulate.name(),
-            "face_lanes": est.face_lanes(),
-            "order": if order.is_some() { "spatial" } else { "input" },
+            "face_lanes": o.est.face_lanes(),
+            "order": if o.order.is_some() { "spatial" } else { "input" },
             "topology_ms": c.topology_ms,
             "passes": passes(&c.timing),
             "kernel_ms": c.timing.kernel_ms,
@@ -215,7 +201,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         if let Some(n) = a.runs {
             let mut timed = Vec::with_capacity(n);
             for _ in 0..n {
-                timed.push(est.run()?);
+                timed.push(o.est.run()?);
             }
             runs_stats(&mut stats, &timed, c.timing.wall_ms);
         }

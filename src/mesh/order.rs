@@ -152,10 +152,7 @@ impl LocalityOrder {
             .collect();
         keyed.sort_unstable();
         let input_vertex: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
-        let mut new_of = vec![0u32; nv];
-        for (new, &old) in input_vertex.iter().enumerate() {
-            new_of[old as usize] = new as u32;
-        }
+        let new_of = inverse(&input_vertex);
         // Counting sort of the faces by their smallest new vertex index.
         let key = |f: &[u32; 3]| f.map(|v| new_of[v as usize]).into_iter().min().unwrap_or(0);
         let mut start = vec![0u32; nv + 1];
@@ -190,10 +187,7 @@ impl LocalityOrder {
             mesh.n_vertices() == self.input_vertex.len() && mesh.n_faces() == self.input_face.len(),
             "LocalityOrder::apply: the order was made for another mesh"
         );
-        let mut new_of = vec![0u32; mesh.n_vertices()];
-        for (new, &old) in self.input_vertex.iter().enumerate() {
-            new_of[old as usize] = new as u32;
-        }
+        let new_of = inverse(&self.input_vertex);
         Mesh {
             positions: self
                 .input_vertex
@@ -220,14 +214,11 @@ impl LocalityOrder {
             "LocalityOrder::frame_faces: the order was made for another mesh"
         );
         let owner = super::topology::max_face(input.n_vertices(), &input.faces);
-        let mut new_face = vec![0i32; self.input_face.len()];
-        for (new, &old) in self.input_face.iter().enumerate() {
-            new_face[old as usize] = new as i32;
-        }
+        let new_face = inverse(&self.input_face);
         self.input_vertex
             .iter()
             .map(|&v| match owner[v as usize] {
-                f if f >= 0 => new_face[f as usize],
+                f if f >= 0 => new_face[f as usize] as i32,
                 _ => -1,
             })
             .collect()
@@ -263,6 +254,15 @@ impl LocalityOrder {
             dk: self.to_input(&f.dk),
         }
     }
+}
+
+/// The inverse of a permutation: for each input index, its new index.
+fn inverse(input_of: &[u32]) -> Vec<u32> {
+    let mut new_of = vec![0u32; input_of.len()];
+    for (new, &old) in input_of.iter().enumerate() {
+        new_of[old as usize] = new as u32;
+    }
+    new_of
 }
 
 /// The low 21 bits of `x` spread to every third bit (bit i → bit 3i).

@@ -835,36 +835,72 @@ impl CurvatureEstimator {
     }
 }
 
+/// An estimator of a whole mesh computed in the memory order `order` asks
+/// for ([`crate::mesh::order`]): built, each vertex's frame seeded from the
+/// face that seeds it in the input's order (so directions keep their
+/// signs), and the pose uploaded. Run it through `est`; read its results in
+/// the input's vertex order with [`OrderedEstimator::read`].
+pub struct OrderedEstimator {
+    /// The estimator, on the mesh in its computing order.
+    pub est: CurvatureEstimator,
+    /// The renumbering it computes in, or `None` for the input's order.
+    pub order: Option<LocalityOrder>,
+    /// Host ms of choosing and applying the order.
+    pub reorder_ms: f64,
+}
+
+impl OrderedEstimator {
+    /// Builds the estimator of `mesh` for `opts` in the order `order` picks.
+    pub fn new(
+        gpu: Arc<Gpu>,
+        mesh: &crate::Mesh,
+        opts: CurvatureOptions,
+        order: MeshOrder,
+    ) -> Result<Self> {
+        let t0 = Instant::now();
+        let order = LocalityOrder::choose(mesh, order);
+        let reordered = order.as_ref().map(|o| o.apply(mesh));
+        let m = reordered.as_ref().unwrap_or(mesh);
+        let reorder_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let mut est = CurvatureEstimator::new(gpu, m.n_vertices(), &m.faces, opts)?;
+        if let Some(o) = &order {
+            est.set_frame_faces(&o.frame_faces(mesh))?;
+        }
+        est.set_positions(&m.positions)?;
+        Ok(OrderedEstimator {
+            est,
+            order,
+            reorder_ms,
+        })
+    }
+
+    /// The results of the last full run, in the input's vertex order.
+    pub fn read(&self) -> Result<CurvatureField> {
+        let field = self.est.read()?;
+        Ok(match &self.order {
+            Some(o) => o.field_to_input(&field),
+            None => field,
+        })
+    }
+}
+
 /// One-shot estimation: allocate, upload, run every pass, read back (the
 /// front door's `shapecue::curvature_on`). A mesh whose order is scattered
 /// is computed in a Morton order for cache locality and its results are
-/// mapped back ([`crate::mesh::order`], [`MeshOrder::Auto`]); the time of
+/// mapped back ([`OrderedEstimator`], [`MeshOrder::Auto`]); the time of
 /// reordering counts as topology.
 pub fn estimate(
     gpu: Arc<Gpu>,
     mesh: &crate::Mesh,
     opts: CurvatureOptions,
 ) -> Result<crate::spec::curvature::Curvature> {
-    let t0 = Instant::now();
-    let order = LocalityOrder::choose(mesh, MeshOrder::Auto);
-    let reordered = order.as_ref().map(|o| o.apply(mesh));
-    let m = reordered.as_ref().unwrap_or(mesh);
-    let reorder_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut est = CurvatureEstimator::new(gpu, m.n_vertices(), &m.faces, opts)?;
-    if let Some(o) = &order {
-        est.set_frame_faces(&o.frame_faces(mesh))?;
-    }
-    est.set_positions(&m.positions)?;
-    let timing = est.run()?;
-    let field = est.read()?;
+    let mut o = OrderedEstimator::new(gpu, mesh, opts, MeshOrder::Auto)?;
+    let timing = o.est.run()?;
     Ok(crate::spec::curvature::Curvature {
-        field: match &order {
-            Some(o) => o.field_to_input(&field),
-            None => field,
-        },
-        counts: est.counts()?,
+        field: o.read()?,
+        counts: o.est.counts()?,
         timing,
-        topology_ms: reorder_ms + est.topology_ms(),
-        device_bytes: est.device_bytes(),
+        topology_ms: o.reorder_ms + o.est.topology_ms(),
+        device_bytes: o.est.device_bytes(),
     })
 }

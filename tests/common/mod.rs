@@ -155,6 +155,15 @@ pub fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_shapecue"))
 }
 
+/// Fails the test, with the command's stderr, unless it exited with success.
+pub fn assert_succeeded(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Runs the `shapecue` binary with `args` and returns what it did.
 pub fn run_cli<I, S>(args: I) -> Output
 where
