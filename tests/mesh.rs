@@ -122,6 +122,66 @@ fn obj_keeps_file_vertex_order() {
     assert_eq!(m.faces[0].to_vec(), idx);
 }
 
+/// The OBJ reader agrees with `tobj` on every shared OBJ mesh: the same
+/// triangles (as triples of positions, bit for bit, in the same order), and
+/// every vertex `tobj` keeps (it keeps those faces use) is one of ours.
+#[test]
+fn obj_reader_agrees_with_tobj() {
+    let Some(dir) = shared("meshes") else { return };
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 5, "{files:?}");
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    for path in files {
+        let ours = load(&path, &plain()).unwrap_or_else(|e| panic!("{e}"));
+        let (models, _) = tobj::load_obj(&path, &opts).unwrap();
+        let mut theirs: Vec<[[f64; 3]; 3]> = Vec::new();
+        for m in &models {
+            let p = &m.mesh.positions;
+            let at = |i: u32| {
+                let i = 3 * i as usize;
+                [p[i], p[i + 1], p[i + 2]]
+            };
+            for t in m.mesh.indices.chunks_exact(3) {
+                theirs.push([at(t[0]), at(t[1]), at(t[2])]);
+            }
+        }
+        let mine: Vec<[[f64; 3]; 3]> = ours
+            .faces
+            .iter()
+            .map(|f| f.map(|v| ours.positions[v as usize]))
+            .collect();
+        let name = path.display();
+        assert_eq!(mine.len(), theirs.len(), "{name}: triangle count");
+        if let Some(i) = (0..mine.len()).find(|&i| mine[i] != theirs[i]) {
+            panic!(
+                "{name}: triangle {i} is {:?} here and {:?} in tobj",
+                mine[i], theirs[i]
+            );
+        }
+        let used: std::collections::HashSet<[u64; 3]> =
+            ours.positions.iter().map(|p| p.map(f64::to_bits)).collect();
+        for m in &models {
+            for p in m.mesh.positions.chunks_exact(3) {
+                let bits = [p[0], p[1], p[2]].map(f64::to_bits);
+                assert!(
+                    used.contains(&bits),
+                    "{name}: tobj vertex {p:?} is not ours"
+                );
+            }
+        }
+    }
+}
+
 /// The two PLY byte orders agree with a re-encoding of the same mesh.
 #[test]
 fn horse_round_trips_through_the_writer() {

@@ -1,5 +1,3 @@
-use std::fmt::Write as _;
-
 use super::{Error, Mesh, Result};
 
 /// Strips an end-of-line comment.
@@ -7,97 +5,147 @@ fn uncomment(line: &str) -> &str {
     line.split('#').next().unwrap_or("")
 }
 
+/// Why [`scan`] stopped.
+enum Stop {
+    /// Something is wrong on this line (1-based); [`locate`] says what.
+    Line(usize),
+    /// A positive index beyond the file's vertices: found once all vertices
+    /// are counted, so [`locate`] finds the face.
+    Range,
+    /// More vertices than 32-bit indices address.
+    TooBig,
+}
+
 pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
-    let text = String::from_utf8_lossy(bytes);
-    let mut kept = String::with_capacity(text.len());
-    let (mut nv, mut nf) = (0usize, 0usize);
-    for (i, line) in text.lines().enumerate() {
-        let line = uncomment(line);
-        let mut toks = line.split_whitespace();
-        match toks.next() {
-            Some("v") => {
-                nv += 1;
-                // x y z [w] are kept; x y z r g b loses its colour. No
-                // allocation per line: the first five tokens and the count.
-                let mut rest = [""; 5];
-                let mut len = 0;
-                for t in toks {
-                    if len < rest.len() {
-                        rest[len] = t;
-                    }
-                    len += 1;
+    scan(bytes).map_err(|stop| match stop {
+        Stop::TooBig => too_big(source),
+        Stop::Line(ln) => locate(&String::from_utf8_lossy(bytes), source, Some(ln)),
+        Stop::Range => locate(&String::from_utf8_lossy(bytes), source, None),
+    })
+}
+
+/// ASCII whitespace as `split_whitespace` sees it in a line (the line
+/// break is already cut off).
+fn is_space(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\r' | b'\x0b' | b'\x0c')
+}
+
+/// The whitespace-separated tokens of a line.
+fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|&b| is_space(b)).filter(|t| !t.is_empty())
+}
+
+fn number(tok: &[u8]) -> Option<f64> {
+    std::str::from_utf8(tok).ok()?.parse().ok()
+}
+
+/// An optionally signed decimal integer of at most 18 digits.
+fn integer(tok: &[u8]) -> Option<i64> {
+    let (neg, digits) = match tok.split_first() {
+        Some((b'-', d)) => (true, d),
+        Some((b'+', d)) => (false, d),
+        _ => (false, tok),
+    };
+    if digits.is_empty() || digits.len() > 18 {
+        return None;
+    }
+    let mut v = 0i64;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        v = v * 10 + i64::from(d - b'0');
+    }
+    Some(if neg { -v } else { v })
+}
+
+/// The vertex index of a face corner `v[/vt[/vn]]` (texture and normal
+/// indices are checked and dropped), 0-based, given the vertices read so
+/// far; `None` when the corner is malformed or points before the first
+/// vertex. A positive index may point past the vertices read so far (OBJ
+/// allows it); the caller checks it once the file is read.
+fn corner(tok: &[u8], seen: usize) -> Option<i64> {
+    let mut parts = tok.split(|&b| b == b'/');
+    let v = integer(parts.next()?)?;
+    let mut extra = 0;
+    for p in parts {
+        extra += 1;
+        if extra > 2 || (!p.is_empty() && integer(p).is_none()) {
+            return None;
+        }
+    }
+    match v {
+        0 => None,
+        v if v > 0 => Some(v - 1),
+        v => {
+            let i = seen as i64 + v;
+            (i >= 0).then_some(i)
+        }
+    }
+}
+
+/// One pass over the bytes: `v` and `f` statements, everything else
+/// (texture coordinates, normals, groups, objects, materials, lines,
+/// comments) skipped. Polygons are fan-triangulated.
+fn scan(bytes: &[u8]) -> std::result::Result<Mesh, Stop> {
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut max_index = -1i64;
+    let mut poly: Vec<i64> = Vec::new();
+    let mut start = 0usize;
+    let mut ln = 0usize;
+    while start < bytes.len() {
+        let end = memchr::memchr(b'\n', &bytes[start..]).map_or(bytes.len(), |i| start + i);
+        let mut line = &bytes[start..end];
+        start = end + 1;
+        ln += 1;
+        if let Some(hash) = memchr::memchr(b'#', line) {
+            line = &line[..hash];
+        }
+        let first = line.iter().position(|&b| !is_space(b));
+        let Some(first) = first else { continue };
+        let line = &line[first..];
+        let statement = line.len() == 1 || is_space(line[1]);
+        match line[0] {
+            b'v' if statement => {
+                let mut t = tokens(&line[1..]);
+                let mut p = [0.0; 3];
+                for x in &mut p {
+                    *x = t.next().and_then(number).ok_or(Stop::Line(ln))?;
                 }
-                let n = if len == 4 { 4 } else { len.min(3) };
-                kept.push('v');
-                for t in &rest[..n] {
-                    kept.push(' ');
-                    kept.push_str(t);
+                // A fourth value alone is the weight w (ignored, but it
+                // must be a non-zero number); more values are a colour.
+                if let (Some(w), None) = (t.next(), t.next())
+                    && number(w).is_none_or(|w| w == 0.0)
+                {
+                    return Err(Stop::Line(ln));
                 }
-                kept.push('\n');
+                positions.push(p);
             }
-            Some("f") => {
-                let corners = toks.count();
-                if corners < 3 {
-                    return Err(Error::input(
-                        source,
-                        format!("face {nf}"),
-                        format!(
-                            "line {}: {corners} vertex indices; a face needs at least 3",
-                            i + 1
-                        ),
-                    ));
+            b'f' if statement => {
+                poly.clear();
+                for tok in tokens(&line[1..]) {
+                    let v = corner(tok, positions.len()).ok_or(Stop::Line(ln))?;
+                    max_index = max_index.max(v);
+                    poly.push(v);
                 }
-                nf += 1;
-                kept.push_str(line);
-                kept.push('\n');
+                if poly.len() < 3 {
+                    return Err(Stop::Line(ln));
+                }
+                // Indices are below 2^60 here; the range check below makes
+                // them fit u32.
+                for k in 1..poly.len() - 1 {
+                    faces.push([poly[0], poly[k], poly[k + 1]].map(|v| v as u32));
+                }
             }
             _ => {}
         }
     }
-
-    let skip = if nv >= 3 { nv - 2 } else { 0 };
-    let mut input = String::with_capacity(kept.len() + 8 * nv + 2);
-    if skip > 0 {
-        input.push('f');
-        for k in 1..=nv {
-            write!(input, " {k}").expect("writing to a String cannot fail");
-        }
-        input.push('\n');
+    if u32::try_from(positions.len()).is_err() {
+        return Err(Stop::TooBig);
     }
-    input.push_str(&kept);
-    drop(kept);
-
-    let options = tobj::LoadOptions {
-        single_index: false,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, _materials) = tobj::load_obj_buf(&mut input.as_bytes(), &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| locate(&text, source, e))?;
-
-    let mut positions = Vec::with_capacity(nv);
-    let mut faces = Vec::with_capacity(nf);
-    let mut first = true;
-    for model in models {
-        let m = &model.mesh;
-        let offset = u32::try_from(positions.len()).map_err(|_| too_big(source))?;
-        positions.extend(m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
-        let mut tris = m.indices.chunks_exact(3);
-        if first && skip > 0 {
-            // The triangles of the prepended polygon.
-            tris.by_ref().take(skip).for_each(drop);
-        }
-        first = false;
-        for t in tris {
-            let f = [t[0], t[1], t[2]].map(|v| v.checked_add(offset));
-            match f {
-                [Some(a), Some(b), Some(c)] => faces.push([a, b, c]),
-                _ => return Err(too_big(source)),
-            }
-        }
+    if max_index >= positions.len() as i64 {
+        return Err(Stop::Range);
     }
     Ok(Mesh { positions, faces })
 }
@@ -106,9 +154,10 @@ fn too_big(source: &str) -> Error {
     Error::input(source, "mesh", "too many vertices for 32-bit indices")
 }
 
-/// Turns a `tobj` error (which carries no position) into one naming the
-/// offending element, by re-scanning the text for the first bad line.
-fn locate(text: &str, source: &str, err: tobj::LoadError) -> Error {
+/// Finds the first bad statement and names it: its element (`vertex 12`,
+/// `face 7`), its line and the problem. `line` is where [`scan`] stopped,
+/// when it knows; a problem this re-reading cannot name is reported there.
+fn locate(text: &str, source: &str, line: Option<usize>) -> Error {
     let total = text
         .lines()
         .filter(|l| uncomment(l).split_whitespace().next() == Some("v"))
@@ -140,7 +189,8 @@ fn locate(text: &str, source: &str, err: tobj::LoadError) -> Error {
                 nv += 1;
             }
             Some("f") => {
-                for tok in toks {
+                let corners: Vec<&str> = toks.collect();
+                for tok in &corners {
                     if let Some(p) = check_corner(tok, nv, total) {
                         return Error::input(
                             source,
@@ -149,12 +199,29 @@ fn locate(text: &str, source: &str, err: tobj::LoadError) -> Error {
                         );
                     }
                 }
+                if corners.len() < 3 {
+                    return Error::input(
+                        source,
+                        format!("face {nf}"),
+                        format!(
+                            "line {ln}: {} vertex indices; a face needs at least 3",
+                            corners.len()
+                        ),
+                    );
+                }
                 nf += 1;
             }
             _ => {}
         }
     }
-    Error::input(source, "file", format!("OBJ parser: {err}"))
+    match line {
+        Some(ln) => Error::input(
+            source,
+            "file",
+            format!("line {ln}: cannot read this statement"),
+        ),
+        None => Error::input(source, "file", "a face index is out of range"),
+    }
 }
 
 /// Describes what is wrong with one face corner `v[/vt[/vn]]`, if anything.
@@ -183,5 +250,66 @@ fn check_corner(tok: &str, seen: usize, total: usize) -> Option<String> {
         ))
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        parse(text.as_bytes(), "t.obj").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn corners_and_integers() {
+        assert_eq!(integer(b"12"), Some(12));
+        assert_eq!(integer(b"-3"), Some(-3));
+        assert_eq!(integer(b"+3"), Some(3));
+        assert_eq!(integer(b"-"), None);
+        assert_eq!(integer(b"1x"), None);
+        assert_eq!(integer(b"1234567890123456789"), None);
+        assert_eq!(corner(b"3", 0), Some(2));
+        assert_eq!(corner(b"3/1/2", 0), Some(2));
+        assert_eq!(corner(b"3//2", 0), Some(2));
+        assert_eq!(corner(b"3/", 0), Some(2));
+        assert_eq!(corner(b"-1", 5), Some(4));
+        assert_eq!(corner(b"-6", 5), None);
+        assert_eq!(corner(b"0", 5), None);
+        assert_eq!(corner(b"1/2/3/4", 5), None);
+        assert_eq!(corner(b"1/x", 5), None);
+    }
+
+    #[test]
+    fn forward_references_weights_and_colours() {
+        let m = parse(
+            b"f 1 2 3\nv 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\n\tv  0 1 0\r\nvt 1 1\nf 3 2 1\n",
+            "t.obj",
+        )
+        .unwrap();
+        assert_eq!(
+            m.positions,
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        );
+        assert_eq!(m.faces, vec![[0, 1, 2], [2, 1, 0]]);
+    }
+
+    #[test]
+    fn bad_statements_are_named() {
+        let e = err("v 0 0 0\nv 1 0\nf 1 2 3\n");
+        assert!(e.contains("vertex 1") && e.contains("line 2"), "{e}");
+        let e = err("v 0 0 0 0\nf 1 1 1\n");
+        assert!(e.contains("vertex 0") && e.contains("w is 0"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2/x 3\n");
+        assert!(e.contains("face 1") && e.contains("line 5"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n");
+        assert!(e.contains("face 0") && e.contains("out of range"), "{e}");
+        let e = err("v 0 0 0\nv\nf 1 2 1\n");
+        assert!(e.contains("vertex 1") && e.contains("found 0"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nf 1 2\n");
+        assert!(e.contains("face 0") && e.contains("at least 3"), "{e}");
+        // Not whitespace to this reader: a no-break space between numbers.
+        let e = err("v 0 0 0\nv 1\u{a0}0 0\nv 0 1 0\nf 1 2 3\n");
+        assert!(e.contains("line 2"), "{e}");
     }
 }
