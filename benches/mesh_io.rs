@@ -6,7 +6,9 @@
 //! - `mesh_io/load/<input>`: [`shapecue::mesh::load`] (read the file, parse,
 //!   validate) of the Stanford bunny (OBJ, 2.4 MB) and lucy (binary PLY,
 //!   1.9 MB) from `shared/data/meshes` (each skipped if absent) and of a
-//!   generated 500k-vertex torus written as OBJ to a temporary folder.
+//!   generated 500k-vertex torus written to a temporary folder as OBJ and as
+//!   the binary PLY with 19 float properties that `shapecue curvature -o`
+//!   writes.
 //! - `mesh_io/write-curvature-ply/bunny`: [`shapecue::export::ply::write_ply`]
 //!   of the bunny with its 16 curvature properties (from the CPU twin), as
 //!   the CLI writes it: to a temporary file, synced, renamed over the output.
@@ -18,7 +20,7 @@ mod common;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use shapecue::Mesh;
 use shapecue::mesh::{self, LoadOptions};
-use shapecue::spec::curvature::CurvatureOptions;
+use shapecue::spec::curvature::{CurvatureField, CurvatureOptions};
 use std::hint::black_box;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -34,6 +36,19 @@ fn write_obj(path: &Path, m: &Mesh) -> std::io::Result<()> {
         writeln!(w, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1)?;
     }
     w.flush()
+}
+
+/// A curvature field of zeros (the values do not change a file's size).
+fn zero_field(n: usize) -> CurvatureField {
+    CurvatureField {
+        normals: vec![[0.0; 3]; n],
+        areas: vec![0.0; n],
+        k1: vec![0.0; n],
+        k2: vec![0.0; n],
+        d1: vec![[0.0; 3]; n],
+        d2: vec![[0.0; 3]; n],
+        dk: vec![[0.0; 4]; n],
+    }
 }
 
 fn bench_load(c: &mut Criterion, tmp: &Path) {
@@ -52,6 +67,12 @@ fn bench_load(c: &mut Criterion, tmp: &Path) {
         let p = tmp.join("torus-500k.obj");
         match write_obj(&p, &torus) {
             Ok(()) => inputs.push(("torus-500k-obj", p)),
+            Err(e) => eprintln!("mesh_io bench: cannot write {}: {e}", p.display()),
+        }
+        // As `shapecue curvature -o` writes it: 19 float properties.
+        let p = tmp.join("torus-500k.ply");
+        match shapecue::export::ply::write_ply(&p, &torus, Some(&zero_field(torus.n_vertices()))) {
+            Ok(_) => inputs.push(("torus-500k-curvature-ply", p)),
             Err(e) => eprintln!("mesh_io bench: cannot write {}: {e}", p.display()),
         }
     }

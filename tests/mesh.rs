@@ -182,6 +182,52 @@ fn obj_reader_agrees_with_tobj() {
     }
 }
 
+/// The binary PLY reader agrees with `ply-rs-bw`'s generic reader on the
+/// shared binary PLY meshes: the same positions and triangles.
+#[test]
+fn binary_ply_reader_agrees_with_ply_rs() {
+    use ply_rs_bw::ply::{DefaultElement, Property};
+    let Some(dir) = shared("meshes") else { return };
+    for file in ["horse.ply", "lucy.ply"] {
+        let path = dir.join(file);
+        let ours = load(&path, &plain()).unwrap_or_else(|e| panic!("{e}"));
+        let mut f = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
+        let ply = ply_rs_bw::parser::Parser::<DefaultElement>::new()
+            .read_ply(&mut f)
+            .unwrap();
+        assert_ne!(
+            ply.header.encoding,
+            ply_rs_bw::ply::Encoding::Ascii,
+            "{file}"
+        );
+        let num = |p: &Property| match *p {
+            Property::Float(v) => f64::from(v),
+            Property::Double(v) => v,
+            ref other => panic!("{file}: coordinate {other:?}"),
+        };
+        let positions: Vec<[f64; 3]> = ply.payload["vertex"]
+            .iter()
+            .map(|v| [num(&v["x"]), num(&v["y"]), num(&v["z"])])
+            .collect();
+        let mut faces = Vec::new();
+        for face in &ply.payload["face"] {
+            let idx: Vec<u32> = match face
+                .get("vertex_indices")
+                .or_else(|| face.get("vertex_index"))
+            {
+                Some(Property::ListInt(v)) => v.iter().map(|&i| i as u32).collect(),
+                Some(Property::ListUInt(v)) => v.clone(),
+                other => panic!("{file}: face list {other:?}"),
+            };
+            for k in 1..idx.len() - 1 {
+                faces.push([idx[0], idx[k], idx[k + 1]]);
+            }
+        }
+        assert_eq!(ours.positions, positions, "{file}");
+        assert_eq!(ours.faces, faces, "{file}");
+    }
+}
+
 /// The two PLY byte orders agree with a re-encoding of the same mesh.
 #[test]
 fn horse_round_trips_through_the_writer() {

@@ -155,8 +155,9 @@ fn vertex_index(
 /// Hand-written OFF reader (`OFF`, `COFF`, `NOFF`, `STOFF`, ... ASCII only).
 mod off;
 
-/// PLY reader on top of `ply-rs-bw`, reading one element at a time so that
-/// errors name the element.
+/// PLY reader: the header through `ply-rs-bw`; ASCII payloads one element at
+/// a time through it, so that errors name the element and the line; binary
+/// payloads read directly from the bytes.
 mod ply;
 
 /// OBJ reader, by hand: one pass over the bytes reading `v` and `f`
