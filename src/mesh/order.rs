@@ -21,7 +21,6 @@
 //! mean index spread of the faces first.
 
 use super::Mesh;
-use crate::spec::curvature::CurvatureField;
 
 /// How to order a mesh's vertices and faces in device memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -237,22 +236,6 @@ impl LocalityOrder {
             out[old as usize] = values[new];
         }
         out
-    }
-}
-
-impl LocalityOrder {
-    /// A curvature field computed on the reordered mesh, back in the input's
-    /// vertex order.
-    pub fn field_to_input(&self, f: &CurvatureField) -> CurvatureField {
-        CurvatureField {
-            normals: self.to_input(&f.normals),
-            areas: self.to_input(&f.areas),
-            k1: self.to_input(&f.k1),
-            k2: self.to_input(&f.k2),
-            d1: self.to_input(&f.d1),
-            d2: self.to_input(&f.d2),
-            dk: self.to_input(&f.dk),
-        }
     }
 }
 
