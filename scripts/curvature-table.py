@@ -155,6 +155,10 @@ def main():
 
     kernel_rows, process_rows = [], []
     for rt, env in runtimes:
+        # shapecue's program cache as a new user has it: empty at first, so
+        # that entries left in the user's own cache (from a run with
+        # SHAPECUE_CACHE_POCL=1, say) do not stand in for the default.
+        env = dict(env, SHAPECUE_CACHE_DIR=os.path.join(tmp, "cache-" + rt.split()[0]))
         for name, path in inputs:
             out, stats = os.path.join(tmp, "o.ply"), os.path.join(tmp, "s.json")
             base = [a.bin, "curvature", path, "-o", out, "--force"]
