@@ -330,6 +330,55 @@ fn binary_ply_any_types_both_byte_orders() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Binary vertices with a list property (rows of varying size), a face
+/// list whose count type is signed, and the errors of a negative count and
+/// of a list cut short.
+#[test]
+fn binary_ply_lists_in_vertices_and_bad_counts() {
+    let dir = scratch("binary-lists");
+    let head = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+                property list uchar float uv\nproperty float y\nproperty float z\n\
+                element face 1\nproperty list char int vertex_indices\nend_header\n";
+    let mut body = Vec::new();
+    for (k, p) in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        .iter()
+        .enumerate()
+    {
+        body.extend(p[0].to_le_bytes());
+        body.push(k as u8); // k texture coordinates
+        for _ in 0..k {
+            body.extend(0.5f32.to_le_bytes());
+        }
+        body.extend(p[1].to_le_bytes());
+        body.extend(p[2].to_le_bytes());
+    }
+    let face = |count: i8, idx: &[i32]| {
+        let mut b = vec![count as u8];
+        for v in idx {
+            b.extend(v.to_le_bytes());
+        }
+        b
+    };
+    let file = |tail: &[u8]| [head.as_bytes(), &body, tail].concat();
+    let p = write(&dir, "good.ply", &file(&face(3, &[0, 1, 2])));
+    let m = load(&p, &plain()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.positions[2], [0.0, 1.0, 0.0]);
+    assert_eq!(m.faces, vec![[0, 1, 2]]);
+
+    let msg = load_err(&write(&dir, "negative.ply", &file(&face(-1, &[0, 1, 2]))));
+    assert!(msg.contains("face 0") && msg.contains("negative"), "{msg}");
+    let msg = load_err(&write(&dir, "short.ply", &file(&face(4, &[0, 1, 2]))));
+    assert!(msg.contains("face 0") && msg.contains("end of file"), "{msg}");
+    let msg = load_err(&write(&dir, "range.ply", &file(&face(3, &[0, 1, 3]))));
+    assert!(msg.contains("face 0") && msg.contains("out of range"), "{msg}");
+    let cut = file(&face(3, &[0, 1, 2]));
+    // Vertices take 13, 17 and 21 bytes: 45 bytes pass the header's size
+    // check (13 per vertex, 1 per face at least) and end inside vertex 2.
+    let msg = load_err(&write(&dir, "cut-vertex.ply", &cut[..head.len() + 45]));
+    assert!(msg.contains("vertex 2") && msg.contains("end of file"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn off_pentagon_comments_and_counts_on_header_line() {
     let dir = scratch("off-pentagon");
