@@ -197,9 +197,11 @@ SC_OL SC_INLINE GM face_tensor(GTri t, GV3 ft, GV3 fb, GV3 n0, GV3 n1, GV3 n2, G
 #undef TENSOR_EDGE
     GT w11 = w00 + w22, w12 = w01;
     GT d0 = w00;
-    GT l10 = w01 / d0;
+    GT r0 = RL(1) / d0;
+    GT l10 = w01 * r0;
     GT d1 = w11 - l10 * w01;
-    GT l21 = w12 / d1;
+    GT r1 = RL(1) / d1;
+    GT l21 = w12 * r1;
 #ifdef SC_COMPAT
     GT d2 = w22; // trimesh2 2.16's pivot quirk (reads the lower triangle before filling it)
 #else
@@ -208,8 +210,8 @@ SC_OL SC_INLINE GM face_tensor(GTri t, GV3 ft, GV3 fb, GV3 n0, GV3 n1, GV3 n2, G
     GT y1 = m1 - l10 * m0;
     GT y2 = m2 - l21 * y1;
     GT x2 = y2 / d2;
-    GT x1 = y1 / d1 - l21 * x2;
-    GT x0 = m0 / d0 - l10 * x1;
+    GT x1 = y1 * r1 - l21 * x2;
+    GT x0 = m0 * r0 - l10 * x1;
     *x = v3(x0, x1, x2);
     return (d0 > 0) & (d1 > 0) & (d2 > 0) & isfinite(x0) & isfinite(x1) & isfinite(x2);
 }
@@ -237,19 +239,22 @@ SC_OL SC_INLINE GM face_dcurv(GTri t, GV3 ft, GV3 fb, GV3 f0, GV3 f1, GV3 f2, GV
     DCURV_EDGE(t.e2, sub3(f1, f0));
 #undef DCURV_EDGE
     GT d0 = a;
-    GT l10 = b / d0;
+    GT r0 = RL(1) / d0;
+    GT l10 = b * r0;
     GT d1 = RL(2) * a + c - l10 * b;
-    GT l21 = RL(2) * b / d1;
+    GT r1 = RL(1) / d1;
+    GT l21 = RL(2) * b * r1;
     GT d2 = a + RL(2) * c - l21 * (RL(2) * b);
-    GT l32 = b / d2;
+    GT r2 = RL(1) / d2;
+    GT l32 = b * r2;
     GT d3 = c - l32 * b;
     GT y1 = m1 - l10 * m0;
     GT y2 = m2 - l21 * y1;
     GT y3 = m3 - l32 * y2;
     GT x3 = y3 / d3;
-    GT x2 = y2 / d2 - l32 * x3;
-    GT x1 = y1 / d1 - l21 * x2;
-    GT x0 = m0 / d0 - l10 * x1;
+    GT x2 = y2 * r2 - l32 * x3;
+    GT x1 = y1 * r1 - l21 * x2;
+    GT x0 = m0 * r0 - l10 * x1;
     *x = v4(x0, x1, x2, x3);
     return (d0 > 0) & (d1 > 0) & (d2 > 0) & (d3 > 0) & isfinite(x0) & isfinite(x1) &
            isfinite(x2) & isfinite(x3);
