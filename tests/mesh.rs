@@ -368,14 +368,23 @@ fn binary_ply_lists_in_vertices_and_bad_counts() {
     let msg = load_err(&write(&dir, "negative.ply", &file(&face(-1, &[0, 1, 2]))));
     assert!(msg.contains("face 0") && msg.contains("negative"), "{msg}");
     let msg = load_err(&write(&dir, "short.ply", &file(&face(4, &[0, 1, 2]))));
-    assert!(msg.contains("face 0") && msg.contains("end of file"), "{msg}");
+    assert!(
+        msg.contains("face 0") && msg.contains("end of file"),
+        "{msg}"
+    );
     let msg = load_err(&write(&dir, "range.ply", &file(&face(3, &[0, 1, 3]))));
-    assert!(msg.contains("face 0") && msg.contains("out of range"), "{msg}");
+    assert!(
+        msg.contains("face 0") && msg.contains("out of range"),
+        "{msg}"
+    );
     let cut = file(&face(3, &[0, 1, 2]));
     // Vertices take 13, 17 and 21 bytes: 45 bytes pass the header's size
     // check (13 per vertex, 1 per face at least) and end inside vertex 2.
     let msg = load_err(&write(&dir, "cut-vertex.ply", &cut[..head.len() + 45]));
-    assert!(msg.contains("vertex 2") && msg.contains("end of file"), "{msg}");
+    assert!(
+        msg.contains("vertex 2") && msg.contains("end of file"),
+        "{msg}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
