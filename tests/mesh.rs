@@ -360,19 +360,19 @@ fn binary_ply_lists_in_vertices_and_bad_counts() {
         b
     };
     let file = |tail: &[u8]| [head.as_bytes(), &body, tail].concat();
-    let p = write(&dir, "good.ply", &file(&face(3, &[0, 1, 2])));
+    let p = write(&dir, "good.ply", file(&face(3, &[0, 1, 2])));
     let m = load(&p, &plain()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.positions[2], [0.0, 1.0, 0.0]);
     assert_eq!(m.faces, vec![[0, 1, 2]]);
 
-    let msg = load_err(&write(&dir, "negative.ply", &file(&face(-1, &[0, 1, 2]))));
+    let msg = load_err(&write(&dir, "negative.ply", file(&face(-1, &[0, 1, 2]))));
     assert!(msg.contains("face 0") && msg.contains("negative"), "{msg}");
-    let msg = load_err(&write(&dir, "short.ply", &file(&face(4, &[0, 1, 2]))));
+    let msg = load_err(&write(&dir, "short.ply", file(&face(4, &[0, 1, 2]))));
     assert!(
         msg.contains("face 0") && msg.contains("end of file"),
         "{msg}"
     );
-    let msg = load_err(&write(&dir, "range.ply", &file(&face(3, &[0, 1, 3]))));
+    let msg = load_err(&write(&dir, "range.ply", file(&face(3, &[0, 1, 3]))));
     assert!(
         msg.contains("face 0") && msg.contains("out of range"),
         "{msg}"
