@@ -814,6 +814,19 @@ fn wrong_pose_sizes_and_non_finite_poses_are_errors() {
     let other = est.read().unwrap();
     assert!(other.all_finite());
     assert_fields_close(&own, &other, 1e-5, "other frame faces");
+    // Placed reads: a reversal puts vertex v at n − 1 − v; a repeated or
+    // missing place is refused.
+    let n = m.n_vertices();
+    let rev: Vec<u32> = (0..n as u32).rev().collect();
+    let placed = est.read_placed(Some(&rev)).unwrap();
+    assert_eq!(placed.k1[n - 1 - 7], other.k1[7]);
+    assert_eq!(placed.d2[n - 1 - 7], other.d2[7]);
+    assert_eq!(placed.dk[0], other.dk[n - 1]);
+    let mut twice = rev.clone();
+    twice[1] = twice[0];
+    let e = est.read_placed(Some(&twice)).unwrap_err().to_string();
+    assert!(e.contains("permutation"), "{e}");
+    assert!(est.read_placed(Some(&rev[1..])).is_err());
 }
 
 #[test]

@@ -828,17 +828,21 @@ impl CurvatureEstimator {
     ///
     /// # Errors
     ///
-    /// [`Error::InvalidArgument`] when `place` does not have one index below
-    /// the vertex count per vertex; OpenCL errors of the reads.
+    /// [`Error::InvalidArgument`] when `place` is not a permutation of the
+    /// vertices; OpenCL errors of the reads.
     pub fn read_placed(&self, place: Option<&[u32]>) -> Result<CurvatureField> {
         let n = self.nv;
-        if let Some(p) = place
-            && (p.len() != n || p.iter().any(|&i| i as usize >= n))
-        {
-            return Err(Error::InvalidArgument(format!(
-                "read_placed: {} places, not one below {n} for each of {n} vertices",
-                p.len()
-            )));
+        if let Some(p) = place {
+            let mut seen = vec![false; n];
+            let permutation = p.len() == n
+                && p.iter()
+                    .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true));
+            if !permutation {
+                return Err(Error::InvalidArgument(format!(
+                    "read_placed: {} places are not a permutation of the {n} vertices",
+                    p.len()
+                )));
+            }
         }
         let at = |v: usize| place.map_or(v, |p| p[v] as usize);
         let s = self.norm.scale;
