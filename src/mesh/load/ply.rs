@@ -84,14 +84,11 @@ fn first_line(e: &ParseError) -> String {
 }
 
 /// One-line description of a parser error met while reading element
-/// `def`; `ascii_line` is the line number and text of an ASCII element.
-fn describe(e: &ParseError, def: &ElementDef, ascii_line: Option<(usize, &str)>) -> String {
-    match (e.kind(), ascii_line) {
-        (ErrorKind::UnexpectedEof, _) => format!(
-            "unexpected end of file: the header declares {} '{}' elements",
-            def.count, def.name
-        ),
-        (ErrorKind::InvalidInput, Some((ln, text))) => {
+/// `def` from line `ln`, whose text is `text`.
+fn describe(e: &ParseError, def: &ElementDef, (ln, text): (usize, &str)) -> String {
+    match e.kind() {
+        ErrorKind::UnexpectedEof => eof_problem(def),
+        ErrorKind::InvalidInput => {
             let props: Vec<&str> = def.properties.keys().map(String::as_str).collect();
             let text: String = text.trim().chars().take(80).collect();
             format!(
@@ -107,11 +104,10 @@ fn describe(e: &ParseError, def: &ElementDef, ascii_line: Option<(usize, &str)>)
     }
 }
 
-/// The payload stream: the bytes after the header and, for ASCII files,
-/// the number of the next line.
+/// An ASCII payload: the bytes after the header and the number of the
+/// next line (binary payloads are read by [`parse_binary`]).
 struct Stream<'a> {
     reader: Reader<&'a [u8]>,
-    encoding: Encoding,
     line_no: usize,
     line: String,
 }
@@ -123,30 +119,21 @@ impl Stream<'_> {
         parser: &Parser<E>,
         def: &ElementDef,
     ) -> std::result::Result<E, ParseError> {
-        match self.encoding {
-            Encoding::BinaryLittleEndian => {
-                parser.read_little_endian_element(self.reader.get_mut(), def)
+        // One element per line; blank lines are tolerated.
+        loop {
+            self.line.clear();
+            self.line_no += 1;
+            if self.reader.get_mut().read_line(&mut self.line)? == 0 {
+                return Err(std::io::Error::from(ErrorKind::UnexpectedEof).into());
             }
-            Encoding::BinaryBigEndian => parser.read_big_endian_element(self.reader.get_mut(), def),
-            Encoding::Ascii => {
-                // One element per line; blank lines are tolerated.
-                loop {
-                    self.line.clear();
-                    self.line_no += 1;
-                    if self.reader.get_mut().read_line(&mut self.line)? == 0 {
-                        return Err(std::io::Error::from(ErrorKind::UnexpectedEof).into());
-                    }
-                    if !self.line.trim().is_empty() {
-                        let e = parser.read_ascii_element(&self.line, def)?;
-                        // The parser ignores values past the declared ones;
-                        // a line with more is a malformed file, not a
-                        // comment.
-                        if extra_values(&self.line, def) {
-                            return Err(std::io::Error::from(ErrorKind::InvalidInput).into());
-                        }
-                        return Ok(e);
-                    }
+            if !self.line.trim().is_empty() {
+                let e = parser.read_ascii_element(&self.line, def)?;
+                // The parser ignores values past the declared ones; a line
+                // with more is a malformed file, not a comment.
+                if extra_values(&self.line, def) {
+                    return Err(std::io::Error::from(ErrorKind::InvalidInput).into());
                 }
+                return Ok(e);
             }
         }
     }
@@ -158,20 +145,13 @@ impl Stream<'_> {
         source: &str,
         mut sink: impl FnMut(usize, E) -> Result<()>,
     ) -> Result<()> {
-        if def.properties.is_empty() && self.encoding != Encoding::Ascii {
-            // Binary elements without properties take no bytes: there is
-            // nothing to read, however many the header declares.
-            return Ok(());
-        }
         let parser = Parser::<E>::new();
         for i in 0..def.count {
             let e = self.element(&parser, def).map_err(|e| {
-                let ascii = (self.encoding == Encoding::Ascii)
-                    .then_some((self.line_no, self.line.as_str()));
                 Error::input(
                     source,
                     format!("{} {i}", def.name),
-                    describe(&e, def, ascii),
+                    describe(&e, def, (self.line_no, self.line.as_str())),
                 )
             })?;
             sink(i, e)?;
@@ -409,19 +389,18 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     check_header(&header, source)?;
     let payload = reader.get_ref().len();
     check_counts(&header, reader.get_ref(), source)?;
+    let nv = header.elements.get("vertex").map_or(0, |d| d.count);
+    if header.encoding != Encoding::Ascii {
+        let big = header.encoding == Encoding::BinaryBigEndian;
+        return parse_binary(&header, reader.get_ref(), big, nv, source);
+    }
     let mut stream = Stream {
         // `line()` is the number of the first payload line; `element`
         // increments before reading.
         line_no: reader.line().saturating_sub(1),
         reader,
-        encoding: header.encoding,
         line: String::new(),
     };
-    let nv = header.elements.get("vertex").map_or(0, |d| d.count);
-    if header.encoding != Encoding::Ascii {
-        let big = header.encoding == Encoding::BinaryBigEndian;
-        return parse_binary(&header, stream.reader.get_ref(), big, nv, source);
-    }
 
     let mut positions = Vec::new();
     let mut faces = Vec::new();
@@ -438,26 +417,49 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
             "face" => {
                 faces.reserve(capacity(def, header.encoding, payload));
                 stream.read_all(def, source, |i, f: Face| {
-                    let element = || format!("face {i}");
-                    if f.0.len() < 3 {
-                        return Err(Error::input(
-                            source,
-                            element(),
-                            format!("{} vertex indices; a face needs at least 3", f.0.len()),
-                        ));
-                    }
-                    poly.clear();
-                    for &v in &f.0 {
-                        poly.push(vertex_index(v, nv, source, element)?);
-                    }
-                    fan(&poly, &mut faces);
-                    Ok(())
+                    add_polygon(f.0.into_iter(), i, nv, source, &mut poly, &mut faces)
                 })?;
             }
             _ => stream.read_all(def, source, |_, _: Skip| Ok(()))?,
         }
     }
     Ok(Mesh { positions, faces })
+}
+
+/// The end-of-file problem of an element of `def` cut short.
+fn eof_problem(def: &ElementDef) -> String {
+    format!(
+        "unexpected end of file: the header declares {} '{}' elements",
+        def.count, def.name
+    )
+}
+
+/// Checks the vertex indices of face `i` (at least three, each a vertex of
+/// the file's `nv`) and appends its fan triangulation to `faces`; `poly` is
+/// scratch space.
+#[inline]
+fn add_polygon(
+    indices: impl ExactSizeIterator<Item = i64>,
+    i: usize,
+    nv: usize,
+    source: &str,
+    poly: &mut Vec<u32>,
+    faces: &mut Vec<[u32; 3]>,
+) -> Result<()> {
+    let element = || format!("face {i}");
+    if indices.len() < 3 {
+        return Err(Error::input(
+            source,
+            element(),
+            format!("{} vertex indices; a face needs at least 3", indices.len()),
+        ));
+    }
+    poly.clear();
+    for v in indices {
+        poly.push(vertex_index(v, nv, source, element)?);
+    }
+    fan(poly, faces);
+    Ok(())
 }
 
 /// What the binary reader keeps of a property.
@@ -563,14 +565,7 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
                 .and_then(|rest| rest.get(..def.count.checked_mul(stride)?))
                 .ok_or_else(|| {
                     let i = (body.len() - pos) / stride;
-                    Error::input(
-                        source,
-                        format!("{name} {i}"),
-                        format!(
-                            "unexpected end of file: the header declares {} '{name}' elements",
-                            def.count
-                        ),
-                    )
+                    Error::input(source, format!("{name} {i}"), eof_problem(def))
                 })?;
             positions.extend(
                 rows.chunks_exact(stride).map(|r| {
@@ -582,18 +577,10 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
         }
         for i in 0..def.count {
             let element = || format!("{name} {i}");
-            let eof = || {
-                Error::input(
-                    source,
-                    element(),
-                    format!(
-                        "unexpected end of file: the header declares {} '{name}' elements",
-                        def.count
-                    ),
-                )
-            };
+            let eof = || Error::input(source, element(), eof_problem(def));
             let mut p = [0.0; 3];
-            let mut listed = false;
+            // The bytes and item type of the face's index list.
+            let mut list: (&[u8], &ScalarType) = (&[], &ScalarType::Int);
             for &(ty, role, pname) in &layout {
                 match ty {
                     PropertyType::Scalar(t) => {
@@ -621,12 +608,7 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
                         let items = body.get(pos..pos + len).ok_or_else(eof)?;
                         pos += len;
                         if role == Role::Indices {
-                            listed = true;
-                            poly.clear();
-                            for item in items.chunks_exact(size) {
-                                let v = binary_value(item, t, big) as i64;
-                                poly.push(vertex_index(v, nv, source, element)?);
-                            }
+                            list = (items, t);
                         }
                     }
                 }
@@ -634,15 +616,11 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
             if is_vertex {
                 positions.push(p);
             } else if is_face {
-                let n = if listed { poly.len() } else { 0 };
-                if n < 3 {
-                    return Err(Error::input(
-                        source,
-                        element(),
-                        format!("{n} vertex indices; a face needs at least 3"),
-                    ));
-                }
-                fan(&poly, &mut faces);
+                let (items, t) = list;
+                let indices = items
+                    .chunks_exact(scalar_size(t))
+                    .map(|b| binary_value(b, t, big) as i64);
+                add_polygon(indices, i, nv, source, &mut poly, &mut faces)?;
             }
         }
     }
