@@ -38,19 +38,6 @@ fn write_obj(path: &Path, m: &Mesh) -> std::io::Result<()> {
     w.flush()
 }
 
-/// A curvature field of zeros (the values do not change a file's size).
-fn zero_field(n: usize) -> CurvatureField {
-    CurvatureField {
-        normals: vec![[0.0; 3]; n],
-        areas: vec![0.0; n],
-        k1: vec![0.0; n],
-        k2: vec![0.0; n],
-        d1: vec![[0.0; 3]; n],
-        d2: vec![[0.0; 3]; n],
-        dk: vec![[0.0; 4]; n],
-    }
-}
-
 fn bench_load(c: &mut Criterion, tmp: &Path) {
     let mut inputs: Vec<(&str, PathBuf)> = Vec::new();
     for (name, file) in [
@@ -69,9 +56,14 @@ fn bench_load(c: &mut Criterion, tmp: &Path) {
             Ok(()) => inputs.push(("torus-500k-obj", p)),
             Err(e) => eprintln!("mesh_io bench: cannot write {}: {e}", p.display()),
         }
-        // As `shapecue curvature -o` writes it: 19 float properties.
+        // As `shapecue curvature -o` writes it: 19 float properties (zeros:
+        // the values do not change the file's size).
         let p = tmp.join("torus-500k.ply");
-        match shapecue::export::ply::write_ply(&p, &torus, Some(&zero_field(torus.n_vertices()))) {
+        match shapecue::export::ply::write_ply(
+            &p,
+            &torus,
+            Some(&CurvatureField::zeros(torus.n_vertices())),
+        ) {
             Ok(_) => inputs.push(("torus-500k-curvature-ply", p)),
             Err(e) => eprintln!("mesh_io bench: cannot write {}: {e}", p.display()),
         }

@@ -25,23 +25,8 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
     let d = scratch("ply");
     let ply = d.join("sub/torus.ply");
     let json = d.join("torus.json");
-    let out = cli()
-        .args([
-            "curvature",
-            "--generate",
-            "torus",
-            "--resolution",
-            "2000",
-            "-o",
-        ])
-        .arg(&ply)
-        .arg("--stats")
-        .arg(&json)
-        // The paper's scheme, whose passes are listed below.
-        .args(["--accumulate", "atomic"])
-        .output()
-        .unwrap();
-    common::assert_succeeded(&out);
+    // The paper's scheme, whose passes are listed below.
+    let stats = curvature_torus(&ply, &json, 2000, &["--accumulate", "atomic"]);
     let (names, values, faces) = shapecue::export::ply::read_ply_properties(&ply).unwrap();
     assert_eq!(
         names.join(" "),
@@ -50,8 +35,6 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
     assert!(!faces.is_empty());
     // torus R=1 r=0.4: k1 = 2.5 everywhere
     assert!(values.iter().all(|v| (v[7] - 2.5).abs() < 0.1), "k1 off");
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     for key in [
         "device",
         "passes",
@@ -165,35 +148,38 @@ fn cpu_reference_and_every_variant_run_from_the_cli() {
     }
 }
 
-/// Runs `shapecue curvature` on a generated torus of about 3,000 vertices
-/// with `extra` arguments, writing `<name>.ply` and `<name>.json` in `d`;
-/// checks it succeeded and returns the PLY's path and the stats.
+/// Runs `shapecue curvature` on a generated torus of about `resolution`
+/// vertices with `extra` arguments, writing `ply` and the stats `json`;
+/// checks it succeeded and returns the stats.
+fn curvature_torus(
+    ply: &std::path::Path,
+    json: &std::path::Path,
+    resolution: usize,
+    extra: &[&str],
+) -> serde_json::Value {
+    let out = cli()
+        .args(["curvature", "--generate", "torus", "--resolution"])
+        .arg(resolution.to_string())
+        .arg("-o")
+        .arg(ply)
+        .arg("--stats")
+        .arg(json)
+        .args(extra)
+        .output()
+        .unwrap();
+    common::assert_succeeded(&out);
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
+/// [`curvature_torus`] of about 3,000 vertices, writing `<name>.ply` and
+/// `<name>.json` in `d`: the PLY's path and the stats.
 fn curvature_torus_3000(
     d: &std::path::Path,
     name: &str,
     extra: &[&str],
 ) -> (std::path::PathBuf, serde_json::Value) {
-    let (ply, json) = (
-        d.join(format!("{name}.ply")),
-        d.join(format!("{name}.json")),
-    );
-    let out = cli()
-        .args([
-            "curvature",
-            "--generate",
-            "torus",
-            "--resolution",
-            "3000",
-            "-o",
-        ])
-        .arg(&ply)
-        .arg("--stats")
-        .arg(&json)
-        .args(extra)
-        .output()
-        .unwrap();
-    common::assert_succeeded(&out);
-    let stats = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let ply = d.join(format!("{name}.ply"));
+    let stats = curvature_torus(&ply, &d.join(format!("{name}.json")), 3000, extra);
     (ply, stats)
 }
 

@@ -41,6 +41,19 @@ pub struct CurvatureField {
 }
 
 impl CurvatureField {
+    /// A field of `n` vertices with every value zero.
+    pub fn zeros(n: usize) -> Self {
+        CurvatureField {
+            normals: vec![[0.0; 3]; n],
+            areas: vec![0.0; n],
+            k1: vec![0.0; n],
+            k2: vec![0.0; n],
+            d1: vec![[0.0; 3]; n],
+            d2: vec![[0.0; 3]; n],
+            dk: vec![[0.0; 4]; n],
+        }
+    }
+
     /// Number of vertices.
     pub fn len(&self) -> usize {
         self.k1.len()

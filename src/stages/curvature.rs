@@ -846,15 +846,7 @@ impl CurvatureEstimator {
         }
         let at = |v: usize| place.map_or(v, |p| p[v] as usize);
         let s = self.norm.scale;
-        let mut f = CurvatureField {
-            normals: vec![[0.0; 3]; n],
-            areas: vec![0.0; n],
-            k1: vec![0.0; n],
-            k2: vec![0.0; n],
-            d1: vec![[0.0; 3]; n],
-            d2: vec![[0.0; 3]; n],
-            dk: vec![[0.0; 4]; n],
-        };
+        let mut f = CurvatureField::zeros(n);
         let mut st = vec![0u8; 4 * n * self.real];
         // The scalings are those of `Normalization::unapply`, operation for
         // operation, so that the values are the same bits.
