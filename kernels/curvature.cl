@@ -75,7 +75,7 @@
 // per-face kernels are bound by arithmetic, and a 16-lane division costs
 // several multiplications): tensor corners 84 → 78 ms and dcurv corners
 // 86 → 79 ms on the 2M torus on PoCL (medians of 4 interleaved processes of
-// 7 runs), results within an ulp of the quotients the CPU twin keeps.
+// 7 runs), results within an ulp of the quotients (the CPU twin does the same).
 // Memory order matters on scanned meshes too: the host renumbers a
 // scattered mesh along a Morton curve first (src/mesh/order.rs). On the
 // Stanford bunny (PoCL, medians of 41 runs per kernel) that makes the ring

@@ -191,10 +191,13 @@ pub fn face_tensor(t: &Tri, ft: V3, fb: V3, n: [V3; 3], compat: Compat) -> Optio
         m2 += dnv * v;
     }
     let (w11, w12) = (w00 + w22, w01);
+    // One division per pivot, as in the kernel (kernels/curvature.cl).
     let d0 = w00;
-    let l10 = w01 / d0;
+    let r0 = 1.0 / d0;
+    let l10 = w01 * r0;
     let d1 = w11 - l10 * w01;
-    let l21 = w12 / d1;
+    let r1 = 1.0 / d1;
+    let l21 = w12 * r1;
     let d2 = match compat {
         Compat::Trimesh2 => w22,
         Compat::Exact => w22 - l21 * w12,
@@ -205,8 +208,8 @@ pub fn face_tensor(t: &Tri, ft: V3, fb: V3, n: [V3; 3], compat: Compat) -> Optio
     let y1 = m1 - l10 * m0;
     let y2 = m2 - l21 * y1;
     let x2 = y2 / d2;
-    let x1 = y1 / d1 - l21 * x2;
-    let x0 = m0 / d0 - l10 * x1;
+    let x1 = y1 * r1 - l21 * x2;
+    let x0 = m0 * r0 - l10 * x1;
     let x = [x0, x1, x2];
     x.iter().all(|c| c.is_finite()).then_some(x)
 }
@@ -229,11 +232,14 @@ pub fn face_dcurv(t: &Tri, ft: V3, fb: V3, fc: [V3; 3]) -> Option<[f64; 4]> {
         m[3] += v * d[2];
     }
     let d0 = a;
-    let l10 = b / d0;
+    let r0 = 1.0 / d0;
+    let l10 = b * r0;
     let d1 = 2.0 * a + c - l10 * b;
-    let l21 = 2.0 * b / d1;
+    let r1 = 1.0 / d1;
+    let l21 = 2.0 * b * r1;
     let d2 = a + 2.0 * c - l21 * (2.0 * b);
-    let l32 = b / d2;
+    let r2 = 1.0 / d2;
+    let l32 = b * r2;
     let d3 = c - l32 * b;
     if !(d0 > 0.0 && d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
         return None;
@@ -242,9 +248,9 @@ pub fn face_dcurv(t: &Tri, ft: V3, fb: V3, fc: [V3; 3]) -> Option<[f64; 4]> {
     let y2 = m[2] - l21 * y1;
     let y3 = m[3] - l32 * y2;
     let x3 = y3 / d3;
-    let x2 = y2 / d2 - l32 * x3;
-    let x1 = y1 / d1 - l21 * x2;
-    let x0 = m[0] / d0 - l10 * x1;
+    let x2 = y2 * r2 - l32 * x3;
+    let x1 = y1 * r1 - l21 * x2;
+    let x0 = m[0] * r0 - l10 * x1;
     let x = [x0, x1, x2, x3];
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
