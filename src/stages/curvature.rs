@@ -774,18 +774,20 @@ impl CurvatureEstimator {
     /// read-back is ~300 MB of f64s, and every intermediate vector costs its
     /// page faults).
     fn to_f64(&self, bytes: &[u8]) -> Vec<f64> {
-        bytes
-            .chunks_exact(self.real)
-            .map(|b| self.real_at(b))
-            .collect()
+        self.rows::<1>(bytes).map(|[x]| x).collect()
     }
 
     fn to_vecs<const N: usize>(&self, bytes: &[u8]) -> Vec<[f64; N]> {
+        self.rows(bytes).collect()
+    }
+
+    /// The values of a buffer of `N` device reals per vertex, vertex by
+    /// vertex, as f64.
+    fn rows<'b, const N: usize>(&'b self, bytes: &'b [u8]) -> impl Iterator<Item = [f64; N]> + 'b {
         let r = self.real;
         bytes
             .chunks_exact(N * r)
-            .map(|c| std::array::from_fn(|i| self.real_at(&c[i * r..(i + 1) * r])))
-            .collect()
+            .map(move |c| std::array::from_fn(|i| self.real_at(&c[i * r..(i + 1) * r])))
     }
 
     /// Reads the raw device state (normalized coordinates): the seven
@@ -850,37 +852,47 @@ impl CurvatureEstimator {
         let mut st = vec![0u8; 4 * n * self.real];
         // The scalings are those of `Normalization::unapply`, operation for
         // operation, so that the values are the same bits.
-        self.each::<3>(self.fetch(&mut st, &self.nrm, 3)?, |v, x| {
-            f.normals[at(v)] = x
-        });
-        self.each::<1>(self.fetch(&mut st, &self.area, 1)?, |v, [a]| {
-            f.areas[at(v)] = a * (s * s)
-        });
-        self.each::<3>(self.fetch(&mut st, &self.pd1, 3)?, |v, x| f.d1[at(v)] = x);
-        self.each::<3>(self.fetch(&mut st, &self.pd2, 3)?, |v, x| f.d2[at(v)] = x);
-        self.each::<2>(self.fetch(&mut st, &self.kk, 2)?, |v, [a, b]| {
+        for (v, x) in self
+            .rows::<3>(self.fetch(&mut st, &self.nrm, 3)?)
+            .enumerate()
+        {
+            f.normals[at(v)] = x;
+        }
+        for (v, [a]) in self
+            .rows::<1>(self.fetch(&mut st, &self.area, 1)?)
+            .enumerate()
+        {
+            f.areas[at(v)] = a * (s * s);
+        }
+        for (v, x) in self
+            .rows::<3>(self.fetch(&mut st, &self.pd1, 3)?)
+            .enumerate()
+        {
+            f.d1[at(v)] = x;
+        }
+        for (v, x) in self
+            .rows::<3>(self.fetch(&mut st, &self.pd2, 3)?)
+            .enumerate()
+        {
+            f.d2[at(v)] = x;
+        }
+        for (v, [a, b]) in self
+            .rows::<2>(self.fetch(&mut st, &self.kk, 2)?)
+            .enumerate()
+        {
             let i = at(v);
             f.k1[i] = a / s;
             f.k2[i] = b / s;
-        });
+        }
         if self.opts.dcurv {
-            self.each::<4>(self.fetch(&mut st, &self.dk, 4)?, |v, d| {
-                f.dk[at(v)] = d.map(|d| d / (s * s))
-            });
+            for (v, d) in self
+                .rows::<4>(self.fetch(&mut st, &self.dk, 4)?)
+                .enumerate()
+            {
+                f.dk[at(v)] = d.map(|d| d / (s * s));
+            }
         }
         Ok(f)
-    }
-
-    /// Calls `put(v, values)` for each vertex `v` of a buffer of `N` device
-    /// reals per vertex.
-    fn each<const N: usize>(&self, bytes: &[u8], mut put: impl FnMut(usize, [f64; N])) {
-        let r = self.real;
-        for (v, c) in bytes.chunks_exact(N * r).enumerate() {
-            put(
-                v,
-                std::array::from_fn(|i| self.real_at(&c[i * r..(i + 1) * r])),
-            );
-        }
     }
 }
 
