@@ -115,7 +115,12 @@
 // counted once; the rule is the same at every precision and in the CPU twin. A least-squares system whose pivots are not positive (rounding
 // on extreme slivers) is skipped and counted. Nothing here can write NaN.
 //
-// Build options: -DSC_DOUBLE (double precision), -DSC_COMPAT (trimesh2 2.16:
+// Build options: -DSC_GATHER (the gather scheme: the program holds the
+// corner and ring-sum kernels and not the atomic ones, and the reverse without
+// it; the program PoCL 3.1 builds from source is then about 5 % quicker to
+// build, 650-710 against 680-750 ms on the bunny with an empty kernel cache,
+// and no quicker from its warm cache), -DSC_LANES=N (above),
+// -DSC_DOUBLE (double precision), -DSC_COMPAT (trimesh2 2.16:
 // its 3×3 LDLᵀ third pivot Σv² instead of Σv² − (Σuv)²/d1, and |k1| ≥ |k2|
 // ordering instead of k1 ≥ k2).
 // Shared with the host (src/spec/curvature.rs): Precision::F64 ↔ SC_DOUBLE,
@@ -416,6 +421,9 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
 
 // ---------------------------------------------------------------------------
 // Atomic (scatter) variant: one work-item per face, float atomics on the one-ring.
+// A program holds the kernels of one scheme: these without SC_GATHER, the
+// gather kernels below with it (the host sets it for the gather scheme).
+#ifndef SC_GATHER
 
 __kernel void curv_clear(uint nv, __global REAL *nrm, __global REAL *area, __global REAL *tens,
                          __global REAL *dk)
@@ -513,6 +521,9 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
     atomic_add4(dk, v2, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
 }
 
+#endif // !SC_GATHER
+
+#ifdef SC_GATHER
 // ---------------------------------------------------------------------------
 // Gather variant. Face kernels: no atomics, no inner loops, no arrays, and
 // SC_LANES faces per work-item (one face block); a skipped face writes zeros
@@ -651,6 +662,8 @@ __kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off, __global co
     dk[4 * gid + 2] = s.z;
     dk[4 * gid + 3] = s.w;
 }
+#endif // SC_GATHER
+
 // ---------------------------------------------------------------------------
 // Positions of a device-resident mesh (a fused isosurface, index space):
 // pos = a ⊙ src + b, the host's normalization folded with the volume's

@@ -36,7 +36,17 @@ fn a_build_failure_returns_the_file_and_the_build_log() {
 fn every_embedded_kernel_family_builds_in_every_variant() {
     let gpu = Gpu::new(None).unwrap();
     let f = kernel_file("curvature").unwrap();
-    for opts in ["", "-DSC_COMPAT", "-DSC_DOUBLE", "-DSC_DOUBLE -DSC_COMPAT"] {
+    // Without SC_GATHER the program holds the atomic scheme's kernels, with
+    // it the gather scheme's (per-face kernels on 1 or 16 lanes).
+    for opts in [
+        "",
+        "-DSC_COMPAT",
+        "-DSC_DOUBLE",
+        "-DSC_DOUBLE -DSC_COMPAT",
+        "-DSC_GATHER",
+        "-DSC_GATHER -DSC_LANES=16",
+        "-DSC_GATHER -DSC_DOUBLE -DSC_COMPAT",
+    ] {
         if opts.contains("DOUBLE") && !gpu.info.fp64 {
             continue;
         }

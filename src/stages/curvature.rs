@@ -164,7 +164,8 @@ pub struct UploadMs {
 }
 
 struct Kernels {
-    clear: Kernel,
+    /// Atomic variant only: zeroes the accumulators.
+    clear: Option<Kernel>,
     /// Atomic variant: the per-face scatter kernel; gather: the per-face corner kernel.
     normals_areas: Kernel,
     frames: Kernel,
@@ -194,8 +195,12 @@ struct GatherBufs {
 /// per work-item in the gather variant's per-face kernels.
 pub fn build_options(opts: &CurvatureOptions, lanes: u32) -> String {
     let mut s = String::new();
-    if opts.accumulate == Accumulate::Gather && lanes > 1 {
-        s.push_str(&format!("-DSC_LANES={lanes} "));
+    if opts.accumulate == Accumulate::Gather {
+        // The program then holds the gather kernels only (smaller to load).
+        s.push_str("-DSC_GATHER ");
+        if lanes > 1 {
+            s.push_str(&format!("-DSC_LANES={lanes} "));
+        }
     }
     if opts.accumulate == Accumulate::AtomicNative {
         // atomic_fetch_add_explicit on atomic_float needs OpenCL C 2.0 or later
@@ -305,7 +310,11 @@ impl CurvatureEstimator {
             None
         };
         let k = Kernels {
-            clear: gpu.kernel(&program, "curv_clear")?,
+            clear: if gather {
+                None
+            } else {
+                Some(gpu.kernel(&program, "curv_clear")?)
+            },
             normals_areas: gpu.kernel(&program, &kname("curv_normals_areas"))?,
             frames: gpu.kernel(&program, "curv_frames")?,
             count_empty: gpu.kernel(&program, "curv_count_empty")?,
@@ -672,8 +681,8 @@ impl CurvatureEstimator {
             Ok(evs)
         };
 
-        if self.gather.is_none() {
-            let ev = launch(g, &self.k.clear, nv, &[Arg::U32(nv32), nrm, area, tens, dk])?;
+        if let Some(clear) = &self.k.clear {
+            let ev = launch(g, clear, nv, &[Arg::U32(nv32), nrm, area, tens, dk])?;
             record(Pass::Clear, ev);
         }
         if Pass::NormalsAreas <= last {
