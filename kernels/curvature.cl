@@ -123,8 +123,9 @@
 // -DSC_DOUBLE (double precision), -DSC_COMPAT (trimesh2 2.16:
 // its 3×3 LDLᵀ third pivot Σv² instead of Σv² − (Σuv)²/d1, and |k1| ≥ |k2|
 // ordering instead of k1 ≥ k2).
-// Shared with the host (src/spec/curvature.rs): Precision::F64 ↔ SC_DOUBLE,
-// Compat::Trimesh2 ↔ SC_COMPAT, the counters uint[4] in CurvatureCounts order.
+// Shared with the host (src/spec/curvature.rs): Accumulate::Gather ↔
+// SC_GATHER, Precision::F64 ↔ SC_DOUBLE, Compat::Trimesh2 ↔ SC_COMPAT, the
+// counters uint[4] in CurvatureCounts order.
 
 // Mirrored by the DEGEN_* constants of src/spec/curvature.rs (the CPU twin uses them).
 #define DEGEN_AREA_REL RL(5e-8)                  // × (l0² + l1² + l2²)
