@@ -225,14 +225,9 @@ fn gather_is_bitwise_reproducible_and_agrees_with_atomic() {
     assert_fields_close(&at, &a, 1e-6, "atomic vs gather");
 }
 
-/// A mesh in scattered order (its vertices and faces shuffled, as in scanned
-/// meshes) is computed in a Morton order by the one-shot estimate and the
-/// CLI, and gives the input-order results to rounding: the same curvatures
-/// and, since the frames are seeded from the input's owning faces, the same
-/// principal directions with the same signs, and the same derivative.
-#[test]
-fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
-    use shapecue::mesh::order::{LocalityOrder, MeshOrder};
+/// A 96 × 48 torus with its vertices and faces in a fixed pseudo-random
+/// order (as in scanned meshes).
+fn shuffled_torus() -> Mesh {
     let t = mesh::torus(1.0, 0.4, 96, 48);
     let nv = t.n_vertices();
     // A fixed pseudo-random permutation of the vertices and of the faces.
@@ -256,7 +251,20 @@ fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
         .iter()
         .map(|&f| t.faces[f as usize].map(|v| pv[v as usize]))
         .collect();
-    let m = Mesh::new(positions, faces, "shuffled torus").unwrap();
+    Mesh::new(positions, faces, "shuffled torus").unwrap()
+}
+
+/// A mesh in scattered order (its vertices and faces shuffled, as in scanned
+/// meshes) is computed in a Morton order by the one-shot estimate and the
+/// CLI, and gives the input-order results to rounding: the same curvatures
+/// and, since the frames are seeded from the input's owning faces, the same
+/// principal directions with the same signs, and the same derivative.
+#[test]
+fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
+    use shapecue::mesh::order::{LocalityOrder, MeshOrder};
+    let t = mesh::torus(1.0, 0.4, 96, 48);
+    let nv = t.n_vertices();
+    let m = shuffled_torus();
     assert!(LocalityOrder::scattered(nv, &m.faces));
     assert!(
         LocalityOrder::choose(&t, MeshOrder::Auto).is_none(),
@@ -288,6 +296,50 @@ fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
         let e = rmse(&a, &b) / rmse(&a, &vec![0.0; a.len()]);
         eprintln!("{acc:?}: dk relative RMS difference {e:.2e}");
         assert!(e < 1e-4, "{acc:?}: dk relative RMS difference {e:.2e}");
+    }
+}
+
+/// The device buffers read in place (mapped, converted vertex by vertex,
+/// as the CLI writes its PLY file) give the bits of the copying read, in
+/// the input's order after a Morton reordering, in both precisions, with
+/// and without the derivative (zeros without it, as the copy has).
+#[test]
+fn mapped_reads_give_the_bits_of_copied_reads() {
+    use shapecue::mesh::order::MeshOrder;
+    use shapecue::stages::curvature::OrderedEstimator;
+    let m = shuffled_torus();
+    for (precision, dcurv) in [
+        (Precision::F32, true),
+        (Precision::F64, true),
+        (Precision::F32, false),
+    ] {
+        let o = CurvatureOptions {
+            dcurv,
+            ..with(CurvatureOptions::default(), Accumulate::Gather, precision)
+        };
+        let mut est = OrderedEstimator::new(gpu(), &m, o, MeshOrder::Auto).unwrap();
+        assert!(est.order.is_some(), "the shuffled torus is reordered");
+        est.est.run().unwrap();
+        let copied = est.read().unwrap();
+        let mapped = est.mapped().unwrap();
+        assert_eq!(mapped.len(), m.n_vertices());
+        for i in 0..m.n_vertices() {
+            let (a, b) = (copied.vertex(i), mapped.vertex(i));
+            let bits = |v: &shapecue::spec::curvature::VertexCurvature| {
+                let mut x: Vec<u64> = v.normal.iter().map(|x| x.to_bits()).collect();
+                x.extend([v.area, v.k1, v.k2].map(f64::to_bits));
+                x.extend(v.d1.iter().chain(&v.d2).chain(&v.dk).map(|x| x.to_bits()));
+                x
+            };
+            assert_eq!(
+                bits(&a),
+                bits(&b),
+                "{precision:?} dcurv {dcurv}: vertex {i}"
+            );
+        }
+        if !dcurv {
+            assert!((0..m.n_vertices()).all(|i| mapped.vertex(i).dk == [0.0; 4]));
+        }
     }
 }
 

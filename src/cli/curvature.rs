@@ -5,8 +5,10 @@
 //! The stats time every phase of the command (`phases_ms`: load = parse and
 //! validation, device, reorder (the memory order of `--order`), program
 //! build, topology, normalisation, upload, the first run with the driver's
-//! compilation at first launch, read-back (with the mapping back to the
-//! input's order), program-cache write, PLY write), and `--runs N` adds N
+//! compilation at first launch, program-cache write, read-back (the device
+//! buffers mapped, not copied: CPU runtimes hand over their own memory), PLY
+//! write (with each value's conversion, scaling back and mapping back to
+//! the input's order, done as it is written)), and `--runs N` adds N
 //! timed runs of the device passes after the one whose results are written,
 //! with medians.
 
@@ -16,7 +18,7 @@ use clap::Args;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
-use shapecue::spec::curvature::{Accumulate, Compat, Curvature, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use shapecue::spec::timing::Timing;
 use shapecue::stages::curvature::OrderedEstimator;
 use std::path::PathBuf;
@@ -136,7 +138,10 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         phases.insert(name.to_string(), serde_json::json!(ms));
     };
     phase("load", load_ms);
-    let (c, mut stats) = if a.cpu {
+    // The results: the CPU twin's field, or the device's buffers, read in
+    // place below (no copy of the field: on a 2M-vertex mesh a copy is
+    // 256 MB of fresh pages, whose first touch costs more than the rest).
+    let (field, mut device, counts, mut stats) = if a.cpu {
         // The reference computes in f64, so it judges faces by f64 rounding.
         let opts = CurvatureOptions {
             precision: shapecue::spec::curvature::Precision::F64,
@@ -160,7 +165,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             stats["wall_median_ms"] = serde_json::json!(median(&mut walls));
         }
         phase("first_run", c.timing.wall_ms);
-        (c, stats)
+        (Some(c.field), None, c.counts, stats)
     } else {
         let t = Instant::now();
         let gpu = Arc::new(Gpu::new(device)?);
@@ -177,33 +182,29 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         phase("upload", o.est.upload_ms().write);
         let timing = o.est.run().with_context(setup)?;
         phase("first_run", timing.wall_ms);
-        let t = Instant::now();
-        let c = Curvature {
-            field: o.read()?,
-            counts: o.est.counts()?,
-            timing,
-            topology_ms: o.est.topology_ms(),
-            device_bytes: o.est.device_bytes(),
-        };
-        phase("read_back", ms_since(t));
+        let counts = o.est.counts()?;
+        let device_bytes = o.est.device_bytes();
         let mut stats = serde_json::json!({
             "device": gpu.info,
             "accumulate": opts.accumulate.name(),
             "face_lanes": o.est.face_lanes(),
             "order": if o.order.is_some() { "spatial" } else { "input" },
-            "topology_ms": c.topology_ms,
-            "passes": passes(&c.timing),
-            "kernel_ms": c.timing.kernel_ms,
-            "run_wall_ms": c.timing.wall_ms,
-            "device_bytes": c.device_bytes,
-            "device_bytes_per_vertex": c.device_bytes as f64 / mesh.n_vertices() as f64,
+            "topology_ms": o.est.topology_ms(),
+            "passes": passes(&timing),
+            "kernel_ms": timing.kernel_ms,
+            "run_wall_ms": timing.wall_ms,
+            "device_bytes": device_bytes,
+            "device_bytes_per_vertex": device_bytes as f64 / mesh.n_vertices() as f64,
         });
         if let Some(n) = a.runs {
+            // Each run writes the same values (the passes are deterministic
+            // for gather; atomic sums may differ in the last bits), so the
+            // field read below is the last run's.
             let mut timed = Vec::with_capacity(n);
             for _ in 0..n {
                 timed.push(o.est.run()?);
             }
-            runs_stats(&mut stats, &timed, c.timing.wall_ms);
+            runs_stats(&mut stats, &timed, timing.wall_ms);
         }
         // After the runs, so that code the driver compiled at the first
         // launch is in the saved binaries; a no-op when the cache hit.
@@ -211,15 +212,35 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         gpu.persist_programs();
         phase("cache_write", ms_since(t));
         stats["programs"] = serde_json::to_value(gpu.program_builds())?;
-        (c, stats)
+        (None, Some(o), counts, stats)
     };
-    let total_ms = t_all.elapsed().as_secs_f64() * 1e3;
-    let (field, counts) = (&c.field, c.counts);
-    if !field.all_finite() {
+    let t = Instant::now();
+    let mapped = device.as_mut().map(OrderedEstimator::mapped).transpose()?;
+    if mapped.is_some() {
+        phases.insert("read_back".into(), serde_json::json!(ms_since(t)));
+    }
+    let vertex = |i: usize| match (&field, &mapped) {
+        (Some(f), _) => f.vertex(i),
+        (None, Some(m)) => m.vertex(i),
+        (None, None) => unreachable!("a field or a device"),
+    };
+    let n = mesh.n_vertices();
+    let mut finite = true;
+    let (mut k1min, mut k1max, mut k2min, mut k2max) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for v in (0..n).map(vertex) {
+        finite &= v.all_finite();
+        (k1min, k1max) = (k1min.min(v.k1), k1max.max(v.k1));
+        (k2min, k2max) = (k2min.min(v.k2), k2max.max(v.k2));
+    }
+    if !finite {
         bail!("internal error: non-finite output (please report with the input mesh)");
     }
-    let (k1min, k1max) = minmax(&field.k1);
-    let (k2min, k2max) = minmax(&field.k2);
+    let total_ms = t_all.elapsed().as_secs_f64() * 1e3;
     out!(
         "{name}: {} vertices, {} faces; k1 in [{k1min:.4}, {k1max:.4}], k2 in [{k2min:.4}, {k2max:.4}]; \
          {} degenerate faces skipped, {} vertices without curvature; {total_ms:.1} ms",
@@ -240,7 +261,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     }
     if let Some(out) = &a.output {
         let t = Instant::now();
-        let written = shapecue::export::ply::write_ply(out, &mesh, Some(field))?;
+        let written = shapecue::export::ply::write_ply_vertices(out, &mesh, n, vertex)?;
         phases.insert("ply_write".into(), serde_json::json!(ms_since(t)));
         super::note_double(out, &written);
         out!("wrote {}", out.display());
@@ -305,13 +326,6 @@ pub(super) fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_
     stats["wall_min_ms"] = serde_json::json!(wmin);
     stats["passes_median"] = serde_json::Value::Array(per_pass);
     stats["first_launch_compile_ms"] = serde_json::json!((first_wall_ms - wall_median).max(0.0));
-}
-
-fn minmax(v: &[f64]) -> (f64, f64) {
-    v.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        })
 }
 
 /// The curvature stats' `passes`: one `{pass, kernel_ms}` per curvature

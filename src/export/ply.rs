@@ -14,7 +14,7 @@ use ply_rs_bw::ply::{DefaultElement, PropertyType};
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::spec::curvature::CurvatureField;
+use crate::spec::curvature::{CurvatureField, VertexCurvature};
 
 /// Names of the vertex position properties, first in every file.
 pub const POSITION_PROPERTIES: [&str; 3] = ["x", "y", "z"];
@@ -64,22 +64,51 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
             )));
         }
     }
+    match field {
+        Some(f) => write_ply_vertices(path, mesh, n, |i| f.vertex(i)),
+        None => {
+            check_face_indices(mesh)?;
+            write_rows(path, mesh, &POSITION_PROPERTIES, |_, _| {})
+        }
+    }
+}
+
+/// [`write_ply`] with a field given vertex by vertex: `vertex(i)` gives the
+/// values of vertex `i` of the `n` (e.g. read in place from the device
+/// buffers, with no copy of the whole field). Each vertex is asked for twice:
+/// once to check the values, once to write them.
+///
+/// # Errors
+///
+/// As [`write_ply`]; [`Error::InvalidArgument`] also when `n` is not the
+/// mesh's number of vertices.
+pub fn write_ply_vertices(
+    path: &Path,
+    mesh: &Mesh,
+    n: usize,
+    vertex: impl Fn(usize) -> VertexCurvature,
+) -> Result<PlyWritten> {
+    if n != mesh.n_vertices() {
+        return Err(Error::InvalidArgument(format!(
+            "a curvature field of {n} vertices for a mesh of {} vertices",
+            mesh.n_vertices()
+        )));
+    }
     check_face_indices(mesh)?;
     let names: Vec<&str> = POSITION_PROPERTIES
         .iter()
-        .chain(field.map_or(&[][..], |_| &FIELD_PROPERTIES[..]))
+        .chain(&FIELD_PROPERTIES)
         .copied()
         .collect();
     write_rows(path, mesh, &names, |i, row| {
-        if let Some(f) = field {
-            row.extend(f.normals[i]);
-            row.push(f.areas[i]);
-            row.push(f.k1[i]);
-            row.push(f.k2[i]);
-            row.extend(f.d1[i]);
-            row.extend(f.d2[i]);
-            row.extend(f.dk[i]);
-        }
+        let v = vertex(i);
+        row.extend(v.normal);
+        row.push(v.area);
+        row.push(v.k1);
+        row.push(v.k2);
+        row.extend(v.d1);
+        row.extend(v.d2);
+        row.extend(v.dk);
     })
 }
 

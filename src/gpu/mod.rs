@@ -342,6 +342,57 @@ impl Gpu {
         self.finish()
     }
 
+    /// Maps the first `len` elements of `buf` for reading (blocking): the
+    /// device's own memory where it is the host's (CPU runtimes: no copy and
+    /// no fresh pages), a copy the driver makes otherwise. Unmapped when the
+    /// returned view is dropped. The view borrows `buf` shared, so nothing
+    /// can launch a kernel that writes it through `&mut` while it lives.
+    pub fn map_read<'b, T: Copy>(
+        &'b self,
+        buf: &'b Buffer<T>,
+        len: usize,
+    ) -> Result<Mapped<'b, T>> {
+        if len == 0 {
+            return Ok(Mapped {
+                queue: &self.queue,
+                mem: opencl3::memory::ClMem::get(buf),
+                ptr: std::ptr::NonNull::<T>::dangling().as_ptr(),
+                len: 0,
+                mapped: false,
+            });
+        }
+        let mut ptr: opencl3::types::cl_mem = std::ptr::null_mut();
+        // SAFETY: a blocking read-only map of a range inside the buffer; the
+        // pointer is only read through `Mapped` and unmapped in its `Drop`.
+        unsafe {
+            self.queue.enqueue_map_buffer(
+                buf,
+                CL_BLOCKING,
+                opencl3::memory::CL_MAP_READ,
+                0,
+                len * std::mem::size_of::<T>(),
+                &mut ptr,
+                &[],
+            )
+        }
+        .map_err(|e| Error::cl("clEnqueueMapBuffer", e))?;
+        let view = Mapped {
+            queue: &self.queue,
+            mem: opencl3::memory::ClMem::get(buf),
+            ptr: ptr.cast::<T>(),
+            len,
+            mapped: true,
+        };
+        if ptr.is_null() || !(ptr as usize).is_multiple_of(std::mem::align_of::<T>()) {
+            // Dropping the view unmaps it.
+            return Err(Error::cl(
+                "clEnqueueMapBuffer",
+                format!("a pointer ({ptr:p}) not aligned for the buffer's elements"),
+            ));
+        }
+        Ok(view)
+    }
+
     /// Reads `out.len()` elements of `buf` from element `offset` on. Only
     /// enqueued: the data is there after [`Gpu::finish`] (or any blocking
     /// call on the queue), so many small reads cost one wait.
@@ -412,6 +463,41 @@ impl Gpu {
     /// Waits for every queued command.
     pub fn finish(&self) -> Result<()> {
         self.queue.finish().map_err(|e| Error::cl("clFinish", e))
+    }
+}
+
+/// A device buffer mapped for reading ([`Gpu::map_read`]), read as a slice;
+/// unmapped (and the unmap waited for) when dropped.
+pub struct Mapped<'b, T> {
+    queue: &'b CommandQueue,
+    mem: opencl3::types::cl_mem,
+    ptr: *const T,
+    len: usize,
+    mapped: bool,
+}
+
+impl<T> std::ops::Deref for Mapped<'_, T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        // SAFETY: the blocking map made `len` elements readable at `ptr`
+        // (checked non-null and aligned), and they stay mapped until drop.
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+impl<T> Drop for Mapped<'_, T> {
+    fn drop(&mut self) {
+        if self.mapped {
+            // SAFETY: `ptr` is the pointer the map returned for `mem`, and
+            // no slice of it outlives `self`.
+            let unmapped = unsafe {
+                self.queue
+                    .enqueue_unmap_mem_object(self.mem, self.ptr as *mut _, &[])
+            };
+            if unmapped.is_ok() {
+                let _ = self.queue.finish();
+            }
+        }
     }
 }
 

@@ -40,6 +40,38 @@ pub struct CurvatureField {
     pub dk: Vec<[f64; 4]>,
 }
 
+/// One vertex's values of a [`CurvatureField`] (the same conventions).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VertexCurvature {
+    /// Unit normal.
+    pub normal: [f64; 3],
+    /// Voronoi point area.
+    pub area: f64,
+    /// Maximum principal curvature.
+    pub k1: f64,
+    /// Minimum principal curvature.
+    pub k2: f64,
+    /// Principal direction of `k1`.
+    pub d1: [f64; 3],
+    /// Principal direction of `k2`.
+    pub d2: [f64; 3],
+    /// Curvature derivative tensor in the (d1, d2) frame.
+    pub dk: [f64; 4],
+}
+
+impl VertexCurvature {
+    /// True if every value is finite.
+    pub fn all_finite(&self) -> bool {
+        self.normal
+            .iter()
+            .chain(&self.d1)
+            .chain(&self.d2)
+            .chain(&self.dk)
+            .chain([&self.area, &self.k1, &self.k2])
+            .all(|x| x.is_finite())
+    }
+}
+
 impl CurvatureField {
     /// A field of `n` vertices with every value zero.
     pub fn zeros(n: usize) -> Self {
@@ -57,6 +89,19 @@ impl CurvatureField {
     /// Number of vertices.
     pub fn len(&self) -> usize {
         self.k1.len()
+    }
+
+    /// The values of vertex `i` (which must be below [`CurvatureField::len`]).
+    pub fn vertex(&self, i: usize) -> VertexCurvature {
+        VertexCurvature {
+            normal: self.normals[i],
+            area: self.areas[i],
+            k1: self.k1[i],
+            k2: self.k2[i],
+            d1: self.d1[i],
+            d2: self.d2[i],
+            dk: self.dk[i],
+        }
     }
 
     /// True when there are no vertices.

@@ -11,12 +11,12 @@
 //! [`crate::spec::curvature`]; one-ring lists: [`crate::mesh::topology`].
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, Mapped, buf, event_ms, kernel_file, launch};
 use crate::mesh::order::{LocalityOrder, MeshOrder};
 use crate::mesh::topology::one_rings;
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, corner_reals_bound,
+    Precision, VertexCurvature, corner_reals_bound,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -844,18 +844,7 @@ impl CurvatureEstimator {
     /// vertices; OpenCL errors of the reads.
     pub fn read_placed(&self, place: Option<&[u32]>) -> Result<CurvatureField> {
         let n = self.nv;
-        if let Some(p) = place {
-            let mut seen = vec![false; n];
-            let permutation = p.len() == n
-                && p.iter()
-                    .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true));
-            if !permutation {
-                return Err(Error::InvalidArgument(format!(
-                    "read_placed: {} places are not a permutation of the {n} vertices",
-                    p.len()
-                )));
-            }
-        }
+        check_place("read_placed", place, n)?;
         let at = |v: usize| place.map_or(v, |p| p[v] as usize);
         let s = self.norm.scale;
         let mut f = CurvatureField::zeros(n);
@@ -904,6 +893,129 @@ impl CurvatureEstimator {
         }
         Ok(f)
     }
+
+    /// The results of the last full run read where they lie, with no copy
+    /// of the field: the device buffers mapped (on CPU runtimes the device's
+    /// memory is the host's, so mapping copies nothing), each vertex's values
+    /// converted and scaled back when asked for, with the same operations
+    /// and so the same bits as [`CurvatureEstimator::read_placed`] with the
+    /// same `place`. For writing a large field straight to a file: on a
+    /// 2M-vertex mesh the field is 256 MB of fresh pages whose first touch
+    /// costs more than the conversions.
+    ///
+    /// # Errors
+    ///
+    /// As [`CurvatureEstimator::read_placed`]; OpenCL errors of the maps.
+    pub fn mapped(&mut self, place: Option<&[u32]>) -> Result<MappedField<'_>> {
+        let n = self.nv;
+        check_place("mapped", place, n)?;
+        let device_of = place.map(|p| {
+            let mut d = vec![0u32; n];
+            for (v, &i) in p.iter().enumerate() {
+                d[i as usize] = v as u32;
+            }
+            d
+        });
+        let this: &Self = self;
+        let map = |b, comps: usize| this.map_reals(b, comps);
+        Ok(MappedField {
+            n,
+            precision: this.opts.precision,
+            scale: this.norm.scale,
+            device_of,
+            nrm: map(&this.nrm, 3)?,
+            area: map(&this.area, 1)?,
+            pd1: map(&this.pd1, 3)?,
+            pd2: map(&this.pd2, 3)?,
+            kk: map(&this.kk, 2)?,
+            dk: if this.opts.dcurv {
+                Some(map(&this.dk, 4)?)
+            } else {
+                None
+            },
+        })
+    }
+
+    /// Maps the first `comps` reals per vertex of `b` for reading.
+    fn map_reals<'a>(&'a self, b: &'a Buffer<u8>, comps: usize) -> Result<Mapped<'a, u8>> {
+        self.gpu.map_read(b, comps * self.nv * self.real)
+    }
+}
+
+/// Refuses a `place` that is not a permutation of the `n` vertices.
+fn check_place(what: &str, place: Option<&[u32]>, n: usize) -> Result<()> {
+    if let Some(p) = place {
+        let mut seen = vec![false; n];
+        let permutation = p.len() == n
+            && p.iter()
+                .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true));
+        if !permutation {
+            return Err(Error::InvalidArgument(format!(
+                "{what}: {} places are not a permutation of the {n} vertices",
+                p.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The results of a run read in place from the device buffers
+/// ([`CurvatureEstimator::mapped`]); the buffers stay mapped, and the
+/// estimator borrowed, while it lives.
+pub struct MappedField<'a> {
+    n: usize,
+    precision: Precision,
+    scale: f64,
+    /// For each vertex of the field's order, the device's vertex.
+    device_of: Option<Vec<u32>>,
+    nrm: Mapped<'a, u8>,
+    area: Mapped<'a, u8>,
+    pd1: Mapped<'a, u8>,
+    pd2: Mapped<'a, u8>,
+    kk: Mapped<'a, u8>,
+    dk: Option<Mapped<'a, u8>>,
+}
+
+impl MappedField<'_> {
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// True when there are no vertices.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// Real `k` of the buffer `b` as f64.
+    fn at(&self, b: &[u8], k: usize) -> f64 {
+        match self.precision {
+            Precision::F32 => f64::from(f32::from_ne_bytes(
+                b[4 * k..4 * k + 4].try_into().expect("4 bytes"),
+            )),
+            Precision::F64 => f64::from_ne_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes")),
+        }
+    }
+
+    /// The values of vertex `i` (below [`MappedField::len`]) in the field's
+    /// order, in the pose's own coordinates: the scalings of
+    /// [`CurvatureEstimator::read_placed`], operation for operation.
+    pub fn vertex(&self, i: usize) -> VertexCurvature {
+        let v = self.device_of.as_ref().map_or(i, |d| d[i] as usize);
+        let s = self.scale;
+        let vec3 = |b: &[u8]| std::array::from_fn(|c| self.at(b, 3 * v + c));
+        VertexCurvature {
+            normal: vec3(&self.nrm),
+            area: self.at(&self.area, v) * (s * s),
+            k1: self.at(&self.kk, 2 * v) / s,
+            k2: self.at(&self.kk, 2 * v + 1) / s,
+            d1: vec3(&self.pd1),
+            d2: vec3(&self.pd2),
+            dk: self.dk.as_ref().map_or([0.0; 4], |b| {
+                std::array::from_fn(|c| self.at(b, 4 * v + c) / (s * s))
+            }),
+        }
+    }
 }
 
 /// An estimator of a whole mesh computed in the memory order `order` asks
@@ -949,6 +1061,14 @@ impl OrderedEstimator {
     pub fn read(&self) -> Result<CurvatureField> {
         self.est
             .read_placed(self.order.as_ref().map(|o| &o.input_vertex[..]))
+    }
+
+    /// [`OrderedEstimator::read`] without the copy: the device buffers
+    /// mapped, read vertex by vertex in the input's order
+    /// ([`CurvatureEstimator::mapped`]); the same values, bit for bit.
+    pub fn mapped(&mut self) -> Result<MappedField<'_>> {
+        self.est
+            .mapped(self.order.as_ref().map(|o| &o.input_vertex[..]))
     }
 }
 
