@@ -58,11 +58,15 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Mesh> {
             });
         }
     };
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut mesh = parse(&bytes, &name)?;
+    let mut mesh = if ext.as_deref() == Some("ply") {
+        ply::load(path, &name)?
+    } else {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        parse(&bytes, &name)?
+    };
     // Validate before welding: `Mesh::weld` indexes with the face indices.
     mesh.validate(&name)?;
     if opts.weld {
@@ -157,7 +161,7 @@ mod off;
 
 /// PLY reader: the header through `ply-rs-bw`; ASCII payloads one element at
 /// a time through it, so that errors name the element and the line; binary
-/// payloads read directly from the bytes.
+/// payloads read directly from the bytes, a chunk of the file at a time.
 mod ply;
 
 /// OBJ reader, by hand: one pass over the bytes reading `v` and `f`
@@ -200,5 +204,104 @@ mod tests {
         bytes.extend_from_slice(&HEAD.as_bytes()[20..]);
         let e = ply::parse(&bytes, "t.ply").unwrap_err().to_string();
         assert!(e.contains("header line 3") && e.contains("0xe9"), "{e}");
+    }
+
+    /// A binary PLY file with `nv` vertices of 25 bytes (x y z, a normal, a
+    /// flag) and `nv` faces (triangles and quads, with a property after the
+    /// list), behind a header of `comments` comment lines.
+    fn binary_ply(nv: usize, comments: usize, big: bool) -> Vec<u8> {
+        let order = if big { "big" } else { "little" };
+        let mut h = format!("ply\nformat binary_{order}_endian 1.0\n");
+        for i in 0..comments {
+            h.push_str(&format!("comment line {i} of a long header\n"));
+        }
+        h.push_str(&format!(
+            "element vertex {nv}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float nx\nproperty float ny\nproperty float nz\nproperty uchar flag\n\
+             element face {nv}\nproperty list uchar int vertex_indices\nproperty int flags\n\
+             end_header\n"
+        ));
+        let mut b = h.into_bytes();
+        let f = |x: f32| {
+            if big {
+                x.to_be_bytes()
+            } else {
+                x.to_le_bytes()
+            }
+        };
+        let i = |x: i32| {
+            if big {
+                x.to_be_bytes()
+            } else {
+                x.to_le_bytes()
+            }
+        };
+        for v in 0..nv {
+            let t = v as f32;
+            for x in [t, 0.5 * t, (t * 0.01).sin(), 0.0, 0.0, 1.0] {
+                b.extend(f(x));
+            }
+            b.push(7);
+        }
+        for k in 0..nv {
+            let n = if k % 5 == 0 { 4 } else { 3 };
+            b.push(n as u8);
+            for c in 0..n {
+                b.extend(i(((k + c) % nv) as i32));
+            }
+            b.extend(i(-1));
+        }
+        b
+    }
+
+    /// Loading a PLY file a chunk at a time gives what parsing its bytes
+    /// whole gives: the same mesh, or the same error, for files spanning
+    /// many chunks, headers longer than one read, both byte orders, and
+    /// files cut anywhere (in the header, a row, a face list, between
+    /// chunks).
+    #[test]
+    fn chunked_ply_load_matches_parsing_the_bytes() {
+        let dir = std::env::temp_dir().join(format!("shapecue-ply-chunks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("m.ply");
+        let check = |bytes: &[u8], what: &str| {
+            std::fs::write(&path, bytes).unwrap();
+            let whole = ply::parse(bytes, "m.ply");
+            let chunked = ply::load(&path, "m.ply");
+            match (whole, chunked) {
+                (Ok(a), Ok(b)) => {
+                    assert_eq!(a.positions, b.positions, "{what}");
+                    assert_eq!(a.faces, b.faces, "{what}");
+                    a.faces.len()
+                }
+                (Err(a), Err(b)) => {
+                    assert_eq!(a.to_string(), b.to_string(), "{what}");
+                    0
+                }
+                (a, b) => panic!("{what}: whole {:?}, chunked {:?}", a.err(), b.err()),
+            }
+        };
+        for (nv, comments, big) in [(120_000, 0, false), (90_001, 3000, true), (5, 0, false)] {
+            let b = binary_ply(nv, comments, big);
+            let faces = check(&b, "whole file");
+            assert_eq!(faces, nv + nv.div_ceil(5), "quads give two triangles");
+            let body = b.len() - (25 + 17) * nv - nv.div_ceil(5) * 4;
+            let cuts = [
+                10,
+                body - 3,
+                body + 25 * (nv / 2) + 11,
+                body + 25 * nv + 2,
+                body + 25 * nv + 1 + 4 + 17 * (nv / 3),
+                b.len() - 1,
+                (1 << 20) + 1,
+            ];
+            for cut in cuts.into_iter().filter(|&c| c < b.len()) {
+                check(&b[..cut], &format!("{nv} vertices cut at {cut}"));
+            }
+        }
+        // An ASCII file through the same entry point.
+        let ascii = format!("{HEAD}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+        assert_eq!(check(ascii.as_bytes(), "ascii"), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

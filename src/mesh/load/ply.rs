@@ -1,4 +1,5 @@
-use std::io::{BufRead, ErrorKind};
+use std::io::{BufRead, ErrorKind, Read};
+use std::path::Path;
 
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{
@@ -246,6 +247,11 @@ fn check_counts(header: &Header, body: &[u8], source: &str) -> Result<()> {
         }
         return Ok(());
     }
+    check_binary_counts(header, payload, source)
+}
+
+/// The binary half of [`check_counts`], for a payload of `payload` bytes.
+fn check_binary_counts(header: &Header, payload: usize, source: &str) -> Result<()> {
     let mut room = payload as u128;
     for (name, def) in &header.elements {
         let min = min_element_bytes(def, header.encoding) as u128;
@@ -392,7 +398,8 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
     let nv = header.elements.get("vertex").map_or(0, |d| d.count);
     if header.encoding != Encoding::Ascii {
         let big = header.encoding == Encoding::BinaryBigEndian;
-        return parse_binary(&header, reader.get_ref(), big, nv, source);
+        let body = reader.get_ref();
+        return parse_binary(&header, &mut SliceBody(body), body.len(), big, nv, source);
     }
     let mut stream = Stream {
         // `line()` is the number of the first payload line; `element`
@@ -523,11 +530,20 @@ fn binary_value(b: &[u8], t: &ScalarType, big: bool) -> f64 {
 /// files, which binary files also went through before: this is 3.2 times as
 /// fast on lucy and 2.1 times on a 500k-vertex torus with 19 properties
 /// (`cargo bench --bench mesh_io`), as it builds no value per property.
-fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str) -> Result<Mesh> {
+/// `payload` is the number of bytes the body holds (it bounds what is
+/// reserved); the body is read in order, a few rows at a time.
+fn parse_binary(
+    header: &Header,
+    body: &mut impl Body,
+    payload: usize,
+    big: bool,
+    nv: usize,
+    source: &str,
+) -> Result<Mesh> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut poly: Vec<u32> = Vec::new();
-    let mut pos = 0usize;
+    let mut indices: Vec<i64> = Vec::new();
     for (name, def) in &header.elements {
         if def.properties.is_empty() {
             continue;
@@ -553,47 +569,57 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
             })
             .collect();
         if is_vertex {
-            positions.reserve(capacity(def, header.encoding, body.len()));
+            positions.reserve(capacity(def, header.encoding, payload));
         } else if is_face {
-            faces.reserve(capacity(def, header.encoding, body.len()));
+            faces.reserve(capacity(def, header.encoding, payload));
         }
         // Fixed-size elements with their coordinates at fixed offsets (the
-        // usual vertex element) are read row by row without the walk.
+        // usual vertex element) are read many rows at a time without the walk.
         if is_vertex && let Some((stride, axes)) = fixed_rows(&layout) {
-            let rows = body
-                .get(pos..)
-                .and_then(|rest| rest.get(..def.count.checked_mul(stride)?))
-                .ok_or_else(|| {
-                    let i = (body.len() - pos) / stride;
-                    Error::input(source, format!("{name} {i}"), eof_problem(def))
-                })?;
-            positions.extend(
-                rows.chunks_exact(stride).map(|r| {
+            let batch = (BODY_CHUNK / stride).max(1);
+            let mut done = 0;
+            while done < def.count {
+                let k = batch.min(def.count - done);
+                let rows = body.take(k * stride)?;
+                positions.extend(rows.chunks_exact(stride).map(|r| {
                     std::array::from_fn(|k| binary_value(&r[axes[k].0..], &axes[k].1, big))
-                }),
-            );
-            pos += rows.len();
+                }));
+                if rows.len() < k * stride {
+                    let i = done + rows.len() / stride;
+                    return Err(Error::input(
+                        source,
+                        format!("{name} {i}"),
+                        eof_problem(def),
+                    ));
+                }
+                done += k;
+            }
             continue;
         }
         for i in 0..def.count {
             let element = || format!("{name} {i}");
             let eof = || Error::input(source, element(), eof_problem(def));
             let mut p = [0.0; 3];
-            // The bytes and item type of the face's index list.
-            let mut list: (&[u8], &ScalarType) = (&[], &ScalarType::Int);
+            // The face's vertex indices, decoded as they are read.
+            indices.clear();
             for &(ty, role, pname) in &layout {
                 match ty {
                     PropertyType::Scalar(t) => {
                         let size = scalar_size(t);
-                        let b = body.get(pos..pos + size).ok_or_else(eof)?;
+                        let b = body.take(size)?;
+                        if b.len() < size {
+                            return Err(eof());
+                        }
                         if let Role::Axis(k) = role {
                             p[k] = binary_value(b, t, big);
                         }
-                        pos += size;
                     }
                     PropertyType::List(c, t) => {
                         let cs = scalar_size(c);
-                        let b = body.get(pos..pos + cs).ok_or_else(eof)?;
+                        let b = body.take(cs)?;
+                        if b.len() < cs {
+                            return Err(eof());
+                        }
                         let n = binary_value(b, c, big);
                         if n < 0.0 {
                             return Err(Error::input(
@@ -602,13 +628,18 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
                                 format!("list '{pname}' has a negative length {n}"),
                             ));
                         }
-                        pos += cs;
                         let size = scalar_size(t);
                         let len = n as usize * size;
-                        let items = body.get(pos..pos + len).ok_or_else(eof)?;
-                        pos += len;
+                        let items = body.take(len)?;
+                        if items.len() < len {
+                            return Err(eof());
+                        }
                         if role == Role::Indices {
-                            list = (items, t);
+                            indices.extend(
+                                items
+                                    .chunks_exact(size)
+                                    .map(|b| binary_value(b, t, big) as i64),
+                            );
                         }
                     }
                 }
@@ -616,13 +647,230 @@ fn parse_binary(header: &Header, body: &[u8], big: bool, nv: usize, source: &str
             if is_vertex {
                 positions.push(p);
             } else if is_face {
-                let (items, t) = list;
-                let indices = items
-                    .chunks_exact(scalar_size(t))
-                    .map(|b| binary_value(b, t, big) as i64);
-                add_polygon(indices, i, nv, source, &mut poly, &mut faces)?;
+                add_polygon(
+                    indices.iter().copied(),
+                    i,
+                    nv,
+                    source,
+                    &mut poly,
+                    &mut faces,
+                )?;
             }
         }
     }
     Ok(Mesh { positions, faces })
+}
+
+/// How many bytes [`FileBody`] reads at a time, and about how many the
+/// fixed-row reader asks for at once.
+const BODY_CHUNK: usize = 1 << 20;
+
+/// The payload of a binary file, read in order.
+trait Body {
+    /// The next `n` bytes, or fewer where the payload ends.
+    fn take(&mut self, n: usize) -> Result<&[u8]>;
+}
+
+/// A payload in memory.
+struct SliceBody<'a>(&'a [u8]);
+
+impl Body for SliceBody<'_> {
+    #[inline]
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        let (head, rest) = self.0.split_at(n.min(self.0.len()));
+        self.0 = rest;
+        Ok(head)
+    }
+}
+
+/// A payload read from a file [`BODY_CHUNK`] bytes at a time into one
+/// buffer that is reused (and grown only for a longer request, and only as
+/// far as the file holds bytes), so that a large file is never copied whole
+/// into fresh memory.
+struct FileBody<'p, R> {
+    r: R,
+    path: &'p Path,
+    buf: Vec<u8>,
+    start: usize,
+    end: usize,
+    eof: bool,
+}
+
+impl<R: Read> Body for FileBody<'_, R> {
+    #[inline]
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        if self.end - self.start < n && !self.eof {
+            self.fill(n)?;
+        }
+        let k = n.min(self.end - self.start);
+        let out = &self.buf[self.start..self.start + k];
+        self.start += k;
+        Ok(out)
+    }
+}
+
+impl<R: Read> FileBody<'_, R> {
+    /// Reads until `n` bytes are buffered or the file ends.
+    #[cold]
+    fn fill(&mut self, n: usize) -> Result<()> {
+        self.buf.copy_within(self.start..self.end, 0);
+        self.end -= self.start;
+        self.start = 0;
+        if self.buf.len() < BODY_CHUNK {
+            self.buf.resize(BODY_CHUNK, 0);
+        }
+        while self.end < n && !self.eof {
+            if self.end == self.buf.len() {
+                // Full and still short: grow, doubling, as bytes arrive.
+                let len = self.buf.len();
+                self.buf.resize(len.saturating_mul(2).min(n.max(len)), 0);
+            }
+            match self.r.read(&mut self.buf[self.end..]) {
+                Ok(0) => self.eof = true,
+                Ok(got) => self.end += got,
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(source) => {
+                    return Err(Error::Io {
+                        path: self.path.to_path_buf(),
+                        source,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The length of the header at the start of `bytes` (through the newline
+/// after `end_header`), `None` when `bytes` does not hold all of it.
+fn header_len(bytes: &[u8]) -> Option<usize> {
+    let mut at = 0;
+    for line in bytes.split_inclusive(|&b| b == b'\n') {
+        at += line.len();
+        let text = line.strip_suffix(b"\n")?;
+        if text.strip_suffix(b"\r").unwrap_or(text) == b"end_header" {
+            return Some(at);
+        }
+    }
+    None
+}
+
+/// Loads a PLY file: as [`parse`] of its bytes, with the same checks and
+/// messages, but a binary payload is read a chunk at a time rather than
+/// whole (a 2M-vertex file with curvature properties is 200 MB, and
+/// reading it into fresh memory costs more than parsing it).
+pub(super) fn load(path: &Path, source: &str) -> Result<Mesh> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        // A pipe or device: its length is not known ahead, so read it whole.
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).map_err(io)?;
+        return parse(&bytes, source);
+    }
+    let file_len = meta.len();
+    // The header, and perhaps the start of the payload.
+    let mut head = Vec::new();
+    let body_at = loop {
+        if let Some(n) = header_len(&head) {
+            break n;
+        }
+        let got = (&mut file)
+            .take(64 << 10)
+            .read_to_end(&mut head)
+            .map_err(io)?;
+        if got == 0 {
+            // No complete header: the whole file is here.
+            return parse(&head, source);
+        }
+    };
+    check_header_text(&head[..body_at], source)?;
+    let header = Parser::<Skip>::new()
+        .read_header(&mut Reader::new(&head[..body_at]))
+        .map_err(|e| Error::input(source, "header", first_line(&e)))?;
+    if header.encoding == Encoding::Ascii {
+        file.read_to_end(&mut head).map_err(io)?;
+        return parse(&head, source);
+    }
+    check_header(&header, source)?;
+    let payload = usize::try_from(file_len.saturating_sub(body_at as u64)).unwrap_or(usize::MAX);
+    check_binary_counts(&header, payload, source)?;
+    let nv = header.elements.get("vertex").map_or(0, |d| d.count);
+    let big = header.encoding == Encoding::BinaryBigEndian;
+    let end = head.len() - body_at;
+    head.copy_within(body_at.., 0);
+    let mut body = FileBody {
+        r: file,
+        path,
+        buf: head,
+        start: 0,
+        end,
+        eof: false,
+    };
+    parse_binary(&header, &mut body, payload, big, nv, source)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file that ends before its header's counts (it shrank while being
+    /// read) is reported at the row where it ends, by the chunked reader as
+    /// by the reader of bytes in memory, in the fixed-row vertex reader too.
+    #[test]
+    fn a_payload_shorter_than_its_length_ends_at_the_same_element() {
+        let nv = 100_000;
+        let mut b = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex {nv}\nproperty float x\n\
+             property float y\nproperty float z\nelement face 1\n\
+             property list uchar int vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        let at = header_len(&b).unwrap();
+        assert_eq!(at, b.len());
+        for v in 0..nv {
+            b.extend([v as f32, 1.0, 2.0].iter().flat_map(|x| x.to_le_bytes()));
+        }
+        b.push(3);
+        b.extend([0i32, 1, 2].iter().flat_map(|x| x.to_le_bytes()));
+        let header = Parser::<Skip>::new()
+            .read_header(&mut Reader::new(&b[..at]))
+            .unwrap();
+        let payload = b.len() - at;
+        for cut in [payload, payload - 1, 12 * 70_001 + 5, 12 * 87_381 + 1, 0] {
+            let body = &b[at..at + cut];
+            let whole = parse_binary(&header, &mut SliceBody(body), payload, false, nv, "m.ply");
+            let mut chunked = FileBody {
+                r: std::io::Cursor::new(body),
+                path: Path::new("m.ply"),
+                buf: Vec::new(),
+                start: 0,
+                end: 0,
+                eof: false,
+            };
+            let chunked = parse_binary(&header, &mut chunked, payload, false, nv, "m.ply");
+            match (whole, chunked) {
+                (Ok(a), Ok(c)) => {
+                    assert_eq!(cut, payload);
+                    assert_eq!((a.positions, a.faces), (c.positions, c.faces));
+                }
+                (Err(a), Err(c)) => {
+                    let (a, c) = (a.to_string(), c.to_string());
+                    assert_eq!(a, c);
+                    let row = (cut / 12).min(nv);
+                    let element = if cut >= 12 * nv {
+                        "face 0"
+                    } else {
+                        &format!("vertex {row}")
+                    };
+                    assert!(a.contains(element) && a.contains("end of file"), "{a}");
+                }
+                (a, c) => panic!("cut {cut}: {:?} against {:?}", a.err(), c.err()),
+            }
+        }
+    }
 }
