@@ -1129,6 +1129,19 @@ fn ply_values_outside_float_range_are_written_as_double() {
     // The value is in the file as the f64 it was.
     let needle = 1e60f64.to_le_bytes();
     assert!(bytes.windows(8).any(|w| w == needle));
+    // Started again from the first byte: nothing of the float attempt is
+    // left, before or after the header.
+    assert!(bytes.starts_with(b"ply\n"));
+    let body = text.find("end_header\n").unwrap() + "end_header\n".len();
+    assert_eq!(
+        bytes.len() - body,
+        m.n_vertices() * 19 * 8 + m.n_faces() * 13
+    );
+    let (names, rows, faces) = read_ply_properties(&p).unwrap();
+    assert_eq!(
+        (names.len(), rows.len(), faces),
+        (19, m.n_vertices(), m.faces.clone())
+    );
 
     f.areas[3] = 1.0;
     f.k1[5] = 1e-40;

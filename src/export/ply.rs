@@ -160,56 +160,50 @@ fn outside_f32(x: f64) -> bool {
 
 /// Writes the header, one row of properties per vertex (position first,
 /// then what `extra` appends) and the faces; `float` unless a value needs
-/// `double`.
+/// `double`, in which case the file is started again with `double`. One pass
+/// over the values when they all fit a `float` (the usual case): each value
+/// is checked as it is written, and a value that is not finite stops the
+/// write, leaving no file.
 fn write_rows(
     path: &Path,
     mesh: &Mesh,
     names: &[&str],
     extra: impl Fn(usize, &mut Vec<f64>),
 ) -> Result<PlyWritten> {
-    let mut row: Vec<f64> = Vec::with_capacity(names.len());
     let mut written = PlyWritten::default();
-    for (i, p) in mesh.positions.iter().enumerate() {
-        row.clear();
-        row.extend(p);
-        extra(i, &mut row);
-        for (k, &x) in row.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(Error::InvalidArgument(format!(
-                    "{}: property '{}' of vertex {i} is {x}: not written",
-                    path.display(),
-                    names[k]
-                )));
-            }
-            if written.double.is_none() && outside_f32(x) {
-                written.double = Some(format!(
-                    "property '{}' of vertex {i} is {x:e}, outside the range of float \
-                     (about 1.2e-38 to 3.4e38)",
-                    names[k]
-                ));
-            }
-        }
-    }
-    let double = written.double.is_some();
     let write_err = |source| Error::Write {
         path: path.to_path_buf(),
         source,
     };
     super::output::write_atomic(path, |w| {
-        write_body(w, mesh, names, &extra, double, write_err)
+        if let Some(why) = write_body(w, path, mesh, names, &extra, false)? {
+            use std::io::{Seek, SeekFrom};
+            w.flush().map_err(write_err)?;
+            let file = w.get_mut();
+            file.set_len(0).map_err(write_err)?;
+            file.seek(SeekFrom::Start(0)).map_err(write_err)?;
+            write_body(w, path, mesh, names, &extra, true)?;
+            written.double = Some(why);
+        }
+        Ok(())
     })?;
     Ok(written)
 }
 
-/// The bytes of [`write_rows`], into a writer.
+/// The bytes of [`write_rows`], into a writer: `Some(why)` (and the file
+/// left unfinished) when a value does not fit the `float` asked for.
 fn write_body(
     w: &mut BufWriter<File>,
+    path: &Path,
     mesh: &Mesh,
     names: &[&str],
     extra: &impl Fn(usize, &mut Vec<f64>),
     double: bool,
-    write_err: impl Fn(std::io::Error) -> Error,
-) -> Result<()> {
+) -> Result<Option<String>> {
+    let write_err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
     let n = mesh.n_vertices();
     let ty = if double { "double" } else { "float" };
     let mut header = String::new();
@@ -220,7 +214,7 @@ fn write_body(
     }
     header.push_str(&format!("element face {}\n", mesh.n_faces()));
     header.push_str("property list uchar int vertex_indices\nend_header\n");
-    w.write_all(header.as_bytes()).map_err(&write_err)?;
+    w.write_all(header.as_bytes()).map_err(write_err)?;
 
     let mut row: Vec<f64> = Vec::with_capacity(names.len());
     let mut bytes: Vec<u8> = Vec::with_capacity(8 * row.capacity());
@@ -229,14 +223,27 @@ fn write_body(
         row.extend(p);
         extra(i, &mut row);
         bytes.clear();
-        for &v in &row {
+        for (k, &x) in row.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: property '{}' of vertex {i} is {x}: not written",
+                    path.display(),
+                    names[k]
+                )));
+            }
             if double {
-                bytes.extend_from_slice(&v.to_le_bytes());
+                bytes.extend_from_slice(&x.to_le_bytes());
+            } else if outside_f32(x) {
+                return Ok(Some(format!(
+                    "property '{}' of vertex {i} is {x:e}, outside the range of float \
+                     (about 1.2e-38 to 3.4e38)",
+                    names[k]
+                )));
             } else {
-                bytes.extend_from_slice(&(v as f32).to_le_bytes());
+                bytes.extend_from_slice(&(x as f32).to_le_bytes());
             }
         }
-        w.write_all(&bytes).map_err(&write_err)?;
+        w.write_all(&bytes).map_err(write_err)?;
     }
 
     for face in &mesh.faces {
@@ -246,9 +253,9 @@ fn write_body(
             // Checked above to fit an i32, so the u32 bytes are the i32 bytes.
             rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
         }
-        w.write_all(&rec).map_err(&write_err)?;
+        w.write_all(&rec).map_err(write_err)?;
     }
-    Ok(())
+    Ok(None)
 }
 
 /// The contents of a PLY file as [`read_ply_properties`] returns them: the
