@@ -110,6 +110,12 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         super::print_str(&text)?;
         return Ok(());
     }
+    // Before the load: a refused output should not wait for a large mesh.
+    check_outputs(
+        a.input.as_deref(),
+        a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
+        a.force,
+    )?;
     let t_load = Instant::now();
     let (name, mesh) = match (&a.input, a.generate) {
         (_, Some(kind)) => {
@@ -123,11 +129,6 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         (None, None) => bail!("give an input mesh, --generate or --report"),
     };
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-    check_outputs(
-        a.input.as_deref(),
-        a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
-        a.force,
-    )?;
     if a.output.is_none() && a.stats.is_none() {
         eprintln!("note: no --output or --stats given; computing and printing a summary only");
     }
