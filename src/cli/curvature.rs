@@ -142,7 +142,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     // The results: the CPU twin's field, or the device's buffers, read in
     // place below (no copy of the field: on a 2M-vertex mesh a copy is
     // 256 MB of fresh pages, whose first touch costs more than the rest).
-    let (field, mut estimator, counts, mut stats) = if a.cpu {
+    let (field, estimator, counts, mut stats) = if a.cpu {
         // The reference computes in f64, so it judges faces by f64 rounding.
         let opts = CurvatureOptions {
             precision: shapecue::spec::curvature::Precision::F64,
@@ -217,7 +217,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     };
     let t = Instant::now();
     let mapped = estimator
-        .as_mut()
+        .as_ref()
         .map(OrderedEstimator::mapped)
         .transpose()?;
     if mapped.is_some() {

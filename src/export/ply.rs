@@ -75,8 +75,9 @@ pub fn write_ply(path: &Path, mesh: &Mesh, field: Option<&CurvatureField>) -> Re
 
 /// [`write_ply`] with a field given vertex by vertex: `vertex(i)` gives the
 /// values of vertex `i` of the `n` (e.g. read in place from the device
-/// buffers, with no copy of the whole field). Each vertex is asked for twice:
-/// once to check the values, once to write them.
+/// buffers, with no copy of the whole field). Each vertex is asked for once,
+/// its values checked as they are written; twice when a value needs the
+/// file started again as `double`.
 ///
 /// # Errors
 ///

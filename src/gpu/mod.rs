@@ -352,13 +352,14 @@ impl Gpu {
         buf: &'b Buffer<T>,
         len: usize,
     ) -> Result<Mapped<'b, T>> {
+        let mem = opencl3::memory::ClMem::get(buf);
         if len == 0 {
+            let ptr = std::ptr::NonNull::<T>::dangling().as_ptr();
             return Ok(Mapped {
                 queue: &self.queue,
-                mem: opencl3::memory::ClMem::get(buf),
-                ptr: std::ptr::NonNull::<T>::dangling().as_ptr(),
-                len: 0,
-                mapped: false,
+                mem,
+                ptr,
+                len,
             });
         }
         let mut ptr: opencl3::types::cl_mem = std::ptr::null_mut();
@@ -378,10 +379,9 @@ impl Gpu {
         .map_err(|e| Error::cl("clEnqueueMapBuffer", e))?;
         let view = Mapped {
             queue: &self.queue,
-            mem: opencl3::memory::ClMem::get(buf),
+            mem,
             ptr: ptr.cast::<T>(),
             len,
-            mapped: true,
         };
         if ptr.is_null() || !(ptr as usize).is_multiple_of(std::mem::align_of::<T>()) {
             // Dropping the view unmaps it.
@@ -472,8 +472,8 @@ pub struct Mapped<'b, T> {
     queue: &'b CommandQueue,
     mem: opencl3::types::cl_mem,
     ptr: *const T,
+    /// Elements; 0 for a view of nothing, which was never mapped.
     len: usize,
-    mapped: bool,
 }
 
 impl<T> std::ops::Deref for Mapped<'_, T> {
@@ -487,7 +487,7 @@ impl<T> std::ops::Deref for Mapped<'_, T> {
 
 impl<T> Drop for Mapped<'_, T> {
     fn drop(&mut self) {
-        if self.mapped {
+        if self.len > 0 {
             // SAFETY: `ptr` is the pointer the map returned for `mem`, and
             // no slice of it outlives `self`.
             let unmapped = unsafe {

@@ -906,7 +906,7 @@ impl CurvatureEstimator {
     /// # Errors
     ///
     /// As [`CurvatureEstimator::read_placed`]; OpenCL errors of the maps.
-    pub fn mapped(&mut self, place: Option<&[u32]>) -> Result<MappedField<'_>> {
+    pub fn mapped(&self, place: Option<&[u32]>) -> Result<MappedField<'_>> {
         let n = self.nv;
         check_place("mapped", place, n)?;
         let device_of = place.map(|p| {
@@ -916,20 +916,19 @@ impl CurvatureEstimator {
             }
             d
         });
-        let this: &Self = self;
-        let map = |b, comps: usize| this.map_reals(b, comps);
+        let map = |b, comps: usize| self.map_reals(b, comps);
         Ok(MappedField {
             n,
-            precision: this.opts.precision,
-            scale: this.norm.scale,
+            precision: self.opts.precision,
+            scale: self.norm.scale,
             device_of,
-            nrm: map(&this.nrm, 3)?,
-            area: map(&this.area, 1)?,
-            pd1: map(&this.pd1, 3)?,
-            pd2: map(&this.pd2, 3)?,
-            kk: map(&this.kk, 2)?,
-            dk: if this.opts.dcurv {
-                Some(map(&this.dk, 4)?)
+            nrm: map(&self.nrm, 3)?,
+            area: map(&self.area, 1)?,
+            pd1: map(&self.pd1, 3)?,
+            pd2: map(&self.pd2, 3)?,
+            kk: map(&self.kk, 2)?,
+            dk: if self.opts.dcurv {
+                Some(map(&self.dk, 4)?)
             } else {
                 None
             },
@@ -1066,7 +1065,7 @@ impl OrderedEstimator {
     /// [`OrderedEstimator::read`] without the copy: the device buffers
     /// mapped, read vertex by vertex in the input's order
     /// ([`CurvatureEstimator::mapped`]); the same values, bit for bit.
-    pub fn mapped(&mut self) -> Result<MappedField<'_>> {
+    pub fn mapped(&self) -> Result<MappedField<'_>> {
         self.est
             .mapped(self.order.as_ref().map(|o| &o.input_vertex[..]))
     }
