@@ -59,3 +59,30 @@ fn every_embedded_kernel_family_builds_in_every_variant() {
     }
     assert!(kernel_file("nonexistent").is_none());
 }
+
+/// `Gpu::zero` fills with the widest pattern that divides the length; every
+/// length and element size clears exactly the first `len` elements.
+#[test]
+fn zero_clears_exactly_the_first_len_elements() {
+    let gpu = Gpu::new(None).unwrap();
+    fn check<T: bytemuck::Pod + PartialEq + std::fmt::Debug>(gpu: &Gpu, one: T) {
+        let total = 700;
+        for len in [
+            1usize, 2, 3, 7, 8, 31, 32, 33, 64, 96, 128, 129, 256, 513, 640, 700,
+        ] {
+            let mut b = gpu.buffer::<T>(total).unwrap();
+            gpu.write(&mut b, &vec![one; total]).unwrap();
+            gpu.zero(&mut b, len).unwrap();
+            let mut out = vec![one; total];
+            gpu.read(&b, &mut out).unwrap();
+            let zero = T::zeroed();
+            assert!(out[..len].iter().all(|v| *v == zero), "{len}: {out:?}");
+            assert!(out[len..].iter().all(|v| *v == one), "{len}: past the end");
+        }
+    }
+    check::<u8>(&gpu, 7);
+    check::<u32>(&gpu, 0xdead_beef);
+    check::<f64>(&gpu, 1.5);
+    check::<[u8; 3]>(&gpu, [1, 2, 3]);
+    check::<[u32; 3]>(&gpu, [1, 2, 3]);
+}

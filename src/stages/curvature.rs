@@ -13,7 +13,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, Mapped, buf, event_ms, kernel_file, launch};
 use crate::mesh::order::{LocalityOrder, MeshOrder};
-use crate::mesh::topology::one_rings;
+use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
     Precision, VertexCurvature, corner_reals_bound,
@@ -29,7 +29,8 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Pass {
-    /// Owning face per vertex (atomic_max); once per topology.
+    /// Owning face per vertex (atomic_max, or the last one-ring entry in the
+    /// gather variant); once per topology.
     MaxFace,
     /// Zero the accumulators (atomic variant only).
     Clear,
@@ -388,9 +389,6 @@ impl CurvatureEstimator {
     ) -> Result<Self> {
         let gather = opts.accumulate == Accumulate::Gather;
         let real = opts.precision.bytes();
-        let max_face = gpu.kernel(&program, "curv_max_face")?;
-        let mut owner = gpu.buffer::<i32>(nv)?;
-        gpu.write(&mut owner, &vec![-1i32; nv])?;
         if gather && corner_reals_bound(nf) > u32::MAX as usize {
             return Err(Error::InvalidArgument(format!(
                 "{nf} faces are more than the gather scheme's 32-bit corner slots address \
@@ -398,12 +396,21 @@ impl CurvatureEstimator {
                 u32::MAX as usize / 12 - crate::spec::curvature::MAX_FACE_LANES as usize
             )));
         }
+        let mut owner = gpu.buffer::<i32>(nv)?;
         let gather_bufs = if gather {
-            let (off, ring) = one_rings(nv, faces.unwrap_or(&[]));
-            let mut ring_off = gpu.buffer::<u32>(off.len())?;
-            gpu.write(&mut ring_off, &off)?;
-            let mut ring_b = gpu.buffer::<u32>(ring.len())?;
-            gpu.write(&mut ring_b, &ring)?;
+            // The one-ring lists are built in the device buffers themselves
+            // (mapped: no host copy on CPU runtimes), and the owning faces are
+            // their last entries, so no curv_max_face pass runs.
+            let faces = faces.unwrap_or(&[]);
+            let mut ring_off = gpu.buffer::<u32>(nv + 1)?;
+            let ring_len = crate::spec::curvature::one_ring_len_bound(nf);
+            let mut ring_b = gpu.buffer::<u32>(ring_len)?;
+            gpu.write_with(&mut ring_off, nv + 1, |off| {
+                gpu.write_with(&mut ring_b, ring_len, |ring| {
+                    one_rings_into(faces, off, ring);
+                    gpu.write_with(&mut owner, nv, |o| owners_from_rings(off, ring, o))
+                })
+            })???;
             Some(GatherBufs {
                 ring_off,
                 ring: ring_b,
@@ -423,12 +430,16 @@ impl CurvatureEstimator {
             Ok(b)
         };
         let bufs = [3, 3, 1, 3, 3, 3, 2, 4].map(|n| rb(n * nv));
-        launch(
-            &gpu,
-            &max_face,
-            nf,
-            &[Arg::U32(nf as u32), buf(&faces_b), buf(&owner)],
-        )?;
+        if !gather {
+            let max_face = gpu.kernel(&program, "curv_max_face")?;
+            gpu.write(&mut owner, &vec![-1i32; nv])?;
+            launch(
+                &gpu,
+                &max_face,
+                nf,
+                &[Arg::U32(nf as u32), buf(&faces_b), buf(&owner)],
+            )?;
+        }
         gpu.finish()?;
         let [pos, nrm, area, pd1, pd2, tens, kk, dk] = bufs;
         let est = CurvatureEstimator {

@@ -518,7 +518,7 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// topology; an isosurface's faces stay on the device and its estimator
     /// runs here, with normals from the volume gradient.
     fn one_rings(&mut self, frame: usize) -> Result<()> {
-        let how = "owning faces (atomic_max); includes the first program build";
+        let how = "one-ring lists or owning faces (atomic_max); includes the first program build";
         if let Some(p) = &self.pipe {
             let est = p.estimator().expect("built for the one-rings pass");
             let ms = est.topology_ms();
