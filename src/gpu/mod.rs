@@ -352,6 +352,18 @@ impl Gpu {
         buf: &'b Buffer<T>,
         len: usize,
     ) -> Result<Mapped<'b, T>> {
+        self.map(buf, opencl3::memory::CL_MAP_READ, len)
+    }
+
+    /// Maps the first `len` elements of `buf` (blocking) with `flags`, as a
+    /// view that unmaps when dropped; a pointer the map returns null or not
+    /// aligned for `T` is an error (and unmapped).
+    fn map<'b, T>(
+        &'b self,
+        buf: &'b Buffer<T>,
+        flags: opencl3::types::cl_map_flags,
+        len: usize,
+    ) -> Result<Mapped<'b, T>> {
         let mem = opencl3::memory::ClMem::get(buf);
         if len == 0 {
             let ptr = std::ptr::NonNull::<T>::dangling().as_ptr();
@@ -363,13 +375,13 @@ impl Gpu {
             });
         }
         let mut ptr: opencl3::types::cl_mem = std::ptr::null_mut();
-        // SAFETY: a blocking read-only map of a range inside the buffer; the
-        // pointer is only read through `Mapped` and unmapped in its `Drop`.
+        // SAFETY: a blocking map of a range inside the buffer; the pointer is
+        // only used through `Mapped` and unmapped in its `Drop` or `unmap`.
         unsafe {
             self.queue.enqueue_map_buffer(
                 buf,
                 CL_BLOCKING,
-                opencl3::memory::CL_MAP_READ,
+                flags,
                 0,
                 len * std::mem::size_of::<T>(),
                 &mut ptr,
@@ -405,43 +417,12 @@ impl Gpu {
         len: usize,
         fill: impl FnOnce(&mut [T]) -> R,
     ) -> Result<R> {
-        if len == 0 {
-            return Ok(fill(&mut []));
-        }
-        let mut ptr: opencl3::types::cl_mem = std::ptr::null_mut();
-        // SAFETY: a blocking map of a range inside the buffer; the pointer is
-        // only used below, as a slice that does not outlive the unmap.
-        unsafe {
-            self.queue.enqueue_map_buffer(
-                buf,
-                CL_BLOCKING,
-                opencl3::memory::CL_MAP_WRITE_INVALIDATE_REGION,
-                0,
-                len * std::mem::size_of::<T>(),
-                &mut ptr,
-                &[],
-            )
-        }
-        .map_err(|e| Error::cl("clEnqueueMapBuffer", e))?;
-        let mem = opencl3::memory::ClMem::get(buf);
-        let unmap = |ptr: opencl3::types::cl_mem| -> Result<()> {
-            // SAFETY: `ptr` is the pointer the map returned for `mem`, and no
-            // slice of it is alive any more.
-            unsafe { self.queue.enqueue_unmap_mem_object(mem, ptr, &[]) }
-                .map_err(|e| Error::cl("clEnqueueUnmapMemObject", e))?;
-            self.finish()
-        };
-        if ptr.is_null() || !(ptr as usize).is_multiple_of(std::mem::align_of::<T>()) {
-            unmap(ptr)?;
-            return Err(Error::cl(
-                "clEnqueueMapBuffer",
-                format!("a pointer ({ptr:p}) not aligned for the buffer's elements"),
-            ));
-        }
-        // SAFETY: the blocking map made `len` elements of a plain-old-data
-        // type writable at `ptr` (non-null, aligned) until the unmap.
-        let out = fill(unsafe { std::slice::from_raw_parts_mut(ptr.cast::<T>(), len) });
-        unmap(ptr)?;
+        let view = self.map(buf, opencl3::memory::CL_MAP_WRITE_INVALIDATE_REGION, len)?;
+        // SAFETY: the map made `len` elements of a plain-old-data type
+        // writable at this pointer (non-null and aligned, or dangling for
+        // none) until the unmap, and no other slice of them exists.
+        let out = fill(unsafe { std::slice::from_raw_parts_mut(view.ptr.cast_mut(), len) });
+        view.unmap()?;
         Ok(out)
     }
 
@@ -561,6 +542,24 @@ impl<T> std::ops::Deref for Mapped<'_, T> {
         // SAFETY: the blocking map made `len` elements readable at `ptr`
         // (checked non-null and aligned), and they stay mapped until drop.
         unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+impl<T> Mapped<'_, T> {
+    /// Unmaps now and waits, reporting a failure (a drop unmaps silently).
+    fn unmap(self) -> Result<()> {
+        let view = std::mem::ManuallyDrop::new(self);
+        if view.len == 0 {
+            return Ok(());
+        }
+        // SAFETY: `ptr` is the pointer the map returned for `mem`; `view` is
+        // not dropped, so it is unmapped once, and no slice of it is alive.
+        unsafe {
+            view.queue
+                .enqueue_unmap_mem_object(view.mem, view.ptr as *mut _, &[])
+        }
+        .map_err(|e| Error::cl("clEnqueueUnmapMemObject", e))?;
+        view.queue.finish().map_err(|e| Error::cl("clFinish", e))
     }
 }
 
