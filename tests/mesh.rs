@@ -1155,3 +1155,59 @@ fn ply_values_outside_float_range_are_written_as_double() {
     assert!(e.contains("'k1'") && e.contains("vertex 5"), "{e}");
     assert!(!dir.join("inf.ply").exists(), "nothing written on error");
 }
+
+/// The writer converts and checks vertices in blocks: on a mesh of several
+/// blocks every value lands in its own vertex and property (float and
+/// double files), and the value that forces double, or stops the write, is
+/// named with its own vertex even far past the first block, the first one in
+/// file order when there are several.
+#[test]
+fn ply_writer_blocks_keep_every_value_in_place() {
+    let dir = scratch("ply-blocks");
+    let m = shapecue::mesh::icosphere(1.0, 5);
+    let n = m.n_vertices();
+    assert!(n > 3 * 1024, "{n} vertices: several blocks");
+    let mut f = field_for(&m);
+    let expect = |f: &CurvatureField, i: usize| -> Vec<f32> {
+        let mut row: Vec<f64> = m.positions[i].to_vec();
+        row.extend(f.vertex(i).row());
+        row.into_iter().map(|x| x as f32).collect()
+    };
+    let p = dir.join("float.ply");
+    assert_eq!(write_ply(&p, &m, Some(&f)).unwrap().double, None);
+    let (names, rows, faces) = read_ply_properties(&p).unwrap();
+    assert_eq!((names.len(), rows.len()), (19, n));
+    assert_eq!(faces, m.faces);
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row, &expect(&f, i), "vertex {i}");
+    }
+
+    f.dk[5000][2] = 1e300;
+    f.k2[7000] = -1e-300;
+    let p = dir.join("double.ply");
+    let why = write_ply(&p, &m, Some(&f)).unwrap().double.unwrap();
+    assert!(
+        why.contains("'dk2'") && why.contains("vertex 5000"),
+        "{why}"
+    );
+    let (_, rows, faces) = read_ply_properties(&p).unwrap();
+    assert_eq!(faces, m.faces);
+    assert_eq!(rows[5000][3 + 14], f32::INFINITY, "1e300 read back as f32");
+    for i in (0..n).filter(|&i| i != 5000 && i != 7000) {
+        assert_eq!(rows[i], expect(&f, i), "vertex {i}");
+    }
+
+    f.d1[6000][1] = f64::NAN;
+    let e = write_ply(&dir.join("nan.ply"), &m, Some(&f))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'d1y'") && e.contains("vertex 6000"), "{e}");
+    f.d1[6000][1] = 0.0;
+    f.normals[2047][0] = f64::NEG_INFINITY;
+    let e = write_ply(&dir.join("inf.ply"), &m, Some(&f))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'nx'") && e.contains("vertex 2047"), "{e}");
+    assert!(!dir.join("inf.ply").exists() && !dir.join("nan.ply").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -102,14 +102,7 @@ pub fn write_ply_vertices(
         .copied()
         .collect();
     write_rows(path, mesh, &names, |i, row| {
-        let v = vertex(i);
-        row.extend(v.normal);
-        row.push(v.area);
-        row.push(v.k1);
-        row.push(v.k2);
-        row.extend(v.d1);
-        row.extend(v.d2);
-        row.extend(v.dk);
+        row.copy_from_slice(&vertex(i).row());
     })
 }
 
@@ -133,7 +126,7 @@ pub fn write_ply_with_normals(
     }
     check_face_indices(mesh)?;
     write_rows(path, mesh, &["x", "y", "z", "nx", "ny", "nz"], |i, row| {
-        row.extend(normals[i]);
+        row.copy_from_slice(&normals[i]);
     })
 }
 
@@ -151,16 +144,30 @@ fn check_face_indices(mesh: &Mesh) -> Result<()> {
     Ok(())
 }
 
-/// True when `x` (finite) would not survive as an `f32`: it would become
-/// infinite, or a non-zero value would become zero or lose precision as a
-/// subnormal.
-fn outside_f32(x: f64) -> bool {
-    let a = x.abs();
-    a > f64::from(f32::MAX) || (a != 0.0 && a < f64::from(f32::MIN_POSITIVE))
+/// The bits of `|x|` (ordered as `|x|` is, NaN above infinity).
+fn abs_bits(x: f64) -> u64 {
+    x.to_bits() & !(1 << 63)
+}
+
+/// True when `x` is finite (as [`f64::is_finite`], on the bits, so that a
+/// loop over many values needs no branch).
+fn fits_f64(x: f64) -> bool {
+    abs_bits(x) < f64::INFINITY.to_bits()
+}
+
+/// True when `x` is finite and survives as an `f32`: zero, or between
+/// `f32`'s smallest normal and largest magnitude (beyond, it would become
+/// infinite, or a non-zero value zero or a subnormal that lost precision);
+/// on the bits, as [`fits_f64`].
+fn fits_f32(x: f64) -> bool {
+    const LO: u64 = (f32::MIN_POSITIVE as f64).to_bits();
+    const HI: u64 = (f32::MAX as f64).to_bits();
+    let a = abs_bits(x);
+    (a == 0) | (a.wrapping_sub(LO) <= HI - LO)
 }
 
 /// Writes the header, one row of properties per vertex (position first,
-/// then what `extra` appends) and the faces; `float` unless a value needs
+/// then what `extra` fills in) and the faces; `float` unless a value needs
 /// `double`, in which case the file is started again with `double`. One pass
 /// over the values when they all fit a `float` (the usual case): each value
 /// is checked as it is written, and a value that is not finite stops the
@@ -169,7 +176,7 @@ fn write_rows(
     path: &Path,
     mesh: &Mesh,
     names: &[&str],
-    extra: impl Fn(usize, &mut Vec<f64>),
+    extra: impl Fn(usize, &mut [f64]),
 ) -> Result<PlyWritten> {
     let mut written = PlyWritten::default();
     let write_err = |source| Error::Write {
@@ -191,14 +198,24 @@ fn write_rows(
     Ok(written)
 }
 
+/// Vertices converted and written per block: small enough for the values
+/// and their bytes to stay in cache, large enough that the per-block work
+/// (a check, a conversion loop, one buffered write) runs over many values.
+const BLOCK_VERTICES: usize = 1024;
+
 /// The bytes of [`write_rows`], into a writer: `Some(why)` (and the file
 /// left unfinished) when a value does not fit the `float` asked for.
+///
+/// `extra(i, row)` fills the values after the position of vertex `i`
+/// (`names.len() - 3` of them). Vertices go in blocks of
+/// [`BLOCK_VERTICES`]: their values gathered, checked in one loop, then
+/// converted in one loop; the faces in blocks of 13-byte records.
 fn write_body(
     w: &mut BufWriter<File>,
     path: &Path,
     mesh: &Mesh,
     names: &[&str],
-    extra: &impl Fn(usize, &mut Vec<f64>),
+    extra: &impl Fn(usize, &mut [f64]),
     double: bool,
 ) -> Result<Option<String>> {
     let write_err = |source| Error::Write {
@@ -217,14 +234,31 @@ fn write_body(
     header.push_str("property list uchar int vertex_indices\nend_header\n");
     w.write_all(header.as_bytes()).map_err(write_err)?;
 
-    let mut row: Vec<f64> = Vec::with_capacity(names.len());
-    let mut bytes: Vec<u8> = Vec::with_capacity(8 * row.capacity());
-    for (i, p) in mesh.positions.iter().enumerate() {
-        row.clear();
-        row.extend(p);
-        extra(i, &mut row);
-        bytes.clear();
-        for (k, &x) in row.iter().enumerate() {
+    let cols = names.len();
+    let width = if double { 8 } else { 4 };
+    let mut vals = vec![0.0f64; BLOCK_VERTICES * cols];
+    let mut bytes = vec![0u8; BLOCK_VERTICES * cols * width];
+    for (b, block) in mesh.positions.chunks(BLOCK_VERTICES).enumerate() {
+        let first = b * BLOCK_VERTICES;
+        let vals = &mut vals[..block.len() * cols];
+        for (k, (row, p)) in vals.chunks_exact_mut(cols).zip(block).enumerate() {
+            row[..3].copy_from_slice(p);
+            extra(first + k, &mut row[3..]);
+        }
+        // The common case, all finite and (for float) all in range, is one
+        // branch-free pass over the values' bits; the first value that is
+        // not is then found.
+        let fine = if double {
+            vals.iter().fold(true, |ok, &x| ok & fits_f64(x))
+        } else {
+            vals.iter().fold(true, |ok, &x| ok & fits_f32(x))
+        };
+        if !fine {
+            let at = vals
+                .iter()
+                .position(|&x| if double { !fits_f64(x) } else { !fits_f32(x) })
+                .expect("a value that is not fine");
+            let (i, k, x) = (first + at / cols, at % cols, vals[at]);
             if !x.is_finite() {
                 return Err(Error::InvalidArgument(format!(
                     "{}: property '{}' of vertex {i} is {x}: not written",
@@ -232,29 +266,37 @@ fn write_body(
                     names[k]
                 )));
             }
-            if double {
-                bytes.extend_from_slice(&x.to_le_bytes());
-            } else if outside_f32(x) {
-                return Ok(Some(format!(
-                    "property '{}' of vertex {i} is {x:e}, outside the range of float \
-                     (about 1.2e-38 to 3.4e38)",
-                    names[k]
-                )));
-            } else {
-                bytes.extend_from_slice(&(x as f32).to_le_bytes());
+            return Ok(Some(format!(
+                "property '{}' of vertex {i} is {x:e}, outside the range of float \
+                 (about 1.2e-38 to 3.4e38)",
+                names[k]
+            )));
+        }
+        let bytes = &mut bytes[..vals.len() * width];
+        if double {
+            for (o, x) in bytes.chunks_exact_mut(8).zip(vals.iter()) {
+                o.copy_from_slice(&x.to_le_bytes());
+            }
+        } else {
+            for (o, &x) in bytes.chunks_exact_mut(4).zip(vals.iter()) {
+                o.copy_from_slice(&(x as f32).to_le_bytes());
             }
         }
-        w.write_all(&bytes).map_err(write_err)?;
+        w.write_all(bytes).map_err(write_err)?;
     }
 
-    for face in &mesh.faces {
-        let mut rec = [0u8; 13];
-        rec[0] = 3;
-        for (k, &v) in face.iter().enumerate() {
-            // Checked above to fit an i32, so the u32 bytes are the i32 bytes.
-            rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
+    const REC: usize = 13;
+    let mut recs = vec![0u8; BLOCK_VERTICES * REC];
+    for block in mesh.faces.chunks(BLOCK_VERTICES) {
+        let recs = &mut recs[..block.len() * REC];
+        for (rec, face) in recs.chunks_exact_mut(REC).zip(block) {
+            rec[0] = 3;
+            for (k, &v) in face.iter().enumerate() {
+                // Checked above to fit an i32, so the u32 bytes are the i32 bytes.
+                rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
+            }
         }
-        w.write_all(&rec).map_err(write_err)?;
+        w.write_all(recs).map_err(write_err)?;
     }
     Ok(None)
 }
@@ -333,4 +375,47 @@ pub fn read_ply_properties(path: &Path) -> Result<PlyProperties> {
         }
     }
     Ok((names, rows, faces))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{fits_f32, fits_f64};
+
+    /// The range test written plainly, as the bit tests must agree with.
+    fn plain_fits_f32(x: f64) -> bool {
+        let a = x.abs();
+        x.is_finite()
+            && !(a > f64::from(f32::MAX) || (a != 0.0 && a < f64::from(f32::MIN_POSITIVE)))
+    }
+
+    #[test]
+    fn bit_range_tests_agree_with_the_plain_ones() {
+        let max = f64::from(f32::MAX);
+        let min = f64::from(f32::MIN_POSITIVE);
+        let mut xs = vec![
+            0.0,
+            1.0,
+            1e-300,
+            1e300,
+            max,
+            min,
+            f64::from(f32::MIN_POSITIVE / 2.0),
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::INFINITY,
+            f64::NAN,
+            -f64::NAN,
+        ];
+        for x in [max, min] {
+            xs.extend([x.next_up(), x.next_down()]);
+        }
+        for x in xs.clone() {
+            xs.push(-x);
+        }
+        for x in xs {
+            assert_eq!(fits_f32(x), plain_fits_f32(x), "{x:e}");
+            assert_eq!(fits_f64(x), x.is_finite(), "{x:e}");
+        }
+    }
 }

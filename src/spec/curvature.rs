@@ -60,15 +60,21 @@ pub struct VertexCurvature {
 }
 
 impl VertexCurvature {
+    /// The values in the order the fields are declared (the order of the
+    /// PLY properties shapecue writes): normal, area, k1, k2, d1, d2, dk.
+    pub fn row(&self) -> [f64; 16] {
+        let [nx, ny, nz] = self.normal;
+        let [ax, ay, az] = self.d1;
+        let [bx, by, bz] = self.d2;
+        let [d0, d1, d2, d3] = self.dk;
+        [
+            nx, ny, nz, self.area, self.k1, self.k2, ax, ay, az, bx, by, bz, d0, d1, d2, d3,
+        ]
+    }
+
     /// True if every value is finite.
     pub fn all_finite(&self) -> bool {
-        self.normal
-            .iter()
-            .chain(&self.d1)
-            .chain(&self.d2)
-            .chain(&self.dk)
-            .chain([&self.area, &self.k1, &self.k2])
-            .all(|x| x.is_finite())
+        self.row().iter().fold(true, |ok, x| ok & x.is_finite())
     }
 }
 

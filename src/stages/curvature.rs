@@ -997,33 +997,44 @@ impl MappedField<'_> {
         self.n == 0
     }
 
-    /// Real `k` of the buffer `b` as f64.
-    fn at(&self, b: &[u8], k: usize) -> f64 {
-        match self.precision {
-            Precision::F32 => f64::from(f32::from_ne_bytes(
-                b[4 * k..4 * k + 4].try_into().expect("4 bytes"),
-            )),
-            Precision::F64 => f64::from_ne_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes")),
-        }
-    }
-
     /// The values of vertex `i` (below [`MappedField::len`]) in the field's
     /// order, in the pose's own coordinates: the scalings of
     /// [`CurvatureEstimator::read_placed`], operation for operation.
     pub fn vertex(&self, i: usize) -> VertexCurvature {
         let v = self.device_of.as_ref().map_or(i, |d| d[i] as usize);
+        match self.precision {
+            Precision::F32 => self.vertex_as::<f32>(v),
+            Precision::F64 => self.vertex_as::<f64>(v),
+        }
+    }
+
+    /// [`MappedField::vertex`] of device vertex `v`, the buffers holding
+    /// reals of type `R`: each buffer's slice for the vertex cut once, its
+    /// reals read unaligned (the maps' pointers are only known to be byte
+    /// aligned), so a vertex costs a few bounds checks, not one per value.
+    #[inline]
+    fn vertex_as<R: bytemuck::Pod + Into<f64>>(&self, v: usize) -> VertexCurvature {
+        fn reals<R: bytemuck::Pod + Into<f64>, const N: usize>(b: &[u8], v: usize) -> [f64; N] {
+            let w = std::mem::size_of::<R>();
+            let b = &b[N * w * v..N * w * (v + 1)];
+            std::array::from_fn(|c| {
+                bytemuck::pod_read_unaligned::<R>(&b[c * w..(c + 1) * w]).into()
+            })
+        }
         let s = self.scale;
-        let vec3 = |b: &[u8]| std::array::from_fn(|c| self.at(b, 3 * v + c));
+        let [area] = reals::<R, 1>(&self.area, v);
+        let [k1, k2] = reals::<R, 2>(&self.kk, v);
         VertexCurvature {
-            normal: vec3(&self.nrm),
-            area: self.at(&self.area, v) * (s * s),
-            k1: self.at(&self.kk, 2 * v) / s,
-            k2: self.at(&self.kk, 2 * v + 1) / s,
-            d1: vec3(&self.pd1),
-            d2: vec3(&self.pd2),
-            dk: self.dk.as_ref().map_or([0.0; 4], |b| {
-                std::array::from_fn(|c| self.at(b, 4 * v + c) / (s * s))
-            }),
+            normal: reals::<R, 3>(&self.nrm, v),
+            area: area * (s * s),
+            k1: k1 / s,
+            k2: k2 / s,
+            d1: reals::<R, 3>(&self.pd1, v),
+            d2: reals::<R, 3>(&self.pd2, v),
+            dk: self
+                .dk
+                .as_ref()
+                .map_or([0.0; 4], |b| reals::<R, 4>(b, v).map(|d| d / (s * s))),
         }
     }
 }
