@@ -532,9 +532,9 @@ fn binary_value(b: &[u8], t: &ScalarType, big: bool) -> f64 {
 /// (`cargo bench --bench mesh_io`), as it builds no value per property.
 /// `payload` is the number of bytes the body holds (it bounds what is
 /// reserved); the body is read in order, a few rows at a time.
-fn parse_binary(
+fn parse_binary<B: Body>(
     header: &Header,
-    body: &mut impl Body,
+    body: &mut B,
     payload: usize,
     big: bool,
     nv: usize,
@@ -596,7 +596,14 @@ fn parse_binary(
             }
             continue;
         }
-        for i in 0..def.count {
+        // One element read property by property: every element of a
+        // general layout, and in the triangle reader below the rows it
+        // leaves (a polygon, a bad index, the end of the payload).
+        let mut element_at = |body: &mut B,
+                              i: usize,
+                              positions: &mut Vec<[f64; 3]>,
+                              faces: &mut Vec<[u32; 3]>|
+         -> Result<()> {
             let element = || format!("{name} {i}");
             let eof = || Error::input(source, element(), eof_problem(def));
             let mut p = [0.0; 3];
@@ -647,15 +654,45 @@ fn parse_binary(
             if is_vertex {
                 positions.push(p);
             } else if is_face {
-                add_polygon(
-                    indices.iter().copied(),
-                    i,
-                    nv,
-                    source,
-                    &mut poly,
-                    &mut faces,
-                )?;
+                add_polygon(indices.iter().copied(), i, nv, source, &mut poly, faces)?;
             }
+            Ok(())
+        };
+        // A face element of the index list alone (the usual one) is read
+        // many rows at a time while its rows are triangles with indices in
+        // range: what the element reader would make of them, without its
+        // walk over the layout and its list per face.
+        if is_face && let [(PropertyType::List(c, t), Role::Indices, _)] = layout.as_slice() {
+            let (cs, size) = (scalar_size(c), scalar_size(t));
+            let rec = cs + 3 * size;
+            let batch = (BODY_CHUNK / rec).max(1);
+            let mut i = 0;
+            while i < def.count {
+                let want = batch.min(def.count - i);
+                let mut rows = 0;
+                for r in body.peek(want * rec)?.chunks_exact(rec) {
+                    if binary_value(r, c, big) != 3.0 {
+                        break;
+                    }
+                    let tri: [i64; 3] =
+                        std::array::from_fn(|k| binary_value(&r[cs + k * size..], t, big) as i64);
+                    if tri.iter().any(|&v| v < 0 || v as u64 >= nv as u64) {
+                        break;
+                    }
+                    faces.push(tri.map(|v| v as u32));
+                    rows += 1;
+                }
+                body.skip(rows * rec);
+                i += rows;
+                if rows < want {
+                    element_at(body, i, &mut positions, &mut faces)?;
+                    i += 1;
+                }
+            }
+            continue;
+        }
+        for i in 0..def.count {
+            element_at(body, i, &mut positions, &mut faces)?;
         }
     }
     Ok(Mesh { positions, faces })
@@ -669,6 +706,11 @@ const BODY_CHUNK: usize = 1 << 20;
 trait Body {
     /// The next `n` bytes, or fewer where the payload ends.
     fn take(&mut self, n: usize) -> Result<&[u8]>;
+    /// The next `n` bytes (or fewer where the payload ends) without taking
+    /// them: the next call sees them again.
+    fn peek(&mut self, n: usize) -> Result<&[u8]>;
+    /// Takes `n` bytes that [`Body::peek`] has just shown.
+    fn skip(&mut self, n: usize);
 }
 
 /// A payload in memory.
@@ -680,6 +722,16 @@ impl Body for SliceBody<'_> {
         let (head, rest) = self.0.split_at(n.min(self.0.len()));
         self.0 = rest;
         Ok(head)
+    }
+
+    #[inline]
+    fn peek(&mut self, n: usize) -> Result<&[u8]> {
+        Ok(&self.0[..n.min(self.0.len())])
+    }
+
+    #[inline]
+    fn skip(&mut self, n: usize) {
+        self.0 = &self.0[n..];
     }
 }
 
@@ -706,6 +758,20 @@ impl<R: Read> Body for FileBody<'_, R> {
         let out = &self.buf[self.start..self.start + k];
         self.start += k;
         Ok(out)
+    }
+
+    #[inline]
+    fn peek(&mut self, n: usize) -> Result<&[u8]> {
+        if self.end - self.start < n && !self.eof {
+            self.fill(n)?;
+        }
+        Ok(&self.buf[self.start..self.start + n.min(self.end - self.start)])
+    }
+
+    #[inline]
+    fn skip(&mut self, n: usize) {
+        assert!(n <= self.end - self.start, "skipped more than was shown");
+        self.start += n;
     }
 }
 
@@ -872,5 +938,150 @@ mod tests {
                 (a, c) => panic!("cut {cut}: {:?} against {:?}", a.err(), c.err()),
             }
         }
+    }
+
+    /// The triangle reader of face elements gives what the element reader
+    /// gives: polygons among the triangles (one across a batch boundary),
+    /// every count and index type in both byte orders, in memory and from
+    /// a file in small chunks; an index out of range, a negative one, a
+    /// list too short and a payload cut short far into the faces are named
+    /// at their own face, with the element reader's messages.
+    #[test]
+    fn the_triangle_reader_agrees_with_the_element_reader() {
+        let nv = 7u32;
+        let nf = 40_000;
+        // Face i: a triangle, but for a few polygons of 4 and 5 vertices.
+        let face = |i: usize| -> Vec<i64> {
+            let a = (i % nv as usize) as i64;
+            let b = (a + 1) % i64::from(nv);
+            let c = (a + 2) % i64::from(nv);
+            match i {
+                0 | 1000 | 39_999 => vec![a, b, c, (a + 3) % 7],
+                2 => vec![a, b, c, (a + 3) % 7, (a + 4) % 7],
+                _ => vec![a, b, c],
+            }
+        };
+        let encode = |x: i64, t: &str, big: bool| -> Vec<u8> {
+            macro_rules! b {
+                ($v:expr) => {
+                    if big {
+                        $v.to_be_bytes().to_vec()
+                    } else {
+                        $v.to_le_bytes().to_vec()
+                    }
+                };
+            }
+            match t {
+                "uchar" => b!(x as u8),
+                "char" => b!(x as i8),
+                "ushort" => b!(x as u16),
+                "short" => b!(x as i16),
+                "uint" => b!(x as u32),
+                "int" => b!(x as i32),
+                "float" => b!(x as f32),
+                _ => b!(x as f64),
+            }
+        };
+        let file = |count: &str, item: &str, big: bool, faces: &[Vec<i64>]| -> (Vec<u8>, usize) {
+            let order = if big { "big" } else { "little" };
+            let mut b = format!(
+                "ply\nformat binary_{order}_endian 1.0\nelement vertex {nv}\nproperty double x\n\
+                 property double y\nproperty double z\nelement face {}\n\
+                 property list {count} {item} vertex_indices\nend_header\n",
+                faces.len()
+            )
+            .into_bytes();
+            let at = b.len();
+            for v in 0..nv {
+                for x in [f64::from(v), 1.0, -2.0] {
+                    b.extend(if big {
+                        x.to_be_bytes()
+                    } else {
+                        x.to_le_bytes()
+                    });
+                }
+            }
+            for f in faces {
+                b.extend(encode(f.len() as i64, count, big));
+                for &v in f {
+                    b.extend(encode(v, item, big));
+                }
+            }
+            (b, at)
+        };
+        let read = |b: &[u8], at: usize| -> [std::result::Result<Mesh, String>; 2] {
+            let header = Parser::<Skip>::new()
+                .read_header(&mut Reader::new(&b[..at]))
+                .unwrap();
+            let body = &b[at..];
+            let n = nv as usize;
+            let big = header.encoding == Encoding::BinaryBigEndian;
+            let whole = parse_binary(&header, &mut SliceBody(body), body.len(), big, n, "m.ply");
+            let mut chunked = FileBody {
+                r: std::io::Cursor::new(body),
+                path: Path::new("m.ply"),
+                buf: Vec::new(),
+                start: 0,
+                end: 0,
+                eof: false,
+            };
+            let chunked = parse_binary(&header, &mut chunked, body.len(), big, n, "m.ply");
+            [whole, chunked].map(|r| r.map_err(|e| e.to_string()))
+        };
+        let faces: Vec<Vec<i64>> = (0..nf).map(face).collect();
+        let mut expect = Vec::new();
+        for f in &faces {
+            let f: Vec<u32> = f.iter().map(|&v| v as u32).collect();
+            super::fan(&f, &mut expect);
+        }
+        for (count, item) in [
+            ("uchar", "int"),
+            ("uchar", "uint"),
+            ("char", "short"),
+            ("ushort", "uchar"),
+            ("int", "int"),
+            ("uchar", "float"),
+            ("uint", "double"),
+        ] {
+            for big in [false, true] {
+                let (b, at) = file(count, item, big, &faces);
+                for got in read(&b, at) {
+                    let m = got.unwrap_or_else(|e| panic!("{count} {item} {big}: {e}"));
+                    assert_eq!(m.faces, expect, "{count} {item} big {big}");
+                    assert_eq!(m.positions.len(), nv as usize);
+                }
+            }
+        }
+        // Problems far into the faces, each named at its face.
+        let cases: [(usize, Vec<i64>, &str); 3] = [
+            (30_001, vec![1, 7, 2], "vertex index 7 out of range"),
+            (25_000, vec![1, -1, 2], "negative vertex index -1"),
+            (
+                20_000,
+                vec![1, 2],
+                "2 vertex indices; a face needs at least 3",
+            ),
+        ];
+        for (at_face, bad, why) in cases {
+            let mut f = faces.clone();
+            f[at_face] = bad;
+            let (b, at) = file("uchar", "int", false, &f);
+            for got in read(&b, at) {
+                let e = got.expect_err("an error");
+                assert!(
+                    e.contains(&format!("face {at_face}")) && e.contains(why),
+                    "{e}"
+                );
+            }
+        }
+        let (b, at) = file("uchar", "int", false, &faces);
+        let cut = b.len() - 13 * 5000 - 7;
+        let [a, c] = read(&b[..cut], at);
+        let (a, c) = (a.expect_err("cut short"), c.expect_err("cut short"));
+        assert_eq!(a, c);
+        assert!(
+            a.contains(&format!("face {}", nf - 5001)) && a.contains("end of file"),
+            "{a}"
+        );
     }
 }
