@@ -1112,6 +1112,8 @@ fn curvature_runs_times_the_device_passes() {
     for phase in [
         "load",
         "device",
+        "program_prepare",
+        "device_wait",
         "program_build",
         "topology",
         "normalise",
@@ -1299,4 +1301,43 @@ fn curvature_report_has_a_row_for_every_variant() {
         rows.last().unwrap().starts_with("| cpu reference"),
         "{text}"
     );
+}
+
+/// The device is opened, and the curvature program built, beside the mesh's
+/// load: a device that does not exist is still a clear error naming it,
+/// with no output written, and an input that cannot be read is reported
+/// first, as it was when the device was opened after the load.
+#[test]
+fn curvature_device_errors_beside_the_load() {
+    let d = scratch("device-beside-load");
+    let out = d.join("out.ply");
+    let o = run_cli([
+        "--device".as_ref(),
+        "no-such-device".as_ref(),
+        "curvature".as_ref(),
+        "--generate".as_ref(),
+        "sphere".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("'no-such-device'"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    let o = run_cli([
+        "--device".as_ref(),
+        "no-such-device".as_ref(),
+        "curvature".as_ref(),
+        d.join("missing.obj").as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("missing.obj") && !err.contains("no-such-device"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
 }

@@ -20,7 +20,7 @@ use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use shapecue::spec::timing::Timing;
-use shapecue::stages::curvature::OrderedEstimator;
+use shapecue::stages::curvature::{CurvatureEstimator, OrderedEstimator};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -90,6 +90,38 @@ pub struct CurvatureArgs {
     runs: Option<usize>,
 }
 
+/// The device opened and the curvature program built for the options, with
+/// the variant chosen for the device.
+struct Prepared {
+    gpu: Arc<Gpu>,
+    accumulate: Accumulate,
+    device_ms: f64,
+    prepare_ms: f64,
+}
+
+/// Opens the device and gets the curvature program for `opts` built (or
+/// loaded from a cache), the accumulation variant being `accumulate` or the
+/// device type's default. A program the device refuses is not an error
+/// here: building the estimator reports it, with its context.
+fn prepare_device(
+    device: Option<&str>,
+    mut opts: CurvatureOptions,
+    accumulate: Option<Accumulate>,
+) -> Result<Prepared> {
+    let t = Instant::now();
+    let gpu = Arc::new(Gpu::new(device)?);
+    let device_ms = ms_since(t);
+    opts.accumulate = accumulate.unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
+    let t = Instant::now();
+    let _ = CurvatureEstimator::prepare(&gpu, &opts);
+    Ok(Prepared {
+        gpu,
+        accumulate: opts.accumulate,
+        device_ms,
+        prepare_ms: ms_since(t),
+    })
+}
+
 /// Runs `shapecue curvature`.
 pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let mut opts = CurvatureOptions {
@@ -116,19 +148,36 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
         a.force,
     )?;
-    let t_load = Instant::now();
-    let (name, mesh) = match (&a.input, a.generate) {
-        (_, Some(kind)) => {
-            shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
-            kind.mesh(a.resolution)
-        }
-        (Some(path), None) => {
-            let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
-            (path.display().to_string(), m)
-        }
-        (None, None) => bail!("give an input mesh, --generate or --report"),
+    // Opening the device and building the curvature program need no mesh:
+    // they run on a thread of their own beside the load (both are a single
+    // core's work; on a CPU device the other core is otherwise idle).
+    let load = || -> Result<(String, shapecue::Mesh, f64)> {
+        let t_load = Instant::now();
+        let (name, mesh) = match (&a.input, a.generate) {
+            (_, Some(kind)) => {
+                shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
+                kind.mesh(a.resolution)
+            }
+            (Some(path), None) => {
+                let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
+                (path.display().to_string(), m)
+            }
+            (None, None) => bail!("give an input mesh, --generate or --report"),
+        };
+        Ok((name, mesh, t_load.elapsed().as_secs_f64() * 1e3))
     };
-    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    let (loaded, prepared) = std::thread::scope(|s| {
+        let prepare = (!a.cpu).then(|| s.spawn(|| prepare_device(device, opts, a.accumulate)));
+        let loaded = load();
+        let t_wait = Instant::now();
+        let prepared = prepare.map(|h| match h.join() {
+            Ok(p) => p.map(|p| (p, ms_since(t_wait))),
+            Err(panic) => std::panic::resume_unwind(panic),
+        });
+        (loaded, prepared)
+    });
+    let (name, mesh, load_ms) = loaded?;
+    let prepared = prepared.transpose()?;
     if a.output.is_none() && a.stats.is_none() {
         eprintln!("note: no --output or --stats given; computing and printing a summary only");
     }
@@ -168,12 +217,12 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         phase("first_run", c.timing.wall_ms);
         (Some(c.field), None, c.counts, stats)
     } else {
-        let t = Instant::now();
-        let gpu = Arc::new(Gpu::new(device)?);
-        phase("device", ms_since(t));
-        opts.accumulate = a
-            .accumulate
-            .unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
+        let (p, wait_ms) = prepared.expect("prepared when not on the CPU reference");
+        phase("device", p.device_ms);
+        phase("program_prepare", p.prepare_ms);
+        phase("device_wait", wait_ms);
+        let gpu = p.gpu;
+        opts.accumulate = p.accumulate;
         let setup = || format!("setting up curvature for {name}");
         let mut o = OrderedEstimator::new(gpu.clone(), &mesh, opts, a.order).with_context(setup)?;
         phase("reorder", o.reorder_ms);

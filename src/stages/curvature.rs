@@ -247,6 +247,19 @@ impl CurvatureEstimator {
         )
     }
 
+    /// Gets the program an estimator for `opts` runs into `gpu`'s table of
+    /// built programs (from source, shapecue's binary cache or the driver's),
+    /// so that a later [`CurvatureEstimator::new`] on `gpu` finds it built.
+    /// It needs no mesh: a caller can run it beside the mesh's load.
+    ///
+    /// # Errors
+    ///
+    /// As [`CurvatureEstimator::new`] for options the device cannot run,
+    /// and OpenCL build errors.
+    pub fn prepare(gpu: &Arc<Gpu>, opts: &CurvatureOptions) -> Result<()> {
+        Self::build(gpu, opts).map(drop)
+    }
+
     fn build(
         gpu: &Arc<Gpu>,
         opts: &CurvatureOptions,
