@@ -506,6 +506,11 @@ impl Gpu {
         Ok(())
     }
 
+    /// Submits every queued command to the device without waiting.
+    pub fn flush(&self) -> Result<()> {
+        self.queue.flush().map_err(|e| Error::cl("clFlush", e))
+    }
+
     /// Waits for every queued command.
     pub fn finish(&self) -> Result<()> {
         self.queue.finish().map_err(|e| Error::cl("clFinish", e))
