@@ -884,6 +884,18 @@ pub(super) fn load(path: &Path, source: &str) -> Result<Mesh> {
 mod tests {
     use super::*;
 
+    /// `body` as the chunked reader of files reads it, from an empty buffer.
+    fn chunked_body(body: &[u8]) -> FileBody<'static, std::io::Cursor<&[u8]>> {
+        FileBody {
+            r: std::io::Cursor::new(body),
+            path: Path::new("m.ply"),
+            buf: Vec::new(),
+            start: 0,
+            end: 0,
+            eof: false,
+        }
+    }
+
     /// A file that ends before its header's counts (it shrank while being
     /// read) is reported at the row where it ends, by the chunked reader as
     /// by the reader of bytes in memory, in the fixed-row vertex reader too.
@@ -910,14 +922,7 @@ mod tests {
         for cut in [payload, payload - 1, 12 * 70_001 + 5, 12 * 87_381 + 1, 0] {
             let body = &b[at..at + cut];
             let whole = parse_binary(&header, &mut SliceBody(body), payload, false, nv, "m.ply");
-            let mut chunked = FileBody {
-                r: std::io::Cursor::new(body),
-                path: Path::new("m.ply"),
-                buf: Vec::new(),
-                start: 0,
-                end: 0,
-                eof: false,
-            };
+            let mut chunked = chunked_body(body);
             let chunked = parse_binary(&header, &mut chunked, payload, false, nv, "m.ply");
             match (whole, chunked) {
                 (Ok(a), Ok(c)) => {
@@ -1017,14 +1022,7 @@ mod tests {
             let n = nv as usize;
             let big = header.encoding == Encoding::BinaryBigEndian;
             let whole = parse_binary(&header, &mut SliceBody(body), body.len(), big, n, "m.ply");
-            let mut chunked = FileBody {
-                r: std::io::Cursor::new(body),
-                path: Path::new("m.ply"),
-                buf: Vec::new(),
-                start: 0,
-                end: 0,
-                eof: false,
-            };
+            let mut chunked = chunked_body(body);
             let chunked = parse_binary(&header, &mut chunked, body.len(), big, n, "m.ply");
             [whole, chunked].map(|r| r.map_err(|e| e.to_string()))
         };
