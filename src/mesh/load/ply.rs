@@ -946,22 +946,27 @@ mod tests {
     }
 
     /// The triangle reader of face elements gives what the element reader
-    /// gives: polygons among the triangles (one across a batch boundary),
-    /// every count and index type in both byte orders, in memory and from
-    /// a file in small chunks; an index out of range, a negative one, a
-    /// list too short and a payload cut short far into the faces are named
-    /// at their own face, with the element reader's messages.
+    /// gives: polygons among the triangles (two at the end of the first
+    /// batch of 13-byte rows), every count and index type in both byte
+    /// orders, in memory and from a file read a chunk at a time (the faces
+    /// span several chunks); an index out of range, a negative one, a list
+    /// too short and a payload cut short far into the faces are named at
+    /// their own face, with the element reader's messages.
     #[test]
     fn the_triangle_reader_agrees_with_the_element_reader() {
         let nv = 7u32;
-        let nf = 40_000;
+        let nf = 200_000;
+        // The last row of the first batch of `uchar int` triangles.
+        let edge = BODY_CHUNK / 13 - 1;
+        assert!(2 * BODY_CHUNK < 13 * nf, "the faces span several chunks");
         // Face i: a triangle, but for a few polygons of 4 and 5 vertices.
         let face = |i: usize| -> Vec<i64> {
             let a = (i % nv as usize) as i64;
             let b = (a + 1) % i64::from(nv);
             let c = (a + 2) % i64::from(nv);
             match i {
-                0 | 1000 | 39_999 => vec![a, b, c, (a + 3) % 7],
+                _ if i == edge || i == edge + 1 => vec![a, b, c, (a + 3) % 7],
+                0 | 1000 | 199_999 => vec![a, b, c, (a + 3) % 7],
                 2 => vec![a, b, c, (a + 3) % 7, (a + 4) % 7],
                 _ => vec![a, b, c],
             }
@@ -1052,7 +1057,7 @@ mod tests {
         }
         // Problems far into the faces, each named at its face.
         let cases: [(usize, Vec<i64>, &str); 3] = [
-            (30_001, vec![1, 7, 2], "vertex index 7 out of range"),
+            (150_001, vec![1, 7, 2], "vertex index 7 out of range"),
             (25_000, vec![1, -1, 2], "negative vertex index -1"),
             (
                 20_000,
