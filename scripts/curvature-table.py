@@ -16,10 +16,11 @@ whose results are written; in the memory order shapecue picks, and for the
 gather scheme also in the file's own order, `--order input`; `--rounds R`
 processes per scheme, every scheme in turn, and the median of their
 medians), then N fresh processes with the default scheme
-timed end to end (median), on PoCL the same with shapecue's own program cache
-switched on (SHAPECUE_CACHE_POCL=1; it is always on with Intel's runtime), and
-on the bunny one process with empty kernel caches (the first run after
-install).
+timed end to end (median), the same after `shapecue build-kernels` (which
+fills shapecue's own kernel cache; an ordinary run fills it on Intel's runtime
+but not on PoCL), and on the bunny one process with empty kernel caches
+(nothing built) and one after `shapecue build-kernels` with PoCL's own cache
+empty (the first run after an install that ran it).
 
 trimesh2 is timed in the same run when you give programs built from it
 (this script does not build trimesh2):
@@ -157,7 +158,7 @@ def main():
     for rt, env in runtimes:
         # shapecue's program cache as a new user has it: empty at first, so
         # that entries left in the user's own cache (from a run with
-        # SHAPECUE_CACHE_POCL=1, say) do not stand in for the default.
+        # `shapecue build-kernels`, say) do not stand in for the default.
         env = dict(env, SHAPECUE_CACHE_DIR=os.path.join(tmp, "cache-" + rt.split()[0]))
         for name, path in inputs:
             out, stats = os.path.join(tmp, "o.ply"), os.path.join(tmp, "s.json")
@@ -179,24 +180,28 @@ def main():
             for key, vals in got.items():
                 ms = [v[0] for v in vals if v[0] is not None]
                 k[key] = (statistics.median(ms) if ms else None, vals[0][1])
-            cold = None
+            # After `shapecue build-kernels` (what the README's install
+            # runs): shapecue's own program cache filled, which an ordinary
+            # run does not fill on PoCL.
+            built_dir = os.path.join(tmp, "built-" + rt.split()[0])
+            built_env = dict(env, SHAPECUE_CACHE_DIR=built_dir)
+            if not os.path.isdir(built_dir):
+                run([a.bin, "build-kernels"], built_env)
+            built = timed(base, built_env, a.runs)
+            cold = cold_built = None
             if name == "bunny":
-                # Empty kernel caches: PoCL's own and shapecue's.
+                # Empty kernel caches, PoCL's own and shapecue's: a first run
+                # with nothing built.
                 fresh = tempfile.mkdtemp(dir=tmp)
-                cold_env = dict(env, POCL_CACHE_DIR=os.path.join(fresh, "pocl"),
-                                SHAPECUE_CACHE_DIR=os.path.join(fresh, "shapecue"))
-                cold = timed(base, cold_env, 1)
-            cached = None
-            if rt == "PoCL":
-                # shapecue's own program cache, which on PoCL is used only
-                # with SHAPECUE_CACHE_POCL=1 (two processes fill it).
-                cache_env = dict(env, SHAPECUE_CACHE_POCL="1",
-                                 SHAPECUE_CACHE_DIR=os.path.join(tmp, "program-cache"))
-                run(base, cache_env)
-                run(base, cache_env)
-                cached = timed(base, cache_env, a.runs)
+                cold = timed(base, dict(env, POCL_CACHE_DIR=os.path.join(fresh, "pocl"),
+                                        SHAPECUE_CACHE_DIR=os.path.join(fresh, "shapecue")), 1)
+                # The first run after build-kernels, with PoCL's cache empty
+                # (so that only shapecue's cache can have the kernels).
+                fresh = tempfile.mkdtemp(dir=tmp)
+                cold_built = timed(base, dict(built_env,
+                                              POCL_CACHE_DIR=os.path.join(fresh, "pocl")), 1)
             kernel_rows.append((rt, name, k))
-            process_rows.append((rt, name, timed(base, env, a.runs), cached, cold))
+            process_rows.append((rt, name, timed(base, env, a.runs), built, cold, cold_built))
             print(f"{rt} {name}: done", file=sys.stderr)
 
     def tm2_cell(v, star, digits=1):
@@ -216,14 +221,14 @@ def main():
               f"{fmt(k['gather 1'][0])} | {fmt(k['gather'][0])} (N = {lanes}) | "
               f"{fmt(k['gather input'][0])} | {tm2_cell(tk, star)} | {ratio} |")
     print()
-    print("| runtime | mesh | shapecue process | with SHAPECUE_CACHE_POCL=1 | trimesh2 process | "
-          "shapecue first run (empty kernel caches) |")
-    print("|---|---|---|---|---|---|")
-    for rt, name, proc, cached, cold in process_rows:
+    print("| runtime | mesh | shapecue process | after `shapecue build-kernels` | "
+          "trimesh2 process | shapecue first run, nothing built (empty kernel caches) | "
+          "first run after `shapecue build-kernels` (PoCL's cache empty) |")
+    print("|---|---|---|---|---|---|---|")
+    for rt, name, proc, built, cold, cold_built in process_rows:
         _, tp, star = tm2[name]
-        cached = "(the default)" if cached is None else f"{cached:.0f}"
-        print(f"| {rt} | {name} | {proc:.0f} | {cached} | {tm2_cell(tp, star, 0)}"
-              f" | {fmt(cold, 0)} |")
+        print(f"| {rt} | {name} | {proc:.0f} | {built:.0f} | {tm2_cell(tp, star, 0)}"
+              f" | {fmt(cold, 0)} | {fmt(cold_built, 0)} |")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's main job, on bundled data (data/) and generated meshes: sets up,
-# builds, lists the OpenCL devices, computes curvature of Spot, a torus and an ellipsoid to PLY + JSON
+# builds, lists the OpenCL devices, builds the curvature kernels into the
+# kernel cache, computes curvature of Spot, a torus and an ellipsoid to PLY + JSON
 # stats in out/, prints the accuracy/time table of every variant, then extracts
 # isosurfaces of procedural fields (with curvature) and prints their report,
 # renders the bundled scenes (torus, gyroid, strokes), and draws curvature-
@@ -12,6 +13,9 @@ cargo build --release
 bin=target/release/shapecue
 mkdir -p out
 $bin devices
+# Builds the curvature kernels for the device once, into shapecue's kernel
+# cache, so that no later command compiles them.
+$bin build-kernels
 $bin curvature data/spot.obj -o out/spot.ply --stats out/spot.json --force
 $bin curvature --generate torus --resolution 40000 -o out/torus.ply --stats out/torus.json --force
 $bin curvature --generate ellipsoid --resolution 40000 -o out/ellipsoid.ply --stats out/ellipsoid.json --force

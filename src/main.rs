@@ -33,6 +33,11 @@ enum Cmd {
     /// Per-vertex normals, areas, principal curvatures and directions, and the
     /// curvature derivative, written as binary PLY.
     Curvature(cli::curvature::CurvatureArgs),
+    /// Build the curvature kernels for the device once and keep them in
+    /// shapecue's kernel cache, so that later commands load them instead of
+    /// compiling (run it after installing, or after a driver update; on PoCL
+    /// it takes seconds per variant).
+    BuildKernels(cli::kernels::KernelsArgs),
     /// Isosurface of a volume (marching cubes with vertex fusion on the
     /// device), optionally with curvature computed on the device right after.
     Isosurface(cli::isosurface::IsoArgs),
@@ -59,6 +64,7 @@ fn main() {
     let result = match cli.cmd {
         Cmd::Devices { json } => cli::devices::run(json),
         Cmd::Curvature(a) => cli::curvature::run(device, a),
+        Cmd::BuildKernels(a) => cli::kernels::run(device, a),
         Cmd::Isosurface(a) => cli::isosurface::run(device, a),
         Cmd::Edges(a) => cli::edges::run(device, a),
         Cmd::Render(a) => cli::render::run(device, a),

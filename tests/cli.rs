@@ -920,6 +920,18 @@ fn curvature_cached(
     tag: &str,
     extra: &[&str],
 ) -> (serde_json::Value, Vec<u8>) {
+    curvature_cached_saving(cache, out_dir, tag, extra, true)
+}
+
+/// [`curvature_cached`], with saving on PoCL (`SHAPECUE_CACHE_POCL=1`) or
+/// as an ordinary user runs it (`save_on_pocl` false).
+fn curvature_cached_saving(
+    cache: Option<&std::path::Path>,
+    out_dir: &std::path::Path,
+    tag: &str,
+    extra: &[&str],
+    save_on_pocl: bool,
+) -> (serde_json::Value, Vec<u8>) {
     let (ply, json) = (
         out_dir.join(format!("{tag}.ply")),
         out_dir.join(format!("{tag}.json")),
@@ -942,7 +954,7 @@ fn curvature_cached(
     match cache {
         Some(dir) => cmd
             .env("SHAPECUE_CACHE_DIR", dir)
-            .env("SHAPECUE_CACHE_POCL", "1")
+            .env("SHAPECUE_CACHE_POCL", if save_on_pocl { "1" } else { "0" })
             .env_remove("SHAPECUE_NO_CACHE"),
         None => cmd.env("SHAPECUE_NO_CACHE", "1"),
     };
@@ -1057,6 +1069,67 @@ fn program_cache_hits_and_survives_corrupt_and_truncated_files() {
     let (s, ply) = curvature_cached(Some(&blocked.join("cache")), &d, "blocked", &[]);
     assert!(cache_outcome(&s).starts_with("rejected") || cache_outcome(&s) == "miss");
     assert_eq!(ply, reference);
+}
+
+/// `shapecue build-kernels` saves the gather program on every runtime
+/// (PoCL included, where an ordinary run does not save), says so, and finds
+/// it built the second time; a `curvature` process then loads it from the
+/// cache and writes the same bytes as one with the cache off. With the
+/// cache off it is an error that says why.
+#[test]
+fn build_kernels_fills_the_cache_that_curvature_then_loads() {
+    let d = scratch("build-kernels");
+    let cache = d.join("cache");
+    let build = |cache_env: Option<&std::path::Path>| {
+        let mut cmd = cli();
+        cmd.args(["build-kernels", "--accumulate", "gather"])
+            .env_remove("SHAPECUE_CACHE_POCL");
+        match cache_env {
+            Some(dir) => cmd
+                .env("SHAPECUE_CACHE_DIR", dir)
+                .env_remove("SHAPECUE_NO_CACHE"),
+            None => cmd.env("SHAPECUE_NO_CACHE", "1"),
+        };
+        cmd.output().unwrap()
+    };
+    let (_, reference) = curvature_cached(None, &d, "reference", &[]);
+    // An ordinary run on an empty cache saves nothing on PoCL; elsewhere
+    // it saves, and build-kernels then finds the program built.
+    let (s, ply) = curvature_cached_saving(Some(&cache), &d, "plain", &[], false);
+    assert_eq!(ply, reference);
+    let pocl = s["device"]["platform"]
+        .as_str()
+        .is_some_and(|p| p.contains("Portable Computing Language"));
+    if pocl {
+        assert_eq!(cache_outcome(&s), "miss");
+        assert_eq!(s["programs"][0]["saved"], false, "{s}");
+        assert!(clbin_entries(&cache).is_empty());
+    }
+    let _ = std::fs::remove_dir_all(&cache);
+
+    let out = build(Some(&cache));
+    common::assert_succeeded(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("gather f32 exact") && text.contains("saved in"),
+        "{text}"
+    );
+    assert_eq!(clbin_entries(&cache).len(), 1, "{text}");
+    let out = build(Some(&cache));
+    common::assert_succeeded(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("already built"), "{text}");
+    assert_eq!(clbin_entries(&cache).len(), 1);
+
+    let (s, ply) = curvature_cached_saving(Some(&cache), &d, "after", &[], false);
+    assert_eq!(cache_outcome(&s), "hit", "{s}");
+    assert_eq!(ply, reference, "output from the built kernels differs");
+
+    let out = build(None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("kernel cache is off"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Processes started together on an empty cache all succeed with the same

@@ -69,6 +69,9 @@ fn every_readme_example_runs_as_written() {
             .arg(line)
             .current_dir(&d)
             .env("PATH", &path)
+            // `shapecue build-kernels` and the programs' saves go here, not
+            // into the user's kernel cache.
+            .env("SHAPECUE_CACHE_DIR", d.join("kernel-cache"))
             .output()
             .unwrap();
         if common::cli_gl_missing(&out) {

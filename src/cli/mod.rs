@@ -6,6 +6,7 @@ pub mod curvature;
 pub mod devices;
 pub mod edges;
 pub mod isosurface;
+pub mod kernels;
 pub mod render;
 pub mod strokes;
 pub mod tables;

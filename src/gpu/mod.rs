@@ -46,6 +46,9 @@ pub struct Gpu {
     cache_tag: String,
     /// Programs built from source in this `Gpu`, not yet saved: (key, program).
     unsaved: Mutex<Vec<(u128, Arc<Program>)>>,
+    /// Set by [`Gpu::save_every_build`]: programs built from source are
+    /// saved on every runtime, PoCL included.
+    save_all: std::sync::atomic::AtomicBool,
     builds: Mutex<Vec<ProgramBuild>>,
     /// `SHAPECUE_DEVICE_MEMORY`: a simulated device memory in bytes, and the
     /// bytes allocated so far against it (see [`Gpu::buffer_flags`]).
@@ -80,7 +83,8 @@ pub struct ProgramBuild {
     /// saved again).
     pub cache: String,
     /// Whether [`Gpu::persist_programs`] saved it into the cache (a miss is
-    /// saved at its second build from source, see [`cache`]).
+    /// saved where [`cache::saves`] says so, or after
+    /// [`Gpu::save_every_build`]).
     pub saved: bool,
     /// Wall ms of getting the program (read + build, or build from source).
     pub ms: f64,
@@ -138,6 +142,7 @@ impl Gpu {
                 .transpose()?,
             cache_tag,
             unsaved: Mutex::new(Vec::new()),
+            save_all: false.into(),
             builds: Mutex::new(Vec::new()),
         })
     }
@@ -179,7 +184,8 @@ impl Gpu {
             Some(Ok(p)) => (Arc::new(p), "hit".to_string()),
             other => {
                 let p = Arc::new(program::build_source(&self.context, file, &src, &opts)?);
-                let saves = cache::saves(&self.info.platform);
+                let saves = cache::saves(&self.info.platform)
+                    || self.save_all.load(std::sync::atomic::Ordering::Relaxed);
                 let (outcome, save) = match (other, &self.cache_dir) {
                     (Some(Err(why)), Some(_)) if why == cache::Reject::Missing.to_string() => {
                         ("miss".to_string(), saves)
@@ -202,6 +208,21 @@ impl Gpu {
         });
         programs.insert(map_key, p.clone());
         Ok(p)
+    }
+
+    /// From now on, programs this `Gpu` builds from source are saved into
+    /// the binary cache on every runtime, PoCL included (see
+    /// [`cache::saves`]: there the save compiles every kernel of the program
+    /// for any work-group size, seconds that `shapecue build-kernels` spends
+    /// once so that no later command does). No effect with the cache off.
+    pub fn save_every_build(&self) {
+        self.save_all
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The binary cache's folder, or `None` when the cache is off.
+    pub fn cache_folder(&self) -> Option<&std::path::Path> {
+        self.cache_dir.as_deref()
     }
 
     /// How each program of this `Gpu` was obtained, in build order.

@@ -260,6 +260,23 @@ impl CurvatureEstimator {
         Self::build(gpu, opts).map(drop)
     }
 
+    /// Gets the program for `opts` built into `gpu` (as [`Self::prepare`])
+    /// and runs every pass of it once on a small icosphere (642 vertices), so
+    /// that the code a runtime compiles at a kernel's first launch (PoCL: a
+    /// work-group function per kernel and local size) is compiled too and
+    /// goes into the binary that [`Gpu::persist_programs`] saves. Returns
+    /// the run's timing.
+    ///
+    /// # Errors
+    ///
+    /// As [`CurvatureEstimator::new`] and [`CurvatureEstimator::run`].
+    pub fn warm_up(gpu: &Arc<Gpu>, opts: &CurvatureOptions) -> Result<Timing> {
+        let (_, mesh) = crate::mesh::Generated::Sphere.mesh(642);
+        let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, *opts)?;
+        est.set_positions(&mesh.positions)?;
+        est.run()
+    }
+
     fn build(
         gpu: &Arc<Gpu>,
         opts: &CurvatureOptions,
@@ -1084,6 +1101,34 @@ pub struct OrderedEstimator {
     pub reorder_ms: f64,
 }
 
+/// The host half of an [`OrderedEstimator`], which needs no device: the
+/// memory order chosen for a mesh, the mesh renumbered in it and each
+/// vertex's frame-seeding face. A caller can compute it while the device
+/// opens ([`OrderedEstimator::with_plan`]).
+pub struct OrderPlan {
+    order: Option<LocalityOrder>,
+    reordered: Option<crate::Mesh>,
+    frame_faces: Option<Vec<i32>>,
+    /// Host ms of choosing and applying the order.
+    pub reorder_ms: f64,
+}
+
+impl OrderPlan {
+    /// Chooses the order `order` asks for on `mesh` and applies it.
+    pub fn new(mesh: &crate::Mesh, order: MeshOrder) -> OrderPlan {
+        let t0 = Instant::now();
+        let order = LocalityOrder::choose(mesh, order);
+        let reordered = order.as_ref().map(|o| o.apply(mesh));
+        let frame_faces = order.as_ref().map(|o| o.frame_faces(mesh));
+        OrderPlan {
+            order,
+            reordered,
+            frame_faces,
+            reorder_ms: t0.elapsed().as_secs_f64() * 1e3,
+        }
+    }
+}
+
 impl OrderedEstimator {
     /// Builds the estimator of `mesh` for `opts` in the order `order` picks.
     pub fn new(
@@ -1092,20 +1137,38 @@ impl OrderedEstimator {
         opts: CurvatureOptions,
         order: MeshOrder,
     ) -> Result<Self> {
-        let t0 = Instant::now();
-        let order = LocalityOrder::choose(mesh, order);
-        let reordered = order.as_ref().map(|o| o.apply(mesh));
-        let m = reordered.as_ref().unwrap_or(mesh);
-        let reorder_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Self::with_plan(gpu, mesh, opts, OrderPlan::new(mesh, order))
+    }
+
+    /// Builds the estimator of `mesh` for `opts` in the order of `plan`,
+    /// made for this `mesh` by [`OrderPlan::new`].
+    pub fn with_plan(
+        gpu: Arc<Gpu>,
+        mesh: &crate::Mesh,
+        opts: CurvatureOptions,
+        plan: OrderPlan,
+    ) -> Result<Self> {
+        if let Some(o) = &plan.order
+            && (o.input_vertex.len() != mesh.n_vertices() || o.input_face.len() != mesh.n_faces())
+        {
+            return Err(Error::InvalidArgument(format!(
+                "memory order made for a mesh of {} vertices and {} faces, given one of {} and {}",
+                o.input_vertex.len(),
+                o.input_face.len(),
+                mesh.n_vertices(),
+                mesh.n_faces()
+            )));
+        }
+        let m = plan.reordered.as_ref().unwrap_or(mesh);
         let mut est = CurvatureEstimator::new(gpu, m.n_vertices(), &m.faces, opts)?;
-        if let Some(o) = &order {
-            est.set_frame_faces(&o.frame_faces(mesh))?;
+        if let Some(f) = &plan.frame_faces {
+            est.set_frame_faces(f)?;
         }
         est.set_positions(&m.positions)?;
         Ok(OrderedEstimator {
             est,
-            order,
-            reorder_ms,
+            order: plan.order,
+            reorder_ms: plan.reorder_ms,
         })
     }
 
