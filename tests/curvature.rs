@@ -299,6 +299,44 @@ fn scattered_meshes_are_reordered_and_give_the_input_order_results() {
     }
 }
 
+/// A memory order planned on the host before the device opens
+/// (`OrderPlan`, as the CLI does beside the load) gives the bits of the
+/// one-call estimator; a plan made for another mesh is refused by name,
+/// not applied.
+#[test]
+fn an_order_plan_gives_the_bits_of_the_one_call_estimator() {
+    use shapecue::mesh::order::MeshOrder;
+    use shapecue::stages::curvature::{OrderPlan, OrderedEstimator};
+    let m = shuffled_torus();
+    let o = with(
+        CurvatureOptions::default(),
+        Accumulate::Gather,
+        Precision::F32,
+    );
+    let mut direct = OrderedEstimator::new(gpu(), &m, o, MeshOrder::Auto).unwrap();
+    let plan = OrderPlan::new(&m, MeshOrder::Auto);
+    let mut planned = OrderedEstimator::with_plan(gpu(), &m, o, plan).unwrap();
+    assert!(planned.order.is_some(), "the shuffled torus is reordered");
+    direct.est.run().unwrap();
+    planned.est.run().unwrap();
+    let (a, b) = (direct.read().unwrap(), planned.read().unwrap());
+    for i in 0..m.n_vertices() {
+        let (x, y) = (a.vertex(i), b.vertex(i));
+        assert_eq!(
+            (x.k1.to_bits(), x.k2.to_bits(), x.d1.map(f64::to_bits)),
+            (y.k1.to_bits(), y.k2.to_bits(), y.d1.map(f64::to_bits)),
+            "vertex {i}"
+        );
+    }
+    let other = mesh::icosphere(1.0, 2);
+    let plan = OrderPlan::new(&m, MeshOrder::Spatial);
+    let err = OrderedEstimator::with_plan(gpu(), &other, o, plan)
+        .err()
+        .expect("a plan for another mesh is refused")
+        .to_string();
+    assert!(err.contains("memory order made for a mesh of"), "{err}");
+}
+
 /// The device buffers read in place (mapped, converted vertex by vertex,
 /// as the CLI writes its PLY file) give the bits of the copying read, in
 /// the input's order after a Morton reordering, in both precisions, with
