@@ -40,6 +40,7 @@ __all__ = [
     "Isosurface",
     "RenderError",
     "Volume",
+    "build_kernels",
     "curvature",
     "devices",
     "feature_edges",
@@ -154,6 +155,43 @@ def devices() -> list:
     ``gl_sharing``, ``int64_atomics`` and ``default`` (the device used
     without ``device=``). Raises :class:`DeviceError` without any platform."""
     return _shapecue.devices()
+
+
+def build_kernels(
+    *,
+    accumulate: Sequence[str] = ("auto",),
+    precision: Sequence[str] = ("f32",),
+    compat: Sequence[str] = ("exact",),
+    device: Union[int, str, None] = None,
+) -> list:
+    """Builds the curvature kernels of every combination of the given
+    variants on the device once and keeps them in shapecue's kernel cache
+    (``$SHAPECUE_CACHE_DIR``, else ``$XDG_CACHE_HOME/shapecue`` or
+    ``~/.cache/shapecue``), as the command line's ``shapecue build-kernels``
+    does, so that later processes load them instead of compiling (on PoCL a
+    process with nothing built compiles for seconds). Run it once after
+    installing or after a driver update. The defaults are :func:`curvature`'s.
+
+    Returns one dict per program: ``variant`` ("gather f32 exact"),
+    ``options`` (the build options), ``cache`` ("hit" when it was built
+    already, else "miss"), ``saved``, ``build_s`` and ``save_s``. Raises
+    :class:`ValueError` for an unknown variant name or when the cache is off
+    (``SHAPECUE_NO_CACHE``), :class:`DeviceError` for a variant the device
+    cannot run."""
+    def names(v: Sequence[str], what: str) -> list:
+        if isinstance(v, str):
+            v = (v,)
+        v = list(v)
+        if not v or not all(isinstance(x, str) for x in v):
+            raise TypeError(f"{what}: expected a non-empty list of names")
+        return v
+
+    return _shapecue.build_kernels(
+        [_accumulate(a) for a in names(accumulate, "accumulate")],
+        names(precision, "precision"),
+        names(compat, "compat"),
+        _device(device),
+    )
 
 
 def curvature(

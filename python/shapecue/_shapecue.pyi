@@ -15,6 +15,9 @@ class RenderError(RuntimeError):
     """No headless OpenGL, or an OpenGL call failed."""
 
 def devices() -> list[dict[str, Any]]: ...
+def build_kernels(
+    accumulate: list[str], precision: list[str], compat: list[str], device: str | None
+) -> list[dict[str, Any]]: ...
 def curvature(
     vertices: npt.NDArray[np.floating],
     faces: npt.NDArray[np.integer],

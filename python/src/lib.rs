@@ -317,6 +317,53 @@ fn devices(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     Ok(out)
 }
 
+/// build_kernels(accumulate, precision, compat, device) -> list[dict]
+///
+/// Builds the curvature program of every combination of the given
+/// variants on the device, runs it once and saves it into shapecue's kernel
+/// cache (`shapecue::stages::curvature::build_kernels`), with a `Gpu` of its
+/// own so that later calls of this process keep the usual saving rule.
+#[pyfunction]
+#[pyo3(signature = (accumulate, precision, compat, device))]
+fn build_kernels<'py>(
+    py: Python<'py>,
+    accumulate: Vec<String>,
+    precision: Vec<String>,
+    compat: Vec<String>,
+    device: Option<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut variants = Vec::new();
+    for a in &accumulate {
+        for p in &precision {
+            for c in &compat {
+                variants.push((a.clone(), options(a, p, c, true)?));
+            }
+        }
+    }
+    let built = py
+        .detach(|| {
+            let gpu = Arc::new(Gpu::new(device.as_deref())?);
+            let variants: Vec<CurvatureOptions> = variants
+                .iter()
+                .map(|(a, o)| device_options(*o, a, &gpu))
+                .collect();
+            shapecue::stages::curvature::build_kernels(&gpu, &variants)
+        })
+        .map_err(to_py)?;
+    let out = PyList::empty(py);
+    for b in built {
+        let e = PyDict::new(py);
+        e.set_item("variant", &b.variant)?;
+        e.set_item("options", &b.program.options)?;
+        e.set_item("cache", &b.program.cache)?;
+        e.set_item("saved", b.program.saved)?;
+        e.set_item("build_s", b.build_s)?;
+        e.set_item("save_s", b.save_s)?;
+        out.append(e)?;
+    }
+    Ok(out)
+}
+
 /// curvature(vertices, faces, accumulate, precision, compat, dcurv, device, reference) -> dict
 #[pyfunction]
 #[pyo3(signature = (vertices, faces, accumulate, precision, compat, dcurv, device, reference))]
@@ -779,6 +826,7 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RenderError", py.get_type::<RenderError>())?;
     m.add_function(wrap_pyfunction!(devices, m)?)?;
     m.add_function(wrap_pyfunction!(curvature, m)?)?;
+    m.add_function(wrap_pyfunction!(build_kernels, m)?)?;
     m.add_function(wrap_pyfunction!(isosurface, m)?)?;
     m.add_function(wrap_pyfunction!(feature_edges, m)?)?;
     m.add_function(wrap_pyfunction!(render_file, m)?)?;

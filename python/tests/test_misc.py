@@ -86,3 +86,24 @@ def test_readme_python_example(device, tmp_path, monkeypatch):
     block = block[: block.index("```")]
     monkeypatch.chdir(REPO)
     exec(compile(block, "README.md", "exec"), {})
+
+
+def test_build_kernels_fills_the_kernel_cache(tmp_path, monkeypatch, device):
+    cache = tmp_path / "kernels"
+    monkeypatch.setenv("SHAPECUE_CACHE_DIR", str(cache))
+    monkeypatch.delenv("SHAPECUE_NO_CACHE", raising=False)
+    first = shapecue.build_kernels(accumulate=["gather"], precision="f32")
+    assert [b["variant"] for b in first] == ["gather f32 exact"]
+    # An empty cache folder: built and saved, on PoCL too.
+    assert first[0]["cache"] == "miss" and first[0]["saved"] is True, first
+    assert first[0]["build_s"] >= 0 and first[0]["save_s"] >= 0
+    assert len(list(cache.glob("*.clbin"))) == 1
+    again = shapecue.build_kernels(accumulate=["gather"])
+    assert again[0]["cache"] == "hit" and again[0]["saved"] is False
+    with pytest.raises(ValueError, match="accumulation"):
+        shapecue.build_kernels(accumulate=["sideways"])
+    with pytest.raises(TypeError, match="precision"):
+        shapecue.build_kernels(precision=[])
+    monkeypatch.setenv("SHAPECUE_NO_CACHE", "1")
+    with pytest.raises(ValueError, match="kernel cache is off"):
+        shapecue.build_kernels()

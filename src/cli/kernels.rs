@@ -11,9 +11,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use shapecue::gpu::Gpu;
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
-use shapecue::stages::curvature::CurvatureEstimator;
+use shapecue::stages::curvature::build_kernels;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// The arguments of `shapecue build-kernels`.
 #[derive(Args)]
@@ -38,75 +37,50 @@ pub struct KernelsArgs {
 /// Runs `shapecue build-kernels`.
 pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
     let gpu = Arc::new(Gpu::new(device)?);
-    let Some(dir) = gpu.cache_folder().map(std::path::Path::to_path_buf) else {
-        anyhow::bail!(
-            "the kernel cache is off (SHAPECUE_NO_CACHE is set, or neither \
-             SHAPECUE_CACHE_DIR, XDG_CACHE_HOME nor HOME is), so there is \
-             nowhere to keep built kernels"
-        );
-    };
-    gpu.save_every_build();
     let lanes = a.lanes.as_deref().map_or(Ok(0), str::parse)?;
     let accumulate = if a.accumulate.is_empty() {
         vec![Accumulate::default_for(&gpu.info.kind)]
     } else {
         a.accumulate.clone()
     };
-    out!(
-        "building curvature kernels for {} ({}) into {}",
-        gpu.info.name,
-        gpu.info.platform,
-        dir.display()
-    );
     let mut variants = Vec::new();
-    for &acc in &accumulate {
+    for &accumulate in &accumulate {
         for &precision in &a.precision {
             for &compat in &a.compat {
-                let v = CurvatureOptions {
-                    accumulate: acc,
+                variants.push(CurvatureOptions {
+                    accumulate,
                     precision,
                     compat,
                     dcurv: true,
                     lanes,
-                };
-                if !variants.contains(&v) {
-                    variants.push(v);
-                }
+                });
             }
         }
     }
-    for opts in &variants {
-        let what = format!(
-            "{} {} {}",
-            opts.accumulate.name(),
-            opts.precision.name(),
-            opts.compat.name()
+    if let Some(dir) = gpu.cache_folder() {
+        out!(
+            "building curvature kernels for {} ({}) into {}",
+            gpu.info.name,
+            gpu.info.platform,
+            dir.display()
         );
-        let t = Instant::now();
-        CurvatureEstimator::warm_up(&gpu, opts)
-            .with_context(|| format!("building the curvature kernels ({what})"))?;
-        let build_s = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        gpu.persist_programs();
-        let save_s = t.elapsed().as_secs_f64();
-        let Some(b) = gpu.program_builds().pop() else {
-            continue;
-        };
-        let how = match (b.cache.as_str(), b.saved) {
+    }
+    for b in build_kernels(&gpu, &variants).context("building the curvature kernels")? {
+        let how = match (b.program.cache.as_str(), b.program.saved) {
             ("hit", _) => "already built (loaded from the cache)".to_string(),
-            (_, true) => format!("built in {build_s:.1} s, saved in {save_s:.1} s"),
+            (_, true) => format!("built in {:.1} s, saved in {:.1} s", b.build_s, b.save_s),
             (_, false) => format!(
-                "built in {build_s:.1} s, but not saved: the driver gave no binary \
-                 or {} could not be written",
-                dir.display()
+                "built in {:.1} s, but not saved: the driver gave no binary or the \
+                 cache folder could not be written",
+                b.build_s
             ),
         };
-        let options = if b.options.is_empty() {
+        let options = if b.program.options.is_empty() {
             String::new()
         } else {
-            format!(" ({})", b.options)
+            format!(" ({})", b.program.options)
         };
-        out!("  {what}{options}: {how}");
+        out!("  {}{options}: {how}", b.variant);
     }
     Ok(())
 }

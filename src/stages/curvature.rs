@@ -1087,6 +1087,89 @@ impl MappedField<'_> {
     }
 }
 
+/// What [`build_kernels`] did for one variant.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct KernelBuild {
+    /// The variant: accumulation, precision and least squares by their
+    /// command-line names (`gather f32 exact`).
+    pub variant: String,
+    /// How its program was obtained (`hit`: it was built already) and
+    /// whether it was saved.
+    pub program: crate::gpu::ProgramBuild,
+    /// Seconds of getting the program and running it once.
+    pub build_s: f64,
+    /// Seconds of saving it.
+    pub save_s: f64,
+}
+
+/// Builds the curvature program of each variant in `variants` (duplicates
+/// once), runs it once ([`CurvatureEstimator::warm_up`]) and saves it into
+/// shapecue's kernel cache, on every runtime (PoCL included:
+/// [`Gpu::save_every_build`], which stays set on `gpu`, so give it a `Gpu`
+/// of its own). A variant already in the cache is loaded, not rebuilt.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] when the cache is off (nowhere to keep the
+/// kernels), and what [`CurvatureEstimator::warm_up`] returns for a variant
+/// the device cannot run (the variant is named).
+pub fn build_kernels(gpu: &Arc<Gpu>, variants: &[CurvatureOptions]) -> Result<Vec<KernelBuild>> {
+    if gpu.cache_folder().is_none() {
+        return Err(Error::InvalidArgument(
+            "the kernel cache is off (SHAPECUE_NO_CACHE is set, or neither \
+             SHAPECUE_CACHE_DIR, XDG_CACHE_HOME nor HOME is), so there is \
+             nowhere to keep built kernels"
+                .into(),
+        ));
+    }
+    gpu.save_every_build();
+    let mut done: Vec<CurvatureOptions> = Vec::new();
+    let mut out = Vec::new();
+    for opts in variants {
+        let opts = CurvatureOptions {
+            dcurv: true,
+            ..*opts
+        };
+        if done.contains(&opts) {
+            continue;
+        }
+        done.push(opts);
+        let variant = format!(
+            "{} {} {}",
+            opts.accumulate.name(),
+            opts.precision.name(),
+            opts.compat.name()
+        );
+        let known = gpu.program_builds().len();
+        let t = Instant::now();
+        match CurvatureEstimator::warm_up(gpu, &opts) {
+            Ok(_) => {}
+            Err(Error::DeviceUnsupported { device, what }) => {
+                return Err(Error::DeviceUnsupported {
+                    device,
+                    what: format!("{what} (variant {variant})"),
+                });
+            }
+            Err(e) => return Err(e),
+        }
+        let build_s = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        gpu.persist_programs();
+        let save_s = t.elapsed().as_secs_f64();
+        // The build record of this variant's program (none when an earlier
+        // variant here had the same program).
+        if let Some(program) = gpu.program_builds().get(known).cloned() {
+            out.push(KernelBuild {
+                variant,
+                program,
+                build_s,
+                save_s,
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// An estimator of a whole mesh computed in the memory order `order` asks
 /// for ([`crate::mesh::order`]): built, each vertex's frame seeded from the
 /// face that seeds it in the input's order (so directions keep their
