@@ -347,7 +347,7 @@ fn build_kernels<'py>(
                 .iter()
                 .map(|(a, o)| device_options(*o, a, &gpu))
                 .collect();
-            shapecue::stages::curvature::build_kernels(&gpu, &variants)
+            shapecue::stages::curvature::build_kernels(&gpu, &variants, |_| {})
         })
         .map_err(to_py)?;
     let out = PyList::empty(py);

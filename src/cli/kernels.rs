@@ -65,7 +65,7 @@ pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
             dir.display()
         );
     }
-    for b in build_kernels(&gpu, &variants).context("building the curvature kernels")? {
+    let report = |b: &shapecue::stages::curvature::KernelBuild| -> std::io::Result<()> {
         let how = match (b.program.cache.as_str(), b.program.saved) {
             ("hit", _) => "already built (loaded from the cache)".to_string(),
             (_, true) => format!("built in {:.1} s, saved in {:.1} s", b.build_s, b.save_s),
@@ -80,7 +80,17 @@ pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
         } else {
             format!(" ({})", b.program.options)
         };
-        out!("  {}{options}: {how}", b.variant);
-    }
+        super::print(format_args!("  {}{options}: {how}", b.variant))
+    };
+    // Each line as its program is done; a closed standard output stops the
+    // lines, not the builds, and is reported at the end.
+    let mut printed = Ok(());
+    build_kernels(&gpu, &variants, |b| {
+        if printed.is_ok() {
+            printed = report(b);
+        }
+    })
+    .context("building the curvature kernels")?;
+    printed?;
     Ok(())
 }

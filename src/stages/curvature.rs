@@ -1107,13 +1107,19 @@ pub struct KernelBuild {
 /// shapecue's kernel cache, on every runtime (PoCL included:
 /// [`Gpu::save_every_build`], which stays set on `gpu`, so give it a `Gpu`
 /// of its own). A variant already in the cache is loaded, not rebuilt.
+/// `on_built` hears of each program as soon as it is done (a variant can
+/// take seconds on PoCL).
 ///
 /// # Errors
 ///
 /// [`Error::InvalidArgument`] when the cache is off (nowhere to keep the
 /// kernels), and what [`CurvatureEstimator::warm_up`] returns for a variant
 /// the device cannot run (the variant is named).
-pub fn build_kernels(gpu: &Arc<Gpu>, variants: &[CurvatureOptions]) -> Result<Vec<KernelBuild>> {
+pub fn build_kernels(
+    gpu: &Arc<Gpu>,
+    variants: &[CurvatureOptions],
+    mut on_built: impl FnMut(&KernelBuild),
+) -> Result<Vec<KernelBuild>> {
     if gpu.cache_folder().is_none() {
         return Err(Error::InvalidArgument(
             "the kernel cache is off (SHAPECUE_NO_CACHE is set, or neither \
@@ -1159,12 +1165,14 @@ pub fn build_kernels(gpu: &Arc<Gpu>, variants: &[CurvatureOptions]) -> Result<Ve
         // The build record of this variant's program (none when an earlier
         // variant here had the same program).
         if let Some(program) = gpu.program_builds().get(known).cloned() {
-            out.push(KernelBuild {
+            let b = KernelBuild {
                 variant,
                 program,
                 build_s,
                 save_s,
-            });
+            };
+            on_built(&b);
+            out.push(b);
         }
     }
     Ok(out)
