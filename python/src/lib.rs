@@ -21,7 +21,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueEr
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use shapecue::gpu::Gpu;
-use shapecue::spec::curvature::{Curvature, CurvatureOptions};
+use shapecue::spec::curvature::{Accumulate, Compat, Curvature, CurvatureOptions, Precision};
 use shapecue::stages::curvature::CurvatureEstimator as RustEstimator;
 use shapecue::{Error, Mesh};
 use std::cell::RefCell;
@@ -332,21 +332,25 @@ fn build_kernels<'py>(
     compat: Vec<String>,
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let mut variants = Vec::new();
-    for a in &accumulate {
-        for p in &precision {
-            for c in &compat {
-                variants.push((a.clone(), options(a, p, c, true)?));
-            }
-        }
-    }
+    // Names are checked before the device opens; "auto" is the device's default.
+    let accumulate: Vec<Option<Accumulate>> = accumulate
+        .iter()
+        .map(|a| (a != "auto").then(|| parse(a)).transpose())
+        .collect::<PyResult<_>>()?;
+    let precision: Vec<Precision> = precision
+        .iter()
+        .map(|p| parse(p))
+        .collect::<PyResult<_>>()?;
+    let compat: Vec<Compat> = compat.iter().map(|c| parse(c)).collect::<PyResult<_>>()?;
     let built = py
         .detach(|| {
             let gpu = Arc::new(Gpu::new(device.as_deref())?);
-            let variants: Vec<CurvatureOptions> = variants
+            let accumulate: Vec<Accumulate> = accumulate
                 .iter()
-                .map(|(a, o)| device_options(*o, a, &gpu))
+                .map(|a| a.unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind)))
                 .collect();
+            // lanes 0: by device type, as on the command line
+            let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, 0);
             shapecue::stages::curvature::build_kernels(&gpu, &variants, |_| {})
         })
         .map_err(to_py)?;

@@ -43,20 +43,7 @@ pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
     } else {
         a.accumulate.clone()
     };
-    let mut variants = Vec::new();
-    for &accumulate in &accumulate {
-        for &precision in &a.precision {
-            for &compat in &a.compat {
-                variants.push(CurvatureOptions {
-                    accumulate,
-                    precision,
-                    compat,
-                    dcurv: true,
-                    lanes,
-                });
-            }
-        }
-    }
+    let variants = CurvatureOptions::combinations(&accumulate, &a.precision, &a.compat, lanes);
     if let Some(dir) = gpu.cache_folder() {
         out!(
             "building curvature kernels for {} ({}) into {}",

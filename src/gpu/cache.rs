@@ -16,7 +16,8 @@
 //!   program's binary compiles every kernel of the program for any
 //!   work-group size (for `kernels/curvature.cl`, 16 kernels, 7 to 19 s on
 //!   this project's 2-core machine under load), so on PoCL shapecue saves
-//!   only with `SHAPECUE_CACHE_POCL=1` (then the build from PoCL's warm
+//!   only in `shapecue build-kernels` ([`crate::gpu::Gpu::save_every_build`])
+//!   or with `SHAPECUE_CACHE_POCL=1` (then the build from PoCL's warm
 //!   cache drops from about 130 ms to 25–50 ms, and a process whose PoCL
 //!   cache is empty starts in about 1 s instead of 11 s).
 //! - **Where:** `$SHAPECUE_CACHE_DIR`, else `$XDG_CACHE_HOME/shapecue`, else
@@ -159,7 +160,9 @@ pub fn decode(key: u128, bytes: &[u8]) -> Result<&[u8], Reject> {
 /// in every process anyway, and asking it for a program's binary compiles
 /// every kernel of the program for any work-group size (7 to 19 s for
 /// `kernels/curvature.cl` on a loaded 2-core machine), a cost a user would
-/// meet on an ordinary run. Entries that exist are used on every platform.
+/// meet on an ordinary run (`shapecue build-kernels` saves anyway, through
+/// [`crate::gpu::Gpu::save_every_build`]). Entries that exist are used on
+/// every platform.
 pub fn saves(platform: &str) -> bool {
     let pocl = platform.contains("Portable Computing Language") || platform.contains("PoCL");
     !pocl || std::env::var("SHAPECUE_CACHE_POCL").is_ok_and(|v| v == "1")

@@ -296,6 +296,34 @@ pub struct CurvatureOptions {
     pub lanes: u32,
 }
 
+impl CurvatureOptions {
+    /// Every combination of the given schemes, precisions and least-squares
+    /// variants (in that nesting order), with `lanes` and the derivative on:
+    /// what `shapecue build-kernels` and the Python `build_kernels` build.
+    pub fn combinations(
+        accumulate: &[Accumulate],
+        precision: &[Precision],
+        compat: &[Compat],
+        lanes: u32,
+    ) -> Vec<CurvatureOptions> {
+        let mut v = Vec::with_capacity(accumulate.len() * precision.len() * compat.len());
+        for &accumulate in accumulate {
+            for &precision in precision {
+                for &compat in compat {
+                    v.push(CurvatureOptions {
+                        accumulate,
+                        precision,
+                        compat,
+                        dcurv: true,
+                        lanes,
+                    });
+                }
+            }
+        }
+        v
+    }
+}
+
 impl Default for CurvatureOptions {
     fn default() -> Self {
         CurvatureOptions {

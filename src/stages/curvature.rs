@@ -1148,16 +1148,13 @@ pub fn build_kernels(
         );
         let known = gpu.program_builds().len();
         let t = Instant::now();
-        match CurvatureEstimator::warm_up(gpu, &opts) {
-            Ok(_) => {}
-            Err(Error::DeviceUnsupported { device, what }) => {
-                return Err(Error::DeviceUnsupported {
-                    device,
-                    what: format!("{what} (variant {variant})"),
-                });
-            }
-            Err(e) => return Err(e),
-        }
+        CurvatureEstimator::warm_up(gpu, &opts).map_err(|e| match e {
+            Error::DeviceUnsupported { device, what } => Error::DeviceUnsupported {
+                device,
+                what: format!("{what} (variant {variant})"),
+            },
+            e => e,
+        })?;
         let build_s = t.elapsed().as_secs_f64();
         let t = Instant::now();
         gpu.persist_programs();
