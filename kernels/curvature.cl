@@ -248,7 +248,7 @@ typedef SC_CAT(int, SC_LANES) INTN;
 #endif
 
 // One scalar load per lane; the compiler assembles the vector.
-#define SC_LD_ONE(l) a[i.l]
+#define SC_LD_ONE(l) a[(int)i.l]
 SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return (REALN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return (UINTN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE void lst(REALN x, uint slot, __global REAL *a) { VSTOREN(x, slot, a); }
@@ -538,6 +538,127 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
          v2 = ldu(faces, 3 * fid + 2);                                             \
     FTri t = make_tri(ld3(pos, v0), ld3(pos, v1), ld3(pos, v2));
 
+#if SC_LANES > 1
+// Vertex records: what the tensor and derivative face kernels read of each
+// vertex, 16 reals in one 16-real-aligned run, so that a face block loads a
+// vertex of each lane as whole vectors and transposes them in registers
+// (ld_rec) instead of one scalar load per lane and value. curv_pack_frames
+// (after curv_frames) writes the position, area, normal and initial frame,
+// curv_pack_principal (after curv_principal) the principal curvatures and
+// directions: the same values as in the per-vertex buffers. Writing them in
+// curv_frames and curv_principal themselves was slower on PoCL 3.1 (the
+// stores 16 reals apart keep those kernels from vectorising: 500k torus,
+// frames and its record 8.8 against 6.3 ms). Component 15 is never written
+// (the host zeroes the buffer).
+#define REC_POS 0  // x y z; area at 3
+#define REC_AREA 3
+#define REC_NRM 4  // x y z; k1 at 7
+#define REC_K1 7
+#define REC_PD1 8  // x y z; k2 at 11
+#define REC_K2 11
+#define REC_PD2 12 // x y z; 15 unused
+
+#ifdef SC_DOUBLE
+typedef double16 REAL16;
+typedef double8 REAL8;
+#else
+typedef float16 REAL16;
+typedef float8 REAL8;
+#endif
+__kernel void curv_pack_frames(uint nv, __global const REAL *pos, __global const REAL *area,
+                               __global const REAL *nrm, __global const REAL *pd1,
+                               __global const REAL *pd2, __global REAL *rec)
+{
+    GID_OR_RETURN(nv);
+    V3 p = ld3(pos, gid), n = ld3(nrm, gid), d1 = ld3(pd1, gid), d2 = ld3(pd2, gid);
+    REAL z = 0;
+    vstore16((REAL16)(p.x, p.y, p.z, area[gid], n.x, n.y, n.z, z, d1.x, d1.y, d1.z, z, d2.x,
+                      d2.y, d2.z, z),
+             gid, rec);
+}
+
+__kernel void curv_pack_principal(uint nv, __global const REAL *pd1, __global const REAL *pd2,
+                                  __global const REAL *kk, __global REAL *rec)
+{
+    GID_OR_RETURN(nv);
+    V3 d1 = ld3(pd1, gid), d2 = ld3(pd2, gid);
+    vstore8((REAL8)(kk[2 * gid], d1.x, d1.y, d1.z, kk[2 * gid + 1], d2.x, d2.y, d2.z), 0,
+            rec + 16 * gid + 7);
+}
+
+// An SC_LANES × SC_LANES transpose of the rows r0 … r(SC_LANES−1) in
+// log2(SC_LANES) stages; stage b swaps the off-diagonal b × b blocks of each
+// 2b × 2b block (bit b of the row index with bit b of the column index).
+// Each swap is two two-vector shuffles with constant indices.
+#define SC_LO(j, b) (((j) & (b)) ? SC_LANES + (j) - (b) : (j))
+#define SC_HI(j, b) (((j) & (b)) ? SC_LANES + (j) : (j) + (b))
+#define SC_SWAP(x, y, b)                                                   \
+    {                                                                      \
+        REALN lo_ = __builtin_shufflevector(x, y, SC_JLIST(SC_LO, b));     \
+        y = __builtin_shufflevector(x, y, SC_JLIST(SC_HI, b));             \
+        x = lo_;                                                           \
+    }
+#if SC_LANES == 2
+#define SC_JLIST(F, b) F(0, b), F(1, b)
+#define SC_ROWS(F) F(0, s0) F(1, s1)
+#define SC_TRANSPOSE() SC_SWAP(r0, r1, 1)
+#elif SC_LANES == 4
+#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b)
+#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3)
+#define SC_TRANSPOSE()                                                     \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1)
+#elif SC_LANES == 8
+#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b)
+#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7)
+#define SC_TRANSPOSE()                                                              \
+    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)     \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)     \
+    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)
+#else
+#define SC_JLIST(F, b)                                                                      \
+    F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b), F(8, b), F(9, b), \
+        F(10, b), F(11, b), F(12, b), F(13, b), F(14, b), F(15, b)
+#define SC_ROWS(F)                                                                          \
+    F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7) F(8, s8)          \
+    F(9, s9) F(10, sa) F(11, sb) F(12, sc) F(13, sd) F(14, se) F(15, sf)
+#define SC_TRANSPOSE()                                                                  \
+    SC_SWAP(r0, r8, 8) SC_SWAP(r1, r9, 8) SC_SWAP(r2, r10, 8) SC_SWAP(r3, r11, 8)       \
+    SC_SWAP(r4, r12, 8) SC_SWAP(r5, r13, 8) SC_SWAP(r6, r14, 8) SC_SWAP(r7, r15, 8)     \
+    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)         \
+    SC_SWAP(r8, r12, 4) SC_SWAP(r9, r13, 4) SC_SWAP(r10, r14, 4) SC_SWAP(r11, r15, 4)   \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)         \
+    SC_SWAP(r8, r10, 2) SC_SWAP(r9, r11, 2) SC_SWAP(r12, r14, 2) SC_SWAP(r13, r15, 2)   \
+    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)         \
+    SC_SWAP(r8, r9, 1) SC_SWAP(r10, r11, 1) SC_SWAP(r12, r13, 1) SC_SWAP(r14, r15, 1)
+#endif
+
+// The records of the vertices v (one per lane), as 16 vectors: component k
+// of every lane's record in c[k]. Each record is 16 / SC_LANES whole-vector
+// loads; each chunk of SC_LANES components is one transpose.
+typedef struct {
+    FREAL c[16];
+} RecN;
+#define SC_LD_ROW(l, s) FREAL r##l = VLOADN(faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
+#define SC_PUT_ROW(l, s) o.c[q * SC_LANES + l] = r##l;
+// The records of corner c's vertices of face block blk (faces past the last
+// repeat it, as in FACE_BLOCK_OR_RETURN); the face indices are scalar loads,
+// used as addresses only.
+SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint nf, uint blk,
+                      uint c)
+{
+    const uint f0 = SC_LANES * blk, last = nf - 1;
+    RecN o;
+#pragma unroll
+    for (uint q = 0; q < 16 / SC_LANES; q++) {
+        SC_ROWS(SC_LD_ROW)
+        SC_TRANSPOSE()
+        SC_ROWS(SC_PUT_ROW)
+    }
+    return o;
+}
+SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
+#endif // SC_LANES > 1
+
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          __global const uint *faces, __global REAL *corner,
                                          volatile __global uint *counters)
@@ -554,6 +675,66 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
     count_lanes(&counters[0], deg, live);
 }
 
+#if SC_LANES > 1
+// The lane forms of the tensor and derivative face kernels read the vertex
+// records (ld_rec) instead of pos, nrm, area, pd1, pd2 and kk; the same
+// values, the same arithmetic, the same bits.
+__kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global const uint *faces,
+                                  __global REAL *corner, volatile __global uint *counters)
+{
+    FACE_BLOCK_OR_RETURN(nf);
+    RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
+         a2 = ld_rec(rec, faces, nf, blk, 2);
+    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb, x;
+    face_frame(t, &ft, &fb);
+    FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM), rec3(a2, REC_NRM), &x);
+    FMASK use = (!deg) & ok;
+    FREAL w0 = corner_weight(LD_SLOT(corner, 12 * blk + 9), a0.c[REC_AREA]);
+    FREAL w1 = corner_weight(LD_SLOT(corner, 12 * blk + 10), a1.c[REC_AREA]);
+    FREAL w2 = corner_weight(LD_SLOT(corner, 12 * blk + 11), a2.c[REC_AREA]);
+    FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
+    FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
+    FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    st_corner3w(corner, blk, 0, use, c0, !deg, w0);
+    st_corner3w(corner, blk, 1, use, c1, !deg, w1);
+    st_corner3w(corner, blk, 2, use, c2, !deg, w2);
+    count_lanes(&counters[2], (!deg) & (!ok), live);
+}
+
+// A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame, from its record.
+SC_INLINE FV3 rec_curv_in(RecN a, FV3 ft, FV3 fb)
+{
+    return proj_curv(rec3(a, REC_PD1), rec3(a, REC_PD2),
+                     v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]), ft, fb);
+}
+
+__kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,
+                                 __global REAL *corner, volatile __global uint *counters)
+{
+    FACE_BLOCK_OR_RETURN(nf);
+    RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
+         a2 = ld_rec(rec, faces, nf, blk, 2);
+    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb;
+    FV4 x;
+    face_frame(t, &ft, &fb);
+    FMASK ok = face_dcurv(t, ft, fb, rec_curv_in(a0, ft, fb), rec_curv_in(a1, ft, fb),
+                          rec_curv_in(a2, ft, fb), &x);
+    FMASK use = (!deg) & ok;
+    FREAL w0 = LD_SLOT(corner, 12 * blk + 9), w1 = LD_SLOT(corner, 12 * blk + 10),
+          w2 = LD_SLOT(corner, 12 * blk + 11);
+    FV4 c0 = mul4(proj_dcurv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
+    FV4 c1 = mul4(proj_dcurv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
+    FV4 c2 = mul4(proj_dcurv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    st_corner(corner, blk, 0, use, c0);
+    st_corner(corner, blk, 1, use, c1);
+    st_corner(corner, blk, 2, use, c2);
+    count_lanes(&counters[3], (!deg) & (!ok), live);
+}
+#else
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                   __global const REAL *nrm, __global const REAL *area,
                                   __global const REAL *pd1, __global const REAL *pd2,
@@ -613,6 +794,8 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     st_corner(corner, blk, 2, use, c2);
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
+
+#endif // SC_LANES > 1
 
 // Sums the corners of vertex v's one-ring in face order (components x, y, z,
 // and w when `four`; a constant after inlining). One vertex per work-item:

@@ -921,13 +921,36 @@ fn wrong_pose_sizes_and_non_finite_poses_are_errors() {
 
 #[test]
 fn memory_stays_within_budget() {
-    // ≤ 192 bytes per vertex + 32 per face, for every f32 variant
+    // ≤ 192 bytes per vertex + 32 per face for every f32 variant with one
+    // face per work-item (GPUs); the gather scheme's vertex records add 64
+    // per vertex with SIMD lanes (CPU devices)
     let m = mesh::torus(1.0, 0.4, 200, 100);
-    for acc in [Accumulate::Atomic, Accumulate::Gather] {
+    for (acc, lanes, per_vertex) in [
+        (Accumulate::Atomic, 1, 192),
+        (Accumulate::Gather, 1, 192),
+        (Accumulate::Gather, 16, 256),
+    ] {
         let o = with(CurvatureOptions::default(), acc, Precision::F32);
-        let b = shapecue::spec::curvature::device_bytes_bound(m.n_vertices(), m.n_faces(), &o);
-        let budget = 192 * m.n_vertices() as u64 + 32 * m.n_faces() as u64;
-        assert!(b <= budget, "{acc:?}: {b} > {budget}");
+        let (nv, nf) = (m.n_vertices(), m.n_faces());
+        let b = shapecue::spec::curvature::device_bytes_bound(nv, nf, &o, lanes);
+        let budget = per_vertex * nv as u64 + 32 * nf as u64;
+        assert!(b <= budget, "{acc:?}, {lanes} lanes: {b} > {budget}");
+    }
+    // and an estimator reports the bound of its own face lanes
+    for lanes in [1, 16] {
+        let o = CurvatureOptions {
+            lanes,
+            ..with(
+                CurvatureOptions::default(),
+                Accumulate::Gather,
+                Precision::F32,
+            )
+        };
+        let e = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();
+        assert_eq!(e.face_lanes(), lanes);
+        let bound =
+            shapecue::spec::curvature::device_bytes_bound(m.n_vertices(), m.n_faces(), &o, lanes);
+        assert_eq!(e.device_bytes(), bound, "{lanes} lanes");
     }
 }
 

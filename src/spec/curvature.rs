@@ -483,6 +483,12 @@ pub fn padded_faces(nf: usize) -> usize {
     nf.div_ceil(MAX_FACE_LANES as usize) * MAX_FACE_LANES as usize
 }
 
+/// Reals per vertex record of the gather scheme with face lanes (the
+/// `REC_*` layout of kernels/curvature.cl: position and point area, normal
+/// and k1, first direction and k2, second direction), read by the tensor and
+/// derivative face kernels as whole vectors.
+pub const REC_REALS: usize = 16;
+
 /// Reals of the gather variant's corner buffer for `nf` faces: 4 per corner
 /// (the widest pass, the derivative tensor), 12 per face, for
 /// [`padded_faces`] faces.
@@ -514,8 +520,10 @@ pub fn face_lanes_for(requested: u32, device_kind: &str, native_width: u32) -> u
 }
 
 /// Bytes of device memory the curvature estimator allocates for a mesh, by
-/// variant (the same arithmetic as its allocations).
-pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 {
+/// variant and face lanes (the same arithmetic as its allocations): the
+/// gather scheme with more than one lane adds [`REC_REALS`] reals per vertex
+/// of vertex records.
+pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: u32) -> u64 {
     let r = opts.precision.bytes() as u64;
     let (nv, nf) = (nv.max(1), nf.max(1));
     // pos, nrm, pd1, pd2, tens: 3 reals; area: 1; kk: 2; dk: 4  → 20 reals per vertex.
@@ -527,6 +535,9 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions) -> u64 
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
             + corner_reals_bound(nf) as u64 * r;
+        if lanes > 1 {
+            b += nv as u64 * REC_REALS as u64 * r;
+        }
     }
     b
 }

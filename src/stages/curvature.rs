@@ -16,7 +16,7 @@ use crate::mesh::order::{LocalityOrder, MeshOrder};
 use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, VertexCurvature, corner_reals_bound,
+    Precision, REC_REALS, VertexCurvature, corner_reals_bound,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -176,6 +176,11 @@ struct Kernels {
     dcurv: Kernel,
     /// Gather variant only: the per-vertex one-ring sums of the three passes.
     sums: Option<[Kernel; 3]>,
+    /// Gather variant with lanes only: curv_pack_frames and
+    /// curv_pack_principal, which write the vertex records that the tensor
+    /// and derivative face kernels read, after curv_frames and after
+    /// curv_principal.
+    packs: Option<[Kernel; 2]>,
     /// Positions from a device buffer of index-space floats (isosurfaces).
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
@@ -190,6 +195,8 @@ struct GatherBufs {
     ring_off: Buffer<u32>,
     ring: Buffer<u32>,
     corner: Buffer<u8>,
+    /// With lanes: 16 reals per vertex (`REC_*` in kernels/curvature.cl).
+    rec: Option<Buffer<u8>>,
 }
 
 /// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
@@ -354,6 +361,14 @@ impl CurvatureEstimator {
             principal: gpu.kernel(&program, "curv_principal")?,
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
             sums,
+            packs: if gather && lanes > 1 {
+                Some([
+                    gpu.kernel(&program, "curv_pack_frames")?,
+                    gpu.kernel(&program, "curv_pack_principal")?,
+                ])
+            } else {
+                None
+            },
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
             override_normals: gpu.kernel(&program, "curv_override_normals")?,
             lanes: if gather { lanes } else { 1 },
@@ -471,6 +486,15 @@ impl CurvatureEstimator {
                 ring_off,
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
+                rec: if k.packs.is_some() {
+                    // zeroed once: component 15 is never written
+                    let n = REC_REALS * nv.max(1) * real;
+                    let mut r = gpu.buffer::<u8>(n)?;
+                    gpu.zero(&mut r, n)?;
+                    Some(r)
+                } else {
+                    None
+                },
             })
         } else {
             zero_all(&mut bufs)?;
@@ -501,7 +525,7 @@ impl CurvatureEstimator {
             dk,
             counters: gpu.buffer::<u32>(4)?,
             normal_override: None,
-            device_bytes: crate::spec::curvature::device_bytes_bound(nv, nf, &opts),
+            device_bytes: crate::spec::curvature::device_bytes_bound(nv, nf, &opts, k.lanes),
             gpu,
             opts,
             nv,
@@ -763,25 +787,44 @@ impl CurvatureEstimator {
                 );
             }
         }
+        // The vertex records of the gather scheme with lanes (see `Kernels`).
+        let rec = match (&self.gather, &self.k.packs) {
+            (Some(GatherBufs { rec: Some(r), .. }), Some(packs)) => Some((buf(r), packs)),
+            _ => None,
+        };
         if Pass::Frames <= last {
             let args = [Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
             record(Pass::Frames, launch(g, &self.k.frames, nv, &args)?);
+            if let (true, Some((r, packs))) = (Pass::Tensor <= last, &rec) {
+                let args = [Arg::U32(nv32), pos, area, nrm, pd1, pd2, *r];
+                record(Pass::Frames, launch(g, &packs[0], nv, &args)?);
+            }
             let args = [Arg::U32(nv32), area, cnt];
             record(Pass::Frames, launch(g, &self.k.count_empty, nv, &args)?);
         }
         if Pass::Tensor <= last {
-            let args = [pos, faces, nrm, area, pd1, pd2];
-            for (p, e) in one_ring(&self.k.tensor, &args, 1, &[tens], Pass::Tensor)? {
+            let args: &[Arg] = match &rec {
+                Some((r, _)) => &[*r, faces],
+                None => &[pos, faces, nrm, area, pd1, pd2],
+            };
+            for (p, e) in one_ring(&self.k.tensor, args, 1, &[tens], Pass::Tensor)? {
                 record(p, Some(e));
             }
         }
         if Pass::Principal <= last {
             let args = [Arg::U32(nv32), nrm, tens, pd1, pd2, kk];
             record(Pass::Principal, launch(g, &self.k.principal, nv, &args)?);
+            if let (true, Some((r, packs))) = (dcurv, &rec) {
+                let args = [Arg::U32(nv32), pd1, pd2, kk, *r];
+                record(Pass::Principal, launch(g, &packs[1], nv, &args)?);
+            }
         }
         if dcurv {
-            let args = [pos, faces, area, pd1, pd2, kk];
-            for (p, e) in one_ring(&self.k.dcurv, &args, 2, &[dk], Pass::Dcurv)? {
+            let args: &[Arg] = match &rec {
+                Some((r, _)) => &[*r, faces],
+                None => &[pos, faces, area, pd1, pd2, kk],
+            };
+            for (p, e) in one_ring(&self.k.dcurv, args, 2, &[dk], Pass::Dcurv)? {
                 record(p, Some(e));
             }
         }
