@@ -280,8 +280,10 @@ typedef V3N FV3;
 typedef V4N FV4;
 typedef TriN FTri;
 
-// The SC_LANES reals from SC_LANES·slot of a (one per lane; see st_corner).
-#define LD_SLOT(a, slot) VLOADN((slot), (a))
+// The corner areas (then weights) of corner c of the block's faces: one
+// whole vector (see `cw` in the file header).
+#define CW_LD(c) VLOADN(3 * blk + (c), cw)
+#define CW_ST(x, c) VSTOREN((x), 3 * blk + (c), cw)
 
 // Face block b: faces SC_LANES·b … SC_LANES·b + SC_LANES − 1. Lanes past the
 // last face repeat it (`live` is false there); their corners land in the
@@ -329,13 +331,32 @@ typedef V3 FV3;
 typedef V4 FV4;
 typedef Tri FTri;
 
-#define LD_SLOT(a, slot) ((a)[slot])
+#define CW_LD(c) cw[3 * blk + (c)]
+#define CW_ST(x, c) (cw[3 * blk + (c)] = (x))
 
 #define FACE_BLOCK_OR_RETURN(nf)  \
     GID_OR_RETURN(nf);            \
     const uint blk = gid;         \
     const int live = 1;           \
     const FIDX fid = gid;
+
+// The three corners of face f, each at 4·(3f + c) (see CORNER_SLOT).
+SC_INLINE void st_corners(__global REAL *corner, uint f, V4 x0, V4 x1, V4 x2)
+{
+    __global REAL *p = corner + 12 * f;
+    p[0] = x0.x;
+    p[1] = x0.y;
+    p[2] = x0.z;
+    p[3] = x0.w;
+    p[4] = x1.x;
+    p[5] = x1.y;
+    p[6] = x1.z;
+    p[7] = x1.w;
+    p[8] = x2.x;
+    p[9] = x2.y;
+    p[10] = x2.z;
+    p[11] = x2.w;
+}
 
 SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, int live)
 {
@@ -344,9 +365,10 @@ SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, int live)
 }
 #endif
 
-// The corner slot of face f's corner c, component k (see st_corner).
-#define CORNER_SLOT(f, c, k) \
-    ((12 * ((f) / SC_LANES) + 3 * (k) + (c)) * SC_LANES + (f) % SC_LANES)
+// The corner slot of face f's corner c, component k: corner e = 3f + c has
+// its four components at 4e … 4e + 3, so that a ring sum reads a corner as
+// one 16-byte run (for every lane count).
+#define CORNER_SLOT(f, c, k) (12 * (f) + 4 * (c) + (k))
 
 
 // ---------------------------------------------------------------------------
@@ -657,10 +679,41 @@ SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint
     return o;
 }
 SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
+
+// The corners of face block blk, x_c holding corner c of every lane's face:
+// the 12 component vectors (and 4 of zeros) transposed in registers into
+// each face's 12 reals at CORNER_SLOT, stored as whole vectors.
+#if SC_LANES == 16
+#define SC_ST_ROW(l, s)                                 \
+    vstore8(r##l.lo, 0, corner + 12 * (f0 + l));        \
+    vstore4(r##l.s89ab, 0, corner + 12 * (f0 + l) + 8);
+#elif SC_LANES == 8
+#define SC_ST_ROW(l, s)                                 \
+    if (q == 0)                                         \
+        vstore8(r##l, 0, corner + 12 * (f0 + l));       \
+    else                                                \
+        vstore4(r##l.lo, 0, corner + 12 * (f0 + l) + 8);
+#else
+#define SC_ST_ROW(l, s) VSTOREN(r##l, 0, corner + 12 * (f0 + l) + q * SC_LANES);
+#endif
+#define SC_GET_ROW(l, s) FREAL r##l = x[q * SC_LANES + l];
+SC_INLINE void st_corners(__global REAL *corner, uint blk, FV4 x0, FV4 x1, FV4 x2)
+{
+    const uint f0 = SC_LANES * blk;
+    const FREAL z = (FREAL)RL(0);
+    const FREAL x[16] = {x0.x, x0.y, x0.z, x0.w, x1.x, x1.y, x1.z, x1.w,
+                         x2.x, x2.y, x2.z, x2.w, z,    z,    z,    z};
+#pragma unroll
+    for (uint q = 0; q < 12 / SC_LANES + (12 % SC_LANES != 0); q++) {
+        SC_ROWS(SC_GET_ROW)
+        SC_TRANSPOSE()
+        SC_ROWS(SC_ST_ROW)
+    }
+}
 #endif // SC_LANES > 1
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
-                                         __global const uint *faces, __global REAL *corner,
+                                         __global const uint *faces, __global REAL *corner, __global REAL *cw,
                                          volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
@@ -669,9 +722,13 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
     FMASK use = !deg;
     FV3 ca = corner_areas(t), fn = face_normal(t);
     FREAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
-    st_corner(corner, blk, 0, use, ext4(corner_normal(fn, l1, l2), ca.x));
-    st_corner(corner, blk, 1, use, ext4(corner_normal(fn, l2, l0), ca.y));
-    st_corner(corner, blk, 2, use, ext4(corner_normal(fn, l0, l1), ca.z));
+    FV4 x0 = zero_unless(use, ext4(corner_normal(fn, l1, l2), ca.x)),
+        x1 = zero_unless(use, ext4(corner_normal(fn, l2, l0), ca.y)),
+        x2 = zero_unless(use, ext4(corner_normal(fn, l0, l1), ca.z));
+    st_corners(corner, blk, x0, x1, x2);
+    CW_ST(x0.w, 0);
+    CW_ST(x1.w, 1);
+    CW_ST(x2.w, 2);
     count_lanes(&counters[0], deg, live);
 }
 
@@ -680,7 +737,7 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
 // records (ld_rec) instead of pos, nrm, area, pd1, pd2 and kk; the same
 // values, the same arithmetic, the same bits.
 __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                  __global REAL *corner, volatile __global uint *counters)
+                                  __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -691,15 +748,18 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
     face_frame(t, &ft, &fb);
     FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM), rec3(a2, REC_NRM), &x);
     FMASK use = (!deg) & ok;
-    FREAL w0 = corner_weight(LD_SLOT(corner, 12 * blk + 9), a0.c[REC_AREA]);
-    FREAL w1 = corner_weight(LD_SLOT(corner, 12 * blk + 10), a1.c[REC_AREA]);
-    FREAL w2 = corner_weight(LD_SLOT(corner, 12 * blk + 11), a2.c[REC_AREA]);
+    FREAL w0 = corner_weight(CW_LD(0), a0.c[REC_AREA]);
+    FREAL w1 = corner_weight(CW_LD(1), a1.c[REC_AREA]);
+    FREAL w2 = corner_weight(CW_LD(2), a2.c[REC_AREA]);
     FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
     FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
     FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
-    st_corner3w(corner, blk, 0, use, c0, !deg, w0);
-    st_corner3w(corner, blk, 1, use, c1, !deg, w1);
-    st_corner3w(corner, blk, 2, use, c2, !deg, w2);
+    st_corners(corner, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
+               zero_unless(use, ext4(c1, (FREAL)RL(0))), zero_unless(use, ext4(c2, (FREAL)RL(0))));
+    FREAL z = (FREAL)RL(0);
+    CW_ST(!deg ? w0 : z, 0);
+    CW_ST(!deg ? w1 : z, 1);
+    CW_ST(!deg ? w2 : z, 2);
     count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
@@ -711,7 +771,7 @@ SC_INLINE FV3 rec_curv_in(RecN a, FV3 ft, FV3 fb)
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                 __global REAL *corner, volatile __global uint *counters)
+                                 __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -724,21 +784,18 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
     FMASK ok = face_dcurv(t, ft, fb, rec_curv_in(a0, ft, fb), rec_curv_in(a1, ft, fb),
                           rec_curv_in(a2, ft, fb), &x);
     FMASK use = (!deg) & ok;
-    FREAL w0 = LD_SLOT(corner, 12 * blk + 9), w1 = LD_SLOT(corner, 12 * blk + 10),
-          w2 = LD_SLOT(corner, 12 * blk + 11);
+    FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = mul4(proj_dcurv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
     FV4 c1 = mul4(proj_dcurv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
     FV4 c2 = mul4(proj_dcurv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
-    st_corner(corner, blk, 0, use, c0);
-    st_corner(corner, blk, 1, use, c1);
-    st_corner(corner, blk, 2, use, c2);
+    st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 #else
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                   __global const REAL *nrm, __global const REAL *area,
                                   __global const REAL *pd1, __global const REAL *pd2,
-                                  __global REAL *corner, volatile __global uint *counters)
+                                  __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -751,23 +808,26 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     // zero for degenerate faces), read back instead of recomputed, and each
     // corner's weight in its vertex's sum, stored there in their place for
     // curv_dcurv_corners. The same values as computing them here.
-    FREAL w0 = corner_weight(LD_SLOT(corner, 12 * blk + 9), ld1(area, v0));
-    FREAL w1 = corner_weight(LD_SLOT(corner, 12 * blk + 10), ld1(area, v1));
-    FREAL w2 = corner_weight(LD_SLOT(corner, 12 * blk + 11), ld1(area, v2));
+    FREAL w0 = corner_weight(CW_LD(0), ld1(area, v0));
+    FREAL w1 = corner_weight(CW_LD(1), ld1(area, v1));
+    FREAL w2 = corner_weight(CW_LD(2), ld1(area, v2));
     // All three corners before the first store (see curv_dcurv_corners).
     FV3 c0 = tensor_w(pd1, pd2, v0, w0, ft, fb, x);
     FV3 c1 = tensor_w(pd1, pd2, v1, w1, ft, fb, x);
     FV3 c2 = tensor_w(pd1, pd2, v2, w2, ft, fb, x);
-    st_corner3w(corner, blk, 0, use, c0, !deg, w0);
-    st_corner3w(corner, blk, 1, use, c1, !deg, w1);
-    st_corner3w(corner, blk, 2, use, c2, !deg, w2);
+    st_corners(corner, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
+               zero_unless(use, ext4(c1, (FREAL)RL(0))), zero_unless(use, ext4(c2, (FREAL)RL(0))));
+    FREAL z = (FREAL)RL(0);
+    CW_ST(!deg ? w0 : z, 0);
+    CW_ST(!deg ? w1 : z, 1);
+    CW_ST(!deg ? w2 : z, 2);
     count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                  __global const REAL *area, __global const REAL *pd1,
                                  __global const REAL *pd2, __global const REAL *kk,
-                                 __global REAL *corner, volatile __global uint *counters)
+                                 __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -780,8 +840,7 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
                           vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x);
     FMASK use = (!deg) & ok;
     // The corner weights curv_tensor_corners stored (`area` is not read).
-    FREAL w0 = LD_SLOT(corner, 12 * blk + 9), w1 = LD_SLOT(corner, 12 * blk + 10),
-          w2 = LD_SLOT(corner, 12 * blk + 11);
+    FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     // All three corners before the first store: a store to `corner` may
     // alias pd1/pd2 for the compiler, so a corner computed after one would
     // load its vertex's frame again (one scalar load per lane and value)
@@ -789,9 +848,7 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     FV4 c0 = dcurv_w(pd1, pd2, v0, w0, ft, fb, x);
     FV4 c1 = dcurv_w(pd1, pd2, v1, w1, ft, fb, x);
     FV4 c2 = dcurv_w(pd1, pd2, v2, w2, ft, fb, x);
-    st_corner(corner, blk, 0, use, c0);
-    st_corner(corner, blk, 1, use, c1);
-    st_corner(corner, blk, 2, use, c2);
+    st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 
@@ -808,12 +865,16 @@ SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint
 {
     V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-        uint e = ring[r], i = CORNER_SLOT(e / 3, e % 3, 0);
-        s.x += corner[i];
-        s.y += corner[i + 3 * SC_LANES];
-        s.z += corner[i + 6 * SC_LANES];
+#ifdef SC_DOUBLE
+        double4 c = vload4(ring[r], corner);
+#else
+        float4 c = vload4(ring[r], corner);
+#endif
+        s.x += c.x;
+        s.y += c.y;
+        s.z += c.z;
         if (four)
-            s.w += corner[i + 9 * SC_LANES];
+            s.w += c.w;
     }
     return s;
 }

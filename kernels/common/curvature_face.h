@@ -297,31 +297,11 @@ SC_OL SC_INLINE GV4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2,
     return dcurv_w(pd1, pd2, v, corner_weight(ca, ld1(area, v)), ft, fb, x);
 }
 
-// Corner c of face block b (SC_LANES faces, one per lane), component k lives
-// at the SC_LANES reals from SC_LANES·(12b + 3k + c): a block's 12 stores form
-// one gap-free group (stores with gaps, or into several planes of one buffer,
-// keep PoCL from vectorising), and lane l of each is face SC_LANES·b + l.
-// With one lane this is 12f + 3k + c. Unused corners are zero (selected,
+// A face's corner contribution where `use` holds, zero elsewhere (selected,
 // never multiplied, so NaN cannot leak).
-SC_OL SC_INLINE void st_corner(__global REAL *corner, uint b, uint c, GM use, GV4 x)
+SC_OL SC_INLINE GV4 zero_unless(GM use, GV4 x)
 {
-    uint s = 12 * b + c;
-    lst(use ? x.x : (GT)RL(0), s, corner);
-    lst(use ? x.y : (GT)RL(0), s + 3, corner);
-    lst(use ? x.z : (GT)RL(0), s + 6, corner);
-    lst(use ? x.w : (GT)RL(0), s + 9, corner);
+    return v4(use ? x.x : (GT)RL(0), use ? x.y : (GT)RL(0), use ? x.z : (GT)RL(0),
+              use ? x.w : (GT)RL(0));
 }
-// The tensor pass: three components under `use`, and in the fourth (where
-// the normal pass left the corner area) the corner's weight under `keep`,
-// for the derivative pass.
-SC_OL SC_INLINE void st_corner3w(__global REAL *corner, uint b, uint c, GM use, GV3 x, GM keep,
-                                 GT w)
-{
-    uint s = 12 * b + c;
-    lst(use ? x.x : (GT)RL(0), s, corner);
-    lst(use ? x.y : (GT)RL(0), s + 3, corner);
-    lst(use ? x.z : (GT)RL(0), s + 6, corner);
-    lst(keep ? w : (GT)RL(0), s + 9, corner);
-}
-
 #endif // GT

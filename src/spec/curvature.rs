@@ -496,6 +496,12 @@ pub fn corner_reals_bound(nf: usize) -> usize {
     12 * padded_faces(nf)
 }
 
+/// Reals of the gather scheme's corner areas (then weights): 3 per face,
+/// for [`padded_faces`] faces.
+pub fn corner_weights_bound(nf: usize) -> usize {
+    3 * padded_faces(nf)
+}
+
 /// Faces per work-item of the gather variant's per-face kernels on a device:
 /// `requested` when not 0, else by device type (the rule the estimator uses;
 /// `native_width` is the device's `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT` or
@@ -534,7 +540,7 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: 
         // one-ring CSR, 4 reals per face corner
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
-            + corner_reals_bound(nf) as u64 * r;
+            + (corner_reals_bound(nf) + corner_weights_bound(nf)) as u64 * r;
         if lanes > 1 {
             b += nv as u64 * REC_REALS as u64 * r;
         }

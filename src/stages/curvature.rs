@@ -16,7 +16,7 @@ use crate::mesh::order::{LocalityOrder, MeshOrder};
 use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, REC_REALS, VertexCurvature, corner_reals_bound,
+    Precision, REC_REALS, VertexCurvature, corner_reals_bound, corner_weights_bound,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -195,6 +195,8 @@ struct GatherBufs {
     ring_off: Buffer<u32>,
     ring: Buffer<u32>,
     corner: Buffer<u8>,
+    /// Corner areas, then weights, of each face corner (3 reals per face).
+    cw: Buffer<u8>,
     /// With lanes: 16 reals per vertex (`REC_*` in kernels/curvature.cl).
     rec: Option<Buffer<u8>>,
 }
@@ -486,6 +488,7 @@ impl CurvatureEstimator {
                 ring_off,
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
+                cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
                 rec: if k.packs.is_some() {
                     // zeroed once: component 15 is never written
                     let n = REC_REALS * nv.max(1) * real;
@@ -741,7 +744,7 @@ impl CurvatureEstimator {
                 (Some(gb), Some(sums)) => {
                     let mut a = vec![Arg::U32(nf32)];
                     a.extend_from_slice(face_args);
-                    a.extend([buf(&gb.corner), cnt]);
+                    a.extend([buf(&gb.corner), buf(&gb.cw), cnt]);
                     // One work-item per block of `lanes` faces.
                     let blocks = nf.div_ceil(self.k.lanes as usize);
                     evs.extend(launch(g, face_kernel, blocks, &a)?.map(|e| (pass, e)));
