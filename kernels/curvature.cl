@@ -532,16 +532,17 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
     V3 ft, fb;
     V4 x;
     face_frame(t, &ft, &fb);
-    if (!face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, v0, ft, fb),
-                    vertex_curv_in(pd1, pd2, kk, v1, ft, fb),
-                    vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x)) {
+    V4 q0 = vertex_coef(pd1, pd2, v0, ft, fb), q1 = vertex_coef(pd1, pd2, v1, ft, fb),
+       q2 = vertex_coef(pd1, pd2, v2, ft, fb);
+    if (!face_dcurv(t, ft, fb, vertex_curv_by(kk, v0, q0), vertex_curv_by(kk, v1, q1),
+                    vertex_curv_by(kk, v2, q2), &x)) {
         atomic_inc(&counters[3]);
         return;
     }
     V3 ca = corner_areas(t);
-    atomic_add4(dk, v0, dcurv_at(pd1, pd2, area, v0, ca.x, ft, fb, x));
-    atomic_add4(dk, v1, dcurv_at(pd1, pd2, area, v1, ca.y, ft, fb, x));
-    atomic_add4(dk, v2, dcurv_at(pd1, pd2, area, v2, ca.z, ft, fb, x));
+    atomic_add4(dk, v0, dcurv_by(q0, corner_weight(ca.x, area[v0]), x));
+    atomic_add4(dk, v1, dcurv_by(q1, corner_weight(ca.y, area[v1]), x));
+    atomic_add4(dk, v2, dcurv_by(q2, corner_weight(ca.z, area[v2]), x));
 }
 
 #endif // !SC_GATHER
@@ -763,11 +764,14 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
     count_lanes(&counters[2], (!deg) & (!ok), live);
 }
 
-// A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame, from its record.
-SC_INLINE FV3 rec_curv_in(RecN a, FV3 ft, FV3 fb)
+// vertex_coef and vertex_curv_by from a vertex's record.
+SC_INLINE FV4 rec_coef(RecN a, FV3 ft, FV3 fb)
 {
-    return proj_curv(rec3(a, REC_PD1), rec3(a, REC_PD2),
-                     v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]), ft, fb);
+    return proj_coef(rec3(a, REC_PD1), rec3(a, REC_PD2), ft, fb);
+}
+SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
+{
+    return proj_curv_by(c, v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]));
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,
@@ -781,13 +785,12 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
     FV3 ft, fb;
     FV4 x;
     face_frame(t, &ft, &fb);
-    FMASK ok = face_dcurv(t, ft, fb, rec_curv_in(a0, ft, fb), rec_curv_in(a1, ft, fb),
-                          rec_curv_in(a2, ft, fb), &x);
+    FV4 q0 = rec_coef(a0, ft, fb), q1 = rec_coef(a1, ft, fb), q2 = rec_coef(a2, ft, fb);
+    FMASK ok = face_dcurv(t, ft, fb, rec_curv_by(a0, q0), rec_curv_by(a1, q1),
+                          rec_curv_by(a2, q2), &x);
     FMASK use = (!deg) & ok;
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
-    FV4 c0 = mul4(proj_dcurv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
-    FV4 c1 = mul4(proj_dcurv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
-    FV4 c2 = mul4(proj_dcurv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
     st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
@@ -835,19 +838,14 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     FV3 ft, fb;
     FV4 x;
     face_frame(t, &ft, &fb);
-    FMASK ok = face_dcurv(t, ft, fb, vertex_curv_in(pd1, pd2, kk, v0, ft, fb),
-                          vertex_curv_in(pd1, pd2, kk, v1, ft, fb),
-                          vertex_curv_in(pd1, pd2, kk, v2, ft, fb), &x);
+    FV4 q0 = vertex_coef(pd1, pd2, v0, ft, fb), q1 = vertex_coef(pd1, pd2, v1, ft, fb),
+        q2 = vertex_coef(pd1, pd2, v2, ft, fb);
+    FMASK ok = face_dcurv(t, ft, fb, vertex_curv_by(kk, v0, q0), vertex_curv_by(kk, v1, q1),
+                          vertex_curv_by(kk, v2, q2), &x);
     FMASK use = (!deg) & ok;
     // The corner weights curv_tensor_corners stored (`area` is not read).
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
-    // All three corners before the first store: a store to `corner` may
-    // alias pd1/pd2 for the compiler, so a corner computed after one would
-    // load its vertex's frame again (one scalar load per lane and value)
-    // instead of reusing the loads of vertex_curv_in.
-    FV4 c0 = dcurv_w(pd1, pd2, v0, w0, ft, fb, x);
-    FV4 c1 = dcurv_w(pd1, pd2, v1, w1, ft, fb, x);
-    FV4 c2 = dcurv_w(pd1, pd2, v2, w2, ft, fb, x);
+    FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
     st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }

@@ -139,23 +139,38 @@ SC_OL SC_INLINE void rot_coord_sys(GV3 u, GV3 v, GV3 nn, GV3 *ru, GV3 *rv)
     *rv = sel3(flip, neg3(v), sub3(v, mul3(dperp, dot3(v, perp_old))));
 }
 
-// Re-express the tensor k = (ku, kuv, kv) given in (ou, ov) in the frame (nu, nv).
-SC_OL SC_INLINE GV3 proj_curv(GV3 ou, GV3 ov, GV3 k, GV3 nu, GV3 nv)
+// The coefficients (u1, v1, u2, v2) that re-express a tensor given in the
+// frame (ou, ov) in the frame (nu, nv): (nu, nv) rotated into the plane of
+// (ou, ov), dotted with ou and ov. The projection the other way, from
+// (nu, nv) to (ou, ov), has the coefficients (u1, u2, v1, v2) (coef_reverse):
+// the minimal rotations between the two planes are each other's inverse, so
+// one set serves both directions (the derivative pass projects each vertex's
+// tensor into the face frame and the face's result back into the vertex's).
+SC_OL SC_INLINE GV4 proj_coef(GV3 ou, GV3 ov, GV3 nu, GV3 nv)
 {
     GV3 ru, rv;
     rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
-    GT u1 = dot3(ru, ou), v1 = dot3(ru, ov), u2 = dot3(rv, ou), v2 = dot3(rv, ov);
+    return v4(dot3(ru, ou), dot3(ru, ov), dot3(rv, ou), dot3(rv, ov));
+}
+SC_OL SC_INLINE GV4 coef_reverse(GV4 c) { return v4(c.x, c.z, c.y, c.w); }
+
+// Re-express the tensor k = (ku, kuv, kv) by the coefficients c of proj_coef.
+SC_OL SC_INLINE GV3 proj_curv_by(GV4 c, GV3 k)
+{
+    GT u1 = c.x, v1 = c.y, u2 = c.z, v2 = c.w;
     return v3(k.x * u1 * u1 + k.y * (RL(2) * u1 * v1) + k.z * v1 * v1,
               k.x * u1 * u2 + k.y * (u1 * v2 + u2 * v1) + k.z * v1 * v2,
               k.x * u2 * u2 + k.y * (RL(2) * u2 * v2) + k.z * v2 * v2);
 }
+SC_OL SC_INLINE GV3 proj_curv(GV3 ou, GV3 ov, GV3 k, GV3 nu, GV3 nv)
+{
+    return proj_curv_by(proj_coef(ou, ov, nu, nv), k);
+}
 
 // The same for the third-order tensor d = (C111, C112, C122, C222).
-SC_OL SC_INLINE GV4 proj_dcurv(GV3 ou, GV3 ov, GV4 d, GV3 nu, GV3 nv)
+SC_OL SC_INLINE GV4 proj_dcurv_by(GV4 c, GV4 d)
 {
-    GV3 ru, rv;
-    rot_coord_sys(nu, nv, cross3(ou, ov), &ru, &rv);
-    GT u1 = dot3(ru, ou), v1 = dot3(ru, ov), u2 = dot3(rv, ou), v2 = dot3(rv, ov);
+    GT u1 = c.x, v1 = c.y, u2 = c.z, v2 = c.w;
     return v4(d.x * u1 * u1 * u1 + d.y * RL(3) * u1 * u1 * v1 + d.z * RL(3) * u1 * v1 * v1 +
                   d.w * v1 * v1 * v1,
               d.x * u1 * u1 * u2 + d.y * (u1 * u1 * v2 + RL(2) * u2 * u1 * v1) +
@@ -263,12 +278,17 @@ SC_OL SC_INLINE GM face_dcurv(GTri t, GV3 ft, GV3 fb, GV3 f0, GV3 f1, GV3 f2, GV
 // ---------------------------------------------------------------------------
 // Reads of per-vertex state inside face kernels.
 
-// A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame.
-SC_OL SC_INLINE GV3 vertex_curv_in(__global const REAL *pd1, __global const REAL *pd2,
-                                   __global const REAL *kk, GI v, GV3 ft, GV3 fb)
+// The proj_coef coefficients from vertex v's frame to a face frame (ft, fb).
+SC_OL SC_INLINE GV4 vertex_coef(__global const REAL *pd1, __global const REAL *pd2, GI v, GV3 ft,
+                                GV3 fb)
 {
-    return proj_curv(ld3(pd1, v), ld3(pd2, v), v3(ld1(kk, 2 * v), (GT)RL(0), ld1(kk, 2 * v + 1)),
-                     ft, fb);
+    return proj_coef(ld3(pd1, v), ld3(pd2, v), ft, fb);
+}
+// A vertex tensor (diagonal in (d1, d2)) re-expressed in a face frame, by
+// the coefficients of vertex_coef.
+SC_OL SC_INLINE GV3 vertex_curv_by(__global const REAL *kk, GI v, GV4 c)
+{
+    return proj_curv_by(c, v3(ld1(kk, 2 * v), (GT)RL(0), ld1(kk, 2 * v + 1)));
 }
 
 // The tensor of face (ft, fb, x) in vertex v's frame, times the corner's
@@ -285,17 +305,9 @@ SC_OL SC_INLINE GV3 tensor_at(__global const REAL *pd1, __global const REAL *pd2
     return tensor_w(pd1, pd2, v, corner_weight(ca, ld1(area, v)), ft, fb, x);
 }
 
-// The weighted derivative tensor of a face in vertex v's frame.
-SC_OL SC_INLINE GV4 dcurv_w(__global const REAL *pd1, __global const REAL *pd2, GI v, GT w,
-                            GV3 ft, GV3 fb, GV4 x)
-{
-    return mul4(proj_dcurv(ft, fb, x, ld3(pd1, v), ld3(pd2, v)), w);
-}
-SC_OL SC_INLINE GV4 dcurv_at(__global const REAL *pd1, __global const REAL *pd2,
-                             __global const REAL *area, GI v, GT ca, GV3 ft, GV3 fb, GV4 x)
-{
-    return dcurv_w(pd1, pd2, v, corner_weight(ca, ld1(area, v)), ft, fb, x);
-}
+// The weighted derivative tensor of a face in a vertex's frame, from the
+// vertex_coef coefficients c of that vertex and face.
+SC_OL SC_INLINE GV4 dcurv_by(GV4 c, GT w, GV4 x) { return mul4(proj_dcurv_by(coef_reverse(c), x), w); }
 
 // A face's corner contribution where `use` holds, zero elsewhere (selected,
 // never multiplied, so NaN cannot leak).

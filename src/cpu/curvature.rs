@@ -140,10 +140,24 @@ fn rot_coord_sys(u: V3, v: V3, nn: V3) -> (V3, V3) {
     )
 }
 
-/// Re-expresses the tensor `k` = (ku, kuv, kv) from frame (ou, ov) in (nu, nv).
-pub fn proj_curv(ou: V3, ov: V3, k: V3, nu: V3, nv: V3) -> V3 {
+/// The coefficients (u1, v1, u2, v2) that re-express a tensor from frame
+/// (ou, ov) in (nu, nv): (nu, nv) rotated into the plane of (ou, ov), dotted
+/// with ou and ov. The projection the other way has the coefficients
+/// (u1, u2, v1, v2) ([`coef_reverse`]): the minimal rotations between the two
+/// planes are each other's inverse (as in `kernels/common/curvature_face.h`).
+pub fn proj_coef(ou: V3, ov: V3, nu: V3, nv: V3) -> [f64; 4] {
     let (ru, rv) = rot_coord_sys(nu, nv, cross(ou, ov));
-    let (u1, v1, u2, v2) = (dot(ru, ou), dot(ru, ov), dot(rv, ou), dot(rv, ov));
+    [dot(ru, ou), dot(ru, ov), dot(rv, ou), dot(rv, ov)]
+}
+
+/// The coefficients of the projection opposite to `c`'s.
+pub fn coef_reverse(c: [f64; 4]) -> [f64; 4] {
+    [c[0], c[2], c[1], c[3]]
+}
+
+/// Re-expresses the tensor `k` = (ku, kuv, kv) by the coefficients of [`proj_coef`].
+pub fn proj_curv_by(c: [f64; 4], k: V3) -> V3 {
+    let [u1, v1, u2, v2] = c;
     [
         k[0] * u1 * u1 + k[1] * (2.0 * u1 * v1) + k[2] * v1 * v1,
         k[0] * u1 * u2 + k[1] * (u1 * v2 + u2 * v1) + k[2] * v1 * v2,
@@ -151,10 +165,14 @@ pub fn proj_curv(ou: V3, ov: V3, k: V3, nu: V3, nv: V3) -> V3 {
     ]
 }
 
+/// Re-expresses the tensor `k` = (ku, kuv, kv) from frame (ou, ov) in (nu, nv).
+pub fn proj_curv(ou: V3, ov: V3, k: V3, nu: V3, nv: V3) -> V3 {
+    proj_curv_by(proj_coef(ou, ov, nu, nv), k)
+}
+
 /// The same for the derivative tensor (C111, C112, C122, C222).
-pub fn proj_dcurv(ou: V3, ov: V3, d: [f64; 4], nu: V3, nv: V3) -> [f64; 4] {
-    let (ru, rv) = rot_coord_sys(nu, nv, cross(ou, ov));
-    let (u1, v1, u2, v2) = (dot(ru, ou), dot(ru, ov), dot(rv, ou), dot(rv, ov));
+pub fn proj_dcurv_by(c: [f64; 4], d: [f64; 4]) -> [f64; 4] {
+    let [u1, v1, u2, v2] = c;
     [
         d[0] * u1 * u1 * u1
             + d[1] * 3.0 * u1 * u1 * v1
@@ -439,14 +457,12 @@ impl State {
                 continue;
             }
             let (ft, fb) = t.frame();
-            let fc = t.v.map(|v| {
-                proj_curv(
-                    self.pd1[v],
-                    self.pd2[v],
-                    [self.k[v][0], 0.0, self.k[v][1]],
-                    ft,
-                    fb,
-                )
+            // One set of projection coefficients per corner serves both
+            // directions: the vertex tensor into the face frame, the face's
+            // result back (see `proj_coef`).
+            let q = t.v.map(|v| proj_coef(self.pd1[v], self.pd2[v], ft, fb));
+            let fc: [V3; 3] = std::array::from_fn(|c| {
+                proj_curv_by(q[c], [self.k[t.v[c]][0], 0.0, self.k[t.v[c]][1]])
             });
             let Some(x) = face_dcurv(&t, ft, fb, fc) else {
                 self.counts.dcurv_solves_skipped += 1;
@@ -455,7 +471,7 @@ impl State {
             let ca = t.corner_areas();
             for c in 0..3 {
                 let v = t.v[c];
-                let o = proj_dcurv(ft, fb, x, self.pd1[v], self.pd2[v]);
+                let o = proj_dcurv_by(coef_reverse(q[c]), x);
                 let w = corner_weight(ca[c], self.areas[v]);
                 for i in 0..4 {
                     self.dk[v][i] += w * o[i];
