@@ -224,31 +224,40 @@ typedef SC_CAT(int, SC_LANES) INTN;
 #define VSTOREN SC_CAT(vstore, SC_LANES)
 #define CONVERT_UCHARN SC_CAT(convert_uchar, SC_LANES)
 #define CONVERT_INTN SC_CAT(convert_int, SC_LANES)
+#define CONVERT_UINTN SC_CAT(convert_uint, SC_LANES)
 #ifdef SC_DOUBLE
 #define CONVERT_MASKN SC_CAT(convert_long, SC_LANES)
 #else
 #define CONVERT_MASKN SC_CAT(convert_int, SC_LANES)
 #endif
 
-// F applied to each lane's component name, as a comma-separated list.
+// F applied to each lane's component name, as a comma-separated list
+// (SC_LANE_LIST), and F(j, b) for each lane number j (SC_JLIST, for the
+// constant indices of __builtin_shufflevector).
 #if SC_LANES == 2
 #define SC_LANE_LIST(F) F(s0), F(s1)
 #define SC_IOTA ((UINTN)(0, 1))
+#define SC_JLIST(F, b) F(0, b), F(1, b)
 #elif SC_LANES == 4
 #define SC_LANE_LIST(F) F(s0), F(s1), F(s2), F(s3)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3))
+#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b)
 #elif SC_LANES == 8
 #define SC_LANE_LIST(F) F(s0), F(s1), F(s2), F(s3), F(s4), F(s5), F(s6), F(s7)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7))
+#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b)
 #else
 #define SC_LANE_LIST(F)                                                                       \
     F(s0), F(s1), F(s2), F(s3), F(s4), F(s5), F(s6), F(s7), F(s8), F(s9), F(sa), F(sb), F(sc), \
         F(sd), F(se), F(sf)
 #define SC_IOTA ((UINTN)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+#define SC_JLIST(F, b)                                                                      \
+    F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b), F(8, b), F(9, b), \
+        F(10, b), F(11, b), F(12, b), F(13, b), F(14, b), F(15, b)
 #endif
 
 // One scalar load per lane; the compiler assembles the vector.
-#define SC_LD_ONE(l) a[(int)i.l]
+#define SC_LD_ONE(l) a[i.l]
 SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return (REALN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return (UINTN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE void lst(REALN x, uint slot, __global REAL *a) { VSTOREN(x, slot, a); }
@@ -384,6 +393,147 @@ __kernel void curv_max_face(uint nf, __global const uint *faces, volatile __glob
 // ---------------------------------------------------------------------------
 // Per-vertex passes (both variants).
 
+#if SC_LANES > 1
+// Vertex records: what the tensor and derivative face kernels read of each
+// vertex, 16 reals in one 16-real-aligned run, so that a face block loads a
+// vertex of each lane as whole vectors and transposes them in registers
+// (ld_rec) instead of one scalar load per lane and value. curv_frames writes
+// the records with the position, area, normal and initial frame, and
+// curv_principal rewrites them with the principal curvatures and
+// directions: the same values as in the per-vertex buffers, transposed in
+// registers from the kernels' lane vectors (st_rec) and stored whole.
+#define REC_POS 0  // x y z; area at 3
+#define REC_AREA 3
+#define REC_NRM 4  // x y z; k1 at 7
+#define REC_K1 7
+#define REC_PD1 8  // x y z; k2 at 11
+#define REC_K2 11
+#define REC_PD2 12 // x y z; 15 unused
+
+#ifdef SC_DOUBLE
+typedef double16 REAL16;
+typedef double8 REAL8;
+#else
+typedef float16 REAL16;
+typedef float8 REAL8;
+#endif
+// An SC_LANES × SC_LANES transpose of the rows r0 … r(SC_LANES−1) in
+// log2(SC_LANES) stages; stage b swaps the off-diagonal b × b blocks of each
+// 2b × 2b block (bit b of the row index with bit b of the column index).
+// Each swap is two two-vector shuffles with constant indices.
+#define SC_LO(j, b) (((j) & (b)) ? SC_LANES + (j) - (b) : (j))
+#define SC_HI(j, b) (((j) & (b)) ? SC_LANES + (j) : (j) + (b))
+#define SC_SWAP(x, y, b)                                                   \
+    {                                                                      \
+        REALN lo_ = __builtin_shufflevector(x, y, SC_JLIST(SC_LO, b));     \
+        y = __builtin_shufflevector(x, y, SC_JLIST(SC_HI, b));             \
+        x = lo_;                                                           \
+    }
+#if SC_LANES == 2
+#define SC_ROWS(F) F(0, s0) F(1, s1)
+#define SC_TRANSPOSE() SC_SWAP(r0, r1, 1)
+#elif SC_LANES == 4
+#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3)
+#define SC_TRANSPOSE()                                                     \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1)
+#elif SC_LANES == 8
+#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7)
+#define SC_TRANSPOSE()                                                              \
+    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)     \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)     \
+    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)
+#else
+#define SC_ROWS(F)                                                                          \
+    F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7) F(8, s8)          \
+    F(9, s9) F(10, sa) F(11, sb) F(12, sc) F(13, sd) F(14, se) F(15, sf)
+#define SC_TRANSPOSE()                                                                  \
+    SC_SWAP(r0, r8, 8) SC_SWAP(r1, r9, 8) SC_SWAP(r2, r10, 8) SC_SWAP(r3, r11, 8)       \
+    SC_SWAP(r4, r12, 8) SC_SWAP(r5, r13, 8) SC_SWAP(r6, r14, 8) SC_SWAP(r7, r15, 8)     \
+    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)         \
+    SC_SWAP(r8, r12, 4) SC_SWAP(r9, r13, 4) SC_SWAP(r10, r14, 4) SC_SWAP(r11, r15, 4)   \
+    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)         \
+    SC_SWAP(r8, r10, 2) SC_SWAP(r9, r11, 2) SC_SWAP(r12, r14, 2) SC_SWAP(r13, r15, 2)   \
+    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)         \
+    SC_SWAP(r8, r9, 1) SC_SWAP(r10, r11, 1) SC_SWAP(r12, r13, 1) SC_SWAP(r14, r15, 1)
+#endif
+
+// The records of the vertices v (one per lane), as 16 vectors: component k
+// of every lane's record in c[k]. Each record is 16 / SC_LANES whole-vector
+// loads; each chunk of SC_LANES components is one transpose.
+typedef struct {
+    FREAL c[16];
+} RecN;
+#define SC_LD_ROW(l, s) FREAL r##l = VLOADN(faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
+#define SC_PUT_ROW(l, s) o.c[q * SC_LANES + l] = r##l;
+// The records of corner c's vertices of face block blk (faces past the last
+// repeat it, as in FACE_BLOCK_OR_RETURN); the face indices are scalar loads,
+// used as addresses only.
+SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint nf, uint blk,
+                      uint c)
+{
+    const uint f0 = SC_LANES * blk, last = nf - 1;
+    RecN o;
+#pragma unroll
+    for (uint q = 0; q < 16 / SC_LANES; q++) {
+        SC_ROWS(SC_LD_ROW)
+        SC_TRANSPOSE()
+        SC_ROWS(SC_PUT_ROW)
+    }
+    return o;
+}
+SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
+
+// The records of vertex block blk (SC_LANES consecutive vertices), component
+// k of every lane in x[k]: each chunk of SC_LANES components is transposed
+// and stored as whole vectors.
+#define SC_GET_ROW(l, s) FREAL r##l = x[q * SC_LANES + l];
+#define SC_ST_REC_ROW(l, s) VSTOREN(r##l, 0, rec + 16 * (v0 + l) + q * SC_LANES);
+SC_INLINE void st_rec(__global REAL *rec, uint blk, const FREAL *x)
+{
+    const uint v0 = SC_LANES * blk;
+#pragma unroll
+    for (uint q = 0; q < 16 / SC_LANES; q++) {
+        SC_ROWS(SC_GET_ROW)
+        SC_TRANSPOSE()
+        SC_ROWS(SC_ST_REC_ROW)
+    }
+}
+// The record of a vertex from its values (component 15 is zero).
+#define REC_OF(p, a, n, k1, d1, k2, d2)                                                     \
+    {p.x, p.y, p.z, a, n.x, n.y, n.z, k1, d1.x, d1.y, d1.z, k2, d2.x, d2.y, d2.z, (FREAL)RL(0)}
+
+// The corners of face block blk, x_c holding corner c of every lane's face:
+// the 12 component vectors (and 4 of zeros) transposed in registers into
+// each face's 12 reals at CORNER_SLOT, stored as whole vectors.
+#if SC_LANES == 16
+#define SC_ST_ROW(l, s)                                 \
+    vstore8(r##l.lo, 0, corner + 12 * (f0 + l));        \
+    vstore4(r##l.s89ab, 0, corner + 12 * (f0 + l) + 8);
+#elif SC_LANES == 8
+#define SC_ST_ROW(l, s)                                 \
+    if (q == 0)                                         \
+        vstore8(r##l, 0, corner + 12 * (f0 + l));       \
+    else                                                \
+        vstore4(r##l.lo, 0, corner + 12 * (f0 + l) + 8);
+#else
+#define SC_ST_ROW(l, s) VSTOREN(r##l, 0, corner + 12 * (f0 + l) + q * SC_LANES);
+#endif
+SC_INLINE void st_corners(__global REAL *corner, uint blk, FV4 x0, FV4 x1, FV4 x2)
+{
+    const uint f0 = SC_LANES * blk;
+    const FREAL z = (FREAL)RL(0);
+    const FREAL x[16] = {x0.x, x0.y, x0.z, x0.w, x1.x, x1.y, x1.z, x1.w,
+                         x2.x, x2.y, x2.z, x2.w, z,    z,    z,    z};
+#pragma unroll
+    for (uint q = 0; q < 12 / SC_LANES + (12 % SC_LANES != 0); q++) {
+        SC_ROWS(SC_GET_ROW)
+        SC_TRANSPOSE()
+        SC_ROWS(SC_ST_ROW)
+    }
+}
+#endif // SC_LANES > 1
+
+#if SC_LANES == 1
 // Unit normal, and the initial tangent frame from the owner face:
 // pd1 = (edge to the next vertex of that face) × n, pd2 = n × pd1.
 __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint *faces,
@@ -404,16 +554,6 @@ __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint
     p1 = sel3((f >= 0) & (l > RL(1e-20)) & isfinite(l), mul3(p1, RL(1) / l), any_perp(n));
     st3(p1, gid, pd1);
     st3(cross3(n, p1), gid, pd2);
-}
-
-// Counts the vertices that no usable face touches (kept out of curv_frames:
-// an atomic in a kernel keeps PoCL from vectorising it).
-__kernel void curv_count_empty(uint nv, __global const REAL *area,
-                               volatile __global uint *counters)
-{
-    GID_OR_RETURN(nv);
-    if (!(area[gid] > 0))
-        atomic_inc(&counters[1]);
 }
 
 // One Jacobi rotation diagonalises the 2×2 tensor.
@@ -440,6 +580,130 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
     st3(cross3(n, d1), gid, pd2);
     kk[2 * gid] = keep ? k1 : k2;
     kk[2 * gid + 1] = keep ? k2 : k1;
+}
+
+#else // SC_LANES > 1
+// With lanes, curv_frames and curv_principal handle SC_LANES consecutive
+// vertices per work-item, as vectors: their per-vertex buffers (3 or 2 reals
+// per vertex) are read and written as whole vectors and (de)interleaved in
+// registers (ld3c, st3c, st2c), instead of a gather or scatter per value;
+// each also writes the block's vertex records (st_rec).
+// The host pads every per-vertex buffer to whole blocks of MAX_FACE_LANES
+// vertices (the padding's results are never read). The arithmetic is the
+// one-lane kernels' above, operation for operation.
+#define VERTEX_BLOCK_OR_RETURN(nv)                            \
+    const uint blk = (uint)get_global_id(0);                  \
+    if (blk >= ((nv) + SC_LANES - 1) / SC_LANES) return;      \
+    const FIDX vid = (FIDX)(SC_LANES * blk) + SC_IOTA;
+
+// Component k of the 3-real records of a block: stream element 3j + k of
+// the three vectors a b c, picked from a and b first, then from c.
+#define SC_D1(j, k) ((3 * (j) + (k)) < 2 * SC_LANES ? 3 * (j) + (k) : 0)
+#define SC_D2(j, k) ((3 * (j) + (k)) < 2 * SC_LANES ? (j) : 3 * (j) + (k) - SC_LANES)
+#define SC_DEINT(a, b, c, k) \
+    __builtin_shufflevector(__builtin_shufflevector(a, b, SC_JLIST(SC_D1, k)), c, SC_JLIST(SC_D2, k))
+// Vector o of the stream of three component vectors x y z (element
+// e = o·SC_LANES + j is component e % 3 of lane e / 3), and of two (e % 2, e / 2).
+#define SC_E(j, o) ((o) * SC_LANES + (j))
+#define SC_I1(j, o) \
+    (SC_E(j, o) % 3 == 0 ? SC_E(j, o) / 3 : SC_E(j, o) % 3 == 1 ? SC_LANES + SC_E(j, o) / 3 : 0)
+#define SC_I2(j, o) (SC_E(j, o) % 3 == 2 ? SC_LANES + SC_E(j, o) / 3 : (j))
+#define SC_INT3(x, y, z, o) \
+    __builtin_shufflevector(__builtin_shufflevector(x, y, SC_JLIST(SC_I1, o)), z, SC_JLIST(SC_I2, o))
+#define SC_IW(j, o) (SC_E(j, o) % 2 == 0 ? SC_E(j, o) / 2 : SC_LANES + SC_E(j, o) / 2)
+
+SC_INLINE FV3 ld3c(__global const REAL *p, uint blk)
+{
+    FREAL a = VLOADN(3 * blk, p), b = VLOADN(3 * blk + 1, p), c = VLOADN(3 * blk + 2, p);
+    return v3(SC_DEINT(a, b, c, 0), SC_DEINT(a, b, c, 1), SC_DEINT(a, b, c, 2));
+}
+SC_INLINE void st3c(FV3 v, uint blk, __global REAL *p)
+{
+    VSTOREN(SC_INT3(v.x, v.y, v.z, 0), 3 * blk, p);
+    VSTOREN(SC_INT3(v.x, v.y, v.z, 1), 3 * blk + 1, p);
+    VSTOREN(SC_INT3(v.x, v.y, v.z, 2), 3 * blk + 2, p);
+}
+SC_INLINE void st2c(FREAL a, FREAL b, uint blk, __global REAL *p)
+{
+    VSTOREN(__builtin_shufflevector(a, b, SC_JLIST(SC_IW, 0)), 2 * blk, p);
+    VSTOREN(__builtin_shufflevector(a, b, SC_JLIST(SC_IW, 1)), 2 * blk + 1, p);
+}
+
+SC_INLINE FV3 any_perp_n(FV3 n)
+{
+    FREAL ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
+    FREAL o = (FREAL)RL(1), z = (FREAL)RL(0);
+    FV3 ex = v3(o, z, z), ey = v3(z, o, z), ez = v3(z, z, o);
+    FV3 a = sel3((ax <= ay) & (ax <= az), ex, sel3(ay <= az, ey, ez));
+    return normalize3(cross3(n, a));
+}
+
+__kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint *faces,
+                          __global const int *owner, __global REAL *nrm, __global REAL *pd1,
+                          __global REAL *pd2, __global const REAL *area, __global REAL *rec)
+{
+    VERTEX_BLOCK_OR_RETURN(nv);
+    FV3 n = ld3c(nrm, blk);
+    FREAL len = len3(n);
+    FREAL o = (FREAL)RL(1), z = (FREAL)RL(0);
+    n = sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(z, z, o));
+    st3c(n, blk, nrm);
+    INTN f = VLOADN(blk, owner);
+    FIDX fi = CONVERT_UINTN(max(f, 0));
+    FIDX a = ldu(faces, 3 * fi), b = ldu(faces, 3 * fi + 1), c = ldu(faces, 3 * fi + 2);
+    FIDX next = vid == a ? b : vid == b ? c : a;
+    FV3 p = ld3c(pos, blk);
+    FV3 p1 = cross3(sub3(ld3(pos, next), p), n);
+    FREAL l = len3(p1);
+    p1 = sel3(CONVERT_MASKN(f >= 0) & (l > RL(1e-20)) & isfinite(l), mul3(p1, RL(1) / l),
+              any_perp_n(n));
+    FV3 p2 = cross3(n, p1);
+    st3c(p1, blk, pd1);
+    st3c(p2, blk, pd2);
+    const FREAL r[16] = REC_OF(p, VLOADN(blk, area), n, z, p1, z, p2);
+    st_rec(rec, blk, r);
+}
+
+__kernel void curv_principal(uint nv, __global const REAL *nrm, __global const REAL *tens,
+                             __global REAL *pd1, __global REAL *pd2, __global REAL *kk,
+                             __global const REAL *pos, __global const REAL *area,
+                             __global REAL *rec)
+{
+    VERTEX_BLOCK_OR_RETURN(nv);
+    FV3 n = ld3c(nrm, blk), ru, rv;
+    rot_coord_sys(ld3c(pd1, blk), ld3c(pd2, blk), n, &ru, &rv);
+    FV3 t3 = ld3c(tens, blk);
+    FREAL ku = t3.x, kuv = t3.y, kv = t3.z;
+    FREAL h = RL(0.5) * (kv - ku) / kuv;
+    FREAL root = sqrt(RL(1) + h * h);
+    FREAL tt = kuv != 0 ? ((h < 0) ? RL(1) / (h - root) : RL(1) / (h + root)) : (FREAL)RL(0);
+    FREAL c = RL(1) / sqrt(RL(1) + tt * tt);
+    FREAL s = tt * c;
+    FREAL k1 = ku - tt * kuv, k2 = kv + tt * kuv;
+#ifdef SC_COMPAT
+    FMASK keep = fabs(k1) >= fabs(k2);
+#else
+    FMASK keep = k1 >= k2;
+#endif
+    FV3 d1 = sel3(keep, sub3(mul3(ru, c), mul3(rv, s)), add3(mul3(ru, s), mul3(rv, c)));
+    FV3 d2 = cross3(n, d1);
+    FREAL ka = keep ? k1 : k2, kb = keep ? k2 : k1;
+    st3c(d1, blk, pd1);
+    st3c(d2, blk, pd2);
+    st2c(ka, kb, blk, kk);
+    const FREAL r[16] = REC_OF(ld3c(pos, blk), VLOADN(blk, area), n, ka, d1, kb, d2);
+    st_rec(rec, blk, r);
+}
+#endif // SC_LANES > 1
+
+// Counts the vertices that no usable face touches (kept out of curv_frames:
+// an atomic in a kernel keeps PoCL from vectorising it).
+__kernel void curv_count_empty(uint nv, __global const REAL *area,
+                               volatile __global uint *counters)
+{
+    GID_OR_RETURN(nv);
+    if (!(area[gid] > 0))
+        atomic_inc(&counters[1]);
 }
 
 // ---------------------------------------------------------------------------
@@ -561,157 +825,6 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
          v2 = ldu(faces, 3 * fid + 2);                                             \
     FTri t = make_tri(ld3(pos, v0), ld3(pos, v1), ld3(pos, v2));
 
-#if SC_LANES > 1
-// Vertex records: what the tensor and derivative face kernels read of each
-// vertex, 16 reals in one 16-real-aligned run, so that a face block loads a
-// vertex of each lane as whole vectors and transposes them in registers
-// (ld_rec) instead of one scalar load per lane and value. curv_pack_frames
-// (after curv_frames) writes the position, area, normal and initial frame,
-// curv_pack_principal (after curv_principal) the principal curvatures and
-// directions: the same values as in the per-vertex buffers. Writing them in
-// curv_frames and curv_principal themselves was slower on PoCL 3.1 (the
-// stores 16 reals apart keep those kernels from vectorising: 500k torus,
-// frames and its record 8.8 against 6.3 ms). Component 15 is never written
-// (the host zeroes the buffer).
-#define REC_POS 0  // x y z; area at 3
-#define REC_AREA 3
-#define REC_NRM 4  // x y z; k1 at 7
-#define REC_K1 7
-#define REC_PD1 8  // x y z; k2 at 11
-#define REC_K2 11
-#define REC_PD2 12 // x y z; 15 unused
-
-#ifdef SC_DOUBLE
-typedef double16 REAL16;
-typedef double8 REAL8;
-#else
-typedef float16 REAL16;
-typedef float8 REAL8;
-#endif
-__kernel void curv_pack_frames(uint nv, __global const REAL *pos, __global const REAL *area,
-                               __global const REAL *nrm, __global const REAL *pd1,
-                               __global const REAL *pd2, __global REAL *rec)
-{
-    GID_OR_RETURN(nv);
-    V3 p = ld3(pos, gid), n = ld3(nrm, gid), d1 = ld3(pd1, gid), d2 = ld3(pd2, gid);
-    REAL z = 0;
-    vstore16((REAL16)(p.x, p.y, p.z, area[gid], n.x, n.y, n.z, z, d1.x, d1.y, d1.z, z, d2.x,
-                      d2.y, d2.z, z),
-             gid, rec);
-}
-
-__kernel void curv_pack_principal(uint nv, __global const REAL *pd1, __global const REAL *pd2,
-                                  __global const REAL *kk, __global REAL *rec)
-{
-    GID_OR_RETURN(nv);
-    V3 d1 = ld3(pd1, gid), d2 = ld3(pd2, gid);
-    vstore8((REAL8)(kk[2 * gid], d1.x, d1.y, d1.z, kk[2 * gid + 1], d2.x, d2.y, d2.z), 0,
-            rec + 16 * gid + 7);
-}
-
-// An SC_LANES × SC_LANES transpose of the rows r0 … r(SC_LANES−1) in
-// log2(SC_LANES) stages; stage b swaps the off-diagonal b × b blocks of each
-// 2b × 2b block (bit b of the row index with bit b of the column index).
-// Each swap is two two-vector shuffles with constant indices.
-#define SC_LO(j, b) (((j) & (b)) ? SC_LANES + (j) - (b) : (j))
-#define SC_HI(j, b) (((j) & (b)) ? SC_LANES + (j) : (j) + (b))
-#define SC_SWAP(x, y, b)                                                   \
-    {                                                                      \
-        REALN lo_ = __builtin_shufflevector(x, y, SC_JLIST(SC_LO, b));     \
-        y = __builtin_shufflevector(x, y, SC_JLIST(SC_HI, b));             \
-        x = lo_;                                                           \
-    }
-#if SC_LANES == 2
-#define SC_JLIST(F, b) F(0, b), F(1, b)
-#define SC_ROWS(F) F(0, s0) F(1, s1)
-#define SC_TRANSPOSE() SC_SWAP(r0, r1, 1)
-#elif SC_LANES == 4
-#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b)
-#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3)
-#define SC_TRANSPOSE()                                                     \
-    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1)
-#elif SC_LANES == 8
-#define SC_JLIST(F, b) F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b)
-#define SC_ROWS(F) F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7)
-#define SC_TRANSPOSE()                                                              \
-    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)     \
-    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)     \
-    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)
-#else
-#define SC_JLIST(F, b)                                                                      \
-    F(0, b), F(1, b), F(2, b), F(3, b), F(4, b), F(5, b), F(6, b), F(7, b), F(8, b), F(9, b), \
-        F(10, b), F(11, b), F(12, b), F(13, b), F(14, b), F(15, b)
-#define SC_ROWS(F)                                                                          \
-    F(0, s0) F(1, s1) F(2, s2) F(3, s3) F(4, s4) F(5, s5) F(6, s6) F(7, s7) F(8, s8)          \
-    F(9, s9) F(10, sa) F(11, sb) F(12, sc) F(13, sd) F(14, se) F(15, sf)
-#define SC_TRANSPOSE()                                                                  \
-    SC_SWAP(r0, r8, 8) SC_SWAP(r1, r9, 8) SC_SWAP(r2, r10, 8) SC_SWAP(r3, r11, 8)       \
-    SC_SWAP(r4, r12, 8) SC_SWAP(r5, r13, 8) SC_SWAP(r6, r14, 8) SC_SWAP(r7, r15, 8)     \
-    SC_SWAP(r0, r4, 4) SC_SWAP(r1, r5, 4) SC_SWAP(r2, r6, 4) SC_SWAP(r3, r7, 4)         \
-    SC_SWAP(r8, r12, 4) SC_SWAP(r9, r13, 4) SC_SWAP(r10, r14, 4) SC_SWAP(r11, r15, 4)   \
-    SC_SWAP(r0, r2, 2) SC_SWAP(r1, r3, 2) SC_SWAP(r4, r6, 2) SC_SWAP(r5, r7, 2)         \
-    SC_SWAP(r8, r10, 2) SC_SWAP(r9, r11, 2) SC_SWAP(r12, r14, 2) SC_SWAP(r13, r15, 2)   \
-    SC_SWAP(r0, r1, 1) SC_SWAP(r2, r3, 1) SC_SWAP(r4, r5, 1) SC_SWAP(r6, r7, 1)         \
-    SC_SWAP(r8, r9, 1) SC_SWAP(r10, r11, 1) SC_SWAP(r12, r13, 1) SC_SWAP(r14, r15, 1)
-#endif
-
-// The records of the vertices v (one per lane), as 16 vectors: component k
-// of every lane's record in c[k]. Each record is 16 / SC_LANES whole-vector
-// loads; each chunk of SC_LANES components is one transpose.
-typedef struct {
-    FREAL c[16];
-} RecN;
-#define SC_LD_ROW(l, s) FREAL r##l = VLOADN(faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
-#define SC_PUT_ROW(l, s) o.c[q * SC_LANES + l] = r##l;
-// The records of corner c's vertices of face block blk (faces past the last
-// repeat it, as in FACE_BLOCK_OR_RETURN); the face indices are scalar loads,
-// used as addresses only.
-SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint nf, uint blk,
-                      uint c)
-{
-    const uint f0 = SC_LANES * blk, last = nf - 1;
-    RecN o;
-#pragma unroll
-    for (uint q = 0; q < 16 / SC_LANES; q++) {
-        SC_ROWS(SC_LD_ROW)
-        SC_TRANSPOSE()
-        SC_ROWS(SC_PUT_ROW)
-    }
-    return o;
-}
-SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
-
-// The corners of face block blk, x_c holding corner c of every lane's face:
-// the 12 component vectors (and 4 of zeros) transposed in registers into
-// each face's 12 reals at CORNER_SLOT, stored as whole vectors.
-#if SC_LANES == 16
-#define SC_ST_ROW(l, s)                                 \
-    vstore8(r##l.lo, 0, corner + 12 * (f0 + l));        \
-    vstore4(r##l.s89ab, 0, corner + 12 * (f0 + l) + 8);
-#elif SC_LANES == 8
-#define SC_ST_ROW(l, s)                                 \
-    if (q == 0)                                         \
-        vstore8(r##l, 0, corner + 12 * (f0 + l));       \
-    else                                                \
-        vstore4(r##l.lo, 0, corner + 12 * (f0 + l) + 8);
-#else
-#define SC_ST_ROW(l, s) VSTOREN(r##l, 0, corner + 12 * (f0 + l) + q * SC_LANES);
-#endif
-#define SC_GET_ROW(l, s) FREAL r##l = x[q * SC_LANES + l];
-SC_INLINE void st_corners(__global REAL *corner, uint blk, FV4 x0, FV4 x1, FV4 x2)
-{
-    const uint f0 = SC_LANES * blk;
-    const FREAL z = (FREAL)RL(0);
-    const FREAL x[16] = {x0.x, x0.y, x0.z, x0.w, x1.x, x1.y, x1.z, x1.w,
-                         x2.x, x2.y, x2.z, x2.w, z,    z,    z,    z};
-#pragma unroll
-    for (uint q = 0; q < 12 / SC_LANES + (12 % SC_LANES != 0); q++) {
-        SC_ROWS(SC_GET_ROW)
-        SC_TRANSPOSE()
-        SC_ROWS(SC_ST_ROW)
-    }
-}
-#endif // SC_LANES > 1
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          __global const uint *faces, __global REAL *corner, __global REAL *cw,

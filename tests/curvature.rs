@@ -381,10 +381,12 @@ fn mapped_reads_give_the_bits_of_copied_reads() {
     }
 }
 
-/// The gather variant's per-face kernels give the same bits for every lane
-/// count (faces per work-item): on meshes whose face count is not a multiple
-/// of 16 (lanes past the last face), with degenerate faces and skipped
-/// solves (masked lanes), in both precisions. Counts agree too.
+/// The gather variant's lane kernels (the per-face kernels, and curv_frames
+/// and curv_principal with their vertex records) give the same bits for
+/// every lane count: on meshes whose face and vertex counts are not
+/// multiples of 16 (lanes past the last face or vertex), with degenerate
+/// faces and skipped solves (masked lanes), in both precisions. Counts agree
+/// too.
 #[test]
 fn face_lanes_give_bitwise_identical_results() {
     let mut sliver = mesh::jittered_sphere(1.0, 3, 0.2, 5);
@@ -408,7 +410,8 @@ fn face_lanes_give_bitwise_identical_results() {
         ("torus", mesh::torus(1.0, 0.4, 37, 19)),
     ];
     for (what, m) in &meshes {
-        assert_ne!(m.n_faces() % 16, 0, "{what}: want a partial last block");
+        assert_ne!(m.n_faces() % 16, 0, "{what}: want a partial last face block");
+        assert_ne!(m.n_vertices() % 16, 0, "{what}: want a partial last vertex block");
         for prec in [Precision::F32, Precision::F64] {
             let o = |lanes| CurvatureOptions {
                 lanes,

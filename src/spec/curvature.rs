@@ -483,6 +483,13 @@ pub fn padded_faces(nf: usize) -> usize {
     nf.div_ceil(MAX_FACE_LANES as usize) * MAX_FACE_LANES as usize
 }
 
+/// Vertices the per-vertex buffers are sized for: `nv` rounded up to whole
+/// blocks of [`MAX_FACE_LANES`] (the per-vertex kernels with lanes read and
+/// write whole blocks).
+pub fn padded_vertices(nv: usize) -> usize {
+    nv.div_ceil(MAX_FACE_LANES as usize) * MAX_FACE_LANES as usize
+}
+
 /// Reals per vertex record of the gather scheme with face lanes (the
 /// `REC_*` layout of kernels/curvature.cl: position and point area, normal
 /// and k1, first direction and k2, second direction), read by the tensor and
@@ -532,17 +539,18 @@ pub fn face_lanes_for(requested: u32, device_kind: &str, native_width: u32) -> u
 pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: u32) -> u64 {
     let r = opts.precision.bytes() as u64;
     let (nv, nf) = (nv.max(1), nf.max(1));
-    // pos, nrm, pd1, pd2, tens: 3 reals; area: 1; kk: 2; dk: 4  → 20 reals per vertex.
+    // pos, nrm, pd1, pd2, tens: 3 reals; area: 1; kk: 2; dk: 4  → 20 reals per
+    // vertex, for whole blocks of vertices
     let per_vertex = 20 * r + 4; // + owner
     let per_face = 12;
-    let mut b = nv as u64 * per_vertex + nf as u64 * per_face + 16;
+    let mut b = padded_vertices(nv) as u64 * per_vertex + nf as u64 * per_face + 16;
     if opts.accumulate == Accumulate::Gather {
         // one-ring CSR, 4 reals per face corner
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
             + (corner_reals_bound(nf) + corner_weights_bound(nf)) as u64 * r;
         if lanes > 1 {
-            b += nv as u64 * REC_REALS as u64 * r;
+            b += padded_vertices(nv) as u64 * REC_REALS as u64 * r;
         }
     }
     b

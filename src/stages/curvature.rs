@@ -17,6 +17,7 @@ use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
     Precision, REC_REALS, VertexCurvature, corner_reals_bound, corner_weights_bound,
+    padded_vertices,
 };
 use crate::spec::timing::{Step, Timing};
 use opencl3::kernel::Kernel;
@@ -176,11 +177,9 @@ struct Kernels {
     dcurv: Kernel,
     /// Gather variant only: the per-vertex one-ring sums of the three passes.
     sums: Option<[Kernel; 3]>,
-    /// Gather variant with lanes only: curv_pack_frames and
-    /// curv_pack_principal, which write the vertex records that the tensor
-    /// and derivative face kernels read, after curv_frames and after
-    /// curv_principal.
-    packs: Option<[Kernel; 2]>,
+    /// Gather variant with lanes: curv_frames and curv_principal also write
+    /// the vertex records that the tensor and derivative face kernels read.
+    records: bool,
     /// Positions from a device buffer of index-space floats (isosurfaces).
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
@@ -363,14 +362,7 @@ impl CurvatureEstimator {
             principal: gpu.kernel(&program, "curv_principal")?,
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
             sums,
-            packs: if gather && lanes > 1 {
-                Some([
-                    gpu.kernel(&program, "curv_pack_frames")?,
-                    gpu.kernel(&program, "curv_pack_principal")?,
-                ])
-            } else {
-                None
-            },
+            records: gather && lanes > 1,
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
             override_normals: gpu.kernel(&program, "curv_override_normals")?,
             lanes: if gather { lanes } else { 1 },
@@ -443,7 +435,10 @@ impl CurvatureEstimator {
                 u32::MAX as usize / 12 - crate::spec::curvature::MAX_FACE_LANES as usize
             )));
         }
-        let mut owner = gpu.buffer::<i32>(nv)?;
+        // Per-vertex buffers hold whole blocks of MAX_FACE_LANES vertices: the
+        // per-vertex kernels with lanes read and write whole blocks.
+        let nvp = padded_vertices(nv);
+        let mut owner = gpu.buffer::<i32>(nvp)?;
         // Zeroed once: a partial run (normals only, for contours) leaves the
         // curvature buffers unwritten, and later stages reading them through
         // [`CurvatureEstimator::device_outputs`] must see finite values.
@@ -451,7 +446,7 @@ impl CurvatureEstimator {
         const REALS: [usize; 8] = [3, 3, 1, 3, 3, 3, 2, 4];
         let mut bufs = REALS
             .iter()
-            .map(|n| gpu.buffer::<u8>(n * nv * real))
+            .map(|n| gpu.buffer::<u8>(n * nvp * real))
             .collect::<Result<Vec<_>>>()?;
         // The fills are enqueued (no host zeros) and run on the device
         // beside the host's work below; the one `finish` at the end waits
@@ -460,7 +455,7 @@ impl CurvatureEstimator {
         // torus the topology phase went from 259-304 to 191-214 ms.
         let zero_all = |bufs: &mut [Buffer<u8>]| -> Result<()> {
             for (b, n) in bufs.iter_mut().zip(REALS) {
-                gpu.zero(b, n * nv * real)?;
+                gpu.zero(b, n * nvp * real)?;
             }
             gpu.flush()
         };
@@ -476,10 +471,12 @@ impl CurvatureEstimator {
             let mut ring_b = gpu.buffer::<u32>(ring_len)?;
             gpu.write_with(&mut ring_off, nv + 1, |off| {
                 gpu.write_with(&mut ring_b, ring_len, |ring| {
-                    gpu.write_with(&mut owner, nv, |o| {
+                    gpu.write_with(&mut owner, nvp, |o| {
                         zero_all(&mut bufs)?;
                         one_rings_into(faces, off, ring);
+                        let (o, pad) = o.split_at_mut(nv);
                         owners_from_rings(off, ring, o);
+                        pad.fill(-1);
                         Ok::<(), Error>(())
                     })
                 })
@@ -489,12 +486,9 @@ impl CurvatureEstimator {
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
                 cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
-                rec: if k.packs.is_some() {
-                    // zeroed once: component 15 is never written
-                    let n = REC_REALS * nv.max(1) * real;
-                    let mut r = gpu.buffer::<u8>(n)?;
-                    gpu.zero(&mut r, n)?;
-                    Some(r)
+                // written whole by curv_frames before any kernel reads them
+                rec: if k.records {
+                    Some(gpu.buffer::<u8>(REC_REALS * nvp * real)?)
                 } else {
                     None
                 },
@@ -505,7 +499,7 @@ impl CurvatureEstimator {
         };
         if !gather {
             let max_face = gpu.kernel(&program, "curv_max_face")?;
-            gpu.write(&mut owner, &vec![-1i32; nv])?;
+            gpu.write(&mut owner, &vec![-1i32; nvp])?;
             launch(
                 &gpu,
                 &max_face,
@@ -730,6 +724,9 @@ impl CurvatureEstimator {
         );
         let (tens, kk, dk) = (buf(&self.tens), buf(&self.kk), buf(&self.dk));
         let dcurv = self.opts.dcurv && Pass::Dcurv <= last;
+        // Work-items of curv_frames and curv_principal: one per block of
+        // `lanes` vertices.
+        let vblocks = nv.div_ceil(self.k.lanes as usize);
 
         // A one-ring pass: the atomic variant scatters from its face kernel (args
         // + output + counters); the gather variant writes corners, then sums them.
@@ -791,23 +788,20 @@ impl CurvatureEstimator {
             }
         }
         // The vertex records of the gather scheme with lanes (see `Kernels`).
-        let rec = match (&self.gather, &self.k.packs) {
-            (Some(GatherBufs { rec: Some(r), .. }), Some(packs)) => Some((buf(r), packs)),
+        let rec = match &self.gather {
+            Some(GatherBufs { rec: Some(r), .. }) => Some(buf(r)),
             _ => None,
         };
         if Pass::Frames <= last {
-            let args = [Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
-            record(Pass::Frames, launch(g, &self.k.frames, nv, &args)?);
-            if let (true, Some((r, packs))) = (Pass::Tensor <= last, &rec) {
-                let args = [Arg::U32(nv32), pos, area, nrm, pd1, pd2, *r];
-                record(Pass::Frames, launch(g, &packs[0], nv, &args)?);
-            }
+            let mut args = vec![Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
+            args.extend(rec.map(|r| [area, r]).into_iter().flatten());
+            record(Pass::Frames, launch(g, &self.k.frames, vblocks, &args)?);
             let args = [Arg::U32(nv32), area, cnt];
             record(Pass::Frames, launch(g, &self.k.count_empty, nv, &args)?);
         }
         if Pass::Tensor <= last {
             let args: &[Arg] = match &rec {
-                Some((r, _)) => &[*r, faces],
+                Some(r) => &[*r, faces],
                 None => &[pos, faces, nrm, area, pd1, pd2],
             };
             for (p, e) in one_ring(&self.k.tensor, args, 1, &[tens], Pass::Tensor)? {
@@ -815,16 +809,16 @@ impl CurvatureEstimator {
             }
         }
         if Pass::Principal <= last {
-            let args = [Arg::U32(nv32), nrm, tens, pd1, pd2, kk];
-            record(Pass::Principal, launch(g, &self.k.principal, nv, &args)?);
-            if let (true, Some((r, packs))) = (dcurv, &rec) {
-                let args = [Arg::U32(nv32), pd1, pd2, kk, *r];
-                record(Pass::Principal, launch(g, &packs[1], nv, &args)?);
-            }
+            let mut args = vec![Arg::U32(nv32), nrm, tens, pd1, pd2, kk];
+            args.extend(rec.map(|r| [pos, area, r]).into_iter().flatten());
+            record(
+                Pass::Principal,
+                launch(g, &self.k.principal, vblocks, &args)?,
+            );
         }
         if dcurv {
             let args: &[Arg] = match &rec {
-                Some((r, _)) => &[*r, faces],
+                Some(r) => &[*r, faces],
                 None => &[pos, faces, area, pd1, pd2, kk],
             };
             for (p, e) in one_ring(&self.k.dcurv, args, 2, &[dk], Pass::Dcurv)? {
