@@ -17,39 +17,72 @@
 // with no inner loops, and counts its skipped faces. A per-vertex kernel
 // (curv_*_sum) then adds the corners of its one-ring (CSR lists built once on
 // the host, in face order). The result is bitwise reproducible.
+// The derivative pass computes one set of projection coefficients per face
+// corner (proj_coef) and uses it both ways: the vertex's tensor into the
+// face frame, and the face's derivative tensor back into the vertex frame
+// (the two minimal rotations between the planes are each other's inverse).
+// Three frame rotations and twelve dot products fewer per face; dk moves by
+// rounding only (bunny: relative RMS 1e-7). 500k torus, PoCL: dcurv corners
+// 9.3 → 8.2 ms.
 //
 // Explicit SIMD lanes (SC_LANES, set by the host: the device's native vector
-// width on CPUs, 1 on GPUs). The gather variant's per-face kernels handle
-// SC_LANES consecutive faces per work-item: their geometry
+// width on CPUs, 1 on GPUs; only with the gather scheme). The per-face
+// kernels handle SC_LANES consecutive faces per work-item, and curv_frames
+// and curv_principal SC_LANES consecutive vertices: their geometry
 // (kernels/common/curvature_face.h) is written once over type macros and
 // instantiated on scalars and on REAL vectors of SC_LANES lanes, with
-// overloaded helper names, so one kernel text serves both. Loads through the
-// face indices are one scalar load per lane; corner stores are whole-vector
-// stores. The arithmetic is the same operation for operation, so every lane
-// count gives the same bits (tests/curvature.rs checks 1 to 16 lanes).
+// overloaded helper names, so one kernel text serves both. The arithmetic is
+// the same operation for operation, so every lane count gives the same bits
+// (tests/curvature.rs checks 1 to 16 lanes, on face and vertex counts that
+// are not multiples of 16).
 // Why: PoCL 3.1 leaves these kernels scalar when written one face per
 // work-item. It runs -O3 with the SLP vectoriser on the single work-item
 // kernel before it builds the work-item loops; SLP packs pairs of corners into
 // <2 x float>, and the loop vectoriser then refuses the vector-typed
 // instructions (POCL_VECTORIZER_REMARKS, "instruction return type cannot be
 // vectorized"). Its build options cannot switch SLP off (it accepts only
-// -cl-*, -w, -Werror, -g, -D and -I). Disassembly of PoCL's kernel cache
-// (pthread-haswell, AVX2) with 8 lanes: 717 of curv_normals_areas_corners'
-// 1,819 instructions, 2,263 of curv_tensor_corners' 5,160 and 3,692 of
-// curv_dcurv_corners' 7,300 are packed 8-float (ymm) operations; with one
-// lane there are none (1,831 scalar float operations of 2,876 in
-// curv_tensor_corners). On pthread-skylake-avx512 with 16 lanes: 825 of
-// curv_normals_areas_corners' 1,384 instructions, 2,683 of
-// curv_tensor_corners' 3,663 and 3,919 of curv_dcurv_corners' 8,849 are
-// 16-float (zmm) operations, against none with one lane (1,664 scalar float
-// operations of 2,346 in curv_tensor_corners). The kernels run 1.7-2.6x
-// faster (README).
-// Still scalar on the AVX2 target: the per-vertex passes (curv_frames,
-// curv_principal, curv_*_sum), whose loops or selects the work-item
-// vectoriser does not take; on the AVX-512 target it vectorises frames and
-// principal (about 40 % of their instructions on ymm/zmm registers) but not
-// the ring sums (no vector instruction in curv_tensor_sum). Intel's CPU
-// runtime vectorises across work-items itself; lanes change little there.
+// -cl-*, -w, -Werror, -g, -D and -I). With one lane there are no packed
+// float operations in curv_tensor_corners (1,664 scalar float operations of
+// 2,346 instructions on pthread-skylake-avx512).
+// Memory access with lanes: nothing is gathered one lane at a time except
+// the positions and face indices of curv_normals_areas_corners and the
+// owner faces' vertices in curv_frames.
+//  - Vertex records (rec, REC_*): 16 reals per vertex (position, point area,
+//    normal, k1, first direction, k2, second direction), written by
+//    curv_frames and rewritten by curv_principal. The tensor and derivative
+//    face kernels load each lane's record of a corner as whole vectors (the
+//    face index a scalar load, used as an address) and transpose them in
+//    registers (ld_rec: log2(SC_LANES) stages of two-vector shuffles per
+//    SC_LANES × SC_LANES block). Against one scalar load per lane and value
+//    (hardware gathers on AVX-512; 39 values per face in the tensor pass):
+//    500k torus, PoCL, tensor corners 16.7 → 10.7 ms, dcurv corners
+//    18.5 → 13.6 ms.
+//  - Corner stores: the face kernels transpose their component vectors the
+//    same way and store each face's 12 reals whole (st_corners).
+//  - curv_frames and curv_principal load and store their 3- and 2-real
+//    per-vertex buffers as whole vectors, (de)interleaved in registers (ld3c,
+//    st3c, st2c), and write the records the same way (st_rec); the host pads
+//    every per-vertex buffer to whole blocks of 16 vertices. 500k torus,
+//    PoCL: frames with its records 6.2 → 3.3 ms (PoCL's own vectorisation
+//    across work-items had gathers and scatters for every value), principal
+//    with its records 4.9 → 2.2 ms. Written in separate pack kernels, the
+//    records cost 1.7 and 1.4 ms more; written by the one-lane kernels they
+//    kept PoCL from vectorising those (frames 8.8 against 6.3 ms).
+// Disassembly of PoCL's kernel cache, pthread-skylake-avx512, 16 lanes (the
+// work-group function; instructions / of them on zmm registers / shuffles
+// and inserts / gathers / stack accesses):
+//   curv_normals_areas_corners   588 /   377 / 134 / 24 / 22   (positions, face indices)
+//   curv_tensor_corners        1,532 /   795 / 337 /  0 / 198
+//   curv_dcurv_corners         1,793 / 1,006 / 371 /  0 / 292
+//   curv_frames                  464 /   325 / 158 / 12 / 20   (owner faces' vertices)
+//   curv_principal               457 /   333 / 172 /  0 / 10
+//   curv_tensor_sum               59 /     0 /   2 /  0 / 0    (scalar)
+// The stack accesses of the tensor and derivative kernels are spills: three
+// records of 16 vectors outnumber the 32 registers.
+// Still scalar: the ring sums (curv_*_sum; their loop keeps PoCL's work-item
+// vectoriser off, and written with SC_LANES vertices per work-item, rings
+// walked together to the longest, they ran no faster). Intel's CPU runtime
+// vectorises across work-items itself; lanes gain less there.
 // Fusing each ring sum with the per-vertex pass after it (normal sum with
 // curv_frames, tensor sum with curv_principal, raw sums left unstored) was
 // measured slower on PoCL 3.1 (bunny, medians of 41 runs: 0.9 ms against
@@ -65,11 +98,14 @@
 // 19 against 59 ms) but the per-face kernels slower by as much, their whole-
 // vector stores becoming one scattered store per lane (tensor corners 71
 // against 41 ms): no gain in total, so the corners stay in face order.
-// Ring entries holding the corner slots themselves (computed by the host,
-// no index arithmetic in the sums) made PoCL 5–8 % faster in total but
-// Intel's CPU runtime 2.7× slower in the sums (torus 500k: 15.7 against
-// 5.9 ms for the normal sum, also with pointer offsets), so the sums
-// compute the slot from face·3 + corner.
+// The corners are stored per corner: corner e = 3f + c (a ring entry) has
+// its four components at 4e … 4e + 3, so that a ring sum reads a corner as
+// one 16-byte vload4 within one cache line, where the earlier layout (one
+// lane vector per component) put them on four lines. 500k torus: each ring
+// sum 4.4–4.7 → 2.8–3.1 ms on PoCL and 4.5 → 3.0 ms on Intel's runtime. On
+// Intel's runtime the form matters: four scalar loads from 4·ring[r] made its
+// sums 2.3× slower than the vload4 (and ring entries holding precomputed
+// slots, an older trial, 2.7× slower).
 // The LDLᵀ solves of face_tensor and face_dcurv divide by each pivot once
 // and multiply by its reciprocal twice (3 and 4 divisions fewer per face; the
 // per-face kernels are bound by arithmetic, and a 16-lane division costs
@@ -82,12 +118,14 @@
 // sums 1.3× and the tensor and dcurv face kernels 1.2× faster, 15 % in all.
 //
 // Vectors are structs of scalars (V3, V4) and per-corner values are named
-// (e0 e1 e2, a0 a1 a2), never float3/vload3 and never private arrays: PoCL's
-// work-item vectoriser gives up on OpenCL vector types, private arrays,
-// selects of whole structs, fmax and atomics. Helpers are SC_INLINE
-// (always_inline): left to PoCL's inliner, proj_dcurv, tensor_at and
-// vertex_curv_in stay calls returning structs through the stack, which cost
-// ~15 % of curv_dcurv.
+// (e0 e1 e2, a0 a1 a2), never float3/vload3 and never private arrays in the
+// one-lane kernels: PoCL's work-item vectoriser gives up on OpenCL vector
+// types, private arrays, selects of whole structs, fmax and atomics. (The
+// lane kernels are vector code already; their small arrays have constant
+// indices after unrolling and live in registers.) Helpers are SC_INLINE
+// (always_inline): left to PoCL's inliner, the projections and tensor_at
+// stayed calls returning structs through the stack, which cost ~15 % of
+// curv_dcurv.
 //
 // Buffers (V vertices, F faces; REAL is float or double, see real.h):
 //   pos   REAL[3V]  positions, centred and scaled by the host (unit RMS radius)
@@ -100,14 +138,18 @@
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
 //   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
 //   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
-//                    16): corner c of face f, component k at
-//                    L·(12·(f / L) + 3k + c) + f % L with L = SC_LANES (12f + 3k + c
-//                    for one lane): per block of L faces, 12 whole-vector stores.
-//                    Component 3 also carries data between passes: the
-//                    normal pass leaves each corner's area there, the tensor
-//                    pass reads it and leaves the corner's weight (corner
-//                    area ÷ point area), which the dcurv pass reads instead
-//                    of recomputing (4 % on the bunny, mostly divisions)
+//                    16): corner c of face f, component k at 12f + 4c + k
+//                    (CORNER_SLOT); the normal pass's component 3 is the corner area
+//   cw    REAL[3F']  gather only: the corner areas (normal pass), then each
+//                    corner's weight, corner area ÷ point area (tensor pass),
+//                    which the dcurv pass reads instead of recomputing (4 %
+//                    on the bunny, mostly divisions); corner c of face f at
+//                    L·(3·(f / L) + c) + f % L (L = SC_LANES): whole vectors.
+//                    (In the corner buffer's component 3, read one lane at a
+//                    time, they cost 3 ms more on the 500k torus.)
+//   rec   REAL[16V'] gather with lanes only: vertex records (REC_*, above)
+// With lanes the per-vertex buffers hold V' = V rounded up to 16 vertices
+// (owner −1 in the padding); nothing reads the padding's results.
 //
 // Degenerate faces (an edge shorter than 1e-12 of the mesh's RMS radius,
 // twice the area below 5e-8 × Σ edge², or 2A/√(Σ edge²) below the f32

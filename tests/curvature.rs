@@ -410,8 +410,16 @@ fn face_lanes_give_bitwise_identical_results() {
         ("torus", mesh::torus(1.0, 0.4, 37, 19)),
     ];
     for (what, m) in &meshes {
-        assert_ne!(m.n_faces() % 16, 0, "{what}: want a partial last face block");
-        assert_ne!(m.n_vertices() % 16, 0, "{what}: want a partial last vertex block");
+        assert_ne!(
+            m.n_faces() % 16,
+            0,
+            "{what}: want a partial last face block"
+        );
+        assert_ne!(
+            m.n_vertices() % 16,
+            0,
+            "{what}: want a partial last vertex block"
+        );
         for prec in [Precision::F32, Precision::F64] {
             let o = |lanes| CurvatureOptions {
                 lanes,

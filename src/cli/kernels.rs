@@ -22,7 +22,7 @@ pub struct KernelsArgs {
     /// (gather on CPU devices, atomic on GPUs).
     #[arg(long, value_enum, value_delimiter = ',')]
     accumulate: Vec<Accumulate>,
-    /// Faces per work-item of the gather variant, as in `shapecue curvature
+    /// SIMD lanes of the gather variant, as in `shapecue curvature
     /// --lanes`. Default: the device's native vector width on CPU devices.
     #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
     lanes: Option<String>,

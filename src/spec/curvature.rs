@@ -289,7 +289,8 @@ pub struct CurvatureOptions {
     pub compat: Compat,
     /// Compute the curvature derivative (the dcurv pass).
     pub dcurv: bool,
-    /// Faces per work-item of the gather variant's per-face kernels, as
+    /// Faces per work-item of the gather variant's per-face kernels (and
+    /// vertices per work-item of its frame and principal kernels), as
     /// explicit SIMD lanes: 0 picks by device type ([`face_lanes_for`]),
     /// else 1, 2, 4, 8 or 16. Results do not depend on it; the atomic
     /// variant ignores it.

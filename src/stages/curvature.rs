@@ -184,8 +184,9 @@ struct Kernels {
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
     override_normals: Kernel,
-    /// Faces per work-item of the gather variant's per-face kernels (1 for
-    /// the atomic variant): `SC_LANES` of the build.
+    /// Faces (vertices) per work-item of the gather variant's per-face
+    /// (frame and principal) kernels, 1 for the atomic variant: `SC_LANES`
+    /// of the build.
     lanes: u32,
 }
 
@@ -576,7 +577,8 @@ impl CurvatureEstimator {
     }
 
     /// Faces per work-item of the gather variant's per-face kernels as built
-    /// for this device (1 for the atomic variant).
+    /// for this device (also vertices per work-item of its frame and
+    /// principal kernels; 1 for the atomic variant).
     pub fn face_lanes(&self) -> u32 {
         self.k.lanes
     }
