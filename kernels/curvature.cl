@@ -439,7 +439,9 @@ __kernel void curv_max_face(uint nf, __global const uint *faces, volatile __glob
 // Vertex records: what the tensor and derivative face kernels read of each
 // vertex, 16 reals in one 16-real-aligned run, so that a face block loads a
 // vertex of each lane as whole vectors and transposes them in registers
-// (ld_rec) instead of one scalar load per lane and value. curv_frames writes
+// (ld_rec) instead of one scalar load per lane and value. Record offsets are
+// computed in size_t (16 reals per vertex pass 32 bits at 2^28 vertices).
+// curv_frames writes
 // the records with the position, area, normal and initial frame, and
 // curv_principal rewrites them with the principal curvatures and
 // directions: the same values as in the per-vertex buffers, transposed in
@@ -505,7 +507,8 @@ typedef float8 REAL8;
 typedef struct {
     FREAL c[16];
 } RecN;
-#define SC_LD_ROW(l, s) FREAL r##l = VLOADN(faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
+#define SC_LD_ROW(l, s) \
+    FREAL r##l = VLOADN((size_t)faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
 #define SC_PUT_ROW(l, s) o.c[q * SC_LANES + l] = r##l;
 // The records of corner c's vertices of face block blk (faces past the last
 // repeat it, as in FACE_BLOCK_OR_RETURN); the face indices are scalar loads,
@@ -529,7 +532,7 @@ SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
 // k of every lane in x[k]: each chunk of SC_LANES components is transposed
 // and stored as whole vectors.
 #define SC_GET_ROW(l, s) FREAL r##l = x[q * SC_LANES + l];
-#define SC_ST_REC_ROW(l, s) VSTOREN(r##l, 0, rec + 16 * (v0 + l) + q * SC_LANES);
+#define SC_ST_REC_ROW(l, s) VSTOREN(r##l, 0, rec + 16 * (size_t)(v0 + l) + q * SC_LANES);
 SC_INLINE void st_rec(__global REAL *rec, uint blk, const FREAL *x)
 {
     const uint v0 = SC_LANES * blk;

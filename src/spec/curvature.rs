@@ -546,7 +546,7 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: 
     let per_face = 12;
     let mut b = padded_vertices(nv) as u64 * per_vertex + nf as u64 * per_face + 16;
     if opts.accumulate == Accumulate::Gather {
-        // one-ring CSR, 4 reals per face corner
+        // one-ring CSR, 4 reals per face corner, 1 corner weight per corner
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
             + (corner_reals_bound(nf) + corner_weights_bound(nf)) as u64 * r;
