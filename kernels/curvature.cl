@@ -636,7 +636,8 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
 // vertices per work-item, as vectors: their per-vertex buffers (3 or 2 reals
 // per vertex) are read and written as whole vectors and (de)interleaved in
 // registers (ld3c, st3c, st2c), instead of a gather or scatter per value;
-// each also writes the block's vertex records (st_rec).
+// each also writes the block's vertex records (st_rec), and curv_frames
+// counts the vertices without area itself (no curv_count_empty launch).
 // The host pads every per-vertex buffer to whole blocks of MAX_FACE_LANES
 // vertices (the padding's results are never read). The arithmetic is the
 // one-lane kernels' above, operation for operation.
@@ -689,7 +690,8 @@ SC_INLINE FV3 any_perp_n(FV3 n)
 
 __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint *faces,
                           __global const int *owner, __global REAL *nrm, __global REAL *pd1,
-                          __global REAL *pd2, __global const REAL *area, __global REAL *rec)
+                          __global REAL *pd2, __global const REAL *area, __global REAL *rec,
+                          volatile __global uint *counters)
 {
     VERTEX_BLOCK_OR_RETURN(nv);
     FV3 n = ld3c(nrm, blk);
@@ -709,8 +711,12 @@ __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint
     FV3 p2 = cross3(n, p1);
     st3c(p1, blk, pd1);
     st3c(p2, blk, pd2);
-    const FREAL r[16] = REC_OF(p, VLOADN(blk, area), n, z, p1, z, p2);
+    FREAL ar = VLOADN(blk, area);
+    const FREAL r[16] = REC_OF(p, ar, n, z, p1, z, p2);
     st_rec(rec, blk, r);
+    // curv_count_empty's count, here (one atomic per block; explicit lanes
+    // need no work-item vectoriser)
+    count_lanes(&counters[1], !(ar > 0), vid < (FIDX)nv);
 }
 
 __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const REAL *tens,

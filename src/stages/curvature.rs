@@ -792,10 +792,13 @@ impl CurvatureEstimator {
         };
         if Pass::Frames <= last {
             let mut args = vec![Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
-            args.extend(rec.map(|r| [area, r]).into_iter().flatten());
+            args.extend(rec.map(|r| [area, r, cnt]).into_iter().flatten());
             record(Pass::Frames, launch(g, &self.k.frames, vblocks, &args)?);
-            let args = [Arg::U32(nv32), area, cnt];
-            record(Pass::Frames, launch(g, &self.k.count_empty, nv, &args)?);
+            if rec.is_none() {
+                // (curv_frames with lanes counts these itself)
+                let args = [Arg::U32(nv32), area, cnt];
+                record(Pass::Frames, launch(g, &self.k.count_empty, nv, &args)?);
+            }
         }
         if Pass::Tensor <= last {
             let args: &[Arg] = match &rec {
