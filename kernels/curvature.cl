@@ -81,7 +81,10 @@
 //   curv_principal               457 /   333 / 172 /  0 / 10
 //   curv_tensor_sum               59 /     0 /   2 /  0 / 0    (scalar)
 // The stack accesses of the tensor and derivative kernels are spills: three
-// records of 16 vectors outnumber the 32 registers.
+// records of 16 vectors outnumber the 32 registers. Loading each record in
+// two halves, the second (frame) half of a corner only where it is
+// projected, did not help (500k torus, tensor + dcurv: 25.4–25.7 against
+// 24.9–26.8 ms over three interleaved pairs).
 // Still scalar: the ring sums (curv_*_sum; their loop keeps PoCL's work-item
 // vectoriser off, and written with SC_LANES vertices per work-item, rings
 // walked together to the longest, they ran no faster). Intel's CPU runtime
@@ -882,7 +885,8 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
 
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
-                                         __global const uint *faces, __global const uint *slot, __global REAL *corner, __global REAL *cw,
+                                         __global const uint *faces, __global const uint *slot,
+                                         __global REAL *corner, __global REAL *cw,
                                          volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
@@ -906,7 +910,8 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
 // records (ld_rec) instead of pos, nrm, area, pd1, pd2 and kk; the same
 // values, the same arithmetic, the same bits.
 __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                  __global const uint *slot, __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
+                                  __global const uint *slot, __global REAL *corner,
+                                  __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -943,7 +948,8 @@ SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                 __global const uint *slot, __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
+                                 __global const uint *slot, __global REAL *corner,
+                                 __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -959,14 +965,16 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
     FMASK use = (!deg) & ok;
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
-    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
+    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1),
+               zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 #else
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                   __global const REAL *nrm, __global const REAL *area,
                                   __global const REAL *pd1, __global const REAL *pd2,
-                                  __global const uint *slot, __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
+                                  __global const uint *slot, __global REAL *corner,
+                                  __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -998,7 +1006,8 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                  __global const REAL *area, __global const REAL *pd1,
                                  __global const REAL *pd2, __global const REAL *kk,
-                                 __global const uint *slot, __global REAL *corner, __global REAL *cw, volatile __global uint *counters)
+                                 __global const uint *slot, __global REAL *corner,
+                                 __global REAL *cw, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -1014,7 +1023,8 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     // The corner weights curv_tensor_corners stored (`area` is not read).
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
-    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
+    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1),
+               zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 
