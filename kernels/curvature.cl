@@ -16,9 +16,7 @@
 // (curv_*_corners) writes its three corner contributions to a corner buffer,
 // with no inner loops, and counts its skipped faces. A per-vertex kernel
 // (curv_*_sum) then adds the corners of its one-ring (CSR lists built once on
-// the host, in face order): each corner is stored at its position in its
-// vertex's list (`slot`), so a sum reads one contiguous run. The result is
-// bitwise reproducible.
+// the host, in face order). The result is bitwise reproducible.
 // The derivative pass computes one set of projection coefficients per face
 // corner (proj_coef) and uses it both ways: the vertex's tensor into the
 // face frame, and the face's derivative tensor back into the vertex frame
@@ -60,8 +58,7 @@
 //    500k torus, PoCL, tensor corners 16.7 → 10.7 ms, dcurv corners
 //    18.5 → 13.6 ms.
 //  - Corner stores: the face kernels transpose their component vectors the
-//    same way, so that each corner is a 4-real piece of a vector, and store
-//    it whole at its slot (st_corners).
+//    same way and store each face's 12 reals whole (st_corners).
 //  - curv_frames and curv_principal load and store their 3- and 2-real
 //    per-vertex buffers as whole vectors, (de)interleaved in registers (ld3c,
 //    st3c, st2c), and write the records the same way (st_rec); the host pads
@@ -95,19 +92,23 @@
 // 0.48 for the normal sum and frames, 0.6 against 0.4 for the tensor sum and
 // principal): the loop of the sum keeps the fused kernel scalar, and the
 // frames and principal passes lose their vectorisation. They stay apart.
-// Corner layout, measured on the 500k torus with PoCL unless said:
-//  - One lane vector per component in face blocks (an older layout): a ring
-//    sum touched four cache lines per corner.
-//  - Per corner in face order (corner e = 3f + c at 4e … 4e + 3): each ring
-//    sum 4.4–4.7 → 2.8–3.1 ms (Intel's runtime 4.5 → 3.0), one 16-byte
-//    vload4 per corner. On Intel's runtime the form matters: four scalar
-//    loads from 4·ring[r] made its sums 2.3× slower than the vload4.
-//  - Per corner at its ring slot (now): each sum reads a contiguous run with
-//    no ring index to load, 3.6–3.8 → 1.8–2.1 ms in a slower spell, the face
-//    kernels 0.1–0.9 ms slower (one 16-byte store per corner instead of
-//    whole-face runs), 6–10 % faster in all. An older trial of slots, before
-//    the transposed stores, had one scattered store per lane and component
-//    and lost as much in the face kernels as the sums gained.
+// Recomputing pd2 = n × pd1 in curv_tensor_corners instead of loading it
+// (three scalar loads per lane fewer) gained nothing measurable (0.78
+// against 0.80 ms), so the loads stay.
+// Storing each corner at its vertex's one-ring position instead (a slot
+// map built with the rings, so that each vertex sums a contiguous run, with
+// no ring index to load) made the three ring sums 3× faster (torus 2M:
+// 19 against 59 ms) but the per-face kernels slower by as much, their whole-
+// vector stores becoming one scattered store per lane (tensor corners 71
+// against 41 ms): no gain in total, so the corners stay in face order.
+// The corners are stored per corner: corner e = 3f + c (a ring entry) has
+// its four components at 4e … 4e + 3, so that a ring sum reads a corner as
+// one 16-byte vload4 within one cache line, where the earlier layout (one
+// lane vector per component) put them on four lines. 500k torus: each ring
+// sum 4.4–4.7 → 2.8–3.1 ms on PoCL and 4.5 → 3.0 ms on Intel's runtime. On
+// Intel's runtime the form matters: four scalar loads from 4·ring[r] made its
+// sums 2.3× slower than the vload4 (and ring entries holding precomputed
+// slots, an older trial, 2.7× slower).
 // The LDLᵀ solves of face_tensor and face_dcurv divide by each pivot once
 // and multiply by its reciprocal twice (3 and 4 divisions fewer per face; the
 // per-face kernels are bound by arithmetic, and a 16-lane division costs
@@ -138,12 +139,10 @@
 //   tens  REAL[3V]  curvature tensor (ku, kuv, kv) in the initial frame
 //   kk    REAL[2V]  (k1, k2)                              dk REAL[4V] derivative tensor
 //   counters uint[4] degenerate faces, vertices without area, tensor and dcurv solves skipped
-//   ring_off uint[V+1] one-ring offsets, gather variant only: vertex v's
-//                    corners are entries ring_off[v] … ring_off[v+1] − 1, in face order
-//   slot  uint[3F]   gather only: the entry of corner 3f + c in its vertex's one-ring
-//   corner REAL[4·3F] per-corner contributions, gather only: the corner in
-//                    entry r at 4r … 4r + 3; the normal pass's component 3 is
-//                    the corner area
+//   ring_off uint[V+1], ring uint[3F] one-ring (face*3 + corner), gather variant only
+//   corner REAL[12F'] per-corner contributions, gather only (F' = F rounded up to
+//                    16): corner c of face f, component k at 12f + 4c + k
+//                    (CORNER_SLOT); the normal pass's component 3 is the corner area
 //   cw    REAL[3F']  gather only: the corner areas (normal pass), then each
 //                    corner's weight, corner area ÷ point area (tensor pass),
 //                    which the dcurv pass reads instead of recomputing (4 %
@@ -395,20 +394,22 @@ typedef Tri FTri;
     const int live = 1;           \
     const FIDX fid = gid;
 
-// The three corners of face f, each at its slot.
-SC_INLINE void st4(__global REAL *p, V4 x)
+// The three corners of face f, each at 4·(3f + c) (see CORNER_SLOT).
+SC_INLINE void st_corners(__global REAL *corner, uint f, V4 x0, V4 x1, V4 x2)
 {
-    p[0] = x.x;
-    p[1] = x.y;
-    p[2] = x.z;
-    p[3] = x.w;
-}
-SC_INLINE void st_corners(__global REAL *corner, __global const uint *slot, uint nf, uint f,
-                          V4 x0, V4 x1, V4 x2)
-{
-    st4(corner + 4 * (size_t)slot[3 * f], x0);
-    st4(corner + 4 * (size_t)slot[3 * f + 1], x1);
-    st4(corner + 4 * (size_t)slot[3 * f + 2], x2);
+    __global REAL *p = corner + 12 * f;
+    p[0] = x0.x;
+    p[1] = x0.y;
+    p[2] = x0.z;
+    p[3] = x0.w;
+    p[4] = x1.x;
+    p[5] = x1.y;
+    p[6] = x1.z;
+    p[7] = x1.w;
+    p[8] = x2.x;
+    p[9] = x2.y;
+    p[10] = x2.z;
+    p[11] = x2.w;
 }
 
 SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, int live)
@@ -418,6 +419,10 @@ SC_INLINE void count_lanes(volatile __global uint *c, FMASK m, int live)
 }
 #endif
 
+// The corner slot of face f's corner c, component k: corner e = 3f + c has
+// its four components at 4e … 4e + 3, so that a ring sum reads a corner as
+// one 16-byte run (for every lane count).
+#define CORNER_SLOT(f, c, k) (12 * (f) + 4 * (c) + (k))
 
 
 // ---------------------------------------------------------------------------
@@ -546,33 +551,24 @@ SC_INLINE void st_rec(__global REAL *rec, uint blk, const FREAL *x)
     {p.x, p.y, p.z, a, n.x, n.y, n.z, k1, d1.x, d1.y, d1.z, k2, d2.x, d2.y, d2.z, (FREAL)RL(0)}
 
 // The corners of face block blk, x_c holding corner c of every lane's face:
-// the 12 component vectors (and 4 of zeros) transposed in registers, so
-// that each face's corner is one 4-real piece of a vector, stored at its
-// slot (see `slot` in the file header). Lanes past the last face store the
-// last face's corners again, with the same values.
-#define SC_CSLOT(l, c) (corner + 4 * (size_t)slot[3 * min(f0 + l, last) + (c)])
+// the 12 component vectors (and 4 of zeros) transposed in registers into
+// each face's 12 reals at CORNER_SLOT, stored as whole vectors.
 #if SC_LANES == 16
 #define SC_ST_ROW(l, s)                                 \
-    vstore4(r##l.s0123, 0, SC_CSLOT(l, 0));             \
-    vstore4(r##l.s4567, 0, SC_CSLOT(l, 1));             \
-    vstore4(r##l.s89ab, 0, SC_CSLOT(l, 2));
+    vstore8(r##l.lo, 0, corner + 12 * (f0 + l));        \
+    vstore4(r##l.s89ab, 0, corner + 12 * (f0 + l) + 8);
 #elif SC_LANES == 8
 #define SC_ST_ROW(l, s)                                 \
-    if (q == 0) {                                       \
-        vstore4(r##l.lo, 0, SC_CSLOT(l, 0));            \
-        vstore4(r##l.hi, 0, SC_CSLOT(l, 1));            \
-    } else {                                            \
-        vstore4(r##l.lo, 0, SC_CSLOT(l, 2));            \
-    }
-#elif SC_LANES == 4
-#define SC_ST_ROW(l, s) vstore4(r##l, 0, SC_CSLOT(l, q));
+    if (q == 0)                                         \
+        vstore8(r##l, 0, corner + 12 * (f0 + l));       \
+    else                                                \
+        vstore4(r##l.lo, 0, corner + 12 * (f0 + l) + 8);
 #else
-#define SC_ST_ROW(l, s) vstore2(r##l, 0, SC_CSLOT(l, q / 2) + 2 * (q % 2));
+#define SC_ST_ROW(l, s) VSTOREN(r##l, 0, corner + 12 * (f0 + l) + q * SC_LANES);
 #endif
-SC_INLINE void st_corners(__global REAL *corner, __global const uint *slot, uint nf, uint blk,
-                          FV4 x0, FV4 x1, FV4 x2)
+SC_INLINE void st_corners(__global REAL *corner, uint blk, FV4 x0, FV4 x1, FV4 x2)
 {
-    const uint f0 = SC_LANES * blk, last = nf - 1;
+    const uint f0 = SC_LANES * blk;
     const FREAL z = (FREAL)RL(0);
     const FREAL x[16] = {x0.x, x0.y, x0.z, x0.w, x1.x, x1.y, x1.z, x1.w,
                          x2.x, x2.y, x2.z, x2.w, z,    z,    z,    z};
@@ -885,8 +881,8 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
 
 
 __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
-                                         __global const uint *faces, __global const uint *slot,
-                                         __global REAL *corner, __global REAL *cw,
+                                         __global const uint *faces, __global REAL *corner,
+                                         __global REAL *cw,
                                          volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
@@ -898,7 +894,7 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
     FV4 x0 = zero_unless(use, ext4(corner_normal(fn, l1, l2), ca.x)),
         x1 = zero_unless(use, ext4(corner_normal(fn, l2, l0), ca.y)),
         x2 = zero_unless(use, ext4(corner_normal(fn, l0, l1), ca.z));
-    st_corners(corner, slot, nf, blk, x0, x1, x2);
+    st_corners(corner, blk, x0, x1, x2);
     CW_ST(x0.w, 0);
     CW_ST(x1.w, 1);
     CW_ST(x2.w, 2);
@@ -910,8 +906,8 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
 // records (ld_rec) instead of pos, nrm, area, pd1, pd2 and kk; the same
 // values, the same arithmetic, the same bits.
 __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                  __global const uint *slot, __global REAL *corner,
-                                  __global REAL *cw, volatile __global uint *counters)
+                                  __global REAL *corner, __global REAL *cw,
+                                  volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -928,7 +924,7 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
     FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
     FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
     FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
-    st_corners(corner, slot, nf, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
+    st_corners(corner, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
                zero_unless(use, ext4(c1, (FREAL)RL(0))), zero_unless(use, ext4(c2, (FREAL)RL(0))));
     FREAL z = (FREAL)RL(0);
     CW_ST(!deg ? w0 : z, 0);
@@ -948,8 +944,8 @@ SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,
-                                 __global const uint *slot, __global REAL *corner,
-                                 __global REAL *cw, volatile __global uint *counters)
+                                 __global REAL *corner, __global REAL *cw,
+                                 volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
@@ -965,16 +961,15 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
     FMASK use = (!deg) & ok;
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
-    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1),
-               zero_unless(use, c2));
+    st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 #else
 __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                   __global const REAL *nrm, __global const REAL *area,
                                   __global const REAL *pd1, __global const REAL *pd2,
-                                  __global const uint *slot, __global REAL *corner,
-                                  __global REAL *cw, volatile __global uint *counters)
+                                  __global REAL *corner, __global REAL *cw,
+                                  volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -994,7 +989,7 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
     FV3 c0 = tensor_w(pd1, pd2, v0, w0, ft, fb, x);
     FV3 c1 = tensor_w(pd1, pd2, v1, w1, ft, fb, x);
     FV3 c2 = tensor_w(pd1, pd2, v2, w2, ft, fb, x);
-    st_corners(corner, slot, nf, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
+    st_corners(corner, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
                zero_unless(use, ext4(c1, (FREAL)RL(0))), zero_unless(use, ext4(c2, (FREAL)RL(0))));
     FREAL z = (FREAL)RL(0);
     CW_ST(!deg ? w0 : z, 0);
@@ -1006,8 +1001,8 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *pos, __global co
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global const uint *faces,
                                  __global const REAL *area, __global const REAL *pd1,
                                  __global const REAL *pd2, __global const REAL *kk,
-                                 __global const uint *slot, __global REAL *corner,
-                                 __global REAL *cw, volatile __global uint *counters)
+                                 __global REAL *corner, __global REAL *cw,
+                                 volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
     LOAD_FACE_BLOCK(pos, faces);
@@ -1023,8 +1018,7 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
     // The corner weights curv_tensor_corners stored (`area` is not read).
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
-    st_corners(corner, slot, nf, blk, zero_unless(use, c0), zero_unless(use, c1),
-               zero_unless(use, c2));
+    st_corners(corner, blk, zero_unless(use, c0), zero_unless(use, c1), zero_unless(use, c2));
     count_lanes(&counters[3], (!deg) & (!ok), live);
 }
 
@@ -1036,15 +1030,15 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
 // longest, masked) these ran no faster on PoCL 3.1 (4.1 against 4.2 ms for
 // the three on the bunny), so their loads (a ring entry, then its corner),
 // not their few adds, look like the limit.
-SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const REAL *corner,
-                      bool four)
+SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint *ring,
+                      __global const REAL *corner, bool four)
 {
     V4 s = v4(RL(0), RL(0), RL(0), RL(0));
     for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
 #ifdef SC_DOUBLE
-        double4 c = vload4(r, corner);
+        double4 c = vload4(ring[r], corner);
 #else
-        float4 c = vload4(r, corner);
+        float4 c = vload4(ring[r], corner);
 #endif
         s.x += c.x;
         s.y += c.y;
@@ -1056,28 +1050,28 @@ SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const REAL
 }
 
 __kernel void curv_normals_areas_sum(uint nv, __global const uint *ring_off,
-                                     __global const REAL *corner, __global REAL *nrm,
-                                     __global REAL *area)
+                                     __global const uint *ring, __global const REAL *corner,
+                                     __global REAL *nrm, __global REAL *area)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, corner, true);
+    V4 s = sum_ring(gid, ring_off, ring, corner, true);
     st3(v3(s.x, s.y, s.z), gid, nrm);
     area[gid] = s.w;
 }
 
-__kernel void curv_tensor_sum(uint nv, __global const uint *ring_off,
+__kernel void curv_tensor_sum(uint nv, __global const uint *ring_off, __global const uint *ring,
                               __global const REAL *corner, __global REAL *tens)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, corner, false);
+    V4 s = sum_ring(gid, ring_off, ring, corner, false);
     st3(v3(s.x, s.y, s.z), gid, tens);
 }
 
-__kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off,
+__kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off, __global const uint *ring,
                              __global const REAL *corner, __global REAL *dk)
 {
     GID_OR_RETURN(nv);
-    V4 s = sum_ring(gid, ring_off, corner, true);
+    V4 s = sum_ring(gid, ring_off, ring, corner, true);
     dk[4 * gid] = s.x;
     dk[4 * gid + 1] = s.y;
     dk[4 * gid + 2] = s.z;

@@ -49,45 +49,6 @@ pub fn one_rings_into(faces: &[[u32; 3]], off: &mut [u32], ring: &mut [u32]) {
     ring[3 * faces.len()..].fill(0);
 }
 
-/// The one-ring offsets, each corner's position in its vertex's one-ring
-/// list and the owning faces, without the lists themselves (into given
-/// slices, e.g. device buffers mapped for writing): `off` of length V+1 as in
-/// [`one_rings_into`]; `slot[3f + c]` = the index r at which that list holds
-/// corner 3f + c (`ring[r] == 3f + c`), for the 3F corners, entries past 3F
-/// zeroed; `owner[v]` = the largest face using v, −1 for none, for the first
-/// V entries (as [`owners_from_rings`]). Face indices must be below V.
-pub fn one_ring_slots_into(
-    faces: &[[u32; 3]],
-    off: &mut [u32],
-    slot: &mut [u32],
-    owner: &mut [i32],
-) {
-    assert!(!off.is_empty() && slot.len() >= 3 * faces.len() && owner.len() + 1 >= off.len());
-    off.fill(0);
-    for f in faces {
-        for &v in f {
-            off[v as usize + 1] += 1;
-        }
-    }
-    for i in 1..off.len() {
-        off[i] += off[i - 1];
-    }
-    owner[..off.len() - 1].fill(-1);
-    // off[v] is the fill cursor of v's list, as in one_rings_into; faces
-    // come in increasing order, so the last one to visit v owns it.
-    for (fi, f) in faces.iter().enumerate() {
-        for (c, &v) in f.iter().enumerate() {
-            let cursor = &mut off[v as usize];
-            slot[fi * 3 + c] = *cursor;
-            *cursor += 1;
-            owner[v as usize] = fi as i32;
-        }
-    }
-    off.copy_within(..off.len() - 1, 1);
-    off[0] = 0;
-    slot[3 * faces.len()..].fill(0);
-}
-
 /// The owning faces ([`max_face`]) read from one-ring lists: as each list is
 /// in increasing face order, its last entry is the largest face using the
 /// vertex. Writes `owner[v]` for every vertex (−1 for an empty list).
@@ -188,24 +149,5 @@ mod tests {
         assert_eq!(owner, want);
         assert_eq!(owner[5], -1);
         assert_eq!(owner[3], 3);
-    }
-
-    #[test]
-    fn ring_slots_invert_the_rings_and_give_the_owners() {
-        let f = faces();
-        let (off, ring) = one_rings(7, &f);
-        let mut off2 = vec![u32::MAX; 8];
-        let mut slot = vec![u32::MAX; 3 * f.len() + 4];
-        let mut owner = vec![7i32; 9]; // two entries of padding, left alone
-        one_ring_slots_into(&f, &mut off2, &mut slot, &mut owner);
-        assert_eq!(off2, off);
-        for (r, &e) in ring.iter().enumerate() {
-            assert_eq!(slot[e as usize], r as u32, "corner {e}");
-        }
-        assert!(slot[3 * f.len()..].iter().all(|&s| s == 0));
-        let mut want = vec![0i32; 7];
-        owners_from_rings(&off, &ring, &mut want);
-        assert_eq!(owner[..7], want[..]);
-        assert_eq!(owner[7..], [7, 7]);
     }
 }

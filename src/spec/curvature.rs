@@ -467,8 +467,8 @@ pub fn degen_height_ulp(p: Precision) -> f64 {
 }
 
 /// Entries of the one-ring lists of a mesh with `nf` faces (one per face
-/// corner; their CSR offsets have `nv + 1` entries): the size of the gather
-/// variant's `slot` buffer (each corner's entry in its vertex's list).
+/// corner; their CSR offsets have `nv + 1` entries): the `ring` buffer of the
+/// gather variant.
 pub fn one_ring_len_bound(nf: usize) -> usize {
     3 * nf
 }

@@ -13,7 +13,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, Mapped, buf, event_ms, kernel_file, launch};
 use crate::mesh::order::{LocalityOrder, MeshOrder};
-use crate::mesh::topology::one_ring_slots_into;
+use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
     Precision, REC_REALS, VertexCurvature, corner_reals_bound, corner_weights_bound,
@@ -193,9 +193,7 @@ struct Kernels {
 /// Buffers of the gather variant: one-ring lists and corner contributions.
 struct GatherBufs {
     ring_off: Buffer<u32>,
-    /// Each face corner's position in its vertex's one-ring: where the
-    /// face kernels store it, so that a ring sum reads a contiguous run.
-    slot: Buffer<u32>,
+    ring: Buffer<u32>,
     corner: Buffer<u8>,
     /// Corner areas, then weights, of each face corner (3 reals per face).
     cw: Buffer<u8>,
@@ -471,21 +469,22 @@ impl CurvatureEstimator {
             let faces = faces.unwrap_or(&[]);
             let mut ring_off = gpu.buffer::<u32>(nv + 1)?;
             let ring_len = crate::spec::curvature::one_ring_len_bound(nf);
-            let mut slot_b = gpu.buffer::<u32>(ring_len)?;
+            let mut ring_b = gpu.buffer::<u32>(ring_len)?;
             gpu.write_with(&mut ring_off, nv + 1, |off| {
-                gpu.write_with(&mut slot_b, ring_len, |slot| {
+                gpu.write_with(&mut ring_b, ring_len, |ring| {
                     gpu.write_with(&mut owner, nvp, |o| {
                         zero_all(&mut bufs)?;
-                        // owners for the first nv entries, −1 in the padding
-                        o[nv..].fill(-1);
-                        one_ring_slots_into(faces, off, slot, o);
+                        one_rings_into(faces, off, ring);
+                        let (o, pad) = o.split_at_mut(nv);
+                        owners_from_rings(off, ring, o);
+                        pad.fill(-1);
                         Ok::<(), Error>(())
                     })
                 })
             })????;
             Some(GatherBufs {
                 ring_off,
-                slot: slot_b,
+                ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
                 cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
                 // written whole by curv_frames before any kernel reads them
@@ -744,11 +743,16 @@ impl CurvatureEstimator {
                 (Some(gb), Some(sums)) => {
                     let mut a = vec![Arg::U32(nf32)];
                     a.extend_from_slice(face_args);
-                    a.extend([buf(&gb.slot), buf(&gb.corner), buf(&gb.cw), cnt]);
+                    a.extend([buf(&gb.corner), buf(&gb.cw), cnt]);
                     // One work-item per block of `lanes` faces.
                     let blocks = nf.div_ceil(self.k.lanes as usize);
                     evs.extend(launch(g, face_kernel, blocks, &a)?.map(|e| (pass, e)));
-                    let mut a = vec![Arg::U32(nv32), buf(&gb.ring_off), buf(&gb.corner)];
+                    let mut a = vec![
+                        Arg::U32(nv32),
+                        buf(&gb.ring_off),
+                        buf(&gb.ring),
+                        buf(&gb.corner),
+                    ];
                     a.extend_from_slice(outputs);
                     evs.extend(launch(g, &sums[sum], nv, &a)?.map(|e| (pass, e)));
                 }
