@@ -69,12 +69,12 @@
 //    records cost 1.7 and 1.4 ms more; written by the one-lane kernels they
 //    kept PoCL from vectorising those (frames 8.8 against 6.3 ms).
 // Disassembly of PoCL's kernel cache, pthread-skylake-avx512, 16 lanes (the
-// work-group function; instructions / of them on zmm registers / shuffles
-// and inserts / gathers / stack accesses):
+// work-group function PoCL built for the 500k torus; instructions / of them
+// on zmm registers / shuffles and inserts / gathers / stack accesses):
 //   curv_normals_areas_corners   588 /   377 / 134 / 24 / 22   (positions, face indices)
 //   curv_tensor_corners        1,532 /   795 / 337 /  0 / 198
 //   curv_dcurv_corners         1,793 / 1,006 / 371 /  0 / 292
-//   curv_frames                  464 /   325 / 158 / 12 / 20   (owner faces' vertices)
+//   curv_frames                  531 /   331 / 170 / 12 / 24   (owner faces' vertices)
 //   curv_principal               457 /   333 / 172 /  0 / 10
 //   curv_tensor_sum               59 /     0 /   2 /  0 / 0    (scalar)
 // The stack accesses of the tensor and derivative kernels are spills: three
@@ -109,6 +109,12 @@
 // Intel's runtime the form matters: four scalar loads from 4·ring[r] made its
 // sums 2.3× slower than the vload4 (and ring entries holding precomputed
 // slots, an older trial, 2.7× slower).
+// Storing each corner, after the transposes, as one 16-byte piece at its
+// vertex's one-ring position was tried again: on the 500k torus each sum
+// went 3.6–3.8 → 1.8–2.1 ms and the face kernels lost 0.1–0.9 ms (6–10 %
+// faster in all), but on lucy (scanned, in Morton order) the scattered
+// stores made the face kernels 1.4× slower (medians of 61 runs: tensor
+// corners 1.29 → 1.91 ms) for 0.03–0.13 ms gained per sum. Not kept.
 // The LDLᵀ solves of face_tensor and face_dcurv divide by each pivot once
 // and multiply by its reciprocal twice (3 and 4 divisions fewer per face; the
 // per-face kernels are bound by arithmetic, and a 16-lane division costs
@@ -211,7 +217,6 @@
 
 SC_OL SC_INLINE REAL ld1(__global const REAL *a, uint i) { return a[i]; }
 SC_OL SC_INLINE uint ldu(__global const uint *a, uint i) { return a[i]; }
-SC_OL SC_INLINE void lst(REAL x, uint slot, __global REAL *a) { a[slot] = x; }
 
 #define GT REAL
 #define GM int
@@ -305,7 +310,6 @@ typedef SC_CAT(int, SC_LANES) INTN;
 #define SC_LD_ONE(l) a[i.l]
 SC_OL SC_INLINE REALN ld1(__global const REAL *a, UINTN i) { return (REALN)(SC_LANE_LIST(SC_LD_ONE)); }
 SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return (UINTN)(SC_LANE_LIST(SC_LD_ONE)); }
-SC_OL SC_INLINE void lst(REALN x, uint slot, __global REAL *a) { VSTOREN(x, slot, a); }
 
 #define GT REALN
 #define GM MASKN
@@ -455,15 +459,8 @@ __kernel void curv_max_face(uint nf, __global const uint *faces, volatile __glob
 #define REC_K1 7
 #define REC_PD1 8  // x y z; k2 at 11
 #define REC_K2 11
-#define REC_PD2 12 // x y z; 15 unused
+#define REC_PD2 12 // x y z; 15 is zero
 
-#ifdef SC_DOUBLE
-typedef double16 REAL16;
-typedef double8 REAL8;
-#else
-typedef float16 REAL16;
-typedef float8 REAL8;
-#endif
 // An SC_LANES × SC_LANES transpose of the rows r0 … r(SC_LANES−1) in
 // log2(SC_LANES) stages; stage b swaps the off-diagonal b × b blocks of each
 // 2b × 2b block (bit b of the row index with bit b of the column index).

@@ -1,15 +1,13 @@
 // curvature_face.h: the per-face geometry of kernels/curvature.cl, written
 // over type macros so that it is instantiated twice: once on scalars (every
 // kernel of the file) and, when SC_LANES > 1, once on OpenCL vectors of
-// SC_LANES faces (the gather variant's per-face kernels; see the header of
-// curvature.cl for why). The includer defines
+// SC_LANES faces or vertices (the gather variant's lane kernels; see the
+// header of curvature.cl for why). The includer defines
 //   GT   the real type (REAL, or a REAL vector of SC_LANES lanes)
 //   GM   the mask type of a comparison of two GT (int, or an int/long vector)
 //   GI   the index type (uint, or a uint vector: one face or vertex per lane)
 //   GV3, GV4, GTri   the names of the structs this instance defines
-//   ld1(a, GI), lst(x, slot, a)   the buffer access of the instance: a load of
-//        a[i] per lane, and a store of x at the SC_LANES reals from
-//        SC_LANES·slot (one real at `slot` for scalars)
+//   ld1(a, GI)   the buffer load of the instance: a[i] per lane
 // and SC_OL, empty for one instance and __attribute__((overloadable)) when
 // there are two, so that both instances share their function names.
 // An include with GT undefined is empty.
