@@ -448,11 +448,11 @@ __kernel void curv_max_face(uint nf, __global const uint *faces, volatile __glob
 // vertex of each lane as whole vectors and transposes them in registers
 // (ld_rec) instead of one scalar load per lane and value. Record offsets are
 // computed in size_t (16 reals per vertex pass 32 bits at 2^28 vertices).
-// curv_frames writes
-// the records with the position, area, normal and initial frame, and
-// curv_principal rewrites them with the principal curvatures and
-// directions: the same values as in the per-vertex buffers, transposed in
-// registers from the kernels' lane vectors (st_rec) and stored whole.
+// curv_frames writes the records with the position, area, normal and
+// initial frame, and curv_principal rewrites them with the principal
+// curvatures and directions: the same values as in the per-vertex buffers,
+// transposed in registers from the kernels' lane vectors (st_rec) and
+// stored whole.
 #define REC_POS 0  // x y z; area at 3
 #define REC_AREA 3
 #define REC_NRM 4  // x y z; k1 at 7
