@@ -249,15 +249,6 @@ SC_INLINE Tri load_tri(__global const REAL *pos, __global const uint *faces, uin
     return make_tri(ld3(pos, *v0), ld3(pos, *v1), ld3(pos, *v2));
 }
 
-// Any unit vector perpendicular to n (n unit).
-SC_INLINE V3 any_perp(V3 n)
-{
-    REAL ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
-    V3 ex = v3(RL(1), RL(0), RL(0)), ey = v3(RL(0), RL(1), RL(0)), ez = v3(RL(0), RL(0), RL(1));
-    V3 a = sel3((ax <= ay) & (ax <= az), ex, sel3(ay <= az, ey, ez));
-    return normalize3(cross3(n, a));
-}
-
 #if SC_LANES > 1
 #define SC_CAT_(a, b) a##b
 #define SC_CAT(a, b) SC_CAT_(a, b)
@@ -586,17 +577,13 @@ __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint
                           __global REAL *pd2)
 {
     GID_OR_RETURN(nv);
-    V3 n = ld3(nrm, gid);
-    REAL len = len3(n);
-    n = sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(RL(0), RL(0), RL(1)));
+    V3 n = unit_normal(ld3(nrm, gid));
     st3(n, gid, nrm);
     int f = owner[gid];
     uint fi = (uint)max(f, 0);
     uint a = faces[3 * fi], b = faces[3 * fi + 1], c = faces[3 * fi + 2];
     uint next = gid == a ? b : gid == b ? c : a;
-    V3 p1 = cross3(sub3(ld3(pos, next), ld3(pos, gid)), n);
-    REAL l = len3(p1);
-    p1 = sel3((f >= 0) & (l > RL(1e-20)) & isfinite(l), mul3(p1, RL(1) / l), any_perp(n));
+    V3 p1 = first_dir(sub3(ld3(pos, next), ld3(pos, gid)), n, f >= 0);
     st3(p1, gid, pd1);
     st3(cross3(n, p1), gid, pd2);
 }
@@ -608,23 +595,12 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
     GID_OR_RETURN(nv);
     V3 n = ld3(nrm, gid), ru, rv;
     rot_coord_sys(ld3(pd1, gid), ld3(pd2, gid), n, &ru, &rv);
-    REAL ku = tens[3 * gid], kuv = tens[3 * gid + 1], kv = tens[3 * gid + 2];
-    REAL h = RL(0.5) * (kv - ku) / kuv;
-    REAL root = sqrt(RL(1) + h * h);
-    REAL tt = kuv != 0 ? ((h < 0) ? RL(1) / (h - root) : RL(1) / (h + root)) : RL(0);
-    REAL c = RL(1) / sqrt(RL(1) + tt * tt);
-    REAL s = tt * c;
-    REAL k1 = ku - tt * kuv, k2 = kv + tt * kuv;
-#ifdef SC_COMPAT
-    bool keep = fabs(k1) >= fabs(k2);
-#else
-    bool keep = k1 >= k2;
-#endif
-    V3 d1 = sel3(keep, sub3(mul3(ru, c), mul3(rv, s)), add3(mul3(ru, s), mul3(rv, c)));
+    REAL ka, kb;
+    V3 d1 = principal_dir(ru, rv, ld3(tens, gid), &ka, &kb);
     st3(d1, gid, pd1);
     st3(cross3(n, d1), gid, pd2);
-    kk[2 * gid] = keep ? k1 : k2;
-    kk[2 * gid + 1] = keep ? k2 : k1;
+    kk[2 * gid] = ka;
+    kk[2 * gid + 1] = kb;
 }
 
 #else // SC_LANES > 1
@@ -635,8 +611,9 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
 // each also writes the block's vertex records (st_rec), and curv_frames
 // counts the vertices without area itself (no curv_count_empty launch).
 // The host pads every per-vertex buffer to whole blocks of MAX_FACE_LANES
-// vertices (the padding's results are never read). The arithmetic is the
-// one-lane kernels' above, operation for operation.
+// vertices (the padding's results are never read). Their arithmetic is the
+// one-lane kernels' above: the same helpers of kernels/common/curvature_face.h
+// (unit_normal, first_dir, principal_dir) on the lane types.
 #define VERTEX_BLOCK_OR_RETURN(nv)                            \
     const uint blk = (uint)get_global_id(0);                  \
     if (blk >= ((nv) + SC_LANES - 1) / SC_LANES) return;      \
@@ -675,40 +652,25 @@ SC_INLINE void st2c(FREAL a, FREAL b, uint blk, __global REAL *p)
     VSTOREN(__builtin_shufflevector(a, b, SC_JLIST(SC_IW, 1)), 2 * blk + 1, p);
 }
 
-SC_INLINE FV3 any_perp_n(FV3 n)
-{
-    FREAL ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
-    FREAL o = (FREAL)RL(1), z = (FREAL)RL(0);
-    FV3 ex = v3(o, z, z), ey = v3(z, o, z), ez = v3(z, z, o);
-    FV3 a = sel3((ax <= ay) & (ax <= az), ex, sel3(ay <= az, ey, ez));
-    return normalize3(cross3(n, a));
-}
-
 __kernel void curv_frames(uint nv, __global const REAL *pos, __global const uint *faces,
                           __global const int *owner, __global REAL *nrm, __global REAL *pd1,
                           __global REAL *pd2, __global const REAL *area, __global REAL *rec,
                           volatile __global uint *counters)
 {
     VERTEX_BLOCK_OR_RETURN(nv);
-    FV3 n = ld3c(nrm, blk);
-    FREAL len = len3(n);
-    FREAL o = (FREAL)RL(1), z = (FREAL)RL(0);
-    n = sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(z, z, o));
+    FV3 n = unit_normal(ld3c(nrm, blk));
     st3c(n, blk, nrm);
     INTN f = VLOADN(blk, owner);
     FIDX fi = CONVERT_UINTN(max(f, 0));
     FIDX a = ldu(faces, 3 * fi), b = ldu(faces, 3 * fi + 1), c = ldu(faces, 3 * fi + 2);
     FIDX next = vid == a ? b : vid == b ? c : a;
     FV3 p = ld3c(pos, blk);
-    FV3 p1 = cross3(sub3(ld3(pos, next), p), n);
-    FREAL l = len3(p1);
-    p1 = sel3(CONVERT_MASKN(f >= 0) & (l > RL(1e-20)) & isfinite(l), mul3(p1, RL(1) / l),
-              any_perp_n(n));
+    FV3 p1 = first_dir(sub3(ld3(pos, next), p), n, CONVERT_MASKN(f >= 0));
     FV3 p2 = cross3(n, p1);
     st3c(p1, blk, pd1);
     st3c(p2, blk, pd2);
     FREAL ar = VLOADN(blk, area);
-    const FREAL r[16] = REC_OF(p, ar, n, z, p1, z, p2);
+    const FREAL z = (FREAL)RL(0), r[16] = REC_OF(p, ar, n, z, p1, z, p2);
     st_rec(rec, blk, r);
     // curv_count_empty's count, here (one atomic per block; explicit lanes
     // need no work-item vectoriser)
@@ -723,22 +685,9 @@ __kernel void curv_principal(uint nv, __global const REAL *nrm, __global const R
     VERTEX_BLOCK_OR_RETURN(nv);
     FV3 n = ld3c(nrm, blk), ru, rv;
     rot_coord_sys(ld3c(pd1, blk), ld3c(pd2, blk), n, &ru, &rv);
-    FV3 t3 = ld3c(tens, blk);
-    FREAL ku = t3.x, kuv = t3.y, kv = t3.z;
-    FREAL h = RL(0.5) * (kv - ku) / kuv;
-    FREAL root = sqrt(RL(1) + h * h);
-    FREAL tt = kuv != 0 ? ((h < 0) ? RL(1) / (h - root) : RL(1) / (h + root)) : (FREAL)RL(0);
-    FREAL c = RL(1) / sqrt(RL(1) + tt * tt);
-    FREAL s = tt * c;
-    FREAL k1 = ku - tt * kuv, k2 = kv + tt * kuv;
-#ifdef SC_COMPAT
-    FMASK keep = fabs(k1) >= fabs(k2);
-#else
-    FMASK keep = k1 >= k2;
-#endif
-    FV3 d1 = sel3(keep, sub3(mul3(ru, c), mul3(rv, s)), add3(mul3(ru, s), mul3(rv, c)));
+    FREAL ka, kb;
+    FV3 d1 = principal_dir(ru, rv, ld3c(tens, blk), &ka, &kb);
     FV3 d2 = cross3(n, d1);
-    FREAL ka = keep ? k1 : k2, kb = keep ? k2 : k1;
     st3c(d1, blk, pd1);
     st3c(d2, blk, pd2);
     st2c(ka, kb, blk, kk);

@@ -1,4 +1,5 @@
-// curvature_face.h: the per-face geometry of kernels/curvature.cl, written
+// curvature_face.h: the per-face geometry of kernels/curvature.cl and the
+// per-vertex steps of its frame and principal passes, written
 // over type macros so that it is instantiated twice: once on scalars (every
 // kernel of the file) and, when SC_LANES > 1, once on OpenCL vectors of
 // SC_LANES faces or vertices (the gather variant's lane kernels; see the
@@ -271,6 +272,59 @@ SC_OL SC_INLINE GM face_dcurv(GTri t, GV3 ft, GV3 fb, GV3 f0, GV3 f1, GV3 f2, GV
     *x = v4(x0, x1, x2, x3);
     return (d0 > 0) & (d1 > 0) & (d2 > 0) & (d3 > 0) & isfinite(x0) & isfinite(x1) &
            isfinite(x2) & isfinite(x3);
+}
+
+// ---------------------------------------------------------------------------
+// Per-vertex steps of curv_frames and curv_principal (one vertex per lane).
+
+// Any unit vector perpendicular to n (n unit).
+SC_OL SC_INLINE GV3 any_perp(GV3 n)
+{
+    GT ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
+    GT o = (GT)RL(1), z = (GT)RL(0);
+    GV3 ex = v3(o, z, z), ey = v3(z, o, z), ez = v3(z, z, o);
+    GV3 a = sel3((ax <= ay) & (ax <= az), ex, sel3(ay <= az, ey, ez));
+    return normalize3(cross3(n, a));
+}
+
+// The unit normal of an accumulated one; +z where it has no finite length.
+SC_OL SC_INLINE GV3 unit_normal(GV3 n)
+{
+    GT len = len3(n);
+    GT o = (GT)RL(1), z = (GT)RL(0);
+    return sel3((len > 0) & isfinite(len), mul3(n, RL(1) / len), v3(z, z, o));
+}
+
+// The initial first direction: e × n made unit, e the edge from the vertex
+// to the next vertex of its owner face; any perpendicular to n where there
+// is no owner face (`owned` false) or e × n has no length.
+SC_OL SC_INLINE GV3 first_dir(GV3 e, GV3 n, GM owned)
+{
+    GV3 p1 = cross3(e, n);
+    GT l = len3(p1);
+    return sel3(owned & (l > RL(1e-20)) & isfinite(l), mul3(p1, RL(1) / l), any_perp(n));
+}
+
+// One Jacobi rotation diagonalises the tensor t = (ku, kuv, kv) given in the
+// frame (ru, rv): the first principal direction, with the principal
+// curvatures in *ka ≥ *kb (|*ka| ≥ |*kb| with SC_COMPAT).
+SC_OL SC_INLINE GV3 principal_dir(GV3 ru, GV3 rv, GV3 t, GT *ka, GT *kb)
+{
+    GT ku = t.x, kuv = t.y, kv = t.z;
+    GT h = RL(0.5) * (kv - ku) / kuv;
+    GT root = sqrt(RL(1) + h * h);
+    GT tt = kuv != 0 ? ((h < 0) ? RL(1) / (h - root) : RL(1) / (h + root)) : (GT)RL(0);
+    GT c = RL(1) / sqrt(RL(1) + tt * tt);
+    GT s = tt * c;
+    GT k1 = ku - tt * kuv, k2 = kv + tt * kuv;
+#ifdef SC_COMPAT
+    GM keep = fabs(k1) >= fabs(k2);
+#else
+    GM keep = k1 >= k2;
+#endif
+    *ka = keep ? k1 : k2;
+    *kb = keep ? k2 : k1;
+    return sel3(keep, sub3(mul3(ru, c), mul3(rv, s)), add3(mul3(ru, s), mul3(rv, c)));
 }
 
 // ---------------------------------------------------------------------------

@@ -177,9 +177,6 @@ struct Kernels {
     dcurv: Kernel,
     /// Gather variant only: the per-vertex one-ring sums of the three passes.
     sums: Option<[Kernel; 3]>,
-    /// Gather variant with lanes: curv_frames and curv_principal also write
-    /// the vertex records that the tensor and derivative face kernels read.
-    records: bool,
     /// Positions from a device buffer of index-space floats (isosurfaces).
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
@@ -363,7 +360,6 @@ impl CurvatureEstimator {
             principal: gpu.kernel(&program, "curv_principal")?,
             dcurv: gpu.kernel(&program, &kname("curv_dcurv"))?,
             sums,
-            records: gather && lanes > 1,
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
             override_normals: gpu.kernel(&program, "curv_override_normals")?,
             lanes: if gather { lanes } else { 1 },
@@ -488,7 +484,9 @@ impl CurvatureEstimator {
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
                 cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
                 // written whole by curv_frames before any kernel reads them
-                rec: if k.records {
+                // with lanes (only the gather variant has them), curv_frames
+                // and curv_principal also write the vertex records
+                rec: if k.lanes > 1 {
                     Some(gpu.buffer::<u8>(REC_REALS * nvp * real)?)
                 } else {
                     None
