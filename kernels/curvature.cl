@@ -45,8 +45,24 @@
 // float operations in curv_tensor_corners (1,664 scalar float operations of
 // 2,346 instructions on pthread-skylake-avx512).
 // Memory access with lanes: nothing is gathered one lane at a time except
-// the positions and face indices of curv_normals_areas_corners and the
-// owner faces' vertices in curv_frames.
+// the owner faces' vertices and their positions in curv_frames.
+//  - Positions of the normal pass (ld_pos): each lane's x y z is one 4-real
+//    load (the next vertex's x comes along unused; the pos buffer has one
+//    real of padding past its last vertex), addressed through a scalar
+//    face-index load, and the rows are transposed into lane vectors in
+//    registers (rows_v3: the rows' stream gathered into four whole vectors,
+//    then two-source shuffles), instead of 9 hardware gathers of positions
+//    and 3 of face indices per block. 500k torus, PoCL: normal corners
+//    6.2–7.2 → 3.2–4.1 ms; lucy 0.65–0.98 → 0.38–0.43 ms (medians of 11 and
+//    61 runs, interleaved processes). Written the same way in curv_frames
+//    (three scalar loads of the owner face per lane, then the next vertex's
+//    row), the chains of dependent scalar loads were slower on the scanned
+//    meshes (lucy 0.24 → 0.29–0.31 ms, bunny 0.17–0.21 → 0.20–0.26) though
+//    faster on the torus (3.3 → 2.3 ms): not kept.
+//  - Face indices: the host pads the faces buffer to whole blocks of 16
+//    faces with copies of the last face, so a block's face indices are
+//    scalar loads at constant offsets. With the clamp at the last face that
+//    this replaces, LLVM had turned them into gathers (3 per corner).
 //  - Vertex records (rec, REC_*): 16 reals per vertex (position, point area,
 //    normal, k1, first direction, k2, second direction), written by
 //    curv_frames and rewritten by curv_principal. The tensor and derivative
@@ -69,14 +85,15 @@
 //    records cost 1.7 and 1.4 ms more; written by the one-lane kernels they
 //    kept PoCL from vectorising those (frames 8.8 against 6.3 ms).
 // Disassembly of PoCL's kernel cache, pthread-skylake-avx512, 16 lanes (the
-// work-group function PoCL built for the 500k torus; instructions / of them
-// on zmm registers / shuffles and inserts / gathers / stack accesses):
-//   curv_normals_areas_corners   588 /   377 / 134 / 24 / 22   (positions, face indices)
-//   curv_tensor_corners        1,532 /   795 / 337 /  0 / 198
-//   curv_dcurv_corners         1,793 / 1,006 / 371 /  0 / 292
-//   curv_frames                  531 /   331 / 170 / 12 / 24   (owner faces' vertices)
-//   curv_principal               457 /   333 / 172 /  0 / 10
-//   curv_tensor_sum               59 /     0 /   2 /  0 / 0    (scalar)
+// work-group function PoCL built for the 500k torus, objdump; instructions /
+// of them on zmm registers / shuffles, inserts, extracts and broadcasts /
+// gathers / operands on the stack, at %rsp or %rbp):
+//   curv_normals_areas_corners   746 /   339 / 190 /  0 /  42
+//   curv_tensor_corners        1,456 /   794 / 352 /  0 / 173
+//   curv_dcurv_corners         1,724 / 1,009 / 340 /  0 / 267
+//   curv_frames                  603 /   331 / 184 / 12 /  45   (owner faces' vertices)
+//   curv_principal               534 /   333 / 176 /  0 /  49
+//   curv_tensor_sum               51 /     0 /   2 /  0 /   0   (scalar)
 // The stack accesses of the tensor and derivative kernels are spills: three
 // records of 16 vectors outnumber the 32 registers. Loading each record in
 // two halves, the second (frame) half of a corner only where it is
@@ -85,7 +102,13 @@
 // Still scalar: the ring sums (curv_*_sum; their loop keeps PoCL's work-item
 // vectoriser off, and written with SC_LANES vertices per work-item, rings
 // walked together to the longest, they ran no faster). Intel's CPU runtime
-// vectorises across work-items itself; lanes gain less there.
+// vectorises across work-items itself; lanes gain less there. Each sum adds
+// a corner as one 4-real vector (one vector add, the same bits as four
+// scalar adds): lucy 0.27 → 0.24 ms per sum, 500k torus 2.5–2.7 → 2.4–2.6.
+// Four consecutive vertices per work-item, their rings walked together to
+// the longest with selects (four independent chains, no branch per vertex),
+// were slower: lucy 0.24 → 0.25 ms, 500k torus 2.4 → 3.1–3.4 ms per sum. So
+// the sums are bound by their loads, not by the latency of their adds.
 // Fusing each ring sum with the per-vertex pass after it (normal sum with
 // curv_frames, tensor sum with curv_principal, raw sums left unstored) was
 // measured slower on PoCL 3.1 (bunny, medians of 41 runs: 0.9 ms against
@@ -137,8 +160,10 @@
 // curv_dcurv.
 //
 // Buffers (V vertices, F faces; REAL is float or double, see real.h):
-//   pos   REAL[3V]  positions, centred and scaled by the host (unit RMS radius)
-//   faces uint[3F]  triangle vertex indices
+//   pos   REAL[3V+1] positions, centred and scaled by the host (unit RMS
+//                    radius), and one real of padding (ld_pos)
+//   faces uint[3F']  triangle vertex indices (F' = F rounded up to 16; the
+//                    padding repeats the last face)
 //   owner int[V]    owning face (−1: unreferenced vertex)
 //   nrm   REAL[3V]  normal (accumulated, then unit)      area REAL[V] point area
 //   pd1, pd2 REAL[3V] initial frame, overwritten by principal directions
@@ -499,15 +524,15 @@ typedef struct {
     FREAL c[16];
 } RecN;
 #define SC_LD_ROW(l, s) \
-    FREAL r##l = VLOADN((size_t)faces[3 * min(f0 + l, last) + c] * (16 / SC_LANES) + q, rec);
+    FREAL r##l = VLOADN((size_t)faces[3 * (f0 + l) + c] * (16 / SC_LANES) + q, rec);
 #define SC_PUT_ROW(l, s) o.c[q * SC_LANES + l] = r##l;
-// The records of corner c's vertices of face block blk (faces past the last
-// repeat it, as in FACE_BLOCK_OR_RETURN); the face indices are scalar loads,
-// used as addresses only.
-SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint nf, uint blk,
-                      uint c)
+// The records of corner c's vertices of face block blk (the faces buffer
+// holds whole blocks: the host repeats the last face in its padding, as
+// FACE_BLOCK_OR_RETURN repeats it in lanes past the last face); the face
+// indices are scalar loads with constant offsets, used as addresses only.
+SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint blk, uint c)
 {
-    const uint f0 = SC_LANES * blk, last = nf - 1;
+    const uint f0 = SC_LANES * blk;
     RecN o;
 #pragma unroll
     for (uint q = 0; q < 16 / SC_LANES; q++) {
@@ -518,6 +543,51 @@ SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint
     return o;
 }
 SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
+
+// The positions of corner c's vertices of face block blk, as lane vectors:
+// each lane's x y z (and the next vertex's x, unused) is one 4-real load
+// addressed through a scalar face-index load (the pos buffer has one real of
+// padding past its last vertex), and the SC_LANES rows of 4 are transposed in
+// registers, instead of one hardware gather per component and face index.
+// The rows' stream is first gathered into four whole vectors a0 … a3
+// (elements 4l … 4l + 3 are lane l's row), then component k of lane j is
+// picked from a0 a1 (lanes of the first half) or a2 a3 (second half).
+#define SC_C2(x, y) __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7)
+#define SC_C4(x, y) \
+    __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+#define SC_P01(j, k) (4 * (j) + (k) < 2 * SC_LANES ? 4 * (j) + (k) : 0)
+#define SC_P23(j, k) (4 * (j) + (k) >= 2 * SC_LANES ? 4 * (j) + (k) - 2 * SC_LANES : 0)
+#define SC_PSEL(j, b) (2 * (j) < SC_LANES ? (j) : SC_LANES + (j))
+#define SC_POS_K(k)                                                                   \
+    __builtin_shufflevector(__builtin_shufflevector(a0, a1, SC_JLIST(SC_P01, k)),     \
+                            __builtin_shufflevector(a2, a3, SC_JLIST(SC_P23, k)),     \
+                            SC_JLIST(SC_PSEL, 0))
+// x y z of lane l's row p[l], as lane vectors.
+SC_INLINE FV3 rows_v3(const REAL4 *p)
+{
+#if SC_LANES == 16
+    const REALN a0 = SC_C4(SC_C2(p[0], p[1]), SC_C2(p[2], p[3])),
+                a1 = SC_C4(SC_C2(p[4], p[5]), SC_C2(p[6], p[7])),
+                a2 = SC_C4(SC_C2(p[8], p[9]), SC_C2(p[10], p[11])),
+                a3 = SC_C4(SC_C2(p[12], p[13]), SC_C2(p[14], p[15]));
+#elif SC_LANES == 8
+    const REALN a0 = SC_C2(p[0], p[1]), a1 = SC_C2(p[2], p[3]), a2 = SC_C2(p[4], p[5]),
+                a3 = SC_C2(p[6], p[7]);
+#elif SC_LANES == 4
+    const REALN a0 = p[0], a1 = p[1], a2 = p[2], a3 = p[3];
+#else
+    const REALN a0 = p[0].lo, a1 = p[0].hi, a2 = p[1].lo, a3 = p[1].hi;
+#endif
+    return v3(SC_POS_K(0), SC_POS_K(1), SC_POS_K(2));
+}
+#define SC_LD_POS_ROW(l, s) p[l] = vload4(0, pos + 3 * (size_t)faces[3 * (f0 + l) + c]);
+SC_INLINE FV3 ld_pos(__global const REAL *pos, __global const uint *faces, uint blk, uint c)
+{
+    const uint f0 = SC_LANES * blk;
+    REAL4 p[SC_LANES];
+    SC_ROWS(SC_LD_POS_ROW)
+    return rows_v3(p);
+}
 
 // The records of vertex block blk (SC_LANES consecutive vertices), component
 // k of every lane in x[k]: each chunk of SC_LANES components is transposed
@@ -832,7 +902,12 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
                                          volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
+#if SC_LANES > 1
+    FTri t = make_tri(ld_pos(pos, faces, blk, 0), ld_pos(pos, faces, blk, 1),
+                      ld_pos(pos, faces, blk, 2));
+#else
     LOAD_FACE_BLOCK(pos, faces);
+#endif
     FMASK deg = tri_degenerate(t);
     FMASK use = !deg;
     FV3 ca = corner_areas(t), fn = face_normal(t);
@@ -856,8 +931,8 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
                                   volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
-         a2 = ld_rec(rec, faces, nf, blk, 2);
+    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
+         a2 = ld_rec(rec, faces, blk, 2);
     FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
     FMASK deg = tri_degenerate(t);
     FV3 ft, fb, x;
@@ -894,8 +969,8 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
                                  volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, nf, blk, 0), a1 = ld_rec(rec, faces, nf, blk, 1),
-         a2 = ld_rec(rec, faces, nf, blk, 2);
+    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
+         a2 = ld_rec(rec, faces, blk, 2);
     FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
     FMASK deg = tri_degenerate(t);
     FV3 ft, fb;
@@ -979,20 +1054,10 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *pos, __global con
 SC_INLINE V4 sum_ring(uint v, __global const uint *ring_off, __global const uint *ring,
                       __global const REAL *corner, bool four)
 {
-    V4 s = v4(RL(0), RL(0), RL(0), RL(0));
-    for (uint r = ring_off[v]; r < ring_off[v + 1]; r++) {
-#ifdef SC_DOUBLE
-        double4 c = vload4(ring[r], corner);
-#else
-        float4 c = vload4(ring[r], corner);
-#endif
-        s.x += c.x;
-        s.y += c.y;
-        s.z += c.z;
-        if (four)
-            s.w += c.w;
-    }
-    return s;
+    REAL4 s = (REAL4)(RL(0));
+    for (uint r = ring_off[v]; r < ring_off[v + 1]; r++)
+        s += vload4(ring[r], corner);
+    return v4(s.x, s.y, s.z, four ? s.w : RL(0));
 }
 
 __kernel void curv_normals_areas_sum(uint nv, __global const uint *ring_off,

@@ -6,10 +6,12 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double REAL;
 typedef double3 REAL3;
+typedef double4 REAL4;
 #define RL(x) ((double)(x))
 #else
 typedef float REAL;
 typedef float3 REAL3;
+typedef float4 REAL4;
 #define RL(x) ((float)(x))
 #endif
 

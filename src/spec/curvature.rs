@@ -544,7 +544,10 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: 
     // vertex, for whole blocks of vertices
     let per_vertex = 20 * r + 4; // + owner
     let per_face = 12;
-    let mut b = padded_vertices(nv) as u64 * per_vertex + nf as u64 * per_face + 16;
+    // (faces in whole blocks, + one real of padding past the positions, + the
+    // counters)
+    let mut b =
+        padded_vertices(nv) as u64 * per_vertex + padded_faces(nf) as u64 * per_face + r + 16;
     if opts.accumulate == Accumulate::Gather {
         // one-ring CSR, 4 reals per face corner, 1 corner weight per corner
         b += (nv as u64 + 1) * 4

@@ -16,7 +16,7 @@ use crate::mesh::order::{LocalityOrder, MeshOrder};
 use crate::mesh::topology::{one_rings_into, owners_from_rings};
 use crate::spec::curvature::{
     Accumulate, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Normalization,
-    Precision, REC_REALS, VertexCurvature, corner_reals_bound, corner_weights_bound,
+    Precision, REC_REALS, VertexCurvature, corner_reals_bound, corner_weights_bound, padded_faces,
     padded_vertices,
 };
 use crate::spec::timing::{Step, Timing};
@@ -238,8 +238,20 @@ impl CurvatureEstimator {
         let (k, program) = Self::build(&gpu, &opts)?;
         let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let flat: &[u32] = bytemuck::cast_slice(faces);
-        let mut faces_b = gpu.buffer::<u32>(flat.len())?;
-        gpu.write(&mut faces_b, flat)?;
+        // Whole blocks of MAX_FACE_LANES faces, the last face repeated in the
+        // padding: the per-face kernels with lanes load a block's face
+        // indices at constant offsets, with no clamp at the last face.
+        let len = 3 * padded_faces(faces.len());
+        let mut faces_b = gpu.buffer::<u32>(len)?;
+        if let Some(last) = faces.last() {
+            gpu.write_with(&mut faces_b, len, |b| {
+                let (head, pad) = b.split_at_mut(flat.len());
+                head.copy_from_slice(flat);
+                for f in pad.chunks_exact_mut(3) {
+                    f.copy_from_slice(last);
+                }
+            })?;
+        }
         Self::with_faces(
             gpu,
             n_vertices,
@@ -441,9 +453,13 @@ impl CurvatureEstimator {
         // [`CurvatureEstimator::device_outputs`] must see finite values.
         // Reals per vertex of pos, nrm, area, pd1, pd2, tens, kk, dk.
         const REALS: [usize; 8] = [3, 3, 1, 3, 3, 3, 2, 4];
+        // The positions have one real more: the normal pass with lanes loads
+        // each vertex's x y z as 4 reals (kernels/curvature.cl, ld_pos).
+        let reals = |i: usize, n: usize| n * nvp + usize::from(i == 0);
         let mut bufs = REALS
             .iter()
-            .map(|n| gpu.buffer::<u8>(n * nvp * real))
+            .enumerate()
+            .map(|(i, &n)| gpu.buffer::<u8>(reals(i, n) * real))
             .collect::<Result<Vec<_>>>()?;
         // The fills are enqueued (no host zeros) and run on the device
         // beside the host's work below; the one `finish` at the end waits
@@ -451,8 +467,8 @@ impl CurvatureEstimator {
         // buffers' pages, which then costs the host nothing: on the 2M
         // torus the topology phase went from 259-304 to 191-214 ms.
         let zero_all = |bufs: &mut [Buffer<u8>]| -> Result<()> {
-            for (b, n) in bufs.iter_mut().zip(REALS) {
-                gpu.zero(b, n * nvp * real)?;
+            for (i, (b, n)) in bufs.iter_mut().zip(REALS).enumerate() {
+                gpu.zero(b, reals(i, n) * real)?;
             }
             gpu.flush()
         };
