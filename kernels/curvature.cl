@@ -99,6 +99,10 @@
 // two halves, the second (frame) half of a corner only where it is
 // projected, did not help (500k torus, tensor + dcurv: 25.4–25.7 against
 // 24.9–26.8 ms over three interleaved pairs).
+// Nor did taking the derivative pass's positions from ld_pos and loading
+// each corner's record only once the face frame is known, so that it dies
+// after its projection: LLVM scheduled the loads early all the same (1,853
+// instructions, 334 on the stack), and lucy's dcurv corners got slower.
 // Still scalar: the ring sums (curv_*_sum; their loop keeps PoCL's work-item
 // vectoriser off, and written with SC_LANES vertices per work-item, rings
 // walked together to the longest, they ran no faster). Intel's CPU runtime
