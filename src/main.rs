@@ -7,6 +7,9 @@ mod cli;
 
 use clap::{Parser, Subcommand};
 
+#[global_allocator]
+static ALLOC: cli::alloc::HugeBlocks = cli::alloc::HugeBlocks;
+
 #[derive(Parser)]
 #[command(
     name = "shapecue",

@@ -2,6 +2,7 @@
 //! share: writing to standard output (a closed pipe ends the command
 //! quietly), the outputs check, JSON stats, and the one error report.
 
+pub mod alloc;
 pub mod curvature;
 pub mod devices;
 pub mod edges;
