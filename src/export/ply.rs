@@ -5,13 +5,13 @@
 //! field `nx ny nz area k1 k2 d1x d1y d1z d2x d2y d2z dk0 dk1 dk2 dk3`
 //! ([`FIELD_PROPERTIES`]). Faces: `property list uchar int vertex_indices`.
 
-use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, PropertyType};
 
+use super::output::OutputFile;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureField, VertexCurvature};
@@ -185,11 +185,8 @@ fn write_rows(
     };
     super::output::write_atomic(path, |w| {
         if let Some(why) = write_body(w, path, mesh, names, &extra, false)? {
-            use std::io::{Seek, SeekFrom};
             w.flush().map_err(write_err)?;
-            let file = w.get_mut();
-            file.set_len(0).map_err(write_err)?;
-            file.seek(SeekFrom::Start(0)).map_err(write_err)?;
+            w.get_mut().restart().map_err(write_err)?;
             write_body(w, path, mesh, names, &extra, true)?;
             written.double = Some(why);
         }
@@ -211,7 +208,7 @@ const BLOCK_VERTICES: usize = 1024;
 /// [`BLOCK_VERTICES`]: their values gathered, checked in one loop, then
 /// converted in one loop; the faces in blocks of 13-byte records.
 fn write_body(
-    w: &mut BufWriter<File>,
+    w: &mut BufWriter<OutputFile>,
     path: &Path,
     mesh: &Mesh,
     names: &[&str],
