@@ -11,7 +11,7 @@
 //! - `curvature/cpu-reference/bunny`: wall time of the f64 CPU reference,
 //!   for scale.
 //!
-//! Inputs: the Stanford bunny from `shared/data/meshes` (skipped if absent)
+//! Inputs: the Stanford bunny and lucy from `shared/data/meshes` (skipped if absent)
 //! and generated tori of about 500k and 2M vertices, each in the memory order
 //! `shapecue curvature` computes it in (`--order auto`: the bunny's scanned
 //! order is renumbered along a Morton curve, the tori's grid order is kept;
@@ -65,6 +65,7 @@ const SMALL: Sampling = Sampling {
 fn trimesh2_ms(input: &str) -> Option<f64> {
     match input {
         "bunny" => Some(19.7),
+        "lucy" => Some(28.7),
         "torus-500k" => Some(253.0),
         "torus-2m" => Some(1014.0),
         _ => None,
@@ -85,6 +86,11 @@ fn inputs() -> Vec<Input> {
     if common::quick() {
         eprintln!("curvature bench: SHAPECUE_BENCH_QUICK set, bunny only");
     } else {
+        v.push(Input {
+            name: "lucy",
+            make: || common::shared_mesh("curvature", "lucy.ply"),
+            sampling: SMALL,
+        });
         v.push(Input {
             name: "torus-500k",
             make: || Some(torus_of(500_000)),
@@ -209,7 +215,8 @@ fn curvature_benches(c: &mut Criterion) {
                     Duration::from_secs_f64(ms * 1e-3)
                 })
             });
-            if let Some(t2) = trimesh2_ms(input.name) {
+            // (nothing ran when a filter left this variant out)
+            if let Some(t2) = trimesh2_ms(input.name).filter(|_| !each.is_empty()) {
                 let k = shapecue::metrics::median(&mut each);
                 eprintln!(
                     "curvature/{id}: kernel median {k:.2} ms, {:.1}× faster than trimesh2's {t2} ms",
