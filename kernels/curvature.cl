@@ -26,7 +26,7 @@
 // 9.3 → 8.2 ms.
 //
 // Explicit SIMD lanes (SC_LANES, set by the host: the device's native vector
-// width on CPUs, 1 on GPUs; only with the gather scheme). The per-face
+// width on CPUs, 1 on GPUs; either scheme). The per-face
 // kernels handle SC_LANES consecutive faces per work-item, and curv_frames
 // and curv_principal SC_LANES consecutive vertices: their geometry
 // (kernels/common/curvature_face.h) is written once over type macros and
@@ -350,7 +350,7 @@ SC_OL SC_INLINE UINTN ldu(__global const uint *a, UINTN i) { return (UINTN)(SC_L
 #undef GTri
 
 #if SC_LANES > 1
-// The types of the gather variant's per-face kernels.
+// The types of the per-face kernels.
 typedef REALN FREAL;
 typedef MASKN FMASK;
 typedef UINTN FIDX;
@@ -547,6 +547,15 @@ SC_INLINE RecN ld_rec(__global const REAL *rec, __global const uint *faces, uint
     return o;
 }
 SC_INLINE FV3 rec3(RecN a, int k) { return v3(a.c[k], a.c[k + 1], a.c[k + 2]); }
+// vertex_coef and vertex_curv_by from a vertex's record.
+SC_INLINE FV4 rec_coef(RecN a, FV3 ft, FV3 fb)
+{
+    return proj_coef(rec3(a, REC_PD1), rec3(a, REC_PD2), ft, fb);
+}
+SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
+{
+    return proj_curv_by(c, v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]));
+}
 
 // The positions of corner c's vertices of face block blk, as lane vectors:
 // each lane's x y z (and the next vertex's x, unused) is one 4-real load
@@ -781,7 +790,8 @@ __kernel void curv_count_empty(uint nv, __global const REAL *area,
 }
 
 // ---------------------------------------------------------------------------
-// Atomic (scatter) variant: one work-item per face, float atomics on the one-ring.
+// Atomic (scatter) variant: one work-item per face (or per block of SC_LANES
+// faces), float atomics on the one-ring.
 // A program holds the kernels of one scheme: these without SC_GATHER, the
 // gather kernels below with it (the host sets it for the gather scheme).
 #ifndef SC_GATHER
@@ -814,6 +824,7 @@ SC_INLINE void atomic_add4(volatile __global REAL *a, uint v, V4 x)
     atomic_add_real(&a[4 * v + 3], x.w);
 }
 
+#if SC_LANES == 1
 __kernel void curv_normals_areas(uint nf, __global const REAL *pos, __global const uint *faces,
                                  volatile __global REAL *nrm, volatile __global REAL *area,
                                  volatile __global uint *counters)
@@ -882,6 +893,115 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
     atomic_add4(dk, v1, dcurv_by(q1, corner_weight(ca.y, area[v1]), x));
     atomic_add4(dk, v2, dcurv_by(q2, corner_weight(ca.z, area[v2]), x));
 }
+
+#else // SC_LANES > 1
+// With lanes (CPU devices): SC_LANES consecutive faces per work-item, their
+// arithmetic the lane code of the gather kernels below (positions through
+// ld_pos, the vertex records through ld_rec, the same helpers), and then
+// each lane's corners added to their vertices one float atomic add per value
+// (scatter_*), lane after lane, for the lanes whose face is used. The adds
+// stay scalar; what they save is the scalar arithmetic: with one face per
+// work-item PoCL 3.1 leaves these kernels unvectorised (an atomic stops its
+// work-item vectoriser), and with the compare-and-swap adds replaced by
+// plain ones (a timing probe, wrong results) the scheme took 5.9-6.5 of its
+// 7.8 ms on the bunny. With lanes (medians of 11-21 runs, interleaved
+// processes): PoCL, bunny 8.4-8.7 -> 7.0-7.6 ms, lucy 11.3 -> 8.4-8.8,
+// 500k torus 114 -> 87 (tensor 34 -> 23, dcurv 44 -> 31; the normal pass,
+// almost all adds, 29 -> 28 there and 2.2 -> 2.7-2.9 on the bunny); Intel's
+// runtime, bunny 8.0 -> 5.9 ms, 500k torus 120 -> 88 (native float adds
+// 6.5 -> 5.9 and 98 -> 88). What remains is the adds: about 5.5-6.5 ns of a
+// core per add (the bunny's tensor pass: 625,000 adds in 1.75 ms on 2 cores),
+// scalar, each a read, an add and a locked compare-and-swap.
+#define SC_SCATTER_NA(l, s)                                  \
+    if (m.s) {                                               \
+        atomic_add3(nrm, v.s, v3(x.x.s, x.y.s, x.z.s));      \
+        atomic_add_real(&area[v.s], x.w.s);                  \
+    }
+SC_INLINE void scatter_na(volatile __global REAL *nrm, volatile __global REAL *area, FIDX v,
+                          FV4 x, INTN m)
+{
+    SC_ROWS(SC_SCATTER_NA)
+}
+#define SC_SCATTER3(l, s) \
+    if (m.s) atomic_add3(acc, v.s, v3(x.x.s, x.y.s, x.z.s));
+SC_INLINE void scatter3(volatile __global REAL *acc, FIDX v, FV3 x, INTN m)
+{
+    SC_ROWS(SC_SCATTER3)
+}
+#define SC_SCATTER4(l, s) \
+    if (m.s) atomic_add4(acc, v.s, v4(x.x.s, x.y.s, x.z.s, x.w.s));
+SC_INLINE void scatter4(volatile __global REAL *acc, FIDX v, FV4 x, INTN m)
+{
+    SC_ROWS(SC_SCATTER4)
+}
+
+__kernel void curv_normals_areas(uint nf, __global const REAL *pos, __global const uint *faces,
+                                 volatile __global REAL *nrm, volatile __global REAL *area,
+                                 volatile __global uint *counters)
+{
+    FACE_BLOCK_OR_RETURN(nf);
+    FTri t = make_tri(ld_pos(pos, faces, blk, 0), ld_pos(pos, faces, blk, 1),
+                      ld_pos(pos, faces, blk, 2));
+    FMASK deg = tri_degenerate(t);
+    FV3 ca = corner_areas(t), fn = face_normal(t);
+    FREAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
+    INTN m = CONVERT_INTN(!deg) & live;
+    scatter_na(nrm, area, ldu(faces, 3 * fid), ext4(corner_normal(fn, l1, l2), ca.x), m);
+    scatter_na(nrm, area, ldu(faces, 3 * fid + 1), ext4(corner_normal(fn, l2, l0), ca.y), m);
+    scatter_na(nrm, area, ldu(faces, 3 * fid + 2), ext4(corner_normal(fn, l0, l1), ca.z), m);
+    count_lanes(&counters[0], deg, live);
+}
+
+__kernel void curv_tensor(uint nf, __global const REAL *rec, __global const uint *faces,
+                          volatile __global REAL *tens, volatile __global uint *counters)
+{
+    FACE_BLOCK_OR_RETURN(nf);
+    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
+         a2 = ld_rec(rec, faces, blk, 2);
+    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb, x;
+    face_frame(t, &ft, &fb);
+    FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM), rec3(a2, REC_NRM), &x);
+    INTN m = CONVERT_INTN((!deg) & ok) & live;
+    FV3 ca = corner_areas(t);
+    FREAL w0 = corner_weight(ca.x, a0.c[REC_AREA]);
+    FREAL w1 = corner_weight(ca.y, a1.c[REC_AREA]);
+    FREAL w2 = corner_weight(ca.z, a2.c[REC_AREA]);
+    FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
+    FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
+    FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    scatter3(tens, ldu(faces, 3 * fid), c0, m);
+    scatter3(tens, ldu(faces, 3 * fid + 1), c1, m);
+    scatter3(tens, ldu(faces, 3 * fid + 2), c2, m);
+    count_lanes(&counters[2], (!deg) & (!ok), live);
+}
+
+__kernel void curv_dcurv(uint nf, __global const REAL *rec, __global const uint *faces,
+                         volatile __global REAL *dk, volatile __global uint *counters)
+{
+    FACE_BLOCK_OR_RETURN(nf);
+    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
+         a2 = ld_rec(rec, faces, blk, 2);
+    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
+    FMASK deg = tri_degenerate(t);
+    FV3 ft, fb;
+    FV4 x;
+    face_frame(t, &ft, &fb);
+    FV4 q0 = rec_coef(a0, ft, fb), q1 = rec_coef(a1, ft, fb), q2 = rec_coef(a2, ft, fb);
+    FMASK ok = face_dcurv(t, ft, fb, rec_curv_by(a0, q0), rec_curv_by(a1, q1),
+                          rec_curv_by(a2, q2), &x);
+    INTN m = CONVERT_INTN((!deg) & ok) & live;
+    FV3 ca = corner_areas(t);
+    FV4 c0 = dcurv_by(q0, corner_weight(ca.x, a0.c[REC_AREA]), x);
+    FV4 c1 = dcurv_by(q1, corner_weight(ca.y, a1.c[REC_AREA]), x);
+    FV4 c2 = dcurv_by(q2, corner_weight(ca.z, a2.c[REC_AREA]), x);
+    scatter4(dk, ldu(faces, 3 * fid), c0, m);
+    scatter4(dk, ldu(faces, 3 * fid + 1), c1, m);
+    scatter4(dk, ldu(faces, 3 * fid + 2), c2, m);
+    count_lanes(&counters[3], (!deg) & (!ok), live);
+}
+#endif // SC_LANES > 1
 
 #endif // !SC_GATHER
 
@@ -956,16 +1076,6 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
     CW_ST(!deg ? w1 : z, 1);
     CW_ST(!deg ? w2 : z, 2);
     count_lanes(&counters[2], (!deg) & (!ok), live);
-}
-
-// vertex_coef and vertex_curv_by from a vertex's record.
-SC_INLINE FV4 rec_coef(RecN a, FV3 ft, FV3 fb)
-{
-    return proj_coef(rec3(a, REC_PD1), rec3(a, REC_PD2), ft, fb);
-}
-SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
-{
-    return proj_curv_by(c, v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]));
 }
 
 __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global const uint *faces,

@@ -464,6 +464,71 @@ fn face_lanes_give_bitwise_identical_results() {
     assert!(err.to_string().contains("1, 2, 4, 8 or 16"), "{err}");
 }
 
+/// The atomic scheme with face lanes (SIMD arithmetic, then one float atomic
+/// add per value and lane) agrees with its one-lane form on the same meshes
+/// as above (partial face and vertex blocks, degenerate faces, skipped
+/// solves), in both precisions: the counts exactly, the normals, areas and
+/// principal curvatures up to the rounding of sums taken in another order
+/// (atomic sums have no fixed order in either form). Directions are left out:
+/// on these near-umbilic spheres they turn with any rounding.
+#[test]
+fn atomic_scheme_with_lanes_matches_one_lane() {
+    let mut sliver = mesh::jittered_sphere(1.0, 3, 0.2, 5);
+    let v = sliver.faces[7];
+    sliver.faces.push([v[0], v[0], v[1]]);
+    let p = sliver.positions[v[0] as usize];
+    sliver.positions.push(p);
+    let n = sliver.positions.len() as u32 - 1;
+    sliver.faces.push([v[0], n, v[1]]);
+    let mut open_sphere = mesh::jittered_sphere(1.0, 4, 0.3, 3);
+    open_sphere.faces.truncate(open_sphere.faces.len() - 5);
+    let meshes = [
+        ("jittered sphere with a hole", open_sphere),
+        ("sphere with degenerate faces", sliver),
+        ("torus", mesh::torus(1.0, 0.4, 37, 19)),
+    ];
+    for (what, m) in &meshes {
+        assert_ne!(
+            m.n_faces() % 16,
+            0,
+            "{what}: want a partial last face block"
+        );
+        for (prec, tol) in [(Precision::F32, 1e-5), (Precision::F64, 1e-12)] {
+            let o = |lanes| CurvatureOptions {
+                lanes,
+                ..with(CurvatureOptions::default(), Accumulate::Atomic, prec)
+            };
+            let run = |lanes| {
+                let mut est =
+                    CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o(lanes)).unwrap();
+                assert_eq!(est.face_lanes(), lanes);
+                est.set_positions(&m.positions).unwrap();
+                est.run().unwrap();
+                (est.read().unwrap(), est.counts().unwrap())
+            };
+            let (one, one_counts) = run(1);
+            for lanes in [4, 16] {
+                let (f, counts) = run(lanes);
+                assert_eq!(counts, one_counts, "{what} {prec:?}: {lanes} lanes' counts");
+                let flat = |v: &[[f64; 3]]| v.iter().flatten().copied().collect::<Vec<_>>();
+                for (name, a, b) in [
+                    ("normals", flat(&f.normals), flat(&one.normals)),
+                    ("areas", f.areas.clone(), one.areas.clone()),
+                    ("k1", f.k1.clone(), one.k1.clone()),
+                    ("k2", f.k2.clone(), one.k2.clone()),
+                ] {
+                    assert!(a.iter().all(|x| x.is_finite()), "{what} {prec:?}: {name}");
+                    let e = nrmse(&a, &b);
+                    assert!(
+                        e <= tol,
+                        "{what} {prec:?}, {lanes} lanes: {name} NRMSE {e:e}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// `--accumulate atomic-native` (cl_ext_float_atomics) agrees with the
 /// compare-and-swap atomics and the CPU reference where the device offers
 /// native float atomics (Intel's CPU runtime), and is refused with a message
@@ -933,11 +998,12 @@ fn wrong_pose_sizes_and_non_finite_poses_are_errors() {
 #[test]
 fn memory_stays_within_budget() {
     // f32: the atomic scheme ≤ 192 bytes per vertex + 32 per face; the
-    // gather scheme ≤ 96 + 96 (one-ring lists, corners and corner weights),
-    // and 64 more per vertex with SIMD lanes (its vertex records)
+    // gather scheme ≤ 96 + 96 (one-ring lists, corners and corner weights);
+    // either 64 more per vertex with SIMD lanes (the vertex records)
     let m = mesh::torus(1.0, 0.4, 200, 100);
     for (acc, lanes, per_vertex, per_face) in [
         (Accumulate::Atomic, 1, 192, 32),
+        (Accumulate::Atomic, 16, 256, 32),
         (Accumulate::Gather, 1, 96, 96),
         (Accumulate::Gather, 16, 160, 96),
     ] {
@@ -948,20 +1014,21 @@ fn memory_stays_within_budget() {
         assert!(b <= budget, "{acc:?}, {lanes} lanes: {b} > {budget}");
     }
     // and an estimator reports the bound of its own face lanes
-    for lanes in [1, 16] {
+    for (acc, lanes) in [
+        (Accumulate::Gather, 1),
+        (Accumulate::Gather, 16),
+        (Accumulate::Atomic, 1),
+        (Accumulate::Atomic, 16),
+    ] {
         let o = CurvatureOptions {
             lanes,
-            ..with(
-                CurvatureOptions::default(),
-                Accumulate::Gather,
-                Precision::F32,
-            )
+            ..with(CurvatureOptions::default(), acc, Precision::F32)
         };
         let e = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();
         assert_eq!(e.face_lanes(), lanes);
         let bound =
             shapecue::spec::curvature::device_bytes_bound(m.n_vertices(), m.n_faces(), &o, lanes);
-        assert_eq!(e.device_bytes(), bound, "{lanes} lanes");
+        assert_eq!(e.device_bytes(), bound, "{acc:?}, {lanes} lanes");
     }
 }
 

@@ -50,11 +50,13 @@ pub struct CurvatureArgs {
     /// faster exact scheme of each).
     #[arg(long, value_enum)]
     accumulate: Option<Accumulate>,
-    /// Faces per work-item of the gather scheme's per-face kernels (and
-    /// vertices per work-item of its frame and principal passes), computed
-    /// as SIMD lanes: 1, 2, 4, 8 or 16. Default: the device's native vector
-    /// width on CPU devices, 1 on GPUs. The results do not depend on it;
-    /// more than one lane adds 64 bytes of device memory per vertex (f32).
+    /// Faces per work-item of the per-face kernels (and vertices per
+    /// work-item of the frame and principal passes), computed as SIMD
+    /// lanes: 1, 2, 4, 8 or 16. Default: the device's native vector width on
+    /// CPU devices, 1 on GPUs. The gather scheme gives the same bits for
+    /// every count, the atomic schemes the same values up to the rounding
+    /// of their sums; more than one lane adds 64 bytes of device memory per
+    /// vertex (f32).
     #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
     lanes: Option<String>,
     /// Order of the vertices and faces in device memory: auto renumbers

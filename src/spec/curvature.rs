@@ -289,11 +289,13 @@ pub struct CurvatureOptions {
     pub compat: Compat,
     /// Compute the curvature derivative (the dcurv pass).
     pub dcurv: bool,
-    /// Faces per work-item of the gather variant's per-face kernels (and
-    /// vertices per work-item of its frame and principal kernels), as
-    /// explicit SIMD lanes: 0 picks by device type ([`face_lanes_for`]),
-    /// else 1, 2, 4, 8 or 16. Results do not depend on it; the atomic
-    /// variant ignores it.
+    /// Faces per work-item of the per-face kernels (and vertices per
+    /// work-item of the frame and principal kernels), as explicit SIMD
+    /// lanes: 0 picks by device type ([`face_lanes_for`]), else 1, 2, 4, 8
+    /// or 16. The gather variant gives the same bits for every count, the
+    /// atomic variants the same values up to the rounding of their sums.
+    /// A mesh already on the device ([`crate::stages::curvature::CurvatureEstimator::from_device`])
+    /// always runs with 1.
     pub lanes: u32,
 }
 
@@ -473,8 +475,7 @@ pub fn one_ring_len_bound(nf: usize) -> usize {
     3 * nf
 }
 
-/// The most faces one work-item of the gather variant's per-face kernels
-/// handles (`SC_LANES` in `kernels/curvature.cl`).
+/// The most faces one work-item of the per-face kernels handles (`SC_LANES` in `kernels/curvature.cl`).
 pub const MAX_FACE_LANES: u32 = 16;
 
 /// Faces the gather variant's buffers are sized for: `nf` rounded up to whole
@@ -510,7 +511,7 @@ pub fn corner_weights_bound(nf: usize) -> usize {
     3 * padded_faces(nf)
 }
 
-/// Faces per work-item of the gather variant's per-face kernels on a device:
+/// Faces per work-item of the per-face kernels on a device (either scheme):
 /// `requested` when not 0, else by device type (the rule the estimator uses;
 /// `native_width` is the device's `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT` or
 /// `_DOUBLE` for the precision):
@@ -534,9 +535,8 @@ pub fn face_lanes_for(requested: u32, device_kind: &str, native_width: u32) -> u
 }
 
 /// Bytes of device memory the curvature estimator allocates for a mesh, by
-/// variant and face lanes (the same arithmetic as its allocations): the
-/// gather scheme with more than one lane adds [`REC_REALS`] reals per vertex
-/// of vertex records.
+/// variant and face lanes (the same arithmetic as its allocations): more
+/// than one lane adds [`REC_REALS`] reals per vertex of vertex records.
 pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: u32) -> u64 {
     let r = opts.precision.bytes() as u64;
     let (nv, nf) = (nv.max(1), nf.max(1));
@@ -553,9 +553,9 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: 
         b += (nv as u64 + 1) * 4
             + one_ring_len_bound(nf) as u64 * 4
             + (corner_reals_bound(nf) + corner_weights_bound(nf)) as u64 * r;
-        if lanes > 1 {
-            b += padded_vertices(nv) as u64 * REC_REALS as u64 * r;
-        }
+    }
+    if lanes > 1 {
+        b += padded_vertices(nv) as u64 * REC_REALS as u64 * r;
     }
     b
 }

@@ -140,6 +140,10 @@ pub struct CurvatureEstimator {
     faces: Buffer<u32>,
     owner: Buffer<i32>,
     gather: Option<GatherBufs>,
+    /// With lanes (either scheme): 16 reals per vertex (`REC_*` in
+    /// kernels/curvature.cl), what the tensor and derivative face kernels
+    /// read of each vertex.
+    rec: Option<Buffer<u8>>,
     pos: Buffer<u8>,
     nrm: Buffer<u8>,
     area: Buffer<u8>,
@@ -181,9 +185,8 @@ struct Kernels {
     load_positions: Kernel,
     /// Given unit normals replace the accumulated ones (isosurfaces).
     override_normals: Kernel,
-    /// Faces (vertices) per work-item of the gather variant's per-face
-    /// (frame and principal) kernels, 1 for the atomic variant: `SC_LANES`
-    /// of the build.
+    /// Faces per work-item of the per-face kernels, and vertices per
+    /// work-item of the frame and principal kernels: `SC_LANES` of the build.
     lanes: u32,
 }
 
@@ -194,21 +197,19 @@ struct GatherBufs {
     corner: Buffer<u8>,
     /// Corner areas, then weights, of each face corner (3 reals per face).
     cw: Buffer<u8>,
-    /// With lanes: 16 reals per vertex (`REC_*` in kernels/curvature.cl).
-    rec: Option<Buffer<u8>>,
 }
 
 /// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
-/// per work-item in the gather variant's per-face kernels.
+/// per work-item in the per-face kernels.
 pub fn build_options(opts: &CurvatureOptions, lanes: u32) -> String {
     let mut s = String::new();
     if opts.accumulate == Accumulate::Gather {
         // The program then holds the gather kernels only, not the atomic ones
         // (PoCL builds it from source about 5 % sooner).
         s.push_str("-DSC_GATHER ");
-        if lanes > 1 {
-            s.push_str(&format!("-DSC_LANES={lanes} "));
-        }
+    }
+    if lanes > 1 {
+        s.push_str(&format!("-DSC_LANES={lanes} "));
     }
     if opts.accumulate == Accumulate::AtomicNative {
         // atomic_fetch_add_explicit on atomic_float needs OpenCL C 2.0 or later
@@ -374,7 +375,7 @@ impl CurvatureEstimator {
             sums,
             load_positions: gpu.kernel(&program, "curv_load_positions")?,
             override_normals: gpu.kernel(&program, "curv_override_normals")?,
-            lanes: if gather { lanes } else { 1 },
+            lanes,
         };
         Ok((k, program))
     }
@@ -407,6 +408,9 @@ impl CurvatureEstimator {
             }
             .map_err(|e| Error::cl("clEnqueueCopyBuffer", e))?;
         }
+        // One face per work-item: the face kernels with lanes read the faces
+        // in whole blocks, which this buffer, copied as it is, does not hold.
+        let opts = CurvatureOptions { lanes: 1, ..opts };
         let t0 = Instant::now();
         let (k, program) = Self::build(&gpu, &opts)?;
         let build_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -499,14 +503,6 @@ impl CurvatureEstimator {
                 ring: ring_b,
                 corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
                 cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
-                // written whole by curv_frames before any kernel reads them
-                // with lanes (only the gather variant has them), curv_frames
-                // and curv_principal also write the vertex records
-                rec: if k.lanes > 1 {
-                    Some(gpu.buffer::<u8>(REC_REALS * nvp * real)?)
-                } else {
-                    None
-                },
             })
         } else {
             zero_all(&mut bufs)?;
@@ -526,7 +522,15 @@ impl CurvatureEstimator {
         let [pos, nrm, area, pd1, pd2, tens, kk, dk]: [Buffer<u8>; 8] = bufs
             .try_into()
             .unwrap_or_else(|_| unreachable!("one buffer per entry of REALS"));
+        // With lanes, curv_frames and curv_principal also write the vertex
+        // records (written whole by curv_frames before any kernel reads them).
+        let rec = if k.lanes > 1 {
+            Some(gpu.buffer::<u8>(REC_REALS * nvp * real)?)
+        } else {
+            None
+        };
         let est = CurvatureEstimator {
+            rec,
             pos,
             nrm,
             area,
@@ -590,9 +594,9 @@ impl CurvatureEstimator {
         self.gpu.write(&mut self.owner, owner)
     }
 
-    /// Faces per work-item of the gather variant's per-face kernels as built
-    /// for this device (also vertices per work-item of its frame and
-    /// principal kernels; 1 for the atomic variant).
+    /// Faces per work-item of the per-face kernels as built for this device
+    /// (also vertices per work-item of the frame and principal kernels; 1 for
+    /// a mesh already on the device).
     pub fn face_lanes(&self) -> u32 {
         self.k.lanes
     }
@@ -775,7 +779,9 @@ impl CurvatureEstimator {
                     a.extend_from_slice(face_args);
                     a.extend_from_slice(outputs);
                     a.push(cnt);
-                    evs.extend(launch(g, face_kernel, nf, &a)?.map(|e| (pass, e)));
+                    // One work-item per block of `lanes` faces.
+                    let blocks = nf.div_ceil(self.k.lanes as usize);
+                    evs.extend(launch(g, face_kernel, blocks, &a)?.map(|e| (pass, e)));
                 }
             }
             Ok(evs)
@@ -803,11 +809,8 @@ impl CurvatureEstimator {
                 );
             }
         }
-        // The vertex records of the gather scheme with lanes (see `Kernels`).
-        let rec = match &self.gather {
-            Some(GatherBufs { rec: Some(r), .. }) => Some(buf(r)),
-            _ => None,
-        };
+        // The vertex records of either scheme with lanes (see `Kernels`).
+        let rec = self.rec.as_ref().map(buf);
         if Pass::Frames <= last {
             let mut args = vec![Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
             args.extend(rec.map(|r| [area, r, cnt]).into_iter().flatten());
