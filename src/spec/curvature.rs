@@ -294,7 +294,7 @@ pub struct CurvatureOptions {
     /// lanes: 0 picks by device type ([`face_lanes_for`]), else 1, 2, 4, 8
     /// or 16. The gather variant gives the same bits for every count, the
     /// atomic variants the same values up to the rounding of their sums.
-    /// A mesh already on the device ([`crate::stages::curvature::CurvatureEstimator::from_device`])
+    /// A mesh already on the device (`CurvatureEstimator::from_device`)
     /// always runs with 1.
     pub lanes: u32,
 }
@@ -475,7 +475,8 @@ pub fn one_ring_len_bound(nf: usize) -> usize {
     3 * nf
 }
 
-/// The most faces one work-item of the per-face kernels handles (`SC_LANES` in `kernels/curvature.cl`).
+/// The most faces one work-item of the per-face kernels handles (`SC_LANES`
+/// in `kernels/curvature.cl`).
 pub const MAX_FACE_LANES: u32 = 16;
 
 /// Faces the gather variant's buffers are sized for: `nf` rounded up to whole
