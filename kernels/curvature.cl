@@ -809,19 +809,38 @@ __kernel void curv_clear(uint nv, __global REAL *nrm, __global REAL *area, __glo
     dk[4 * gid + 3] = 0;
 }
 
+// With SC_PAIR_ADDS, a vertex's 3 reals take one pair add and one single
+// (the pair at 3v for even v, at 3v + 1 for odd v: 8-byte aligned either
+// way) and its 4 reals two pair adds: 11 locked operations per face corner
+// become 7.
 SC_INLINE void atomic_add3(volatile __global REAL *a, uint v, V3 x)
 {
+#ifdef SC_PAIR_ADDS
+    if (v & 1) {
+        atomic_add_real(&a[3 * v], x.x);
+        atomic_add_pair(&a[3 * v + 1], x.y, x.z);
+    } else {
+        atomic_add_pair(&a[3 * v], x.x, x.y);
+        atomic_add_real(&a[3 * v + 2], x.z);
+    }
+#else
     atomic_add_real(&a[3 * v], x.x);
     atomic_add_real(&a[3 * v + 1], x.y);
     atomic_add_real(&a[3 * v + 2], x.z);
+#endif
 }
 
 SC_INLINE void atomic_add4(volatile __global REAL *a, uint v, V4 x)
 {
+#ifdef SC_PAIR_ADDS
+    atomic_add_pair(&a[4 * v], x.x, x.y);
+    atomic_add_pair(&a[4 * v + 2], x.z, x.w);
+#else
     atomic_add_real(&a[4 * v], x.x);
     atomic_add_real(&a[4 * v + 1], x.y);
     atomic_add_real(&a[4 * v + 2], x.z);
     atomic_add_real(&a[4 * v + 3], x.w);
+#endif
 }
 
 #if SC_LANES == 1
@@ -909,9 +928,15 @@ __kernel void curv_dcurv(uint nf, __global const REAL *pos, __global const uint 
 // 500k torus 114 -> 87 (tensor 34 -> 23, dcurv 44 -> 31; the normal pass,
 // almost all adds, 29 -> 28 there and 2.2 -> 2.7-2.9 on the bunny); Intel's
 // runtime, bunny 8.0 -> 5.9 ms, 500k torus 120 -> 88 (native float adds
-// 6.5 -> 5.9 and 98 -> 88). What remains is the adds: about 5.5-6.5 ns of a
-// core per add (the bunny's tensor pass: 625,000 adds in 1.75 ms on 2 cores),
-// scalar, each a read, an add and a locked compare-and-swap.
+// 6.5 -> 5.9 and 98 -> 88). What remained was the adds: about 5.5-6.5 ns
+// of a core per add (the bunny's tensor pass: 625,000 adds in 1.75 ms on 2
+// cores), scalar, each a read, an add and a locked compare-and-swap. Pair
+// adds (SC_PAIR_ADDS, kernels/common/atomics.h: two adjacent floats in one
+// 64-bit compare-and-swap, 7 locked operations per face corner instead of
+// 11) then took, with 16 lanes (medians of 11-21 runs, 3 interleaved pairs
+// of processes): PoCL, bunny 6.2 -> 4.2-4.6 ms (tensor 1.71 -> 1.22, dcurv
+// 2.27 -> 1.30, normals 2.03 -> 1.55), lucy 9.0-10.5 -> 6.1-7.3, 500k torus
+// 92.6 -> 65.6; Intel's runtime, bunny 6.3 -> 4.3, 500k torus 92 -> 63.
 #define SC_SCATTER_NA(l, s)                                  \
     if (m.s) {                                               \
         atomic_add3(nrm, v.s, v3(x.x.s, x.y.s, x.z.s));      \

@@ -529,6 +529,59 @@ fn atomic_scheme_with_lanes_matches_one_lane() {
     }
 }
 
+/// The compare-and-swap scheme in f32 adds two adjacent floats in one 64-bit
+/// compare-and-swap on a device with cl_khr_int64_base_atomics (both CPU
+/// runtimes here). The same device told it has no 64-bit atomics builds the
+/// one-float form: both agree, counts exactly and values up to the rounding
+/// of the sums' order, with lanes and without, and the option is named in
+/// the program's build options only where it applies.
+#[test]
+fn pair_adds_match_single_adds() {
+    let paired = gpu();
+    if !paired.info.int64_atomics {
+        eprintln!("skipping: the device has no cl_khr_int64_base_atomics");
+        return;
+    }
+    let mut single = shapecue::gpu::Gpu::new(None).unwrap();
+    single.info.int64_atomics = false;
+    let single = std::sync::Arc::new(single);
+    let m = mesh::jittered_sphere(1.0, 4, 0.3, 3);
+    for lanes in [1, 16] {
+        let o = CurvatureOptions {
+            lanes,
+            ..with(
+                CurvatureOptions::default(),
+                Accumulate::Atomic,
+                Precision::F32,
+            )
+        };
+        let run = |g: &std::sync::Arc<shapecue::gpu::Gpu>| {
+            let mut est = CurvatureEstimator::new(g.clone(), m.n_vertices(), &m.faces, o).unwrap();
+            est.set_positions(&m.positions).unwrap();
+            est.run().unwrap();
+            (est.read().unwrap(), est.counts().unwrap())
+        };
+        let ((a, ca), (b, cb)) = (run(&paired), run(&single));
+        assert_eq!(ca, cb, "{lanes} lanes: counts");
+        for (name, x, y) in [
+            ("areas", &a.areas, &b.areas),
+            ("k1", &a.k1, &b.k1),
+            ("k2", &a.k2, &b.k2),
+        ] {
+            let e = nrmse(x, y);
+            assert!(e <= 1e-5, "{lanes} lanes: {name} NRMSE {e:e}");
+        }
+        let opts = |g: &shapecue::gpu::Gpu| {
+            g.program_builds()
+                .iter()
+                .map(|b| b.options.clone())
+                .collect::<Vec<_>>()
+        };
+        assert!(opts(&paired).iter().any(|o| o.contains("-DSC_PAIR_ADDS")));
+        assert!(opts(&single).iter().all(|o| !o.contains("-DSC_PAIR_ADDS")));
+    }
+}
+
 /// `--accumulate atomic-native` (cl_ext_float_atomics) agrees with the
 /// compare-and-swap atomics and the CPU reference where the device offers
 /// native float atomics (Intel's CPU runtime), and is refused with a message

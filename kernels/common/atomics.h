@@ -42,3 +42,20 @@ inline void atomic_add_real(volatile __global REAL *p, REAL v)
     } while (atomic_cmpxchg((volatile __global uint *)p, old_v.u, new_v.u) != old_v.u);
 }
 #endif
+
+// With -DSC_PAIR_ADDS (float compare-and-swap accumulation on a device with
+// cl_khr_int64_base_atomics): two adjacent floats, p 8-byte aligned, added in
+// one 64-bit compare-and-swap. Each float gets the same rounded sum as from
+// its own add; the pair only halves the locked operations, which bound the
+// atomic scheme on CPU devices.
+#ifdef SC_PAIR_ADDS
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+inline void atomic_add_pair(volatile __global float *p, float a, float b)
+{
+    union { ulong u; float2 f; } old_v, new_v;
+    do {
+        old_v.u = *(volatile __global ulong *)p;
+        new_v.f = old_v.f + (float2)(a, b);
+    } while (atom_cmpxchg((volatile __global ulong *)p, old_v.u, new_v.u) != old_v.u);
+}
+#endif

@@ -200,9 +200,14 @@ struct GatherBufs {
 }
 
 /// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
-/// per work-item in the per-face kernels.
-pub fn build_options(opts: &CurvatureOptions, lanes: u32) -> String {
+/// per work-item in the per-face kernels; `pair_adds`: the compare-and-swap
+/// scheme in f32 adds two adjacent floats in one 64-bit compare-and-swap
+/// where it can (the device has `cl_khr_int64_base_atomics`).
+pub fn build_options(opts: &CurvatureOptions, lanes: u32, pair_adds: bool) -> String {
     let mut s = String::new();
+    if pair_adds && opts.accumulate == Accumulate::Atomic && opts.precision == Precision::F32 {
+        s.push_str("-DSC_PAIR_ADDS ");
+    }
     if opts.accumulate == Accumulate::Gather {
         // The program then holds the gather kernels only, not the atomic ones
         // (PoCL builds it from source about 5 % sooner).
@@ -342,7 +347,8 @@ impl CurvatureEstimator {
         };
         let lanes = crate::spec::curvature::face_lanes_for(opts.lanes, &gpu.info.kind, native);
         let file = kernel_file("curvature").expect("curvature kernels are embedded");
-        let program = gpu.program(&file, &build_options(opts, lanes))?;
+        let pair_adds = gpu.info.int64_atomics;
+        let program = gpu.program(&file, &build_options(opts, lanes, pair_adds))?;
         let gather = opts.accumulate == Accumulate::Gather;
         let kname = |base: &str| {
             if gather {
