@@ -556,6 +556,37 @@ SC_INLINE FV3 rec_curv_by(RecN a, FV4 c)
 {
     return proj_curv_by(c, v3(a.c[REC_K1], (FREAL)RL(0), a.c[REC_K2]));
 }
+// tensor_w from a vertex's record.
+SC_INLINE FV3 rec_tensor_w(RecN a, FREAL w, FV3 ft, FV3 fb, FV3 x)
+{
+    return mul3(proj_curv(ft, fb, x, rec3(a, REC_PD1), rec3(a, REC_PD2)), w);
+}
+
+// The start of the tensor and derivative face kernels with lanes, of either
+// scheme (as LOAD_FACE_BLOCK for one lane): the records a0 a1 a2 of the
+// block's corners, its triangle t, the degenerate lanes deg and the face
+// frame ft fb.
+#define REC_FACE_BLOCK(rec, faces)                                              \
+    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),      \
+         a2 = ld_rec(rec, faces, blk, 2);                                       \
+    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS)); \
+    FMASK deg = tri_degenerate(t);                                              \
+    FV3 ft, fb;                                                                 \
+    face_frame(t, &ft, &fb);
+// The tensor pass's face solve (after REC_FACE_BLOCK): x, and ok where it
+// was solved.
+#define REC_TENSOR_SOLVE()                                                      \
+    FV3 x;                                                                      \
+    FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM),     \
+                           rec3(a2, REC_NRM), &x);
+// The derivative pass's (after REC_FACE_BLOCK): the projection coefficients
+// q0 q1 q2 of the corners, x, and ok.
+#define REC_DCURV_SOLVE()                                                       \
+    FV4 x;                                                                      \
+    FV4 q0 = rec_coef(a0, ft, fb), q1 = rec_coef(a1, ft, fb),                   \
+        q2 = rec_coef(a2, ft, fb);                                              \
+    FMASK ok = face_dcurv(t, ft, fb, rec_curv_by(a0, q0), rec_curv_by(a1, q1),  \
+                          rec_curv_by(a2, q2), &x);
 
 // The positions of corner c's vertices of face block blk, as lane vectors:
 // each lane's x y z (and the next vertex's x, unused) is one 4-real load
@@ -600,6 +631,12 @@ SC_INLINE FV3 ld_pos(__global const REAL *pos, __global const uint *faces, uint 
     REAL4 p[SC_LANES];
     SC_ROWS(SC_LD_POS_ROW)
     return rows_v3(p);
+}
+// The triangles of face block blk from the positions (ld_pos per corner).
+SC_INLINE FTri ld_pos_tri(__global const REAL *pos, __global const uint *faces, uint blk)
+{
+    return make_tri(ld_pos(pos, faces, blk, 0), ld_pos(pos, faces, blk, 1),
+                    ld_pos(pos, faces, blk, 2));
 }
 
 // The records of vertex block blk (SC_LANES consecutive vertices), component
@@ -999,8 +1036,7 @@ __kernel void curv_normals_areas(uint nf, __global const REAL *pos, __global con
                                  volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    FTri t = make_tri(ld_pos(pos, faces, blk, 0), ld_pos(pos, faces, blk, 1),
-                      ld_pos(pos, faces, blk, 2));
+    FTri t = ld_pos_tri(pos, faces, blk);
     FMASK deg = tri_degenerate(t);
     FV3 ca = corner_areas(t), fn = face_normal(t);
     FREAL l0 = dot3(t.e0, t.e0), l1 = dot3(t.e1, t.e1), l2 = dot3(t.e2, t.e2);
@@ -1015,21 +1051,16 @@ __kernel void curv_tensor(uint nf, __global const REAL *rec, __global const uint
                           volatile __global REAL *tens, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
-         a2 = ld_rec(rec, faces, blk, 2);
-    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
-    FMASK deg = tri_degenerate(t);
-    FV3 ft, fb, x;
-    face_frame(t, &ft, &fb);
-    FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM), rec3(a2, REC_NRM), &x);
+    REC_FACE_BLOCK(rec, faces)
+    REC_TENSOR_SOLVE()
     INTN m = CONVERT_INTN((!deg) & ok) & live;
     FV3 ca = corner_areas(t);
     FREAL w0 = corner_weight(ca.x, a0.c[REC_AREA]);
     FREAL w1 = corner_weight(ca.y, a1.c[REC_AREA]);
     FREAL w2 = corner_weight(ca.z, a2.c[REC_AREA]);
-    FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
-    FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
-    FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    FV3 c0 = rec_tensor_w(a0, w0, ft, fb, x);
+    FV3 c1 = rec_tensor_w(a1, w1, ft, fb, x);
+    FV3 c2 = rec_tensor_w(a2, w2, ft, fb, x);
     scatter3(tens, ldu(faces, 3 * fid), c0, m);
     scatter3(tens, ldu(faces, 3 * fid + 1), c1, m);
     scatter3(tens, ldu(faces, 3 * fid + 2), c2, m);
@@ -1040,16 +1071,8 @@ __kernel void curv_dcurv(uint nf, __global const REAL *rec, __global const uint 
                          volatile __global REAL *dk, volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
-         a2 = ld_rec(rec, faces, blk, 2);
-    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
-    FMASK deg = tri_degenerate(t);
-    FV3 ft, fb;
-    FV4 x;
-    face_frame(t, &ft, &fb);
-    FV4 q0 = rec_coef(a0, ft, fb), q1 = rec_coef(a1, ft, fb), q2 = rec_coef(a2, ft, fb);
-    FMASK ok = face_dcurv(t, ft, fb, rec_curv_by(a0, q0), rec_curv_by(a1, q1),
-                          rec_curv_by(a2, q2), &x);
+    REC_FACE_BLOCK(rec, faces)
+    REC_DCURV_SOLVE()
     INTN m = CONVERT_INTN((!deg) & ok) & live;
     FV3 ca = corner_areas(t);
     FV4 c0 = dcurv_by(q0, corner_weight(ca.x, a0.c[REC_AREA]), x);
@@ -1086,8 +1109,7 @@ __kernel void curv_normals_areas_corners(uint nf, __global const REAL *pos,
 {
     FACE_BLOCK_OR_RETURN(nf);
 #if SC_LANES > 1
-    FTri t = make_tri(ld_pos(pos, faces, blk, 0), ld_pos(pos, faces, blk, 1),
-                      ld_pos(pos, faces, blk, 2));
+    FTri t = ld_pos_tri(pos, faces, blk);
 #else
     LOAD_FACE_BLOCK(pos, faces);
 #endif
@@ -1114,20 +1136,15 @@ __kernel void curv_tensor_corners(uint nf, __global const REAL *rec, __global co
                                   volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
-         a2 = ld_rec(rec, faces, blk, 2);
-    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
-    FMASK deg = tri_degenerate(t);
-    FV3 ft, fb, x;
-    face_frame(t, &ft, &fb);
-    FMASK ok = face_tensor(t, ft, fb, rec3(a0, REC_NRM), rec3(a1, REC_NRM), rec3(a2, REC_NRM), &x);
+    REC_FACE_BLOCK(rec, faces)
+    REC_TENSOR_SOLVE()
     FMASK use = (!deg) & ok;
     FREAL w0 = corner_weight(CW_LD(0), a0.c[REC_AREA]);
     FREAL w1 = corner_weight(CW_LD(1), a1.c[REC_AREA]);
     FREAL w2 = corner_weight(CW_LD(2), a2.c[REC_AREA]);
-    FV3 c0 = mul3(proj_curv(ft, fb, x, rec3(a0, REC_PD1), rec3(a0, REC_PD2)), w0);
-    FV3 c1 = mul3(proj_curv(ft, fb, x, rec3(a1, REC_PD1), rec3(a1, REC_PD2)), w1);
-    FV3 c2 = mul3(proj_curv(ft, fb, x, rec3(a2, REC_PD1), rec3(a2, REC_PD2)), w2);
+    FV3 c0 = rec_tensor_w(a0, w0, ft, fb, x);
+    FV3 c1 = rec_tensor_w(a1, w1, ft, fb, x);
+    FV3 c2 = rec_tensor_w(a2, w2, ft, fb, x);
     st_corners(corner, blk, zero_unless(use, ext4(c0, (FREAL)RL(0))),
                zero_unless(use, ext4(c1, (FREAL)RL(0))), zero_unless(use, ext4(c2, (FREAL)RL(0))));
     FREAL z = (FREAL)RL(0);
@@ -1142,16 +1159,8 @@ __kernel void curv_dcurv_corners(uint nf, __global const REAL *rec, __global con
                                  volatile __global uint *counters)
 {
     FACE_BLOCK_OR_RETURN(nf);
-    RecN a0 = ld_rec(rec, faces, blk, 0), a1 = ld_rec(rec, faces, blk, 1),
-         a2 = ld_rec(rec, faces, blk, 2);
-    FTri t = make_tri(rec3(a0, REC_POS), rec3(a1, REC_POS), rec3(a2, REC_POS));
-    FMASK deg = tri_degenerate(t);
-    FV3 ft, fb;
-    FV4 x;
-    face_frame(t, &ft, &fb);
-    FV4 q0 = rec_coef(a0, ft, fb), q1 = rec_coef(a1, ft, fb), q2 = rec_coef(a2, ft, fb);
-    FMASK ok = face_dcurv(t, ft, fb, rec_curv_by(a0, q0), rec_curv_by(a1, q1),
-                          rec_curv_by(a2, q2), &x);
+    REC_FACE_BLOCK(rec, faces)
+    REC_DCURV_SOLVE()
     FMASK use = (!deg) & ok;
     FREAL w0 = CW_LD(0), w1 = CW_LD(1), w2 = CW_LD(2);
     FV4 c0 = dcurv_by(q0, w0, x), c1 = dcurv_by(q1, w1, x), c2 = dcurv_by(q2, w2, x);
