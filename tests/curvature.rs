@@ -381,14 +381,10 @@ fn mapped_reads_give_the_bits_of_copied_reads() {
     }
 }
 
-/// The gather variant's lane kernels (the per-face kernels, and curv_frames
-/// and curv_principal with their vertex records) give the same bits for
-/// every lane count: on meshes whose face and vertex counts are not
-/// multiples of 16 (lanes past the last face or vertex), with degenerate
-/// faces and skipped solves (masked lanes), in both precisions. Counts agree
-/// too.
-#[test]
-fn face_lanes_give_bitwise_identical_results() {
+/// Meshes for the lane tests: face and vertex counts that are not multiples
+/// of 16 (lanes past the last face or vertex), degenerate faces and skipped
+/// solves (masked lanes).
+fn lane_test_meshes() -> Vec<(&'static str, Mesh)> {
     let mut sliver = mesh::jittered_sphere(1.0, 3, 0.2, 5);
     // a zero-area face and a repeated vertex: degenerate lanes in a block
     let v = sliver.faces[7];
@@ -400,7 +396,7 @@ fn face_lanes_give_bitwise_identical_results() {
     let mut open_sphere = mesh::jittered_sphere(1.0, 4, 0.3, 3);
     open_sphere.faces.truncate(open_sphere.faces.len() - 5);
     let lone = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let meshes = [
+    let meshes = vec![
         ("jittered sphere with a hole", open_sphere),
         (
             "lone triangle",
@@ -420,6 +416,20 @@ fn face_lanes_give_bitwise_identical_results() {
             0,
             "{what}: want a partial last vertex block"
         );
+    }
+    meshes
+}
+
+/// The gather variant's lane kernels (the per-face kernels, and curv_frames
+/// and curv_principal with their vertex records) give the same bits for
+/// every lane count: on meshes whose face and vertex counts are not
+/// multiples of 16 (lanes past the last face or vertex), with degenerate
+/// faces and skipped solves (masked lanes), in both precisions. Counts agree
+/// too.
+#[test]
+fn face_lanes_give_bitwise_identical_results() {
+    let meshes = lane_test_meshes();
+    for (what, m) in &meshes {
         for prec in [Precision::F32, Precision::F64] {
             let o = |lanes| CurvatureOptions {
                 lanes,
@@ -464,35 +474,15 @@ fn face_lanes_give_bitwise_identical_results() {
     assert!(err.to_string().contains("1, 2, 4, 8 or 16"), "{err}");
 }
 
-/// The atomic scheme with face lanes (SIMD arithmetic, then one float atomic
-/// add per value and lane) agrees with its one-lane form on the same meshes
-/// as above (partial face and vertex blocks, degenerate faces, skipped
-/// solves), in both precisions: the counts exactly, the normals, areas and
-/// principal curvatures up to the rounding of sums taken in another order
-/// (atomic sums have no fixed order in either form). Directions are left out:
+/// The atomic scheme with face lanes (SIMD arithmetic, then float atomic
+/// adds, lane after lane) agrees with its one-lane form on the meshes of
+/// [`lane_test_meshes`], in both precisions: the counts exactly, the
+/// normals, areas and principal curvatures up to the rounding of sums taken
+/// in another order (atomic sums have no fixed order in either form). Directions are left out:
 /// on these near-umbilic spheres they turn with any rounding.
 #[test]
 fn atomic_scheme_with_lanes_matches_one_lane() {
-    let mut sliver = mesh::jittered_sphere(1.0, 3, 0.2, 5);
-    let v = sliver.faces[7];
-    sliver.faces.push([v[0], v[0], v[1]]);
-    let p = sliver.positions[v[0] as usize];
-    sliver.positions.push(p);
-    let n = sliver.positions.len() as u32 - 1;
-    sliver.faces.push([v[0], n, v[1]]);
-    let mut open_sphere = mesh::jittered_sphere(1.0, 4, 0.3, 3);
-    open_sphere.faces.truncate(open_sphere.faces.len() - 5);
-    let meshes = [
-        ("jittered sphere with a hole", open_sphere),
-        ("sphere with degenerate faces", sliver),
-        ("torus", mesh::torus(1.0, 0.4, 37, 19)),
-    ];
-    for (what, m) in &meshes {
-        assert_ne!(
-            m.n_faces() % 16,
-            0,
-            "{what}: want a partial last face block"
-        );
+    for (what, m) in &lane_test_meshes() {
         for (prec, tol) in [(Precision::F32, 1e-5), (Precision::F64, 1e-12)] {
             let o = |lanes| CurvatureOptions {
                 lanes,
