@@ -121,11 +121,11 @@ pub fn label(o: &CurvatureOptions) -> String {
             Compat::Trimesh2 => "trimesh2",
         },
         if o.dcurv { "" } else { " no-dcurv" }
-    ) + &match (o.accumulate, o.lanes) {
-        // explicit lane counts of the gather scheme; 0 is the device's default
-        (Accumulate::Gather, 1) => " 1-lane".to_string(),
-        (Accumulate::Gather, n) if n > 1 => format!(" {n}-lanes"),
-        _ => String::new(),
+    ) + &match o.lanes {
+        // explicit lane counts; 0 is the device's default
+        0 => String::new(),
+        1 => " 1-lane".to_string(),
+        n => format!(" {n}-lanes"),
     }
 }
 
@@ -134,6 +134,9 @@ pub fn variants() -> Vec<CurvatureOptions> {
     let d = CurvatureOptions::default();
     vec![
         d,
+        // the compare-and-swap scheme one face per work-item (the paper's
+        // form): what SIMD lanes gain it on a CPU device
+        CurvatureOptions { lanes: 1, ..d },
         CurvatureOptions { dcurv: false, ..d },
         CurvatureOptions {
             accumulate: Accumulate::Gather,
