@@ -249,7 +249,7 @@ __kernel void curv_max_face(uint nf, __global const uint *faces, volatile __glob
 #include "common/curvature_lanes.h"
 
 // ---------------------------------------------------------------------------
-// Per-vertex passes (both variants).
+// Per-vertex passes (both schemes).
 
 #if SC_LANES == 1
 // Unit normal, and the initial tangent frame from the owner face:

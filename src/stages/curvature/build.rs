@@ -56,8 +56,8 @@ pub fn build_options(opts: &CurvatureOptions, lanes: u32, pair_adds: bool) -> St
         s.push_str("-DSC_PAIR_ADDS ");
     }
     if opts.accumulate == Accumulate::Gather {
-        // The program then holds the gather kernels only, not the atomic ones
-        // (PoCL builds it from source about 5 % sooner).
+        // kernels/curvature.cl then includes the gather scheme's kernels
+        // (kernels/curvature_gather.cl), not the atomic ones.
         s.push_str("-DSC_GATHER ");
     }
     if lanes > 1 {
