@@ -9,6 +9,7 @@
 use super::{OneRing, Pass};
 use crate::error::Result;
 use crate::gpu::{Arg, Gpu, buf, launch};
+use crate::spec::curvature::CurvKernel;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -26,11 +27,11 @@ impl Kernels {
     /// The kernels of a program built without `SC_GATHER`.
     pub(super) fn new(gpu: &Gpu, program: &Program) -> Result<Self> {
         Ok(Kernels {
-            clear: gpu.kernel(program, "curv_clear")?,
+            clear: gpu.entry(program, CurvKernel::Clear)?,
             face: [
-                gpu.kernel(program, "curv_normals_areas")?,
-                gpu.kernel(program, "curv_tensor")?,
-                gpu.kernel(program, "curv_dcurv")?,
+                gpu.entry(program, CurvKernel::NormalsAreas)?,
+                gpu.entry(program, CurvKernel::Tensor)?,
+                gpu.entry(program, CurvKernel::Dcurv)?,
             ],
         })
     }
@@ -72,7 +73,7 @@ pub(super) fn owners(
     owner: &mut Buffer<i32>,
     nvp: usize,
 ) -> Result<()> {
-    let max_face = gpu.kernel(program, "curv_max_face")?;
+    let max_face = gpu.entry(program, CurvKernel::MaxFace)?;
     gpu.write(owner, &vec![-1i32; nvp])?;
     launch(
         gpu,

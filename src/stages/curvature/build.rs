@@ -5,6 +5,7 @@
 use super::{CurvatureEstimator, atomic, gather};
 use crate::error::{Error, Result};
 use crate::gpu::{Gpu, kernel_file};
+use crate::spec::curvature::CurvKernel;
 use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use crate::spec::timing::Timing;
 use opencl3::kernel::Kernel;
@@ -160,11 +161,11 @@ impl CurvatureEstimator {
             SchemeKernels::Atomic(atomic::Kernels::new(gpu, &program)?)
         };
         let k = Kernels {
-            frames: gpu.kernel(&program, "curv_frames")?,
-            count_empty: gpu.kernel(&program, "curv_count_empty")?,
-            principal: gpu.kernel(&program, "curv_principal")?,
-            load_positions: gpu.kernel(&program, "curv_load_positions")?,
-            override_normals: gpu.kernel(&program, "curv_override_normals")?,
+            frames: gpu.entry(&program, CurvKernel::Frames)?,
+            count_empty: gpu.entry(&program, CurvKernel::CountEmpty)?,
+            principal: gpu.entry(&program, CurvKernel::Principal)?,
+            load_positions: gpu.entry(&program, CurvKernel::LoadPositions)?,
+            override_normals: gpu.entry(&program, CurvKernel::OverrideNormals)?,
             lanes,
         };
         Ok(Built {

@@ -9,6 +9,7 @@ use super::{OneRing, Pass};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, launch};
 use crate::mesh::topology::{one_rings_into, owners_from_rings};
+use crate::spec::curvature::CurvKernel;
 use crate::spec::curvature::{
     MAX_FACE_LANES, corner_reals_bound, corner_weights_bound, one_ring_len_bound, padded_vertices,
 };
@@ -30,14 +31,14 @@ impl Kernels {
     pub(super) fn new(gpu: &Gpu, program: &Program) -> Result<Self> {
         Ok(Kernels {
             sums: [
-                gpu.kernel(program, "curv_normals_areas_sum")?,
-                gpu.kernel(program, "curv_tensor_sum")?,
-                gpu.kernel(program, "curv_dcurv_sum")?,
+                gpu.entry(program, CurvKernel::NormalsAreasSum)?,
+                gpu.entry(program, CurvKernel::TensorSum)?,
+                gpu.entry(program, CurvKernel::DcurvSum)?,
             ],
             face: [
-                gpu.kernel(program, "curv_normals_areas_corners")?,
-                gpu.kernel(program, "curv_tensor_corners")?,
-                gpu.kernel(program, "curv_dcurv_corners")?,
+                gpu.entry(program, CurvKernel::NormalsAreasCorners)?,
+                gpu.entry(program, CurvKernel::TensorCorners)?,
+                gpu.entry(program, CurvKernel::DcurvCorners)?,
             ],
         })
     }

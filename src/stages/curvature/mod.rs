@@ -61,17 +61,10 @@ pub enum Pass {
 }
 
 impl Pass {
-    /// The pass name used in stats and reports.
+    /// The pass name used in stats and reports: its timing step's name
+    /// (the kernel entry point without `curv_`).
     pub fn name(self) -> &'static str {
-        match self {
-            Pass::MaxFace => "max_face",
-            Pass::Clear => "clear",
-            Pass::NormalsAreas => "normals_areas",
-            Pass::Frames => "frames",
-            Pass::Tensor => "tensor",
-            Pass::Principal => "principal",
-            Pass::Dcurv => "dcurv",
-        }
+        self.step().name()
     }
 }
 
