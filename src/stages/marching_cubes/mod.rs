@@ -1,25 +1,28 @@
-//! Host wiring of `kernels/marching_cubes.cl` and the isosurface pipeline:
-//! the volume is uploaded once; each extraction runs `mc_classify` → scan →
-//! `mc_triangles` and then vertex fusion ([`crate::stages::vertex_fusion`]),
-//! leaving the indexed mesh on the device (for the curvature passes) until
-//! the caller reads it. CPU twin: [`crate::cpu::marching_cubes`]; shared
-//! case table, layout, bounds and options: [`crate::spec::marching_cubes`].
+//! The isosurface pipeline on the device, one algorithm per file over the
+//! same uploaded volume and case table: [`soup`] wires
+//! `kernels/marching_cubes.cl` (`mc_classify` → scan → `mc_triangles`, then
+//! vertex fusion, [`crate::stages::vertex_fusion`]) and [`direct`] wires
+//! `kernels/marching_cubes_direct.cl` (direct numbering, after Flying
+//! Edges). Either leaves the indexed mesh on the device (for the curvature
+//! passes) until the caller reads it. CPU twin: [`crate::cpu::marching_cubes`];
+//! shared case table, layout, bounds and options: [`crate::spec::marching_cubes`].
 //!
-//! Memory: the soup is sized exactly from the classify counts; the kernels
-//! still check a capacity and count what would not fit, so a bug can never
-//! write past a buffer. A volume or an output that the device cannot hold is
-//! a clear error naming the bytes needed.
+//! Memory: a volume or an output that the device cannot hold is a clear
+//! error naming the bytes needed.
+
+mod direct;
+mod soup;
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureOptions, Normalization};
-use crate::spec::marching_cubes::{cell_rows, edge_key_bits, soup_vertices_bound, table};
-use crate::spec::timing::{Step, Timing};
-use crate::spec::vertex_fusion::{Fusion, FusionCounts};
+use crate::spec::marching_cubes::{cell_rows, edge_key_bits, table};
+use crate::spec::timing::Timing;
+use crate::spec::vertex_fusion::Fusion;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::scan::Scan;
-use crate::stages::vertex_fusion::{Fuser, Grow, build_options};
+use crate::stages::vertex_fusion::{Fuser, build_options};
 use crate::volume::Volume;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -81,41 +84,11 @@ pub struct Isosurfacer {
     counts: Buffer<u8>,
     tris: Buffer<u8>,
     flat: Buffer<u8>,
-    classify: Kernel,
-    triangles: Kernel,
-    iota: Kernel,
     gradient: Kernel,
-    direct_rows: Kernel,
-    direct_count: Kernel,
-    direct_hits: Kernel,
-    direct_triangles: Kernel,
-    direct_points: Kernel,
-    direct_recount: Kernel,
     scan: Scan,
     fuser: Fuser,
-    row_tris: Buffer<u32>,
-    row_off: Buffer<u32>,
-    counters: Buffer<u32>,
-    pos: Grow<f32>,
-    key: Grow<u32>,
-    idx: Grow<u32>,
-    soup_faces: Grow<u32>,
-    /// Direct numbering: per grid row counts (scanned in place), splits, trims.
-    rowc: Buffer<u32>,
-    info: Buffer<u32>,
-    split: Buffer<u32>,
-    trim: Buffer<u32>,
-    hit_keys: Grow<u32>,
-    /// Kept triangles per cell row where there are hits (scanned in place).
-    tcount: Buffer<u32>,
-    /// Triangles with a corner on a grid point: (face, a, b, c, in a grid plane).
-    side: Grow<u32>,
-    side_n: Buffer<u32>,
-    dpos: Grow<f32>,
-    dfaces: Grow<u32>,
-    /// The volume has NaN or infinite voxels (known at upload): direct
-    /// numbering then removes the vertices of edges only skipped cells use.
-    nonfinite: bool,
+    soup: soup::Soup,
+    direct: direct::Direct,
     result: Option<(Holder, usize, usize)>,
 }
 
@@ -147,8 +120,12 @@ impl Isosurfacer {
                 "volume of {n} voxels: at most 2^32 − 1 voxels"
             )));
         }
+        let opts = build_options(collide_mask);
         let file = kernel_file("marching_cubes").expect("marching_cubes kernels are embedded");
-        let p = gpu.program(&file, &build_options(collide_mask))?;
+        let p = gpu.program(&file, &opts)?;
+        let file = kernel_file("marching_cubes_direct")
+            .expect("marching_cubes_direct kernels are embedded");
+        let pd = gpu.program(&file, &opts)?;
         let mut volb = gpu.buffer_flags::<f32>(n, CL_MEM_READ_ONLY)?;
         gpu.write(&mut volb, &vol.values)?;
         let t = table();
@@ -168,36 +145,16 @@ impl Isosurfacer {
             counts,
             tris,
             flat,
-            classify: gpu.kernel(&p, "mc_classify")?,
-            triangles: gpu.kernel(&p, "mc_triangles")?,
-            iota: gpu.kernel(&p, "mc_iota")?,
             gradient: gpu.kernel(&p, "mc_gradient_normals")?,
-            direct_rows: gpu.kernel(&p, "mc_direct_rows")?,
-            direct_count: gpu.kernel(&p, "mc_direct_count")?,
-            direct_hits: gpu.kernel(&p, "mc_direct_hits")?,
-            direct_triangles: gpu.kernel(&p, "mc_direct_triangles")?,
-            direct_points: gpu.kernel(&p, "mc_direct_points")?,
-            direct_recount: gpu.kernel(&p, "mc_direct_recount")?,
             scan: Scan::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
-            row_tris: gpu.buffer::<u32>(rows)?,
-            row_off: gpu.buffer::<u32>(rows)?,
-            counters: gpu.buffer::<u32>(2)?,
-            pos: Grow::new(&gpu)?,
-            key: Grow::new(&gpu)?,
-            idx: Grow::new(&gpu)?,
-            soup_faces: Grow::new(&gpu)?,
-            rowc: gpu.buffer::<u32>(4 * grid_rows)?,
-            info: gpu.buffer::<u32>(4 * grid_rows)?,
-            split: gpu.buffer::<u32>(2 * grid_rows)?,
-            trim: gpu.buffer::<u32>(2 * grid_rows)?,
-            hit_keys: Grow::new(&gpu)?,
-            tcount: gpu.buffer::<u32>(grid_rows)?,
-            side: Grow::new(&gpu)?,
-            side_n: gpu.buffer::<u32>(1)?,
-            dpos: Grow::new(&gpu)?,
-            dfaces: Grow::new(&gpu)?,
-            nonfinite: vol.values.iter().any(|v| !v.is_finite()),
+            soup: soup::Soup::new(&gpu, &p, rows)?,
+            direct: direct::Direct::new(
+                &gpu,
+                &pd,
+                grid_rows,
+                vol.values.iter().any(|v| !v.is_finite()),
+            )?,
             result: None,
             gpu,
         })
@@ -217,16 +174,10 @@ impl Isosurfacer {
     pub fn device_bytes(&self) -> u64 {
         let rows = cell_rows(self.dims) as u64;
         4 * (self.dims.iter().product::<usize>() as u64)
-            + 8 * rows
-            + self.pos.bytes()
-            + self.key.bytes()
-            + self.idx.bytes()
-            + self.soup_faces.bytes()
-            + 52 * (self.dims[1] * self.dims[2]) as u64
-            + self.side.bytes()
-            + self.hit_keys.bytes()
-            + self.dpos.bytes()
-            + self.dfaces.bytes()
+            + self.soup.device_bytes(rows)
+            + self
+                .direct
+                .device_bytes((self.dims[1] * self.dims[2]) as u64)
             + self.fuser.device_bytes()
     }
 
@@ -238,7 +189,6 @@ impl Isosurfacer {
                 "iso value must be finite, got {iso}"
             )));
         }
-        let g = self.gpu.clone();
         let t0 = Instant::now();
         let [nx, ny, nz] = self.dims;
         let voxels = nx * ny * nz;
@@ -263,341 +213,12 @@ impl Isosurfacer {
         }
         if fusion == Fusion::Direct {
             self.extract_direct(iso, &mut st)?;
-            st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-            st.device_bytes = self.device_bytes();
-            return Ok(st);
-        }
-        let common = [
-            Arg::U32(rows as u32),
-            Arg::U32(nx as u32),
-            Arg::U32(ny as u32),
-            buf(&self.vol),
-            Arg::F32(iso),
-        ];
-        let mut a = common.to_vec();
-        a.extend([buf(&self.counts), buf(&self.row_tris)]);
-        let e_cls = launch(&g, &self.classify, rows, &a)?;
-        let tris = self.scan.exclusive(&self.row_tris, &self.row_off, rows)? as usize;
-        if let Some(e) = &e_cls {
-            st.timing.add(Step::McClassify, event_ms(e));
-        }
-        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-        let soup = soup_vertices_bound(tris);
-        if soup as u64 > u32::MAX as u64 {
-            return Err(Error::InvalidArgument(format!(
-                "iso {iso}: {tris} triangles exceed the 32-bit soup index"
-            )));
-        }
-        let need = crate::spec::marching_cubes::device_bytes_bound(voxels, rows, soup);
-        if need > g.info.global_mem {
-            return Err(Error::DeviceUnsupported {
-                device: g.info.name.clone(),
-                what: format!(
-                    "iso {iso} gives {tris} triangles; extracting and fusing them needs about \
-                     {need} bytes of device memory, the device has {}",
-                    g.info.global_mem
-                ),
-            });
-        }
-        self.pos.reserve(&g, 3 * soup)?;
-        if fusion != Fusion::None {
-            self.key.reserve(&g, soup)?;
-            self.idx.reserve(&g, soup)?;
-        }
-        g.write(&mut self.counters, &[0, 0])?;
-        let mut a = common.to_vec();
-        a.extend([
-            buf(&self.counts),
-            buf(&self.tris),
-            buf(&self.row_off),
-            Arg::U32(soup as u32),
-            Arg::U32(fusion.code()),
-            buf(&self.pos.buf),
-            buf(&self.key.buf),
-            buf(&self.idx.buf),
-            buf(&self.counters),
-        ]);
-        let e_tri = launch(&g, &self.triangles, rows, &a)?;
-        let mut c = [0u32; 2];
-        g.read(&self.counters, &mut c)?;
-        if let Some(e) = &e_tri {
-            st.timing.add(Step::McTriangles, event_ms(e));
-        }
-        if c[0] != 0 {
-            return Err(Error::InvalidArgument(format!(
-                "internal: mc_triangles produced {} more soup vertices than mc_classify counted \
-                 ({soup}); nothing was written past the buffer",
-                c[0]
-            )));
-        }
-        st.soup_triangles = tris;
-        st.soup_vertices = soup;
-        match fusion {
-            Fusion::None => {
-                self.soup_faces.reserve(&g, soup)?;
-                let e = launch(
-                    &g,
-                    &self.iota,
-                    soup,
-                    &[Arg::U32(soup as u32), buf(&self.soup_faces.buf)],
-                )?;
-                g.finish()?;
-                if let Some(e) = &e {
-                    st.timing.add(Step::McIota, event_ms(e));
-                }
-                st.vertices = soup;
-                st.faces = tris;
-                self.result = Some((Holder::Soup, soup, tris));
-            }
-            _ => {
-                let key_bits = match fusion {
-                    Fusion::Hash => 32,
-                    _ => edge_key_bits(voxels).expect("checked above"),
-                };
-                let (
-                    FusionCounts {
-                        vertices,
-                        faces,
-                        dropped,
-                    },
-                    ft,
-                ) = self.fuser.fuse(
-                    fusion,
-                    &mut self.key.buf,
-                    &mut self.idx.buf,
-                    &self.pos.buf,
-                    soup,
-                    key_bits,
-                )?;
-                st.vertices = vertices;
-                st.faces = faces;
-                st.degenerate_dropped = dropped;
-                st.timing.extend(&ft);
-                self.result = Some((Holder::Fused, vertices, faces));
-            }
+        } else {
+            self.extract_soup(iso, fusion, rows, &mut st)?;
         }
         st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         st.device_bytes = self.device_bytes();
         Ok(st)
-    }
-
-    /// Direct numbering (see `kernels/marching_cubes.cl`): count → one scan
-    /// → triangles, with one host round trip (the scan's partial totals,
-    /// which size the outputs); where vertices land on grid points also
-    /// hits → (host sort) → recount → scan → points, the twin check of the
-    /// listed triangles, and the clean-up only if it would change the mesh.
-    fn extract_direct(&mut self, iso: f32, st: &mut IsoStats) -> Result<()> {
-        let g = self.gpu.clone();
-        let [nx, ny, nz] = self.dims;
-        let voxels = nx * ny * nz;
-        let gr = ny * nz;
-        let common = [
-            Arg::U32(gr as u32),
-            Arg::U32(nx as u32),
-            Arg::U32(ny as u32),
-            Arg::U32(nz as u32),
-            buf(&self.vol),
-            Arg::F32(iso),
-        ];
-        // The case table as the direct kernels take it: counts, tris, flat.
-        let tables = [buf(&self.counts), buf(&self.tris), buf(&self.flat)];
-        let e_rows = launch(
-            &g,
-            &self.direct_rows,
-            gr,
-            &[
-                Arg::U32(gr as u32),
-                Arg::U32(nx as u32),
-                buf(&self.vol),
-                Arg::F32(iso),
-                buf(&self.info),
-            ],
-        )?;
-        let mut a = [&common[..], &tables[..]].concat();
-        a.extend([
-            buf(&self.info),
-            buf(&self.rowc),
-            buf(&self.split),
-            buf(&self.trim),
-        ]);
-        let e_count = launch(&g, &self.direct_count, gr, &a)?;
-        let (total, at) = self
-            .scan
-            .exclusive_at(&self.rowc, &self.rowc, 4 * gr, &[gr, 2 * gr, 3 * gr])
-            .map_err(|e| match e {
-                Error::InvalidInput { .. } => Error::InvalidArgument(format!(
-                    "iso {iso}: the isosurface's vertices and triangles exceed the 32-bit \
-                     indices of the device"
-                )),
-                e => e,
-            })?;
-        if let Some(e) = &e_rows {
-            st.timing.add(Step::McDirectRows, event_ms(e));
-        }
-        if let Some(e) = &e_count {
-            st.timing.add(Step::McDirectCount, event_ms(e));
-        }
-        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-        let (v, t, h, twins) = (
-            at[0] as usize,
-            (at[1] - at[0]) as usize,
-            (at[2] - at[1]) as usize,
-            (total - at[2] as u64) as usize,
-        );
-        let slots = v + h;
-        if 3 * slots as u64 > u32::MAX as u64 || 3 * t as u64 > u32::MAX as u64 {
-            return Err(Error::InvalidArgument(format!(
-                "iso {iso}: {slots} vertices and {t} triangles exceed the 32-bit indices of \
-                 the device (at most {} of each)",
-                u32::MAX / 3
-            )));
-        }
-        let cleanup = h > 0 || self.nonfinite;
-        let side_cap = side_records(h, t);
-        let need = 4 * voxels as u64
-            + crate::spec::vertex_fusion::direct_device_bytes_bound(gr, v, h, t, side_cap, cleanup);
-        if need > g.info.global_mem {
-            return Err(Error::DeviceUnsupported {
-                device: g.info.name.clone(),
-                what: format!(
-                    "iso {iso} gives {t} triangles; extracting them needs about {need} bytes \
-                     of device memory, the device has {}",
-                    g.info.global_mem
-                ),
-            });
-        }
-        st.soup_triangles = t + twins;
-        st.exact_hits = h;
-        // Hits: their grid points sorted and made unique (the vertices after
-        // the edge vertices), and the triangles that collapse onto them
-        // recounted where rows have hits.
-        let (mut u, mut tk, mut collapsed) = (0, t, 0);
-        if h > 0 {
-            self.hit_keys.reserve(&g, h)?;
-            let mut a = common.to_vec();
-            a.extend([
-                buf(&self.rowc),
-                buf(&self.trim),
-                Arg::U32(at[1]),
-                Arg::U32(at[2]),
-                buf(&self.hit_keys.buf),
-            ]);
-            let e = launch(&g, &self.direct_hits, gr, &a)?;
-            // Sorted and made unique on the host: the keys come back anyway
-            // to size the vertices, and a device sort is a dozen launches.
-            let mut keys = vec![0u32; h];
-            g.read(&self.hit_keys.buf, &mut keys)?;
-            keys.sort_unstable();
-            keys.dedup();
-            u = keys.len();
-            g.write(&mut self.hit_keys.buf, &keys)?;
-            if let Some(e) = &e {
-                st.timing.add(Step::McDirectHits, event_ms(e));
-            }
-            let mut a = [&common[..], &tables[..]].concat();
-            a.extend([buf(&self.rowc), buf(&self.trim), buf(&self.tcount)]);
-            let e = launch(&g, &self.direct_recount, gr, &a)?;
-            tk = self.scan.exclusive(&self.tcount, &self.tcount, gr)? as usize;
-            if let Some(e) = &e {
-                st.timing.add(Step::McDirectRecount, event_ms(e));
-            }
-            st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-            collapsed = t - tk;
-        }
-        let nv = v + u;
-        self.dpos.reserve(&g, 3 * nv)?;
-        self.dfaces.reserve(&g, 3 * tk)?;
-        if h > 0 {
-            // Only written where there are hits (a blocking write otherwise
-            // would be a second wait of the extraction).
-            self.side.reserve(&g, 5 * side_cap)?;
-            g.write(&mut self.side_n, &[0])?;
-        }
-        let (toff, tshift, tbase) = if h > 0 {
-            (&self.tcount, 0, 0)
-        } else {
-            (&self.rowc, gr as u32, v as u32)
-        };
-        let mut a = [&common[..], &tables[..]].concat();
-        a.extend([
-            buf(&self.rowc),
-            buf(&self.split),
-            buf(&self.trim),
-            buf(toff),
-            Arg::U32(tshift),
-            Arg::U32(tbase),
-            Arg::U32(v as u32),
-            Arg::U32(u as u32),
-            buf(&self.hit_keys.buf),
-            buf(&self.dpos.buf),
-            buf(&self.dfaces.buf),
-            Arg::U32(side_cap as u32),
-            buf(&self.side.buf),
-            buf(&self.side_n),
-        ]);
-        let e_tri = launch(&g, &self.direct_triangles, gr, &a)?;
-        let e_pts = launch(
-            &g,
-            &self.direct_points,
-            u,
-            &[
-                Arg::U32(u as u32),
-                buf(&self.hit_keys.buf),
-                Arg::U32(nx as u32),
-                Arg::U32(ny as u32),
-                Arg::U32(v as u32),
-                buf(&self.dpos.buf),
-            ],
-        )?;
-        // Does anything remain for vertex fusion's clean-up to do?
-        let mut full = self.nonfinite;
-        if h > 0 && !full {
-            let mut n = [0u32];
-            g.read(&self.side_n, &mut n)?;
-            let n = n[0] as usize;
-            full = n > side_cap || {
-                let mut rec = vec![0u32; 5 * n];
-                g.read(&self.side.buf, &mut rec)?;
-                hit_twins(&rec)
-            };
-        }
-        if !full && (collapsed > 0 || twins > 0) {
-            // Dropped triangles may have been a vertex's only ones.
-            full = self.fuser.count_referenced(&self.dfaces.buf, nv, tk)? < nv;
-        }
-        let dropped = twins + collapsed;
-        if full {
-            let (c, ft) = self
-                .fuser
-                .finish(&self.dfaces.buf, &self.dpos.buf, nv, tk)?;
-            st.vertices = c.vertices;
-            st.faces = c.faces;
-            st.degenerate_dropped = dropped + c.dropped;
-            self.result = Some((Holder::Fused, c.vertices, c.faces));
-            Self::add_events(st, &e_tri, &e_pts);
-            st.timing.extend(&ft);
-        } else {
-            g.finish()?;
-            st.vertices = nv;
-            st.faces = tk;
-            st.degenerate_dropped = dropped;
-            self.result = Some((Holder::Direct, nv, tk));
-            Self::add_events(st, &e_tri, &e_pts);
-        }
-        Ok(())
-    }
-
-    fn add_events(
-        st: &mut IsoStats,
-        tri: &Option<opencl3::event::Event>,
-        pts: &Option<opencl3::event::Event>,
-    ) {
-        if let Some(e) = tri {
-            st.timing.add(Step::McDirectTriangles, event_ms(e));
-        }
-        if let Some(e) = pts {
-            st.timing.add(Step::McDirectPoints, event_ms(e));
-        }
     }
 
     /// The current result on the device: (positions: 3 floats per vertex in
@@ -605,9 +226,9 @@ impl Isosurfacer {
     pub fn device_mesh(&self) -> Option<(&Buffer<f32>, &Buffer<u32>, usize, usize)> {
         let (h, nv, nf) = self.result?;
         Some(match h {
-            Holder::Soup => (&self.pos.buf, &self.soup_faces.buf, nv, nf),
+            Holder::Soup => (&self.soup.pos.buf, &self.soup.faces.buf, nv, nf),
             Holder::Fused => (&self.fuser.out_pos.buf, &self.fuser.out_faces.buf, nv, nf),
-            Holder::Direct => (&self.dpos.buf, &self.dfaces.buf, nv, nf),
+            Holder::Direct => (&self.direct.pos.buf, &self.direct.faces.buf, nv, nf),
         })
     }
 
@@ -710,42 +331,4 @@ pub fn curvature(
     }
     let timing = est.run()?;
     Ok((est, timing))
-}
-
-/// True when triangles with a corner on a grid point (records of
-/// `mc_direct_triangles`: face, three corners, 1 if in a grid plane) include
-/// an opposite twin pair: the same three vertices, both windings.
-fn hit_twins(rec: &[u32]) -> bool {
-    let mut seen: std::collections::HashMap<[u32; 3], u8> = Default::default();
-    for r in rec.chunks_exact(5).filter(|r| r[4] != 0) {
-        let (set, even) = crate::cpu::vertex_fusion::tri_set([r[1], r[2], r[3]]);
-        let w = seen.entry(set).or_default();
-        *w |= if even { 1 } else { 2 };
-        if *w == 3 {
-            return true;
-        }
-    }
-    false
-}
-
-/// Room for the list of triangles with a corner on a grid point, which the
-/// host checks for twins: at most 5 per cell and 4 cells per hit edge, and
-/// at most every triangle; capped at 2^21 records (40 MB), past which the
-/// list overflows and the fusion clean-up runs instead (volumes with that
-/// many hits, such as integer data at a voxel value, need it anyway).
-fn side_records(hits: usize, triangles: usize) -> usize {
-    (20 * hits).min(triangles).min(1 << 21)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn hit_twins_finds_opposite_windings_in_grid_planes_only() {
-        use super::hit_twins;
-        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 1]));
-        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 2, 1, 3, 0, 7, 1, 3, 2, 1]));
-        // Same winding (rotations), or not in a grid plane: no twins.
-        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 2, 3, 1, 1]));
-        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 0]));
-    }
 }
