@@ -266,6 +266,13 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
     info[4 * gid + 3] = isfinite(l) ? (l < iso ? 0u : 1u) : 2u;
 }
 
+// Per grid row, from info: the x range where its four rows can differ (none:
+// nothing read); there, rowc[r] vertices inside its owned edges, rowc[G+r]
+// triangles of cell row r, rowc[2G+r] vertices rounding onto a grid point
+// ("hits"), rowc[3G+r] triangles dropped as twins across a cube face
+// (has_twin); split[2r..] the first y and z vertex of the row; trim[2r..] the
+// x range of its non-uniform chunks (Flying Edges' trimming: the later passes
+// read nothing outside it).
 __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
                               __global const float *vol, float iso, __constant uchar *counts,
                               __constant uchar *tris, __constant uchar *flat,
@@ -546,6 +553,10 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
     tcount[gid] = n;
 }
 
+// Per cell row: positions of the vertices the row owns and its triangles with
+// final indices (a hit corner: edge_vertices + the rank of its point among
+// the sorted, unique hit points); triangles with a hit corner are also listed
+// in `side` (face, corners, in a grid plane) for the host's twin check.
 __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
                                   __global const float *vol, float iso,
                                   __constant uchar *counts, __constant uchar *tris,
