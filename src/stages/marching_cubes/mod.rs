@@ -1,9 +1,9 @@
 //! The isosurface pipeline on the device, one algorithm per file over the
-//! same uploaded volume and case table: [`soup`] wires
+//! same uploaded volume and case table: `soup.rs` wires
 //! `kernels/marching_cubes.cl` (`mc_classify` → scan → `mc_triangles`, then
-//! vertex fusion, [`crate::stages::vertex_fusion`]) and [`direct`] wires
+//! vertex fusion, [`crate::stages::vertex_fusion`]) and `direct.rs` wires
 //! `kernels/marching_cubes_direct.cl` (direct numbering, after Flying
-//! Edges). Either leaves the indexed mesh on the device (for the curvature
+//! Edges); this file holds the [`Isosurfacer`] both extend. Either leaves the indexed mesh on the device (for the curvature
 //! passes) until the caller reads it. CPU twin: [`crate::cpu::marching_cubes`];
 //! shared case table, layout, bounds and options: [`crate::spec::marching_cubes`].
 //!
