@@ -11,8 +11,7 @@
 //   caps_adjacency_flags, caps_adjacency
 //                   per cap   House & Li adjacency cap: for a pair of edges sharing a
 //                             vertex, both drawn, a quad (middle vector, p0, sM, p1);
-//                             the flags are scanned into slots, and only drawn caps
-//                             are written, compacted in pair order
+//                             flags scanned into slots, drawn caps compacted
 //
 // Buffers (V vertices, E edge entries, C cap pairs):
 //   params   EdgeParams per frame, see below (packed by EdgeParams::pack)
@@ -20,35 +19,18 @@
 //   edges    uint[4E]   (i0, i1, i2, i3); i3 == i0: boundary or marked
 //   caps     uint[2C]   (e0, e1) edge entries sharing an end vertex (sorted by vertex)
 //   edge_out float[16E] quad vertices 0 = s0 − p, 1 = s1 − p, 2 = s1 + p, 3 = s0 + p;
-//                       half quads (contours, optional): s0, s1, s1 + 2p', s0 + 2p',
-//                       p' = p·sign(m0·p) pointing outward (m0: projected normal of i0).
-//                       Their midpoints lie on the stroke's centre line, so adjacency
-//                       caps join them; McGuire-Hughes caps stay centred on the edge.
+//                       contour half quads (optional): s0, s1, s1 + 2p', s0 + 2p'
 //   kind     uint[E]    bit 0 contour, 1 crease, 2 boundary/marked, 3 drawn
 //   cap_mh0, cap_mh1 float[12E]  half-cap triangles (s, s + p·sign(m·p), s + m)
 //   cap_slot uint[C]    flags, then (scanned) each cap pair's slot among the drawn caps
-//   cap_adj  float[16K] the K drawn caps' quads (sM + mv, sM + p0, sM, sM + p1),
-//                       in pair order (grown by the host when a view draws more)
-// Edge outputs persist between runs: an edge that is undrawn now and was
-// undrawn in the previous run keeps its marker and is not rewritten (the host
-// fills edge-out with markers and kind with 0, once).
+//   cap_adj  float[16K] the K drawn caps' quads (sM + mv, sM + p0, sM, sM + p1)
+// An edge undrawn now and in the previous run keeps its marker (not rewritten).
 //
-// Conventions (documented in src/stages/edges.rs): clip space is OpenGL's; the
-// screen is measured in pixels from the viewport centre (x · W/2, y · H/2 after
-// the divide by w); p is the unit screen perpendicular times half the line
-// width times the depth factor max(1, k/w) (k = 0: off). An edge with an end at
-// w ≤ w_min (at or behind the near plane) is not drawn, so nothing spans the
-// screen when the eye is inside the mesh. Crease: the angle between the two
-// face normals exceeds the user angle θ, i.e. na·nb < cos θ |na||nb|.
-//
-// Scalar code only: PoCL's work-item vectoriser gives up on float3/vload3,
-// private arrays and struct selects (see curvature.cl). Measured with
-// POCL_VECTORIZER_REMARKS=1 (PoCL 3.1): these kernels still run one work-item
-// at a time ("instruction return type cannot be vectorized"), because LLVM's
-// SLP pass first fuses the paired x/y arithmetic into 2-wide vectors; hiding
-// address adjacency did not change that. The time goes to the undrawn path,
-// so drawability is decided from 4-byte kind bits and unchanged markers are
-// not rewritten (below).
+// Conventions (src/stages/edges.rs): clip space is OpenGL's; the screen is in
+// pixels from the viewport centre; p is the unit screen perpendicular times half
+// the line width times max(1, k/w). An edge with an end at w ≤ w_min is not
+// drawn. Crease: na·nb < cos θ |na||nb|. Scalar code only; details and the
+// vectoriser's measurements: docs/notes/isosurface-kernels.md.
 
 // The per-frame parameter block. Mirrors the Rust struct
 // spec::edges::EdgeParamBlock field by field (same names, same order, every

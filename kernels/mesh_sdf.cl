@@ -11,15 +11,11 @@
 // edge-adjacent triangles while they are nearer (adj uint[3T]), which
 // repairs the flooding's wrong candidates (on a sphere mesh the error is
 // then the chordal error, see tests/mesh_sdf.rs).
-// Sign: the generalized winding number (Jacobson et al. 2013) is the mean
-// over ray directions of the signed ray-crossing count; here it is estimated
-// with the six axis directions ±x ±y ±z. Crossings are found per grid line
-// for all voxels at once: each triangle is scan-converted onto the grid
-// lines of each axis with exact 64-bit edge functions on fixed-point
-// coordinates and a top-left tie rule, so a line through a shared edge or
-// vertex is counted exactly once. On a closed mesh the estimate is the exact
-// winding number; with a hole, a voxel is misjudged only if three of its six
-// rays leave through holes.
+// Sign: the generalized winding number (Jacobson et al. 2013), estimated
+// with the six axis rays ±x ±y ±z; crossings are found per grid line for all
+// voxels at once, each triangle scan-converted onto the grid lines of each
+// axis (exact 64-bit edge functions on fixed-point coordinates, a top-left
+// tie rule: a shared edge or vertex counts once). Exact on a closed mesh.
 //
 //   msdf_clear      per voxel     d2 = +inf, id = none
 //   msdf_band_min   per triangle  atomic min of d2 over its grown box

@@ -17,17 +17,11 @@
 //                                  bounds read from hist) by the bits below the top digit
 // Every step walks its data in input order, so the sort is stable.
 //
-// Why this shape: on a CPU device (PoCL, 2 cores) a pass that scatters 8M
-// pairs by an 8-bit digit through DRAM costs 30–70 ms (scattered writes;
-// 4-bit digits halve that but double the passes), and a plain LSD sort pays
-// it 4 times for 32-bit keys. Here only the MSD
-// pass goes through DRAM; the buckets (n/256 pairs each: 32K, 256 KB per
-// buffer for n = 8M) are then sorted in the core's cache. The cost is load
-// balance: keys whose top digit is mostly the same would make one work-item
-// sort most of the pairs, so for those the host runs plain LSD passes instead
-// (radix_histogram, scan, radix_scatter once per digit over the whole data,
-// with shift/mask picking the digit). A GPU would want a different sort
-// (e.g. onesweep).
+// Only the MSD pass goes through DRAM; each bucket is then sorted in the
+// core's cache. Keys whose top digit is mostly the same would leave one
+// work-item most of the pairs, so for those the host runs plain LSD passes
+// (radix_histogram, scan, radix_scatter per digit, shift/mask picking it).
+// Why this shape: docs/notes/isosurface-kernels.md.
 //
 // Buffers:
 //   keys, values          uint[n]         caller's pairs: input, and the output

@@ -88,7 +88,12 @@ pub fn kernel_file(name: &str) -> Option<KernelFile> {
         "marching_cubes" => Some(KernelFile {
             name: "kernels/marching_cubes.cl",
             source: include_str!("../../kernels/marching_cubes.cl"),
-            headers: MC_HEADERS,
+            headers: MC_SOUP_HEADERS,
+        }),
+        "marching_cubes_direct" => Some(KernelFile {
+            name: "kernels/marching_cubes_direct.cl",
+            source: include_str!("../../kernels/marching_cubes_direct.cl"),
+            headers: MC_DIRECT_HEADERS,
         }),
         "vertex_fusion" => Some(KernelFile {
             name: "kernels/vertex_fusion.cl",
@@ -113,6 +118,22 @@ const MC_HEADERS: &[(&str, &str)] = &[
         include_str!("../../kernels/common/mc_edge.h"),
     ),
 ];
+
+/// Headers of the marching-cubes soup kernels: those of vertex fusion and
+/// the cell code both marching-cubes files share.
+const MC_SOUP_HEADERS: &[(&str, &str)] =
+    &[MC_HEADERS[0], MC_HEADERS[1], MC_HEADERS[2], MC_CELL_HEADER];
+
+/// Headers of the direct-numbering kernels: real.h, the edge rule and the
+/// shared cell code.
+const MC_DIRECT_HEADERS: &[(&str, &str)] = &[MC_HEADERS[0], MC_HEADERS[2], MC_CELL_HEADER];
+
+/// The cell arithmetic of `kernels/marching_cubes.cl` and
+/// `kernels/marching_cubes_direct.cl`.
+const MC_CELL_HEADER: (&str, &str) = (
+    "common/mc_cell.h",
+    include_str!("../../kernels/common/mc_cell.h"),
+);
 
 /// The full text handed to the compiler.
 pub fn assemble(file: &KernelFile) -> String {

@@ -1,0 +1,737 @@
+// marching_cubes_direct.cl: the isosurface value = iso by direct numbering
+// (Fusion direct), after Flying Edges (Schroeder, Maynard and Geveci 2015):
+// no soup, no sort. Each vertex is made once, by the voxel edge it lies on,
+// and numbered by a scan over per-row counts; triangles are written with
+// final indices. Twin file: marching_cubes.cl (the soup variants); shared
+// cell code: common/mc_cell.h. Host: src/stages/marching_cubes/direct.rs;
+// CPU twin: cpu::marching_cubes::mc_direct (same steps, same f32 arithmetic).
+//
+// A grid row is every grid point with the same (y, z): G = ny·nz of them,
+// row r = y + ny·z. Row r owns its x-edges and the y- and z-edges that start
+// on it; its vertices are numbered x-edges first, then y, then z, each in x
+// order, from off[r] on. Cell row (y, z) reads grid rows 00 = (y, z),
+// 10 = (y+1, z), 01 = (y, z+1), 11 = (y+1, z+1).
+//   mc_direct_rows       per grid row  where its x-edges cross, its ends' sides (info)
+//   mc_direct_count      per grid row  in the x range where its rows differ:
+//                                      vertices, triangles, hits (vertices on a
+//                                      grid point), twins; y/z splits; trim range
+//   (scan.cl)                          one exclusive scan of rowc[0..4G)
+//   mc_direct_hits       per grid row  only with hits: the hit points' grid indices
+//                                      (sorted and made unique on the host)
+//   mc_direct_recount    per cell row  only then: kept triangles (collapsing dropped)
+//   mc_direct_triangles  per cell row  owned vertices' positions, triangles with
+//                                      final indices; those with a hit corner
+//                                      also listed in `side`
+//   mc_direct_points     per hit       positions of the hit slots
+// One work-item walks one row, 16 cells at a time where it can (float16 loads),
+// reading nothing outside the row's trim range.
+//
+// Buffers: vol float[N]; counts, tris, flat: the case table (flat: the
+// triangles lying in a cube face); info uint[4G]; rowc uint[4G] (scanned in
+// place into off); split uint[2G]; trim uint[2G]; tcount uint[G]; hit_keys
+// uint[H] (sorted, unique: U); pos float[3(V+U)]; faces uint[3T]; side
+// uint[5·20H]; V, T, H the scan's first three partial totals.
+//
+// With no hit and a finite volume no triangle can collapse and the only twins
+// (a flat triangle and its mirror across the face) are found by has_twin;
+// otherwise the host checks the listed triangles and runs vertex fusion's
+// clean-up only when it would change the mesh (docs/notes/isosurface-kernels.md).
+
+#define EV_NONE 0u
+#define EV_IN 1u
+#define EV_LO 2u
+#define EV_HI 3u
+
+// What the edge from value v0 (coordinate a along its axis) to v1 (a + 1)
+// carries: EV_NONE (one side, or an end not finite), EV_IN (a vertex inside
+// the edge, at coordinate *c), EV_LO / EV_HI (the vertex rounds onto the
+// lower / upper grid point). Twin: cpu::marching_cubes::edge_vertex.
+inline uint edge_kind(float v0, float v1, float iso, uint a, float *c)
+{
+    if (!(isfinite(v0) && isfinite(v1)) || ((v0 < iso) == (v1 < iso)))
+        return EV_NONE;
+    const float fa = (float)a;
+    const float cc = fa + mc_edge_t(v0, v1, iso);
+    *c = cc;
+    return cc == fa ? EV_LO : (cc == (float)(a + 1) ? EV_HI : EV_IN);
+}
+
+// Grid row gid; rows past the volume's last y or z alias row 00, so their
+// "edges" join a value to itself and never cross.
+#define GRID_ROW_SETUP                                                              \
+    const uint y = gid % ny, z = gid / ny;                                          \
+    const uint hy = y + 1 < ny, hz = z + 1 < nz;                                    \
+    const ulong b00 = (ulong)nx * (y + (ulong)ny * z);                              \
+    const ulong b10 = b00 + (hy ? nx : 0), b01 = b00 + (hz ? (ulong)nx * ny : 0);   \
+    const ulong b11 = b10 + (b01 - b00);
+
+// True when values x .. nx−1 of the four rows are finite and on one side.
+inline bool tail_uniform(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                         uint x, uint nx, float iso)
+{
+    bool in = true, out = true;
+    for (uint i = x; i < nx; ++i) {
+        const float a = vol[b00 + i], b = vol[b10 + i], c = vol[b01 + i], d = vol[b11 + i];
+        if (!(isfinite(a) && isfinite(b) && isfinite(c) && isfinite(d)))
+            return false;
+        in = in && a < iso && b < iso && c < iso && d < iso;
+        out = out && a >= iso && b >= iso && c >= iso && d >= iso;
+    }
+    return in || out;
+}
+
+// The owned edges at position i of the row: their interior vertices along
+// x, y, z in bits 0, 8, 16 and their hits in bits 24.. (scalars, so the
+// counters stay in registers).
+inline uint count_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                        uint nx, uint y, uint z, float iso)
+{
+    float c;
+    const float a = vol[b00 + i];
+    const uint kx = i + 1 < nx ? edge_kind(a, vol[b00 + i + 1], iso, i, &c) : EV_NONE;
+    const uint ky = edge_kind(a, vol[b10 + i], iso, y, &c);
+    const uint kz = edge_kind(a, vol[b01 + i], iso, z, &c);
+    return (uint)(kx == EV_IN) | ((uint)(ky == EV_IN) << 8) | ((uint)(kz == EV_IN) << 16) |
+           (((uint)(kx >= EV_LO) + (uint)(ky >= EV_LO) + (uint)(kz >= EV_LO)) << 24);
+}
+
+// Cases of the 16 cells x .. x+15 of a cell row (bit c set when corner c is
+// inside), from float16 loads of the values x .. x+16 of the four rows; the
+// corner values come back in a[8] (corner c's value of each lane). *finite
+// is false when one of them is not finite (then the cases are not used).
+inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
+                          uint x, float iso, float16 *a, bool *finite)
+{
+    a[0] = vload16(0, vol + b00 + x);
+    a[1] = vload16(0, vol + b00 + x + 1);
+    a[2] = vload16(0, vol + b10 + x);
+    a[3] = vload16(0, vol + b10 + x + 1);
+    a[4] = vload16(0, vol + b01 + x);
+    a[5] = vload16(0, vol + b01 + x + 1);
+    a[6] = vload16(0, vol + b11 + x);
+    a[7] = vload16(0, vol + b11 + x + 1);
+    const float16 i16 = (float16)(iso);
+    int16 fin = isfinite(a[0]);
+    uint16 cas = (uint16)(0);
+    for (uint c = 0; c < 8; ++c) {
+        fin &= isfinite(a[c]);
+        cas |= as_uint16(isless(a[c], i16)) & (uint16)(1u << c);
+    }
+    *finite = all(fin);
+    return cas;
+}
+
+// Lanes set in a mask of a relational built-in (−1 = true).
+inline uint lanes_set(int16 m)
+{
+    const int8 s8 = m.lo + m.hi;
+    const int4 s4 = s8.lo + s8.hi;
+    const int2 s2 = s4.lo + s4.hi;
+    return (uint)(-(s2.x + s2.y));
+}
+
+// edge_kind for 16 edges at once, all ends finite: *inside gets the lanes
+// with a vertex inside the edge, the return value the lanes that round onto
+// an end. fa is the edges' lower coordinate along their axis.
+inline int16 edge_kinds16(float16 v0, float16 v1, float iso, float16 fa, int16 *inside)
+{
+    const float16 i16 = (float16)(iso);
+    const int16 cross = isless(v0, i16) ^ isless(v1, i16);
+    float16 t = (i16 - v0) / (v1 - v0);
+    t = select((float16)(0.0f), t, isgreaterequal(t, (float16)(0.0f)));
+    t = select(t, (float16)(1.0f), isgreater(t, (float16)(1.0f)));
+    const float16 c = fa + t;
+    const int16 hit = cross & ((c == fa) | (c == fa + 1.0f));
+    *inside = cross & ~hit;
+    return hit;
+}
+
+// True when triangle j of cell (x, y, z) of case cas, flagged as lying in a
+// face of the cube (flat[cas] bit j), has an opposite twin in the cell across
+// that face: the same three voxel edges, the other winding. Both cells drop
+// theirs, as vertex fusion's twin cancellation would. Rare (a fan over a loop
+// through all four edges of an ambiguous face), so it may be slow. Twin:
+// cpu::marching_cubes::has_twin.
+__attribute__((noinline)) bool has_twin(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+                     uint nz, float iso, uint cas, uint j, __constant uchar *counts,
+                     __constant uchar *tris)
+{
+    const uint a0 = tris[16 * cas + 3 * j], a1 = tris[16 * cas + 3 * j + 1],
+               a2 = tris[16 * cas + 3 * j + 2];
+    const uint l0 = edge_lo_corner(a0), l1 = edge_lo_corner(a1), l2 = edge_lo_corner(a2);
+    uint f = 3;
+    for (uint q = 0; q < 3 && f == 3; ++q) {
+        if ((a0 >> 2) != q && (a1 >> 2) != q && (a2 >> 2) != q &&
+            ((l0 >> q) & 1) == ((l1 >> q) & 1) && ((l1 >> q) & 1) == ((l2 >> q) & 1))
+            f = q;
+    }
+    if (f == 3)
+        return false;
+    const uint s = (l0 >> f) & 1;
+    uint p[3] = {x, y, z};
+    const uint dim[3] = {nx, ny, nz};
+    if (s == 0) {
+        if (p[f] == 0)
+            return false;
+        p[f] -= 1;
+    } else {
+        if (p[f] + 2 >= dim[f])
+            return false;
+        p[f] += 1;
+    }
+    const ulong b00 = (ulong)nx * (p[1] + (ulong)ny * p[2]);
+    const ulong b10 = b00 + nx, b01 = b00 + (ulong)nx * ny, b11 = b01 + nx;
+    float v[8];
+    const uint cb = cell_case(vol, b00, b10, b01, b11, p[0], iso, v);
+    if (cb >= 256)
+        return false;
+    for (uint t = 0; t < counts[cb]; ++t) {
+        uint m[3];
+        bool ok = true;
+        for (uint i = 0; i < 3; ++i) {
+            const uint e = tris[16 * cb + 3 * t + i], axis = e >> 2, c0 = edge_lo_corner(e);
+            ok = ok && axis != f && ((c0 >> f) & 1) == 1 - s;
+            m[i] = edge_id(axis, c0 ^ (1u << f));
+        }
+        // The other winding: a rotation of (a0, a2, a1).
+        if (ok && ((m[0] == a0 && m[1] == a2 && m[2] == a1) ||
+                   (m[0] == a2 && m[1] == a1 && m[2] == a0) ||
+                   (m[0] == a1 && m[1] == a0 && m[2] == a2)))
+            return true;
+    }
+    return false;
+}
+
+// Triangles of cell (x, y, z), case cas < 256, dropped as twins.
+inline uint twins_of(__global const float *vol, uint x, uint y, uint z, uint nx, uint ny,
+                     uint nz, float iso, uint cas, __constant uchar *counts,
+                     __constant uchar *tris, __constant uchar *flat)
+{
+    uint n = 0;
+    const uint fl = flat[cas];
+    if (fl != 0) {
+        for (uint j = 0; j < counts[cas]; ++j)
+            n += ((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris);
+    }
+    return n;
+}
+
+// Per grid row, read once (Flying Edges' first pass): info[4r..] = the first
+// cell whose x-edge crosses iso or touches a non-finite value (nx if none),
+// one past the last such cell (0 if none), and the side of the row's first
+// and last value (0 below iso, 1 not below, 2 not finite). Outside
+// [first, last + 1) a row is finite and on one side.
+__kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol, float iso,
+                             __global uint *info)
+{
+    GID_OR_RETURN(grid_rows);
+    const ulong b = (ulong)nx * gid;
+    const float16 i16 = (float16)(iso);
+    uint xl = nx, xr = 0, x = 0, last = nx;
+    int m[16];
+    for (; x + 16 < nx; x += 16) {
+        const float16 a = vload16(0, vol + b + x), c = vload16(0, vol + b + x + 1);
+        const int16 bad = ~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16));
+        if (any(bad)) {
+            if (xl == nx) {
+                vstore16(bad, 0, m);
+                uint i = 0;
+                while (!m[i])
+                    ++i;
+                xl = x + i;
+            }
+            last = x;
+        }
+    }
+    if (last != nx) {
+        // The last lane of the last chunk that crosses.
+        const float16 a = vload16(0, vol + b + last), c = vload16(0, vol + b + last + 1);
+        vstore16(~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16)), 0, m);
+        uint i = 15;
+        while (!m[i])
+            --i;
+        xr = last + i + 1;
+    }
+    for (; x + 1 < nx; ++x) {
+        const float a = vol[b + x], c = vol[b + x + 1];
+        if (!(isfinite(a) && isfinite(c)) || ((a < iso) != (c < iso))) {
+            xl = min(xl, x);
+            xr = x + 1;
+        }
+    }
+    const float f = vol[b], l = vol[b + nx - 1];
+    info[4 * gid] = xl;
+    info[4 * gid + 1] = xr;
+    info[4 * gid + 2] = isfinite(f) ? (f < iso ? 0u : 1u) : 2u;
+    info[4 * gid + 3] = isfinite(l) ? (l < iso ? 0u : 1u) : 2u;
+}
+
+// Per grid row, from info: the x range where its four rows can differ (none:
+// nothing read); there, rowc[r] vertices inside its owned edges, rowc[G+r]
+// triangles of cell row r, rowc[2G+r] vertices rounding onto a grid point
+// ("hits"), rowc[3G+r] triangles dropped as twins across a cube face
+// (has_twin); split[2r..] the first y and z vertex of the row; trim[2r..] the
+// x range of its non-uniform chunks (Flying Edges' trimming: the later passes
+// read nothing outside it).
+__kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
+                              __global const float *vol, float iso, __constant uchar *counts,
+                              __constant uchar *tris, __constant uchar *flat,
+                              __global const uint *info, __global uint *rowc,
+                              __global uint *split, __global uint *trim)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const bool cell = hy && hz;
+    // The x range where the four rows (aliased as b00..b11) can differ: left
+    // of every row's first crossing they are uniform, and alike if their
+    // first values are on one side; likewise right of the last crossing.
+    const uint r10 = gid + hy, r01 = gid + (hz ? ny : 0), r11 = r10 + (r01 - gid);
+    const uint L = min(min(info[4 * gid], info[4 * r10]), min(info[4 * r01], info[4 * r11]));
+    const uint Rx = max(max(info[4 * gid + 1], info[4 * r10 + 1]),
+                        max(info[4 * r01 + 1], info[4 * r11 + 1]));
+    const uint sl = info[4 * gid + 2], sr = info[4 * gid + 3];
+    const bool left = sl != 2 && info[4 * r10 + 2] == sl && info[4 * r01 + 2] == sl &&
+                      info[4 * r11 + 2] == sl;
+    const bool right = sr != 2 && info[4 * r10 + 3] == sr && info[4 * r01 + 3] == sr &&
+                       info[4 * r11 + 3] == sr;
+    const uint start = left ? L : 0, pend = right ? Rx : nx;
+    // Per position at most one owned edge of each kind and three hits: the
+    // packed counts of count_owned add up without carries over a 16-cell
+    // chunk, so they are unpacked once per chunk (and per tail position).
+    uint n0 = 0, n1 = 0, n2 = 0, hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
+    float v[8];
+    float16 a[8];
+    const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    // The chunks of the other passes, from the one holding `start` on.
+    uint x = start >= pend ? nx : start & ~15u;
+    for (; x + 16 < nx && x < pend; x += 16) {
+        bool fin;
+        const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
+        if (fin && all((cv == (uint16)(0)) | (cv == (uint16)(255))))
+            continue;
+        lo = min(lo, x);
+        hi = x + 16;
+        if (fin) {
+            // All finite: the owned edges 16 at a time (corner 0 to 1, 2, 4).
+            int16 in;
+            hits += lanes_set(edge_kinds16(a[0], a[1], iso, (float16)((float)x) + lane, &in));
+            n0 += lanes_set(in);
+            hits += lanes_set(edge_kinds16(a[0], a[2], iso, (float16)((float)y), &in));
+            n1 += lanes_set(in);
+            hits += lanes_set(edge_kinds16(a[0], a[4], iso, (float16)((float)z), &in));
+            n2 += lanes_set(in);
+            if (cell) {
+                uint cs[16];
+                vstore16(cv, 0, cs);
+                uint fl = 0;
+                for (uint i = 0; i < 16; ++i) {
+                    ntri += counts[cs[i]];
+                    fl |= flat[cs[i]];
+                }
+                if (fl != 0) {
+                    for (uint i = 0; i < 16; ++i) {
+                        const uint tw = twins_of(vol, x + i, y, z, nx, ny, nz, iso, cs[i],
+                                                 counts, tris, flat);
+                        ntri -= tw;
+                        twins += tw;
+                    }
+                }
+            }
+            continue;
+        }
+        uint packed = 0;
+        for (uint i = x; i < x + 16; ++i) {
+            if (cell) {
+                const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+                // A finite cell with all corners on one side: its edges, the
+                // row's owned edges at i among them, carry nothing.
+                if (cas == 0 || cas == 255)
+                    continue;
+                packed += count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
+                if (cas < 256) {
+                    const uint tw =
+                        twins_of(vol, i, y, z, nx, ny, nz, iso, cas, counts, tris, flat);
+                    ntri += counts[cas] - tw;
+                    twins += tw;
+                }
+            } else {
+                packed += count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
+            }
+        }
+        n0 += packed & 0xFF;
+        n1 += (packed >> 8) & 0xFF;
+        n2 += (packed >> 16) & 0xFF;
+        hits += packed >> 24;
+    }
+    if (x < pend && !tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
+        lo = min(lo, x);
+        hi = nx;
+        for (uint i = x; i < nx; ++i) {
+            const uint packed = count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
+            n0 += packed & 0xFF;
+            n1 += (packed >> 8) & 0xFF;
+            n2 += (packed >> 16) & 0xFF;
+            hits += packed >> 24;
+            if (cell && i + 1 < nx) {
+                const uint cas = cell_case(vol, b00, b10, b01, b11, i, iso, v);
+                if (cas < 256) {
+                    const uint tw =
+                        twins_of(vol, i, y, z, nx, ny, nz, iso, cas, counts, tris, flat);
+                    ntri += counts[cas] - tw;
+                    twins += tw;
+                }
+            }
+        }
+    }
+    rowc[gid] = n0 + n1 + n2;
+    rowc[grid_rows + gid] = ntri;
+    rowc[2 * grid_rows + gid] = hits;
+    rowc[3 * grid_rows + gid] = twins;
+    split[2 * gid] = n0;
+    split[2 * gid + 1] = n0 + n1;
+    trim[2 * gid] = lo;
+    trim[2 * gid + 1] = hi;
+}
+
+inline void hit_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                      uint nx, uint ny, uint y, uint z, float iso, __global uint *keys, uint *o)
+{
+    float c;
+    const float a = vol[b00 + i];
+    const uint g = grid_index(i, y, z, nx, ny);
+    uint k;
+    if (i + 1 < nx) {
+        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
+        if (k >= EV_LO)
+            keys[(*o)++] = k == EV_LO ? g : g + 1;
+    }
+    k = edge_kind(a, vol[b10 + i], iso, y, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx;
+    k = edge_kind(a, vol[b01 + i], iso, z, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx * ny;
+}
+
+__kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
+                             __global const float *vol, float iso, __global const uint *off,
+                             __global const uint *trim, uint hit_base, uint hit_end,
+                             __global uint *keys)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    const uint first = off[2 * grid_rows + gid];
+    const uint end = gid + 1 < grid_rows ? off[2 * grid_rows + gid + 1] : hit_end;
+    if (first == end)
+        return;
+    uint o = first - hit_base;
+    uint x = lo;
+    for (; x + 16 < nx && x < hi; x += 16) {
+        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+            continue;
+        for (uint i = x; i < x + 16; ++i)
+            hit_owned(vol, b00, b10, b01, i, nx, ny, y, z, iso, keys, &o);
+    }
+    for (; x < hi; ++x)
+        hit_owned(vol, b00, b10, b01, x, nx, ny, y, z, iso, keys, &o);
+}
+
+// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
+// sorted, unique hit points.
+inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
+{
+    uint lo = 0, hi = nh;
+    while (lo < hi) {
+        const uint m = lo + (hi - lo) / 2;
+        if (keys[m] < g)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return edge_vertices + lo;
+}
+
+// Coordinate q of the vertex of edge e of cell (x, y, z), of kind k (not
+// EV_NONE) and, for EV_IN, coordinate cc along the edge.
+inline float corner_coord(uint e, uint k, float cc, uint x, uint y, uint z, uint q)
+{
+    const uint axis = e >> 2, c0 = edge_lo_corner(e);
+    const uint g = (q == 0 ? x : (q == 1 ? y : z)) + ((c0 >> q) & 1);
+    if (q != axis)
+        return (float)g;
+    return k == EV_IN ? cc : (float)(k == EV_HI ? g + 1 : g);
+}
+
+inline void put3(__global float *pos, uint v, float a, float b, float c)
+{
+    pos[3 * v] = a;
+    pos[3 * v + 1] = b;
+    pos[3 * v + 2] = c;
+}
+
+// The kinds k[12] and coordinates c[12] of the twelve edges of cell (x, y,
+// z) in table order (common/mc_cell.h's edge numbering), from its values v[8].
+#define CELL_EDGES                                                                  \
+    k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);                                    \
+    k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);                                    \
+    k[2] = edge_kind(v[4], v[5], iso, x, &c[2]);                                    \
+    k[3] = edge_kind(v[6], v[7], iso, x, &c[3]);                                    \
+    k[4] = edge_kind(v[0], v[2], iso, y, &c[4]);                                    \
+    k[5] = edge_kind(v[1], v[3], iso, y, &c[5]);                                    \
+    k[6] = edge_kind(v[4], v[6], iso, y, &c[6]);                                    \
+    k[7] = edge_kind(v[5], v[7], iso, y, &c[7]);                                    \
+    k[8] = edge_kind(v[0], v[4], iso, z, &c[8]);                                    \
+    k[9] = edge_kind(v[1], v[5], iso, z, &c[9]);                                    \
+    k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);                                  \
+    k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
+
+// Grid index of the point that the vertex of edge e (kind EV_LO or EV_HI) of
+// cell (x, y, z) rounds onto.
+inline uint hit_point(uint e, uint kind, uint x, uint y, uint z, uint nx, uint ny)
+{
+    const uint c0 = edge_lo_corner(e);
+    const uint cn = kind == EV_LO ? c0 : (c0 | (1u << (e >> 2)));
+    return grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2), nx, ny);
+}
+
+// True when two corners of the triangle on edges ea, eb, ec of cell (x, y, z)
+// round onto the same grid point (the triangle collapses: dropped).
+inline bool collapses(uint ea, uint eb, uint ec, const uint *k, uint x, uint y, uint z,
+                      uint nx, uint ny)
+{
+    const uint ka = k[ea], kb = k[eb], kc = k[ec];
+    const uint none = 0xFFFFFFFFu;
+    const uint pa = ka >= EV_LO ? hit_point(ea, ka, x, y, z, nx, ny) : none;
+    const uint pb = kb >= EV_LO ? hit_point(eb, kb, x, y, z, nx, ny) : none - 1;
+    const uint pc = kc >= EV_LO ? hit_point(ec, kc, x, y, z, nx, ny) : none - 2;
+    return pa == pb || pb == pc || pa == pc;
+}
+
+// Only where there are hits: the triangles of each cell row that are kept
+// (twins across faces and collapsing triangles dropped) into tcount[r]; rows
+// whose four grid rows have no hit keep their count from the first scan.
+__kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
+                                __global const float *vol, float iso, __constant uchar *counts,
+                                __constant uchar *tris, __constant uchar *flat,
+                                __global const uint *off, __global const uint *trim,
+                                __global uint *tcount)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    const uint G = grid_rows;
+    if (!(hy && hz)) {
+        tcount[gid] = 0;
+        return;
+    }
+    const uint rows[4] = {gid, gid + 1, gid + ny, gid + ny + 1};
+    uint rh = 0;
+    for (uint i = 0; i < 4; ++i)
+        rh += off[2 * G + rows[i] + 1] - off[2 * G + rows[i]];
+    const uint before = off[G + gid + 1] - off[G + gid];
+    if (rh == 0) {
+        tcount[gid] = before;
+        return;
+    }
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    float v[8], c[12];
+    uint k[12];
+    uint n = 0;
+    for (uint x = lo; x < hi && x + 1 < nx; ++x) {
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        if (cas == 0 || cas >= 255)
+            continue;
+        CELL_EDGES
+        const uint nt = counts[cas], fl = flat[cas];
+        for (uint j = 0; j < nt; ++j) {
+            if (((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
+                continue;
+            n += !collapses(tris[16 * cas + 3 * j], tris[16 * cas + 3 * j + 1],
+                            tris[16 * cas + 3 * j + 2], k, x, y, z, nx, ny);
+        }
+    }
+    tcount[gid] = n;
+}
+
+// Per cell row: positions of the vertices the row owns and its triangles with
+// final indices (a hit corner: edge_vertices + the rank of its point among
+// the sorted, unique hit points); triangles with a hit corner are also listed
+// in `side` (face, corners, in a grid plane) for the host's twin check.
+__kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
+                                  __global const float *vol, float iso,
+                                  __constant uchar *counts, __constant uchar *tris,
+                                  __constant uchar *flat, __global const uint *off,
+                                  __global const uint *split, __global const uint *trim,
+                                  __global const uint *toff, uint tshift, uint tbase,
+                                  uint edge_vertices, uint nh, __global const uint *hit_keys,
+                                  __global float *pos, __global uint *faces, uint side_cap,
+                                  __global uint *side, volatile __global uint *side_n)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    if (!(hy && hz))
+        return;
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    if (lo >= hi)
+        return;
+    const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
+    // First vertex of each row's x, y and z edges (those a cell row uses).
+    const uint bx00 = off[gid], by00 = bx00 + split[2 * gid], bz00 = bx00 + split[2 * gid + 1];
+    const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
+    const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
+    const uint bx11 = off[r11];
+    // Interior vertices met so far per (row, axis): x00 y00 z00 x10 z10 x01 y01 x11.
+    uint n00x = 0, n00y = 0, n00z = 0, n10x = 0, n10z = 0, n01x = 0, n01y = 0, n11x = 0;
+    // The last cell row of y (z) also writes the vertices of row 10 (01),
+    // which is not a cell row; the last cell of a row those at x = nx − 1.
+    const bool wy = y + 2 == ny, wz = z + 2 == nz;
+    // First triangle of the row: toff[tshift + r] − tbase (the triangles'
+    // part of off, which starts at edge_vertices, or the scan of the
+    // recount where there are hits).
+    uint out = 3 * (toff[tshift + gid] - tbase);
+    const float fy = (float)y, fz = (float)z;
+    float v[8], c[12];
+    uint k[12], id[12];
+    float16 a[8];
+    // Cells of the current chunk known (from its vector cases) to be finite
+    // with all corners on one side: bit x − base.
+    uint skip = 0, base = lo;
+    uint x = lo;
+    for (; x < hi && x + 1 < nx; ++x) {
+        // The chunks of mc_direct_count: 16 cells from each multiple of 16
+        // that has 16 more values after it (lo is one of them, or the tail).
+        if ((x & 15) == 0) {
+            skip = 0;
+            base = x;
+            if (x + 16 < nx) {
+                bool fin;
+                const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
+                if (fin) {
+                    const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
+                    if (all(triv)) {
+                        x += 15;
+                        continue;
+                    }
+                    int tv[16];
+                    vstore16(triv, 0, tv);
+                    for (uint i = 0; i < 16; ++i)
+                        skip |= (uint)(tv[i] & 1) << i;
+                }
+            }
+        }
+        if ((skip >> (x - base)) & 1)
+            continue;
+        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        // All corners finite and on one side: nothing to write or count.
+        if (cas == 0 || cas == 255)
+            continue;
+        CELL_EDGES
+        id[0] = bx00 + n00x;
+        id[1] = bx10 + n10x;
+        id[2] = bx01 + n01x;
+        id[3] = bx11 + n11x;
+        id[4] = by00 + n00y;
+        id[5] = id[4] + (k[4] == EV_IN);
+        id[6] = by01 + n01y;
+        id[7] = id[6] + (k[6] == EV_IN);
+        id[8] = bz00 + n00z;
+        id[9] = id[8] + (k[8] == EV_IN);
+        id[10] = bz10 + n10z;
+        id[11] = id[10] + (k[10] == EV_IN);
+        // Corners of this cell on grid points (collapses need two).
+        uint ch = 0;
+        if (nh != 0) {
+            for (uint e = 0; e < 12; ++e) {
+                if (k[e] >= EV_LO) {
+                    id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
+                                       edge_vertices);
+                    ++ch;
+                }
+            }
+        }
+        const float fx = (float)x;
+        if (k[0] == EV_IN)
+            put3(pos, id[0], c[0], fy, fz);
+        if (k[4] == EV_IN)
+            put3(pos, id[4], fx, c[4], fz);
+        if (k[8] == EV_IN)
+            put3(pos, id[8], fx, fy, c[8]);
+        if (wy) {
+            if (k[1] == EV_IN)
+                put3(pos, id[1], c[1], fy + 1.0f, fz);
+            if (k[10] == EV_IN)
+                put3(pos, id[10], fx, fy + 1.0f, c[10]);
+        }
+        if (wz) {
+            if (k[2] == EV_IN)
+                put3(pos, id[2], c[2], fy, fz + 1.0f);
+            if (k[6] == EV_IN)
+                put3(pos, id[6], fx, c[6], fz + 1.0f);
+        }
+        if (wy && wz && k[3] == EV_IN)
+            put3(pos, id[3], c[3], fy + 1.0f, fz + 1.0f);
+        if (x + 2 == nx) {
+            if (k[5] == EV_IN)
+                put3(pos, id[5], fx + 1.0f, c[5], fz);
+            if (k[9] == EV_IN)
+                put3(pos, id[9], fx + 1.0f, fy, c[9]);
+            if (wy && k[11] == EV_IN)
+                put3(pos, id[11], fx + 1.0f, fy + 1.0f, c[11]);
+            if (wz && k[7] == EV_IN)
+                put3(pos, id[7], fx + 1.0f, c[7], fz + 1.0f);
+        }
+        if (cas < 256) {
+            const uint nt = counts[cas], fl = flat[cas];
+            for (uint j = 0; j < nt; ++j) {
+                if (((fl >> j) & 1) &&
+                    has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
+                    continue;
+                const uint ea = tris[16 * cas + 3 * j], eb = tris[16 * cas + 3 * j + 1],
+                           ec = tris[16 * cas + 3 * j + 2];
+                if (ch >= 2 && collapses(ea, eb, ec, k, x, y, z, nx, ny))
+                    continue;
+                faces[out] = id[ea];
+                faces[out + 1] = id[eb];
+                faces[out + 2] = id[ec];
+                // A triangle with a corner on a grid point may have a twin:
+                // listed (face, corners, in a grid plane) for the host to
+                // decide whether the clean-up must run.
+                if (ch != 0 && (k[ea] >= EV_LO || k[eb] >= EV_LO || k[ec] >= EV_LO)) {
+                    uint plane = 0;
+                    for (uint q = 0; q < 3; ++q) {
+                        const float pa = corner_coord(ea, k[ea], c[ea], x, y, z, q);
+                        const float pb = corner_coord(eb, k[eb], c[eb], x, y, z, q);
+                        const float pc = corner_coord(ec, k[ec], c[ec], x, y, z, q);
+                        plane |= pa == pb && pb == pc && pa == floor(pa);
+                    }
+                    const uint o = atomic_inc(&side_n[0]);
+                    if (o < side_cap) {
+                        side[5 * o] = out / 3;
+                        side[5 * o + 1] = id[ea];
+                        side[5 * o + 2] = id[eb];
+                        side[5 * o + 3] = id[ec];
+                        side[5 * o + 4] = plane;
+                    }
+                }
+                out += 3;
+            }
+        }
+        n00x += k[0] == EV_IN;
+        n10x += k[1] == EV_IN;
+        n01x += k[2] == EV_IN;
+        n11x += k[3] == EV_IN;
+        n00y += k[4] == EV_IN;
+        n01y += k[6] == EV_IN;
+        n00z += k[8] == EV_IN;
+        n10z += k[10] == EV_IN;
+    }
+}
+
+__kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,
+                               uint edge_vertices, __global float *pos)
+{
+    GID_OR_RETURN(nh);
+    const uint g = hit_keys[gid];
+    put3(pos, edge_vertices + gid, (float)(g % nx), (float)((g / nx) % ny),
+         (float)(g / (nx * ny)));
+}
