@@ -1,7 +1,9 @@
 //! The OpenCL layer: device discovery and program building.
 
 use shapecue::Error;
-use shapecue::gpu::{Gpu, KernelFile, kernel_file, list_devices};
+use shapecue::gpu::{Gpu, KernelFile, list_devices};
+use shapecue::spec::kernels::KernelEntry;
+use shapecue::stages::kernel_files;
 
 #[test]
 fn devices_are_listed_with_their_capabilities() {
@@ -20,6 +22,7 @@ fn a_build_failure_returns_the_file_and_the_build_log() {
         name: "kernels/broken.cl",
         source: "__kernel void k(__global float *x) {\n  x[0] = undefined_thing;\n}\n",
         headers: &[],
+        includes: &[],
     };
     match gpu.program(&bad, "") {
         Err(Error::Build { file, log, .. }) => {
@@ -35,7 +38,7 @@ fn a_build_failure_returns_the_file_and_the_build_log() {
 #[test]
 fn every_embedded_kernel_family_builds_in_every_variant() {
     let gpu = Gpu::new(None).unwrap();
-    let f = kernel_file("curvature").unwrap();
+    let f = kernel_files::CURVATURE;
     // Without SC_GATHER the program holds the atomic scheme's kernels, with
     // it the gather scheme's (per-face kernels on 1 or 16 lanes).
     for opts in [
@@ -57,7 +60,6 @@ fn every_embedded_kernel_family_builds_in_every_variant() {
         let b = gpu.program(&f, opts).unwrap();
         assert!(std::sync::Arc::ptr_eq(&a, &b));
     }
-    assert!(kernel_file("nonexistent").is_none());
 }
 
 /// `Gpu::zero` fills with the widest pattern that divides the length; every
@@ -85,4 +87,86 @@ fn zero_clears_exactly_the_first_len_elements() {
     check::<f64>(&gpu, 1.5);
     check::<[u8; 3]>(&gpu, [1, 2, 3]);
     check::<[u32; 3]>(&gpu, [1, 2, 3]);
+}
+
+/// Every family's kernel file builds, and every entry point its kernel enum
+/// names exists in it, so a renamed kernel fails here and not at a launch.
+#[test]
+fn every_kernel_file_builds_and_holds_every_entry_its_enum_names() {
+    use shapecue::spec::{
+        ao::AoKernel, curvature::CurvKernel, edges::EdgesKernel, feature_lines::LinesKernel,
+        marching_cubes::McKernel, mesh_sdf::MsdfKernel, radix_sort::RadixKernel, scan::ScanKernel,
+        sdf_lines::SdflKernel, skinning::SkinKernel, vertex_fusion::FuseKernel,
+    };
+    fn names<K: KernelEntry>(all: &[K]) -> Vec<&'static str> {
+        all.iter().map(|k| k.entry()).collect()
+    }
+    let gpu = Gpu::new(None).unwrap();
+    // (file, build options, the entries it must hold)
+    let curv = names(CurvKernel::ALL);
+    let gather_only = |n: &&str| n.ends_with("_corners") || n.ends_with("_sum");
+    let atomic: Vec<_> = curv.iter().copied().filter(|n| !gather_only(n)).collect();
+    let gather: Vec<_> = curv
+        .iter()
+        .copied()
+        .filter(|n| {
+            gather_only(n)
+                || ![
+                    "curv_clear",
+                    "curv_normals_areas",
+                    "curv_tensor",
+                    "curv_dcurv",
+                ]
+                .contains(n)
+        })
+        .collect();
+    let mc = names(McKernel::ALL);
+    let (direct, soup): (Vec<_>, Vec<_>) = mc.iter().partition(|n| n.starts_with("mc_direct_"));
+    let edges: Vec<_> = names(EdgesKernel::ALL)
+        .into_iter()
+        .filter(|n| *n != "edges_probe_layout") // appended by the layout probe test
+        .collect();
+    let msdf_opts = shapecue::stages::mesh_sdf::build_options();
+    let cases: Vec<(KernelFile, &str, Vec<&str>)> = vec![
+        (kernel_files::CURVATURE, "", atomic),
+        (kernel_files::CURVATURE, "-DSC_GATHER", gather),
+        (kernel_files::SCAN, "", names(ScanKernel::ALL)),
+        (kernel_files::RADIX_SORT, "", names(RadixKernel::ALL)),
+        (kernel_files::SKINNING, "", names(SkinKernel::ALL)),
+        (kernel_files::AO, "", names(AoKernel::ALL)),
+        (kernel_files::FEATURE_LINES, "", names(LinesKernel::ALL)),
+        (
+            kernel_files::MARCHING_CUBES,
+            "",
+            soup.into_iter().copied().collect(),
+        ),
+        (
+            kernel_files::MARCHING_CUBES_DIRECT,
+            "",
+            direct.into_iter().copied().collect(),
+        ),
+        (kernel_files::VERTEX_FUSION, "", names(FuseKernel::ALL)),
+        (kernel_files::EDGES, "", edges),
+        (kernel_files::SDF_LINES, "", names(SdflKernel::ALL)),
+        (kernel_files::MESH_SDF, &msdf_opts, names(MsdfKernel::ALL)),
+    ];
+    assert_eq!(
+        kernel_files::ALL.len(),
+        cases
+            .iter()
+            .map(|c| c.0.name)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len(),
+        "every kernel file is checked"
+    );
+    for (file, opts, entries) in cases {
+        let p = gpu
+            .program(&file, opts)
+            .unwrap_or_else(|e| panic!("{} {opts}: {e}", file.name));
+        assert!(!entries.is_empty(), "{}", file.name);
+        for name in entries {
+            gpu.kernel(&p, name)
+                .unwrap_or_else(|e| panic!("{} {opts}: no entry point {name}: {e}", file.name));
+        }
+    }
 }

@@ -9,7 +9,7 @@ mod device;
 mod program;
 
 pub use device::{DeviceInfo, list_devices};
-pub use program::{COMMON_HEADERS, KernelFile, kernel_file};
+pub use program::{COMMON_HEADERS, KernelFile};
 
 use crate::error::{Error, Result};
 use opencl3::command_queue::{CL_QUEUE_PROFILING_ENABLE, CommandQueue};

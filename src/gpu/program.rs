@@ -2,14 +2,15 @@
 //! shared headers of `kernels/common/` are prepended in order, each preceded
 //! by a `#line` marker so compiler messages point at the right file and line.
 //! A line `#include "common/NAME"` in a kernel file is replaced by that
-//! header's text (see [`INCLUDES`]), as often as it appears: a header written
+//! header's text (see [`KernelFile::includes`]), as often as it appears: a header written
 //! over type macros can be instantiated more than once.
 
 use crate::error::{Error, Result};
 use opencl3::context::Context;
 use opencl3::program::Program;
 
-/// One kernel family's source and the shared headers it uses.
+/// One kernel family's source and the shared headers it uses (each family's
+/// is declared in `stages::kernel_files`).
 #[derive(Clone, Copy, Debug)]
 pub struct KernelFile {
     /// File name under `kernels/` (used in errors and logs).
@@ -18,6 +19,10 @@ pub struct KernelFile {
     pub source: &'static str,
     /// `(name, text)` of each header from `kernels/common/`, in include order.
     pub headers: &'static [(&'static str, &'static str)],
+    /// `(name, text)` of each file the source may `#include "name"` (expanded
+    /// by [`assemble`], one level deep; the drivers see one text with no
+    /// include paths).
+    pub includes: &'static [(&'static str, &'static str)],
 }
 
 /// The shared headers every kernel family may use.
@@ -28,112 +33,6 @@ pub const COMMON_HEADERS: &[(&str, &str)] = &[
         include_str!("../../kernels/common/atomics.h"),
     ),
 ];
-
-/// Files a kernel file may `#include` (expanded by [`assemble`], one level
-/// deep; the drivers see one text with no include paths), by their path
-/// under `kernels/`: shared headers, and the accumulation schemes that
-/// `kernels/curvature.cl` includes under `SC_GATHER`.
-pub const INCLUDES: &[(&str, &str)] = &[
-    (
-        "common/curvature_face.h",
-        include_str!("../../kernels/common/curvature_face.h"),
-    ),
-    (
-        "common/curvature_lanes.h",
-        include_str!("../../kernels/common/curvature_lanes.h"),
-    ),
-    (
-        "curvature_atomic.cl",
-        include_str!("../../kernels/curvature_atomic.cl"),
-    ),
-    (
-        "curvature_gather.cl",
-        include_str!("../../kernels/curvature_gather.cl"),
-    ),
-];
-
-/// Looks up a kernel family by name (`"curvature"`, ...).
-pub fn kernel_file(name: &str) -> Option<KernelFile> {
-    match name {
-        "curvature" => Some(KernelFile {
-            name: "kernels/curvature.cl",
-            source: include_str!("../../kernels/curvature.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "scan" => Some(KernelFile {
-            name: "kernels/scan.cl",
-            source: include_str!("../../kernels/scan.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "radix_sort" => Some(KernelFile {
-            name: "kernels/radix_sort.cl",
-            source: include_str!("../../kernels/radix_sort.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "skinning" => Some(KernelFile {
-            name: "kernels/skinning.cl",
-            source: include_str!("../../kernels/skinning.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "ao" => Some(KernelFile {
-            name: "kernels/ao.cl",
-            source: include_str!("../../kernels/ao.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "feature_lines" => Some(KernelFile {
-            name: "kernels/feature_lines.cl",
-            source: include_str!("../../kernels/feature_lines.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        "marching_cubes" => Some(KernelFile {
-            name: "kernels/marching_cubes.cl",
-            source: include_str!("../../kernels/marching_cubes.cl"),
-            headers: MC_SOUP_HEADERS,
-        }),
-        "marching_cubes_direct" => Some(KernelFile {
-            name: "kernels/marching_cubes_direct.cl",
-            source: include_str!("../../kernels/marching_cubes_direct.cl"),
-            headers: MC_DIRECT_HEADERS,
-        }),
-        "vertex_fusion" => Some(KernelFile {
-            name: "kernels/vertex_fusion.cl",
-            source: include_str!("../../kernels/vertex_fusion.cl"),
-            headers: MC_HEADERS,
-        }),
-        "edges" => Some(KernelFile {
-            name: "kernels/edges.cl",
-            source: include_str!("../../kernels/edges.cl"),
-            headers: COMMON_HEADERS,
-        }),
-        _ => None,
-    }
-}
-
-/// Headers of the marching-cubes and vertex-fusion kernels: the common ones and the hash.
-const MC_HEADERS: &[(&str, &str)] = &[
-    ("common/real.h", include_str!("../../kernels/common/real.h")),
-    ("common/hash.h", include_str!("../../kernels/common/hash.h")),
-    (
-        "common/mc_edge.h",
-        include_str!("../../kernels/common/mc_edge.h"),
-    ),
-];
-
-/// Headers of the marching-cubes soup kernels: those of vertex fusion and
-/// the cell code both marching-cubes files share.
-const MC_SOUP_HEADERS: &[(&str, &str)] =
-    &[MC_HEADERS[0], MC_HEADERS[1], MC_HEADERS[2], MC_CELL_HEADER];
-
-/// Headers of the direct-numbering kernels: real.h, the edge rule and the
-/// shared cell code.
-const MC_DIRECT_HEADERS: &[(&str, &str)] = &[MC_HEADERS[0], MC_HEADERS[2], MC_CELL_HEADER];
-
-/// The cell arithmetic of `kernels/marching_cubes.cl` and
-/// `kernels/marching_cubes_direct.cl`.
-const MC_CELL_HEADER: (&str, &str) = (
-    "common/mc_cell.h",
-    include_str!("../../kernels/common/mc_cell.h"),
-);
 
 /// The full text handed to the compiler.
 pub fn assemble(file: &KernelFile) -> String {
@@ -149,7 +48,7 @@ pub fn assemble(file: &KernelFile) -> String {
             .trim()
             .strip_prefix("#include")
             .map(|r| r.trim().trim_matches('"'))
-            .and_then(|name| INCLUDES.iter().find(|(n, _)| *n == name));
+            .and_then(|name| file.includes.iter().find(|(n, _)| *n == name));
         match included {
             Some((name, text)) => {
                 s.push_str(&format!("#line 1 \"kernels/{name}\"\n"));

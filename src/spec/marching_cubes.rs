@@ -251,3 +251,29 @@ impl std::str::FromStr for Inside {
         }
     }
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/marching_cubes.cl` and `kernels/marching_cubes_direct.cl`.
+    pub enum McKernel {
+        /// Per-cell case and triangle count (soup variants).
+        Classify = "mc_classify",
+        /// The soup: three vertices per triangle, each with its key.
+        Triangles = "mc_triangles",
+        /// Soup indices 0..n for the sort.
+        Iota = "mc_iota",
+        /// Vertex normals from the volume gradient.
+        GradientNormals = "mc_gradient_normals",
+        /// Direct numbering: each row trimmed to where the surface is.
+        DirectRows = "mc_direct_rows",
+        /// Per row: vertices on its edges, triangles and exact hits.
+        DirectCount = "mc_direct_count",
+        /// The grid points that vertices land on, listed.
+        DirectHits = "mc_direct_hits",
+        /// Rows with hits recounted for collapsing triangles.
+        DirectRecount = "mc_direct_recount",
+        /// Triangles with their final indices.
+        DirectTriangles = "mc_direct_triangles",
+        /// Vertex positions, each made once by its edge.
+        DirectPoints = "mc_direct_points",
+    }
+}

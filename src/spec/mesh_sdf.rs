@@ -318,3 +318,27 @@ impl PreparedMesh {
         Ok(n)
     }
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/mesh_sdf.cl`.
+    pub enum MsdfKernel {
+        /// The grid reset.
+        Clear = "msdf_clear",
+        /// Exact point-triangle distances in the narrow band (minimum).
+        BandMin = "msdf_band_min",
+        /// The nearest triangle of each band voxel.
+        BandId = "msdf_band_id",
+        /// Jump-flooding seeds from the band.
+        Seed = "msdf_seed",
+        /// One jump-flooding step.
+        Jfa = "msdf_jfa",
+        /// Exact distance to the flooded nearest triangle.
+        Refine = "msdf_refine",
+        /// Ray crossings along the six axis directions.
+        Cross = "msdf_cross",
+        /// The generalized winding number from the crossings.
+        Wind = "msdf_wind",
+        /// Signed distances.
+        Finish = "msdf_finish",
+    }
+}

@@ -8,10 +8,11 @@
 //! [`crate::spec::ao`].
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
+use crate::gpu::{Arg, Gpu, buf, launch, wait_ms};
 use crate::spec::ao::AoKernel;
 use crate::spec::ao::{AoMode, LUT_N, dirs};
 use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::kernel_files;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -33,7 +34,7 @@ pub struct AoStage {
 impl AoStage {
     /// Builds the kernel and uploads the table.
     pub fn new(gpu: Arc<Gpu>) -> Result<Self> {
-        let file = kernel_file("ao").expect("ao kernels are embedded");
+        let file = kernel_files::AO;
         let p = gpu.program(&file, "")?;
         let mut lb = gpu.buffer_flags::<f32>(LUT_N * LUT_N, CL_MEM_READ_ONLY)?;
         gpu.write(&mut lb, crate::spec::ao::lut())?;

@@ -47,13 +47,14 @@
 //!   vertex of the quad, triangle or cap.
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
 use crate::mesh::topology::vertex_normals;
 use crate::spec::edges::EdgesKernel;
 use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
 use crate::spec::timing::{Step, Timing};
+use crate::stages::kernel_files;
 use crate::stages::scan::Scan;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -141,7 +142,7 @@ impl EdgeStage {
         pos: &[[f32; 3]],
         nrm: &[[f32; 3]],
     ) -> Result<EdgeStage> {
-        let file = kernel_file("edges").expect("kernels/edges.cl is registered");
+        let file = kernel_files::EDGES;
         let prog = gpu.program(&file, "")?;
         let (nv, ne, nc) = (pos.len(), topo.edges.len(), topo.caps.len());
         if ne >= (u32::MAX / 16) as usize || nc >= (u32::MAX / 16) as usize {
@@ -410,7 +411,7 @@ impl EdgeStage {
         let g = self.gpu.clone();
         let ne = self.n_edges;
         if self.compact.is_none() {
-            let file = kernel_file("edges").expect("kernels/edges.cl is registered");
+            let file = kernel_files::EDGES;
             let prog = g.program(&file, "")?;
             self.compact = Some(Compactor {
                 k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
@@ -534,7 +535,7 @@ impl EdgeStage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::{COMMON_HEADERS, KernelFile};
+    use crate::gpu::KernelFile;
     use crate::spec::edges::EdgeParamBlock;
 
     /// The kernel's `EdgeParams` has the layout of [`EdgeParamBlock`]: a probe
@@ -559,10 +560,8 @@ mod tests {
         probe += "}\n";
         let file = KernelFile {
             name: "kernels/edges.cl (layout probe)",
-            source: Box::leak(
-                (kernel_file("edges").unwrap().source.to_string() + &probe).into_boxed_str(),
-            ),
-            headers: COMMON_HEADERS,
+            source: Box::leak((kernel_files::EDGES.source.to_string() + &probe).into_boxed_str()),
+            ..kernel_files::EDGES
         };
         let prog = gpu.program(&file, "").unwrap();
         let k = gpu.entry(&prog, EdgesKernel::ProbeLayout).unwrap();

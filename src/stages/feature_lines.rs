@@ -10,12 +10,13 @@
 //! (made by the renderer's camera, or [`View::from_eye`] for lines alone).
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
 use crate::spec::feature_lines::{LineInputs, Segment, segments_bound};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -73,7 +74,7 @@ impl LineExtractor {
     /// Uploads the faces and allocates the buffers.
     pub fn new(gpu: Arc<Gpu>, n_vertices: usize, faces: &[[u32; 3]]) -> Result<Self> {
         crate::mesh::check_faces(n_vertices, faces, "feature lines")?;
-        let file = kernel_file("feature_lines").expect("feature_lines kernels are embedded");
+        let file = kernel_files::FEATURE_LINES;
         let p = gpu.program(&file, "")?;
         let mut fb = gpu.buffer::<u32>(3 * faces.len())?;
         gpu.write(&mut fb, faces.as_flattened())?;

@@ -17,24 +17,19 @@
 //! vertex, 24 per triangle (corners and edge neighbours).
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, COMMON_HEADERS, Gpu, KernelFile, buf, event_ms, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::mesh::Mesh;
+use crate::spec::mesh_sdf::MsdfKernel;
 use crate::spec::mesh_sdf::{
     BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh, prepare,
 };
+use crate::stages::kernel_files;
 use crate::volume::Volume;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The kernel file of this family.
-pub const KERNELS: KernelFile = KernelFile {
-    name: "kernels/mesh_sdf.cl",
-    source: include_str!("../../kernels/mesh_sdf.cl"),
-    headers: COMMON_HEADERS,
-};
 
 /// What one conversion did and how long each pass took.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -131,17 +126,17 @@ pub fn mesh_to_sdf(
 impl MeshSdf {
     /// Builds `kernels/mesh_sdf.cl` (cached per device).
     pub fn new(gpu: Arc<Gpu>) -> Result<MeshSdf> {
-        let p = gpu.program(&KERNELS, &build_options())?;
+        let p = gpu.program(&kernel_files::MESH_SDF, &build_options())?;
         Ok(MeshSdf {
-            clear: gpu.kernel(&p, "msdf_clear")?,
-            band_min: gpu.kernel(&p, "msdf_band_min")?,
-            band_id: gpu.kernel(&p, "msdf_band_id")?,
-            seed: gpu.kernel(&p, "msdf_seed")?,
-            jfa: gpu.kernel(&p, "msdf_jfa")?,
-            refine: gpu.kernel(&p, "msdf_refine")?,
-            cross: gpu.kernel(&p, "msdf_cross")?,
-            wind: gpu.kernel(&p, "msdf_wind")?,
-            finish: gpu.kernel(&p, "msdf_finish")?,
+            clear: gpu.entry(&p, MsdfKernel::Clear)?,
+            band_min: gpu.entry(&p, MsdfKernel::BandMin)?,
+            band_id: gpu.entry(&p, MsdfKernel::BandId)?,
+            seed: gpu.entry(&p, MsdfKernel::Seed)?,
+            jfa: gpu.entry(&p, MsdfKernel::Jfa)?,
+            refine: gpu.entry(&p, MsdfKernel::Refine)?,
+            cross: gpu.entry(&p, MsdfKernel::Cross)?,
+            wind: gpu.entry(&p, MsdfKernel::Wind)?,
+            finish: gpu.entry(&p, MsdfKernel::Finish)?,
             gpu,
         })
     }

@@ -31,9 +31,10 @@
 //! ([`Strategy::Lsd`]).
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::radix_sort::RadixKernel;
 use crate::spec::radix_sort::histogram_len_bound;
+use crate::stages::kernel_files;
 use crate::stages::scan::{Scan, check_len};
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -65,7 +66,7 @@ impl RadixSort {
     /// Builds `kernels/radix_sort.cl` and `kernels/scan.cl` (cached per
     /// device). Scratch is allocated by the first sort that needs it.
     pub fn new(gpu: Arc<Gpu>) -> Result<RadixSort> {
-        let file = kernel_file("radix_sort").expect("radix_sort kernels are embedded");
+        let file = kernel_files::RADIX_SORT;
         let program = gpu.program(&file, &format!("-DRADIX_BITS={DIGIT_BITS}"))?;
         Ok(RadixSort {
             scan: Scan::new(gpu.clone())?,

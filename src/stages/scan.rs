@@ -16,9 +16,10 @@
 //! `u32::MAX`, so on overflow the output is left unchanged.
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::scan::ScanKernel;
 use crate::spec::scan::partials_len_bound;
+use crate::stages::kernel_files;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, ClMem};
@@ -64,7 +65,7 @@ impl Scan {
     /// Builds `kernels/scan.cl` (cached per device) and allocates the scratch
     /// (`8 × (MAX_CHUNKS + 1)` bytes).
     pub fn new(gpu: Arc<Gpu>) -> Result<Scan> {
-        let file = kernel_file("scan").expect("scan kernels are embedded");
+        let file = kernel_files::SCAN;
         let program = gpu.program(&file, "")?;
         Ok(Scan {
             block_sums: gpu.entry(&program, ScanKernel::BlockSums)?,

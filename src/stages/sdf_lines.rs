@@ -17,9 +17,10 @@ use crate::cpu::sdf_lines::{
     self as twin, DenseSample, Principal, cell_count, check, check_points, dense_overflow,
 };
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, COMMON_HEADERS, Gpu, KernelFile, buf, event_ms, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::sdf_lines::SdflKernel;
 use crate::spec::sdf_lines::*;
+use crate::stages::kernel_files;
 use crate::stages::scan::Scan;
 use crate::volume::Volume;
 use opencl3::event::Event;
@@ -27,22 +28,6 @@ use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The kernel file with its headers (real.h for `GID_OR_RETURN` and
-/// `SC_INLINE`, mc_edge.h for the marching-cubes edge rule).
-pub const KERNEL_FILE: KernelFile = KernelFile {
-    name: "kernels/sdf_lines.cl",
-    source: include_str!("../../kernels/sdf_lines.cl"),
-    headers: HEADERS,
-};
-
-const HEADERS: &[(&str, &str)] = &[
-    COMMON_HEADERS[0],
-    (
-        "common/mc_edge.h",
-        include_str!("../../kernels/common/mc_edge.h"),
-    ),
-];
 
 /// Initial capacity of the dense-sample buffer (grown up to the bound).
 const DENSE_START: usize = 1 << 20;
@@ -101,7 +86,7 @@ impl SdfLines {
     /// one the device cannot hold, or an OpenCL failure.
     pub fn new(gpu: Arc<Gpu>, vol: &Volume, opts: &SdfLineOptions) -> Result<SdfLines> {
         let dense_bound = check(vol, opts)?;
-        let p = gpu.program(&KERNEL_FILE, "")?;
+        let p = gpu.program(&kernel_files::SDF_LINES, "")?;
         let kernel = |k: SdflKernel| gpu.entry(&p, k);
         let k = Kernels {
             dense: kernel(SdflKernel::Dense)?,
@@ -651,7 +636,7 @@ fn read_principal(gpu: &Gpu, b: &Buffer<f32>, n: usize) -> Result<Vec<Principal>
 ///
 /// An OpenCL failure.
 pub fn principal_probe(gpu: &Gpu, g: &[[f32; 3]], h: &[[f32; 9]]) -> Result<Vec<Principal>> {
-    let p = gpu.program(&KERNEL_FILE, "")?;
+    let p = gpu.program(&kernel_files::SDF_LINES, "")?;
     let k = gpu.entry(&p, SdflKernel::PrincipalProbe)?;
     let n = g.len().min(h.len());
     let mut gb = gpu.buffer::<f32>(3 * n)?;
@@ -675,7 +660,7 @@ pub fn principal_probe(gpu: &Gpu, g: &[[f32; 3]], h: &[[f32; 9]]) -> Result<Vec<
 ///
 /// An OpenCL failure.
 pub fn layout_probe(gpu: &Gpu) -> Result<[u32; 4]> {
-    let p = gpu.program(&KERNEL_FILE, "")?;
+    let p = gpu.program(&kernel_files::SDF_LINES, "")?;
     let k = gpu.entry(&p, SdflKernel::Probe)?;
     let out = gpu.buffer::<u32>(4)?;
     launch(gpu, &k, 1, &[buf(&out)])?;

@@ -6,10 +6,11 @@
 //! CPU twin: [`crate::cpu::skinning`]; buffer layout: [`crate::spec::skinning`].
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
+use crate::gpu::{Arg, Gpu, buf, launch, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
 use crate::spec::skinning::SkinKernel;
 use crate::spec::skinning::{INFLUENCES, MATRIX_FLOATS, matrices_len};
+use crate::stages::kernel_files;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::{Buffer, CL_MEM_READ_ONLY};
@@ -33,7 +34,7 @@ impl Skinner {
     /// Uploads the rest mesh, joints and weights.
     pub fn new(gpu: Arc<Gpu>, m: &SkinnedMesh) -> Result<Self> {
         let nv = m.rest.positions.len();
-        let file = kernel_file("skinning").expect("skinning kernels are embedded");
+        let file = kernel_files::SKINNING;
         let p = gpu.program(&file, "")?;
         let rest_f: Vec<f32> = m
             .rest

@@ -8,10 +8,11 @@
 //! bounds: [`crate::spec::vertex_fusion`].
 
 use crate::error::Result;
-use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::FuseKernel;
 use crate::spec::vertex_fusion::{Fusion, soup_triangles};
+use crate::stages::kernel_files;
 use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
 use opencl3::kernel::Kernel;
@@ -91,7 +92,7 @@ pub fn build_options(collide_mask: Option<u32>) -> String {
 impl Fuser {
     /// Builds the kernels (and those of the radix sort and scan).
     pub fn new(gpu: Arc<Gpu>) -> Result<Self> {
-        let file = kernel_file("vertex_fusion").expect("vertex_fusion kernels are embedded");
+        let file = kernel_files::VERTEX_FUSION;
         let p = gpu.program(&file, &build_options(None))?;
         Ok(Fuser {
             sort: RadixSort::new(gpu.clone())?,

@@ -4,10 +4,11 @@
 
 use super::{CurvatureEstimator, atomic, gather};
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, kernel_file};
+use crate::gpu::Gpu;
 use crate::spec::curvature::CurvKernel;
 use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use crate::spec::timing::Timing;
+use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;
 use opencl3::program::Program;
 use std::sync::Arc;
@@ -152,7 +153,7 @@ impl CurvatureEstimator {
             Precision::F64 => gpu.info.native_double_width,
         };
         let lanes = crate::spec::curvature::face_lanes_for(opts.lanes, &gpu.info.kind, native);
-        let file = kernel_file("curvature").expect("curvature kernels are embedded");
+        let file = kernel_files::CURVATURE;
         let pair_adds = gpu.info.int64_atomics;
         let program = gpu.program(&file, &build_options(opts, lanes, pair_adds))?;
         let scheme = if opts.accumulate == Accumulate::Gather {

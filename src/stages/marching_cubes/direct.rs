@@ -9,6 +9,7 @@
 use super::{Holder, IsoStats, Isosurfacer};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
+use crate::spec::marching_cubes::McKernel;
 use crate::spec::timing::Step;
 use crate::stages::vertex_fusion::Grow;
 use opencl3::kernel::Kernel;
@@ -47,12 +48,12 @@ impl Direct {
     /// the buffers of a volume of `grid_rows` grid rows.
     pub(super) fn new(gpu: &Gpu, p: &Program, grid_rows: usize, nonfinite: bool) -> Result<Self> {
         Ok(Direct {
-            rows: gpu.kernel(p, "mc_direct_rows")?,
-            count: gpu.kernel(p, "mc_direct_count")?,
-            hits: gpu.kernel(p, "mc_direct_hits")?,
-            triangles: gpu.kernel(p, "mc_direct_triangles")?,
-            points: gpu.kernel(p, "mc_direct_points")?,
-            recount: gpu.kernel(p, "mc_direct_recount")?,
+            rows: gpu.entry(p, McKernel::DirectRows)?,
+            count: gpu.entry(p, McKernel::DirectCount)?,
+            hits: gpu.entry(p, McKernel::DirectHits)?,
+            triangles: gpu.entry(p, McKernel::DirectTriangles)?,
+            points: gpu.entry(p, McKernel::DirectPoints)?,
+            recount: gpu.entry(p, McKernel::DirectRecount)?,
             rowc: gpu.buffer::<u32>(4 * grid_rows)?,
             info: gpu.buffer::<u32>(4 * grid_rows)?,
             split: gpu.buffer::<u32>(2 * grid_rows)?,

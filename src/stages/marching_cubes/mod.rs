@@ -14,13 +14,15 @@ mod direct;
 mod soup;
 
 use crate::error::{Error, Result};
-use crate::gpu::{Arg, Gpu, buf, kernel_file, launch};
+use crate::gpu::{Arg, Gpu, buf, launch};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureOptions, Normalization};
+use crate::spec::marching_cubes::McKernel;
 use crate::spec::marching_cubes::{cell_rows, edge_key_bits, table};
 use crate::spec::timing::Timing;
 use crate::spec::vertex_fusion::Fusion;
 use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::kernel_files;
 use crate::stages::scan::Scan;
 use crate::stages::vertex_fusion::{Fuser, build_options};
 use crate::volume::Volume;
@@ -121,10 +123,9 @@ impl Isosurfacer {
             )));
         }
         let opts = build_options(collide_mask);
-        let file = kernel_file("marching_cubes").expect("marching_cubes kernels are embedded");
+        let file = kernel_files::MARCHING_CUBES;
         let p = gpu.program(&file, &opts)?;
-        let file = kernel_file("marching_cubes_direct")
-            .expect("marching_cubes_direct kernels are embedded");
+        let file = kernel_files::MARCHING_CUBES_DIRECT;
         let pd = gpu.program(&file, &opts)?;
         let mut volb = gpu.buffer_flags::<f32>(n, CL_MEM_READ_ONLY)?;
         gpu.write(&mut volb, &vol.values)?;
@@ -145,7 +146,7 @@ impl Isosurfacer {
             counts,
             tris,
             flat,
-            gradient: gpu.kernel(&p, "mc_gradient_normals")?,
+            gradient: gpu.entry(&p, McKernel::GradientNormals)?,
             scan: Scan::new(gpu.clone())?,
             fuser: Fuser::new(gpu.clone())?,
             soup: soup::Soup::new(&gpu, &p, rows)?,

@@ -8,6 +8,7 @@
 use super::{Holder, IsoStats, Isosurfacer};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
+use crate::spec::marching_cubes::McKernel;
 use crate::spec::marching_cubes::{edge_key_bits, soup_vertices_bound};
 use crate::spec::timing::Step;
 use crate::spec::vertex_fusion::{Fusion, FusionCounts};
@@ -37,9 +38,9 @@ impl Soup {
     /// buffers of a volume of `rows` cell rows.
     pub(super) fn new(gpu: &Gpu, p: &Program, rows: usize) -> Result<Self> {
         Ok(Soup {
-            classify: gpu.kernel(p, "mc_classify")?,
-            triangles: gpu.kernel(p, "mc_triangles")?,
-            iota: gpu.kernel(p, "mc_iota")?,
+            classify: gpu.entry(p, McKernel::Classify)?,
+            triangles: gpu.entry(p, McKernel::Triangles)?,
+            iota: gpu.entry(p, McKernel::Iota)?,
             row_tris: gpu.buffer::<u32>(rows)?,
             row_off: gpu.buffer::<u32>(rows)?,
             counters: gpu.buffer::<u32>(2)?,
