@@ -39,6 +39,7 @@ pub mod edges;
 mod frame;
 mod lines;
 pub mod strokes;
+pub mod visibility;
 
 pub use camera::{Camera, Placement, fit_sphere, framed};
 pub use frame::Frame;
