@@ -42,6 +42,11 @@ pub mod spec;
 pub mod stages;
 pub mod volume;
 
+/// The Rust example of README.md, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 pub use api::{
     IsoOptions, Isosurface, curvature, curvature_on, feature_edges, feature_edges_on, isosurface,
     isosurface_on, render_scene, render_scene_on,

@@ -157,16 +157,10 @@ fn each_segment_end_lies_on_its_mesh_edge_and_closed_contours_meet_in_pairs() {
 #[test]
 fn device_matches_cpu_twin() {
     let torus = mesh::torus(1.0, 0.4, 120, 60);
-    let bunny_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes/stanford-bunny.obj");
     let mut meshes = vec![("torus", torus)];
-    if bunny_path.exists() {
-        meshes.push((
-            "bunny",
-            mesh::load(&bunny_path, &Default::default()).unwrap(),
-        ));
-    } else {
-        eprintln!("skipping the bunny: {} not found", bunny_path.display());
+    // The bunny is added where the shared data sets are (else a message).
+    if let Some(bunny) = common::shared_mesh("stanford-bunny.obj") {
+        meshes.push(("bunny", bunny));
     }
     for (name, m) in meshes {
         let x = inputs(&m);

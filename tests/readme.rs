@@ -1,9 +1,12 @@
-//! Every `shapecue` example in README.md runs as written, from a folder laid
-//! out like the repository root (the bundled `data/` and `scenes/`), with the
-//! built binary first on `PATH`: a user who copies a line from the README
+//! Every `shapecue` example in README.md and in `docs/*.md` runs as written,
+//! from a folder laid out like the repository root (the bundled `data/` and
+//! `scenes/`), with the built binary first on `PATH`: a user who copies a line
 //! gets exit status 0 and the files the line names. Left out: usage synopses
-//! (lines with `MESH` or `[--option]` placeholders) and the `--report`
-//! tables, which take minutes (the main job prints them).
+//! (lines with `MESH` or `[--option]` placeholders) and `shapecue report`,
+//! whose tables take minutes (its topics are tested on tiny sizes in
+//! `tests/cli_report.rs`). An example that needs a downloaded data set (its
+//! line names `../shared/data`, or the scene file it names does) is skipped
+//! with a message when the data set is absent, as on a fresh clone.
 
 mod common;
 
@@ -38,32 +41,105 @@ fn examples(readme: &str) -> Vec<String> {
     out
 }
 
-#[test]
-fn every_readme_example_runs_as_written() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let all = examples(&readme);
-    assert!(all.len() >= 15, "{all:?}");
-    let run: Vec<&String> = all
-        .iter()
-        .filter(|l| !(l.contains("MESH") || l.contains("[--") || l.contains("--report")))
-        .collect();
-    let d = scratch("readme");
-    for sub in ["data", "scenes"] {
-        std::os::unix::fs::symlink(root.join(sub), d.join(sub)).unwrap();
+/// The downloaded data a line needs that is absent: the `../shared/data`
+/// paths the line names (relative to the repository root) and those named by
+/// the scene files it runs (relative to the scene file), with the data set
+/// looked for where the tests look for it.
+fn missing_downloads(root: &Path, line: &str) -> Vec<String> {
+    let mut missing = Vec::new();
+    let shared_absent = !common::shared_data().exists() || !Path::new(SHARED_DATA).exists();
+    for word in line.split_whitespace() {
+        if word.contains("../shared/data") && (shared_absent || !root.join(word).exists()) {
+            missing.push(word.to_string());
+        }
+        if !word.ends_with(".toml") {
+            continue;
+        }
+        let scene = root.join(word);
+        let Ok(text) = std::fs::read_to_string(&scene) else {
+            continue;
+        };
+        for quoted in text.split('"').skip(1).step_by(2) {
+            if quoted.contains("shared/data") {
+                let p = scene.parent().unwrap().join(quoted);
+                if shared_absent || !p.exists() {
+                    missing.push(format!("{word} needs {quoted}"));
+                }
+            }
+        }
     }
+    missing
+}
+
+/// The examples of README.md and of every `docs/*.md` page, each with the
+/// page it comes from.
+fn all_examples(root: &Path) -> Vec<(String, String)> {
+    let mut pages = vec![root.join("README.md")];
+    let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "md"))
+                .collect()
+        })
+        .unwrap_or_default();
+    docs.sort();
+    pages.extend(docs);
+    let mut out = Vec::new();
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap();
+        let name = page.strip_prefix(root).unwrap().display().to_string();
+        out.extend(examples(&text).into_iter().map(|l| (name.clone(), l)));
+    }
+    out
+}
+
+#[test]
+fn every_example_runs_as_written() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let all = all_examples(root);
+    assert!(all.len() >= 15, "{all:?}");
+    let run: Vec<&(String, String)> = all
+        .iter()
+        .filter(|(_, l)| {
+            !(l.contains("MESH")
+                || l.contains("[--")
+                || l.starts_with("shapecue report")
+                || l.contains("--report"))
+        })
+        .collect();
+    // One folder per page, laid out as the repository root: each page's
+    // examples run in order, as a reader of that page would run them.
+    let mut folders = std::collections::HashMap::new();
+    let mut folder = |page: &str| -> std::path::PathBuf {
+        folders
+            .entry(page.to_string())
+            .or_insert_with(|| {
+                let d = scratch("readme");
+                for sub in ["data", "scenes"] {
+                    std::os::unix::fs::symlink(root.join(sub), d.join(sub)).unwrap();
+                }
+                d
+            })
+            .clone()
+    };
     let bin = Path::new(env!("CARGO_BIN_EXE_shapecue")).parent().unwrap();
     let path = format!(
         "{}:{}",
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let shared = Path::new(SHARED_DATA).exists();
-    for line in run {
-        if line.contains("../shared") && !shared {
-            eprintln!("skipping (no ../shared/data): {line}");
+    let mut skipped = 0;
+    for (page, line) in run {
+        let missing = missing_downloads(root, line);
+        if !missing.is_empty() {
+            eprintln!(
+                "skipping ({page}: needs downloaded data, absent: {}): {line}",
+                missing.join(", ")
+            );
+            skipped += 1;
             continue;
         }
+        let d = folder(page);
         let out = std::process::Command::new("bash")
             .arg("-c")
             .arg(line)
@@ -79,7 +155,7 @@ fn every_readme_example_runs_as_written() {
         }
         assert!(
             out.status.success(),
-            "README example failed: {line}\n{}",
+            "{page} example failed: {line}\n{}",
             String::from_utf8_lossy(&out.stderr)
         );
         // The files it names with -o / --svg / --stats / --geometry exist.
@@ -90,5 +166,47 @@ fn every_readme_example_runs_as_written() {
             }
         }
     }
-    let _ = std::fs::remove_dir_all(&d);
+    eprintln!("{skipped} example(s) skipped for absent downloaded data");
+    for d in folders.values() {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
+/// Every scene under `scenes/` runs on bundled data, or says at its top that
+/// it needs a download and names it.
+#[test]
+fn every_scene_is_bundled_or_names_its_download() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut n = 0;
+    for e in std::fs::read_dir(root.join("scenes")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        n += 1;
+        let text = std::fs::read_to_string(&p).unwrap();
+        let needs_shared = text
+            .lines()
+            .filter(|l| !l.trim_start().starts_with('#'))
+            .any(|l| l.contains("shared/data"));
+        if needs_shared {
+            assert!(
+                text.starts_with("# Needs a download:"),
+                "{}: names ../shared/data but does not open with \"# Needs a download:\"",
+                p.display()
+            );
+        } else {
+            // Every quoted path it names that looks like a file is in the repository.
+            for quoted in text.split('"').skip(1).step_by(2) {
+                if quoted.starts_with("../") {
+                    assert!(
+                        p.parent().unwrap().join(quoted).exists(),
+                        "{}: {quoted} is not in the repository",
+                        p.display()
+                    );
+                }
+            }
+        }
+    }
+    assert!(n >= 5, "scenes/ has {n} scenes");
 }

@@ -262,7 +262,17 @@ impl Gpu {
         saved
     }
 
-    /// Creates the kernel `name` from `program`.
+    /// Creates the kernel of entry point `k` (a family's kernel enum,
+    /// [`crate::spec::kernels::KernelEntry`]) from `program`.
+    pub fn entry(
+        &self,
+        program: &Program,
+        k: impl crate::spec::kernels::KernelEntry,
+    ) -> Result<Kernel> {
+        self.kernel(program, k.entry())
+    }
+
+    /// Creates the kernel `name` from `program`; the stages use [`Gpu::entry`].
     pub fn kernel(&self, program: &Program, name: &str) -> Result<Kernel> {
         Kernel::create(program, name).map_err(|e| Error::cl(format!("clCreateKernel({name})"), e))
     }

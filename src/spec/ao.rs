@@ -120,3 +120,11 @@ pub fn dirs() -> Vec<f32> {
         })
         .collect()
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/ao.cl`.
+    pub enum AoKernel {
+        /// Ambient occlusion of each vertex from (k1, k2).
+        Vertex = "ao_vertex",
+    }
+}

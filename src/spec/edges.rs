@@ -483,3 +483,23 @@ pub fn memory_use(mode: CapMode, edges: usize, caps: usize) -> MemoryUse {
         cap_bits,
     }
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/edges.cl`.
+    pub enum EdgesKernel {
+        /// Contour, crease and boundary tests of each edge into edge-out.
+        Detect = "edges_detect",
+        /// McGuire-Hughes half-caps.
+        CapsMh = "caps_mh",
+        /// Which cap pairs a view draws (scanned into slots).
+        CapsAdjacencyFlags = "caps_adjacency_flags",
+        /// House & Li adjacency caps of the flagged pairs.
+        CapsAdjacency = "caps_adjacency",
+        /// Which edge-out entries are drawn (for the compacted read-back).
+        DrawnFlags = "drawn_flags",
+        /// The drawn edges, compacted.
+        CompactEdges = "compact_edges",
+        /// Sizes and offsets of the parameter struct on the device (a probe source appended by the layout test).
+        ProbeLayout = "edges_probe_layout",
+    }
+}

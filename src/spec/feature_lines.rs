@@ -37,3 +37,13 @@ pub struct LineInputs<'a> {
 pub fn segments_bound(faces: usize) -> usize {
     2 * faces
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/feature_lines.cl`.
+    pub enum LinesKernel {
+        /// Per-vertex n·v and radial curvature.
+        Vertex = "lines_vertex",
+        /// One contour or suggestive-contour segment per face.
+        Face = "lines_face",
+    }
+}

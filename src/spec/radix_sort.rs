@@ -61,3 +61,15 @@ pub enum Strategy {
 /// leave the other cores idle (all keys below 2^24 with `key_bits = 32`: 8M
 /// pairs took 180–230 ms that way, against 100–140 ms for LSD).
 pub const SKEW_LIMIT: usize = 8;
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/radix_sort.cl`.
+    pub enum RadixKernel {
+        /// Digit counts per work-group.
+        Histogram = "radix_histogram",
+        /// Stable scatter by the scanned counts.
+        Scatter = "radix_scatter",
+        /// Sorting of small buckets in local memory.
+        BucketSort = "radix_bucket_sort",
+    }
+}

@@ -42,3 +42,15 @@ pub fn chunking(n: usize) -> (usize, usize) {
 pub fn partials_len_bound() -> usize {
     MAX_CHUNKS
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/scan.cl`.
+    pub enum ScanKernel {
+        /// Sum of each block.
+        BlockSums = "scan_block_sums",
+        /// Exclusive scan of the block sums.
+        Partials = "scan_partials",
+        /// Each block scanned, offset by its partial.
+        Apply = "scan_apply",
+    }
+}

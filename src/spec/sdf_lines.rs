@@ -457,3 +457,35 @@ pub fn coefficient_of_variation(values: impl Iterator<Item = f64>) -> (f64, usiz
     }
     (var.sqrt() / mean.abs(), v.len())
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/sdf_lines.cl`.
+    pub enum SdflKernel {
+        /// Field samples and gradients at given points (tests).
+        Probe = "sdfl_probe",
+        /// Sign changes between neighbouring voxels, appended.
+        Dense = "sdfl_dense",
+        /// Samples per Poisson-disk grid cell.
+        CellCount = "sdfl_cell_count",
+        /// Samples sorted into their cells.
+        CellFill = "sdfl_cell_fill",
+        /// One of the 27 conflict-free thinning phases.
+        ThinPhase = "sdfl_thin_phase",
+        /// Which samples survived thinning.
+        ThinFlags = "sdfl_thin_flags",
+        /// The seeds, compacted.
+        ThinCompact = "sdfl_thin_compact",
+        /// Central differences per voxel.
+        Gradient = "sdfl_gradient",
+        /// Principal curvatures and direction at given points (tests).
+        PrincipalProbe = "sdfl_principal_probe",
+        /// Principal curvatures and direction at the seeds.
+        Curvature = "sdfl_curvature",
+        /// κ1 minimum and maximum over the seeds.
+        Range = "sdfl_range",
+        /// RK4 along d1 both ways, projected onto the surface.
+        Trace = "sdfl_trace",
+        /// Tapered triangle strips.
+        Strips = "sdfl_strips",
+    }
+}

@@ -18,3 +18,11 @@ pub const MATRIX_FLOATS: usize = 16;
 pub fn matrices_len(joints: usize) -> usize {
     MATRIX_FLOATS * joints
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/skinning.cl`.
+    pub enum SkinKernel {
+        /// Linear blend skinning of each vertex.
+        Lbs = "skin_lbs",
+    }
+}

@@ -8,6 +8,12 @@
 //! [`Timing`] to the planned passes by these ids, never by kernel-name
 //! strings. Pure data: no device, no clock.
 
+use super::ao::AoKernel;
+use super::edges::EdgesKernel;
+use super::feature_lines::LinesKernel;
+use super::sdf_lines::SdflKernel;
+use super::skinning::SkinKernel;
+use super::vertex_fusion::FuseKernel;
 use serde::Serialize;
 
 /// The stage family a [`Step`] belongs to (one name per family across
@@ -164,30 +170,30 @@ impl Step {
             Step::McDirectPoints => "mc_direct_points",
             Step::McDirectRecount => "mc_direct_recount",
             Step::McGradientNormals => "mc_gradient_normals",
-            Step::FuseIndex => "fuse_index",
-            Step::FuseTriangles => "fuse_triangles",
-            Step::FuseCandidates => "fuse_candidates",
-            Step::FuseCancel => "fuse_cancel",
-            Step::FuseMark => "fuse_mark",
-            Step::FuseCompactVertices => "fuse_compact_vertices",
-            Step::FuseCompactFaces => "fuse_compact_faces",
+            Step::FuseIndex => FuseKernel::Index.name(),
+            Step::FuseTriangles => FuseKernel::Triangles.name(),
+            Step::FuseCandidates => FuseKernel::Candidates.name(),
+            Step::FuseCancel => FuseKernel::Cancel.name(),
+            Step::FuseMark => FuseKernel::Mark.name(),
+            Step::FuseCompactVertices => FuseKernel::CompactVertices.name(),
+            Step::FuseCompactFaces => FuseKernel::CompactFaces.name(),
             Step::ScanExclusive => "scan_exclusive",
             Step::RadixSortPairs => "radix_sort_pairs",
-            Step::EdgesDetect => "edges_detect",
-            Step::CapsMh => "caps_mh",
-            Step::CapsAdjacency => "caps_adjacency",
+            Step::EdgesDetect => EdgesKernel::Detect.name(),
+            Step::CapsMh => EdgesKernel::CapsMh.name(),
+            Step::CapsAdjacency => EdgesKernel::CapsAdjacency.name(),
             Step::EdgesCompact => "edges_compact",
-            Step::SkinLbs => "skin_lbs",
-            Step::LinesVertex => "lines_vertex",
-            Step::LinesFace => "lines_face",
-            Step::AoVertex => "ao_vertex",
-            Step::SdflDense => "sdfl_dense",
-            Step::SdflThin => "sdfl_thin_phase",
-            Step::SdflGradient => "sdfl_gradient",
-            Step::SdflCurvature => "sdfl_curvature",
-            Step::SdflRange => "sdfl_range",
-            Step::SdflTrace => "sdfl_trace",
-            Step::SdflStrips => "sdfl_strips",
+            Step::SkinLbs => SkinKernel::Lbs.name(),
+            Step::LinesVertex => LinesKernel::Vertex.name(),
+            Step::LinesFace => LinesKernel::Face.name(),
+            Step::AoVertex => AoKernel::Vertex.name(),
+            Step::SdflDense => SdflKernel::Dense.name(),
+            Step::SdflThin => SdflKernel::ThinPhase.name(),
+            Step::SdflGradient => SdflKernel::Gradient.name(),
+            Step::SdflCurvature => SdflKernel::Curvature.name(),
+            Step::SdflRange => SdflKernel::Range.name(),
+            Step::SdflTrace => SdflKernel::Trace.name(),
+            Step::SdflStrips => SdflKernel::Strips.name(),
             Step::SdflSweep => "sdfl_sweep",
         }
     }

@@ -179,3 +179,25 @@ mod tests {
         assert_eq!(super::fused_faces_bound(9), 3);
     }
 }
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/vertex_fusion.cl`.
+    pub enum FuseKernel {
+        /// Each soup vertex to the first of its equal keys.
+        Index = "fuse_index",
+        /// Counters reset.
+        Clear = "fuse_clear",
+        /// Triangles re-indexed, collapsed ones dropped.
+        Triangles = "fuse_triangles",
+        /// Triangles that may have an opposite-wound twin.
+        Candidates = "fuse_candidates",
+        /// Twins cancelled.
+        Cancel = "fuse_cancel",
+        /// Vertices still used.
+        Mark = "fuse_mark",
+        /// Used vertices, compacted.
+        CompactVertices = "fuse_compact_vertices",
+        /// Kept faces, compacted.
+        CompactFaces = "fuse_compact_faces",
+    }
+}

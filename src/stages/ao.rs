@@ -9,6 +9,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
+use crate::spec::ao::AoKernel;
 use crate::spec::ao::{AoMode, LUT_N, dirs};
 use crate::stages::curvature::CurvatureEstimator;
 use opencl3::event::Event;
@@ -41,7 +42,7 @@ impl AoStage {
         gpu.write(&mut db, &d)?;
         Ok(AoStage {
             dirs: db,
-            kernel: gpu.kernel(&p, "ao_vertex")?,
+            kernel: gpu.entry(&p, AoKernel::Vertex)?,
             lut: lb,
             k: gpu.buffer(2)?,
             out: gpu.buffer(1)?,

@@ -51,6 +51,7 @@ use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
 use crate::mesh::topology::vertex_normals;
+use crate::spec::edges::EdgesKernel;
 use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, edge_out_bound};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::scan::Scan;
@@ -155,10 +156,10 @@ impl EdgeStage {
             n_vertices: nv,
             n_edges: ne,
             n_caps: nc,
-            k_detect: gpu.kernel(&prog, "edges_detect")?,
-            k_mh: gpu.kernel(&prog, "caps_mh")?,
-            k_adj_flags: gpu.kernel(&prog, "caps_adjacency_flags")?,
-            k_adj: gpu.kernel(&prog, "caps_adjacency")?,
+            k_detect: gpu.entry(&prog, EdgesKernel::Detect)?,
+            k_mh: gpu.entry(&prog, EdgesKernel::CapsMh)?,
+            k_adj_flags: gpu.entry(&prog, EdgesKernel::CapsAdjacencyFlags)?,
+            k_adj: gpu.entry(&prog, EdgesKernel::CapsAdjacency)?,
             params: gpu.buffer(PARAMS_LEN)?,
             pos: gpu.buffer(3 * nv)?,
             nrm: gpu.buffer(3 * nv)?,
@@ -412,8 +413,8 @@ impl EdgeStage {
             let file = kernel_file("edges").expect("kernels/edges.cl is registered");
             let prog = g.program(&file, "")?;
             self.compact = Some(Compactor {
-                k_flags: g.kernel(&prog, "drawn_flags")?,
-                k_edges: g.kernel(&prog, "compact_edges")?,
+                k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
+                k_edges: g.entry(&prog, EdgesKernel::CompactEdges)?,
                 slots: g.buffer(ne.max(1))?,
                 dst: g.buffer(4)?,
                 dst_len: 1,
@@ -564,7 +565,7 @@ mod tests {
             headers: COMMON_HEADERS,
         };
         let prog = gpu.program(&file, "").unwrap();
-        let k = gpu.kernel(&prog, "edges_probe_layout").unwrap();
+        let k = gpu.entry(&prog, EdgesKernel::ProbeLayout).unwrap();
         let mut out: Buffer<u32> = gpu.buffer(fields.len()).unwrap();
         gpu.write(&mut out, &vec![u32::MAX; fields.len()]).unwrap();
         launch(&gpu, &k, 1, &[buf(&out)]).unwrap();

@@ -11,6 +11,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::feature_lines::LinesKernel;
 use crate::spec::feature_lines::{LineInputs, Segment, segments_bound};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
@@ -78,8 +79,8 @@ impl LineExtractor {
         gpu.write(&mut fb, faces.as_flattened())?;
         let nv = n_vertices;
         Ok(LineExtractor {
-            vertex: gpu.kernel(&p, "lines_vertex")?,
-            face: gpu.kernel(&p, "lines_face")?,
+            vertex: gpu.entry(&p, LinesKernel::Vertex)?,
+            face: gpu.entry(&p, LinesKernel::Face)?,
             faces: fb,
             inputs: [
                 gpu.buffer(3 * nv)?,

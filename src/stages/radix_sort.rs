@@ -32,6 +32,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::radix_sort::RadixKernel;
 use crate::spec::radix_sort::histogram_len_bound;
 use crate::stages::scan::{Scan, check_len};
 use opencl3::event::Event;
@@ -68,9 +69,9 @@ impl RadixSort {
         let program = gpu.program(&file, &format!("-DRADIX_BITS={DIGIT_BITS}"))?;
         Ok(RadixSort {
             scan: Scan::new(gpu.clone())?,
-            histogram: gpu.kernel(&program, "radix_histogram")?,
-            scatter: gpu.kernel(&program, "radix_scatter")?,
-            bucket_sort: gpu.kernel(&program, "radix_bucket_sort")?,
+            histogram: gpu.entry(&program, RadixKernel::Histogram)?,
+            scatter: gpu.entry(&program, RadixKernel::Scatter)?,
+            bucket_sort: gpu.entry(&program, RadixKernel::BucketSort)?,
             keys_tmp: gpu.buffer::<u32>(1)?,
             values_tmp: gpu.buffer::<u32>(1)?,
             tmp_len: 0,

@@ -17,6 +17,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
+use crate::spec::scan::ScanKernel;
 use crate::spec::scan::partials_len_bound;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -66,9 +67,9 @@ impl Scan {
         let file = kernel_file("scan").expect("scan kernels are embedded");
         let program = gpu.program(&file, "")?;
         Ok(Scan {
-            block_sums: gpu.kernel(&program, "scan_block_sums")?,
-            partials_kernel: gpu.kernel(&program, "scan_partials")?,
-            apply: gpu.kernel(&program, "scan_apply")?,
+            block_sums: gpu.entry(&program, ScanKernel::BlockSums)?,
+            partials_kernel: gpu.entry(&program, ScanKernel::Partials)?,
+            apply: gpu.entry(&program, ScanKernel::Apply)?,
             partials: gpu.buffer::<u64>(partials_len_bound())?,
             total: gpu.buffer::<u64>(1)?,
             gpu,

@@ -18,6 +18,7 @@ use crate::cpu::sdf_lines::{
 };
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, COMMON_HEADERS, Gpu, KernelFile, buf, event_ms, launch};
+use crate::spec::sdf_lines::SdflKernel;
 use crate::spec::sdf_lines::*;
 use crate::stages::scan::Scan;
 use crate::volume::Volume;
@@ -101,19 +102,19 @@ impl SdfLines {
     pub fn new(gpu: Arc<Gpu>, vol: &Volume, opts: &SdfLineOptions) -> Result<SdfLines> {
         let dense_bound = check(vol, opts)?;
         let p = gpu.program(&KERNEL_FILE, "")?;
-        let kernel = |name: &str| gpu.kernel(&p, name);
+        let kernel = |k: SdflKernel| gpu.entry(&p, k);
         let k = Kernels {
-            dense: kernel("sdfl_dense")?,
-            cell_count: kernel("sdfl_cell_count")?,
-            cell_fill: kernel("sdfl_cell_fill")?,
-            thin_phase: kernel("sdfl_thin_phase")?,
-            thin_flags: kernel("sdfl_thin_flags")?,
-            thin_compact: kernel("sdfl_thin_compact")?,
-            gradient: kernel("sdfl_gradient")?,
-            curvature: kernel("sdfl_curvature")?,
-            range: kernel("sdfl_range")?,
-            trace: kernel("sdfl_trace")?,
-            strips: kernel("sdfl_strips")?,
+            dense: kernel(SdflKernel::Dense)?,
+            cell_count: kernel(SdflKernel::CellCount)?,
+            cell_fill: kernel(SdflKernel::CellFill)?,
+            thin_phase: kernel(SdflKernel::ThinPhase)?,
+            thin_flags: kernel(SdflKernel::ThinFlags)?,
+            thin_compact: kernel(SdflKernel::ThinCompact)?,
+            gradient: kernel(SdflKernel::Gradient)?,
+            curvature: kernel(SdflKernel::Curvature)?,
+            range: kernel(SdflKernel::Range)?,
+            trace: kernel(SdflKernel::Trace)?,
+            strips: kernel(SdflKernel::Strips)?,
         };
         let mut volb = gpu.buffer_flags::<f32>(vol.voxel_count(), CL_MEM_READ_ONLY)?;
         gpu.write(&mut volb, &vol.values)?;
@@ -651,7 +652,7 @@ fn read_principal(gpu: &Gpu, b: &Buffer<f32>, n: usize) -> Result<Vec<Principal>
 /// An OpenCL failure.
 pub fn principal_probe(gpu: &Gpu, g: &[[f32; 3]], h: &[[f32; 9]]) -> Result<Vec<Principal>> {
     let p = gpu.program(&KERNEL_FILE, "")?;
-    let k = gpu.kernel(&p, "sdfl_principal_probe")?;
+    let k = gpu.entry(&p, SdflKernel::PrincipalProbe)?;
     let n = g.len().min(h.len());
     let mut gb = gpu.buffer::<f32>(3 * n)?;
     let mut hb = gpu.buffer::<f32>(9 * n)?;
@@ -675,7 +676,7 @@ pub fn principal_probe(gpu: &Gpu, g: &[[f32; 3]], h: &[[f32; 9]]) -> Result<Vec<
 /// An OpenCL failure.
 pub fn layout_probe(gpu: &Gpu) -> Result<[u32; 4]> {
     let p = gpu.program(&KERNEL_FILE, "")?;
-    let k = gpu.kernel(&p, "sdfl_probe")?;
+    let k = gpu.entry(&p, SdflKernel::Probe)?;
     let out = gpu.buffer::<u32>(4)?;
     launch(gpu, &k, 1, &[buf(&out)])?;
     let mut v = [0u32; 4];

@@ -8,6 +8,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, kernel_file, launch, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
+use crate::spec::skinning::SkinKernel;
 use crate::spec::skinning::{INFLUENCES, MATRIX_FLOATS, matrices_len};
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -49,7 +50,7 @@ impl Skinner {
         gpu.write(&mut weights, m.weights.as_flattened())?;
         let joints = m.joint_nodes.len();
         Ok(Skinner {
-            kernel: gpu.kernel(&p, "skin_lbs")?,
+            kernel: gpu.entry(&p, SkinKernel::Lbs)?,
             mats: gpu.buffer_flags::<f32>(matrices_len(joints.max(1)), CL_MEM_READ_ONLY)?,
             out: gpu.buffer::<f32>(3 * nv)?,
             gpu,

@@ -10,6 +10,7 @@
 use crate::error::Result;
 use crate::gpu::{Arg, Gpu, buf, event_ms, kernel_file, launch};
 use crate::spec::timing::{Step, Timing};
+use crate::spec::vertex_fusion::FuseKernel;
 use crate::spec::vertex_fusion::{Fusion, soup_triangles};
 use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
@@ -95,14 +96,14 @@ impl Fuser {
         Ok(Fuser {
             sort: RadixSort::new(gpu.clone())?,
             scan: Scan::new(gpu.clone())?,
-            index: gpu.kernel(&p, "fuse_index")?,
-            clear: gpu.kernel(&p, "fuse_clear")?,
-            triangles: gpu.kernel(&p, "fuse_triangles")?,
-            candidates: gpu.kernel(&p, "fuse_candidates")?,
-            cancel: gpu.kernel(&p, "fuse_cancel")?,
-            mark: gpu.kernel(&p, "fuse_mark")?,
-            compact_vertices: gpu.kernel(&p, "fuse_compact_vertices")?,
-            compact_faces: gpu.kernel(&p, "fuse_compact_faces")?,
+            index: gpu.entry(&p, FuseKernel::Index)?,
+            clear: gpu.entry(&p, FuseKernel::Clear)?,
+            triangles: gpu.entry(&p, FuseKernel::Triangles)?,
+            candidates: gpu.entry(&p, FuseKernel::Candidates)?,
+            cancel: gpu.entry(&p, FuseKernel::Cancel)?,
+            mark: gpu.entry(&p, FuseKernel::Mark)?,
+            compact_vertices: gpu.entry(&p, FuseKernel::CompactVertices)?,
+            compact_faces: gpu.entry(&p, FuseKernel::CompactFaces)?,
             rep: Grow::new(&gpu)?,
             referenced: Grow::new(&gpu)?,
             vert_id: Grow::new(&gpu)?,

@@ -1,0 +1,168 @@
+//! The view passes: contours and suggestive contours, feature edges with
+//! their caps, and the render pass, run once per frame and camera. Each arm
+//! runs because its pass is in the plan.
+
+use super::*;
+
+impl Executor<'_, '_> {
+    /// Starts a view.
+    pub(in crate::scene::exec) fn begin_view(&mut self) {
+        self.segs.clear();
+        self.lines_ran = None;
+        self.edges_ran = None;
+    }
+
+    /// Runs one view pass from `cam`; the render pass writes `paths`.
+    pub(in crate::scene::exec) fn view_pass(
+        &mut self,
+        pass: Pass,
+        cam: &Camera,
+        paths: &[&PathBuf],
+    ) -> Result<()> {
+        match pass {
+            Pass::Contours => {
+                let t = self.lines(cam)?;
+                self.rec.kernels(
+                    pass,
+                    &t,
+                    "lines_vertex + lines_face (zero crossings of n·v)",
+                );
+            }
+            Pass::SuggestiveContours => {
+                let shared = self.lines_ran.is_some();
+                let t = self.lines(cam)?;
+                if shared {
+                    self.rec.shared(
+                        pass,
+                        "in the same lines_vertex + lines_face launch as the contours (time counted there)",
+                    );
+                } else {
+                    self.rec.kernels(
+                        pass,
+                        &t,
+                        "lines_vertex + lines_face (zero crossings of κr with D_w κr > 0)",
+                    );
+                }
+            }
+            Pass::Edges => {
+                let fx = &self.scene.effects;
+                let [w, h] = self.scene.size;
+                let mut p = EdgeParams::new(cam.view(w, h));
+                p.line_width = fx.edge.0;
+                p.crease_deg = fx.crease;
+                p.contours = fx.edge_contours;
+                p.boundaries = fx.edge_boundaries;
+                let t = self.topo.as_mut().expect("a pose ran");
+                let es = t.edges.as_mut().expect("planned with the edge buffer");
+                let timing = es.run(&p, fx.caps)?;
+                // Only what was drawn comes back, compacted on the device.
+                let out = es.read_drawn()?;
+                self.rec.kernels(
+                    pass,
+                    &timing,
+                    "edges_detect (contour, crease, boundary) into edge-out",
+                );
+                self.edges_ran = Some((timing, out));
+            }
+            Pass::Caps => {
+                let (timing, _) = self.edges_ran.as_ref().expect("planned after the edges");
+                let how = format!("caps_{}", self.scene.effects.caps.name());
+                self.rec.kernels(pass, timing, &how);
+            }
+            Pass::Render => {
+                let t0 = Instant::now();
+                let t = self.topo.as_ref().expect("a pose ran");
+                // The mesh goes to GL once per topology (faces) and once per
+                // pose (positions, normals, colours), not once per view.
+                if !self.gl_topology {
+                    self.renderer.upload_topology(&t.mesh.faces)?;
+                    self.gl_topology = true;
+                }
+                if !self.gl_pose {
+                    let colors = draw::mesh_colors(
+                        self.scene,
+                        self.plan,
+                        &self.pose,
+                        self.color_scale.unwrap_or(1.0),
+                    );
+                    self.renderer
+                        .upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
+                    self.gl_pose = true;
+                }
+                let strokes = self.scene_strokes();
+                let lines = ViewLines {
+                    segments: &self.segs,
+                    edges: self.edges_ran.as_ref().map(|e| &e.1),
+                    strokes: &strokes,
+                    // Half a voxel towards the eye: the strokes lie on the
+                    // interpolated surface, which marching cubes cuts as chords.
+                    stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
+                };
+                let drawn =
+                    draw::draw_view(&mut self.renderer, self.scene, self.plan, cam, lines, paths)?;
+                self.rec.wall(
+                    pass,
+                    ms_since(t0),
+                    "draw mesh, line quads, edge quads and stroke strips; read back",
+                );
+                self.segments[0] += drawn[0];
+                self.segments[1] += drawn[1];
+                self.outputs.extend(paths.iter().map(|p| (*p).clone()));
+            }
+            _ => unreachable!("{pass:?} is not a view pass"),
+        }
+        Ok(())
+    }
+
+    /// Contours and suggestive contours of this view, found once per view
+    /// (one launch finds both): on the device from the curvature buffers,
+    /// or from host normals when no curvature is planned.
+    fn lines(&mut self, cam: &Camera) -> Result<Timing> {
+        if let Some(t) = &self.lines_ran {
+            return Ok(t.clone());
+        }
+        let [w, h] = self.scene.size;
+        let v = cam.view(w, h);
+        let origin = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let opts = self.line_opts;
+        let Topology {
+            mesh,
+            feature_size,
+            est,
+            lines,
+            ..
+        } = self.topo.as_mut().expect("a pose ran");
+        let est = match &self.pipe {
+            Some(p) => p.estimator(),
+            None => est.as_ref(),
+        };
+        let lx = match lines {
+            Some(lx) => lx,
+            None => lines.insert(LineExtractor::new(
+                self.gpu.clone(),
+                mesh.n_vertices(),
+                &mesh.faces,
+            )?),
+        };
+        let feature_size = *feature_size;
+        let (s, stats) = match est {
+            Some(est) => lx.extract_device_at(est, v, feature_size, opts, origin)?,
+            None => {
+                let n = self.pose.pos.len();
+                let z3 = vec![[0f32; 3]; n];
+                let x = LineInputs {
+                    pos: &self.pose.pos,
+                    nrm: &self.pose.nrm,
+                    d1: &z3,
+                    d2: &z3,
+                    k: &vec![[0f32; 2]; n],
+                    dk: &vec![[0f32; 4]; n],
+                };
+                lx.extract(&x, v, feature_size, opts)?
+            }
+        };
+        self.segs = s;
+        self.lines_ran = Some(stats.timing.clone());
+        Ok(stats.timing)
+    }
+}
