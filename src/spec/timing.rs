@@ -11,7 +11,7 @@
 use super::ao::AoKernel;
 use super::edges::EdgesKernel;
 use super::feature_lines::LinesKernel;
-use super::sdf_lines::SdflKernel;
+use super::sdf_lines::{SdflKernel, StepMs};
 use super::skinning::SkinKernel;
 use super::vertex_fusion::FuseKernel;
 use serde::Serialize;
@@ -336,6 +336,33 @@ impl Timing {
     /// Whether any entry's step is in `steps`.
     pub fn ran(&self, steps: &[Step]) -> bool {
         self.steps.iter().any(|s| steps.contains(&s.step))
+    }
+}
+
+// Here rather than in sdf_lines.rs: this module names every family's steps,
+// so the families do not import it back (no cycle inside spec/).
+impl StepMs {
+    /// The steps as the one timing type ([`Timing`]),
+    /// in execution order (the sweep, when it ran, after the gradient), one
+    /// launch each; `wall_ms` the run's wall time.
+    pub fn timing(&self, wall_ms: f64) -> Timing {
+        let mut t = Timing::default();
+        for (step, ms) in [
+            (Step::SdflDense, self.dense),
+            (Step::SdflGradient, self.gradient),
+            (Step::SdflSweep, self.sweep),
+            (Step::SdflThin, self.thin),
+            (Step::SdflCurvature, self.curvature),
+            (Step::SdflRange, self.range),
+            (Step::SdflTrace, self.trace),
+            (Step::SdflStrips, self.strips),
+        ] {
+            if step != Step::SdflSweep || ms > 0.0 {
+                t.add(step, ms);
+            }
+        }
+        t.wall_ms = wall_ms;
+        t
     }
 }
 
