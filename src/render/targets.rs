@@ -104,7 +104,8 @@ pub(super) fn check_limits(
     Ok(())
 }
 
-/// Checks what [`Renderer::new`] and [`Renderer::reconfigure`] can check
+/// Checks what [`Renderer::new`](super::Renderer::new) and
+/// [`Renderer::reconfigure`](super::Renderer::reconfigure) can check
 /// before touching GL.
 pub(super) fn check_options(opts: &RenderOptions) -> Result<()> {
     if opts.width == 0 || opts.height == 0 {
