@@ -1,4 +1,4 @@
-//! Curvature stage benches (`kernels/curvature.cl` ↔ `src/stages/curvature.rs`).
+//! Curvature stage benches (`kernels/curvature*.cl` ↔ `src/stages/curvature/`).
 //!
 //! Groups:
 //! - `curvature/<variant>/<input>`: kernel time from OpenCL profiling events

@@ -1,9 +1,9 @@
-// curvature_face.h: the per-face geometry of kernels/curvature.cl and the
-// per-vertex steps of its frame and principal passes, written
-// over type macros so that it is instantiated twice: once on scalars (every
-// kernel of the file) and, when SC_LANES > 1, once on OpenCL vectors of
-// SC_LANES faces or vertices (the gather variant's lane kernels; see the
-// header of curvature.cl for why). The includer defines
+// curvature_face.h: the per-face geometry of the curvature kernels (both
+// schemes: kernels/curvature_atomic.cl, kernels/curvature_gather.cl) and the
+// per-vertex steps of the frame and principal passes (kernels/curvature.cl),
+// written over type macros so that it is instantiated twice: once on scalars
+// (every kernel) and, when SC_LANES > 1, once on OpenCL vectors of SC_LANES
+// faces or vertices (the lane kernels). The includer defines
 //   GT   the real type (REAL, or a REAL vector of SC_LANES lanes)
 //   GM   the mask type of a comparison of two GT (int, or an int/long vector)
 //   GI   the index type (uint, or a uint vector: one face or vertex per lane)
@@ -15,6 +15,10 @@
 // Masks are what comparisons give: 0 or 1 on scalars, 0 or -1 per lane on
 // vectors; only &, | and ! combine them and only ?: consumes them, which
 // reads the same in both. Literals are scalars (widened by the arithmetic).
+// Vectors are structs of scalars, never float3 or private arrays, and helpers
+// are SC_INLINE: PoCL's work-item vectoriser gives up on OpenCL vector types,
+// private arrays, selects of whole structs, fmax and atomics, and its inliner
+// left the larger helpers as calls returning structs through the stack.
 
 #ifdef GT
 

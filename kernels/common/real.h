@@ -22,5 +22,5 @@ typedef float4 REAL4;
 
 // Helpers called several times per kernel are forced inline: PoCL's inliner
 // leaves the larger ones (cost above its threshold) as calls returning
-// structs through the stack (see kernels/curvature.cl).
+// structs through the stack (see kernels/common/curvature_face.h).
 #define SC_INLINE inline __attribute__((always_inline))

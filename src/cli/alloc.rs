@@ -4,13 +4,9 @@
 //! Why: on a large mesh the host spends much of its time faulting in fresh
 //! 4 KiB pages. With transparent huge pages in their usual `madvise` mode,
 //! `madvise(MADV_HUGEPAGE)` on a block before its first touch takes 512× fewer
-//! faults. On a 2M-vertex torus PLY, PoCL, 5 interleaved pairs of processes:
-//! the load 81–105 → 53–81 ms and the upload 13 → 6.5 ms (`--stats` phases).
-//! glibc's own switch (`GLIBC_TUNABLES=glibc.malloc.hugetlb=1`) does the same
-//! for every large block, the OpenCL runtime's buffers too: that also took
-//! the one-ring lists, which are built in mapped device buffers, from 77–82
-//! to 28–30 ms, but made the first run slower and erratic (143–151 →
-//! 129–492 ms), so the advice is given here, for shapecue's own blocks only.
+//! faults. The advice is given here, for shapecue's own blocks only: glibc's
+//! own switch, which advises the OpenCL runtime's buffers too, made the first
+//! run slower and erratic (measurements: `docs/notes/curvature-kernels.md`).
 //!
 //! Only the binary installs it; the library leaves the allocator to its
 //! callers. The advice is a hint: where transparent huge pages are off, or on

@@ -29,12 +29,28 @@ pub const COMMON_HEADERS: &[(&str, &str)] = &[
     ),
 ];
 
-/// Headers a kernel file may `#include` (expanded by [`assemble`]; the
-/// drivers see one text with no include paths).
-pub const INCLUDES: &[(&str, &str)] = &[(
-    "common/curvature_face.h",
-    include_str!("../../kernels/common/curvature_face.h"),
-)];
+/// Files a kernel file may `#include` (expanded by [`assemble`], one level
+/// deep; the drivers see one text with no include paths), by their path
+/// under `kernels/`: shared headers, and the accumulation schemes that
+/// `kernels/curvature.cl` includes under `SC_GATHER`.
+pub const INCLUDES: &[(&str, &str)] = &[
+    (
+        "common/curvature_face.h",
+        include_str!("../../kernels/common/curvature_face.h"),
+    ),
+    (
+        "common/curvature_lanes.h",
+        include_str!("../../kernels/common/curvature_lanes.h"),
+    ),
+    (
+        "curvature_atomic.cl",
+        include_str!("../../kernels/curvature_atomic.cl"),
+    ),
+    (
+        "curvature_gather.cl",
+        include_str!("../../kernels/curvature_gather.cl"),
+    ),
+];
 
 /// Looks up a kernel family by name (`"curvature"`, ...).
 pub fn kernel_file(name: &str) -> Option<KernelFile> {

@@ -494,7 +494,7 @@ pub fn padded_vertices(nv: usize) -> usize {
 }
 
 /// Reals per vertex record of the gather scheme with face lanes (the
-/// `REC_*` layout of kernels/curvature.cl: position and point area, normal
+/// `REC_*` layout of kernels/common/curvature_lanes.h: position and point area, normal
 /// and k1, first direction and k2, second direction), read by the tensor and
 /// derivative face kernels as whole vectors.
 pub const REC_REALS: usize = 16;
@@ -559,4 +559,44 @@ pub fn device_bytes_bound(nv: usize, nf: usize, opts: &CurvatureOptions, lanes: 
         b += padded_vertices(nv) as u64 * REC_REALS as u64 * r;
     }
     b
+}
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/curvature.cl` and the scheme file it
+    /// includes (`curvature_atomic.cl` or, with `SC_GATHER`,
+    /// `curvature_gather.cl`).
+    pub enum CurvKernel {
+        /// Owning face per vertex (atomic_max).
+        MaxFace = "curv_max_face",
+        /// The accumulators zeroed (atomic schemes).
+        Clear = "curv_clear",
+        /// Corner-weighted normals and Voronoi point areas, added with atomics.
+        NormalsAreas = "curv_normals_areas",
+        /// The same per face corner, written for the ring sums (gather).
+        NormalsAreasCorners = "curv_normals_areas_corners",
+        /// Each vertex's one-ring of normal and area corners summed (gather).
+        NormalsAreasSum = "curv_normals_areas_sum",
+        /// Unit normals and the initial per-vertex frames.
+        Frames = "curv_frames",
+        /// Per-face curvature tensors added into the vertex frames (atomics).
+        Tensor = "curv_tensor",
+        /// The same per face corner (gather).
+        TensorCorners = "curv_tensor_corners",
+        /// Each vertex's one-ring of tensor corners summed (gather).
+        TensorSum = "curv_tensor_sum",
+        /// Diagonalisation: k1, k2, d1, d2.
+        Principal = "curv_principal",
+        /// The curvature derivative, added with atomics.
+        Dcurv = "curv_dcurv",
+        /// The same per face corner (gather).
+        DcurvCorners = "curv_dcurv_corners",
+        /// Each vertex's one-ring of derivative corners summed (gather).
+        DcurvSum = "curv_dcurv_sum",
+        /// Vertices left without a usable face, counted.
+        CountEmpty = "curv_count_empty",
+        /// Positions from a device buffer (isosurfaces) into the records.
+        LoadPositions = "curv_load_positions",
+        /// Vertex normals given by the caller (gradient normals) over the computed ones.
+        OverrideNormals = "curv_override_normals",
+    }
 }

@@ -9,6 +9,7 @@
 //! strings. Pure data: no device, no clock.
 
 use super::ao::AoKernel;
+use super::curvature::CurvKernel;
 use super::edges::EdgesKernel;
 use super::feature_lines::LinesKernel;
 use super::sdf_lines::{SdflKernel, StepMs};
@@ -153,13 +154,13 @@ impl Step {
     /// the host entry point (`scan_exclusive`, `radix_sort_pairs`).
     pub fn kernel(self) -> &'static str {
         match self {
-            Step::CurvMaxFace => "curv_max_face",
-            Step::CurvClear => "curv_clear",
-            Step::CurvNormalsAreas => "curv_normals_areas",
-            Step::CurvFrames => "curv_frames",
-            Step::CurvTensor => "curv_tensor",
-            Step::CurvPrincipal => "curv_principal",
-            Step::CurvDcurv => "curv_dcurv",
+            Step::CurvMaxFace => CurvKernel::MaxFace.name(),
+            Step::CurvClear => CurvKernel::Clear.name(),
+            Step::CurvNormalsAreas => CurvKernel::NormalsAreas.name(),
+            Step::CurvFrames => CurvKernel::Frames.name(),
+            Step::CurvTensor => CurvKernel::Tensor.name(),
+            Step::CurvPrincipal => CurvKernel::Principal.name(),
+            Step::CurvDcurv => CurvKernel::Dcurv.name(),
             Step::McClassify => "mc_classify",
             Step::McTriangles => "mc_triangles",
             Step::McIota => "mc_iota",

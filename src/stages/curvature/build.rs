@@ -1,0 +1,267 @@
+//! Building the curvature program for a variant: the device checks, the
+//! build options, the kernels of the common passes and of the accumulation
+//! scheme; [`build_kernels`] builds and saves variants ahead of use.
+
+use super::{CurvatureEstimator, atomic, gather};
+use crate::error::{Error, Result};
+use crate::gpu::{Gpu, kernel_file};
+use crate::spec::curvature::CurvKernel;
+use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use crate::spec::timing::Timing;
+use opencl3::kernel::Kernel;
+use opencl3::program::Program;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The kernels of the passes both schemes share.
+pub(super) struct Kernels {
+    pub(super) frames: Kernel,
+    pub(super) count_empty: Kernel,
+    pub(super) principal: Kernel,
+    /// Positions from a device buffer of index-space floats (isosurfaces).
+    pub(super) load_positions: Kernel,
+    /// Given unit normals replace the accumulated ones (isosurfaces).
+    pub(super) override_normals: Kernel,
+    /// Faces per work-item of the per-face kernels, and vertices per
+    /// work-item of the frame and principal kernels: `SC_LANES` of the build.
+    pub(super) lanes: u32,
+}
+
+/// The kernels of the accumulation scheme a program was built for.
+pub(super) enum SchemeKernels {
+    /// `kernels/curvature_atomic.cl` (either atomic scheme).
+    Atomic(atomic::Kernels),
+    /// `kernels/curvature_gather.cl`.
+    Gather(gather::Kernels),
+}
+
+/// A program built for one variant, its kernels, and when the estimator's
+/// set-up began (what [`CurvatureEstimator::with_faces`] needs of a build).
+pub(super) struct Built {
+    pub(super) k: Kernels,
+    pub(super) scheme: SchemeKernels,
+    pub(super) program: Arc<Program>,
+    /// When the set-up began (the build is part of the topology time).
+    pub(super) t0: Instant,
+    /// Wall ms of getting the program and creating the kernels.
+    pub(super) build_ms: f64,
+}
+
+/// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
+/// per work-item in the per-face kernels; `pair_adds`: the compare-and-swap
+/// scheme in f32 adds two adjacent floats in one 64-bit compare-and-swap
+/// where it can (the device has `cl_khr_int64_base_atomics`).
+pub fn build_options(opts: &CurvatureOptions, lanes: u32, pair_adds: bool) -> String {
+    let mut s = String::new();
+    if pair_adds && opts.accumulate == Accumulate::Atomic && opts.precision == Precision::F32 {
+        s.push_str("-DSC_PAIR_ADDS ");
+    }
+    if opts.accumulate == Accumulate::Gather {
+        // kernels/curvature.cl then includes the gather scheme's kernels
+        // (kernels/curvature_gather.cl), not the atomic ones.
+        s.push_str("-DSC_GATHER ");
+    }
+    if lanes > 1 {
+        s.push_str(&format!("-DSC_LANES={lanes} "));
+    }
+    if opts.accumulate == Accumulate::AtomicNative {
+        // atomic_fetch_add_explicit on atomic_float needs OpenCL C 2.0 or later
+        s.push_str("-cl-std=CL3.0 -DSC_NATIVE_ATOMICS ");
+    }
+    if opts.precision == Precision::F64 {
+        s.push_str("-DSC_DOUBLE ");
+    }
+    if opts.compat == Compat::Trimesh2 {
+        s.push_str("-DSC_COMPAT ");
+    }
+    s.trim_end().to_string()
+}
+
+impl CurvatureEstimator {
+    /// Gets the program an estimator for `opts` runs into `gpu`'s table of
+    /// built programs (from source, shapecue's binary cache or the driver's),
+    /// so that a later [`CurvatureEstimator::new`] on `gpu` finds it built.
+    /// It needs no mesh: a caller can run it beside the mesh's load.
+    ///
+    /// # Errors
+    ///
+    /// As [`CurvatureEstimator::new`] for options the device cannot run,
+    /// and OpenCL build errors.
+    pub fn prepare(gpu: &Arc<Gpu>, opts: &CurvatureOptions) -> Result<()> {
+        Self::build(gpu, opts).map(drop)
+    }
+
+    /// Gets the program for `opts` built into `gpu` (as [`Self::prepare`])
+    /// and runs every pass of it once on a small icosphere (642 vertices), so
+    /// that the code a runtime compiles at a kernel's first launch (PoCL: a
+    /// work-group function per kernel and local size) is compiled too and
+    /// goes into the binary that [`Gpu::persist_programs`] saves. Returns
+    /// the run's timing.
+    ///
+    /// # Errors
+    ///
+    /// As [`CurvatureEstimator::new`] and [`CurvatureEstimator::run`].
+    pub fn warm_up(gpu: &Arc<Gpu>, opts: &CurvatureOptions) -> Result<Timing> {
+        let (_, mesh) = crate::mesh::Generated::Sphere.mesh(642);
+        let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, *opts)?;
+        est.set_positions(&mesh.positions)?;
+        est.run()
+    }
+
+    /// Gets the program for `opts` built into `gpu` and creates its kernels.
+    pub(super) fn build(gpu: &Arc<Gpu>, opts: &CurvatureOptions) -> Result<Built> {
+        let t0 = Instant::now();
+        if opts.precision == Precision::F64 {
+            if !gpu.info.fp64 {
+                return Err(Error::DeviceUnsupported {
+                    device: gpu.info.name.clone(),
+                    what: "--precision f64 needs cl_khr_fp64".into(),
+                });
+            }
+            if opts.accumulate == Accumulate::Atomic && !gpu.info.int64_atomics {
+                return Err(Error::DeviceUnsupported {
+                    device: gpu.info.name.clone(),
+                    what: "f64 atomic accumulation needs cl_khr_int64_base_atomics; \
+                           use --accumulate gather"
+                        .into(),
+                });
+            }
+        }
+        let native = match opts.precision {
+            Precision::F32 => gpu.info.float_atomics,
+            Precision::F64 => gpu.info.double_atomics,
+        };
+        if opts.accumulate == Accumulate::AtomicNative && !native {
+            return Err(Error::DeviceUnsupported {
+                device: gpu.info.name.clone(),
+                what: format!(
+                    "--accumulate atomic-native needs native {} float atomic adds \
+                     (cl_ext_float_atomics); use --accumulate atomic or gather",
+                    opts.precision.name()
+                ),
+            });
+        }
+        if !matches!(opts.lanes, 0 | 1 | 2 | 4 | 8 | 16) {
+            return Err(Error::InvalidArgument(format!(
+                "face lanes must be 1, 2, 4, 8 or 16 (or 0: by device type), not {}",
+                opts.lanes
+            )));
+        }
+        let native = match opts.precision {
+            Precision::F32 => gpu.info.native_float_width,
+            Precision::F64 => gpu.info.native_double_width,
+        };
+        let lanes = crate::spec::curvature::face_lanes_for(opts.lanes, &gpu.info.kind, native);
+        let file = kernel_file("curvature").expect("curvature kernels are embedded");
+        let pair_adds = gpu.info.int64_atomics;
+        let program = gpu.program(&file, &build_options(opts, lanes, pair_adds))?;
+        let scheme = if opts.accumulate == Accumulate::Gather {
+            SchemeKernels::Gather(gather::Kernels::new(gpu, &program)?)
+        } else {
+            SchemeKernels::Atomic(atomic::Kernels::new(gpu, &program)?)
+        };
+        let k = Kernels {
+            frames: gpu.entry(&program, CurvKernel::Frames)?,
+            count_empty: gpu.entry(&program, CurvKernel::CountEmpty)?,
+            principal: gpu.entry(&program, CurvKernel::Principal)?,
+            load_positions: gpu.entry(&program, CurvKernel::LoadPositions)?,
+            override_normals: gpu.entry(&program, CurvKernel::OverrideNormals)?,
+            lanes,
+        };
+        Ok(Built {
+            k,
+            scheme,
+            program,
+            t0,
+            build_ms: t0.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+}
+
+/// What [`build_kernels`] did for one variant.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct KernelBuild {
+    /// The variant: accumulation, precision and least squares by their
+    /// command-line names (`gather f32 exact`).
+    pub variant: String,
+    /// How its program was obtained (`hit`: it was built already) and
+    /// whether it was saved.
+    pub program: crate::gpu::ProgramBuild,
+    /// Seconds of getting the program and running it once.
+    pub build_s: f64,
+    /// Seconds of saving it.
+    pub save_s: f64,
+}
+
+/// Builds the curvature program of each variant in `variants` (duplicates
+/// once), runs it once ([`CurvatureEstimator::warm_up`]) and saves it into
+/// shapecue's kernel cache, on every runtime (PoCL included:
+/// [`Gpu::save_every_build`], which stays set on `gpu`, so give it a `Gpu`
+/// of its own). A variant already in the cache is loaded, not rebuilt.
+/// `on_built` hears of each program as soon as it is done (a variant can
+/// take seconds on PoCL).
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] when the cache is off (nowhere to keep the
+/// kernels), and what [`CurvatureEstimator::warm_up`] returns for a variant
+/// the device cannot run (the variant is named).
+pub fn build_kernels(
+    gpu: &Arc<Gpu>,
+    variants: &[CurvatureOptions],
+    mut on_built: impl FnMut(&KernelBuild),
+) -> Result<Vec<KernelBuild>> {
+    if gpu.cache_folder().is_none() {
+        return Err(Error::InvalidArgument(
+            "the kernel cache is off (SHAPECUE_NO_CACHE is set, or neither \
+             SHAPECUE_CACHE_DIR, XDG_CACHE_HOME nor HOME is), so there is \
+             nowhere to keep built kernels"
+                .into(),
+        ));
+    }
+    gpu.save_every_build();
+    let mut done: Vec<CurvatureOptions> = Vec::new();
+    let mut out = Vec::new();
+    for opts in variants {
+        let opts = CurvatureOptions {
+            dcurv: true,
+            ..*opts
+        };
+        if done.contains(&opts) {
+            continue;
+        }
+        done.push(opts);
+        let variant = format!(
+            "{} {} {}",
+            opts.accumulate.name(),
+            opts.precision.name(),
+            opts.compat.name()
+        );
+        let known = gpu.program_builds().len();
+        let t = Instant::now();
+        CurvatureEstimator::warm_up(gpu, &opts).map_err(|e| match e {
+            Error::DeviceUnsupported { device, what } => Error::DeviceUnsupported {
+                device,
+                what: format!("{what} (variant {variant})"),
+            },
+            e => e,
+        })?;
+        let build_s = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        gpu.persist_programs();
+        let save_s = t.elapsed().as_secs_f64();
+        // The build record of this variant's program (none when an earlier
+        // variant here had the same program).
+        if let Some(program) = gpu.program_builds().get(known).cloned() {
+            let b = KernelBuild {
+                variant,
+                program,
+                build_s,
+                save_s,
+            };
+            on_built(&b);
+            out.push(b);
+        }
+    }
+    Ok(out)
+}
