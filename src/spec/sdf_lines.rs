@@ -362,6 +362,32 @@ pub struct StepMs {
     pub total: f64,
 }
 
+impl StepMs {
+    /// The steps as the one timing type ([`crate::spec::timing::Timing`]),
+    /// in execution order (the sweep, when it ran, after the gradient), one
+    /// launch each; `wall_ms` the run's wall time.
+    pub fn timing(&self, wall_ms: f64) -> crate::spec::timing::Timing {
+        use crate::spec::timing::{Step, Timing};
+        let mut t = Timing::default();
+        for (step, ms) in [
+            (Step::SdflDense, self.dense),
+            (Step::SdflGradient, self.gradient),
+            (Step::SdflSweep, self.sweep),
+            (Step::SdflThin, self.thin),
+            (Step::SdflCurvature, self.curvature),
+            (Step::SdflRange, self.range),
+            (Step::SdflTrace, self.trace),
+            (Step::SdflStrips, self.strips),
+        ] {
+            if step != Step::SdflSweep || ms > 0.0 {
+                t.add(step, ms);
+            }
+        }
+        t.wall_ms = wall_ms;
+        t
+    }
+}
+
 /// What a run did.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct SdfLineStats {
