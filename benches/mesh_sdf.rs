@@ -7,8 +7,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::cpu::mesh_sdf as cpu;
 use shapecue::gpu::Gpu;
+use shapecue::mesh::mesh_sdf::prepare;
 use shapecue::metrics::median;
-use shapecue::spec::mesh_sdf::{MeshSdfOptions, prepare};
+use shapecue::spec::mesh_sdf::MeshSdfOptions;
 use shapecue::stages::mesh_sdf::MeshSdf;
 use std::path::Path;
 use std::sync::Arc;

@@ -35,6 +35,7 @@ pub mod export;
 pub mod gpu;
 pub mod mesh;
 pub mod metrics;
+pub mod output;
 pub mod render;
 pub mod scene;
 pub mod spec;

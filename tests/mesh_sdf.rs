@@ -7,8 +7,9 @@ mod common;
 
 use common::{gpu, shared_mesh};
 use shapecue::cpu::mesh_sdf as cpu;
+use shapecue::mesh::mesh_sdf::prepare;
 use shapecue::mesh::{Mesh, icosphere, plane};
-use shapecue::spec::mesh_sdf::{MeshSdfOptions, PreparedMesh, prepare};
+use shapecue::spec::mesh_sdf::{MeshSdfOptions, PreparedMesh};
 use shapecue::stages::mesh_sdf::{self as stage, MeshSdf};
 use shapecue::volume::Volume;
 fn opts(resolution: usize) -> MeshSdfOptions {

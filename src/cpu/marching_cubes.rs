@@ -24,17 +24,9 @@ use crate::volume::Volume;
 
 use crate::spec::marching_cubes::{END, common_face, edge_corners, edge_of, table};
 
-/// One vertex of the triangle soup: its position in index space (voxel
-/// units; world = origin + spacing × p) and its exact key: `4g + axis` for a
-/// vertex inside the edge of axis `axis` starting at grid point `g`, `4g + 3`
-/// for a vertex at grid point `g`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SoupVertex {
-    /// Index-space position.
-    pub p: [f32; 3],
-    /// Exact key (u64; the device uses u32 and checks that it fits).
-    pub key: u64,
-}
+// The soup is what vertex fusion reads, so its vertex type lives there (the
+// stages too depend marching cubes -> vertex fusion, never back).
+pub use super::vertex_fusion::SoupVertex;
 
 /// The case of the cell at `(x, y, z)`, or `None` when a corner is not finite.
 pub fn cell_case(vol: &Volume, iso: f32, x: usize, y: usize, z: usize) -> Option<usize> {

@@ -16,13 +16,14 @@
 
 use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::mesh::mesh_sdf::prepare;
 use crate::spec::mesh_sdf::{
-    FIX_BITS, FIX_ONE, MAX_DESCENT, MeshSdfOptions, NO_TRIANGLE, PreparedMesh, SdfGrid, prepare,
+    FIX_BITS, FIX_ONE, MAX_DESCENT, MeshSdfOptions, NO_TRIANGLE, PreparedMesh, SdfGrid,
 };
 use crate::volume::Volume;
 
 /// Mesh → signed distance field on the grid of
-/// [`crate::spec::mesh_sdf::prepare`] (world coordinates are the mesh's;
+/// [`crate::mesh::mesh_sdf::prepare`] (world coordinates are the mesh's;
 /// negative inside, positive outside, in world units).
 ///
 /// # Errors

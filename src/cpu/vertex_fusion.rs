@@ -10,9 +10,21 @@
 //! The representative of a set of equal positions is the lowest soup index,
 //! so the hash and the exact variant give the same mesh, vertex for vertex.
 
-use super::marching_cubes::SoupVertex;
-
 use crate::spec::vertex_fusion::Fusion;
+
+/// One vertex of the triangle soup that marching cubes writes
+/// ([`mc_triangles`](super::marching_cubes::mc_triangles)) and fusion
+/// reads: its position in index space (voxel units; world = origin +
+/// spacing × p) and its exact key: `4g + axis` for a vertex inside the edge
+/// of axis `axis` starting at grid point `g`, `4g + 3` for a vertex at grid
+/// point `g`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoupVertex {
+    /// Index-space position.
+    pub p: [f32; 3],
+    /// Exact key (u64; the device uses u32 and checks that it fits).
+    pub key: u64,
+}
 
 /// The 32-bit position hash (same integer mix as the kernel's `fuse_hash`).
 pub fn fuse_hash(p: [f32; 3]) -> u32 {

@@ -11,6 +11,7 @@ pub mod flipbook;
 mod generate;
 pub mod libigl;
 mod load;
+pub mod mesh_sdf;
 pub mod order;
 mod quality;
 pub mod skinned;

@@ -14,9 +14,9 @@ use std::time::Instant;
 
 use glam::Vec3;
 
+use super::visibility::{DEFAULT_BIAS, visible_polylines};
 use super::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, Uploads, framed};
 use crate::error::Result;
-use crate::export::svg::{DEFAULT_BIAS, visible_polylines};
 use crate::gpu::{DeviceInfo, Gpu};
 use crate::mesh::Mesh;
 use crate::mesh::edges::{EdgeTopology, read_marked};

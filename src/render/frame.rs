@@ -50,7 +50,7 @@ impl Frame {
     /// Writes the colour as an 8-bit RGBA PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
         let image = self.to_image();
-        crate::export::output::write_atomic(path, |w| {
+        crate::output::write_atomic(path, |w| {
             image
                 .write_to(w, image::ImageFormat::Png)
                 .map_err(|e| Error::Write {

@@ -1,6 +1,7 @@
 //! Shared types of the `mesh_sdf` family (see [`crate::spec`]): the options,
 //! the grid a mesh is sampled on, and the prepared input both the kernels
-//! (`kernels/mesh_sdf.cl`) and the CPU twin (`crate::cpu::mesh_sdf`) read.
+//! (`kernels/mesh_sdf.cl`) and the CPU twin (`crate::cpu::mesh_sdf`) read;
+//! `crate::mesh::mesh_sdf::prepare` makes it from a mesh.
 //!
 //! The grid: the box is the bounding box of the vertices that faces use,
 //! padded on every side by [`padding_voxels`] voxels (at least
@@ -24,7 +25,6 @@
 //! Snapping moves a vertex by at most 2⁻¹⁷ voxel.
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
 
 /// Default samples along the longest axis.
 pub const DEFAULT_RESOLUTION: usize = 128;
@@ -135,141 +135,6 @@ pub struct PreparedMesh {
     /// the smallest-index other kept triangle sharing that edge, or
     /// [`NO_TRIANGLE`] on a boundary.
     pub adjacent: Vec<[u32; 3]>,
-}
-
-/// Validates `mesh`, chooses the grid and snaps the vertices.
-///
-/// # Errors
-///
-/// [`Error::InvalidInput`] (source `source`) for a mesh without faces, an
-/// index out of range, a non-finite coordinate, or faces that are all
-/// degenerate (zero area); [`Error::InvalidArgument`] for a resolution
-/// outside `MIN_RESOLUTION..=MAX_RESOLUTION`.
-pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<PreparedMesh> {
-    let n = opts.resolution;
-    if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&n) {
-        return Err(Error::InvalidArgument(format!(
-            "mesh signed distance resolution {n}: expected {MIN_RESOLUTION} to {MAX_RESOLUTION} \
-             samples along the longest axis"
-        )));
-    }
-    mesh.validate(source)?;
-    // The box of the vertices that faces use (unreferenced vertices, like
-    // the Stanford bunny's 1,113, do not widen it).
-    let used = mesh.referenced();
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for (p, _) in mesh.positions.iter().zip(&used).filter(|(_, u)| **u) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let ext: [f64; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
-    let longest = ext.iter().copied().fold(0.0, f64::max);
-    let all_degenerate = || {
-        Error::input(
-            source,
-            "faces",
-            format!(
-                "all {} faces are degenerate (zero area): there is no surface to measure \
-                 a distance to",
-                mesh.faces.len()
-            ),
-        )
-    };
-    if longest <= 0.0 || !longest.is_finite() {
-        return Err(all_degenerate());
-    }
-    let pad = padding_voxels(n);
-    let h = longest / (n as f64 - 1.0 - 2.0 * pad);
-    let axis = (0..3)
-        .max_by(|&a, &b| ext[a].total_cmp(&ext[b]))
-        .unwrap_or(0);
-    let dims: [usize; 3] = std::array::from_fn(|k| {
-        if k == axis {
-            n
-        } else {
-            (((ext[k] / h + 2.0 * pad) - 1e-9).ceil() as usize + 1).clamp(2, n)
-        }
-    });
-    let origin: [f64; 3] =
-        std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]) - 0.5 * (dims[k] as f64 - 1.0) * h);
-    let grid = SdfGrid {
-        dims,
-        spacing: h,
-        origin,
-    };
-    let scale = FIX_ONE as f64 / h;
-    let fixed: Vec<[i32; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            std::array::from_fn(|k| {
-                let max = ((dims[k] - 1) as i64 * FIX_ONE) as f64;
-                ((p[k] - origin[k]) * scale).round().clamp(0.0, max) as i32
-            })
-        })
-        .collect();
-    let inv = 1.0 / FIX_ONE as f32;
-    let grid_pos = fixed.iter().map(|q| q.map(|c| c as f32 * inv)).collect();
-    let triangles: Vec<[u32; 3]> = mesh
-        .faces
-        .iter()
-        .copied()
-        .filter(|f| !collinear(&fixed, f))
-        .collect();
-    let degenerate = mesh.faces.len() - triangles.len();
-    if triangles.is_empty() {
-        return Err(all_degenerate());
-    }
-    let adjacent = adjacency(&triangles);
-    Ok(PreparedMesh {
-        grid,
-        fixed,
-        grid_pos,
-        triangles,
-        degenerate,
-        adjacent,
-    })
-}
-
-/// Edge neighbours of each triangle (see [`PreparedMesh::adjacent`]).
-fn adjacency(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    use std::collections::HashMap;
-    let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    let mut by_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(3 * tris.len() / 2);
-    for (t, f) in tris.iter().enumerate() {
-        for k in 0..3 {
-            by_edge
-                .entry(key(f[k], f[(k + 1) % 3]))
-                .or_default()
-                .push(t as u32);
-        }
-    }
-    tris.iter()
-        .enumerate()
-        .map(|(t, f)| {
-            std::array::from_fn(|k| {
-                by_edge[&key(f[k], f[(k + 1) % 3])]
-                    .iter()
-                    .copied()
-                    .filter(|&o| o != t as u32)
-                    .min()
-                    .unwrap_or(NO_TRIANGLE)
-            })
-        })
-        .collect()
-}
-
-/// Whether the snapped corners of `f` are collinear (exact, in `i64`).
-fn collinear(q: &[[i32; 3]], f: &[u32; 3]) -> bool {
-    let [a, b, c] = f.map(|v| q[v as usize].map(i64::from));
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    u[1] * v[2] - u[2] * v[1] == 0
-        && u[2] * v[0] - u[0] * v[2] == 0
-        && u[0] * v[1] - u[1] * v[0] == 0
 }
 
 impl PreparedMesh {

@@ -21,6 +21,7 @@ pub mod radix_sort;
 pub mod scan;
 pub mod sdf_lines;
 pub mod skinning;
+mod step_entries;
 pub mod timing;
 pub mod vertex_fusion;
 pub mod view;

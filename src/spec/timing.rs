@@ -8,13 +8,6 @@
 //! [`Timing`] to the planned passes by these ids, never by kernel-name
 //! strings. Pure data: no device, no clock.
 
-use super::ao::AoKernel;
-use super::curvature::CurvKernel;
-use super::edges::EdgesKernel;
-use super::feature_lines::LinesKernel;
-use super::sdf_lines::SdflKernel;
-use super::skinning::SkinKernel;
-use super::vertex_fusion::FuseKernel;
 use serde::Serialize;
 
 /// The stage family a [`Step`] belongs to (one name per family across
@@ -150,55 +143,6 @@ pub enum Step {
 }
 
 impl Step {
-    /// The kernel entry point (`<prefix>_<step>`), or for a sub-stage call
-    /// the host entry point (`scan_exclusive`, `radix_sort_pairs`).
-    pub fn kernel(self) -> &'static str {
-        match self {
-            Step::CurvMaxFace => CurvKernel::MaxFace.name(),
-            Step::CurvClear => CurvKernel::Clear.name(),
-            Step::CurvNormalsAreas => CurvKernel::NormalsAreas.name(),
-            Step::CurvFrames => CurvKernel::Frames.name(),
-            Step::CurvTensor => CurvKernel::Tensor.name(),
-            Step::CurvPrincipal => CurvKernel::Principal.name(),
-            Step::CurvDcurv => CurvKernel::Dcurv.name(),
-            Step::McClassify => "mc_classify",
-            Step::McTriangles => "mc_triangles",
-            Step::McIota => "mc_iota",
-            Step::McDirectRows => "mc_direct_rows",
-            Step::McDirectCount => "mc_direct_count",
-            Step::McDirectHits => "mc_direct_hits",
-            Step::McDirectTriangles => "mc_direct_triangles",
-            Step::McDirectPoints => "mc_direct_points",
-            Step::McDirectRecount => "mc_direct_recount",
-            Step::McGradientNormals => "mc_gradient_normals",
-            Step::FuseIndex => FuseKernel::Index.name(),
-            Step::FuseTriangles => FuseKernel::Triangles.name(),
-            Step::FuseCandidates => FuseKernel::Candidates.name(),
-            Step::FuseCancel => FuseKernel::Cancel.name(),
-            Step::FuseMark => FuseKernel::Mark.name(),
-            Step::FuseCompactVertices => FuseKernel::CompactVertices.name(),
-            Step::FuseCompactFaces => FuseKernel::CompactFaces.name(),
-            Step::ScanExclusive => "scan_exclusive",
-            Step::RadixSortPairs => "radix_sort_pairs",
-            Step::EdgesDetect => EdgesKernel::Detect.name(),
-            Step::CapsMh => EdgesKernel::CapsMh.name(),
-            Step::CapsAdjacency => EdgesKernel::CapsAdjacency.name(),
-            Step::EdgesCompact => "edges_compact",
-            Step::SkinLbs => SkinKernel::Lbs.name(),
-            Step::LinesVertex => LinesKernel::Vertex.name(),
-            Step::LinesFace => LinesKernel::Face.name(),
-            Step::AoVertex => AoKernel::Vertex.name(),
-            Step::SdflDense => SdflKernel::Dense.name(),
-            Step::SdflThin => SdflKernel::ThinPhase.name(),
-            Step::SdflGradient => SdflKernel::Gradient.name(),
-            Step::SdflCurvature => SdflKernel::Curvature.name(),
-            Step::SdflRange => SdflKernel::Range.name(),
-            Step::SdflTrace => SdflKernel::Trace.name(),
-            Step::SdflStrips => SdflKernel::Strips.name(),
-            Step::SdflSweep => "sdfl_sweep",
-        }
-    }
-
     /// The step's name within its family: the entry point without the
     /// family prefix (`tensor` for `curv_tensor`), as the curvature stats
     /// list their passes.

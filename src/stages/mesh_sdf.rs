@@ -1,6 +1,6 @@
 //! Host wiring of `kernels/mesh_sdf.cl`: a triangle mesh to a signed
 //! distance field (negative inside, world units, on the grid of
-//! [`crate::spec::mesh_sdf::prepare`]), the input the curvature-directed
+//! [`crate::mesh::mesh_sdf::prepare`]), the input the curvature-directed
 //! strokes need when they are given a mesh. CPU twin:
 //! [`crate::cpu::mesh_sdf`], which matches it bit for bit.
 //!
@@ -19,10 +19,9 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::mesh::Mesh;
+use crate::mesh::mesh_sdf::prepare;
 use crate::spec::mesh_sdf::MsdfKernel;
-use crate::spec::mesh_sdf::{
-    BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh, prepare,
-};
+use crate::spec::mesh_sdf::{BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh};
 use crate::stages::kernel_files;
 use crate::volume::Volume;
 use opencl3::event::Event;

@@ -10,8 +10,8 @@
 //! `.nhdr`), MetaImage (`.mhd`, `.mha`), VTK legacy `STRUCTURED_POINTS`
 //! (`.vtk`) and VTK XML ImageData (`.vti`) in `vtk.rs`, and SLC (`.slc`).
 //! Procedural signed distance fields with analytic curvature are in [`sdf`].
-//! This file holds the [`Volume`] type; `format.rs` the dispatcher
-//! ([`load`]) and what the readers share about formats (scalar types, sizes,
+//! This file holds the [`Volume`] type; `load.rs` the dispatcher
+//! ([`load`]); `format.rs` what the readers share about formats (scalar types, sizes,
 //! header numbers, geometry); `decode.rs` the decoding of samples
 //! (conversion, ASCII numbers, decompression, NRRD and MetaImage payloads).
 //!
@@ -37,6 +37,7 @@
 mod data_files;
 mod decode;
 mod format;
+mod load;
 mod mhd;
 mod nrrd;
 mod raw;
@@ -44,7 +45,8 @@ pub mod sdf;
 mod slc;
 mod vtk;
 
-pub use format::{RawSpec, ScalarType, load, load_with_files};
+pub use format::{RawSpec, ScalarType};
+pub use load::{load, load_with_files};
 
 // The helpers the readers share, named here so that each reader takes them
 // from `super`.

@@ -13,6 +13,10 @@
 //! - [`install_interrupt_cleanup`] removes the temporary files still being
 //!   written when the process receives SIGINT, SIGTERM or SIGHUP, then exits
 //!   with the conventional status 128 + signal (130 for Ctrl-C).
+//!
+//! Below both the writers (`crate::export`, which re-exports this module as
+//! `export::output`) and the renderer's PNG writer (`Frame::save_png`), so
+//! that neither imports the other for it; it knows only the error type.
 
 use crate::error::{Error, Result};
 use std::fs::File;
