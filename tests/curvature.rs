@@ -9,7 +9,7 @@ use common::{gpu, shared_mesh};
 
 use shapecue::cpu::curvature as cpu;
 use shapecue::mesh::{self, Mesh};
-use shapecue::metrics::{analytic_rms, nrmse, rmse};
+use shapecue::report::metrics::{analytic_rms, nrmse, rmse};
 use shapecue::spec::curvature::{
     Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
 };

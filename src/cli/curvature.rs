@@ -1,6 +1,6 @@
 //! `shapecue curvature`: per-vertex curvature of a mesh file or a generated
 //! mesh ([`shapecue::curvature`] or its CPU twin), written as PLY with JSON
-//! stats; `--report` prints the accuracy/time table.
+//! stats (`shapecue report curvature` prints the accuracy/time table).
 //!
 //! The stats time every phase of the command (`phases_ms`: load = parse and
 //! validation, device, reorder (the memory order of `--order`), program
@@ -29,7 +29,7 @@ use std::time::Instant;
 #[derive(Args)]
 pub struct CurvatureArgs {
     /// Input mesh (.obj, .ply, .off).
-    #[arg(required_unless_present_any = ["generate", "report"])]
+    #[arg(required_unless_present = "generate")]
     input: Option<PathBuf>,
     /// Use a generated mesh instead of a file.
     #[arg(long, value_enum, conflicts_with = "input")]
@@ -84,12 +84,8 @@ pub struct CurvatureArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     force: bool,
-    /// Print the accuracy/time table of every variant instead (no input needed).
-    #[arg(long)]
-    report: bool,
-    /// With --report: runs per variant for the median times (default 7).
-    /// Otherwise: after the run whose results are written (the warm-up), N
-    /// more timed runs of the device passes; --stats gives their medians.
+    /// After the run whose results are written (the warm-up), N more timed
+    /// runs of the device passes; --stats gives their medians.
     #[arg(long)]
     runs: Option<usize>,
 }
@@ -139,13 +135,6 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
-    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
-    if a.report {
-        let gpu = Arc::new(Gpu::new(device)?);
-        let text = super::tables::curvature_report(gpu, a.resolution, a.runs.unwrap_or(7))?;
-        super::print_str(&text)?;
-        return Ok(());
-    }
     // Before the load: a refused output should not wait for a large mesh.
     check_outputs(
         a.input.as_deref(),
@@ -168,7 +157,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
                 (path.display().to_string(), m)
             }
-            (None, None) => bail!("give an input mesh, --generate or --report"),
+            (None, None) => bail!("give an input mesh or --generate"),
         };
         let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
         let plan = (!a.cpu).then(|| OrderPlan::new(&mesh, a.order));

@@ -1,7 +1,6 @@
 //! What accuracy costs in time: error metrics (RMSE, NRMSE, analytic
-//! errors, medians) and timed runs of the stages, shared by the tests, the
-//! benches and the report tables of the `shapecue` command line (which
-//! print them, so the README's tables are produced, not typed).
+//! errors, medians) and timed runs of the stages and of the front door,
+//! shared by the report tables, the tests and the benches.
 
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -50,19 +49,7 @@ pub fn torus_truth(m: &Mesh) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Median of a list of numbers (0 for an empty list).
-pub fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
+pub use crate::spec::timing::median;
 
 /// One measured variant: the field of its last run and median times.
 pub struct Measured {
@@ -185,4 +172,27 @@ pub fn measure_isosurface(
         w.push(st.timing.wall_ms);
     }
     Ok((median(&mut k), median(&mut w), st))
+}
+
+/// Timings of `runs` calls of the front door's [`crate::isosurface_on`]
+/// with `opts` (each uploads the volume and extracts once; its
+/// [`crate::stages::marching_cubes::IsoStats::timing`] is the extraction's,
+/// with the volume on the device), for the medians of
+/// `shapecue isosurface --runs`. Curvature and gradient normals are left
+/// out: the runs time the extraction.
+pub fn isosurface_runs(
+    gpu: &Arc<Gpu>,
+    volume: &crate::volume::Volume,
+    iso: f32,
+    opts: &crate::IsoOptions,
+    runs: usize,
+) -> Result<Vec<crate::spec::timing::Timing>> {
+    let opts = crate::IsoOptions {
+        curvature: None,
+        gradient_normals: false,
+        ..*opts
+    };
+    (0..runs)
+        .map(|_| Ok(crate::isosurface_on(gpu, volume, iso, &opts)?.stats.timing))
+        .collect()
 }
