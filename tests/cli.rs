@@ -705,3 +705,32 @@ fn jpeg_names_and_huge_widths_are_refused() {
     let e = run(&["edges", "missing.obj", "--width", "1e30", "-o", "x.png"]);
     assert!(e.contains("--width") && e.contains("at most"), "{e}");
 }
+
+/// `isosurface --runs N`: N more extractions through the library's call
+/// after the one written; the stats give their count and medians, per pass
+/// too, and the summary says so.
+#[test]
+fn isosurface_runs_time_the_extraction() {
+    let d = scratch("iso-runs");
+    let stats = d.join("s.json");
+    let out = run_cli([
+        "isosurface",
+        "--sdf",
+        "sphere",
+        "--resolution",
+        "16",
+        "--curvature",
+        "--runs",
+        "2",
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    common::assert_succeeded(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("2 timed extractions: median"), "{text}");
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(s["runs"], 2, "{s}");
+    assert!(s["kernel_median_ms"].as_f64().unwrap() > 0.0, "{s}");
+    assert!(!s["passes_median"].as_array().unwrap().is_empty(), "{s}");
+    let _ = std::fs::remove_dir_all(&d);
+}

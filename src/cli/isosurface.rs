@@ -225,7 +225,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             "write_ms": write_ms,
         });
         if !runs.is_empty() {
-            super::curvature::runs_stats(&mut stats, &runs, st.timing.wall_ms);
+            shapecue::report::metrics::runs_stats(&mut stats, &runs, st.timing.wall_ms);
         }
         write_json(path, &stats)?;
     }

@@ -6,6 +6,7 @@ use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::mesh::{self, Mesh};
 use crate::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use crate::spec::timing::Timing;
 use crate::stages::curvature::CurvatureEstimator;
 use std::sync::Arc;
 
@@ -195,4 +196,35 @@ pub fn isosurface_runs(
     (0..runs)
         .map(|_| Ok(crate::isosurface_on(gpu, volume, iso, &opts)?.stats.timing))
         .collect()
+}
+
+/// The `--runs` keys of a command's JSON stats (`shapecue curvature` and
+/// `isosurface`): the count, kernel and wall medians and minima, the median
+/// of each pass, and an estimate of the driver's compilation at first
+/// launch (first run's wall − median wall).
+pub fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
+    let mut kernel: Vec<f64> = timed.iter().map(|t| t.kernel_ms).collect();
+    let mut wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
+    let (kmin, wmin) = (
+        kernel.iter().copied().fold(f64::INFINITY, f64::min),
+        wall.iter().copied().fold(f64::INFINITY, f64::min),
+    );
+    let wall_median = median(&mut wall);
+    let per_pass: Vec<serde_json::Value> = timed
+        .first()
+        .map(|t| &t.steps[..])
+        .unwrap_or_default()
+        .iter()
+        .map(|s| {
+            let mut ms: Vec<f64> = timed.iter().map(|t| t.ms(&[s.step])).collect();
+            serde_json::json!({ "pass": s.step.name(), "kernel_ms": median(&mut ms) })
+        })
+        .collect();
+    stats["runs"] = serde_json::json!(timed.len());
+    stats["kernel_median_ms"] = serde_json::json!(median(&mut kernel));
+    stats["kernel_min_ms"] = serde_json::json!(kmin);
+    stats["wall_median_ms"] = serde_json::json!(wall_median);
+    stats["wall_min_ms"] = serde_json::json!(wmin);
+    stats["passes_median"] = serde_json::Value::Array(per_pass);
+    stats["first_launch_compile_ms"] = serde_json::json!((first_wall_ms - wall_median).max(0.0));
 }
