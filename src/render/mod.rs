@@ -32,7 +32,6 @@
 //! one after another; each public call makes its own context current first.
 
 mod camera;
-pub mod cap_quality;
 pub mod colormap;
 mod context;
 pub mod edges;
