@@ -179,9 +179,9 @@ fn curvature_benches(c: &mut Criterion) {
         return;
     };
     // the report's variants, so the README table and the bench cover the same set
-    let variants: Vec<(String, _)> = shapecue::metrics::variants()
+    let variants: Vec<(String, _)> = shapecue::report::metrics::variants()
         .into_iter()
-        .map(|o| (shapecue::metrics::label(&o).replace(' ', "-"), o))
+        .map(|o| (shapecue::report::metrics::label(&o).replace(' ', "-"), o))
         .collect();
     let mut cpu_input: Option<Mesh> = None;
 
@@ -217,7 +217,7 @@ fn curvature_benches(c: &mut Criterion) {
             });
             // (nothing ran when a filter left this variant out)
             if let Some(t2) = trimesh2_ms(input.name).filter(|_| !each.is_empty()) {
-                let k = shapecue::metrics::median(&mut each);
+                let k = shapecue::report::metrics::median(&mut each);
                 eprintln!(
                     "curvature/{id}: kernel median {k:.2} ms, {:.1}× faster than trimesh2's {t2} ms",
                     t2 / k

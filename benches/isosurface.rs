@@ -5,12 +5,12 @@
 //! SDFs at 128³ and 256³ and the real volumes of `../shared/data/volumes`
 //! (skipped with a message when absent). Kernel-only medians are printed
 //! per input. `SHAPECUE_BENCH_QUICK=1` keeps the 128³ fields only.
-//! 512³ is measured by `shapecue isosurface --report`, not here.
+//! 512³ is measured by `shapecue report isosurface`, not here.
 
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shapecue::metrics::median;
+use shapecue::report::metrics::median;
 use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::sdf::{Sdf, sdf};

@@ -2,7 +2,7 @@
 //! (skipped with a message when `../shared/data` is absent): one frame of the
 //! default per-pose device pipeline
 //! ([`shapecue::stages::pipeline::PosePipeline::frame`], the code behind
-//! `shapecue render --report`): skin, curvature with dcurv (f32,
+//! `shapecue report pipeline`): skin, curvature with dcurv (f32,
 //! atomic), AO (`lut`), contours + suggestive contours from one perspective
 //! view, chained on the device; per frame only the joint matrices go up and
 //! the segments come back. Frames step through the first clip. Per model the
@@ -13,7 +13,7 @@ mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::mesh::skinned::load_gltf;
-use shapecue::metrics::median;
+use shapecue::report::metrics::median;
 use shapecue::spec::timing::Family;
 use shapecue::stages::feature_lines::LineOptions;
 use shapecue::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};

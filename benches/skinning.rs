@@ -9,7 +9,7 @@ mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
-use shapecue::metrics::median;
+use shapecue::report::metrics::median;
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::skinning::Skinner;

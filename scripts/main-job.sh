@@ -19,13 +19,13 @@ $bin build-kernels
 $bin curvature data/spot.obj -o out/spot.ply --stats out/spot.json --force
 $bin curvature --generate torus --resolution 40000 -o out/torus.ply --stats out/torus.json --force
 $bin curvature --generate ellipsoid --resolution 40000 -o out/ellipsoid.ply --stats out/ellipsoid.json --force
-$bin curvature --report --resolution 40000
+$bin report curvature --resolution 40000
 # Isosurfaces: marching cubes + vertex fusion on the device, then curvature
 # of the fused mesh without a host round trip, on procedural fields.
 $bin isosurface data/bucky.nhdr --iso 51 --curvature -o out/bucky-iso.ply --stats out/bucky-iso.json --force
 $bin isosurface --sdf torus --resolution 128 --curvature --normals -o out/torus-iso.ply --stats out/torus-iso.json --force
 $bin isosurface --sdf gyroid --resolution 128 --fusion hash -o out/gyroid-iso.ply --stats out/gyroid-iso.json --force
-$bin isosurface --report --max-resolution 256 --runs 3
+$bin report isosurface --max-resolution 256 --runs 3
 # Scenes: only the passes each scene's cues need run; images, SVG line
 # drawings and a JSON report of the passes that ran go to out/scenes/.
 $bin render scenes/spot.toml scenes/torus.toml scenes/gyroid.toml scenes/strokes.toml --out out/scenes --force

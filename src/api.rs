@@ -12,8 +12,9 @@
 //! takes a device the caller already holds, so programs are built once.
 //! The CPU twins have the same signatures where a twin exists:
 //! [`crate::cpu::curvature::curvature`], [`crate::cpu::edges::feature_edges`].
-//! The `shapecue` command line calls these and only these (and the report
-//! tables), then writes and prints what they return.
+//! The `shapecue` command line calls these and only these, then writes and
+//! prints what they return; `shapecue report` ([`crate::report`]) times
+//! them from above.
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -81,9 +82,6 @@ pub struct IsoOptions {
     /// Also compute per-vertex normals from the volume gradient
     /// ([`Isosurface::normals`]).
     pub gradient_normals: bool,
-    /// Timed extractions after the first (which warms the device up), with
-    /// the volume on the device: their timings are [`Isosurface::runs`].
-    pub timed_runs: usize,
 }
 
 impl Default for IsoOptions {
@@ -94,7 +92,6 @@ impl Default for IsoOptions {
             curvature: None,
             curvature_normals: IsoNormals::Gradient,
             gradient_normals: false,
-            timed_runs: 0,
         }
     }
 }
@@ -112,8 +109,6 @@ pub struct Isosurface {
     pub stats: IsoStats,
     /// Uploading the volume and building the programs, ms.
     pub upload_ms: f64,
-    /// Timings of the [`IsoOptions::timed_runs`] extractions.
-    pub runs: Vec<crate::spec::timing::Timing>,
 }
 
 /// The isosurface of `volume` at `iso` on the default device: marching
@@ -153,12 +148,7 @@ pub fn isosurface_on(
     let t_up = Instant::now();
     let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
     let upload_ms = t_up.elapsed().as_secs_f64() * 1e3;
-    // The stats are the first extraction's; the timed runs repeat it.
     let stats = ex.extract(iso, opts.fusion)?;
-    let mut runs = Vec::with_capacity(opts.timed_runs);
-    for _ in 0..opts.timed_runs {
-        runs.push(ex.extract(iso, opts.fusion)?.timing);
-    }
     let curvature = match opts.curvature {
         Some(o) => {
             let o = CurvatureOptions {
@@ -193,7 +183,6 @@ pub fn isosurface_on(
         curvature,
         stats,
         upload_ms,
-        runs,
     })
 }
 

@@ -58,11 +58,15 @@ enum Cmd {
     /// field's Hessian after Kindlmann et al. 2003): a volume, a procedural
     /// field or a mesh turned into a distance field, to PNG (and SVG, PLY).
     Strokes(cli::strokes::StrokesArgs),
+    /// Measurements as Markdown tables (with --json numbers and --plot SVG
+    /// charts), each headed by the date, the device and the command:
+    /// curvature, isosurface, strokes, pipeline, caps, memory.
+    Report(cli::report::ReportArgs),
 }
 
 fn main() {
     shapecue::export::output::install_interrupt_cleanup();
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| cli::report::parse_error(e));
     let device = cli.device.as_deref();
     let result = match cli.cmd {
         Cmd::Devices { json } => cli::devices::run(json),
@@ -72,6 +76,7 @@ fn main() {
         Cmd::Edges(a) => cli::edges::run(device, a),
         Cmd::Render(a) => cli::render::run(device, a),
         Cmd::Strokes(a) => cli::strokes::run(device, a),
+        Cmd::Report(a) => cli::report::run(device, a),
     };
     if let Err(e) = result {
         std::process::exit(cli::fail(&e));

@@ -12,7 +12,7 @@ use curvature_support::*;
 
 use shapecue::cpu::curvature as cpu;
 use shapecue::mesh::{self, Mesh};
-use shapecue::metrics::{analytic_rms, nrmse, rmse};
+use shapecue::report::metrics::{analytic_rms, nrmse, rmse};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use shapecue::stages::curvature::{CurvatureEstimator, Pass};
 

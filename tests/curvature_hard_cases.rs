@@ -10,7 +10,7 @@ use curvature_support::*;
 
 use shapecue::cpu::curvature as cpu;
 use shapecue::mesh::{self, Mesh};
-use shapecue::metrics::nrmse;
+use shapecue::report::metrics::nrmse;
 use shapecue::spec::curvature::{Accumulate, CurvatureField, CurvatureOptions, Precision};
 
 // ---------------------------------------------------------------- hard cases

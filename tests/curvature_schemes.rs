@@ -11,7 +11,7 @@ use curvature_support::*;
 
 use shapecue::cpu::curvature as cpu;
 use shapecue::mesh::{self, Mesh};
-use shapecue::metrics::{nrmse, rmse};
+use shapecue::report::metrics::{nrmse, rmse};
 use shapecue::spec::curvature::{Accumulate, CurvatureOptions, Precision};
 use shapecue::stages::curvature::CurvatureEstimator;
 

@@ -643,24 +643,6 @@ fn cli_bad_input_is_a_clear_error() {
 }
 
 #[test]
-fn cli_memory_table_lists_the_generated_meshes() {
-    let out = run_cli(["edges", "--memory-table"]);
-    assert!(out.status.success());
-    let s = String::from_utf8_lossy(&out.stdout);
-    let cube = s.lines().find(|l| l.starts_with("cube")).unwrap();
-    let f: Vec<u64> = cube
-        .split_whitespace()
-        .skip(1)
-        .map(|x| x.parse().unwrap())
-        .collect();
-    assert_eq!(f[0], 18);
-    assert_eq!(f[2], 18 * 21 * 32);
-    for name in ["cylinder", "cone", "icosphere"] {
-        assert!(s.contains(name), "{s}");
-    }
-}
-
-#[test]
 fn outputs_persist_correctly_across_frames() {
     // Undrawn-then-undrawn primitives are not rewritten: a stage reused for
     // different views, widths and cap modes must still match a fresh CPU run.
@@ -759,7 +741,7 @@ fn ideal_stroke_of_one_segment_is_a_capsule() {
 }
 
 fn st_ideal(edge_out: &[[f32; 4]]) -> Vec<bool> {
-    shapecue::render::cap_quality::ideal_coverage(edge_out, 100, 100, 5.0)
+    shapecue::report::caps::ideal_coverage(edge_out, 100, 100, 5.0)
 }
 
 #[test]
@@ -774,7 +756,7 @@ fn caps_close_the_gaps_of_thick_edges() {
     cam.fov_y_deg = 20.0;
     let mut p = params_of(cam);
     p.line_width = 10.0;
-    let q = shapecue::render::cap_quality::cap_quality(gpu(), &m, &t, &p).unwrap();
+    let q = shapecue::report::caps::cap_quality(gpu(), &m, &t, &p).unwrap();
     let (none, mh, adj) = (&q[0], &q[1], &q[2]);
     assert!(
         none.gap > 50,

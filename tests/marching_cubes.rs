@@ -453,7 +453,7 @@ fn tri_set_orientation() {
 
 #[test]
 fn curvature_on_the_device_resident_isosurface() {
-    use shapecue::metrics::analytic_rms;
+    use shapecue::report::metrics::analytic_rms;
     use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
     use shapecue::spec::marching_cubes::IsoNormals;
     use shapecue::stages::marching_cubes::curvature;
@@ -478,7 +478,7 @@ fn curvature_on_the_device_resident_isosurface() {
             let host = shapecue::stages::curvature::estimate(gpu(), &mesh, opts)
                 .unwrap()
                 .field;
-            let d = shapecue::metrics::rmse(&f.k1, &host.k1);
+            let d = shapecue::report::metrics::rmse(&f.k1, &host.k1);
             assert!(
                 d < 1e-9,
                 "{kind:?} {res}: device-resident vs host path k1 rmse {d}"

@@ -492,7 +492,7 @@ fn ellipsoid_curvature_at_the_axes() {
 
 #[test]
 fn ellipsoid_curvature_matches_the_isosurface_estimate() {
-    use shapecue::metrics::analytic_rms;
+    use shapecue::report::metrics::analytic_rms;
     use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
     use shapecue::spec::marching_cubes::IsoNormals;
     use shapecue::spec::vertex_fusion::Fusion;

@@ -429,7 +429,7 @@ fn pose_pipeline_runs_frames_and_reports() {
     };
     assert!(PosePipeline::new(gpu(), &m, bad).is_err());
     let out = common::cli()
-        .args(["render", "--report", "--frames", "2", "--runs", "1"])
+        .args(["report", "pipeline", "--frames", "2", "--runs", "1"])
         .arg(&path)
         .output()
         .unwrap();

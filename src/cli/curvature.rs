@@ -1,6 +1,6 @@
 //! `shapecue curvature`: per-vertex curvature of a mesh file or a generated
 //! mesh ([`shapecue::curvature`] or its CPU twin), written as PLY with JSON
-//! stats; `--report` prints the accuracy/time table.
+//! stats (`shapecue report curvature` prints the accuracy/time table).
 //!
 //! The stats time every phase of the command (`phases_ms`: load = parse and
 //! validation, device, reorder (the memory order of `--order`), program
@@ -19,7 +19,6 @@ use shapecue::gpu::Gpu;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
-use shapecue::spec::timing::Timing;
 use shapecue::stages::curvature::{CurvatureEstimator, OrderPlan, OrderedEstimator};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -29,7 +28,7 @@ use std::time::Instant;
 #[derive(Args)]
 pub struct CurvatureArgs {
     /// Input mesh (.obj, .ply, .off).
-    #[arg(required_unless_present_any = ["generate", "report"])]
+    #[arg(required_unless_present = "generate")]
     input: Option<PathBuf>,
     /// Use a generated mesh instead of a file.
     #[arg(long, value_enum, conflicts_with = "input")]
@@ -84,12 +83,8 @@ pub struct CurvatureArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     force: bool,
-    /// Print the accuracy/time table of every variant instead (no input needed).
-    #[arg(long)]
-    report: bool,
-    /// With --report: runs per variant for the median times (default 7).
-    /// Otherwise: after the run whose results are written (the warm-up), N
-    /// more timed runs of the device passes; --stats gives their medians.
+    /// After the run whose results are written (the warm-up), N more timed
+    /// runs of the device passes; --stats gives their medians.
     #[arg(long)]
     runs: Option<usize>,
 }
@@ -139,13 +134,6 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
-    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
-    if a.report {
-        let gpu = Arc::new(Gpu::new(device)?);
-        let text = super::tables::curvature_report(gpu, a.resolution, a.runs.unwrap_or(7))?;
-        super::print_str(&text)?;
-        return Ok(());
-    }
     // Before the load: a refused output should not wait for a large mesh.
     check_outputs(
         a.input.as_deref(),
@@ -168,7 +156,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
                 (path.display().to_string(), m)
             }
-            (None, None) => bail!("give an input mesh, --generate or --report"),
+            (None, None) => bail!("give an input mesh or --generate"),
         };
         let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
         let plan = (!a.cpu).then(|| OrderPlan::new(&mesh, a.order));
@@ -220,7 +208,8 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 );
             }
             stats["runs"] = serde_json::json!(n);
-            stats["wall_median_ms"] = serde_json::json!(median(&mut walls));
+            stats["wall_median_ms"] =
+                serde_json::json!(shapecue::report::metrics::median(&mut walls));
         }
         phase("first_run", c.timing.wall_ms);
         (Some(c.field), None, c.counts, stats)
@@ -265,7 +254,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             for _ in 0..n {
                 timed.push(o.est.run()?);
             }
-            runs_stats(&mut stats, &timed, timing.wall_ms);
+            shapecue::report::metrics::runs_stats(&mut stats, &timed, timing.wall_ms);
         }
         // After the runs, so that code the driver compiled at the first
         // launch is in the saved binaries; a no-op when the cache hit.
@@ -371,46 +360,6 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
 
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
-}
-
-/// The median of `v` (the mean of the middle two for an even count; 0 for none).
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
-/// The `--runs` keys of the device stats: the count, kernel and wall
-/// medians and minima, the median of each pass, and an estimate of the
-/// driver's compilation at first launch (first run's wall − median wall).
-pub(super) fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
-    let mut kernel: Vec<f64> = timed.iter().map(|t| t.kernel_ms).collect();
-    let mut wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
-    let (kmin, wmin) = (
-        kernel.iter().copied().fold(f64::INFINITY, f64::min),
-        wall.iter().copied().fold(f64::INFINITY, f64::min),
-    );
-    let wall_median = median(&mut wall);
-    let per_pass: Vec<serde_json::Value> = timed
-        .first()
-        .map(|t| &t.steps[..])
-        .unwrap_or_default()
-        .iter()
-        .map(|s| {
-            let mut ms: Vec<f64> = timed.iter().map(|t| t.ms(&[s.step])).collect();
-            serde_json::json!({ "pass": s.step.name(), "kernel_ms": median(&mut ms) })
-        })
-        .collect();
-    stats["runs"] = serde_json::json!(timed.len());
-    stats["kernel_median_ms"] = serde_json::json!(median(&mut kernel));
-    stats["kernel_min_ms"] = serde_json::json!(kmin);
-    stats["wall_median_ms"] = serde_json::json!(wall_median);
-    stats["wall_min_ms"] = serde_json::json!(wmin);
-    stats["passes_median"] = serde_json::Value::Array(per_pass);
-    stats["first_launch_compile_ms"] = serde_json::json!((first_wall_ms - wall_median).max(0.0));
 }
 
 /// The curvature stats' `passes`: one `{pass, kernel_ms}` per curvature

@@ -1,7 +1,7 @@
 //! `shapecue edges`: object-space feature edges with caps (House & Li),
 //! drawn over the shaded mesh by [`shapecue::render::edges::draw`] to PNG,
-//! with the visible edges as SVG and JSON stats; `--memory-table` and
-//! `--cap-quality` print the tables of [`super::tables`].
+//! with the visible edges as SVG and JSON stats (`shapecue report caps` and
+//! `shapecue report memory` print the cap-quality and memory tables).
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
@@ -19,8 +19,7 @@ use std::sync::Arc;
 #[derive(Args)]
 pub struct EdgesArgs {
     /// Input mesh (.obj, .ply, .off).
-    #[arg(required_unless_present_any = ["cap_quality", "memory_table"])]
-    mesh: Option<PathBuf>,
+    mesh: PathBuf,
     /// Eye position, e.g. 5,5,5 (default: from direction 1,1,1 off the
     /// centre of the mesh, far enough that the mesh fills the view).
     #[arg(
@@ -87,13 +86,6 @@ pub struct EdgesArgs {
     /// code 3 without the extension), off (host path).
     #[arg(long, value_enum, default_value = "auto")]
     interop: shapecue::spec::edges::InteropMode,
-    /// Print the cap-quality table (gap and extra pixels against the ideal
-    /// round-joined stroke) for the standard meshes instead.
-    #[arg(long)]
-    cap_quality: bool,
-    /// Print the memory table (bits per mesh for each cap variant) instead.
-    #[arg(long)]
-    memory_table: bool,
     /// After the first frame, this many more timed frames of the same view
     /// with the topology, device buffers, GL context and uploaded mesh kept
     /// (as a batch of views reuses them); --stats gives their medians
@@ -139,20 +131,14 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
-    if a.memory_table {
-        return super::tables::edges_memory_table();
-    }
     let gpu = Arc::new(Gpu::new(device)?);
     let interop = decide_interop(a.interop, gpu.info.gl_sharing, &gpu.info.name)?;
-    if a.cap_quality {
-        return super::tables::edges_cap_quality(&gpu, (w, h), a.width, a.crease, a.fov, a.ortho);
-    }
-    let path = a.mesh.as_deref().expect("clap requires MESH here");
+    let path = a.mesh.as_path();
     if let Some(o) = &a.output {
         super::require_png("-o", o)?;
     }
     let Some(output) = &a.output else {
-        bail!("give -o OUT.png (or --cap-quality / --memory-table)");
+        bail!("give -o OUT.png");
     };
     check_outputs(
         [path].into_iter().chain(a.marked.as_deref()),

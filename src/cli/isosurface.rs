@@ -1,7 +1,7 @@
 //! `shapecue isosurface`: the isosurface of a volume file or a procedural
 //! signed distance field ([`shapecue::isosurface`]), optionally with its
-//! curvature, written as PLY with JSON stats; `--report` prints the
-//! fusion and resolution tables.
+//! curvature, written as PLY with JSON stats (`shapecue report isosurface`
+//! prints the fusion and resolution tables).
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
@@ -21,7 +21,7 @@ use std::time::Instant;
 pub struct IsoArgs {
     /// Input volume: .nrrd/.nhdr, .mhd/.mha, .vtk (STRUCTURED_POINTS), .vti, or
     /// raw data with --dims and --type.
-    #[arg(required_unless_present_any = ["sdf", "report"])]
+    #[arg(required_unless_present = "sdf")]
     input: Option<PathBuf>,
     /// Use a procedural signed distance field instead: sphere, torus or gyroid.
     #[arg(long, conflicts_with = "input")]
@@ -85,15 +85,10 @@ pub struct IsoArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     force: bool,
-    /// Print the isosurface accuracy/time report instead (no input needed).
-    #[arg(long)]
-    report: bool,
-    /// Largest resolution of the report's sweep.
-    #[arg(long, default_value_t = 512)]
-    max_resolution: usize,
-    /// Runs per measurement in the report (median, default 5); otherwise one
-    /// warm-up and this many more timed extractions with the volume on the
-    /// device, whose medians --stats gives.
+    /// After the extraction whose results are written, this many more
+    /// timed extractions (each a call of the library's isosurface, volume
+    /// upload included; the times are the extraction's, with the volume on
+    /// the device), whose medians --stats gives.
     #[arg(long)]
     runs: Option<usize>,
 }
@@ -102,16 +97,6 @@ pub struct IsoArgs {
 pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
-    }
-    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
-    if a.report {
-        let gpu = Arc::new(Gpu::new(device)?);
-        super::print_str(&super::tables::isosurface_report(
-            gpu,
-            a.max_resolution,
-            a.runs.unwrap_or(5),
-        )?)?;
-        return Ok(());
     }
     let t_load = Instant::now();
     let (name, vol, read) = match (&a.input, &a.sdf) {
@@ -131,7 +116,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             let (vol, read) = volume::load_with_files(path, raw.as_ref())?;
             (path.display().to_string(), vol, read)
         }
-        (None, None) => bail!("give an input volume, --sdf or --report"),
+        (None, None) => bail!("give an input volume or --sdf"),
     };
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     let iso = match (a.iso, &a.sdf) {
@@ -171,10 +156,13 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         curvature,
         curvature_normals: a.curvature_normals,
         gradient_normals: a.normals && a.output.is_some(),
-        timed_runs: a.runs.unwrap_or(0),
     };
     let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)
         .with_context(|| format!("uploading {name}"))?;
+    let runs = match a.runs {
+        Some(n) => shapecue::report::metrics::isosurface_runs(&gpu, &vol, iso, &opts, n)?,
+        None => Vec::new(),
+    };
     let st = &s.stats;
     if st.faces == 0 {
         // As in scenes: an empty surface is an error, not an empty file.
@@ -197,12 +185,12 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         st.timing.wall_ms
     );
     if let Some(n) = a.runs {
-        let mut k: Vec<f64> = s.runs.iter().map(|t| t.kernel_ms).collect();
-        let mut w: Vec<f64> = s.runs.iter().map(|t| t.wall_ms).collect();
+        let mut k: Vec<f64> = runs.iter().map(|t| t.kernel_ms).collect();
+        let mut w: Vec<f64> = runs.iter().map(|t| t.wall_ms).collect();
         out!(
             "{n} timed extractions: median {:.2} ms kernels, {:.2} ms wall",
-            shapecue::metrics::median(&mut k),
-            shapecue::metrics::median(&mut w)
+            shapecue::report::metrics::median(&mut k),
+            shapecue::report::metrics::median(&mut w)
         );
     }
     let t_write = Instant::now();
@@ -236,8 +224,8 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             "curvature": curv,
             "write_ms": write_ms,
         });
-        if !s.runs.is_empty() {
-            super::curvature::runs_stats(&mut stats, &s.runs, st.timing.wall_ms);
+        if !runs.is_empty() {
+            shapecue::report::metrics::runs_stats(&mut stats, &runs, st.timing.wall_ms);
         }
         write_json(path, &stats)?;
     }

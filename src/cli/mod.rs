@@ -9,8 +9,8 @@ pub mod edges;
 pub mod isosurface;
 pub mod kernels;
 pub mod render;
+pub mod report;
 pub mod strokes;
-pub mod tables;
 
 use anyhow::Result;
 use std::io::Write;
@@ -169,22 +169,6 @@ pub fn require_png(option: &str, path: &Path) -> anyhow::Result<()> {
         anyhow::bail!(
             "{option} {}: images are written as PNG; give a name ending in .png",
             path.display()
-        );
-    }
-    Ok(())
-}
-
-/// Refuses `--report` together with an input or an output: the report
-/// measures generated shapes and writes nothing, so either would be ignored.
-pub fn report_alone(
-    report: bool,
-    input: Option<&Path>,
-    output: Option<&Path>,
-) -> anyhow::Result<()> {
-    if report && (input.is_some() || output.is_some()) {
-        anyhow::bail!(
-            "--report prints the accuracy/time table of generated shapes and reads no input \
-                 nor writes -o; run it without them"
         );
     }
     Ok(())

@@ -1,35 +1,21 @@
 //! `shapecue render`: scene files through the planner and the executor
 //! ([`shapecue::scene::exec`]), with a progress bar on a terminal and each
-//! scene's report printed; `--explain` prints the plans, `--report` the
-//! per-frame device pipeline table.
+//! scene's report printed; `--explain` prints the plans (`shapecue report
+//! pipeline` prints the per-frame device pipeline table).
 
 use super::out;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
-use shapecue::gpu::Gpu;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 /// The arguments of `shapecue render`.
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene files (with `--report`: glTF files to time the per-frame device
-    /// pipeline on; default ../shared/data/animations/gltf/BrainStem.glb).
-    #[arg(required_unless_present = "report")]
+    /// Scene files.
+    #[arg(required = true)]
     scenes: Vec<PathBuf>,
-    /// Print the per-frame device pipeline table (skin, curvature with dcurv,
-    /// AO at each level with its error, contours and suggestive contours) of
-    /// skinned glTF models, timed apart from rendering.
-    #[arg(long)]
-    report: bool,
-    /// Frames of the first clip sampled by `--report`.
-    #[arg(long, default_value_t = 30)]
-    frames: usize,
-    /// Timed runs per frame for `--report` (medians are printed).
-    #[arg(long, default_value_t = 3)]
-    runs: usize,
     /// Output folder (overrides each scene's `[output] dir`).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -44,9 +30,6 @@ pub struct RenderArgs {
 
 /// Runs `shapecue render`.
 pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
-    if a.report {
-        return pipeline_tables(device, &a);
-    }
     let opts = ExecOptions {
         out_dir: a.out.clone(),
         force: a.force,
@@ -78,29 +61,6 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
         })?;
         bar.finish_and_clear();
         print_report(&r)?;
-    }
-    Ok(())
-}
-
-/// `--report`: the per-frame device pipeline table of each glTF model.
-fn pipeline_tables(device: Option<&str>, a: &RenderArgs) -> Result<()> {
-    let models = if a.scenes.is_empty() {
-        vec![PathBuf::from(
-            "../shared/data/animations/gltf/BrainStem.glb",
-        )]
-    } else {
-        a.scenes.clone()
-    };
-    let gpu = Arc::new(Gpu::new(device)?);
-    for m in &models {
-        if !m.exists() {
-            bail!(
-                "{}: not found (give the glTF files to time: `shapecue render --report MODEL.glb`)",
-                m.display()
-            );
-        }
-        let t = super::tables::pipeline_report(gpu.clone(), m, a.frames.max(1), a.runs.max(1))?;
-        super::print_str(&t)?;
     }
     Ok(())
 }

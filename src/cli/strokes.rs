@@ -5,8 +5,8 @@
 //!
 //! Thin: parses, calls the library (`stages::sdf_lines` for the strokes,
 //! `stages::marching_cubes` for the surface under them, `render` and
-//! `export`), prints one summary line. `--report` prints the accuracy/time
-//! table against the analytic torus instead.
+//! `export`), prints one summary line (`shapecue report strokes` prints the
+//! accuracy/time table against the analytic torus).
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -28,7 +28,7 @@ const FIT_DIRECTION: [f32; 3] = [0.3, -1.0, 0.9];
 pub struct StrokesArgs {
     /// Input: a volume (.nrrd/.nhdr, .mhd/.mha, .vtk, .vti, .slc, or raw
     /// data with --dims and --type) or a triangle mesh (.obj, .ply, .off).
-    #[arg(required_unless_present_any = ["sdf", "report"])]
+    #[arg(required_unless_present = "sdf")]
     pub input: Option<PathBuf>,
     /// Use a procedural signed distance field instead: sphere, torus or gyroid.
     #[arg(long, conflicts_with = "input")]
@@ -71,7 +71,7 @@ pub struct StrokesArgs {
     #[arg(long, default_value = "auto")]
     pub sampling: String,
     /// Output PNG.
-    #[arg(short, long, required_unless_present = "report")]
+    #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
     /// Also write the strokes facing the eye as SVG (each a filled
     /// variable-width outline).
@@ -97,11 +97,6 @@ pub struct StrokesArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Print the accuracy/time table (κ1 and direction error against the
-    /// analytic torus per grid resolution and sampling distance, beside the
-    /// kernel time) instead; no input needed.
-    #[arg(long)]
-    pub report: bool,
 }
 
 /// Runs `shapecue strokes`.
@@ -112,14 +107,8 @@ pub struct StrokesArgs {
 /// built (no faces, non-finite vertices), outputs that exist without `--force` or
 /// are the input, and any library error.
 pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
-    super::report_alone(a.report, a.input.as_deref(), a.output.as_deref())?;
-    if a.report {
-        let gpu = Arc::new(Gpu::new(device)?);
-        super::print_str(&torus_report(gpu)?)?;
-        return Ok(());
-    }
     let (w, h) = super::size_arg(&a.size)?;
-    let output = a.output.clone().expect("clap requires -o without --report");
+    let output = a.output.clone().expect("clap requires -o");
     super::require_png("-o", &output)?;
     let outputs: Vec<&Path> = [
         Some(&output),
@@ -389,87 +378,4 @@ fn load_input(
         .collect();
     check_outputs(&inputs, outputs, a.force)?;
     Ok((path.display().to_string(), v, false))
-}
-
-/// The accuracy/time table: on the torus SDF (tube radius r, κ1 = 1/r with
-/// d1 around the tube), per grid resolution and sampling distance, the
-/// relative κ1 error and the angle between d1 and the tube's cross-section
-/// direction at the seeds (median and 95th percentile), beside the kernel
-/// ms of the whole run (seed spacing fixed at 0.05 so the seed counts
-/// compare).
-fn torus_report(gpu: Arc<Gpu>) -> Result<String> {
-    use shapecue::volume::sdf::{Sdf, TORUS_TUBE, sdf, torus_curvature};
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "torus SDF (R 0.6, r {TORUS_TUBE}: κ1 = 1/r = {:.1}, d1 around the tube); seed spacing 0.05",
-        1.0 / TORUS_TUBE
-    );
-    let _ = writeln!(
-        s,
-        "{:>4} {:>8} {:>8} {:>6} {:>11} {:>11} {:>10} {:>10} {:>9}",
-        "res",
-        "h/voxel",
-        "h",
-        "seeds",
-        "κ1 err med",
-        "κ1 err p95",
-        "d1 ° med",
-        "d1 ° p95",
-        "kernel ms"
-    );
-    for res in [32usize, 64, 128, 256] {
-        let vol = sdf(Sdf::Torus, res);
-        let voxel = vol.spacing[0];
-        for hv in [1.0, 2.0, 4.0] {
-            let opts = SdfLineOptions {
-                sampling: Sampling::Fixed(hv * voxel),
-                spacing: Some(0.05),
-                ..SdfLineOptions::default()
-            };
-            let out = SdfLines::new(gpu.clone(), &vol, &opts)?.run()?;
-            let mut ke = Vec::new();
-            let mut de = Vec::new();
-            for sd in out.seeds.iter().filter(|s| s.valid) {
-                let (k1, _) = torus_curvature(sd.p);
-                ke.push(((sd.k1 - k1) / k1).abs());
-                // Tube direction: normal × ring tangent (ring tangent ∝ (−y, x, 0)).
-                let [x, y, _] = sd.p;
-                let t = [-y, x, 0.0];
-                let n = sd.n;
-                let d = [
-                    n[1] * t[2] - n[2] * t[1],
-                    n[2] * t[0] - n[0] * t[2],
-                    n[0] * t[1] - n[1] * t[0],
-                ];
-                let dl = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                let dot = (d[0] * sd.d1[0] + d[1] * sd.d1[1] + d[2] * sd.d1[2]).abs() / dl;
-                de.push(dot.clamp(0.0, 1.0).acos().to_degrees());
-            }
-            let q = |v: &mut Vec<f64>, f: f64| -> f64 {
-                if v.is_empty() {
-                    return f64::NAN;
-                }
-                v.sort_by(f64::total_cmp);
-                v[((v.len() - 1) as f64 * f).round() as usize]
-            };
-            let _ = writeln!(
-                s,
-                "{res:>4} {hv:>8.1} {:>8.4} {:>6} {:>11.2e} {:>11.2e} {:>10.3} {:>10.3} {:>9.2}",
-                hv * voxel,
-                ke.len(),
-                q(&mut ke, 0.5),
-                q(&mut ke, 0.95),
-                q(&mut de, 0.5),
-                q(&mut de, 0.95),
-                out.stats.ms.total
-            );
-        }
-    }
-    let _ = writeln!(
-        s,
-        "(errors at the thinned seeds; kernel ms from OpenCL profiling events, sweep excluded: fixed h)"
-    );
-    Ok(s)
 }

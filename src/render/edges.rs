@@ -390,7 +390,7 @@ fn frame_sum(ph: &EdgePhases) -> f64 {
 
 /// Medians of timed frames (their phases and kernel times).
 fn runs_summary(each: &[(EdgePhases, f64)]) -> EdgeRuns {
-    use crate::metrics::median;
+    use crate::spec::timing::median;
     let of = |f: &dyn Fn(&EdgePhases) -> f64| {
         median(&mut each.iter().map(|e| f(&e.0)).collect::<Vec<_>>())
     };

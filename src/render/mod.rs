@@ -41,7 +41,6 @@
 //! arithmetic on the CPU.
 
 mod camera;
-pub mod cap_quality;
 pub mod colormap;
 mod context;
 mod draw_clip;

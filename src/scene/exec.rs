@@ -331,9 +331,9 @@ fn render_all(
         vertices,
         faces,
         passes: ex.rec.in_plan_order(&plan),
-        pose_ms_median: crate::metrics::median(&mut pose_ms),
-        view_ms_median: crate::metrics::median(&mut view_ms),
-        render_ms_median: crate::metrics::median(&mut render_ms),
+        pose_ms_median: crate::spec::timing::median(&mut pose_ms),
+        view_ms_median: crate::spec::timing::median(&mut view_ms),
+        render_ms_median: crate::spec::timing::median(&mut render_ms),
         gl_uploads: {
             let now = ex.uploads();
             crate::render::Uploads {

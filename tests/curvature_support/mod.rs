@@ -6,7 +6,7 @@
 
 use crate::common::gpu;
 use shapecue::mesh::Mesh;
-use shapecue::metrics::nrmse;
+use shapecue::report::metrics::nrmse;
 use shapecue::spec::curvature::{
     Accumulate, Compat, CurvatureField, CurvatureOptions, Normalization, Precision,
 };

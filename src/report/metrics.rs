@@ -1,12 +1,12 @@
 //! What accuracy costs in time: error metrics (RMSE, NRMSE, analytic
-//! errors, medians) and timed runs of the stages, shared by the tests, the
-//! benches and the report tables of the `shapecue` command line (which
-//! print them, so the README's tables are produced, not typed).
+//! errors, medians) and timed runs of the stages and of the front door,
+//! shared by the report tables, the tests and the benches.
 
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::mesh::{self, Mesh};
 use crate::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use crate::spec::timing::Timing;
 use crate::stages::curvature::CurvatureEstimator;
 use std::sync::Arc;
 
@@ -50,19 +50,7 @@ pub fn torus_truth(m: &Mesh) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Median of a list of numbers (0 for an empty list).
-pub fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
+pub use crate::spec::timing::median;
 
 /// One measured variant: the field of its last run and median times.
 pub struct Measured {
@@ -185,4 +173,58 @@ pub fn measure_isosurface(
         w.push(st.timing.wall_ms);
     }
     Ok((median(&mut k), median(&mut w), st))
+}
+
+/// Timings of `runs` calls of the front door's [`crate::isosurface_on`]
+/// with `opts` (each uploads the volume and extracts once; its
+/// [`crate::stages::marching_cubes::IsoStats::timing`] is the extraction's,
+/// with the volume on the device), for the medians of
+/// `shapecue isosurface --runs`. Curvature and gradient normals are left
+/// out: the runs time the extraction.
+pub fn isosurface_runs(
+    gpu: &Arc<Gpu>,
+    volume: &crate::volume::Volume,
+    iso: f32,
+    opts: &crate::IsoOptions,
+    runs: usize,
+) -> Result<Vec<crate::spec::timing::Timing>> {
+    let opts = crate::IsoOptions {
+        curvature: None,
+        gradient_normals: false,
+        ..*opts
+    };
+    (0..runs)
+        .map(|_| Ok(crate::isosurface_on(gpu, volume, iso, &opts)?.stats.timing))
+        .collect()
+}
+
+/// The `--runs` keys of a command's JSON stats (`shapecue curvature` and
+/// `isosurface`): the count, kernel and wall medians and minima, the median
+/// of each pass, and an estimate of the driver's compilation at first
+/// launch (first run's wall − median wall).
+pub fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms: f64) {
+    let mut kernel: Vec<f64> = timed.iter().map(|t| t.kernel_ms).collect();
+    let mut wall: Vec<f64> = timed.iter().map(|t| t.wall_ms).collect();
+    let (kmin, wmin) = (
+        kernel.iter().copied().fold(f64::INFINITY, f64::min),
+        wall.iter().copied().fold(f64::INFINITY, f64::min),
+    );
+    let wall_median = median(&mut wall);
+    let per_pass: Vec<serde_json::Value> = timed
+        .first()
+        .map(|t| &t.steps[..])
+        .unwrap_or_default()
+        .iter()
+        .map(|s| {
+            let mut ms: Vec<f64> = timed.iter().map(|t| t.ms(&[s.step])).collect();
+            serde_json::json!({ "pass": s.step.name(), "kernel_ms": median(&mut ms) })
+        })
+        .collect();
+    stats["runs"] = serde_json::json!(timed.len());
+    stats["kernel_median_ms"] = serde_json::json!(median(&mut kernel));
+    stats["kernel_min_ms"] = serde_json::json!(kmin);
+    stats["wall_median_ms"] = serde_json::json!(wall_median);
+    stats["wall_min_ms"] = serde_json::json!(wmin);
+    stats["passes_median"] = serde_json::Value::Array(per_pass);
+    stats["first_launch_compile_ms"] = serde_json::json!((first_wall_ms - wall_median).max(0.0));
 }

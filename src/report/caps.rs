@@ -1,25 +1,123 @@
-//! Cap-quality evaluation of the edges stage (House & Li's table): how closely
-//! each cap variant's rendered stroke matches the ideal round-joined stroke
-//! of the same edges.
+//! `shapecue report caps`: cap quality of the edges stage (House & Li's
+//! table), how closely each cap variant's rendered stroke matches the ideal
+//! round-joined stroke of the same edges, on the standard meshes.
 //!
-//! It lives beside the renderer, not in `stages/`, because it measures a
-//! *drawing*: it runs the stage, rasterises the edges and caps with the GL
-//! renderer and compares the covered pixels with an analytic coverage
-//! ([`ideal_coverage`]). Compute knows no screen; this is where the screen
-//! judges the compute.
+//! It measures a *drawing*: it runs the stage, rasterises the edges and caps
+//! with the GL renderer and compares the covered pixels with an analytic
+//! coverage ([`ideal_coverage`]). Compute knows no screen and the screen
+//! runs no compute; the measurement, above both, composes them.
 
 use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::edges::draw_edges;
-use super::{RenderOptions, Renderer};
+use super::{Block, Cell, Chart, Column, Report, Row, Table, edge_meshes};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
-use crate::spec::edges::{CapMode, EdgeParams};
+use crate::render::edges::draw_edges;
+use crate::render::{Placement, RenderOptions, Renderer, framed};
+use crate::spec::edges::{CapMode, EdgeParams, crease_from_degrees};
 use crate::stages::edges::EdgeStage;
+
+/// The view and strokes of the report (the `edges` command's options of
+/// the same names).
+#[derive(Clone, Copy, Debug)]
+pub struct CapsReportOptions {
+    /// Image size in pixels.
+    pub size: (u32, u32),
+    /// Edge width in pixels.
+    pub width: f32,
+    /// Crease angle in degrees.
+    pub crease_deg: f32,
+    /// Vertical field of view in degrees.
+    pub fov_deg: f32,
+    /// Orthographic projection.
+    pub ortho: bool,
+}
+
+impl Default for CapsReportOptions {
+    fn default() -> Self {
+        CapsReportOptions {
+            size: (800, 600),
+            width: 4.0,
+            crease_deg: 30.0,
+            fov_deg: 40.0,
+            ortho: false,
+        }
+    }
+}
+
+/// The report: gap and extra pixels of each cap variant against the ideal
+/// round-joined stroke ([`cap_quality`]), unit-sized meshes seen from
+/// (5, 5, 5).
+///
+/// # Errors
+/// Bad width or crease, device and GL failures.
+pub fn report(gpu: &Arc<Gpu>, o: CapsReportOptions) -> Result<Report> {
+    let (w, h) = o.size;
+    let crease = crease_from_degrees(o.crease_deg)?;
+    let mut r = Report::new("caps", gpu.info.name.clone());
+    r.text(format!(
+        "eye (5,5,5), unit-sized meshes at the origin, {w}x{h}, width {} px, crease {}°",
+        o.width, o.crease_deg
+    ));
+    let mut t = Table::new(
+        "caps",
+        vec![
+            Column::new("mesh", "mesh"),
+            Column::new("caps", "caps"),
+            Column::new("ideal", "ideal_px"),
+            Column::new("rendered", "rendered_px"),
+            Column::new("gap", "gap_px"),
+            Column::new("extra", "extra_px"),
+        ],
+    );
+    let mut groups = Vec::new();
+    let mut series: Vec<(String, Vec<f64>)> = CapMode::ALL
+        .iter()
+        .map(|m| (m.name().to_string(), Vec::new()))
+        .collect();
+    for (name, m) in edge_meshes() {
+        let topo = EdgeTopology::new(&m, &[], &name)?;
+        let cam = framed(
+            Placement::At(glam::Vec3::splat(5.0)),
+            Some(glam::Vec3::ZERO),
+            None,
+            o.fov_deg,
+            o.ortho,
+            m.bounds(),
+            w as f32 / h as f32,
+        )?;
+        let mut p = EdgeParams::new(cam.view(w, h));
+        p.line_width = o.width;
+        p.crease_deg = crease;
+        for q in cap_quality(gpu.clone(), &m, &topo, &p)? {
+            if let Some(s) = series.iter_mut().find(|s| s.0 == q.mode.name()) {
+                s.1.push(q.gap as f64);
+            }
+            t.rows.push(Row::new(vec![
+                Cell::text(name.clone()),
+                Cell::text(q.mode.name()),
+                Cell::int(q.ideal),
+                Cell::int(q.rendered),
+                Cell::int(q.gap),
+                Cell::int(q.extra),
+            ]));
+        }
+        groups.push(name);
+    }
+    r.blocks.push(Block::Table(t));
+    r.charts.push(Chart::Bars {
+        title: "Cap quality: gap pixels against the ideal round-joined stroke".into(),
+        y_label: "gap pixels".into(),
+        log_y: false,
+        groups,
+        series,
+    });
+    Ok(r)
+}
 
 /// How closely one cap variant's stroke matches the ideal round-joined stroke.
 #[derive(Clone, Debug, Serialize)]

@@ -1,0 +1,319 @@
+//! `shapecue report <topic>`: the measurement tables of [`shapecue::report`]
+//! (accuracy against time of the curvature variants, the isosurfaces and
+//! the strokes; the per-frame pipeline; the edges' cap quality and memory).
+//! Parses, calls the library's report, prints its Markdown and writes its
+//! numbers (`--json`) and charts (`--plot`), atomically.
+
+use super::check_outputs;
+use anyhow::{Result, bail};
+use clap::{Args, Subcommand};
+use shapecue::gpu::Gpu;
+use shapecue::report::{self, Report};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The arguments of `shapecue report`.
+#[derive(Args)]
+#[command(subcommand_value_name = "TOPIC", subcommand_help_heading = "Topics")]
+pub struct ReportArgs {
+    #[command(subcommand)]
+    topic: Topic,
+}
+
+/// The outputs every topic can write besides the printed Markdown.
+#[derive(Args)]
+struct Outputs {
+    /// Write the numbers as JSON: each table's rows as objects with named,
+    /// unit-suffixed fields, with the date, the device and the command.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// Draw the numbers as an SVG plot (error against time on log axes,
+    /// error against h with the h² slope, or bars).
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Subcommand)]
+enum Topic {
+    /// Every curvature variant on a generated torus: error against the
+    /// analytic curvature and the f64 CPU reference, median kernel and wall
+    /// ms; then the refinement sweep (error against edge length h).
+    Curvature {
+        /// Approximate vertex count of the torus.
+        #[arg(long, default_value_t = 40_000)]
+        resolution: usize,
+        /// Timed runs per variant (medians).
+        #[arg(long, default_value_t = 7)]
+        runs: usize,
+        #[command(flatten)]
+        out: Outputs,
+    },
+    /// Isosurfaces: extraction + fusion time and mesh quality of every
+    /// fusion variant, then the resolution sweep of the sphere and torus
+    /// fields (curvature error against the analytic values, and its time).
+    Isosurface {
+        /// Largest grid of the extraction table and the resolution sweep.
+        #[arg(long, default_value_t = 512)]
+        max_resolution: usize,
+        /// Runs per measurement (medians).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        #[command(flatten)]
+        out: Outputs,
+    },
+    /// Curvature-directed strokes on the torus field: κ1 and direction
+    /// error against the analytic torus per grid resolution and sampling
+    /// distance, beside the kernel time.
+    Strokes {
+        /// Largest grid of the sweep (32, 64, 128, 256).
+        #[arg(long, default_value_t = 256)]
+        max_resolution: usize,
+        #[command(flatten)]
+        out: Outputs,
+    },
+    /// The per-frame device pipeline of skinned glTF models (skin,
+    /// curvature with dcurv, AO at each level with its error, contours and
+    /// suggestive contours), timed apart from rendering.
+    Pipeline {
+        /// glTF models (default: BrainStem.glb of the shared data).
+        models: Vec<PathBuf>,
+        /// Frames of the first clip.
+        #[arg(long, default_value_t = 30)]
+        frames: usize,
+        /// Timed runs per frame (medians).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        #[command(flatten)]
+        out: Outputs,
+    },
+    /// Cap quality of the feature edges: gap and extra pixels of each cap
+    /// variant against the ideal round-joined stroke, on the standard meshes.
+    Caps {
+        /// Image size, e.g. 800x600.
+        #[arg(long, default_value = "800x600")]
+        size: String,
+        /// Edge width in pixels.
+        #[arg(long, default_value_t = 4.0, allow_negative_numbers = true)]
+        width: f32,
+        /// Crease angle in degrees.
+        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+        crease: f32,
+        /// Vertical field of view in degrees.
+        #[arg(long, default_value_t = 40.0)]
+        fov: f32,
+        /// Orthographic projection.
+        #[arg(long)]
+        ortho: bool,
+        #[command(flatten)]
+        out: Outputs,
+    },
+    /// Memory of the feature edges: bits per mesh of each cap variant, from
+    /// the buffer sizes (no device needed).
+    Memory {
+        #[command(flatten)]
+        out: Outputs,
+    },
+}
+
+/// Reports a command line clap refused and exits with clap's code; a topic
+/// of `shapecue report` that does not exist gets the list of topics.
+pub fn parse_error(e: clap::Error) -> ! {
+    use clap::CommandFactory;
+    use clap::error::ErrorKind;
+    let unknown_topic =
+        e.kind() == ErrorKind::InvalidSubcommand && std::env::args().skip(1).any(|a| a == "report");
+    if !unknown_topic {
+        e.exit();
+    }
+    let _ = e.print();
+    let topics: Vec<String> = Topics::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect();
+    eprintln!(
+        "The topics of `shapecue report` are: {}.",
+        topics.join(", ")
+    );
+    std::process::exit(e.exit_code());
+}
+
+/// [`Topic`] as a command of its own, to list the topics' names.
+#[derive(clap::Parser)]
+struct Topics {
+    #[command(subcommand)]
+    _topic: Topic,
+}
+
+/// The command as typed, for the report's header (`shapecue report ...`),
+/// arguments with spaces or quotes quoted.
+fn command_line() -> String {
+    let quote = |a: String| {
+        if !a.is_empty()
+            && a.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_./=,:@+".contains(c))
+        {
+            a
+        } else {
+            format!("'{}'", a.replace('\'', r"'\''"))
+        }
+    };
+    std::iter::once("shapecue".to_string())
+        .chain(std::env::args().skip(1).map(quote))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn runs(n: usize) -> Result<usize> {
+    shapecue::spec::limits::check_count("--runs", n, 10_000)?;
+    Ok(n)
+}
+
+/// Runs `shapecue report`.
+pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
+    let gpu = || -> Result<Arc<Gpu>> { Ok(Arc::new(Gpu::new(device)?)) };
+    let (report, out) = match a.topic {
+        Topic::Curvature {
+            resolution,
+            runs: n,
+            out,
+        } => {
+            let o = report::curvature::CurvatureReportOptions {
+                resolution,
+                runs: runs(n)?,
+            };
+            shapecue::spec::limits::check_mesh_vertices("--resolution", resolution)?;
+            check(&[], &out)?;
+            (report::curvature::report(&gpu()?, o)?, out)
+        }
+        Topic::Isosurface {
+            max_resolution,
+            runs: n,
+            out,
+        } => {
+            let o = report::isosurface::IsosurfaceReportOptions {
+                max_resolution,
+                runs: runs(n)?,
+            };
+            shapecue::spec::limits::check_volume_resolution("--max-resolution", max_resolution)?;
+            check(&[], &out)?;
+            (report::isosurface::report(&gpu()?, o)?, out)
+        }
+        Topic::Strokes {
+            max_resolution,
+            out,
+        } => {
+            check(&[], &out)?;
+            let o = report::strokes::StrokesReportOptions { max_resolution };
+            (report::strokes::report(&gpu()?, o)?, out)
+        }
+        Topic::Pipeline {
+            models,
+            frames,
+            runs: n,
+            out,
+        } => {
+            let models = if models.is_empty() {
+                vec![report::pipeline::default_model()]
+            } else {
+                models
+            };
+            if models.len() > report::pipeline::MAX_MODELS {
+                bail!(
+                    "give at most {} glTF models per report",
+                    report::pipeline::MAX_MODELS
+                );
+            }
+            for m in &models {
+                if !m.exists() {
+                    bail!(
+                        "{}: not found (give the glTF files to time: \
+                         `shapecue report pipeline MODEL.glb`)",
+                        m.display()
+                    );
+                }
+            }
+            let paths: Vec<&Path> = models.iter().map(PathBuf::as_path).collect();
+            check(&paths, &out)?;
+            let o = report::pipeline::PipelineReportOptions {
+                frames: frames.max(1),
+                runs: runs(n.max(1))?,
+            };
+            (report::pipeline::report(&gpu()?, &paths, o)?, out)
+        }
+        Topic::Caps {
+            size,
+            width,
+            crease,
+            fov,
+            ortho,
+            out,
+        } => {
+            let (w, h) = super::size_arg(&size)?;
+            if !(width.is_finite() && width > 0.0) {
+                bail!("--width {width}: the edge width must be a positive number of pixels");
+            }
+            let widest = w.max(h) as f32;
+            if width > widest {
+                bail!(
+                    "--width {width}: the edge width must be at most the image's larger side \
+                     ({widest} pixels)"
+                );
+            }
+            check(&[], &out)?;
+            let o = report::caps::CapsReportOptions {
+                size: (w, h),
+                width,
+                crease_deg: crease,
+                fov_deg: fov,
+                ortho,
+            };
+            (report::caps::report(&gpu()?, o)?, out)
+        }
+        Topic::Memory { out } => {
+            check(&[], &out)?;
+            (report::memory::report()?, out)
+        }
+    };
+    write(report.with_command(command_line()), &out)
+}
+
+/// Checks the outputs before any measuring: `--plot` must be `.svg`, and
+/// neither may overwrite an input or (without `--force`) an existing file.
+fn check(inputs: &[&Path], out: &Outputs) -> Result<()> {
+    if let Some(p) = &out.plot {
+        let svg = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+        if !svg {
+            bail!(
+                "--plot {}: plots are written as SVG; give a name ending in .svg",
+                p.display()
+            );
+        }
+    }
+    check_outputs(
+        inputs.iter().copied(),
+        out.json.iter().chain(out.plot.iter()).map(PathBuf::as_path),
+        out.force,
+    )
+}
+
+/// Prints the Markdown and writes the JSON and the plot (saying so on
+/// stderr: standard output is the Markdown page alone, to be saved as is).
+fn write(report: Report, out: &Outputs) -> Result<()> {
+    use shapecue::export::output::write_bytes_atomic;
+    super::print_str(&report.markdown())?;
+    if let Some(p) = &out.json {
+        write_bytes_atomic(
+            p,
+            (serde_json::to_string_pretty(&report.json())? + "\n").as_bytes(),
+        )?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &out.plot {
+        write_bytes_atomic(p, shapecue::report::plot::svg(&report)?.as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}

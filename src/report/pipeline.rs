@@ -1,0 +1,195 @@
+//! `shapecue report pipeline`: the per-frame device pipeline of an animated
+//! glTF model ([`PosePipeline`]: skin, curvature + dcurv, AO `lut`,
+//! contours + suggestive contours from [`PosePipeline::front_view`]) over
+//! `frames` poses of the first clip, `runs` times (after one warm-up frame
+//! that pays for JIT compilation). One row per pass with its median kernel
+//! ms; the two other AO levels run on the same curvatures each frame, with
+//! their RMS difference from the `exact` level next to their time (accuracy
+//! and cost side by side); then the median total of the default pipeline
+//! (kernel sum and host wall per frame) and whether it meets the 16 ms
+//! frame budget.
+
+use super::metrics::median;
+use super::{Block, Cell, Chart, Column, Report, Row, Table};
+use crate::error::Result;
+use crate::gpu::Gpu;
+use crate::spec::ao::AoMode;
+use crate::spec::timing::Family;
+use crate::stages::feature_lines::LineOptions;
+use crate::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
+use std::path::Path;
+use std::sync::Arc;
+
+/// The report's sizes.
+#[derive(Clone, Copy, Debug)]
+pub struct PipelineReportOptions {
+    /// Poses sampled from the first clip.
+    pub frames: usize,
+    /// Timed runs over the poses (medians).
+    pub runs: usize,
+}
+
+impl Default for PipelineReportOptions {
+    fn default() -> Self {
+        PipelineReportOptions {
+            frames: 30,
+            runs: 3,
+        }
+    }
+}
+
+/// The model the pipeline report times when none is given.
+pub fn default_model() -> std::path::PathBuf {
+    super::shared_data().join("animations/gltf/BrainStem.glb")
+}
+
+/// Measures the report of each model in `models` on `gpu` (one report,
+/// one table per model).
+///
+/// # Errors
+/// A model that cannot be loaded or has no clip, device failures.
+pub fn report(gpu: &Arc<Gpu>, models: &[&Path], o: PipelineReportOptions) -> Result<Report> {
+    let mut r = Report::new("pipeline", gpu.info.name.clone());
+    for (i, gltf) in models.iter().enumerate() {
+        model(&mut r, gpu, gltf, i, o)?;
+    }
+    Ok(r)
+}
+
+/// The table keys of the models, in order (a JSON key names its table).
+const KEYS: [&str; 8] = [
+    "passes", "passes_2", "passes_3", "passes_4", "passes_5", "passes_6", "passes_7", "passes_8",
+];
+
+/// The most models one report times.
+pub const MAX_MODELS: usize = KEYS.len();
+
+fn model(
+    r: &mut Report,
+    gpu: &Arc<Gpu>,
+    gltf: &Path,
+    index: usize,
+    o: PipelineReportOptions,
+) -> Result<()> {
+    let (frames, runs) = (o.frames.max(1), o.runs.max(1));
+    let m = crate::mesh::skinned::load_gltf(gltf)?;
+    let mut p = PosePipeline::new(gpu.clone(), &m, PipelineOptions::default())?;
+    let poses = clip_poses(&m, frames)?;
+    let (view, size, lines) = (p.front_view(), p.feature_size(), LineOptions::default());
+    p.frame(&poses[0], view, size, lines)?;
+    for mode in AoMode::ALL {
+        p.ao(mode)?;
+    }
+    let mut t = Vec::new();
+    let (mut poly, mut exact) = (Vec::new(), Vec::new());
+    // Squared differences from the exact level, summed over vertices and frames.
+    let (mut se_poly, mut se_lut, mut n) = (0.0f64, 0.0f64, 0usize);
+    for _ in 0..runs {
+        for mats in &poses {
+            let (_, times) = p.frame(mats, view, size, lines)?;
+            t.push(times);
+            let lut = p.read_ao()?;
+            poly.push(p.ao(AoMode::Poly)?);
+            let pv = p.read_ao()?;
+            exact.push(p.ao(AoMode::Exact)?);
+            let ev = p.read_ao()?;
+            for ((l, q), e) in lut.iter().zip(&pv).zip(&ev) {
+                se_lut += f64::from(l - e).powi(2);
+                se_poly += f64::from(q - e).powi(2);
+            }
+            n += ev.len();
+        }
+    }
+    let rms = |se: f64| (se / n.max(1) as f64).sqrt();
+    let med = |f: &dyn Fn(&PassTimes) -> f64| median(&mut t.iter().map(f).collect::<Vec<_>>());
+    let name = gltf.file_name().map_or_else(
+        || gltf.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    r.text(format!(
+        "{}Per-frame device pipeline on {name}: {} vertices, {} faces, {} poses × {runs} runs; \
+         device: {} ({} CUs); AO radius {:.4} (0.1 × RMS radius), feature size {size:.4}, \
+         {} segments in the last frame\n",
+        if index > 0 { "\n" } else { "" },
+        m.rest.positions.len(),
+        m.rest.faces.len(),
+        poses.len(),
+        gpu.info.name,
+        gpu.info.compute_units,
+        p.ao_radius(),
+        t.last().map_or(0, |x| x.segments),
+    ));
+    let mut table = Table::new(
+        KEYS[index.min(KEYS.len() - 1)],
+        vec![
+            Column::new("pass", "pass"),
+            Column::new("median kernel ms", "kernel_ms"),
+            Column::new("AO RMS vs exact", "ao_rms_vs_exact"),
+            Column::hidden("model"),
+        ],
+    );
+    let mut bars = (Vec::new(), Vec::new());
+    let mut row = |pass: &str, ms: f64, err: Cell| {
+        if !pass.starts_with("**") {
+            bars.0.push(pass.to_string());
+            bars.1.push(ms);
+        }
+        table.rows.push(Row::new(vec![
+            Cell::text(pass.trim_matches('*')),
+            Cell::num(ms, format!("{ms:.3}")),
+            err,
+            Cell::text(name.clone()),
+        ]));
+    };
+    let e2 = |v: f64| Cell::num(v, format!("{v:.2e}"));
+    row(
+        "skin",
+        med(&|x| x.family_ms(Family::Skinning)),
+        Cell::empty(),
+    );
+    row(
+        "curvature+dcurv",
+        med(&|x| x.family_ms(Family::Curvature)),
+        Cell::empty(),
+    );
+    row("ao lut", med(&|x| x.family_ms(Family::Ao)), e2(rms(se_lut)));
+    row("ao poly", median(&mut poly), e2(rms(se_poly)));
+    row(
+        "ao exact",
+        median(&mut exact),
+        Cell::shown("0 (reference)", serde_json::json!(0.0)),
+    );
+    row(
+        "contours+suggestive",
+        med(&|x| x.family_ms(Family::FeatureLines)),
+        Cell::empty(),
+    );
+    let (kernel, wall) = (med(&|x| x.kernel_ms), med(&|x| x.wall_ms));
+    row(
+        "**total (skin+curv+dcurv+ao lut+lines)**",
+        kernel,
+        Cell::empty(),
+    );
+    // The total's name is bold in the table, plain in the JSON.
+    if let Some(last) = table.rows.last_mut() {
+        last.cells[0].text = "**total (skin+curv+dcurv+ao lut+lines)**".into();
+    }
+    r.blocks.push(Block::Table(table));
+    let verdict = |ms: f64| if ms <= 16.0 { "met" } else { "NOT met" };
+    r.text(format!(
+        "\nwall ms per frame (median, matrices up, segments back): {wall:.3}\n\
+         16 ms frame budget: {} by the kernel total ({kernel:.2} ms), {} by the wall time ({wall:.2} ms)",
+        verdict(kernel),
+        verdict(wall)
+    ));
+    r.charts.push(Chart::Bars {
+        title: format!(
+            "Per-frame device pipeline on {name}: median kernel ms per pass (total {kernel:.2} ms)"
+        ),
+        y_label: "kernel ms".into(),
+        log_y: false,
+        groups: bars.0,
+        series: vec![("median kernel ms".into(), bars.1)],
+    });
+    Ok(())
+}

@@ -1,0 +1,360 @@
+//! A report's charts as one SVG (plotters, SVG backend only): the header
+//! line (date, device, command) on top, then each chart of
+//! [`Report::charts`] below the other: error against time on log axes with
+//! a labelled point per variant, error against h on log axes with an h²
+//! reference slope, and grouped bars.
+
+use super::{Chart, Report};
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Width of the SVG in pixels.
+const WIDTH: u32 = 960;
+/// Height of one chart in pixels.
+const CHART_HEIGHT: u32 = 540;
+/// Height of the header (two lines: date and device, then the command).
+const HEADER: u32 = 48;
+const FONT: &str = "sans-serif";
+
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+fn err(e: impl std::fmt::Display) -> Error {
+    Error::Render {
+        what: "drawing the report's SVG plot".into(),
+        detail: e.to_string(),
+    }
+}
+
+/// The report's charts as an SVG document.
+///
+/// # Errors
+/// A report without charts; plotters' drawing errors.
+pub fn svg(report: &Report) -> Result<String> {
+    if report.charts.is_empty() {
+        return Err(Error::InvalidArgument(format!(
+            "the {} report has nothing to plot",
+            report.topic
+        )));
+    }
+    let n = report.charts.len() as u32;
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, (WIDTH, HEADER + n * CHART_HEIGHT))
+            .into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let (top, rest) = root.split_vertically(HEADER);
+        let header = report.header();
+        let (first, second) = match header.split_once(", command ") {
+            Some((a, b)) => (a.to_string(), format!("command {b}")),
+            None => (header.clone(), String::new()),
+        };
+        let style = TextStyle::from((FONT, 14).into_font()).color(&BLACK);
+        top.draw_text(&first, &style, (12, 8)).map_err(err)?;
+        top.draw_text(&second, &style, (12, 26)).map_err(err)?;
+        for (area, chart) in rest
+            .split_evenly((n as usize, 1))
+            .iter()
+            .zip(&report.charts)
+        {
+            match chart {
+                Chart::Scatter {
+                    title,
+                    x_label,
+                    y_label,
+                    points,
+                } => scatter(area, title, x_label, y_label, points)?,
+                Chart::Convergence {
+                    title,
+                    x_label,
+                    y_label,
+                    series,
+                } => convergence(area, title, x_label, y_label, series)?,
+                Chart::Bars {
+                    title,
+                    y_label,
+                    log_y,
+                    groups,
+                    series,
+                } => bars(area, &root, title, y_label, *log_y, groups, series)?,
+            }
+        }
+        root.present().map_err(err)?;
+    }
+    Ok(buf)
+}
+
+/// The range of the positive finite values of `v`, widened by a factor
+/// on each side (log axes); `None` when there are none.
+fn log_range(v: impl Iterator<Item = f64>, pad: f64) -> Option<std::ops::Range<f64>> {
+    let (lo, hi) = v
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(l, h), x| (l.min(x), h.max(x)));
+    (lo <= hi).then(|| lo / pad..hi * pad)
+}
+
+/// A tick label: plain decimals from 0.001 to 9999, else `1e5`-style.
+fn tick(v: &f64) -> String {
+    let a = v.abs();
+    let s = if a == 0.0 {
+        return "0".into();
+    } else if !(1e-3..1e4).contains(&a) {
+        return format!("{v:.0e}");
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.4}")
+    };
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+fn no_data(area: &Area, title: &str) -> Result<()> {
+    area.draw_text(
+        &format!("{title}: nothing to plot"),
+        &TextStyle::from((FONT, 16).into_font()),
+        (40, 40),
+    )
+    .map_err(err)
+}
+
+fn scatter(
+    area: &Area,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[(String, f64, f64)],
+) -> Result<()> {
+    let ok = |x: f64| x.is_finite() && x > 0.0;
+    let pts: Vec<&(String, f64, f64)> = points.iter().filter(|p| ok(p.1) && ok(p.2)).collect();
+    let (Some(xr), Some(yr)) = (
+        log_range(pts.iter().map(|p| p.1), 1.6),
+        log_range(pts.iter().map(|p| p.2), 1.6),
+    ) else {
+        return no_data(area, title);
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 17))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(80)
+        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_labels(12)
+        .y_labels(12)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .draw()
+        .map_err(err)?;
+    // Labels alternate above and below their points in the order of x, so
+    // that variants of equal error but near times stay readable.
+    let mut order: Vec<usize> = (0..pts.len()).collect();
+    order.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
+    let mut offset = vec![0; pts.len()];
+    for (rank, &i) in order.iter().enumerate() {
+        offset[i] = [-16, 6, -30, 20][rank % 4];
+    }
+    chart
+        .draw_series(pts.iter().enumerate().map(|(i, (label, x, y))| {
+            let c = Palette99::pick(i).to_rgba();
+            EmptyElement::at((*x, *y))
+                + Circle::new((0, 0), 5, c.filled())
+                + Text::new(label.clone(), (7, offset[i]), (FONT, 12).into_font())
+        }))
+        .map_err(err)?;
+    Ok(())
+}
+
+fn convergence(
+    area: &Area,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    let ok = |p: &&(f64, f64)| p.0.is_finite() && p.0 > 0.0 && p.1.is_finite() && p.1 > 0.0;
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.1.iter().filter(ok).copied())
+        .collect();
+    let (Some(xr), Some(yr)) = (
+        log_range(all.iter().map(|p| p.0), 1.3),
+        log_range(all.iter().map(|p| p.1), 2.0),
+    ) else {
+        return no_data(area, title);
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 17))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(80)
+        .build_cartesian_2d(xr.clone().log_scale(), yr.clone().log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_labels(12)
+        .y_labels(12)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .draw()
+        .map_err(err)?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let c = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> = pts.iter().filter(ok).copied().collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+            .map_err(err)?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))
+            .map_err(err)?;
+    }
+    // The reference slope h², through the smallest error at the largest h.
+    let h0 = all.iter().map(|p| p.0).fold(0.0f64, f64::max);
+    let e0 = all
+        .iter()
+        .filter(|p| p.0 == h0)
+        .map(|p| p.1)
+        .fold(f64::INFINITY, f64::min);
+    let grey = RGBColor(110, 110, 110);
+    let slope: Vec<(f64, f64)> = (0..=32)
+        .map(|i| {
+            let h = xr.start * (xr.end / xr.start).powf(f64::from(i) / 32.0);
+            (h, e0 * (h / h0).powi(2))
+        })
+        .filter(|p| yr.contains(&p.1))
+        .collect();
+    chart
+        .draw_series(LineSeries::new(slope, grey.stroke_width(1)))
+        .map_err(err)?
+        .label("h² slope")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 12))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+fn bars(
+    area: &Area,
+    root: &Area,
+    title: &str,
+    y_label: &str,
+    log_y: bool,
+    groups: &[String],
+    series: &[(String, Vec<f64>)],
+) -> Result<()> {
+    let values = || series.iter().flat_map(|s| s.1.iter().copied());
+    let n = groups.len();
+    if n == 0 || values().all(|v| !v.is_finite()) {
+        return no_data(area, title);
+    }
+    let hi = values().filter(|v| v.is_finite()).fold(0.0f64, f64::max);
+    let x = -0.5..n as f64 - 0.5;
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(title, (FONT, 17))
+        .margin(16)
+        .x_label_area_size(36)
+        .y_label_area_size(80);
+    let k = series.len().max(1) as f64;
+    let width = 0.8 / k;
+    // One bar: series j of group i, from `base` to `v`.
+    let rect = |i: usize, j: usize, base: f64, v: f64| {
+        let x0 = i as f64 - 0.4 + j as f64 * width;
+        Rectangle::new(
+            [(x0, base), (x0 + width * 0.92, v)],
+            Palette99::pick(j).to_rgba().filled(),
+        )
+    };
+    let legend = |j: usize| {
+        let c = Palette99::pick(j).to_rgba();
+        move |(x, y): (i32, i32)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], c.filled())
+    };
+    macro_rules! draw {
+        ($chart:expr, $base:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .disable_x_mesh()
+                .x_labels(0)
+                .y_labels(12)
+                .y_label_formatter(&tick)
+                .y_desc(y_label)
+                .draw()
+                .map_err(err)?;
+            for (j, (name, vals)) in series.iter().enumerate() {
+                let base = $base;
+                chart
+                    .draw_series(
+                        vals.iter()
+                            .enumerate()
+                            .filter(|(_, v)| v.is_finite() && **v > base)
+                            .map(|(i, &v)| rect(i, j, base, v)),
+                    )
+                    .map_err(err)?
+                    .label(name.clone())
+                    .legend(legend(j));
+            }
+            if series.len() > 1 {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font((FONT, 12))
+                    .draw()
+                    .map_err(err)?;
+            }
+            // The group names under the axis, centred on their bars.
+            let base = $base;
+            for (i, g) in groups.iter().enumerate() {
+                let (px, py) = chart.backend_coord(&(i as f64, base));
+                let style = TextStyle::from((FONT, 12).into_font()).pos(
+                    plotters::style::text_anchor::Pos::new(
+                        plotters::style::text_anchor::HPos::Center,
+                        plotters::style::text_anchor::VPos::Top,
+                    ),
+                );
+                root.draw_text(g, &style, (px, py + 8)).map_err(err)?;
+            }
+        }};
+    }
+    if log_y {
+        let lo = values()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let (lo, hi) = (lo / 2.0, hi * 2.0);
+        draw!(
+            builder
+                .build_cartesian_2d(x, (lo..hi).log_scale())
+                .map_err(err)?,
+            lo
+        );
+    } else {
+        draw!(
+            builder
+                .build_cartesian_2d(x, 0.0..(hi * 1.1).max(1e-9))
+                .map_err(err)?,
+            0.0
+        );
+    }
+    Ok(())
+}
