@@ -22,8 +22,8 @@
 //! this run and the last one keeps its marker and is not rewritten (`kind`
 //! remembers what the last run drew), which removes most of the output traffic.
 //! The stage takes a [`crate::spec::view::View`] (inside [`EdgeParams`]) and
-//! knows no screen: framing, drawing and the cap-quality evaluation live in
-//! `render::{camera, edges, cap_quality}`.
+//! knows no screen: framing and drawing live in `render::{camera, edges}`,
+//! and the cap-quality evaluation in `report::caps`.
 //!
 //! Conventions:
 //! - **Contour**: the two face normals face opposite ways seen from the eye

@@ -6,7 +6,7 @@
 //! up and only the segments (and, on request, the AO values) come back.
 //!
 //! The bench (`benches/pipeline.rs`) and the report
-//! (`shapecue render --report`) both drive a frame through
+//! (`shapecue report pipeline`) both drive a frame through
 //! [`PosePipeline::frame`], so the bench measures what the report prints.
 //!
 //! Coordinates: the curvature estimator works in the rest pose's normalized
