@@ -29,7 +29,6 @@ use crate::spec::view::View;
 use crate::stages::edges::EdgeStage;
 use crate::stages::marching_cubes::{self as mcs, IsoStats, Isosurfacer};
 use crate::volume::Volume;
-use std::borrow::Cow;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -144,7 +143,7 @@ pub fn isosurface_on(
     iso: f32,
     opts: &IsoOptions,
 ) -> Result<Isosurface> {
-    let (vol, iso) = oriented(volume, iso, opts.inside);
+    let (vol, iso) = volume.oriented(iso, opts.inside);
     let t_up = Instant::now();
     let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
     let upload_ms = t_up.elapsed().as_secs_f64() * 1e3;
@@ -184,20 +183,6 @@ pub fn isosurface_on(
         stats,
         upload_ms,
     })
-}
-
-/// The volume and iso value marching cubes sees for `inside`: unchanged for
-/// [`Inside::Below`]; negated (exact in f32) for [`Inside::Above`], so faces
-/// and gradient normals point out of the object.
-fn oriented(volume: &Volume, iso: f32, inside: Inside) -> (Cow<'_, Volume>, f32) {
-    match inside {
-        Inside::Below => (Cow::Borrowed(volume), iso),
-        Inside::Above => {
-            let mut v = volume.clone();
-            v.values.iter_mut().for_each(|x| *x = -*x);
-            (Cow::Owned(v), -iso)
-        }
-    }
 }
 
 /// Object-space feature edges of `mesh` seen through `view` on the default

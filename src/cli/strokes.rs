@@ -120,7 +120,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     .flatten()
     .map(PathBuf::as_path)
     .collect();
-    let (name, mut vol, procedural) = load_input(&a, device, &outputs)?;
+    let (name, vol, procedural) = load_input(&a, device, &outputs)?;
     let iso = match (a.iso, procedural) {
         (Some(v), _) => v,
         (None, true) => 0.0,
@@ -149,15 +149,8 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         Some(v) => bail!("--eye needs three finite numbers X,Y,Z, got {v:?}"),
     };
 
-    // Marching cubes orients its triangles out of the region below iso:
-    // for an object above iso, negate the values and iso (exact in f32), so
-    // both the surface and the strokes see the object below.
-    let iso_below = if inside == Inside::Above {
-        vol.values.iter_mut().for_each(|x| *x = -*x);
-        -iso
-    } else {
-        iso
-    };
+    // Both the surface and the strokes see the object below the iso value.
+    let (vol, iso_below) = vol.into_oriented(iso, inside);
     let opts = SdfLineOptions {
         iso: iso_below,
         inside: Inside::Below,
