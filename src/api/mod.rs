@@ -1,6 +1,6 @@
 //! The front door: one call per task, re-exported at the crate root
 //! (`shapecue::curvature`, `shapecue::isosurface`, `shapecue::feature_edges`,
-//! `shapecue::render_scene`), beside the stateful per-topology types that a
+//! `shapecue::strokes`, `shapecue::render_scene`), beside the stateful per-topology types that a
 //! deforming mesh reuses frame after frame
 //! ([`crate::stages::curvature::CurvatureEstimator`],
 //! [`crate::stages::marching_cubes::Isosurfacer`],
@@ -32,6 +32,13 @@ use crate::volume::Volume;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
+
+mod strokes;
+
+pub use strokes::{
+    FIT_DIRECTION, MeshField, Picture, PictureOptions, Strokes, StrokesInput, StrokesOptions,
+    strokes, strokes_on,
+};
 
 fn default_gpu() -> Result<Arc<Gpu>> {
     Ok(Arc::new(Gpu::new(None)?))
