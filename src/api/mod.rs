@@ -1,6 +1,7 @@
 //! The front door: one call per task, re-exported at the crate root
-//! (`shapecue::curvature`, `shapecue::isosurface`, `shapecue::feature_edges`,
-//! `shapecue::strokes`, `shapecue::render_scene`), beside the stateful per-topology types that a
+//! (`shapecue::curvature`, `shapecue::isosurface`, `shapecue::feature_edges`
+//! and `shapecue::feature_edges_picture`, `shapecue::strokes`,
+//! `shapecue::render_scene`), beside the stateful per-topology types that a
 //! deforming mesh reuses frame after frame
 //! ([`crate::stages::curvature::CurvatureEstimator`],
 //! [`crate::stages::marching_cubes::Isosurfacer`],
@@ -33,7 +34,13 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod edges;
 mod strokes;
+
+pub use edges::{
+    EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
+    feature_edges_picture_on,
+};
 
 pub use strokes::{
     FIT_DIRECTION, MeshField, Picture, PictureOptions, Strokes, StrokesInput, StrokesOptions,
@@ -195,7 +202,7 @@ pub fn isosurface_on(
 /// Object-space feature edges of `mesh` seen through `view` on the default
 /// device (House & Li, after McGuire & Hughes 2004): contour, crease,
 /// boundary and marked edges as clip-space quads with the caps of
-/// `opts.caps`; nothing is drawn ([`crate::render::edges`] draws them). For
+/// `opts.caps`; nothing is drawn ([`feature_edges_picture`] draws them). For
 /// many frames of one topology, build an [`EdgeStage`] once instead.
 ///
 /// ```
