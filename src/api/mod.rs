@@ -34,8 +34,11 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod curvature;
 mod edges;
 mod strokes;
+
+pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
 
 pub use edges::{
     EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
