@@ -1,16 +1,18 @@
 //! `shapecue curvature`: per-vertex curvature of a mesh file or a generated
-//! mesh ([`shapecue::curvature`] or its CPU twin), written as PLY with JSON
-//! stats (`shapecue report curvature` prints the accuracy/time table).
+//! mesh (one front-door call, [`shapecue::curvature_of`], or the CPU twin
+//! [`shapecue::cpu::curvature::curvature`]), written as PLY with JSON stats
+//! (`shapecue report curvature` prints the accuracy/time table).
 //!
-//! The stats time every phase of the command (`phases_ms`: load = parse and
+//! The stats time every phase of the command (`phases_ms`): the library
+//! call's phases ([`shapecue::CurvaturePhases`]: load = parse and
 //! validation, device, reorder (the memory order of `--order`), program
 //! build, topology, normalisation, upload, the first run with the driver's
-//! compilation at first launch, program-cache write, read-back (the device
-//! buffers mapped, not copied: CPU runtimes hand over their own memory), PLY
-//! write (with each value's conversion, scaling back and mapping back to
-//! the input's order, done as it is written)), and `--runs N` adds N
-//! timed runs of the device passes after the one whose results are written,
-//! with medians.
+//! compilation at first launch, program-cache write), then read-back (the
+//! device buffers mapped, not copied: CPU runtimes hand over their own
+//! memory) and PLY write (with each value's conversion, scaling back and
+//! mapping back to the input's order, done as it is written); `--runs N`
+//! adds N timed runs of the device passes after the one whose results are
+//! written, with medians.
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
