@@ -101,9 +101,7 @@ fn every_example_runs_as_written() {
     let run: Vec<&(String, String)> = all
         .iter()
         .filter(|(_, l)| {
-            !(l.contains("MESH")
-                || l.contains("[--")
-                || l.starts_with("shapecue report"))
+            !(l.contains("MESH") || l.contains("[--") || l.starts_with("shapecue report"))
         })
         .collect();
     // One folder per page, laid out as the repository root: each page's

@@ -231,12 +231,14 @@ impl EdgePicture {
 /// asked. `name` names the mesh in errors (the marked file names itself).
 /// The phases of the call are timed ([`EdgePhases`]).
 ///
-/// ```no_run
+/// ```
 /// use shapecue::mesh::Generated;
+/// use shapecue::spec::edges::KIND_CONTOUR;
 /// let (_, mesh) = Generated::Torus.mesh(2000);
 /// let opts = shapecue::EdgePictureOptions { eye: None, ..Default::default() };
 /// let pic = shapecue::feature_edges_picture(&mesh, "torus", &opts)?;
-/// pic.frame.save_png("torus-edges.png".as_ref())?;
+/// assert_eq!((pic.frame.width, pic.frame.height), (800, 600));
+/// assert!(pic.count(KIND_CONTOUR) > 0);
 /// # Ok::<(), shapecue::Error>(())
 /// ```
 ///
