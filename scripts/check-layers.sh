@@ -18,13 +18,15 @@
 #                        crate::scene, crate::export
 #   src/export/          writers: no crate::gpu, crate::stages, crate::scene
 #   src/render/          the screen: no crate::export, crate::scene (the
-#                        writers read its frames and cameras, never the reverse)
+#                        writers read its frames and cameras, never the reverse);
+#                        no crate::stages, crate::gpu (the screen runs no
+#                        compute: the caller composes stages and renderer)
 #   src/gpu/             the device layer: no crate::cpu, crate::stages,
 #                        crate::mesh, crate::volume, crate::render,
 #                        crate::export, crate::scene
 #   src/output.rs        files written whole: no crate module but error
 #   everything below the front door (spec, cpu, gpu, stages, mesh, volume,
-#   render, export, scene, api.rs, error.rs): no crate::report (measurement
+#   render, export, scene, api/, error.rs): no crate::report (measurement
 #   sits above the front door and calls it; the library knows no tables)
 #
 # Then an import graph over the same `crate::<module>` paths (python3):
@@ -55,6 +57,7 @@ rules=(
     "src/mesh|gpu stages render scene export|data knows no device and no screen"
     "src/volume|gpu stages render scene export|data knows no device and no screen"
     "src/render|export scene|the screen draws; the writers read its frames and cameras, never the reverse"
+    "src/render|stages gpu|the screen runs no compute: the caller composes stages and renderer"
     "src/export|gpu stages scene|writers know no device (they may read the renderer's frames and cameras)"
     "src/output.rs|api cpu export gpu mesh metrics render scene spec stages volume report|files written whole or not at all: below every layer that writes"
     "src/spec|report|measurement sits above the front door: the library knows no tables"
@@ -66,7 +69,7 @@ rules=(
     "src/render|report|measurement sits above the front door: the library knows no tables"
     "src/export|report|measurement sits above the front door: the library knows no tables"
     "src/scene|report|measurement sits above the front door: the library knows no tables"
-    "src/api.rs|report|measurement sits above the front door: the library knows no tables"
+    "src/api|report|measurement sits above the front door: the library knows no tables"
     "src/error.rs|report|measurement sits above the front door: the library knows no tables"
 )
 

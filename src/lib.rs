@@ -19,7 +19,7 @@
 //! ```
 //!
 //! The front door is one call per task ([`curvature()`], [`isosurface()`],
-//! [`feature_edges()`], [`render_scene()`], each with an `_on` form taking a
+//! [`feature_edges()`] and [`feature_edges_picture()`], [`strokes()`], [`render_scene()`], each with an `_on` form taking a
 //! device; defined in [`api`]), beside the stateful per-topology types for
 //! deforming meshes ([`stages::curvature::CurvatureEstimator`],
 //! [`stages::marching_cubes::Isosurfacer`], [`stages::edges::EdgeStage`],
@@ -48,8 +48,11 @@ pub mod volume;
 pub struct ReadmeDoctests;
 
 pub use api::{
-    IsoOptions, Isosurface, curvature, curvature_on, feature_edges, feature_edges_on, isosurface,
-    isosurface_on, render_scene, render_scene_on,
+    CurvatureJob, CurvaturePhases, CurvatureRun, EdgePicture, EdgePictureOptions, IsoOptions,
+    Isosurface, MeshSource, PictureOptions, Strokes, StrokesInput, StrokesOptions, curvature,
+    curvature_of, curvature_on, feature_edges, feature_edges_on, feature_edges_picture,
+    feature_edges_picture_on, isosurface, isosurface_on, render_scene, render_scene_on, strokes,
+    strokes_on,
 };
 pub use error::{Error, Result};
 pub use mesh::Mesh;

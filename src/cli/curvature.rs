@@ -1,27 +1,28 @@
 //! `shapecue curvature`: per-vertex curvature of a mesh file or a generated
-//! mesh ([`shapecue::curvature`] or its CPU twin), written as PLY with JSON
-//! stats (`shapecue report curvature` prints the accuracy/time table).
+//! mesh (one front-door call, [`shapecue::curvature_of`], or the CPU twin
+//! [`shapecue::cpu::curvature::curvature`]), written as PLY with JSON stats
+//! (`shapecue report curvature` prints the accuracy/time table).
 //!
-//! The stats time every phase of the command (`phases_ms`: load = parse and
+//! The stats time every phase of the command (`phases_ms`): the library
+//! call's phases ([`shapecue::CurvaturePhases`]: load = parse and
 //! validation, device, reorder (the memory order of `--order`), program
 //! build, topology, normalisation, upload, the first run with the driver's
-//! compilation at first launch, program-cache write, read-back (the device
-//! buffers mapped, not copied: CPU runtimes hand over their own memory), PLY
-//! write (with each value's conversion, scaling back and mapping back to
-//! the input's order, done as it is written)), and `--runs N` adds N
-//! timed runs of the device passes after the one whose results are written,
-//! with medians.
+//! compilation at first launch, program-cache write), then read-back (the
+//! device buffers mapped, not copied: CPU runtimes hand over their own
+//! memory) and PLY write (with each value's conversion, scaling back and
+//! mapping back to the input's order, done as it is written); `--runs N`
+//! adds N timed runs of the device passes after the one whose results are
+//! written, with medians.
 
 use super::{check_outputs, out, write_json};
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
-use shapecue::gpu::Gpu;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
-use shapecue::stages::curvature::{CurvatureEstimator, OrderPlan, OrderedEstimator};
+use shapecue::stages::curvature::OrderedEstimator;
+use shapecue::{CurvatureJob, MeshSource};
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// The arguments of `shapecue curvature`.
@@ -89,38 +90,6 @@ pub struct CurvatureArgs {
     runs: Option<usize>,
 }
 
-/// The device opened and the curvature program built for the options, with
-/// the variant chosen for the device.
-struct Prepared {
-    gpu: Arc<Gpu>,
-    accumulate: Accumulate,
-    device_ms: f64,
-    prepare_ms: f64,
-}
-
-/// Opens the device and gets the curvature program for `opts` built (or
-/// loaded from a cache), the accumulation variant being `accumulate` or the
-/// device type's default. A program the device refuses is not an error
-/// here: building the estimator reports it, with its context.
-fn prepare_device(
-    device: Option<&str>,
-    mut opts: CurvatureOptions,
-    accumulate: Option<Accumulate>,
-) -> Result<Prepared> {
-    let t = Instant::now();
-    let gpu = Arc::new(Gpu::new(device)?);
-    let device_ms = ms_since(t);
-    opts.accumulate = accumulate.unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
-    let t = Instant::now();
-    let _ = CurvatureEstimator::prepare(&gpu, &opts);
-    Ok(Prepared {
-        gpu,
-        accumulate: opts.accumulate,
-        device_ms,
-        prepare_ms: ms_since(t),
-    })
-}
-
 /// Runs `shapecue curvature`.
 pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let mut opts = CurvatureOptions {
@@ -140,147 +109,136 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
         a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
         a.force,
     )?;
-    // Opening the device and building the curvature program need no mesh:
-    // they run on a thread of their own beside the load (both are a single
-    // core's work; on a CPU device the other core is otherwise idle).
-    // The memory order is chosen and applied here too (host work that needs
-    // no device), unless the CPU reference computes.
-    let load = || -> Result<(String, shapecue::Mesh, f64, Option<OrderPlan>)> {
-        let t_load = Instant::now();
-        let (name, mesh) = match (&a.input, a.generate) {
-            (_, Some(kind)) => {
-                shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
-                kind.mesh(a.resolution)
-            }
-            (Some(path), None) => {
-                let m = shapecue::mesh::load(path, &LoadOptions { weld: a.weld })?;
-                (path.display().to_string(), m)
-            }
-            (None, None) => bail!("give an input mesh or --generate"),
-        };
-        let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-        let plan = (!a.cpu).then(|| OrderPlan::new(&mesh, a.order));
-        Ok((name, mesh, load_ms, plan))
+    let source = match (&a.input, a.generate) {
+        (_, Some(kind)) => MeshSource::Generated(kind, a.resolution),
+        (Some(path), None) => MeshSource::File(path.clone(), LoadOptions { weld: a.weld }),
+        (None, None) => bail!("give an input mesh or --generate"),
     };
-    let (loaded, prepared) = std::thread::scope(|s| {
-        let prepare = (!a.cpu).then(|| s.spawn(|| prepare_device(device, opts, a.accumulate)));
-        let loaded = load();
-        let t_wait = Instant::now();
-        let prepared = prepare.map(|h| match h.join() {
-            Ok(p) => p.map(|p| (p, ms_since(t_wait))),
-            Err(panic) => std::panic::resume_unwind(panic),
-        });
-        (loaded, prepared)
-    });
-    let (name, mesh, load_ms, plan) = loaded?;
-    let prepared = prepared.transpose()?;
-    if a.output.is_none() && a.stats.is_none() {
-        eprintln!("note: no --output or --stats given; computing and printing a summary only");
-    }
-
-    let t_all = Instant::now();
-    let mut phases = serde_json::Map::new();
-    let mut phase = |name: &str, ms: f64| {
-        phases.insert(name.to_string(), serde_json::json!(ms));
-    };
-    phase("load", load_ms);
     // The results: the CPU twin's field, or the device's buffers, read in
     // place below (no copy of the field: on a 2M-vertex mesh a copy is
     // 256 MB of fresh pages, whose first touch costs more than the rest).
-    let (field, estimator, counts, mut stats) = if a.cpu {
-        // The reference computes in f64, so it judges faces by f64 rounding.
-        let opts = CurvatureOptions {
-            precision: shapecue::spec::curvature::Precision::F64,
-            ..opts
-        };
-        let c = shapecue::cpu::curvature::curvature(&mesh, opts)?;
-        let mut stats = serde_json::json!({
-            "device": "cpu reference (f64, single thread)",
-            "wall_ms": c.timing.wall_ms,
-        });
-        if let Some(n) = a.runs {
-            let mut walls = Vec::with_capacity(n);
-            for _ in 0..n {
-                walls.push(
-                    shapecue::cpu::curvature::curvature(&mesh, opts)?
-                        .timing
-                        .wall_ms,
+    let (name, mesh, load_ms, field, device_run, counts, mut stats, mut phases, before_ms) =
+        if a.cpu {
+            let t_load = Instant::now();
+            let (name, mesh) = source.load()?;
+            let load_ms = ms_since(t_load);
+            let t_compute = Instant::now();
+            // The reference computes in f64, so it judges faces by f64 rounding.
+            let opts = CurvatureOptions {
+                precision: shapecue::spec::curvature::Precision::F64,
+                ..opts
+            };
+            let c = shapecue::cpu::curvature::curvature(&mesh, opts)?;
+            let mut stats = serde_json::json!({
+                "device": "cpu reference (f64, single thread)",
+                "wall_ms": c.timing.wall_ms,
+            });
+            if let Some(n) = a.runs {
+                let mut walls = Vec::with_capacity(n);
+                for _ in 0..n {
+                    walls.push(
+                        shapecue::cpu::curvature::curvature(&mesh, opts)?
+                            .timing
+                            .wall_ms,
+                    );
+                }
+                stats["runs"] = serde_json::json!(n);
+                stats["wall_median_ms"] =
+                    serde_json::json!(shapecue::report::metrics::median(&mut walls));
+            }
+            let mut phases = serde_json::Map::new();
+            phases.insert("load".into(), serde_json::json!(load_ms));
+            phases.insert("first_run".into(), serde_json::json!(c.timing.wall_ms));
+            let counts = c.counts;
+            (
+                name,
+                mesh,
+                load_ms,
+                Some(c.field),
+                None,
+                counts,
+                stats,
+                phases,
+                ms_since(t_compute),
+            )
+        } else {
+            // One library call: the load beside the device's opening and the
+            // program build, then the ordered estimator, run and left on the
+            // device; the phases come back with it.
+            let r = shapecue::curvature_of(&CurvatureJob {
+                source,
+                device: device.map(str::to_string),
+                opts,
+                accumulate: a.accumulate,
+                order: a.order,
+                runs: a.runs.unwrap_or(0),
+            })?;
+            let ph = &r.phases;
+            opts.accumulate = r.opts.accumulate;
+            let device_bytes = r.estimator.est.device_bytes();
+            let mut stats = serde_json::json!({
+                "device": r.gpu.info,
+                "accumulate": opts.accumulate.name(),
+                "face_lanes": r.estimator.est.face_lanes(),
+                "order": if r.reordered() { "spatial" } else { "input" },
+                "topology_ms": r.estimator.est.topology_ms(),
+                "passes": passes(&r.timing),
+                "kernel_ms": r.timing.kernel_ms,
+                "run_wall_ms": r.timing.wall_ms,
+                "device_bytes": device_bytes,
+                "device_bytes_per_vertex": device_bytes as f64 / r.mesh.n_vertices() as f64,
+            });
+            if a.runs.is_some() {
+                shapecue::report::metrics::runs_stats(&mut stats, &r.runs, r.timing.wall_ms);
+            }
+            // PoCL compiles at the first build and launch when its own cache is
+            // empty (seconds), and shapecue saves nothing there on its own.
+            let compile_ms = ph.program_prepare + r.timing.wall_ms;
+            if compile_ms > 1000.0
+                && r.gpu
+                    .program_builds()
+                    .iter()
+                    .any(|b| b.cache == "miss" && !b.saved)
+            {
+                eprintln!(
+                    "note: the curvature kernels were compiled for this run ({:.1} s); \
+                 `shapecue build-kernels` builds them once for later runs",
+                    compile_ms / 1e3
                 );
             }
-            stats["runs"] = serde_json::json!(n);
-            stats["wall_median_ms"] =
-                serde_json::json!(shapecue::report::metrics::median(&mut walls));
-        }
-        phase("first_run", c.timing.wall_ms);
-        (Some(c.field), None, c.counts, stats)
-    } else {
-        let (p, wait_ms) = prepared.expect("prepared when not on the CPU reference");
-        phase("device", p.device_ms);
-        phase("program_prepare", p.prepare_ms);
-        let prepare_ms = p.prepare_ms;
-        phase("device_wait", wait_ms);
-        let gpu = p.gpu;
-        opts.accumulate = p.accumulate;
-        let setup = || format!("setting up curvature for {name}");
-        let plan = plan.expect("an order plan when not on the CPU reference");
-        let mut o =
-            OrderedEstimator::with_plan(gpu.clone(), &mesh, opts, plan).with_context(setup)?;
-        phase("reorder", o.reorder_ms);
-        phase("program_build", o.est.build_ms());
-        phase("topology", o.est.topology_ms() - o.est.build_ms());
-        phase("normalise", o.est.upload_ms().normalise);
-        phase("upload", o.est.upload_ms().write);
-        let timing = o.est.run().with_context(setup)?;
-        phase("first_run", timing.wall_ms);
-        let counts = o.est.counts()?;
-        let device_bytes = o.est.device_bytes();
-        let mut stats = serde_json::json!({
-            "device": gpu.info,
-            "accumulate": opts.accumulate.name(),
-            "face_lanes": o.est.face_lanes(),
-            "order": if o.order.is_some() { "spatial" } else { "input" },
-            "topology_ms": o.est.topology_ms(),
-            "passes": passes(&timing),
-            "kernel_ms": timing.kernel_ms,
-            "run_wall_ms": timing.wall_ms,
-            "device_bytes": device_bytes,
-            "device_bytes_per_vertex": device_bytes as f64 / mesh.n_vertices() as f64,
-        });
-        if let Some(n) = a.runs {
-            // Each run writes the same values (the passes are deterministic
-            // for gather; atomic sums may differ in the last bits), so the
-            // field read below is the last run's.
-            let mut timed = Vec::with_capacity(n);
-            for _ in 0..n {
-                timed.push(o.est.run()?);
-            }
-            shapecue::report::metrics::runs_stats(&mut stats, &timed, timing.wall_ms);
-        }
-        // After the runs, so that code the driver compiled at the first
-        // launch is in the saved binaries; a no-op when the cache hit.
-        let t = Instant::now();
-        gpu.persist_programs();
-        phase("cache_write", ms_since(t));
-        // PoCL compiles at the first build and launch when its own cache is
-        // empty (seconds), and shapecue saves nothing there on its own.
-        let compile_ms = prepare_ms + timing.wall_ms;
-        if compile_ms > 1000.0
-            && gpu
-                .program_builds()
-                .iter()
-                .any(|b| b.cache == "miss" && !b.saved)
-        {
-            eprintln!(
-                "note: the curvature kernels were compiled for this run ({:.1} s); \
-                 `shapecue build-kernels` builds them once for later runs",
-                compile_ms / 1e3
-            );
-        }
-        stats["programs"] = serde_json::to_value(gpu.program_builds())?;
-        (None, Some(o), counts, stats)
-    };
+            stats["programs"] = serde_json::to_value(r.gpu.program_builds())?;
+            let phases = match serde_json::to_value(ph)? {
+                serde_json::Value::Object(m) => m,
+                _ => unreachable!("the phases are a struct"),
+            };
+            let (load_ms, compute_ms) = (ph.load, r.compute_ms);
+            let shapecue::CurvatureRun {
+                name,
+                mesh,
+                counts,
+                estimator,
+                ..
+            } = r;
+            (
+                name,
+                mesh,
+                load_ms,
+                None,
+                Some(estimator),
+                counts,
+                stats,
+                phases,
+                compute_ms,
+            )
+        };
+    if a.output.is_none() && a.stats.is_none() {
+        eprintln!("note: no --output or --stats given; computing and printing a summary only");
+    }
+    // The time after the load (and the device's preparation): the library
+    // call's share, then the read-back and the check below.
+    let t_all = Instant::now();
     let t = Instant::now();
-    let mapped = estimator
+    let mapped = device_run
         .as_ref()
         .map(OrderedEstimator::mapped)
         .transpose()?;
@@ -308,7 +266,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     if !finite {
         bail!("internal error: non-finite output (please report with the input mesh)");
     }
-    let total_ms = t_all.elapsed().as_secs_f64() * 1e3;
+    let total_ms = before_ms + t_all.elapsed().as_secs_f64() * 1e3;
     out!(
         "{name}: {} vertices, {} faces; k1 in [{k1min:.4}, {k1max:.4}], k2 in [{k2min:.4}, {k2max:.4}]; \
          {} degenerate faces skipped, {} vertices without curvature; {total_ms:.1} ms",
@@ -353,7 +311,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     // OS takes back the device buffers, the context and the mesh at once,
     // about 5 ms sooner on the bunny than releasing them one by one.
     std::mem::forget(mapped);
-    std::mem::forget(estimator);
+    std::mem::forget(device_run);
     std::mem::forget(mesh);
     Ok(())
 }

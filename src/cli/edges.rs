@@ -1,14 +1,15 @@
 //! `shapecue edges`: object-space feature edges with caps (House & Li),
-//! drawn over the shaded mesh by [`shapecue::render::edges::draw`] to PNG,
+//! drawn over the shaded mesh by one front-door call
+//! ([`shapecue::feature_edges_picture_on`]) to PNG,
 //! with the visible edges as SVG and JSON stats (`shapecue report caps` and
 //! `shapecue report memory` print the cap-quality and memory tables).
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
+use shapecue::EdgePictureOptions;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::LoadOptions;
-use shapecue::render::edges::{EdgeDrawOptions, draw};
 use shapecue::spec::edges::{
     CapMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, decide_interop,
 };
@@ -155,7 +156,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     if eye.is_none() && a.target.is_some() {
         bail!("--target needs --eye (without both, the view is fitted around the mesh)");
     }
-    let opts = EdgeDrawOptions {
+    let opts = EdgePictureOptions {
         eye,
         target: vec3_arg(&a.target, "target")?,
         up: vec3_arg(&a.up, "up")?,
@@ -173,7 +174,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         polylines: a.svg.is_some(),
         timed_runs: a.runs.unwrap_or(0),
     };
-    let d = draw(gpu, &mesh, &path.display().to_string(), &opts)?;
+    let d = shapecue::feature_edges_picture_on(&gpu, &mesh, &path.display().to_string(), &opts)?;
     let t_png = std::time::Instant::now();
     d.frame.save_png(output)?;
     let png_ms = ms_since(t_png);

@@ -3,25 +3,20 @@
 //! Kindlmann et al. 2003) drawn over the shaded isosurface, to PNG, with the
 //! strokes also as SVG outlines, a PLY of the strips and a stats JSON.
 //!
-//! Thin: parses, calls the library (`stages::sdf_lines` for the strokes,
-//! `stages::marching_cubes` for the surface under them, `render` and
-//! `export`), prints one summary line (`shapecue report strokes` prints the
+//! Thin: parses, makes one front-door call ([`shapecue::strokes_on`]: the
+//! strokes, the surface under them and the picture), writes with `export`,
+//! prints one summary line (`shapecue report strokes` prints the
 //! accuracy/time table against the analytic torus).
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shapecue::export::output::{check_outputs, write_bytes_atomic};
 use shapecue::gpu::Gpu;
-use shapecue::render::strokes::{StrokeStyle, draw};
-use shapecue::render::{MeshStyle, Placement, RenderOptions, Renderer, framed};
-use shapecue::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, SdfLinesOutput, Stroke};
-use shapecue::stages::sdf_lines::SdfLines;
+use shapecue::spec::sdf_lines::{Inside, Sampling};
 use shapecue::volume::{self, Volume};
+use shapecue::{PictureOptions, Strokes, StrokesInput, StrokesOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// Direction (centre → eye) of the fitted camera when `--eye` is not given.
-const FIT_DIRECTION: [f32; 3] = [0.3, -1.0, 0.9];
 
 /// Options of `shapecue strokes`.
 #[derive(Args, Debug)]
@@ -120,11 +115,12 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     .flatten()
     .map(PathBuf::as_path)
     .collect();
-    let (name, mut vol, procedural) = load_input(&a, device, &outputs)?;
-    let iso = match (a.iso, procedural) {
+    let (name, input) = load_input(&a, &outputs)?;
+    let procedural = !matches!(input, Input::File(_));
+    let iso = match (a.iso, &input) {
         (Some(v), _) => v,
-        (None, true) => 0.0,
-        (None, false) => bail!("give --iso ({})", span(&vol)),
+        (None, Input::File(vol)) => bail!("give --iso ({})", span(vol)),
+        (None, _) => 0.0,
     };
     if !iso.is_finite() {
         bail!("--iso {iso} must be finite");
@@ -148,96 +144,40 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         }
         Some(v) => bail!("--eye needs three finite numbers X,Y,Z, got {v:?}"),
     };
-
-    // Marching cubes orients its triangles out of the region below iso:
-    // for an object above iso, negate the values and iso (exact in f32), so
-    // both the surface and the strokes see the object below.
-    let iso_below = if inside == Inside::Above {
-        vol.values.iter_mut().for_each(|x| *x = -*x);
-        -iso
-    } else {
-        iso
-    };
-    let opts = SdfLineOptions {
-        iso: iso_below,
-        inside: Inside::Below,
+    let opts = StrokesOptions {
+        iso,
+        inside,
         sampling,
         spacing: a.seed_spacing,
-        ..SdfLineOptions::default()
+        picture: Some(PictureOptions {
+            width: w,
+            height: h,
+            eye,
+            surface: !a.no_surface,
+        }),
     };
     let gpu = Arc::new(Gpu::new(device)?);
-    let out = SdfLines::new(gpu.clone(), &vol, &opts)
-        .with_context(|| format!("uploading {name}"))?
-        .run()
-        .with_context(|| format!("tracing the strokes of {name}"))?;
-    let st = &out.stats;
-
-    // The surface under the strokes.
-    let mut ex = shapecue::stages::marching_cubes::Isosurfacer::new(gpu.clone(), &vol)?;
-    ex.extract(iso_below, shapecue::spec::vertex_fusion::Fusion::Direct)?;
-    let (ipos, faces) = ex.read_index_space()?;
-    let mesh = ex.world_mesh(&ipos, faces);
-    if mesh.n_faces() == 0 {
-        bail!(
-            "{name}: the isosurface at iso {iso} is empty ({})",
-            span(&vol)
+    let front = match &input {
+        Input::File(v) | Input::Sdf(v) => StrokesInput::Volume(v),
+        Input::Mesh(m) => StrokesInput::Mesh(m, a.resolution),
+    };
+    let out = shapecue::strokes_on(&gpu, front, &opts).with_context(|| name.clone())?;
+    if let Some(f) = &out.field {
+        let st = &f.stats;
+        super::out!(
+            "{name}: signed distance field {}x{}x{} (spacing {:.4}), {:.1} ms kernels, {:.1} ms wall",
+            st.dims[0],
+            st.dims[1],
+            st.dims[2],
+            st.spacing,
+            st.kernel_ms,
+            st.wall_ms
         );
     }
-    let normals = shapecue::cpu::marching_cubes::gradient_normals(&vol, &ipos);
+    let picture = out.picture.as_ref().expect("a picture was asked for");
+    picture.frame.save_png(&output)?;
 
-    // Draw in a frame centred on the surface (f32 precision far from 0).
-    let bounds = mesh.bounds();
-    let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (bounds.0[i] + bounds.1[i]));
-    let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - c[i]) };
-    let lb = (local(&bounds.0), local(&bounds.1));
-    let placement = match eye {
-        Some(e) => Placement::At(e - glam::DVec3::from(c).as_vec3()),
-        None => Placement::Fit(glam::Vec3::from(FIT_DIRECTION)),
-    };
-    let cam = framed(placement, None, None, 35.0, false, lb, w as f32 / h as f32)?;
-    let strokes: Vec<Stroke> = out
-        .strokes
-        .iter()
-        .map(|s| Stroke {
-            points: s.points.iter().map(local).collect(),
-            strip: s.strip.iter().map(local).collect(),
-            ..s.clone()
-        })
-        .collect();
-    let pos: Vec<[f32; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| local(p).map(|x| x as f32))
-        .collect();
-    let nrm: Vec<[f32; 3]> = normals.iter().map(|n| n.map(|x| x as f32)).collect();
-    let mut r = Renderer::new(RenderOptions {
-        width: w,
-        height: h,
-        ..RenderOptions::default()
-    })?;
-    let style = if a.no_surface {
-        MeshStyle {
-            ambient: 1.0,
-            color: [1.0; 3],
-            ..MeshStyle::default()
-        }
-    } else {
-        MeshStyle::default()
-    };
-    let voxel = shapecue::spec::sdf_lines::voxel_size(vol.spacing);
-    r.begin(&cam)?;
-    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, style)?;
-    draw(
-        &mut r,
-        &cam,
-        &strokes,
-        &StrokeStyle {
-            lift: (0.5 * voxel) as f32,
-            ..StrokeStyle::default()
-        },
-    )?;
-    r.finish()?.save_png(&output)?;
-
+    let st = &out.stats;
     let ms = st.ms.total;
     super::out!(
         "{name}: {} surface samples → {} seeds after Poisson-disk thinning (r = {:.4}); {} strokes, \
@@ -256,13 +196,8 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         output.display()
     );
     if let Some(p) = &a.svg {
-        let e = cam.eye;
-        let facing: Vec<Stroke> = strokes
-            .iter()
-            .filter(|s| facing_eye(s, e))
-            .cloned()
-            .collect();
-        shapecue::export::strokes::write_svg(p, &facing, &cam, [w, h])?;
+        let facing = picture.facing_strokes();
+        shapecue::export::strokes::write_svg(p, &facing, &picture.camera, [w, h])?;
         super::out!(
             "wrote {} ({} strokes facing the eye)",
             p.display(),
@@ -274,28 +209,20 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         super::out!("wrote {}", p.display());
     }
     if let Some(p) = &a.stats {
-        write_stats(p, &name, &gpu, &vol, &out)?;
+        write_stats(p, &name, &gpu, &out)?;
     }
     Ok(())
 }
 
-/// Whether a stroke's outward normal at its seed faces the eye (local frame).
-fn facing_eye(s: &Stroke, eye: glam::Vec3) -> bool {
-    let (Some(p), Some(n)) = (s.points.get(s.centre), s.normals.get(s.centre)) else {
-        return false;
-    };
-    let d: [f64; 3] = std::array::from_fn(|i| f64::from(eye[i]) - p[i]);
-    d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0
-}
-
-fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutput) -> Result<()> {
+fn write_stats(p: &Path, name: &str, gpu: &Gpu, out: &Strokes) -> Result<()> {
     let st = &out.stats;
+    let (dims, spacing, origin) = out.grid;
     let s = serde_json::json!({
         "input": name,
         "device": gpu.info,
-        "dims": vol.dims,
-        "spacing": vol.spacing,
-        "origin": vol.origin,
+        "dims": dims,
+        "spacing": spacing,
+        "origin": origin,
         "dense_samples": st.dense,
         "seeds": st.seeds,
         "strokes": st.strokes,
@@ -307,7 +234,7 @@ fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutp
         "k1_min": st.k1_min,
         "k1_max": st.k1_max,
         "kernel_ms": st.ms,
-        "passes": st.ms.timing(st.wall_ms),
+        "passes": out.timing,
         "wall_ms": st.wall_ms,
     });
     write_bytes_atomic(p, (serde_json::to_string_pretty(&s)? + "\n").as_bytes())?;
@@ -315,8 +242,13 @@ fn write_stats(p: &Path, name: &str, gpu: &Gpu, vol: &Volume, out: &SdfLinesOutp
     Ok(())
 }
 
-/// The input as a volume: a procedural field, a volume file, or a refusal
-/// for a mesh. Returns (name, volume, procedural).
+/// The input: a volume file, a procedural field or a triangle mesh.
+enum Input {
+    File(Volume),
+    Sdf(Volume),
+    Mesh(shapecue::Mesh),
+}
+
 /// The range of a volume's values, in words.
 fn span(v: &Volume) -> String {
     v.range()
@@ -327,15 +259,12 @@ fn span(v: &Volume) -> String {
 
 /// Reads the input and checks the outputs against every file read (a
 /// volume's detached data files included) before any conversion runs.
-fn load_input(
-    a: &StrokesArgs,
-    device: Option<&str>,
-    outputs: &[&Path],
-) -> Result<(String, Volume, bool)> {
+/// Returns (name, input).
+fn load_input(a: &StrokesArgs, outputs: &[&Path]) -> Result<(String, Input)> {
     if let Some(kind) = &a.sdf {
         check_outputs(&[], outputs, a.force)?;
         let v = volume::sdf::sdf_by_name(kind, a.resolution)?;
-        return Ok((format!("{kind} SDF {}³", a.resolution), v, true));
+        return Ok((format!("{kind} SDF {}³", a.resolution), Input::Sdf(v)));
     }
     let path = a.input.as_ref().expect("clap requires INPUT or --sdf");
     let ext = path
@@ -343,27 +272,11 @@ fn load_input(
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if matches!(ext.as_str(), "obj" | "ply" | "off") {
-        // A triangle mesh becomes a signed distance field first (negative
-        // inside, sign from the winding number), on the device.
+        // A triangle mesh becomes a signed distance field first (in the
+        // library call).
         let mesh = shapecue::mesh::load(path, &Default::default())?;
         check_outputs(&[path.as_path()], outputs, a.force)?;
-        let gpu = Arc::new(Gpu::new(device)?);
-        let opts = shapecue::spec::mesh_sdf::MeshSdfOptions {
-            resolution: a.resolution,
-        };
-        let (v, st) = shapecue::stages::mesh_sdf::mesh_to_sdf(gpu, &mesh, &opts)
-            .with_context(|| format!("turning {} into a signed distance field", path.display()))?;
-        super::out!(
-            "{}: signed distance field {}x{}x{} (spacing {:.4}), {:.1} ms kernels, {:.1} ms wall",
-            path.display(),
-            st.dims[0],
-            st.dims[1],
-            st.dims[2],
-            st.spacing,
-            st.kernel_ms,
-            st.wall_ms
-        );
-        return Ok((path.display().to_string(), v, true));
+        return Ok((path.display().to_string(), Input::Mesh(mesh)));
     }
     let raw = super::raw_spec(
         a.dims.as_deref(),
@@ -377,5 +290,5 @@ fn load_input(
         .chain(read.iter().map(PathBuf::as_path))
         .collect();
     check_outputs(&inputs, outputs, a.force)?;
-    Ok((path.display().to_string(), v, false))
+    Ok((path.display().to_string(), Input::File(v)))
 }

@@ -60,6 +60,8 @@ use format::{
 };
 
 use crate::error::{Error, Result};
+use crate::spec::marching_cubes::Inside;
+use std::borrow::Cow;
 
 /// A scalar volume on a regular grid.
 ///
@@ -161,5 +163,59 @@ impl Volume {
     /// Size of the samples in memory, in bytes.
     pub fn bytes(&self) -> u64 {
         (self.values.len() as u64) * std::mem::size_of::<f32>() as u64
+    }
+
+    /// The volume and iso value that marching cubes and the SDF lines see
+    /// for an object on the `inside` side of `iso`: both orient their
+    /// output out of the region *below* the iso value, so for
+    /// [`Inside::Below`] (distance fields) this is the volume itself, and for
+    /// [`Inside::Above`] (density data such as CT) the values and the iso
+    /// value are negated (exact in f32, NaN stays NaN), so normals point out
+    /// of the object and its convex parts get positive curvature. The one
+    /// place this rule is written.
+    pub fn oriented(&self, iso: f32, inside: Inside) -> (Cow<'_, Volume>, f32) {
+        match inside {
+            Inside::Below => (Cow::Borrowed(self), iso),
+            Inside::Above => (Cow::Owned(self.clone().negated()), -iso),
+        }
+    }
+
+    /// [`Volume::oriented`] taking the volume by value: negates in place,
+    /// without a copy, for a caller that keeps only the oriented volume.
+    pub fn into_oriented(self, iso: f32, inside: Inside) -> (Volume, f32) {
+        match inside {
+            Inside::Below => (self, iso),
+            Inside::Above => (self.negated(), -iso),
+        }
+    }
+
+    fn negated(mut self) -> Volume {
+        self.values.iter_mut().for_each(|x| *x = -*x);
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oriented_negates_only_for_inside_above() {
+        let v = Volume::new([2, 1, 1], vec![1.5, f32::NAN], "t").unwrap();
+        let (b, iso) = v.oriented(0.25, Inside::Below);
+        assert!(matches!(b, Cow::Borrowed(_)));
+        assert_eq!(iso, 0.25);
+        let (a, iso) = v.oriented(0.25, Inside::Above);
+        assert!(matches!(a, Cow::Owned(_)));
+        assert_eq!(iso, -0.25);
+        assert_eq!(a.values[0], -1.5);
+        assert!(a.values[1].is_nan());
+        // Orientation preserves which samples are above the (new) iso.
+        assert_eq!(1.5 > 0.25, a.values[0] < iso);
+        let (o, iso2) = v.clone().into_oriented(0.25, Inside::Above);
+        assert_eq!(o.values[0].to_bits(), a.values[0].to_bits());
+        assert_eq!(iso2, iso);
+        let (o, iso3) = v.into_oriented(0.25, Inside::Below);
+        assert_eq!((o.values[0], iso3), (1.5, 0.25));
     }
 }

@@ -7,6 +7,7 @@ use crate::mesh::LoadOptions;
 use crate::mesh::Mesh;
 use crate::mesh::skinned::SkinnedMesh;
 use crate::scene::file::{ClipRef, Scene, Source};
+use crate::spec::marching_cubes::Inside;
 use std::path::{Path, PathBuf};
 
 /// The geometry of a scene, loaded on the host.
@@ -135,17 +136,12 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
     })
 }
 
-/// Marching cubes orients its triangles (and the gradient normals) out of
-/// the region *below* the isovalue. When the object is above it (density
-/// data), the values and the isovalue are negated (exact in f32), so normals
-/// point out of the object and its convex parts get positive curvature.
-fn inside_below(mut v: crate::volume::Volume, iso: f32, above: bool) -> Loaded {
-    if above {
-        v.values.iter_mut().for_each(|x| *x = -*x);
-        Loaded::Volume(Box::new(v), -iso, true)
-    } else {
-        Loaded::Volume(Box::new(v), iso, false)
-    }
+/// The volume oriented for marching cubes ([`crate::volume::Volume::oriented`]):
+/// negated, with its isovalue, when the object is above the isovalue.
+fn inside_below(v: crate::volume::Volume, iso: f32, above: bool) -> Loaded {
+    let inside = if above { Inside::Above } else { Inside::Below };
+    let (v, iso) = v.into_oriented(iso, inside);
+    Loaded::Volume(Box::new(v), iso, above)
 }
 
 /// The frame indices a scene renders, checked against what the input has.

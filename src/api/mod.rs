@@ -1,5 +1,6 @@
 //! The front door: one call per task, re-exported at the crate root
-//! (`shapecue::curvature`, `shapecue::isosurface`, `shapecue::feature_edges`,
+//! (`shapecue::curvature`, `shapecue::isosurface`, `shapecue::feature_edges`
+//! and `shapecue::feature_edges_picture`, `shapecue::strokes`,
 //! `shapecue::render_scene`), beside the stateful per-topology types that a
 //! deforming mesh reuses frame after frame
 //! ([`crate::stages::curvature::CurvatureEstimator`],
@@ -29,10 +30,25 @@ use crate::spec::view::View;
 use crate::stages::edges::EdgeStage;
 use crate::stages::marching_cubes::{self as mcs, IsoStats, Isosurfacer};
 use crate::volume::Volume;
-use std::borrow::Cow;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
+
+mod curvature;
+mod edges;
+mod strokes;
+
+pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
+
+pub use edges::{
+    EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
+    feature_edges_picture_on,
+};
+
+pub use strokes::{
+    FIT_DIRECTION, MeshField, Picture, PictureOptions, Strokes, StrokesInput, StrokesOptions,
+    strokes, strokes_on,
+};
 
 fn default_gpu() -> Result<Arc<Gpu>> {
     Ok(Arc::new(Gpu::new(None)?))
@@ -144,7 +160,7 @@ pub fn isosurface_on(
     iso: f32,
     opts: &IsoOptions,
 ) -> Result<Isosurface> {
-    let (vol, iso) = oriented(volume, iso, opts.inside);
+    let (vol, iso) = volume.oriented(iso, opts.inside);
     let t_up = Instant::now();
     let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
     let upload_ms = t_up.elapsed().as_secs_f64() * 1e3;
@@ -186,24 +202,10 @@ pub fn isosurface_on(
     })
 }
 
-/// The volume and iso value marching cubes sees for `inside`: unchanged for
-/// [`Inside::Below`]; negated (exact in f32) for [`Inside::Above`], so faces
-/// and gradient normals point out of the object.
-fn oriented(volume: &Volume, iso: f32, inside: Inside) -> (Cow<'_, Volume>, f32) {
-    match inside {
-        Inside::Below => (Cow::Borrowed(volume), iso),
-        Inside::Above => {
-            let mut v = volume.clone();
-            v.values.iter_mut().for_each(|x| *x = -*x);
-            (Cow::Owned(v), -iso)
-        }
-    }
-}
-
 /// Object-space feature edges of `mesh` seen through `view` on the default
 /// device (House & Li, after McGuire & Hughes 2004): contour, crease,
 /// boundary and marked edges as clip-space quads with the caps of
-/// `opts.caps`; nothing is drawn ([`crate::render::edges`] draws them). For
+/// `opts.caps`; nothing is drawn ([`feature_edges_picture`] draws them). For
 /// many frames of one topology, build an [`EdgeStage`] once instead.
 ///
 /// ```

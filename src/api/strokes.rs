@@ -1,0 +1,322 @@
+//! The strokes front door: curvature-directed strokes on a signed distance
+//! field ([`crate::stages::sdf_lines`]) and, when a picture is asked for,
+//! the isosurface under them ([`crate::stages::marching_cubes`]) drawn with
+//! the strokes over it by the renderer. The compute runs here; the renderer
+//! only draws what it is given.
+
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::mesh::Mesh;
+use crate::render::strokes::{StrokeStyle, draw};
+use crate::render::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, framed};
+use crate::spec::marching_cubes::Inside;
+use crate::spec::mesh_sdf::MeshSdfOptions;
+use crate::spec::sdf_lines::{Sampling, SdfLineOptions, SdfLineStats, Seed, Stroke, voxel_size};
+use crate::spec::timing::Timing;
+use crate::spec::vertex_fusion::Fusion;
+use crate::stages::marching_cubes::Isosurfacer;
+use crate::stages::mesh_sdf::MeshSdfStats;
+use crate::stages::sdf_lines::SdfLines;
+use crate::volume::Volume;
+use std::sync::Arc;
+
+/// Direction (centre → eye) of the fitted camera when no eye is given.
+pub const FIT_DIRECTION: [f32; 3] = [0.3, -1.0, 0.9];
+
+/// What [`strokes`] traces on.
+#[derive(Clone, Copy, Debug)]
+pub enum StrokesInput<'a> {
+    /// A volume (a distance field, or density data with [`Inside::Above`]).
+    Volume(&'a Volume),
+    /// A triangle mesh, first turned into a signed distance field on the
+    /// device (negative inside, sign from the winding number) with
+    /// `resolution` samples along its longest axis.
+    Mesh(&'a Mesh, usize),
+}
+
+/// The picture [`strokes`] draws: the shaded isosurface with the strokes
+/// over it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PictureOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Eye position in world units; `None`: a view fitted to the surface
+    /// from [`FIT_DIRECTION`].
+    pub eye: Option<glam::Vec3>,
+    /// Shade the surface; `false` draws it in the background colour, so it
+    /// still hides the strokes behind it.
+    pub surface: bool,
+}
+
+impl Default for PictureOptions {
+    fn default() -> Self {
+        PictureOptions {
+            width: 800,
+            height: 800,
+            eye: None,
+            surface: true,
+        }
+    }
+}
+
+/// How [`strokes`] traces and what it draws.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StrokesOptions {
+    /// The iso value of the surface.
+    pub iso: f32,
+    /// Which side of the iso value is the object
+    /// ([`crate::volume::Volume::oriented`]).
+    pub inside: Inside,
+    /// The Hessian sampling distance (automatic or fixed).
+    pub sampling: Sampling,
+    /// Poisson-disk seed spacing in world units (`None`: 1.5 × the
+    /// sampling distance).
+    pub spacing: Option<f64>,
+    /// Draw the picture (`None`: strokes only, no surface, no renderer).
+    pub picture: Option<PictureOptions>,
+}
+
+impl Default for StrokesOptions {
+    fn default() -> Self {
+        StrokesOptions {
+            iso: 0.0,
+            inside: Inside::Below,
+            sampling: Sampling::Auto(Vec::new()),
+            spacing: None,
+            picture: Some(PictureOptions::default()),
+        }
+    }
+}
+
+/// A mesh input's signed distance field.
+#[derive(Clone, Debug)]
+pub struct MeshField {
+    /// The field (negative inside).
+    pub volume: Volume,
+    /// Its sizes, counts and timing.
+    pub stats: MeshSdfStats,
+}
+
+/// The drawn picture of [`strokes`], in a frame centred on the surface
+/// (f32 precision far from 0): positions are world minus [`Picture::centre`].
+#[derive(Clone, Debug)]
+pub struct Picture {
+    /// The image.
+    pub frame: Frame,
+    /// The camera it was drawn with (centred frame).
+    pub camera: Camera,
+    /// World position of the frame's origin (the surface's bounding-box centre).
+    pub centre: [f64; 3],
+    /// The strokes in the centred frame.
+    pub strokes: Vec<Stroke>,
+}
+
+impl Picture {
+    /// The strokes whose outward normal at the seed faces the eye (what an
+    /// SVG of the picture shows), in the centred frame.
+    pub fn facing_strokes(&self) -> Vec<Stroke> {
+        let e = self.camera.eye;
+        self.strokes
+            .iter()
+            .filter(|s| facing_eye(s, e))
+            .cloned()
+            .collect()
+    }
+}
+
+/// What [`strokes`] made.
+#[derive(Clone, Debug)]
+pub struct Strokes {
+    /// The thinned seeds, world coordinates.
+    pub seeds: Vec<Seed>,
+    /// The strokes, world coordinates.
+    pub strokes: Vec<Stroke>,
+    /// Counts, the resolved parameters, the sampling sweep.
+    pub stats: SdfLineStats,
+    /// Kernel time per step and wall time of the strokes.
+    pub timing: Timing,
+    /// The volume's grid: samples per axis, spacing, origin.
+    pub grid: ([usize; 3], [f64; 3], [f64; 3]),
+    /// The mesh input's distance field (`None` for a volume input).
+    pub field: Option<MeshField>,
+    /// The isosurface under the strokes (world coordinates), when a picture
+    /// was asked for.
+    pub surface: Option<Mesh>,
+    /// The picture, when asked for.
+    pub picture: Option<Picture>,
+}
+
+/// Curvature-directed strokes on the default device: seeds on the
+/// isosurface thinned by Poisson-disk sampling, traced along the first
+/// principal direction of the field's Hessian (Interrante 1997, curvature
+/// after Kindlmann et al. 2003), as tapered strips; with
+/// `opts.picture`, drawn over the shaded isosurface. For many runs on one
+/// volume, build a [`SdfLines`] once instead.
+///
+/// ```
+/// use shapecue::volume::sdf::{Sdf, sdf};
+/// let vol = sdf(Sdf::Torus, 48);
+/// let opts = shapecue::StrokesOptions { picture: None, ..Default::default() };
+/// let s = shapecue::strokes(shapecue::StrokesInput::Volume(&vol), &opts)?;
+/// assert!(s.stats.strokes > 0 && s.strokes.len() == s.stats.strokes);
+/// # Ok::<(), shapecue::Error>(())
+/// ```
+///
+/// # Errors
+/// No device, a mesh whose distance field cannot be built, an empty
+/// isosurface when a picture is asked for, bad parameters, device and GL
+/// failures.
+pub fn strokes(input: StrokesInput<'_>, opts: &StrokesOptions) -> Result<Strokes> {
+    strokes_on(&super::default_gpu()?, input, opts)
+}
+
+/// [`strokes`] on a given device.
+pub fn strokes_on(
+    gpu: &Arc<Gpu>,
+    input: StrokesInput<'_>,
+    opts: &StrokesOptions,
+) -> Result<Strokes> {
+    let field = match input {
+        StrokesInput::Volume(_) => None,
+        StrokesInput::Mesh(mesh, resolution) => {
+            let (volume, stats) = crate::stages::mesh_sdf::mesh_to_sdf(
+                gpu.clone(),
+                mesh,
+                &MeshSdfOptions { resolution },
+            )?;
+            Some(MeshField { volume, stats })
+        }
+    };
+    let volume = match (input, &field) {
+        (StrokesInput::Volume(v), _) => v,
+        (_, Some(f)) => &f.volume,
+        (StrokesInput::Mesh(..), None) => unreachable!("a mesh input has its field"),
+    };
+    // Both the surface and the strokes see the object below the iso value.
+    let (vol, iso_below) = volume.oriented(opts.iso, opts.inside);
+    let line_opts = SdfLineOptions {
+        iso: iso_below,
+        inside: Inside::Below,
+        sampling: opts.sampling.clone(),
+        spacing: opts.spacing,
+        ..SdfLineOptions::default()
+    };
+    let out = SdfLines::new(gpu.clone(), &vol, &line_opts)?.run()?;
+    let (surface, picture) = match &opts.picture {
+        None => (None, None),
+        Some(p) => {
+            let (mesh, picture) = draw_picture(gpu, &vol, iso_below, opts.iso, &out.strokes, p)?;
+            (Some(mesh), Some(picture))
+        }
+    };
+    let timing = out.stats.ms.timing(out.stats.wall_ms);
+    Ok(Strokes {
+        seeds: out.seeds,
+        strokes: out.strokes,
+        stats: out.stats,
+        timing,
+        grid: (vol.dims, vol.spacing, vol.origin),
+        field,
+        surface,
+        picture,
+    })
+}
+
+/// The isosurface under the strokes and the picture of both.
+fn draw_picture(
+    gpu: &Arc<Gpu>,
+    vol: &Volume,
+    iso_below: f32,
+    iso: f32,
+    world_strokes: &[Stroke],
+    p: &PictureOptions,
+) -> Result<(Mesh, Picture)> {
+    let mut ex = Isosurfacer::new(gpu.clone(), vol)?;
+    ex.extract(iso_below, Fusion::Direct)?;
+    let (ipos, faces) = ex.read_index_space()?;
+    let mesh = ex.world_mesh(&ipos, faces);
+    if mesh.n_faces() == 0 {
+        let span = vol
+            .range()
+            .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
+                format!("the values span {lo} to {hi}")
+            });
+        return Err(Error::InvalidArgument(format!(
+            "the isosurface at iso {iso} is empty ({span})"
+        )));
+    }
+    let normals = crate::cpu::marching_cubes::gradient_normals(vol, &ipos);
+
+    // Draw in a frame centred on the surface (f32 precision far from 0).
+    let bounds = mesh.bounds();
+    let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (bounds.0[i] + bounds.1[i]));
+    let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - c[i]) };
+    let lb = (local(&bounds.0), local(&bounds.1));
+    let placement = match p.eye {
+        Some(e) => Placement::At(e - glam::DVec3::from(c).as_vec3()),
+        None => Placement::Fit(glam::Vec3::from(FIT_DIRECTION)),
+    };
+    let (w, h) = (p.width, p.height);
+    let camera = framed(placement, None, None, 35.0, false, lb, w as f32 / h as f32)?;
+    let strokes: Vec<Stroke> = world_strokes
+        .iter()
+        .map(|s| Stroke {
+            points: s.points.iter().map(local).collect(),
+            strip: s.strip.iter().map(local).collect(),
+            ..s.clone()
+        })
+        .collect();
+    let pos: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| local(p).map(|x| x as f32))
+        .collect();
+    let nrm: Vec<[f32; 3]> = normals.iter().map(|n| n.map(|x| x as f32)).collect();
+    let mut r = Renderer::new(RenderOptions {
+        width: w,
+        height: h,
+        ..RenderOptions::default()
+    })?;
+    let style = if p.surface {
+        MeshStyle::default()
+    } else {
+        MeshStyle {
+            ambient: 1.0,
+            color: [1.0; 3],
+            ..MeshStyle::default()
+        }
+    };
+    let voxel = voxel_size(vol.spacing);
+    r.begin(&camera)?;
+    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, style)?;
+    draw(
+        &mut r,
+        &camera,
+        &strokes,
+        &StrokeStyle {
+            lift: (0.5 * voxel) as f32,
+            ..StrokeStyle::default()
+        },
+    )?;
+    let frame = r.finish()?;
+    Ok((
+        mesh,
+        Picture {
+            frame,
+            camera,
+            centre: c,
+            strokes,
+        },
+    ))
+}
+
+/// Whether a stroke's outward normal at its seed faces the eye (local frame).
+fn facing_eye(s: &Stroke, eye: glam::Vec3) -> bool {
+    let (Some(p), Some(n)) = (s.points.get(s.centre), s.normals.get(s.centre)) else {
+        return false;
+    };
+    let d: [f64; 3] = std::array::from_fn(|i| f64::from(eye[i]) - p[i]);
+    d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0
+}
