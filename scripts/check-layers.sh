@@ -299,6 +299,13 @@ for crate, parent in sorted({(c, m[:k]) for c, m in where.values() for k in rang
 sys.exit(1 if found else 0)
 PY
 
+# The command-line parser belongs to the binary: the library's option enums
+# implement spec::Choice, from which src/cli builds clap's parsers.
+while IFS= read -r hit; do
+    echo "$hit: clap outside src/cli and src/main.rs (the library knows no command-line parser)"
+    status=1
+done < <(grep -rn --include='*.rs' -E '\bclap::|use clap\b' src | grep -v -E '^src/(cli/|main\.rs)' | grep -v -E ':[0-9]+:\s*//' || true)
+
 if [ "$status" -ne 0 ]; then
     echo "check-layers: the layering above is broken; see ARCHITECTURE.md (move the shared type into src/spec/, or the drawing into src/render/; break a cycle by moving the shared piece into the module both use)" >&2
     exit 1

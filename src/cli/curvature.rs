@@ -32,7 +32,7 @@ pub struct CurvatureArgs {
     #[arg(required_unless_present = "generate")]
     input: Option<PathBuf>,
     /// Use a generated mesh instead of a file.
-    #[arg(long, value_enum, conflicts_with = "input")]
+    #[arg(long, value_parser = super::choice::<Generated>(), conflicts_with = "input")]
     generate: Option<Generated>,
     /// Approximate vertex count of a generated mesh.
     #[arg(long, default_value_t = 40_000)]
@@ -48,7 +48,7 @@ pub struct CurvatureArgs {
     /// atomic add, cl_ext_float_atomics), or per-vertex gather (bitwise
     /// reproducible). Default: gather on CPU devices, atomic on GPUs (the
     /// faster exact scheme of each).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::choice::<Accumulate>())]
     accumulate: Option<Accumulate>,
     /// Faces per work-item of the per-face kernels (and vertices per
     /// work-item of the frame and principal passes), computed as SIMD
@@ -64,13 +64,13 @@ pub struct CurvatureArgs {
     /// scanned meshes), for cache locality; spatial always does, input never.
     /// Results are written in the input's order and differ only by the
     /// rounding of sums taken in another order.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = super::choice::<MeshOrder>(), default_value = "auto")]
     order: MeshOrder,
     /// Device precision.
-    #[arg(long, value_enum, default_value = "f32")]
+    #[arg(long, value_parser = super::choice::<Precision>(), default_value = "f32")]
     precision: Precision,
     /// Exact least squares, or trimesh2 2.16 compatibility (its pivot quirk, |k1| ≥ |k2|).
-    #[arg(long, value_enum, default_value = "exact")]
+    #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
     compat: Compat,
     /// Skip the curvature-derivative pass (dk written as zeros).
     #[arg(long)]

@@ -85,7 +85,7 @@ pub struct EdgesArgs {
     /// CL-GL buffer sharing: auto (share when the device reports
     /// cl_khr_gl_sharing, else copy through the host), on (require it: exit
     /// code 3 without the extension), off (host path).
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = super::choice::<shapecue::spec::edges::InteropMode>(), default_value = "auto")]
     interop: shapecue::spec::edges::InteropMode,
     /// After the first frame, this many more timed frames of the same view
     /// with the topology, device buffers, GL context and uploaded mesh kept

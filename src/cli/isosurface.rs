@@ -36,7 +36,7 @@ pub struct IsoArgs {
     /// gradient normals point out and convex parts have positive curvature
     /// (default: above for volume files such as CT or MRI densities, below
     /// for the procedural signed distance fields).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::choice::<Inside>())]
     inside: Option<Inside>,
     /// Raw input: voxels per axis, e.g. 32,32,32.
     #[arg(long, value_delimiter = ',')]
@@ -58,7 +58,7 @@ pub struct IsoArgs {
     /// fastest), edge (a triangle soup fused by exact voxel-edge keys), hash
     /// (the soup fused by Griffin et al.'s position hash + radix sort), none
     /// (the triangle soup).
-    #[arg(long, value_enum, default_value = "direct")]
+    #[arg(long, value_parser = super::choice::<Fusion>(), default_value = "direct")]
     fusion: Fusion,
     /// Write per-vertex normals from the volume gradient.
     #[arg(long)]
@@ -67,11 +67,11 @@ pub struct IsoArgs {
     #[arg(long)]
     curvature: bool,
     /// Curvature precision.
-    #[arg(long, value_enum, default_value = "f32")]
+    #[arg(long, value_parser = super::choice::<Precision>(), default_value = "f32")]
     precision: Precision,
     /// Vertex normals of the curvature passes: the volume gradient (accurate
     /// on marching-cubes meshes) or the mesh's own face normals (the paper's).
-    #[arg(long, value_enum, default_value = "gradient")]
+    #[arg(long, value_parser = super::choice::<IsoNormals>(), default_value = "gradient")]
     curvature_normals: IsoNormals,
     /// Skip the curvature-derivative pass.
     #[arg(long)]

@@ -20,17 +20,17 @@ pub struct KernelsArgs {
     /// One-ring accumulation variants to build (comma-separated), as in
     /// `shapecue curvature --accumulate`. Default: the device type's default
     /// (gather on CPU devices, atomic on GPUs).
-    #[arg(long, value_enum, value_delimiter = ',')]
+    #[arg(long, value_parser = super::choice::<Accumulate>(), value_delimiter = ',')]
     accumulate: Vec<Accumulate>,
     /// SIMD lanes of the gather variant, as in `shapecue curvature
     /// --lanes`. Default: the device's native vector width on CPU devices.
     #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
     lanes: Option<String>,
     /// Device precisions to build (comma-separated).
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "f32")]
+    #[arg(long, value_parser = super::choice::<Precision>(), value_delimiter = ',', default_value = "f32")]
     precision: Vec<Precision>,
     /// Least-squares variants to build (comma-separated).
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "exact")]
+    #[arg(long, value_parser = super::choice::<Compat>(), value_delimiter = ',', default_value = "exact")]
     compat: Vec<Compat>,
 }
 

@@ -173,3 +173,15 @@ pub fn require_png(option: &str, path: &Path) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// The command-line parser of a library option enum ([`shapecue::spec::Choice`]):
+/// its names as clap's possible values, listed bare in `--help`.
+pub fn choice<T: shapecue::spec::Choice>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::all().iter().map(|v| v.label())).map(|name| {
+        *T::all()
+            .iter()
+            .find(|v| v.label() == name)
+            .expect("clap accepts only the listed names")
+    })
+}

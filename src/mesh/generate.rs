@@ -260,22 +260,17 @@ pub fn uv_ellipsoid(a: f64, b: f64, c: f64, nu: usize, nv: usize) -> Mesh {
 
 /// A generated mesh with analytic curvature, as the CLI's `--generate` and
 /// scene files name it ([`Generated::name`]); [`Generated::mesh`] builds it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Generated {
     /// Torus R = 1, r = 0.4.
-    #[value(help = crate::spec::NO_HELP)]
     Torus,
     /// Icosphere of radius 1.
-    #[value(help = crate::spec::NO_HELP)]
     Sphere,
     /// Subdivided ellipsoid with semi-axes (1.5, 1, 0.6).
-    #[value(help = crate::spec::NO_HELP)]
     Ellipsoid,
     /// Open cylinder of radius 1 and height 2.
-    #[value(help = crate::spec::NO_HELP)]
     Cylinder,
     /// Square plane of side 2.
-    #[value(help = crate::spec::NO_HELP)]
     Plane,
 }
 

@@ -23,21 +23,21 @@
 use super::Mesh;
 
 /// How to order a mesh's vertices and faces in device memory.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MeshOrder {
     /// Reorder when the input order is scattered ([`LocalityOrder::scattered`]).
     #[default]
-    #[value(help = crate::spec::NO_HELP)]
     Auto,
     /// Keep the input order.
-    #[value(help = crate::spec::NO_HELP)]
     Input,
     /// Always reorder along a Morton curve.
-    #[value(help = crate::spec::NO_HELP)]
     Spatial,
 }
 
 impl MeshOrder {
+    /// Every order, in `--help` order.
+    pub const ALL: [MeshOrder; 3] = [MeshOrder::Auto, MeshOrder::Input, MeshOrder::Spatial];
+
     /// The name used on the command line and in stats.
     pub fn name(self) -> &'static str {
         match self {
@@ -360,5 +360,14 @@ mod tests {
             faces: vec![[0, 1, 2]],
         };
         assert_eq!(LocalityOrder::spatial(&one).input_vertex, vec![0, 1, 2]);
+    }
+}
+
+impl crate::spec::Choice for MeshOrder {
+    fn all() -> &'static [Self] {
+        &MeshOrder::ALL
+    }
+    fn label(self) -> &'static str {
+        self.name()
     }
 }

@@ -14,17 +14,14 @@
 use std::sync::OnceLock;
 
 /// Accuracy level.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum AoMode {
     /// Griffin et al.'s polynomial along the table's diagonal.
-    #[value(help = super::NO_HELP)]
     Poly,
     /// Bilinear lookup in a precomputed table.
-    #[value(help = super::NO_HELP)]
     Lut,
     /// The integral evaluated per vertex (256 directions).
-    #[value(help = super::NO_HELP)]
     Exact,
 }
 

@@ -143,25 +143,22 @@ impl CurvatureField {
 }
 
 /// How the one-ring sums are formed on the device.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Accumulate {
     /// One work-item per face adds into its vertices with float atomics
     /// (compare-and-swap), as in Griffin et al. Summation order varies run to run.
     #[default]
-    #[value(help = super::NO_HELP)]
     Atomic,
     /// As `Atomic`, with the device's own float atomic add
     /// (`cl_ext_float_atomics`, OpenCL C 3.0 `atomic_fetch_add_explicit`,
     /// relaxed) in place of compare-and-swap loops. Summation order varies
     /// run to run. Only on devices that offer it (Intel's CPU runtime, not
     /// PoCL 3.1); f64 also needs its 64-bit global add.
-    #[value(help = super::NO_HELP)]
     AtomicNative,
     /// Per-face kernels write each corner's contribution to a buffer (12
     /// reals per face, no atomics); per-vertex kernels sum their one-ring
     /// (built once) in face order. Bitwise identical from run to run.
-    #[value(help = super::NO_HELP)]
     Gather,
 }
 
@@ -212,17 +209,15 @@ impl Accumulate {
 }
 
 /// Floating-point precision of the device computation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Precision {
     /// 32-bit floats (default).
     #[default]
-    #[value(help = super::NO_HELP)]
     F32,
     /// 64-bit floats (needs cl_khr_fp64; atomic accumulation also needs
     /// cl_khr_int64_base_atomics). Build option `-DSC_DOUBLE` (`REAL` =
     /// `double` in `kernels/common/real.h`).
-    #[value(help = super::NO_HELP)]
     F64,
 }
 
@@ -248,16 +243,14 @@ impl Precision {
 }
 
 /// Which least-squares solve and ordering to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Compat {
     /// The exact solve of the per-face normal equations; k1 ≥ k2 (signed).
     #[default]
-    #[value(help = super::NO_HELP)]
     Exact,
     /// trimesh2 2.16: its 3×3 LDLᵀ pivot quirk and |k1| ≥ |k2| ordering, for
     /// comparing with that library directly. Build option `-DSC_COMPAT`.
-    #[value(help = super::NO_HELP)]
     Trimesh2,
 }
 

@@ -57,15 +57,12 @@ impl CapMode {
     }
 }
 
-/// clap's `ValueEnum` by hand, not derived: the derive would turn each
-/// variant's rustdoc into CLI help and change `--help`'s layout; the names
-/// are [`CapMode::name`]'s.
-impl clap::ValueEnum for CapMode {
-    fn value_variants<'a>() -> &'a [Self] {
+impl super::Choice for CapMode {
+    fn all() -> &'static [Self] {
         &CapMode::ALL
     }
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()))
+    fn label(self) -> &'static str {
+        self.name()
     }
 }
 
@@ -110,13 +107,12 @@ impl InteropMode {
     }
 }
 
-/// clap's `ValueEnum` by hand, for the same reason as [`CapMode`]'s.
-impl clap::ValueEnum for InteropMode {
-    fn value_variants<'a>() -> &'a [Self] {
+impl super::Choice for InteropMode {
+    fn all() -> &'static [Self] {
         &InteropMode::ALL
     }
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()))
+    fn label(self) -> &'static str {
+        self.name()
     }
 }
 

@@ -192,15 +192,13 @@ pub fn device_bytes_bound(voxels: usize, rows: usize, soup_vertices: usize) -> u
 }
 
 /// Which vertex normals the curvature of an isosurface uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum IsoNormals {
     /// The volume's gradient at each vertex: far more accurate on
     /// marching-cubes meshes, whose sliver triangles make face normals noisy.
-    #[value(help = super::NO_HELP)]
     Gradient,
     /// The estimator's own area-weighted face normals (Rusinkiewicz).
-    #[value(help = super::NO_HELP)]
     Mesh,
 }
 
@@ -225,16 +223,36 @@ super::named_choice!(IsoNormals, "isosurface normals choice");
 /// the iso value are negated first (exact in f32), so normals point out of
 /// the object and its convex parts get positive curvature. The scene file's
 /// `inside = "above" | "below"`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Inside {
     /// The object has the values above the iso value (density volumes).
-    #[value(help = super::NO_HELP)]
     Above,
     /// The object has the values below it (signed distance fields).
     #[default]
-    #[value(help = super::NO_HELP)]
     Below,
+}
+
+impl Inside {
+    /// Both choices, in the order of `--help`.
+    pub const ALL: [Inside; 2] = [Inside::Above, Inside::Below];
+
+    /// The name used on the command line and in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Inside::Above => "above",
+            Inside::Below => "below",
+        }
+    }
+}
+
+impl super::Choice for Inside {
+    fn all() -> &'static [Self] {
+        &Inside::ALL
+    }
+    fn label(self) -> &'static str {
+        self.name()
+    }
 }
 
 impl std::str::FromStr for Inside {

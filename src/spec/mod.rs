@@ -26,18 +26,30 @@ pub mod timing;
 pub mod vertex_fusion;
 pub mod view;
 
-// The option enums of the families derive `clap::ValueEnum` for the CLI.
-// Their variant docs are for rustdoc: `#[value(help = super::NO_HELP)]` on
-// each variant keeps them out of `--help`, which lists the bare names
-// (`[possible values: atomic, gather]`), as the CLI always has.
-
-/// No per-value help text in `--help` (see the comment above).
-pub(crate) const NO_HELP: Option<&str> = None;
+/// An option enum named by words (`atomic`, `gather`, ...): every choice and
+/// its name, the same on the command line, in scene files and in stats.
+/// The command line builds its parsers from this (the library knows no
+/// command-line parser).
+pub trait Choice: Copy + PartialEq + Send + Sync + 'static {
+    /// Every choice, in the order `--help` lists them.
+    fn all() -> &'static [Self];
+    /// The choice's name.
+    fn label(self) -> &'static str;
+}
 
 /// `Display` and `FromStr` by `name()` for an option enum with an `ALL`
 /// array of its variants; `$what` names the option in the parse error.
 macro_rules! named_choice {
     ($t:ty, $what:literal) => {
+        impl $crate::spec::Choice for $t {
+            fn all() -> &'static [Self] {
+                &<$t>::ALL
+            }
+            fn label(self) -> &'static str {
+                <$t>::name(self)
+            }
+        }
+
         impl std::fmt::Display for $t {
             fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
                 f.write_str(self.name())

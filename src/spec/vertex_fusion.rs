@@ -12,23 +12,19 @@
 //! arguments only: no parameter struct crosses.
 
 /// How the vertices of an isosurface are shared between its triangles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Fusion {
     /// Exact and the fastest: no soup; each vertex is made once by the voxel
     /// edge it lies on and numbered by a scan over per-row counts, as
     /// Flying Edges (Schroeder, Maynard and Geveci 2015) does.
-    #[value(help = super::NO_HELP)]
     Direct,
     /// Exact: each vertex keyed by the voxel edge (or grid point) it lies on.
-    #[value(help = super::NO_HELP)]
     Edge,
     /// Griffin et al.'s method: 32-bit hash of the position bits, radix sort,
     /// collisions resolved by comparing positions.
-    #[value(help = super::NO_HELP)]
     Hash,
     /// No fusion: the triangle soup, three vertices per triangle.
-    #[value(help = super::NO_HELP)]
     None,
 }
 
@@ -134,21 +130,20 @@ pub fn device_bytes_bound(soup_vertices: usize) -> u64 {
 
 #[cfg(test)]
 mod tests {
+    use crate::spec::Choice;
     use crate::spec::{ao::AoMode, curvature, marching_cubes, radix_sort, scan};
-    use clap::ValueEnum;
 
-    /// `name()`, `Display`, `FromStr` and the CLI's value names agree.
+    /// `name()`, `Display`, `FromStr` and the command line's names
+    /// ([`Choice`]) agree.
     fn names_agree<T>(all: &[T], name: fn(&T) -> &'static str)
     where
-        T: ValueEnum + std::fmt::Display + std::str::FromStr + PartialEq + std::fmt::Debug,
+        T: Choice + std::fmt::Display + std::str::FromStr + PartialEq + std::fmt::Debug,
     {
-        assert_eq!(all.len(), T::value_variants().len());
-        for (v, cli) in all.iter().zip(T::value_variants()) {
-            let pv = cli.to_possible_value().unwrap();
-            assert_eq!(pv.get_name(), name(v));
+        assert_eq!(all.len(), T::all().len());
+        for (v, cli) in all.iter().zip(T::all()) {
+            assert_eq!(cli.label(), name(v));
             assert_eq!(v.to_string(), name(v));
             assert!(name(v).parse::<T>().ok().as_ref() == Some(v));
-            assert!(pv.get_help().is_none(), "--help lists bare names");
         }
         assert!("no such choice".parse::<T>().is_err());
     }
