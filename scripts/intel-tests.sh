@@ -21,4 +21,4 @@ case "$default" in
 *Intel*) ;;
 *) echo "intel-tests: SHAPECUE_DEVICE=intel did not select Intel's runtime" >&2; exit 1 ;;
 esac
-cargo test --release --test curvature
+cargo test --release --test curvature --test curvature_schemes --test curvature_hard_cases
