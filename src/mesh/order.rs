@@ -48,6 +48,15 @@ impl MeshOrder {
     }
 }
 
+impl crate::spec::Choice for MeshOrder {
+    fn all() -> &'static [Self] {
+        &MeshOrder::ALL
+    }
+    fn label(self) -> &'static str {
+        self.name()
+    }
+}
+
 /// Scatter measures of a mesh's order (see [`LocalityOrder::scattered`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrderSpread {
@@ -360,14 +369,5 @@ mod tests {
             faces: vec![[0, 1, 2]],
         };
         assert_eq!(LocalityOrder::spatial(&one).input_vertex, vec![0, 1, 2]);
-    }
-}
-
-impl crate::spec::Choice for MeshOrder {
-    fn all() -> &'static [Self] {
-        &MeshOrder::ALL
-    }
-    fn label(self) -> &'static str {
-        self.name()
     }
 }
