@@ -31,7 +31,7 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(10));
     let mut kernel_ms = Vec::new();
     g.bench_function(format!("device/bunny-{res}"), |b| {
-        b.iter(|| kernel_ms.push(dev.run(&prep).expect("device run").1.kernel_ms))
+        b.iter(|| kernel_ms.push(dev.run(&prep).expect("device run").1.timing.kernel_ms))
     });
     g.bench_function(format!("cpu/bunny-{res}"), |b| b.iter(|| cpu::run(&prep)));
     g.finish();

@@ -10,6 +10,7 @@ use shapecue::cpu::mesh_sdf as cpu;
 use shapecue::mesh::mesh_sdf::prepare;
 use shapecue::mesh::{Mesh, icosphere, plane};
 use shapecue::spec::mesh_sdf::{MeshSdfOptions, PreparedMesh};
+use shapecue::spec::timing::Step;
 use shapecue::stages::mesh_sdf::{self as stage, MeshSdf};
 use shapecue::volume::Volume;
 fn opts(resolution: usize) -> MeshSdfOptions {
@@ -191,8 +192,26 @@ fn compare_steps(prep: &PreparedMesh, what: &str) {
          flooded points {fl_q:.2e} ({fl_ids}), refined d² {ref_d:.2e} (voxels²), winding \
          mismatches {wind_diff}, values {val_d:.2e} (h = {h:.3e}); kernel {:.1} ms (band {:.1}, \
          jfa {:.1}, refine {:.1}, sign {:.1}); band work {}",
-        st.kernel_ms, st.band_ms, st.jfa_ms, st.refine_ms, st.sign_ms, st.band_work
+        st.timing.kernel_ms,
+        st.timing.ms(&[Step::MsdfBand]),
+        st.timing.ms(&[Step::MsdfJfa]),
+        st.timing.ms(&[Step::MsdfRefine]),
+        st.timing.ms(&[Step::MsdfSign]),
+        st.band_work
     );
+    let steps: Vec<Step> = st.timing.steps.iter().map(|s| s.step).collect();
+    assert_eq!(
+        steps,
+        [
+            Step::MsdfBand,
+            Step::MsdfJfa,
+            Step::MsdfRefine,
+            Step::MsdfSign,
+            Step::MsdfFinish
+        ],
+        "{what}: every pass in the one timing type, in order"
+    );
+    assert!(st.timing.kernel_ms > 0.0 && st.timing.wall_ms > 0.0);
     assert_eq!(wind_diff, 0, "{what}: winding");
     assert!(band_d <= 1e-4, "{what}: band");
     assert!(ref_d <= 1e-3, "{what}: refined");
@@ -309,13 +328,25 @@ fn stanford_bunny_at_128() {
         st.dims,
         st.triangles,
         st.degenerate_faces,
-        st.kernel_ms,
-        st.band_ms,
-        st.jfa_ms,
-        st.refine_ms,
-        st.sign_ms,
-        st.finish_ms,
-        st.wall_ms
+        st.timing.kernel_ms,
+        st.timing.ms(&[Step::MsdfBand]),
+        st.timing.ms(&[Step::MsdfJfa]),
+        st.timing.ms(&[Step::MsdfRefine]),
+        st.timing.ms(&[Step::MsdfSign]),
+        st.timing.ms(&[Step::MsdfFinish]),
+        st.timing.wall_ms
+    );
+    // Every pass is in the one timing type, in order, once each.
+    let steps: Vec<Step> = st.timing.steps.iter().map(|s| s.step).collect();
+    assert_eq!(
+        steps,
+        [
+            Step::MsdfBand,
+            Step::MsdfJfa,
+            Step::MsdfRefine,
+            Step::MsdfSign,
+            Step::MsdfFinish
+        ]
     );
     assert_eq!(v.dims.iter().copied().max(), Some(128));
     assert!(v.values.iter().all(|x| x.is_finite()));

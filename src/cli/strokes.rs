@@ -170,8 +170,8 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
             st.dims[1],
             st.dims[2],
             st.spacing,
-            st.kernel_ms,
-            st.wall_ms
+            st.timing.kernel_ms,
+            st.timing.wall_ms
         );
     }
     let picture = out.picture.as_ref().expect("a picture was asked for");

@@ -9,6 +9,7 @@ use super::curvature::CurvKernel;
 use super::edges::EdgesKernel;
 use super::feature_lines::LinesKernel;
 use super::marching_cubes::McKernel;
+use super::mesh_sdf::MsdfKernel;
 use super::sdf_lines::SdflKernel;
 use super::skinning::SkinKernel;
 use super::timing::Step;
@@ -61,6 +62,11 @@ impl Step {
             Step::SdflTrace => SdflKernel::Trace.name(),
             Step::SdflStrips => SdflKernel::Strips.name(),
             Step::SdflSweep => "sdfl_sweep",
+            Step::MsdfBand => MsdfKernel::BandMin.name(),
+            Step::MsdfJfa => MsdfKernel::Jfa.name(),
+            Step::MsdfRefine => MsdfKernel::Refine.name(),
+            Step::MsdfSign => MsdfKernel::Wind.name(),
+            Step::MsdfFinish => MsdfKernel::Finish.name(),
         }
     }
 }

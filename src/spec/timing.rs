@@ -35,6 +35,8 @@ pub enum Family {
     Ao,
     /// `kernels/sdf_lines.cl` (curvature-directed strokes on a field).
     SdfLines,
+    /// `kernels/mesh_sdf.cl` (a mesh's signed distance field).
+    MeshSdf,
 }
 
 /// A step of a stage: a kernel entry point `<prefix>_<step>` of
@@ -140,6 +142,17 @@ pub enum Step {
     /// The automatic sampling sweep (host entry `sdfl_sweep`): a
     /// provisional thinning and one `sdfl_curvature` per candidate distance.
     SdflSweep,
+    /// `msdf_band_min` (with `msdf_clear` and `msdf_band_id`): exact
+    /// distances in the narrow band.
+    MsdfBand,
+    /// `msdf_jfa` (with `msdf_seed`): every jump-flooding pass.
+    MsdfJfa,
+    /// `msdf_refine`: exact distance to the flooded nearest triangle.
+    MsdfRefine,
+    /// `msdf_wind` (with `msdf_cross`, over the three axes): the sign.
+    MsdfSign,
+    /// `msdf_finish`: the signed field.
+    MsdfFinish,
 }
 
 impl Step {
@@ -156,6 +169,7 @@ impl Step {
             Family::FeatureLines => &k["lines_".len()..],
             Family::Ao => &k["ao_".len()..],
             Family::SdfLines => &k["sdfl_".len()..],
+            Family::MeshSdf => &k["msdf_".len()..],
             Family::Scan | Family::RadixSort | Family::Edges => k,
         }
     }
@@ -179,6 +193,7 @@ impl Step {
             AoVertex => Family::Ao,
             SdflDense | SdflThin | SdflGradient | SdflCurvature | SdflRange | SdflTrace
             | SdflStrips | SdflSweep => Family::SdfLines,
+            MsdfBand | MsdfJfa | MsdfRefine | MsdfSign | MsdfFinish => Family::MeshSdf,
         }
     }
 }

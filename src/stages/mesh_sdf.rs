@@ -22,6 +22,7 @@ use crate::mesh::Mesh;
 use crate::mesh::mesh_sdf::prepare;
 use crate::spec::mesh_sdf::MsdfKernel;
 use crate::spec::mesh_sdf::{BAND_VOXELS, FIX_BITS, MAX_DESCENT, MeshSdfOptions, PreparedMesh};
+use crate::spec::timing::{Step, Timing};
 use crate::stages::kernel_files;
 use crate::volume::Volume;
 use opencl3::event::Event;
@@ -49,20 +50,10 @@ pub struct MeshSdfStats {
     pub band_work: u64,
     /// Jump-flooding passes (steps).
     pub jfa_passes: usize,
-    /// Kernel ms: msdf_clear, msdf_band_min, msdf_band_id.
-    pub band_ms: f64,
-    /// Kernel ms: msdf_seed and all msdf_jfa passes.
-    pub jfa_ms: f64,
-    /// Kernel ms: msdf_refine.
-    pub refine_ms: f64,
-    /// Kernel ms: msdf_cross and msdf_wind over the three axes.
-    pub sign_ms: f64,
-    /// Kernel ms: msdf_finish.
-    pub finish_ms: f64,
-    /// Sum of the kernel times.
-    pub kernel_ms: f64,
-    /// Wall ms from the upload to the field read back (program build excluded).
-    pub wall_ms: f64,
+    /// Kernel ms per step (`MsdfBand`, `MsdfJfa`, `MsdfRefine`, `MsdfSign`,
+    /// `MsdfFinish`), their sum, and the wall ms from the upload to the
+    /// field read back (program build excluded).
+    pub timing: Timing,
     /// Device bytes allocated.
     pub device_bytes: u64,
 }
@@ -208,7 +199,7 @@ impl MeshSdf {
         ev.extend(launch(g, &self.band_min, ntri, &a)?);
         a.push(buf(&id[0]));
         ev.extend(launch(g, &self.band_id, ntri, &a)?);
-        st.band_ms = wait_all(&mut ev)?;
+        st.timing.add(Step::MsdfBand, wait_all(&mut ev)?);
         let mut trace = MeshSdfTrace::default();
         if traced {
             trace.band = (read_vec(g, &d2, n)?, read_vec(g, &id[0], n)?);
@@ -245,7 +236,7 @@ impl MeshSdf {
             ev.extend(launch(g, &self.jfa, n, &a)?);
             cur = 1 - cur;
         }
-        st.jfa_ms = wait_all(&mut ev)?;
+        st.timing.add(Step::MsdfJfa, wait_all(&mut ev)?);
         if traced {
             let flat: Vec<f32> = read_vec(g, &q[cur], 3 * n)?;
             let pts = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
@@ -263,7 +254,7 @@ impl MeshSdf {
             buf(&id[1 - cur]),
         ]);
         ev.extend(launch(g, &self.refine, n, &a)?);
-        st.refine_ms = wait_all(&mut ev)?;
+        st.timing.add(Step::MsdfRefine, wait_all(&mut ev)?);
         if traced {
             trace.refined = (read_vec(g, &d2, n)?, read_vec(g, &id[1 - cur], n)?);
         }
@@ -291,7 +282,7 @@ impl MeshSdf {
             a.extend([buf(&diff), buf(&winding)]);
             ev.extend(launch(g, &self.wind, lines, &a)?);
         }
-        st.sign_ms = wait_all(&mut ev)?;
+        st.timing.add(Step::MsdfSign, wait_all(&mut ev)?);
         if traced {
             trace.winding = read_vec(g, &winding, n)?;
         }
@@ -309,10 +300,9 @@ impl MeshSdf {
                 buf(&out),
             ],
         )?);
-        st.finish_ms = wait_all(&mut ev)?;
+        st.timing.add(Step::MsdfFinish, wait_all(&mut ev)?);
         let values = read_vec(g, &out, n)?;
-        st.kernel_ms = st.band_ms + st.jfa_ms + st.refine_ms + st.sign_ms + st.finish_ms;
-        st.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
             return Err(Error::input(
                 "mesh",
