@@ -18,6 +18,8 @@ const HEADER: u32 = 48;
 const FONT: &str = "sans-serif";
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+/// A chart with log axes on both sides, drawn into an [`Area`].
+type LogLog<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
 
 fn err(e: impl std::fmt::Display) -> Error {
     Error::Render {
@@ -123,21 +125,16 @@ fn no_data(area: &Area, title: &str) -> Result<()> {
     .map_err(err)
 }
 
-fn scatter(
-    area: &Area,
+/// A chart with log axes over `xr` × `yr`, its caption, axis labels and
+/// grid drawn (the scatter and convergence charts share it).
+fn log_log<'a, 'b>(
+    area: &'a Area<'b>,
     title: &str,
     x_label: &str,
     y_label: &str,
-    points: &[(String, f64, f64)],
-) -> Result<()> {
-    let ok = |x: f64| x.is_finite() && x > 0.0;
-    let pts: Vec<&(String, f64, f64)> = points.iter().filter(|p| ok(p.1) && ok(p.2)).collect();
-    let (Some(xr), Some(yr)) = (
-        log_range(pts.iter().map(|p| p.1), 1.6),
-        log_range(pts.iter().map(|p| p.2), 1.6),
-    ) else {
-        return no_data(area, title);
-    };
+    xr: std::ops::Range<f64>,
+    yr: std::ops::Range<f64>,
+) -> Result<LogLog<'a, 'b>> {
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FONT, 17))
         .margin(16)
@@ -155,6 +152,25 @@ fn scatter(
         .y_label_formatter(&tick)
         .draw()
         .map_err(err)?;
+    Ok(chart)
+}
+
+fn scatter(
+    area: &Area,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[(String, f64, f64)],
+) -> Result<()> {
+    let ok = |x: f64| x.is_finite() && x > 0.0;
+    let pts: Vec<&(String, f64, f64)> = points.iter().filter(|p| ok(p.1) && ok(p.2)).collect();
+    let (Some(xr), Some(yr)) = (
+        log_range(pts.iter().map(|p| p.1), 1.6),
+        log_range(pts.iter().map(|p| p.2), 1.6),
+    ) else {
+        return no_data(area, title);
+    };
+    let mut chart = log_log(area, title, x_label, y_label, xr, yr)?;
     // Labels alternate above and below their points in the order of x, so
     // that variants of equal error but near times stay readable.
     let mut order: Vec<usize> = (0..pts.len()).collect();
@@ -192,23 +208,7 @@ fn convergence(
     ) else {
         return no_data(area, title);
     };
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 17))
-        .margin(16)
-        .x_label_area_size(44)
-        .y_label_area_size(80)
-        .build_cartesian_2d(xr.clone().log_scale(), yr.clone().log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .x_labels(12)
-        .y_labels(12)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .draw()
-        .map_err(err)?;
+    let mut chart = log_log(area, title, x_label, y_label, xr.clone(), yr.clone())?;
     for (i, (name, pts)) in series.iter().enumerate() {
         let c = Palette99::pick(i).to_rgba();
         let pts: Vec<(f64, f64)> = pts.iter().filter(ok).copied().collect();
