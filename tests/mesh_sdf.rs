@@ -199,18 +199,7 @@ fn compare_steps(prep: &PreparedMesh, what: &str) {
         st.timing.ms(&[Step::MsdfSign]),
         st.band_work
     );
-    let steps: Vec<Step> = st.timing.steps.iter().map(|s| s.step).collect();
-    assert_eq!(
-        steps,
-        [
-            Step::MsdfBand,
-            Step::MsdfJfa,
-            Step::MsdfRefine,
-            Step::MsdfSign,
-            Step::MsdfFinish
-        ],
-        "{what}: every pass in the one timing type, in order"
-    );
+    assert_passes_timed(&st, what);
     assert!(st.timing.kernel_ms > 0.0 && st.timing.wall_ms > 0.0);
     assert_eq!(wind_diff, 0, "{what}: winding");
     assert!(band_d <= 1e-4, "{what}: band");
@@ -336,18 +325,7 @@ fn stanford_bunny_at_128() {
         st.timing.ms(&[Step::MsdfFinish]),
         st.timing.wall_ms
     );
-    // Every pass is in the one timing type, in order, once each.
-    let steps: Vec<Step> = st.timing.steps.iter().map(|s| s.step).collect();
-    assert_eq!(
-        steps,
-        [
-            Step::MsdfBand,
-            Step::MsdfJfa,
-            Step::MsdfRefine,
-            Step::MsdfSign,
-            Step::MsdfFinish
-        ]
-    );
+    assert_passes_timed(&st, "bunny 128³");
     assert_eq!(v.dims.iter().copied().max(), Some(128));
     assert!(v.values.iter().all(|x| x.is_finite()));
     let h = v.spacing[0];
@@ -560,4 +538,20 @@ fn ellipsoid_curvature_matches_the_isosurface_estimate() {
     for (e1, e2) in &errs {
         assert!(*e1 < 0.15 && *e2 < 0.15, "{errs:?}");
     }
+}
+
+/// Every pass of a conversion is in the one timing type, in order, once each.
+fn assert_passes_timed(st: &stage::MeshSdfStats, what: &str) {
+    let steps: Vec<Step> = st.timing.steps.iter().map(|s| s.step).collect();
+    assert_eq!(
+        steps,
+        [
+            Step::MsdfBand,
+            Step::MsdfJfa,
+            Step::MsdfRefine,
+            Step::MsdfSign,
+            Step::MsdfFinish
+        ],
+        "{what}: every pass in the one timing type, in order"
+    );
 }
