@@ -48,14 +48,7 @@ impl MeshOrder {
     }
 }
 
-impl crate::spec::Choice for MeshOrder {
-    fn all() -> &'static [Self] {
-        &MeshOrder::ALL
-    }
-    fn label(self) -> &'static str {
-        self.name()
-    }
-}
+crate::spec::choice!(MeshOrder);
 
 /// Scatter measures of a mesh's order (see [`LocalityOrder::scattered`]).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -57,14 +57,7 @@ impl CapMode {
     }
 }
 
-impl super::Choice for CapMode {
-    fn all() -> &'static [Self] {
-        &CapMode::ALL
-    }
-    fn label(self) -> &'static str {
-        self.name()
-    }
-}
+crate::spec::choice!(CapMode);
 
 impl std::str::FromStr for CapMode {
     type Err = Error;
@@ -107,14 +100,7 @@ impl InteropMode {
     }
 }
 
-impl super::Choice for InteropMode {
-    fn all() -> &'static [Self] {
-        &InteropMode::ALL
-    }
-    fn label(self) -> &'static str {
-        self.name()
-    }
-}
+crate::spec::choice!(InteropMode);
 
 /// The interop path chosen and why.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]

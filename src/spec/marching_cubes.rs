@@ -246,14 +246,7 @@ impl Inside {
     }
 }
 
-impl super::Choice for Inside {
-    fn all() -> &'static [Self] {
-        &Inside::ALL
-    }
-    fn label(self) -> &'static str {
-        self.name()
-    }
-}
+crate::spec::choice!(Inside);
 
 impl std::str::FromStr for Inside {
     type Err = crate::error::Error;

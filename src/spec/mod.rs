@@ -37,10 +37,11 @@ pub trait Choice: Copy + PartialEq + Send + Sync + 'static {
     fn label(self) -> &'static str;
 }
 
-/// `Display` and `FromStr` by `name()` for an option enum with an `ALL`
-/// array of its variants; `$what` names the option in the parse error.
-macro_rules! named_choice {
-    ($t:ty, $what:literal) => {
+/// [`Choice`] for an option enum with an `ALL` array of its variants and a
+/// `name()`; for one whose parsing is its own (case-insensitive, or with its
+/// own message), beside its `FromStr`.
+macro_rules! choice {
+    ($t:ty) => {
         impl $crate::spec::Choice for $t {
             fn all() -> &'static [Self] {
                 &<$t>::ALL
@@ -49,6 +50,15 @@ macro_rules! named_choice {
                 <$t>::name(self)
             }
         }
+    };
+}
+pub(crate) use choice;
+
+/// [`Choice`], `Display` and `FromStr` by `name()` for an option enum with an
+/// `ALL` array of its variants; `$what` names the option in the parse error.
+macro_rules! named_choice {
+    ($t:ty, $what:literal) => {
+        $crate::spec::choice!($t);
 
         impl std::fmt::Display for $t {
             fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
