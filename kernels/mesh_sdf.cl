@@ -34,10 +34,8 @@
 //   id uint[N] triangle (NO_TRI: none); q float[3N] nearest point (grid
 //   units); diff int[N]; wind int[N] the sum over the six rays of the
 //   signed crossing counts; out float[N].
-// Built with -cl-fp32-correctly-rounded-divide-sqrt and contraction off, so
-// the f32 arithmetic matches the CPU twin's bit for bit.
-
-#pragma OPENCL FP_CONTRACT OFF
+// Built with common/strict.h (contraction off, correctly rounded divide and
+// square root), so the f32 arithmetic matches the CPU twin's bit for bit.
 
 #define NO_TRI 0xffffffffu
 

@@ -26,9 +26,8 @@
 //   pts float[4SK] (xyz, signed step index), nrm float[4SK], meta uint[4S] (first, count, nb, nf),
 //   wid float[S], nverts uint[S], voff uint[S]; strip float[4V] (xyz, width), overflow uint[1]
 //
-// Float contraction is off so that distances and cell indices are computed
-// exactly as the CPU twin does (no fused multiply-add).
-#pragma OPENCL FP_CONTRACT OFF
+// Built with common/strict.h (no contraction, correctly rounded divide and
+// square root), so distances and cell indices are exactly the CPU twin's.
 
 #define NONE 0xFFFFFFFFu
 

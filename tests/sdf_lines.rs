@@ -88,7 +88,19 @@ fn dense_samples_match_the_twin_bit_for_bit() {
         let dev = sorted(s.dense().unwrap());
         assert!(!cpu.is_empty());
         assert_eq!(dev.len(), cpu.len());
-        assert!(dev == cpu, "dense samples differ");
+        if gpu().bitwise_twins() {
+            assert!(dev == cpu, "dense samples differ");
+        } else {
+            // A device without correctly rounded division (or a relaxed
+            // build): the same crossings, each within 4 ulps of the twin's.
+            for (d, c) in dev.iter().zip(&cpu) {
+                assert_eq!(d.key, c.key, "dense samples on other grid edges");
+                for a in 0..3 {
+                    let ulps = (d.p[a].to_bits() as i64 - c.p[a].to_bits() as i64).abs();
+                    assert!(ulps <= 4, "dense sample {:?} vs {:?}", d.p, c.p);
+                }
+            }
+        }
         // On the marching-cubes vertices: every sample is a soup vertex position.
         let soup = shapecue::cpu::marching_cubes::mc_triangles(&vol, iso);
         let sp = vol.spacing.map(|s| s as f32);
@@ -144,7 +156,12 @@ fn thinning_is_deterministic_valid_and_maximal() {
     let a = s.thin(r).unwrap();
     let b = SdfLines::new(gpu(), &vol, &opts).unwrap().thin(r).unwrap();
     assert_eq!(a, b, "two device runs differ");
-    assert_eq!(a, cpu, "device differs from the twin");
+    // Bit for bit where divisions round as the twin's; elsewhere a sample
+    // a few ulps away may win a tie, and validity and maximality (below)
+    // are the promise.
+    if gpu().bitwise_twins() {
+        assert_eq!(a, cpu, "device differs from the twin");
+    }
     // Valid: no two seeds closer than r (in f32, as the test is made).
     let r2 = p.r2;
     for i in 0..a.len() {

@@ -36,6 +36,15 @@ pub struct DeviceInfo {
     pub float_atomics: bool,
     /// The same for f64 (`CL_DEVICE_DOUBLE_FP_ATOMIC_CAPABILITIES_EXT`).
     pub double_atomics: bool,
+    /// `CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT` in `CL_DEVICE_SINGLE_FP_CONFIG`:
+    /// f32 divide and square root can be built correctly rounded
+    /// (`-cl-fp32-correctly-rounded-divide-sqrt`), as the CPU twins compute
+    /// them. Without it, the promises of bits hold only within a tolerance.
+    pub correctly_rounded_div_sqrt: bool,
+    /// NVIDIA's CUDA platform, whose OpenCL C compiler takes inline PTX:
+    /// float atomic adds through `red.global.add` where `cl_ext_float_atomics`
+    /// is missing (`--accumulate atomic-native`).
+    pub ptx: bool,
     /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT`: floats per SIMD register.
     pub native_float_width: u32,
     /// `CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE` (0 without double precision).
@@ -112,6 +121,10 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
                     && fp_atomic_add(&d, CL_DEVICE_SINGLE_FP_ATOMIC_CAPABILITIES_EXT),
                 double_atomics: has("cl_ext_float_atomics")
                     && fp_atomic_add(&d, CL_DEVICE_DOUBLE_FP_ATOMIC_CAPABILITIES_EXT),
+                correctly_rounded_div_sqrt: d.single_fp_config().unwrap_or(0)
+                    & opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT
+                    != 0,
+                ptx: pname.trim().starts_with("NVIDIA CUDA"),
                 native_float_width: d.native_vector_width_float().unwrap_or(1),
                 native_double_width: d.native_vector_width_double().unwrap_or(0),
                 id,
@@ -196,6 +209,8 @@ mod tests {
             int64_atomics: false,
             float_atomics: false,
             double_atomics: false,
+            correctly_rounded_div_sqrt: true,
+            ptx: false,
             native_float_width: 1,
             native_double_width: 0,
             id: std::ptr::null_mut(),

@@ -9,7 +9,7 @@ mod device;
 mod program;
 
 pub use device::{DeviceInfo, list_devices};
-pub use program::{COMMON_HEADERS, KernelFile};
+pub use program::{COMMON_HEADERS, FpMode, KernelFile, STRICT_HEADER, assemble_as};
 
 use crate::error::{Error, Result};
 use opencl3::command_queue::{CL_QUEUE_PROFILING_ENABLE, CommandQueue};
@@ -53,6 +53,11 @@ pub struct Gpu {
     /// `SHAPECUE_DEVICE_MEMORY`: a simulated device memory in bytes, and the
     /// bytes allocated so far against it (see [`Gpu::buffer_flags`]).
     budget: Option<(u64, std::sync::atomic::AtomicU64)>,
+    /// How floating-point arithmetic is built ([`FpMode`]).
+    fp: FpMode,
+    /// `SHAPECUE_CL_OPTIONS`: options added to every build (CI builds with
+    /// `-cl-mad-enable` there, as a GPU compiler's liberty to fuse).
+    extra_options: String,
 }
 
 /// Parses a byte count with an optional binary suffix (`512M`, `2G`, `64KiB`).
@@ -102,6 +107,21 @@ impl Gpu {
     /// `SHAPECUE_DEVICE` environment variable, then to the first GPU, then to
     /// the first CPU device.
     pub fn new(selector: Option<&str>) -> Result<Gpu> {
+        let fp = match std::env::var("SHAPECUE_FP").ok().as_deref().map(str::trim) {
+            None | Some("") | Some("strict") => FpMode::Strict,
+            Some("relaxed") => FpMode::Relaxed,
+            Some(v) => {
+                return Err(Error::InvalidArgument(format!(
+                    "SHAPECUE_FP={v}: expected strict or relaxed"
+                )));
+            }
+        };
+        Self::with_fp(selector, fp)
+    }
+
+    /// As [`Gpu::new`], building every program in the floating-point mode
+    /// `fp` (whatever `SHAPECUE_FP` says).
+    pub fn with_fp(selector: Option<&str>, fp: FpMode) -> Result<Gpu> {
         let info = device::select(selector)?;
         let _guard = program::driver_lock();
         let device = Device::new(info.id);
@@ -144,7 +164,22 @@ impl Gpu {
             unsaved: Mutex::new(Vec::new()),
             save_all: false.into(),
             builds: Mutex::new(Vec::new()),
+            fp,
+            extra_options: std::env::var("SHAPECUE_CL_OPTIONS").unwrap_or_default(),
         })
+    }
+
+    /// How this `Gpu` builds floating-point arithmetic.
+    pub fn fp_mode(&self) -> FpMode {
+        self.fp
+    }
+
+    /// Whether the kernels compute what their CPU twins compute bit for bit
+    /// on this device: the strict mode on a device with correctly rounded
+    /// f32 divide and square root. Elsewhere the promises of bits hold
+    /// within a tolerance (docs/accuracy.md).
+    pub fn bitwise_twins(&self) -> bool {
+        self.fp == FpMode::Strict && self.info.correctly_rounded_div_sqrt
     }
 
     /// The OpenCL context.
@@ -169,8 +204,13 @@ impl Gpu {
             return Ok(p.clone());
         }
         let t0 = Instant::now();
-        let src = program::assemble(file);
-        let opts = program::full_options(options);
+        let src = program::assemble_as(file, self.fp);
+        let opts = program::full_options(
+            options,
+            self.fp,
+            self.info.correctly_rounded_div_sqrt,
+            &self.extra_options,
+        );
         let key = cache::key(&[src.as_bytes(), opts.as_bytes(), self.cache_tag.as_bytes()]);
         let from_cache = self.cache_dir.as_deref().map(|dir| {
             cache::load(dir, key)

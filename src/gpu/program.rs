@@ -8,6 +8,7 @@
 use crate::error::{Error, Result};
 use opencl3::context::Context;
 use opencl3::program::Program;
+use serde::Serialize;
 
 /// One kernel family's source and the shared headers it uses (each family's
 /// is declared in `stages::kernel_files`).
@@ -34,9 +35,53 @@ pub const COMMON_HEADERS: &[(&str, &str)] = &[
     ),
 ];
 
-/// The full text handed to the compiler.
-pub fn assemble(file: &KernelFile) -> String {
+/// `kernels/common/strict.h`: the floating-point rules put first in every
+/// program built in [`FpMode::Strict`].
+pub const STRICT_HEADER: (&str, &str) = (
+    "common/strict.h",
+    include_str!("../../kernels/common/strict.h"),
+);
+
+/// How strictly a [`super::Gpu`] builds floating-point arithmetic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FpMode {
+    /// Every program opens with `kernels/common/strict.h` (no contraction
+    /// into fused multiply-adds) and, where the device reports
+    /// `CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT`, is built with
+    /// `-cl-fp32-correctly-rounded-divide-sqrt`: the kernels compute what
+    /// their CPU twins compute, bit for bit, on every conforming device.
+    #[default]
+    Strict,
+    /// What a GPU compiler does by default: contraction on
+    /// (`FP_CONTRACT ON`, `-cl-mad-enable`) and divide and square root to
+    /// OpenCL's looser bounds. For measuring what the strict rules cost.
+    Relaxed,
+}
+
+impl FpMode {
+    /// The name in stats, reports and `SHAPECUE_FP`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FpMode::Strict => "strict",
+            FpMode::Relaxed => "relaxed",
+        }
+    }
+}
+
+/// The full text handed to the compiler: the floating-point rules of `fp`,
+/// the family's headers, then its source with its includes expanded.
+pub fn assemble_as(file: &KernelFile, fp: FpMode) -> String {
     let mut s = String::new();
+    match fp {
+        FpMode::Strict => {
+            let (name, text) = STRICT_HEADER;
+            s.push_str(&format!("#line 1 \"kernels/{name}\"\n"));
+            s.push_str(text);
+            s.push('\n');
+        }
+        FpMode::Relaxed => s.push_str("#pragma OPENCL FP_CONTRACT ON\n"),
+    }
     for (name, text) in file.headers {
         s.push_str(&format!("#line 1 \"kernels/{name}\"\n"));
         s.push_str(text);
@@ -76,16 +121,36 @@ pub(crate) fn driver_lock() -> std::sync::MutexGuard<'static, ()> {
 }
 
 /// The options handed to the compiler for `options`: the OpenCL C version
-/// first (1.2, unless `options` names one).
-pub(crate) fn full_options(options: &str) -> String {
-    if options
+/// first (1.2, unless `options` names one), then `options`, then the
+/// floating-point options of `fp` (`correctly_rounded`: the device reports
+/// `CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT`, without which the option is not
+/// allowed), then `extra` (`SHAPECUE_CL_OPTIONS`).
+pub(crate) fn full_options(
+    options: &str,
+    fp: FpMode,
+    correctly_rounded: bool,
+    extra: &str,
+) -> String {
+    let mut s = if options
         .split_whitespace()
         .any(|o| o.starts_with("-cl-std="))
     {
         options.to_string()
     } else {
         format!("-cl-std=CL1.2 {options}")
+    };
+    match fp {
+        FpMode::Strict if correctly_rounded => {
+            s.push_str(" -cl-fp32-correctly-rounded-divide-sqrt")
+        }
+        FpMode::Strict => {}
+        FpMode::Relaxed => s.push_str(" -cl-mad-enable"),
     }
+    if !extra.trim().is_empty() {
+        s.push(' ');
+        s.push_str(extra.trim());
+    }
+    s.trim().to_string()
 }
 
 /// Builds `src` (the [`assemble`]d text of `file`) from source with `opts`

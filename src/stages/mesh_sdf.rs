@@ -86,10 +86,11 @@ pub struct MeshSdf {
     finish: Kernel,
 }
 
-/// The options the kernels are built with: correctly rounded `f32` division
-/// and square root (as in the CPU twin) and the fixed-point bits.
+/// The options the kernels are built with: the fixed-point bits. Correctly
+/// rounded `f32` division and square root, as in the CPU twin, come with
+/// every strict build ([`crate::gpu::FpMode`]).
 pub fn build_options() -> String {
-    format!("-cl-fp32-correctly-rounded-divide-sqrt -DSC_FIX_BITS={FIX_BITS}")
+    format!("-DSC_FIX_BITS={FIX_BITS}")
 }
 
 /// Front door: prepares `mesh` ([`prepare`]), converts it on `gpu` and

@@ -79,14 +79,13 @@ pub struct Fuser {
 }
 
 /// Build options of `kernels/vertex_fusion.cl` and `kernels/marching_cubes.cl`:
-/// correctly rounded division so positions match the CPU twin bit for bit,
-/// and an optional hash mask that forces collisions (tests).
+/// an optional hash mask that forces collisions (tests). Correctly rounded
+/// division, so that positions match the CPU twin bit for bit, comes with
+/// every strict build ([`crate::gpu::FpMode`]).
 pub fn build_options(collide_mask: Option<u32>) -> String {
-    let mut s = String::from("-cl-fp32-correctly-rounded-divide-sqrt");
-    if let Some(m) = collide_mask {
-        s.push_str(&format!(" -DSC_HASH_COLLIDE={m:#x}u"));
-    }
-    s
+    collide_mask
+        .map(|m| format!("-DSC_HASH_COLLIDE={m:#x}u"))
+        .unwrap_or_default()
 }
 
 impl Fuser {
