@@ -8,7 +8,21 @@
 // (CL_DEVICE_SINGLE/DOUBLE_FP_ATOMIC_CAPABILITIES_EXT); Intel's CPU compiler
 // does not define the extension's __opencl_c_ext_fp*_global_atomic_add
 // feature macros, so they are not tested here.
-#ifdef SC_NATIVE_ATOMICS
+// With -DSC_PTX_ATOMICS (NVIDIA's CUDA platform without the extension): the
+// paper's CUDA atomicAdd as inline PTX, red.global.add (f64: sm_60 and later).
+#ifdef SC_PTX_ATOMICS
+#ifdef SC_DOUBLE
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    asm volatile("red.global.add.f64 [%0], %1;" ::"l"(p), "d"(v) : "memory");
+}
+#else
+inline void atomic_add_real(volatile __global REAL *p, REAL v)
+{
+    asm volatile("red.global.add.f32 [%0], %1;" ::"l"(p), "f"(v) : "memory");
+}
+#endif
+#elif defined(SC_NATIVE_ATOMICS)
 #ifdef SC_DOUBLE
 inline void atomic_add_real(volatile __global REAL *p, REAL v)
 {

@@ -45,9 +45,9 @@ pub struct CurvatureArgs {
     weld: bool,
     /// One-ring accumulation: float atomics per face (Griffin et al.; as
     /// compare-and-swap loops, or atomic-native: the device's own float
-    /// atomic add, cl_ext_float_atomics), or per-vertex gather (bitwise
-    /// reproducible). Default: gather on CPU devices, atomic on GPUs (the
-    /// faster exact scheme of each).
+    /// atomic add, cl_ext_float_atomics or NVIDIA's PTX red.global.add), or
+    /// per-vertex gather (bitwise reproducible). Default: gather, the faster
+    /// exact scheme on CPU devices and GPUs measured (--stats says why).
     #[arg(long, value_parser = super::choice::<Accumulate>())]
     accumulate: Option<Accumulate>,
     /// Faces per work-item of the per-face kernels (and vertices per
@@ -179,7 +179,15 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             let mut stats = serde_json::json!({
                 "device": r.gpu.info,
                 "accumulate": opts.accumulate.name(),
+                "accumulate_why": match a.accumulate {
+                    Some(_) => "given with --accumulate",
+                    None => Accumulate::why_default(&r.gpu.info.kind),
+                },
                 "face_lanes": r.estimator.est.face_lanes(),
+                "face_lanes_why": match opts.lanes {
+                    0 => shapecue::spec::curvature::why_face_lanes(&r.gpu.info.kind),
+                    _ => "given with --lanes",
+                },
                 "order": if r.reordered() { "spatial" } else { "input" },
                 "topology_ms": r.estimator.est.topology_ms(),
                 "passes": passes(&r.timing),

@@ -19,7 +19,7 @@ use std::sync::Arc;
 pub struct KernelsArgs {
     /// One-ring accumulation variants to build (comma-separated), as in
     /// `shapecue curvature --accumulate`. Default: the device type's default
-    /// (gather on CPU devices, atomic on GPUs).
+    /// (gather, the faster exact scheme on CPU devices and GPUs).
     #[arg(long, value_parser = super::choice::<Accumulate>(), value_delimiter = ',')]
     accumulate: Vec<Accumulate>,
     /// SIMD lanes of the gather variant, as in `shapecue curvature

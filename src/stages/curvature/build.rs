@@ -48,11 +48,27 @@ pub(super) struct Built {
     pub(super) build_ms: f64,
 }
 
+/// How a device adds floats atomically for `--accumulate atomic-native`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NativeAdds {
+    /// `cl_ext_float_atomics` (OpenCL C 3.0 `atomic_fetch_add_explicit`).
+    Extension,
+    /// Inline PTX `red.global.add` on NVIDIA's CUDA platform, the paper's
+    /// CUDA `atomicAdd`, where the extension is missing.
+    Ptx,
+}
+
 /// Build options of `kernels/curvature.cl` for a variant, with `lanes` faces
 /// per work-item in the per-face kernels; `pair_adds`: the compare-and-swap
 /// scheme in f32 adds two adjacent floats in one 64-bit compare-and-swap
-/// where it can (the device has `cl_khr_int64_base_atomics`).
-pub fn build_options(opts: &CurvatureOptions, lanes: u32, pair_adds: bool) -> String {
+/// where it can (the device has `cl_khr_int64_base_atomics`); `native`: how
+/// `atomic-native` adds.
+pub fn build_options(
+    opts: &CurvatureOptions,
+    lanes: u32,
+    pair_adds: bool,
+    native: NativeAdds,
+) -> String {
     let mut s = String::new();
     if pair_adds && opts.accumulate == Accumulate::Atomic && opts.precision == Precision::F32 {
         s.push_str("-DSC_PAIR_ADDS ");
@@ -65,9 +81,13 @@ pub fn build_options(opts: &CurvatureOptions, lanes: u32, pair_adds: bool) -> St
     if lanes > 1 {
         s.push_str(&format!("-DSC_LANES={lanes} "));
     }
-    if opts.accumulate == Accumulate::AtomicNative {
+    match (opts.accumulate, native) {
         // atomic_fetch_add_explicit on atomic_float needs OpenCL C 2.0 or later
-        s.push_str("-cl-std=CL3.0 -DSC_NATIVE_ATOMICS ");
+        (Accumulate::AtomicNative, NativeAdds::Extension) => {
+            s.push_str("-cl-std=CL3.0 -DSC_NATIVE_ATOMICS ")
+        }
+        (Accumulate::AtomicNative, NativeAdds::Ptx) => s.push_str("-DSC_PTX_ATOMICS "),
+        _ => {}
     }
     if opts.precision == Precision::F64 {
         s.push_str("-DSC_DOUBLE ");
@@ -128,16 +148,22 @@ impl CurvatureEstimator {
                 });
             }
         }
-        let native = match opts.precision {
+        let extension = match opts.precision {
             Precision::F32 => gpu.info.float_atomics,
             Precision::F64 => gpu.info.double_atomics,
         };
-        if opts.accumulate == Accumulate::AtomicNative && !native {
+        let native_adds = if extension {
+            NativeAdds::Extension
+        } else {
+            NativeAdds::Ptx
+        };
+        if opts.accumulate == Accumulate::AtomicNative && !extension && !gpu.info.ptx {
             return Err(Error::DeviceUnsupported {
                 device: gpu.info.name.clone(),
                 what: format!(
                     "--accumulate atomic-native needs native {} float atomic adds \
-                     (cl_ext_float_atomics); use --accumulate atomic or gather",
+                     (cl_ext_float_atomics, or NVIDIA's CUDA platform for inline PTX); \
+                     use --accumulate atomic or gather",
                     opts.precision.name()
                 ),
             });
@@ -155,7 +181,7 @@ impl CurvatureEstimator {
         let lanes = crate::spec::curvature::face_lanes_for(opts.lanes, &gpu.info.kind, native);
         let file = kernel_files::CURVATURE;
         let pair_adds = gpu.info.int64_atomics;
-        let program = gpu.program(&file, &build_options(opts, lanes, pair_adds))?;
+        let program = gpu.program(&file, &build_options(opts, lanes, pair_adds, native_adds))?;
         let scheme = if opts.accumulate == Accumulate::Gather {
             SchemeKernels::Gather(gather::Kernels::new(gpu, &program)?)
         } else {
