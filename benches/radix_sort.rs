@@ -23,6 +23,7 @@ use criterion::{
 use opencl3::memory::Buffer;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::splitmix;
+use shapecue::spec::radix_sort::Strategy;
 use shapecue::stages::radix_sort::RadixSort;
 use shapecue::stages::scan::Scan;
 use std::time::{Duration, Instant};
@@ -121,7 +122,25 @@ fn benches(c: &mut Criterion) {
             w.as_secs_f64() * 1e3,
             sorter.scratch_bytes() >> 20
         );
-        for (variant, wall) in [("device", false), ("device-wall", true)] {
+        // The device's own strategy (buckets or LSD per call on CPU devices,
+        // work-groups on GPUs), then each strategy forced, kernel time.
+        let default = sorter.last_strategy();
+        for (variant, wall, strategy) in [
+            ("device", false, None),
+            ("device-wall", true, None),
+            ("work-groups", false, Some(Strategy::WorkGroups)),
+            ("lsd", false, Some(Strategy::Lsd)),
+        ] {
+            match strategy {
+                Some(s) => sorter.set_strategy(Some(s)),
+                None if default == Some(Strategy::WorkGroups) => {
+                    sorter.set_strategy(Some(Strategy::WorkGroups))
+                }
+                None => sorter.set_strategy(None),
+            }
+            if strategy.is_some() {
+                input.run(&gpu, &mut sorter, 1); // JIT warm-up
+            }
             let mut g = c.benchmark_group("radix_sort");
             configure(&mut g, n);
             g.bench_function(format!("{variant}/{name}"), |b| {
@@ -132,6 +151,11 @@ fn benches(c: &mut Criterion) {
             });
             g.finish();
         }
+        sorter.set_strategy(if default == Some(Strategy::WorkGroups) {
+            default
+        } else {
+            None
+        });
         drop(input);
 
         let values = upload(&gpu, &random(n, 256.0, 43));

@@ -17,21 +17,23 @@
 //                                  bounds read from hist) by the bits below the top digit
 // Every step walks its data in input order, so the sort is stable.
 //
-// Only the MSD pass goes through DRAM; each bucket is then sorted in the
-// core's cache. Keys whose top digit is mostly the same would leave one
-// work-item most of the pairs, so for those the host runs plain LSD passes
-// (radix_histogram, scan, radix_scatter per digit, shift/mask picking it).
-// Why this shape: docs/notes/isosurface-kernels.md.
+// Only the MSD pass goes through DRAM (CPUs: docs/notes/isosurface-kernels.md);
+// for skewed top digits the host runs plain LSD passes of the same kernels.
 //
 // Buffers:
 //   keys, values          uint[n]         caller's pairs: input, and the output
 //   keys_tmp, values_tmp  uint[n]         after the MSD pass (ping-pong in radix_bucket_sort)
 //   hist                  uint[RADIX*G]   top-digit counts, then (scanned) offsets
-// A work-item owns one block (histogram, scatter) or one bucket (bucket sort),
-// keeps its RADIX counters in a private array and streams through its data
-// serially, which suits a CPU device (PoCL does not vectorise loops over
-// private arrays across work-items, and need not here).
+// A work-item owns one block or bucket and streams through it serially with
+// RADIX private counters, which suits a CPU device.
 //
+// On GPUs (Satish, Harris & Garland 2009) LSD passes of WG_BITS-bit digits
+// run per work-group of WG work-items on tiles of TILE pairs:
+//   radix_wg_histogram  per tile  digit counts in local memory: hist[d*G + g]
+//   (scan)                        exclusive scan of hist
+//   radix_wg_scatter    per tile  tile staged in local memory, stable local
+//                                 ranks (per-item counts, work-group scan), then
+//                                 out[hist[d*G + g] + rank] = pair
 // Build option: -DRADIX_BITS=<digit width> (the host passes it).
 
 #ifndef RADIX_BITS
@@ -138,6 +140,100 @@ __kernel void radix_bucket_sort(const uint n, const uint blocks, const uint low_
         for (uint i = begin; i < end; ++i) {
             keys_b[i] = ks[i];
             values_b[i] = vs[i];
+        }
+    }
+}
+
+// ---- Work-group LSD passes (GPUs). Mirrors spec::radix_sort: WG_SIZE,
+// WG_ITEMS, WG_BITS. A work-item owns WG_ITEMS consecutive pairs of its tile,
+// so ranking work-item by work-item, item by item, keeps the input order.
+#define WG_SIZE 64
+#define WG_ITEMS 16
+#define WG_TILE (WG_SIZE * WG_ITEMS)
+#define WG_BITS 4
+#define WG_RADIX (1u << WG_BITS)
+
+__kernel __attribute__((reqd_work_group_size(WG_SIZE, 1, 1)))
+void radix_wg_histogram(const uint n, const uint shift, const uint mask,
+                        __global const uint *keys_in, __global uint *hist)
+{
+    __local uint count[WG_RADIX];
+    const uint t = (uint)get_local_id(0), g = (uint)get_group_id(0);
+    const uint groups = (uint)get_num_groups(0);
+    if (t < WG_RADIX)
+        count[t] = 0;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    const uint base = g * WG_TILE;
+    for (uint i = 0; i < WG_ITEMS; ++i) {
+        const uint at = base + i * WG_SIZE + t; // coalesced
+        if (at < n)
+            atomic_inc(&count[(keys_in[at] >> shift) & mask]);
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (t < WG_RADIX)
+        hist[t * groups + g] = count[t];
+}
+
+__kernel __attribute__((reqd_work_group_size(WG_SIZE, 1, 1)))
+void radix_wg_scatter(const uint n, const uint shift, const uint mask,
+                      __global const uint *keys_in, __global const uint *values_in,
+                      __global const uint *hist,
+                      __global uint *keys_out, __global uint *values_out)
+{
+    __local uint tile[WG_TILE];
+    __local uint rank[WG_RADIX * WG_SIZE]; // digit-major: rank[d * WG_SIZE + t]
+    __local uint sums[WG_SIZE];
+    const uint t = (uint)get_local_id(0), g = (uint)get_group_id(0);
+    const uint groups = (uint)get_num_groups(0);
+    const uint base = g * WG_TILE;
+    for (uint i = 0; i < WG_ITEMS; ++i) {
+        const uint at = base + i * WG_SIZE + t;
+        tile[i * WG_SIZE + t] = at < n ? keys_in[at] : 0u;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    const uint mine = t * WG_ITEMS; // this work-item's first pair in the tile
+    uint c[WG_RADIX];
+    for (uint d = 0; d < WG_RADIX; ++d)
+        c[d] = 0;
+    for (uint i = 0; i < WG_ITEMS; ++i)
+        if (base + mine + i < n)
+            c[(tile[mine + i] >> shift) & mask] += 1;
+    for (uint d = 0; d < WG_RADIX; ++d)
+        rank[d * WG_SIZE + t] = c[d];
+    barrier(CLK_LOCAL_MEM_FENCE);
+    // Exclusive scan of rank[] (WG_RADIX * WG_SIZE entries): each work-item
+    // its WG_RADIX consecutive entries, then the work-items' sums.
+    uint run = 0;
+    for (uint j = 0; j < WG_RADIX; ++j) {
+        const uint v = rank[t * WG_RADIX + j];
+        rank[t * WG_RADIX + j] = run;
+        run += v;
+    }
+    sums[t] = run;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (t == 0) {
+        uint r = 0;
+        for (uint s = 0; s < WG_SIZE; ++s) {
+            const uint v = sums[s];
+            sums[s] = r;
+            r += v;
+        }
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint j = 0; j < WG_RADIX; ++j)
+        rank[t * WG_RADIX + j] += sums[t];
+    barrier(CLK_LOCAL_MEM_FENCE);
+    // Digit d of this work-item goes to the tile's slots for d (from the
+    // scanned histogram) plus the pairs of d before it in the tile.
+    for (uint d = 0; d < WG_RADIX; ++d)
+        c[d] = hist[d * groups + g] + rank[d * WG_SIZE + t] - rank[d * WG_SIZE];
+    for (uint i = 0; i < WG_ITEMS; ++i) {
+        const uint at = base + mine + i;
+        if (at < n) {
+            const uint k = tile[mine + i];
+            const uint to = c[(k >> shift) & mask]++;
+            keys_out[to] = k;
+            values_out[to] = values_in[at];
         }
     }
 }

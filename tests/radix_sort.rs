@@ -211,6 +211,8 @@ fn the_cpu_reference_gives_the_same_result_for_any_block_length() {
 #[test]
 fn skewed_keys_take_the_lsd_path_and_spread_keys_the_bucket_path() {
     let mut sorter = RadixSort::new(gpu()).unwrap();
+    // the CPU devices' choice per call (GPUs default to work-groups)
+    sorter.set_strategy(None);
     let n = (1 << 20) + 7;
     let keys = random_keys(n, 12);
     check(&mut sorter, "random", &keys, 32);
@@ -235,4 +237,31 @@ fn skewed_keys_take_the_lsd_path_and_spread_keys_the_bucket_path() {
     assert_eq!(sorter.last_strategy(), Some(Strategy::Lsd));
     check(&mut sorter, "nothing to do", &low[..1], 24);
     assert_eq!(sorter.last_strategy(), None);
+}
+
+/// The GPU strategy (work-group tiles, local ranks, 4-bit LSD passes) and the
+/// plain LSD passes, forced on whatever device runs the tests: every size,
+/// pattern and key width gives `std`'s stable order.
+#[test]
+fn work_group_and_lsd_strategies_sort_every_size_pattern_and_width() {
+    for strategy in [Strategy::WorkGroups, Strategy::Lsd] {
+        let mut sorter = RadixSort::new(gpu()).unwrap();
+        sorter.set_strategy(Some(strategy));
+        for (i, &n) in SIZES.iter().enumerate() {
+            for (what, keys) in patterns(n, 300 + i as u64) {
+                check(&mut sorter, what, &keys, 32);
+                if n >= 2 {
+                    assert_eq!(sorter.last_strategy(), Some(strategy), "{what}");
+                }
+            }
+        }
+        let keys = random_keys(100_003, 9);
+        for bits in [1, 4, 5, 8, 12, 13, 20, 24, 31] {
+            check(&mut sorter, "odd width, high bits set", &keys, bits);
+        }
+        // tiles that end mid-tile and sizes around a tile
+        for n in [1023, 1024, 1025, 4097] {
+            check(&mut sorter, "around a tile", &random_keys(n, n as u64), 32);
+        }
+    }
 }

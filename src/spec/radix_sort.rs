@@ -54,6 +54,41 @@ pub enum Strategy {
     /// A bucket held more than `1/SKEW_LIMIT` of the pairs: plain LSD passes
     /// over the whole data set instead, so that all work-items share the work.
     Lsd,
+    /// GPUs: LSD passes of [`WG_BITS`]-bit digits, each tile of [`WG_TILE`]
+    /// pairs counted and ranked by one work-group in local memory, with a
+    /// device-wide scan between (Satish, Harris & Garland 2009).
+    WorkGroups,
+}
+
+impl Strategy {
+    /// The name in stats and bench ids.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Buckets => "buckets",
+            Strategy::Lsd => "lsd",
+            Strategy::WorkGroups => "work-groups",
+        }
+    }
+}
+
+/// Work-items per work-group of [`Strategy::WorkGroups`] (`WG_SIZE` in the
+/// kernel; the same as [`crate::gpu::LOCAL_SIZE`]'s value).
+pub const WG_SIZE: usize = 64;
+/// Consecutive pairs each work-item ranks (`WG_ITEMS`).
+pub const WG_ITEMS: usize = 16;
+/// Pairs per tile (`WG_TILE`).
+pub const WG_TILE: usize = WG_SIZE * WG_ITEMS;
+/// Bits per digit of [`Strategy::WorkGroups`] (`WG_BITS`): 16 counters per
+/// work-item fit local memory.
+pub const WG_BITS: u32 = 4;
+/// Digits per pass of [`Strategy::WorkGroups`].
+pub const WG_RADIX: usize = 1 << WG_BITS;
+
+/// Tiles (work-groups) of a [`Strategy::WorkGroups`] pass over `n` pairs,
+/// and the entries of its histogram (`WG_RADIX` per tile).
+pub fn wg_tiles(n: usize) -> (usize, usize) {
+    let tiles = n.div_ceil(WG_TILE);
+    (tiles, WG_RADIX * tiles)
 }
 
 /// A sort whose largest top-digit bucket holds more than `n / SKEW_LIMIT`
@@ -71,5 +106,9 @@ crate::spec::kernels::kernel_entries! {
         Scatter = "radix_scatter",
         /// Sorting of small buckets in local memory.
         BucketSort = "radix_bucket_sort",
+        /// Digit counts of a tile, in a work-group (GPUs).
+        WgHistogram = "radix_wg_histogram",
+        /// Stable local ranks and scatter of a tile (GPUs).
+        WgScatter = "radix_wg_scatter",
     }
 }

@@ -29,6 +29,14 @@
 //! point) and, when the largest exceeds `n / SKEW_LIMIT`, runs plain LSD
 //! passes (histogram, scan, scatter per digit) over the whole data set instead
 //! ([`Strategy::Lsd`]).
+//!
+//! That shape suits CPU devices, whose work-items are cores; on a GPU 256
+//! serial work-items leave the card idle (an H200 took 335 ms for 7.57M
+//! pairs). GPUs run [`Strategy::WorkGroups`] instead: LSD passes of
+//! [`WG_BITS`]-bit digits, `radix_wg_histogram` and `radix_wg_scatter` per
+//! tile of [`WG_TILE`] pairs with their counts and stable ranks in local
+//! memory, and the device-wide [`Scan`] between (Satish, Harris & Garland
+//! 2009). [`RadixSort::set_strategy`] picks one for every device.
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
@@ -43,7 +51,13 @@ use opencl3::types::CL_BLOCKING;
 use std::ffi::c_void;
 use std::sync::Arc;
 
-use crate::spec::radix_sort::{DIGIT_BITS, RADIX, SKEW_LIMIT, Strategy, blocking, digits};
+use crate::spec::radix_sort::{
+    DIGIT_BITS, RADIX, SKEW_LIMIT, Strategy, WG_BITS, blocking, digits, wg_tiles,
+};
+
+// The work-group kernels are launched through `launch`, whose work-groups
+// are LOCAL_SIZE work-items: the kernels' WG_SIZE must be the same.
+const _: () = assert!(crate::gpu::LOCAL_SIZE == crate::spec::radix_sort::WG_SIZE);
 
 /// Stable device radix sort of (key, value) pairs; kernels built once,
 /// scratch kept between calls.
@@ -53,6 +67,11 @@ pub struct RadixSort {
     histogram: Kernel,
     scatter: Kernel,
     bucket_sort: Kernel,
+    wg_histogram: Kernel,
+    wg_scatter: Kernel,
+    /// `Some(Strategy::WorkGroups)` on GPUs (or as set), `None`: buckets or
+    /// LSD per call.
+    forced: Option<Strategy>,
     keys_tmp: Buffer<u32>,
     values_tmp: Buffer<u32>,
     tmp_len: usize,
@@ -73,6 +92,9 @@ impl RadixSort {
             histogram: gpu.entry(&program, RadixKernel::Histogram)?,
             scatter: gpu.entry(&program, RadixKernel::Scatter)?,
             bucket_sort: gpu.entry(&program, RadixKernel::BucketSort)?,
+            wg_histogram: gpu.entry(&program, RadixKernel::WgHistogram)?,
+            wg_scatter: gpu.entry(&program, RadixKernel::WgScatter)?,
+            forced: (!gpu.info.kind.eq_ignore_ascii_case("CPU")).then_some(Strategy::WorkGroups),
             keys_tmp: gpu.buffer::<u32>(1)?,
             values_tmp: gpu.buffer::<u32>(1)?,
             tmp_len: 0,
@@ -113,10 +135,18 @@ impl RadixSort {
         if n < 2 || key_bits == 0 {
             return Ok(());
         }
+        let mut events: Vec<Event> = Vec::with_capacity(8);
+        if self.forced == Some(Strategy::WorkGroups) {
+            self.reserve(n, wg_tiles(n).1)?;
+            self.last_strategy = Some(Strategy::WorkGroups);
+            self.work_groups(keys, values, n, key_bits, &mut events)?;
+            self.gpu.finish()?;
+            self.last_ms = events.iter().map(event_ms).sum();
+            return Ok(());
+        }
         let blocks = blocking(n).1;
         self.reserve(n, histogram_len_bound(n))?;
         let (top, low) = digits(key_bits);
-        let mut events: Vec<Event> = Vec::with_capacity(8);
 
         // Top-digit histogram and its scan, then the bucket sizes to the host.
         let msd = Self::pass_args(n, top, low);
@@ -127,7 +157,7 @@ impl RadixSort {
         events.extend(self.scan.enqueue(&self.hist, &self.hist, RADIX * blocks)?);
         let largest = self.largest_bucket(n, blocks)?;
 
-        if largest <= n / SKEW_LIMIT {
+        if largest <= n / SKEW_LIMIT && self.forced != Some(Strategy::Lsd) {
             self.last_strategy = Some(Strategy::Buckets);
             let (keys_tmp, values_tmp) = (buf(&self.keys_tmp), buf(&self.values_tmp));
             let mut args = msd.to_vec();
@@ -237,23 +267,83 @@ impl RadixSort {
             events.extend(launch(&self.gpu, &self.scatter, blocks, &args)?);
         }
         if passes % 2 == 1 {
-            let bytes = n * 4;
-            let q = self.gpu.queue();
-            // SAFETY: both buffers hold at least n elements (checked by the
-            // caller and by `reserve`); the in-order queue orders the copies
-            // after the last pass.
-            unsafe {
-                events.push(
-                    q.enqueue_copy_buffer(&self.keys_tmp, keys, 0, 0, bytes, &[])
-                        .map_err(|e| Error::cl("clEnqueueCopyBuffer(keys)", e))?,
-                );
-                events.push(
-                    q.enqueue_copy_buffer(&self.values_tmp, values, 0, 0, bytes, &[])
-                        .map_err(|e| Error::cl("clEnqueueCopyBuffer(values)", e))?,
-                );
-            }
+            self.copy_back(keys, values, n, events)?;
         }
         Ok(())
+    }
+
+    /// [`Strategy::WorkGroups`]: one histogram, scan and scatter per digit
+    /// of [`WG_BITS`] bits, ping-ponging with the scratch; an odd number of
+    /// passes ends with a copy back.
+    fn work_groups(
+        &mut self,
+        keys: &mut Buffer<u32>,
+        values: &mut Buffer<u32>,
+        n: usize,
+        key_bits: u32,
+        events: &mut Vec<Event>,
+    ) -> Result<()> {
+        let (tiles, hist_len) = wg_tiles(n);
+        let items = tiles * crate::spec::radix_sort::WG_SIZE;
+        let passes = key_bits.div_ceil(WG_BITS);
+        let (hist, keys_tmp, values_tmp) =
+            (buf(&self.hist), buf(&self.keys_tmp), buf(&self.values_tmp));
+        let (user_keys, user_values) = (buf(&*keys), buf(&*values));
+        for pass in 0..passes {
+            let shift = pass * WG_BITS;
+            let mask = (1u32 << (key_bits - shift).min(WG_BITS)) - 1;
+            let (kin, vin, kout, vout) = if pass % 2 == 0 {
+                (user_keys, user_values, keys_tmp, values_tmp)
+            } else {
+                (keys_tmp, values_tmp, user_keys, user_values)
+            };
+            let common = [Arg::U32(n as u32), Arg::U32(shift), Arg::U32(mask)];
+            let mut args = common.to_vec();
+            args.extend([kin, hist]);
+            events.extend(launch(&self.gpu, &self.wg_histogram, items, &args)?);
+            events.extend(self.scan.enqueue(&self.hist, &self.hist, hist_len)?);
+            let mut args = common.to_vec();
+            args.extend([kin, vin, hist, kout, vout]);
+            events.extend(launch(&self.gpu, &self.wg_scatter, items, &args)?);
+        }
+        if passes % 2 == 1 {
+            self.copy_back(keys, values, n, events)?;
+        }
+        Ok(())
+    }
+
+    /// Copies the first `n` pairs of the scratch into the caller's buffers.
+    fn copy_back(
+        &self,
+        keys: &mut Buffer<u32>,
+        values: &mut Buffer<u32>,
+        n: usize,
+        events: &mut Vec<Event>,
+    ) -> Result<()> {
+        let bytes = n * 4;
+        let q = self.gpu.queue();
+        // SAFETY: both buffers hold at least n elements (checked by the
+        // caller and by `reserve`); the in-order queue orders the copies
+        // after the last pass.
+        unsafe {
+            events.push(
+                q.enqueue_copy_buffer(&self.keys_tmp, keys, 0, 0, bytes, &[])
+                    .map_err(|e| Error::cl("clEnqueueCopyBuffer(keys)", e))?,
+            );
+            events.push(
+                q.enqueue_copy_buffer(&self.values_tmp, values, 0, 0, bytes, &[])
+                    .map_err(|e| Error::cl("clEnqueueCopyBuffer(values)", e))?,
+            );
+        }
+        Ok(())
+    }
+
+    /// Sets the strategy of every later sort: `Some(WorkGroups)` or
+    /// `Some(Lsd)` always, `Some(Buckets)` or `None` as chosen per call
+    /// (buckets, LSD for skewed keys). The default is `WorkGroups` on GPUs
+    /// and `None` on CPU devices.
+    pub fn set_strategy(&mut self, s: Option<Strategy>) {
+        self.forced = s.filter(|s| *s != Strategy::Buckets);
     }
 
     /// Grows the scratch to `n` pairs and `hist_len` counters.
