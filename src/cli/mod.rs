@@ -95,7 +95,9 @@ pub fn fail(e: &anyhow::Error) -> i32 {
         prev = text;
     }
     eprintln!("error: {msg}");
-    if e.chain().any(|c| c.downcast_ref::<view::NoDisplay>().is_some()) {
+    if e.chain()
+        .any(|c| c.downcast_ref::<view::NoDisplay>().is_some())
+    {
         return view::NO_DISPLAY;
     }
     e.chain()

@@ -200,7 +200,10 @@ impl App {
             Command::Frame(FrameMove::By(d)) => self.state.step(*d),
             Command::Frame(FrameMove::To(f)) => {
                 if *f >= self.state.frames.len() {
-                    bail!("frame {f}: the scene has {} frame(s)", self.state.frames.len());
+                    bail!(
+                        "frame {f}: the scene has {} frame(s)",
+                        self.state.frames.len()
+                    );
                 }
                 self.state.frame = *f;
             }
@@ -210,7 +213,10 @@ impl App {
                 println!("wrote {}", p.display());
             }
             Command::Passes => {
-                let d = self.shown.as_ref().ok_or_else(|| anyhow!("no frame drawn"))?;
+                let d = self
+                    .shown
+                    .as_ref()
+                    .ok_or_else(|| anyhow!("no frame drawn"))?;
                 let names: Vec<&str> = d.passes.iter().map(|p| p.pass.name()).collect();
                 println!("passes: {}", names.join(" "));
             }
@@ -223,7 +229,10 @@ impl App {
 
     /// Saves the frame on screen as PNG.
     fn screenshot(&self, path: &Path) -> Result<()> {
-        let d = self.shown.as_ref().ok_or_else(|| anyhow!("no frame drawn yet"))?;
+        let d = self
+            .shown
+            .as_ref()
+            .ok_or_else(|| anyhow!("no frame drawn yet"))?;
         let frame = shapecue::render::Frame {
             width: d.image.width(),
             height: d.image.height(),
@@ -270,7 +279,8 @@ impl App {
             match &mut self.texture {
                 Some(t) => t.set(img, egui::TextureOptions::LINEAR),
                 None => {
-                    self.texture = Some(ctx.load_texture("frame", img, egui::TextureOptions::LINEAR))
+                    self.texture =
+                        Some(ctx.load_texture("frame", img, egui::TextureOptions::LINEAR))
                 }
             }
             self.fresh = false;

@@ -25,7 +25,11 @@ pub struct Orbit {
 
 impl Orbit {
     /// The orbit of `view` over world `bounds` at image aspect `aspect`.
-    pub fn new(view: ViewSpec, bounds: ([f64; 3], [f64; 3]), aspect: f32) -> shapecue::Result<Orbit> {
+    pub fn new(
+        view: ViewSpec,
+        bounds: ([f64; 3], [f64; 3]),
+        aspect: f32,
+    ) -> shapecue::Result<Orbit> {
         let (placement, target) = match &view.kind {
             CameraKind::LookAt { eye, target } => {
                 (Placement::At(Vec3::from(*eye)), target.map(Vec3::from))

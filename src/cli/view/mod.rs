@@ -136,8 +136,8 @@ pub fn run(device: Option<&str>, a: ViewArgs) -> Result<()> {
             let wake = Box::new(move || {
                 let _ = proxy.send_event(window::Wake::Reply);
             });
-            let engine = engine::Engine::start(device, wake)
-                .context("cannot start the compute thread")?;
+            let engine =
+                engine::Engine::start(device, wake).context("cannot start the compute thread")?;
             Ok(app::App::new(state, engine, script, out))
         },
         title,

@@ -166,7 +166,10 @@ mod tests {
     fn parses_every_command() {
         let p = |s: &str| parse_line(s, Path::new("")).unwrap().unwrap();
         assert_eq!(p("orbit 30 -10"), Command::Orbit(30.0, -10.0));
-        assert_eq!(p("cue contours off"), Command::Cue("contours".into(), Some(false)));
+        assert_eq!(
+            p("cue contours off"),
+            Command::Cue("contours".into(), Some(false))
+        );
         assert_eq!(p("frame +2"), Command::Frame(FrameMove::By(2)));
         assert_eq!(p("frame 3"), Command::Frame(FrameMove::To(3)));
         assert_eq!(p("screenshot a.png"), Command::Screenshot("a.png".into()));

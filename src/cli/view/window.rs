@@ -58,7 +58,11 @@ struct Handler {
 /// # Errors
 /// [`NoDisplay`] when there is no display to open a window on or no OpenGL
 /// context for it; the app's own errors (a failed frame in a script).
-pub fn run(app_of: impl FnOnce(EventLoopProxy<Wake>) -> anyhow::Result<App>, title: String, inner: [u32; 2]) -> anyhow::Result<()> {
+pub fn run(
+    app_of: impl FnOnce(EventLoopProxy<Wake>) -> anyhow::Result<App>,
+    title: String,
+    inner: [u32; 2],
+) -> anyhow::Result<()> {
     if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
         let wayland = std::env::var_os("WAYLAND_DISPLAY").is_some();
         return Err(NoDisplay(if wayland {
@@ -94,7 +98,11 @@ pub fn run(app_of: impl FnOnce(EventLoopProxy<Wake>) -> anyhow::Result<App>, tit
 }
 
 /// Makes the window and its GL context (EGL, else GLX).
-fn open_window(el: &ActiveEventLoop, title: &str, inner: [u32; 2]) -> Result<(GlWindow, glow::Context), NoDisplay> {
+fn open_window(
+    el: &ActiveEventLoop,
+    title: &str,
+    inner: [u32; 2],
+) -> Result<(GlWindow, glow::Context), NoDisplay> {
     let attrs = Window::default_attributes()
         .with_title(title)
         .with_inner_size(winit::dpi::PhysicalSize::new(inner[0], inner[1]));
@@ -163,9 +171,7 @@ fn open_window(el: &ActiveEventLoop, title: &str, inner: [u32; 2]) -> Result<(Gl
     let _ = surface.set_swap_interval(&context, SwapInterval::DontWait);
     // SAFETY: the context is current on this thread; the loader returns its
     // entry points.
-    let gl = unsafe {
-        glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s))
-    };
+    let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
     Ok((
         GlWindow {
             window,
@@ -257,7 +263,9 @@ impl ApplicationHandler<Wake> for Handler {
             }
             WindowEvent::Resized(s) => {
                 let nz = |v: u32| NonZeroU32::new(v).unwrap_or(NonZeroU32::MIN);
-                open.gl.surface.resize(&open.gl.context, nz(s.width), nz(s.height));
+                open.gl
+                    .surface
+                    .resize(&open.gl.context, nz(s.width), nz(s.height));
             }
             _ => {}
         }
