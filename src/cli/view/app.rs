@@ -40,6 +40,8 @@ pub struct App {
     /// When the animation last moved on; the UI's last repaint.
     played: Instant,
     ui_frame: (Instant, f64),
+    /// Where the next painted window goes (PNG).
+    pub capture: Option<PathBuf>,
     /// Status line (what a key did).
     note: String,
     quit: bool,
@@ -63,6 +65,7 @@ impl App {
             times: Vec::new(),
             played: Instant::now(),
             ui_frame: (Instant::now(), 0.0),
+            capture: None,
             note: String::new(),
             quit: false,
         }
@@ -148,6 +151,10 @@ impl App {
     /// Runs script commands until one needs a frame that is not drawn yet.
     fn run_script(&mut self) -> Result<()> {
         loop {
+            if self.capture.is_some() {
+                // The next repaint saves the window first.
+                return Ok(());
+            }
             let Some(run) = self.script.as_mut() else {
                 return Ok(());
             };
@@ -207,7 +214,9 @@ impl App {
                 }
                 self.state.frame = *f;
             }
-            Command::Wait | Command::Svg(_) => {}
+            Command::Wait => {}
+            Command::Capture(p) => self.capture = Some(p.clone()),
+            Command::Svg(p) => println!("wrote {}", p.display()),
             Command::Screenshot(p) => {
                 self.screenshot(p)?;
                 println!("wrote {}", p.display());
@@ -219,6 +228,12 @@ impl App {
                     .ok_or_else(|| anyhow!("no frame drawn"))?;
                 let names: Vec<&str> = d.passes.iter().map(|p| p.pass.name()).collect();
                 println!("passes: {}", names.join(" "));
+                let times: Vec<String> = d
+                    .passes
+                    .iter()
+                    .map(|p| format!("{} {:.1}", p.pass.name(), p.ms))
+                    .collect();
+                println!("  ms: {}; frame {:.1}", times.join(", "), d.wall_ms);
             }
         }
         if !cmd.needs_frame() {
@@ -409,6 +424,7 @@ impl App {
             egui::Area::new(egui::Id::unique("passes"))
                 .fixed_pos(at)
                 .interactable(false)
+                .fade_in(false)
                 .show(ui.ctx(), |ui| {
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
                         ui.label(format!("{:.1} ms", d.wall_ms));
@@ -468,6 +484,9 @@ impl App {
             moved = before;
         } else if pressed(Key::V) {
             self.save_svg();
+            moved = before;
+        } else if pressed(Key::C) {
+            self.capture = Some(self.free_name("png"));
             moved = before;
         } else if pressed(Key::Q) || pressed(Key::Escape) {
             self.quit = true;

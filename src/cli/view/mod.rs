@@ -141,6 +141,6 @@ pub fn run(device: Option<&str>, a: ViewArgs) -> Result<()> {
             Ok(app::App::new(state, engine, script, out))
         },
         title,
-        [w + 280, h.max(600) + 16],
+        [w + 330, h.max(600) + 16],
     )
 }

@@ -31,6 +31,8 @@ pub enum Command {
     Svg(PathBuf),
     /// Print the passes that ran for the current frame.
     Passes,
+    /// Save the whole window (controls and frame) as PNG.
+    Capture(PathBuf),
 }
 
 /// A frame move.
@@ -53,7 +55,11 @@ impl Command {
     pub fn needs_frame(&self) -> bool {
         matches!(
             self,
-            Command::Wait | Command::Screenshot(_) | Command::Svg(_) | Command::Passes
+            Command::Wait
+                | Command::Screenshot(_)
+                | Command::Svg(_)
+                | Command::Passes
+                | Command::Capture(_)
         )
     }
 }
@@ -125,9 +131,10 @@ fn parse_line(line: &str, base: &Path) -> Result<Option<Command>> {
         "screenshot" => Command::Screenshot(path(w.next())?),
         "svg" => Command::Svg(path(w.next())?),
         "passes" => Command::Passes,
+        "capture" => Command::Capture(path(w.next())?),
         other => bail!(
             "unknown command {other} (orbit, pan, zoom, reset, cue, set, frame, wait, \
-             screenshot, svg, passes)"
+             screenshot, svg, passes, capture)"
         ),
     };
     if let Some(extra) = w.next() {

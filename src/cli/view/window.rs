@@ -50,6 +50,8 @@ struct Handler {
     proxy: EventLoopProxy<Wake>,
     /// A failure to open the window or to draw.
     error: Option<anyhow::Error>,
+    /// Paints since a capture was asked for.
+    painted_for_capture: u32,
 }
 
 /// Opens the window and runs the app until it quits (the user closes the
@@ -87,6 +89,7 @@ pub fn run(
         inner,
         proxy,
         error: None,
+        painted_for_capture: 0,
     };
     event_loop
         .run_app(&mut h)
@@ -204,6 +207,20 @@ impl Handler {
             gl.clear(glow::COLOR_BUFFER_BIT);
         }
         open.egui.paint(&open.gl.window);
+        // egui lays a new overlay out on its first frame unseen: a capture
+        // waits for a second paint.
+        self.painted_for_capture += u32::from(self.app.capture.is_some());
+        if self.painted_for_capture >= 2
+            && let Some(path) = self.app.capture.take()
+        {
+            self.painted_for_capture = 0;
+            let size = open.gl.window.inner_size();
+            let r = save_window(open.egui.painter.gl(), size.width, size.height, &path);
+            match r {
+                Ok(()) => println!("wrote {}", path.display()),
+                Err(e) => return self.fail(el, e),
+            }
+        }
         if let Err(e) = open.gl.surface.swap_buffers(&open.gl.context) {
             let e = anyhow::anyhow!("the window's buffers could not be swapped: {e}");
             self.fail(el, e);
@@ -214,7 +231,7 @@ impl Handler {
             Ok(false) => el.exit(),
             Err(e) => self.fail(el, e),
         }
-        if self.app.wants_frames() {
+        if self.app.wants_frames() || self.app.capture.is_some() {
             self.open.as_ref().map(|o| o.gl.window.request_redraw());
         }
     }
@@ -286,4 +303,41 @@ impl ApplicationHandler<Wake> for Handler {
             o.egui.destroy();
         }
     }
+}
+
+/// Reads the painted back buffer and saves it as PNG (rows flipped: GL's
+/// first row is the bottom one).
+fn save_window(gl: &glow::Context, w: u32, h: u32, path: &std::path::Path) -> anyhow::Result<()> {
+    use glow::HasContext;
+    let mut rgba = vec![0u8; w as usize * h as usize * 4];
+    // SAFETY: the buffer holds w × h RGBA8 pixels, what the call writes.
+    unsafe {
+        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+        gl.read_pixels(
+            0,
+            0,
+            w as i32,
+            h as i32,
+            glow::RGBA,
+            glow::UNSIGNED_BYTE,
+            glow::PixelPackData::Slice(Some(&mut rgba)),
+        );
+    }
+    let row = w as usize * 4;
+    let mut flipped: Vec<u8> = rgba
+        .chunks_exact(row.max(1))
+        .rev()
+        .flatten()
+        .copied()
+        .collect();
+    // The window is opaque whatever alpha its buffer kept.
+    flipped.iter_mut().skip(3).step_by(4).for_each(|a| *a = 255);
+    let frame = shapecue::render::Frame {
+        width: w,
+        height: h,
+        rgba: flipped,
+        depth: Vec::new(),
+    };
+    frame.save_png(path)?;
+    Ok(())
 }
