@@ -71,10 +71,18 @@ impl App {
         }
     }
 
-    /// Whether the event loop should keep repainting (a frame in flight,
-    /// the animation playing, a script running).
+    /// Whether the event loop should repaint at once (a state not sent yet,
+    /// a window capture asked for). Frames from the compute thread wake it
+    /// by themselves, so it does not spin while one is drawn.
     pub fn wants_frames(&self) -> bool {
-        self.state.playing || self.script.is_some() || self.dirty
+        self.dirty || self.capture.is_some()
+    }
+
+    /// How long to wait before the next animation step, while playing.
+    pub fn play_period(&self) -> Option<std::time::Duration> {
+        self.state
+            .playing
+            .then(|| std::time::Duration::from_secs_f32(1.0 / self.state.scene.fps.max(1.0)))
     }
 
     /// Whether the frame on screen is the one of the current state.
@@ -398,7 +406,7 @@ impl App {
         };
         let avail = ui.available_size();
         let [w, h] = tex.size().map(|v| v as f32);
-        let scale = (avail.x / w).min(avail.y / h).min(1.0).max(0.05);
+        let scale = (avail.x / w).min(avail.y / h).clamp(0.05, 1.0);
         let size = egui::vec2(w * scale, h * scale);
         let resp = ui.add(egui::Image::new((tex.id(), size)).sense(Sense::click_and_drag()));
         let shift = ui.input(|i| i.modifiers.shift);

@@ -231,9 +231,15 @@ impl Handler {
             Ok(false) => el.exit(),
             Err(e) => self.fail(el, e),
         }
-        if self.app.wants_frames() || self.app.capture.is_some() {
-            self.open.as_ref().map(|o| o.gl.window.request_redraw());
+        if self.app.wants_frames()
+            && let Some(o) = self.open.as_ref()
+        {
+            o.gl.window.request_redraw();
         }
+        el.set_control_flow(match self.app.play_period() {
+            Some(p) => ControlFlow::WaitUntil(std::time::Instant::now() + p),
+            None => ControlFlow::Wait,
+        });
     }
 }
 
@@ -289,6 +295,15 @@ impl ApplicationHandler<Wake> for Handler {
         let r = open.egui.on_window_event(&open.gl.window, &event);
         if r.repaint {
             open.gl.window.request_redraw();
+        }
+    }
+
+    fn new_events(&mut self, _el: &ActiveEventLoop, cause: winit::event::StartCause) {
+        // The animation's next step is due.
+        if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. })
+            && let Some(o) = &self.open
+        {
+            o.gl.window.request_redraw();
         }
     }
 
