@@ -33,8 +33,9 @@ pub struct App {
     shown: Option<Box<Done>>,
     fresh: bool,
     texture: Option<egui::TextureHandle>,
-    /// The last error of the compute thread.
+    /// The last error of the compute thread, and the request it failed.
     error: Option<String>,
+    failed: Option<u64>,
     /// Frame times (ms, compute thread), for the summary.
     times: Vec<f64>,
     /// When the animation last moved on; the UI's last repaint.
@@ -62,6 +63,7 @@ impl App {
             fresh: false,
             texture: None,
             error: None,
+            failed: None,
             times: Vec::new(),
             played: Instant::now(),
             ui_frame: (Instant::now(), 0.0),
@@ -96,6 +98,7 @@ impl App {
             // Nothing to draw: no request (the planner would plan no pass).
             self.dirty = false;
             self.error = Some("no cue is switched on".into());
+            self.failed = Some(self.sent);
             return;
         }
         self.sent += 1;
@@ -114,6 +117,7 @@ impl App {
                 Reply::Frame(d) => {
                     self.times.push(d.wall_ms);
                     self.error = None;
+                    self.failed = None;
                     if let (Some(svg), Some(to)) = (&d.svg, self.svg_to.as_ref()) {
                         self.note = match copy(svg, to) {
                             Ok(()) => format!("wrote {}", to.display()),
@@ -126,10 +130,7 @@ impl App {
                 }
                 Reply::Failed(id, e) => {
                     self.error = Some(e);
-                    if id == self.sent {
-                        // The state's frame failed: the script stops here.
-                        self.shown = None;
-                    }
+                    self.failed = Some(id);
                 }
             }
         }
@@ -173,8 +174,10 @@ impl App {
             };
             let at = format!("{} line {line}", run.script.path.display());
             if cmd.needs_frame() {
+                // The state's own frame failed (not a stale one): stop here.
                 if let Some(e) = &self.error
                     && !self.dirty
+                    && self.failed == Some(self.sent)
                 {
                     bail!("{at}: the frame failed: {e}");
                 }
@@ -480,7 +483,7 @@ impl App {
             cam.zoom(1.0 / 0.9);
         } else if pressed(Key::R) || pressed(Key::Home) {
             cam.reset();
-        } else if pressed(Key::Space) {
+        } else if pressed(Key::Space) && self.state.frames.len() > 1 {
             self.state.playing = !self.state.playing;
             moved = before;
         } else if pressed(Key::Comma) {

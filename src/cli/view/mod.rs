@@ -71,6 +71,9 @@ fn scene_of_input(input: &str, iso: Option<f32>) -> Result<Scene> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let glob = input.contains(['*', '?', '[']);
+    if !glob && !path.exists() {
+        anyhow::bail!("{}: no such file", path.display());
+    }
     let (line, volume) = if glob {
         (format!("flipbook = {}", quoted(&path)), false)
     } else if ext == "glb" || ext == "gltf" {
