@@ -113,3 +113,44 @@ impl Orbit {
         self.moved = true;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn orbit() -> Orbit {
+        let view = ViewSpec {
+            kind: CameraKind::Fit([0.0, 0.0, 1.0]),
+            up: None,
+            fov: 40.0,
+            ortho: false,
+        };
+        Orbit::new(view, ([-1.0; 3], [1.0; 3]), 4.0 / 3.0).unwrap()
+    }
+
+    #[test]
+    fn orbit_pan_zoom_and_reset() {
+        let mut o = orbit();
+        let home = o.view();
+        let (eye, target) = (o.eye, o.target);
+        let dist = eye.distance(target);
+        o.orbit(30.0, 20.0);
+        assert!((o.eye.distance(o.target) - dist).abs() < 1e-4 * dist);
+        assert!(o.eye.distance(eye) > 0.1 * dist);
+        o.orbit(0.0, -20.0);
+        o.orbit(-30.0, 0.0);
+        assert!(o.eye.distance(eye) < 1e-4 * dist, "{} vs {eye}", o.eye);
+        // Pitch stops short of the pole.
+        o.orbit(0.0, 500.0);
+        let d = (o.eye - o.target).normalize();
+        assert!(d.dot(o.up) < 1.0 - 1e-5 && d.is_finite());
+        o.pan(0.1, 0.0);
+        assert!((o.eye - o.target).is_finite());
+        o.zoom(0.5);
+        assert!((o.eye.distance(o.target) - 0.5 * dist).abs() < 1e-3 * dist);
+        assert!(matches!(o.view().kind, CameraKind::LookAt { .. }));
+        o.reset();
+        assert_eq!(o.view(), home);
+        assert_eq!((o.eye, o.target), (eye, target));
+    }
+}

@@ -261,3 +261,54 @@ fn choice<T: Choice>(key: &str, value: &str) -> Result<T, String> {
             format!("{key}: {value} is not one of {}", names.join(", "))
         })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shapecue::scene::file::CameraKind;
+
+    fn state(input: &str) -> State {
+        let text = format!("[input]\n{input}\n\n[effects]\nshading = {{}}\ncontours = {{}}\n");
+        let scene = Scene::from_str(std::path::Path::new("t.toml"), &text).unwrap();
+        let view = scene.views[0].clone();
+        assert!(matches!(view.kind, CameraKind::Fit(_)));
+        let cam = Orbit::new(view, ([-1.0; 3], [1.0; 3]), 1.0).unwrap();
+        State::new(scene, vec![0], cam, Some((-2.0, 2.0)))
+    }
+
+    #[test]
+    fn cues_and_sliders_follow_the_input() {
+        let mut s = state("generate = \"torus\"");
+        let keys: Vec<Cue> = s.cues.iter().map(|c| c.0).collect();
+        let want: Vec<Cue> = Cue::ALL
+            .into_iter()
+            .filter(|c| c.accepts(s.scene.source.input()))
+            .collect();
+        assert_eq!(keys, want);
+        assert_eq!(s.enabled(), vec![Cue::Shading, Cue::Contours]);
+        assert!(s.set("iso", "0.5").is_err(), "no iso on a mesh");
+        s.set("contour_width", "100").unwrap();
+        assert_eq!(
+            s.scene.effects.contour.0, 8.0,
+            "clamped to the slider's range"
+        );
+        s.set("crease", "180").unwrap();
+        assert_eq!(s.scene.effects.crease, None);
+        s.set("caps", "mh").unwrap();
+        assert!(s.set("caps", "round").is_err());
+        s.set_cue("contours", Some(false)).unwrap();
+        s.set_cue("ao", None).unwrap();
+        assert_eq!(s.enabled(), vec![Cue::Shading, Cue::AmbientOcclusion]);
+        assert!(s.set_cue("curvature_strokes", Some(true)).is_err());
+        let r = s.request_scene();
+        assert_eq!(r.effects.cues, s.enabled());
+        assert_eq!((r.views.len(), r.frames), (1, (0, Some(1), 1)));
+
+        let mut v = state("sdf = \"sphere\"\nresolution = 24");
+        assert!(v.cues.iter().any(|c| c.0 == Cue::CurvatureStrokes));
+        v.set("iso", "0.25").unwrap();
+        assert!(matches!(v.scene.source, Source::Sdf(_, _, iso, _) if iso == 0.25));
+        v.set("iso", "9").unwrap();
+        assert!(matches!(v.scene.source, Source::Sdf(_, _, iso, _) if iso == 2.0));
+    }
+}
