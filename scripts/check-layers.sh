@@ -28,6 +28,9 @@
 #   everything below the front door (spec, cpu, gpu, stages, mesh, volume,
 #   render, export, scene, api/, error.rs): no crate::report (measurement
 #   sits above the front door and calls it; the library knows no tables)
+#   window crates        winit, glutin, glutin-winit, egui, egui-winit and
+#                        egui_glow only in src/cli/view/ (the viewer), which
+#                        uses no shapecue::stages, shapecue::gpu, shapecue::cpu
 #
 # Then an import graph over the same `crate::<module>` paths (python3):
 #   - no cycle between the top-level modules of src/, nor between the files
@@ -305,6 +308,17 @@ while IFS= read -r hit; do
     echo "$hit: clap outside src/cli and src/main.rs (the library knows no command-line parser)"
     status=1
 done < <(grep -rn --include='*.rs' -E '\bclap::|use clap\b' src | grep -v -E '^src/(cli/|main\.rs)' | grep -v -E ':[0-9]+:\s*//' || true)
+
+# The window crates belong to the viewer (src/cli/view/), which reaches the
+# library through the scene executor, not the stages or the device.
+while IFS= read -r hit; do
+    echo "$hit: a window crate outside src/cli/view (the library and its renderer know no window)"
+    status=1
+done < <(grep -rn --include='*.rs' -E '\b(winit|glutin|glutin_winit|egui|egui_winit|egui_glow)::|use (winit|glutin|glutin_winit|egui|egui_winit|egui_glow)\b' src | grep -v -E '^src/cli/view/' | grep -v -E ':[0-9]+:\s*//' || true)
+while IFS= read -r hit; do
+    echo "$hit: src/cli/view must not use shapecue::stages, shapecue::gpu or shapecue::cpu (the viewer draws through the scene executor)"
+    status=1
+done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu)\b' src/cli/view 2>/dev/null | grep -v -E ':[0-9]+:\s*//' || true)
 
 if [ "$status" -ne 0 ]; then
     echo "check-layers: the layering above is broken; see ARCHITECTURE.md (move the shared type into src/spec/, or the drawing into src/render/; break a cycle by moving the shared piece into the module both use)" >&2

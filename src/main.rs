@@ -62,6 +62,12 @@ enum Cmd {
     /// charts), each headed by the date, the device and the command:
     /// curvature, isosurface, strokes, pipeline, caps, memory.
     Report(cli::report::ReportArgs),
+    /// Open a window on a scene file or an input (mesh, glTF skin, LBS set,
+    /// flipbook, volume): orbit, pan and zoom; every cue as a switch;
+    /// sliders; animation; the passes each frame ran and their time; PNG and
+    /// SVG screenshots; `--script` for reproducible figures. Exit code 4: no
+    /// display (or no OpenGL for a window); 1: any other error.
+    View(cli::view::ViewArgs),
 }
 
 fn main() {
@@ -77,6 +83,7 @@ fn main() {
         Cmd::Render(a) => cli::render::run(device, a),
         Cmd::Strokes(a) => cli::strokes::run(device, a),
         Cmd::Report(a) => cli::report::run(device, a),
+        Cmd::View(a) => cli::view::run(device, a),
     };
     if let Err(e) = result {
         std::process::exit(cli::fail(&e));

@@ -7,6 +7,8 @@
 //! `tests/cli_report.rs`). An example that needs a downloaded data set (its
 //! line names `../shared/data`, or the scene file it names does) is skipped
 //! with a message when the data set is absent, as on a fresh clone.
+//! `shapecue view` examples run under Xvfb (`xvfb-run`), and are skipped with
+//! a message where it is absent (unless `SHAPECUE_REQUIRE_GL` is set).
 
 mod common;
 
@@ -137,7 +139,24 @@ fn every_example_runs_as_written() {
             continue;
         }
         let d = folder(page);
-        let out = std::process::Command::new("bash")
+        // `shapecue view` opens a window: it runs under Xvfb, and is skipped
+        // (with a message) where xvfb-run is absent, unless GL is required.
+        let mut cmd = std::process::Command::new("bash");
+        if line.starts_with("shapecue view") {
+            let xvfb = std::process::Command::new("sh")
+                .args(["-c", "command -v xvfb-run"])
+                .output()
+                .is_ok_and(|o| o.status.success());
+            if !xvfb {
+                assert!(!common::gl_required(), "{page}: {line} needs xvfb-run");
+                eprintln!("skipping ({page}: needs xvfb-run): {line}");
+                skipped += 1;
+                continue;
+            }
+            cmd = std::process::Command::new("xvfb-run");
+            cmd.args(["-a", "-s", "-screen 0 1280x1024x24", "bash"]);
+        }
+        let out = cmd
             .arg("-c")
             .arg(line)
             .current_dir(&d)
@@ -163,7 +182,7 @@ fn every_example_runs_as_written() {
             }
         }
     }
-    eprintln!("{skipped} example(s) skipped for absent downloaded data");
+    eprintln!("{skipped} example(s) skipped (absent downloaded data, or no xvfb-run)");
     for d in folders.values() {
         let _ = std::fs::remove_dir_all(d);
     }

@@ -11,6 +11,7 @@ pub mod kernels;
 pub mod render;
 pub mod report;
 pub mod strokes;
+pub mod view;
 
 use anyhow::Result;
 use std::io::Write;
@@ -70,7 +71,8 @@ pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
 /// each cause printed only if the message before it does not already say it
 /// (the library's I/O errors include the OS message), and the code the
 /// library's error decides ([`shapecue::Error::exit_code`]: 3 for
-/// `--interop on` without CL-GL sharing), 1 for everything else.
+/// `--interop on` without CL-GL sharing), 4 where `shapecue view` can open
+/// no window ([`view::NoDisplay`]), 1 for everything else.
 pub fn fail(e: &anyhow::Error) -> i32 {
     let broken_pipe = e.chain().any(|c| {
         c.downcast_ref::<std::io::Error>()
@@ -93,6 +95,11 @@ pub fn fail(e: &anyhow::Error) -> i32 {
         prev = text;
     }
     eprintln!("error: {msg}");
+    if e.chain()
+        .any(|c| c.downcast_ref::<view::NoDisplay>().is_some())
+    {
+        return view::NO_DISPLAY;
+    }
     e.chain()
         .find_map(|c| c.downcast_ref::<shapecue::Error>())
         .map_or(1, shapecue::Error::exit_code)

@@ -1,0 +1,274 @@
+//! `shapecue view` driven by `--script` under Xvfb: the screenshot of the
+//! window equals the headless renderer's image of the same scene (camera and
+//! cues); switching a cue changes exactly the passes the plan adds; a
+//! volume's iso slider re-extracts the isosurface. Without a display the
+//! command fails with exit code 4 and says why.
+//!
+//! Needs `xvfb-run` (Debian's xvfb package), OpenCL (PoCL) and GL; without
+//! xvfb-run or GL the window tests print why and pass, unless
+//! `SHAPECUE_REQUIRE_GL=1` (CI), where they fail.
+//!
+//! Pixel tolerance of the screenshot: a channel may differ by at most 2 in
+//! at most 0.1 % of the pixels (both images come from the same headless
+//! renderer, so they are expected to be equal).
+
+mod common;
+
+use common::{assert_succeeded, cli, cli_gl_missing, gl_required, scratch};
+use shapecue::scene::planner::{Cue, Input, Pass, plan_with};
+use shapecue::spec::edges::CapMode;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(name)
+}
+
+/// Whether `xvfb-run` is on the PATH; says so (or fails, where GL is
+/// required) when it is not.
+fn xvfb() -> bool {
+    let found = std::process::Command::new("sh")
+        .args(["-c", "command -v xvfb-run"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            !gl_required(),
+            "xvfb-run is not installed (apt-get install xvfb)"
+        );
+        eprintln!("skipping window test: xvfb-run is not installed (apt-get install xvfb)");
+    }
+    found
+}
+
+/// Runs `shapecue view ARGS --script SCRIPT` under Xvfb in `dir`; `None`
+/// (after a message) where the machine has no GL.
+fn view(dir: &Path, args: &[&str], script: &str) -> Option<Output> {
+    let s = dir.join("script.txt");
+    std::fs::write(&s, script).unwrap();
+    let bin = env!("CARGO_BIN_EXE_shapecue");
+    let out = std::process::Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x1024x24", bin, "view"])
+        .args(args)
+        .arg("--script")
+        .arg(&s)
+        .current_dir(dir)
+        .output()
+        .expect("run xvfb-run");
+    if cli_gl_missing(&out) {
+        return None;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(4) && !gl_required() {
+        eprintln!("skipping window test: {err}");
+        return None;
+    }
+    assert_succeeded(&out);
+    Some(out)
+}
+
+/// The `passes:` lines the script printed, as sets.
+fn passes(out: &Output) -> Vec<BTreeSet<String>> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.strip_prefix("passes: "))
+        .map(|l| l.split_whitespace().map(str::to_string).collect())
+        .collect()
+}
+
+fn names(passes: &[Pass]) -> BTreeSet<String> {
+    passes.iter().map(|p| p.name().to_string()).collect()
+}
+
+/// Pixels whose largest channel difference exceeds 2, and the image size.
+fn differing(a: &Path, b: &Path) -> (usize, usize) {
+    let a = image::open(a).unwrap().to_rgba8();
+    let b = image::open(b).unwrap().to_rgba8();
+    assert_eq!(a.dimensions(), b.dimensions(), "image sizes");
+    let n = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 2))
+        .count();
+    (n, a.pixels().len())
+}
+
+const SCENE: &str = r#"
+[input]
+mesh = "MESH"
+
+[[camera]]
+direction = [0.6, 0.3, 1.0]
+
+[effects]
+shading = {}
+contours = { width = 2.0 }
+
+[output]
+size = [320, 240]
+name = "spot"
+"#;
+
+#[test]
+fn screenshot_equals_the_headless_image() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-shot");
+    let mesh = data("spot.obj");
+    let text = SCENE.replace("MESH", &mesh.display().to_string().replace('\\', "/"));
+    std::fs::write(dir.join("spot.toml"), &text).unwrap();
+    let r = cli()
+        .args(["render", "spot.toml", "--out", "headless"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    if cli_gl_missing(&r) {
+        return;
+    }
+    assert_succeeded(&r);
+    // With curvature colours too: the same scene with the cue on.
+    let text2 = text.replace("shading = {}", "shading = {}\ncurvature_colors = {}");
+    std::fs::write(
+        dir.join("colors.toml"),
+        text2.replace("\"spot\"", "\"colors\""),
+    )
+    .unwrap();
+    assert_succeeded(
+        &cli()
+            .args(["render", "colors.toml", "--out", "headless"])
+            .current_dir(&dir)
+            .output()
+            .unwrap(),
+    );
+    let script = "screenshot a.png\n\
+                  orbit 40 15\nzoom 0.8\nscreenshot moved.png\nreset\n\
+                  cue curvature_colors on\nscreenshot b.png\n";
+    let Some(_) = view(&dir, &["spot.toml"], script) else {
+        return;
+    };
+    for (shot, headless) in [
+        ("a.png", "spot_f0000_v00.png"),
+        ("b.png", "colors_f0000_v00.png"),
+    ] {
+        let (n, total) = differing(&dir.join(shot), &dir.join("headless").join(headless));
+        assert!(
+            n * 1000 <= total,
+            "{shot}: {n} of {total} pixels differ from {headless}"
+        );
+    }
+    // A moved camera shows another picture.
+    let (n, _) = differing(&dir.join("a.png"), &dir.join("moved.png"));
+    assert!(n > 1000, "orbit and zoom changed only {n} pixels");
+}
+
+#[test]
+fn a_cue_switch_changes_exactly_its_passes() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-passes");
+    let mesh = data("spot.obj");
+    let script = "passes\ncue suggestive_contours on\npasses\ncue shading off\npasses\n\
+                  cue feature_edges on\npasses\n";
+    let Some(out) = view(&dir, &[mesh.to_str().unwrap(), "--size", "200x150"], script) else {
+        return;
+    };
+    let seen = passes(&out);
+    use Cue::*;
+    let plans = [
+        vec![Shading, Contours],
+        vec![Shading, Contours, SuggestiveContours],
+        vec![Contours, SuggestiveContours],
+        vec![Contours, SuggestiveContours, FeatureEdges],
+    ];
+    assert_eq!(
+        seen.len(),
+        plans.len(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    for (i, cues) in plans.iter().enumerate() {
+        let plan = plan_with(cues, Input::Static, CapMode::Adjacency);
+        assert_eq!(seen[i], names(&plan.passes), "passes for {cues:?}");
+    }
+    // The switch adds exactly what the plan adds.
+    let added: BTreeSet<_> = seen[1].difference(&seen[0]).cloned().collect();
+    let plan0 = plan_with(&plans[0], Input::Static, CapMode::Adjacency);
+    let plan1 = plan_with(&plans[1], Input::Static, CapMode::Adjacency);
+    let want: BTreeSet<_> = names(&plan1.passes)
+        .difference(&names(&plan0.passes))
+        .cloned()
+        .collect();
+    assert_eq!(added, want);
+    assert!(added.contains("suggestive_contours") && added.contains("curvature"));
+}
+
+#[test]
+fn the_iso_slider_re_extracts() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-iso");
+    let vol = data("bucky.nhdr");
+    let script = "passes\nscreenshot low.png\nset iso 160\npasses\nscreenshot high.png\n";
+    let Some(out) = view(
+        &dir,
+        &[vol.to_str().unwrap(), "--iso", "60", "--size", "240x180"],
+        script,
+    ) else {
+        return;
+    };
+    let seen = passes(&out);
+    assert_eq!(seen.len(), 2);
+    for s in &seen {
+        assert!(s.contains("isosurface"), "{s:?}");
+    }
+    let (n, _) = differing(&dir.join("low.png"), &dir.join("high.png"));
+    assert!(n > 100, "the iso value changed only {n} pixels");
+}
+
+#[test]
+fn no_display_is_exit_code_4() {
+    let dir = scratch("view-nodisplay");
+    let out = cli()
+        .args(["view", data("spot.obj").to_str().unwrap()])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(4));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cannot open a window") && err.contains("DISPLAY"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_bad_script_fails_before_the_window() {
+    let dir = scratch("view-badscript");
+    std::fs::write(dir.join("s.txt"), "orbit 10 10\nfly 3\n").unwrap();
+    let out = cli()
+        .args([
+            "view",
+            data("spot.obj").to_str().unwrap(),
+            "--script",
+            "s.txt",
+        ])
+        .env_remove("DISPLAY")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("s.txt line 2") && err.contains("unknown command fly"),
+        "{err}"
+    );
+}
