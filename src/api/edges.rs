@@ -24,8 +24,11 @@ use crate::spec::edges::{
     CapMode, EdgeOutput, EdgeParams, InteropDecision, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
     KIND_DRAWN, MemoryUse, crease_from_degrees, memory_use,
 };
+use crate::spec::interop::InteropRoute;
 use crate::spec::timing::Timing;
-use crate::stages::edges::EdgeStage;
+use crate::stages::edges::{EdgeStage, SharedDrawn};
+
+use super::interop::SharedEdges;
 
 /// What [`feature_edges_picture`] draws and how (the `shapecue edges`
 /// options).
@@ -70,6 +73,12 @@ pub struct EdgePictureOptions {
     /// renderer and the uploaded mesh kept, as a batch of views does
     /// ([`EdgePicture::runs`]).
     pub timed_runs: usize,
+    /// How the stage's buffers reach GL: [`InteropRoute::ExternalMemory`]
+    /// compacts what is drawn into memory GL draws from
+    /// ([`super::interop::SharedEdges`]); any other route reads it back and
+    /// uploads it (CL-GL sharing is not carried out by this build, see
+    /// [`crate::spec::interop::GL_SHARING_BUILT`]).
+    pub interop: InteropRoute,
 }
 
 impl Default for EdgePictureOptions {
@@ -91,6 +100,7 @@ impl Default for EdgePictureOptions {
             marked: None,
             polylines: false,
             timed_runs: 0,
+            interop: InteropRoute::Host,
         }
     }
 }
@@ -321,22 +331,55 @@ pub fn feature_edges_picture_on(
     ph.stage_setup = lap();
     let timing = stage.run(&p, opts.caps)?;
     ph.kernels = lap();
-    let output = stage.read_drawn()?;
-    ph.readback = lap();
     let mut r = Renderer::new(RenderOptions {
         width: w,
         height: h,
         msaa: opts.msaa,
         ..Default::default()
     })?;
-    ph.gl_context = lap();
+    // The shared buffer, once per topology: GL's context must exist first.
+    let mut shared = match opts.interop {
+        InteropRoute::ExternalMemory => Some(SharedEdges::new(gpu, &mut r, &stage, opts.caps)?),
+        _ => None,
+    };
+    let gl_ms = lap();
+    // What the frame draws: read back (host) or compacted in place (shared).
+    let fetch = |stage: &mut EdgeStage,
+                 shared: &mut Option<SharedEdges>|
+     -> Result<(EdgeOutput, Option<SharedDrawn>)> {
+        match shared {
+            Some(sh) => {
+                let d = sh.compact(gpu, stage)?;
+                let mut out = EdgeOutput {
+                    kind: d.kind.clone(),
+                    ..EdgeOutput::default()
+                };
+                if opts.polylines {
+                    out.edge_out = sh.read_edges(gpu, &d)?;
+                }
+                Ok((out, Some(d)))
+            }
+            None => Ok((stage.read_drawn()?, None)),
+        }
+    };
+    let (output, drawn) = fetch(&mut stage, &mut shared)?;
+    ph.readback = lap();
+    ph.gl_context = gl_ms;
     r.upload_topology(&mesh.faces)?;
     r.upload_pose(&pos, &nrm, &[])?;
-    let mut frame_run = |ph: &mut EdgePhases, lap: &mut dyn FnMut() -> f64, output: &EdgeOutput| {
+    let black = [0.0, 0.0, 0.0, 1.0];
+    let mut frame_run = |ph: &mut EdgePhases,
+                         lap: &mut dyn FnMut() -> f64,
+                         output: &EdgeOutput,
+                         drawn: Option<&SharedDrawn>,
+                         shared: &Option<SharedEdges>| {
         r.begin(&cam)?;
         r.draw_uploaded(MeshStyle::default())?;
         ph.draw_mesh = lap();
-        draw_edges(&mut r, output, [0.0, 0.0, 0.0, 1.0])?;
+        match (shared, drawn) {
+            (Some(sh), Some(d)) => sh.draw(&mut r, d, black)?,
+            _ => draw_edges(&mut r, output, black)?,
+        }
         ph.draw_edges = lap();
         // Depth only for the SVG's visibility test.
         let frame = if opts.polylines {
@@ -347,7 +390,7 @@ pub fn feature_edges_picture_on(
         ph.image_readback = lap();
         Ok::<_, crate::error::Error>(frame)
     };
-    let frame = frame_run(&mut ph, &mut lap, &output)?;
+    let frame = frame_run(&mut ph, &mut lap, &output, drawn.as_ref(), &shared)?;
     let frame_ms = frame_sum(&ph);
     let polylines = opts
         .polylines
@@ -361,9 +404,9 @@ pub fn feature_edges_picture_on(
             lap();
             let t = stage.run(&p, opts.caps)?;
             q.kernels = lap();
-            let out = stage.read_drawn()?;
+            let (out, d) = fetch(&mut stage, &mut shared)?;
             q.readback = lap();
-            let f = frame_run(&mut q, &mut lap, &out)?;
+            let f = frame_run(&mut q, &mut lap, &out, d.as_ref(), &shared)?;
             if opts.polylines {
                 std::hint::black_box(visible_polylines(&out.edge_out, &f, DEFAULT_BIAS));
                 q.svg_visibility = lap();
@@ -374,6 +417,9 @@ pub fn feature_edges_picture_on(
     } else {
         None
     };
+    if let Some(sh) = shared.take() {
+        sh.free(&mut r);
+    }
     let uploads = r.uploads();
     Ok(EdgePicture {
         memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),

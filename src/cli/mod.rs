@@ -70,7 +70,7 @@ pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
 /// each cause printed only if the message before it does not already say it
 /// (the library's I/O errors include the OS message), and the code the
 /// library's error decides ([`shapecue::Error::exit_code`]: 3 for
-/// `--interop on` without CL-GL sharing), 1 for everything else.
+/// `--interop on` without a shared route), 1 for everything else.
 pub fn fail(e: &anyhow::Error) -> i32 {
     let broken_pipe = e.chain().any(|c| {
         c.downcast_ref::<std::io::Error>()
