@@ -19,8 +19,8 @@ use shapecue::mesh::topology::vertex_normals;
 use shapecue::mesh::{self, Mesh};
 use shapecue::render::Camera;
 use shapecue::spec::edges::{
-    CapMode, EdgeOutput, EdgeParams, InteropMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
-    KIND_DRAWN, memory_use,
+    CapMode, EdgeOutput, EdgeParams, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN,
+    memory_use,
 };
 use shapecue::stages::edges::EdgeStage;
 fn camera(eye: [f32; 3], target: [f32; 3]) -> Camera {

@@ -240,6 +240,11 @@ fn edges_on_external_memory_draws_the_host_image() {
     let d = match decide_interop(InteropMode::On, &o) {
         Ok(d) => d,
         Err(e) => {
+            // scripts/gpu-interop.sh sets this on a GPU that should share.
+            assert!(
+                std::env::var("SHAPECUE_REQUIRE_INTEROP").as_deref() != Ok("1"),
+                "SHAPECUE_REQUIRE_INTEROP=1, but {e}"
+            );
             eprintln!("skipped (GPU half): {e}");
             return;
         }
