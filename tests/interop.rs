@@ -263,6 +263,8 @@ fn edges_on_external_memory_draws_the_host_image() {
         opts.interop = d.route;
         let shared = shapecue::feature_edges_picture_on(&gpu, &mesh, "torus", &opts).unwrap();
         assert_eq!(host.output.kind, shared.output.kind, "{}", caps.name());
+        assert_eq!(host.drawn_caps, shared.drawn_caps, "{}", caps.name());
+        assert_eq!(shared.interop, InteropRoute::ExternalMemory);
         assert!(
             host.frame.rgba == shared.frame.rgba,
             "{}: images differ",

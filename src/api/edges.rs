@@ -120,9 +120,12 @@ pub struct EdgePhases {
     pub stage_setup: f64,
     /// The stage's run: parameter upload, kernels, waiting for them.
     pub kernels: f64,
-    /// Reading back edge-out, kinds and the caps of the variant.
+    /// Reading back edge-out, kinds and the caps of the variant; on the
+    /// external-memory route, compacting them into the shared buffer and
+    /// reading back the kinds only.
     pub readback: f64,
-    /// Creating (or reusing) the renderer: GL context, programs, framebuffers.
+    /// Creating (or reusing) the renderer: GL context, programs,
+    /// framebuffers, and on the external-memory route the shared buffer.
     pub gl_context: f64,
     /// Drawing the shaded mesh (uploads included).
     pub draw_mesh: f64,
@@ -187,6 +190,11 @@ pub struct EdgePicture {
     pub runs: Option<EdgeRuns>,
     /// Mesh data uploads to GL over all frames (one topology and one pose).
     pub uploads: Uploads,
+    /// Adjacency caps drawn in the first frame (on the external-memory
+    /// route they stay on the device, so `output.cap_adj` is empty).
+    pub drawn_caps: usize,
+    /// The route the buffers took to GL.
+    pub interop: InteropRoute,
 }
 
 impl EdgePicture {
@@ -215,7 +223,7 @@ impl EdgePicture {
             "boundary_or_marked": self.count(KIND_BOUNDARY),
             "caps": self.caps,
             // Adjacency caps drawn (the device holds only these).
-            "drawn_caps": self.output.cap_adj.len() / 4,
+            "drawn_caps": self.drawn_caps,
             "interop": interop,
             "timing": self.timing,
             "topology_ms": self.topology_ms,
@@ -421,6 +429,9 @@ pub fn feature_edges_picture_on(
         sh.free(&mut r);
     }
     let uploads = r.uploads();
+    let drawn_caps = drawn
+        .as_ref()
+        .map_or(output.cap_adj.len() / 4, |d| d.adjacency_caps);
     Ok(EdgePicture {
         memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),
         frame,
@@ -438,6 +449,8 @@ pub fn feature_edges_picture_on(
         device: gpu.info.clone(),
         runs,
         uploads,
+        drawn_caps,
+        interop: opts.interop,
     })
 }
 

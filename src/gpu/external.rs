@@ -132,7 +132,7 @@ impl ExternalBuffer {
             });
         }
         let (acquire, release) = entry_points(gpu)?;
-        if bytes == 0 || bytes % 4 != 0 {
+        if bytes == 0 || !bytes.is_multiple_of(4) {
             return Err(Error::InvalidArgument(format!(
                 "an external buffer of floats needs a positive multiple of 4 bytes, got {bytes}"
             )));

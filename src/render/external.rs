@@ -165,7 +165,11 @@ impl Renderer {
         bytes: u64,
     ) -> Result<ImportedBuffer> {
         let f = self.memory_object_fns()?;
-        if bytes == 0 || bytes % 16 != 0 || bytes > allocation || isize::try_from(bytes).is_err() {
+        if bytes == 0
+            || !bytes.is_multiple_of(16)
+            || bytes > allocation
+            || isize::try_from(bytes).is_err()
+        {
             return Err(Error::render(
                 "importing external memory",
                 format!(
