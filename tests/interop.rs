@@ -272,3 +272,50 @@ fn edges_on_external_memory_draws_the_host_image() {
         );
     }
 }
+
+/// The external-memory route's compaction writes, into one buffer, exactly
+/// what the host route reads back (checked on any device with an ordinary
+/// buffer in place of the imported one): edge quads, then the half-caps,
+/// then the adjacency caps.
+#[test]
+fn compaction_into_one_buffer_matches_the_host_read_back() {
+    use shapecue::mesh::edges::EdgeTopology;
+    use shapecue::spec::edges::{CapMode, EdgeParams};
+    use shapecue::stages::edges::EdgeStage;
+    let Ok(gpu) = shapecue::gpu::Gpu::new(None) else {
+        eprintln!("skipped: no OpenCL device");
+        return;
+    };
+    let gpu = std::sync::Arc::new(gpu);
+    let (_, mesh) = shapecue::mesh::Generated::Torus.mesh(3000);
+    let topo = EdgeTopology::new(&mesh, &[], "torus").unwrap();
+    let mut cam = Camera::look_at(Vec3::new(3.0, 2.0, 4.0), Vec3::ZERO);
+    cam.fov_y_deg = 40.0;
+    let p = EdgeParams::new(cam.view(320, 240));
+    let mut stage = EdgeStage::new(gpu.clone(), &mesh, &topo).unwrap();
+    for mode in CapMode::ALL {
+        stage.run(&p, mode).unwrap();
+        let host = stage.read_drawn().unwrap();
+        let n = stage.shared_vertices(mode);
+        let mut dst = gpu.buffer::<f32>(4 * n).unwrap();
+        assert!(stage.compact_into(&mut dst, n - 1).is_err(), "too small");
+        let d = stage.compact_into(&mut dst, n).unwrap();
+        let mut all = vec![[0f32; 4]; n];
+        gpu.read(&dst, bytemuck::cast_slice_mut(&mut all)).unwrap();
+        let e = d.edges;
+        assert!(e > 0, "{}: a torus seen whole draws edges", mode.name());
+        assert_eq!(d.kind, host.kind, "{}", mode.name());
+        let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&all[..4 * e]), bits(&host.edge_out), "{}", mode.name());
+        assert_eq!(d.mh, mode == CapMode::Mh);
+        if d.mh {
+            assert_eq!(bits(&all[4 * e..7 * e]), bits(&host.cap_mh0));
+            assert_eq!(bits(&all[7 * e..10 * e]), bits(&host.cap_mh1));
+        }
+        let caps = &all[d.caps_at..d.caps_at + 4 * d.adjacency_caps];
+        assert_eq!(bits(caps), bits(&host.cap_adj), "{}", mode.name());
+        if mode == CapMode::Adjacency {
+            assert!(d.adjacency_caps > 0, "adjacency caps drawn");
+        }
+    }
+}
