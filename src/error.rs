@@ -7,9 +7,10 @@ use std::path::PathBuf;
 /// Result alias used throughout the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-/// What [`Error::gl_sharing_required`] says the device lacks.
-pub const GL_SHARING_REQUIRED: &str =
-    "--interop on needs cl_khr_gl_sharing, which the device does not report";
+/// What [`Error::gl_sharing_required`] says is missing; the reasons follow it.
+pub const GL_SHARING_REQUIRED: &str = "--interop on needs a shared route, CL-GL sharing \
+     (cl_khr_gl_sharing) or external memory (cl_khr_external_memory_opaque_fd with \
+     GL_EXT_memory_object_fd and Vulkan's VK_KHR_external_memory_fd), and neither can run";
 
 /// Everything that can go wrong in shapecue.
 #[derive(Debug, thiserror::Error)]
@@ -115,6 +116,14 @@ pub enum Error {
         /// The EGL/GL error name, or the shader info log.
         detail: String,
     },
+    /// A Vulkan call failed (external memory exported for OpenCL and GL).
+    #[error("Vulkan error in {what}: {detail}")]
+    Vulkan {
+        /// Which call or step.
+        what: String,
+        /// The Vulkan result or loader message.
+        detail: String,
+    },
 }
 
 impl Error {
@@ -139,22 +148,23 @@ impl Error {
         }
     }
 
-    /// `--interop on` on a device without `cl_khr_gl_sharing`: a
-    /// [`Error::DeviceUnsupported`] whose `what` is [`GL_SHARING_REQUIRED`],
-    /// the one device refusal with its own exit code (see [`Error::exit_code`]).
-    pub fn gl_sharing_required(device: &str) -> Self {
+    /// `--interop on` without a shared route: a [`Error::DeviceUnsupported`]
+    /// whose `what` is [`GL_SHARING_REQUIRED`] followed by `why` (why each
+    /// route cannot run), the one device refusal with its own exit code (see
+    /// [`Error::exit_code`]).
+    pub fn gl_sharing_required(device: &str, why: &str) -> Self {
         Error::DeviceUnsupported {
             device: device.to_string(),
-            what: GL_SHARING_REQUIRED.into(),
+            what: format!("{GL_SHARING_REQUIRED}: {why}"),
         }
     }
 
     /// The process exit code of a command that failed with this error: 3 for
-    /// `--interop on` without CL-GL sharing ([`Error::gl_sharing_required`]),
+    /// `--interop on` without a shared route ([`Error::gl_sharing_required`]),
     /// 1 for everything else. The one place exit codes are decided.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::DeviceUnsupported { what, .. } if what == GL_SHARING_REQUIRED => 3,
+            Error::DeviceUnsupported { what, .. } if what.starts_with(GL_SHARING_REQUIRED) => 3,
             _ => 1,
         }
     }

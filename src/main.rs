@@ -46,8 +46,8 @@ enum Cmd {
     Isosurface(cli::isosurface::IsoArgs),
     /// Object-space feature edges with caps (House & Li): renders the
     /// mesh, then contour, crease and boundary/marked edges as thick quads with
-    /// caps, to PNG (and SVG). Exit code 3: `--interop on` on a device without
-    /// cl_khr_gl_sharing (such as PoCL); 1: any other error.
+    /// caps, to PNG (and SVG). Exit code 3: `--interop on` without a shared
+    /// route (CL-GL sharing or external memory; PoCL has neither); 1: any other error.
     Edges(cli::edges::EdgesArgs),
     /// Render scene files (TOML): only the passes the scene's cues need run;
     /// images (PNG, SVG) and a JSON report of the passes that ran go to the

@@ -19,8 +19,8 @@ use shapecue::mesh::topology::vertex_normals;
 use shapecue::mesh::{self, Mesh};
 use shapecue::render::Camera;
 use shapecue::spec::edges::{
-    CapMode, EdgeOutput, EdgeParams, InteropMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
-    KIND_DRAWN, decide_interop, memory_use,
+    CapMode, EdgeOutput, EdgeParams, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN,
+    memory_use,
 };
 use shapecue::stages::edges::EdgeStage;
 fn camera(eye: [f32; 3], target: [f32; 3]) -> Camera {
@@ -464,29 +464,6 @@ fn bad_parameters_are_clear_errors() {
     let e = "round".parse::<CapMode>().unwrap_err().to_string();
     assert!(e.contains("unknown cap mode \"round\""), "{e}");
     assert_eq!("adjacency".parse::<CapMode>().unwrap(), CapMode::Adjacency);
-}
-
-#[test]
-fn interop_decision_uses_only_the_extension_flag() {
-    let d = decide_interop(InteropMode::Auto, false, "pocl").unwrap();
-    assert!(
-        !d.shared && d.reason.contains("cl_khr_gl_sharing"),
-        "{}",
-        d.reason
-    );
-    let e = decide_interop(InteropMode::On, false, "pocl").unwrap_err();
-    assert!(matches!(e, Error::DeviceUnsupported { .. }) && e.to_string().contains("--interop on"));
-    assert!(
-        !decide_interop(InteropMode::Off, true, "gpu")
-            .unwrap()
-            .shared
-    );
-    assert!(!decide_interop(InteropMode::On, true, "gpu").unwrap().shared);
-    assert!(
-        !decide_interop(InteropMode::Auto, gpu().info.gl_sharing, &gpu().info.name)
-            .unwrap()
-            .shared
-    );
 }
 
 #[test]

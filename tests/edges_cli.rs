@@ -107,7 +107,10 @@ fn cli_bad_input_is_a_clear_error() {
     };
     let (code, err) = run(&["--eye", "5,5,5", "--interop", "on"]);
     assert_eq!(code, Some(3), "{err}");
-    assert!(err.contains("cl_khr_gl_sharing"), "{err}");
+    assert!(
+        err.contains("cl_khr_gl_sharing") && err.contains("cl_khr_external_memory_opaque_fd"),
+        "{err}"
+    );
     let (code, err) = run(&["--eye", "5,5,5", "--caps", "round"]);
     assert_eq!(code, Some(1));
     assert!(err.contains("unknown cap mode \"round\""), "{err}");

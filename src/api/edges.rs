@@ -24,8 +24,11 @@ use crate::spec::edges::{
     CapMode, EdgeOutput, EdgeParams, InteropDecision, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE,
     KIND_DRAWN, MemoryUse, crease_from_degrees, memory_use,
 };
+use crate::spec::interop::InteropRoute;
 use crate::spec::timing::Timing;
-use crate::stages::edges::EdgeStage;
+use crate::stages::edges::{EdgeStage, SharedDrawn};
+
+use super::interop::SharedEdges;
 
 /// What [`feature_edges_picture`] draws and how (the `shapecue edges`
 /// options).
@@ -70,6 +73,12 @@ pub struct EdgePictureOptions {
     /// renderer and the uploaded mesh kept, as a batch of views does
     /// ([`EdgePicture::runs`]).
     pub timed_runs: usize,
+    /// How the stage's buffers reach GL: [`InteropRoute::ExternalMemory`]
+    /// compacts what is drawn into memory GL draws from
+    /// ([`super::interop::SharedEdges`]); any other route reads it back and
+    /// uploads it (CL-GL sharing is not carried out by this build, see
+    /// [`crate::spec::interop::GL_SHARING_BUILT`]).
+    pub interop: InteropRoute,
 }
 
 impl Default for EdgePictureOptions {
@@ -91,6 +100,7 @@ impl Default for EdgePictureOptions {
             marked: None,
             polylines: false,
             timed_runs: 0,
+            interop: InteropRoute::Host,
         }
     }
 }
@@ -110,9 +120,12 @@ pub struct EdgePhases {
     pub stage_setup: f64,
     /// The stage's run: parameter upload, kernels, waiting for them.
     pub kernels: f64,
-    /// Reading back edge-out, kinds and the caps of the variant.
+    /// Reading back edge-out, kinds and the caps of the variant; on the
+    /// external-memory route, compacting them into the shared buffer and
+    /// reading back the kinds only.
     pub readback: f64,
-    /// Creating (or reusing) the renderer: GL context, programs, framebuffers.
+    /// Creating (or reusing) the renderer: GL context, programs,
+    /// framebuffers, and on the external-memory route the shared buffer.
     pub gl_context: f64,
     /// Drawing the shaded mesh (uploads included).
     pub draw_mesh: f64,
@@ -177,6 +190,11 @@ pub struct EdgePicture {
     pub runs: Option<EdgeRuns>,
     /// Mesh data uploads to GL over all frames (one topology and one pose).
     pub uploads: Uploads,
+    /// Adjacency caps drawn in the first frame (on the external-memory
+    /// route they stay on the device, so `output.cap_adj` is empty).
+    pub drawn_caps: usize,
+    /// The route the buffers took to GL.
+    pub interop: InteropRoute,
 }
 
 impl EdgePicture {
@@ -205,7 +223,7 @@ impl EdgePicture {
             "boundary_or_marked": self.count(KIND_BOUNDARY),
             "caps": self.caps,
             // Adjacency caps drawn (the device holds only these).
-            "drawn_caps": self.output.cap_adj.len() / 4,
+            "drawn_caps": self.drawn_caps,
             "interop": interop,
             "timing": self.timing,
             "topology_ms": self.topology_ms,
@@ -321,22 +339,55 @@ pub fn feature_edges_picture_on(
     ph.stage_setup = lap();
     let timing = stage.run(&p, opts.caps)?;
     ph.kernels = lap();
-    let output = stage.read_drawn()?;
-    ph.readback = lap();
     let mut r = Renderer::new(RenderOptions {
         width: w,
         height: h,
         msaa: opts.msaa,
         ..Default::default()
     })?;
-    ph.gl_context = lap();
+    // The shared buffer, once per topology: GL's context must exist first.
+    let mut shared = match opts.interop {
+        InteropRoute::ExternalMemory => Some(SharedEdges::new(gpu, &mut r, &stage, opts.caps)?),
+        _ => None,
+    };
+    let gl_ms = lap();
+    // What the frame draws: read back (host) or compacted in place (shared).
+    let fetch = |stage: &mut EdgeStage,
+                 shared: &mut Option<SharedEdges>|
+     -> Result<(EdgeOutput, Option<SharedDrawn>)> {
+        match shared {
+            Some(sh) => {
+                let d = sh.compact(gpu, stage)?;
+                let mut out = EdgeOutput {
+                    kind: d.kind.clone(),
+                    ..EdgeOutput::default()
+                };
+                if opts.polylines {
+                    out.edge_out = sh.read_edges(gpu, &d)?;
+                }
+                Ok((out, Some(d)))
+            }
+            None => Ok((stage.read_drawn()?, None)),
+        }
+    };
+    let (output, drawn) = fetch(&mut stage, &mut shared)?;
+    ph.readback = lap();
+    ph.gl_context = gl_ms;
     r.upload_topology(&mesh.faces)?;
     r.upload_pose(&pos, &nrm, &[])?;
-    let mut frame_run = |ph: &mut EdgePhases, lap: &mut dyn FnMut() -> f64, output: &EdgeOutput| {
+    let black = [0.0, 0.0, 0.0, 1.0];
+    let mut frame_run = |ph: &mut EdgePhases,
+                         lap: &mut dyn FnMut() -> f64,
+                         output: &EdgeOutput,
+                         drawn: Option<&SharedDrawn>,
+                         shared: &Option<SharedEdges>| {
         r.begin(&cam)?;
         r.draw_uploaded(MeshStyle::default())?;
         ph.draw_mesh = lap();
-        draw_edges(&mut r, output, [0.0, 0.0, 0.0, 1.0])?;
+        match (shared, drawn) {
+            (Some(sh), Some(d)) => sh.draw(&mut r, d, black)?,
+            _ => draw_edges(&mut r, output, black)?,
+        }
         ph.draw_edges = lap();
         // Depth only for the SVG's visibility test.
         let frame = if opts.polylines {
@@ -347,7 +398,7 @@ pub fn feature_edges_picture_on(
         ph.image_readback = lap();
         Ok::<_, crate::error::Error>(frame)
     };
-    let frame = frame_run(&mut ph, &mut lap, &output)?;
+    let frame = frame_run(&mut ph, &mut lap, &output, drawn.as_ref(), &shared)?;
     let frame_ms = frame_sum(&ph);
     let polylines = opts
         .polylines
@@ -361,9 +412,9 @@ pub fn feature_edges_picture_on(
             lap();
             let t = stage.run(&p, opts.caps)?;
             q.kernels = lap();
-            let out = stage.read_drawn()?;
+            let (out, d) = fetch(&mut stage, &mut shared)?;
             q.readback = lap();
-            let f = frame_run(&mut q, &mut lap, &out)?;
+            let f = frame_run(&mut q, &mut lap, &out, d.as_ref(), &shared)?;
             if opts.polylines {
                 std::hint::black_box(visible_polylines(&out.edge_out, &f, DEFAULT_BIAS));
                 q.svg_visibility = lap();
@@ -374,7 +425,13 @@ pub fn feature_edges_picture_on(
     } else {
         None
     };
+    if let Some(sh) = shared.take() {
+        sh.free(&mut r);
+    }
     let uploads = r.uploads();
+    let drawn_caps = drawn
+        .as_ref()
+        .map_or(output.cap_adj.len() / 4, |d| d.adjacency_caps);
     Ok(EdgePicture {
         memory: memory_use(opts.caps, topo.edges.len(), topo.caps.len()),
         frame,
@@ -392,6 +449,8 @@ pub fn feature_edges_picture_on(
         device: gpu.info.clone(),
         runs,
         uploads,
+        drawn_caps,
+        interop: opts.interop,
     })
 }
 

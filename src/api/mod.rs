@@ -36,6 +36,7 @@ use std::time::Instant;
 
 mod curvature;
 mod edges;
+pub mod interop;
 mod strokes;
 
 pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};

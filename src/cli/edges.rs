@@ -82,9 +82,12 @@ pub struct EdgesArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     force: bool,
-    /// CL-GL buffer sharing: auto (share when the device reports
-    /// cl_khr_gl_sharing, else copy through the host), on (require it: exit
-    /// code 3 without the extension), off (host path).
+    /// How the edge and cap buffers reach OpenGL: auto (CL-GL sharing where
+    /// the device reports cl_khr_gl_sharing, else external memory where the
+    /// device reports cl_khr_external_memory_opaque_fd, OpenGL
+    /// GL_EXT_memory_object_fd and Vulkan VK_KHR_external_memory_fd, else
+    /// a copy through the host), on (require a shared route: exit code 3
+    /// without one), off (host path). --stats says which ran and why.
     #[arg(long, value_parser = super::choice::<shapecue::spec::edges::InteropMode>(), default_value = "auto")]
     interop: shapecue::spec::edges::InteropMode,
     /// After the first frame, this many more timed frames of the same view
@@ -133,7 +136,8 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
     let gpu = Arc::new(Gpu::new(device)?);
-    let interop = decide_interop(a.interop, gpu.info.gl_sharing, &gpu.info.name)?;
+    let offer = shapecue::api::interop::interop_offer(&gpu, a.interop);
+    let interop = decide_interop(a.interop, &offer)?;
     let path = a.mesh.as_path();
     if let Some(o) = &a.output {
         super::require_png("-o", o)?;
@@ -173,6 +177,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         marked: a.marked.clone(),
         polylines: a.svg.is_some(),
         timed_runs: a.runs.unwrap_or(0),
+        interop: interop.route,
     };
     let d = shapecue::feature_edges_picture_on(&gpu, &mesh, &path.display().to_string(), &opts)?;
     let t_png = std::time::Instant::now();
@@ -213,6 +218,10 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     }
     if let Some(sp) = &a.stats {
         let mut doc = d.stats(&path.display().to_string(), &interop);
+        // What each route needs, as the device, GL and Vulkan reported it.
+        if let Some(o) = doc.as_object_mut() {
+            o.insert("interop_offer".into(), serde_json::to_value(&offer)?);
+        }
         // The phases outside the library call: loading, PNG, SVG file.
         if let Some(ph) = doc.get_mut("phases_ms").and_then(|v| v.as_object_mut()) {
             ph.insert("load".into(), load_ms.into());

@@ -71,7 +71,7 @@ pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
 /// each cause printed only if the message before it does not already say it
 /// (the library's I/O errors include the OS message), and the code the
 /// library's error decides ([`shapecue::Error::exit_code`]: 3 for
-/// `--interop on` without CL-GL sharing), 4 where `shapecue view` can open
+/// `--interop on` without a shared route), 4 where `shapecue view` can open
 /// no window ([`view::NoDisplay`]), 1 for everything else.
 pub fn fail(e: &anyhow::Error) -> i32 {
     let broken_pipe = e.chain().any(|c| {

@@ -6,7 +6,9 @@
 
 pub mod cache;
 mod device;
+pub mod external;
 mod program;
+pub mod vulkan;
 
 pub use device::{DeviceInfo, list_devices};
 pub use program::{COMMON_HEADERS, FpMode, KernelFile, STRICT_HEADER, assemble_as};

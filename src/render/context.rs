@@ -223,6 +223,17 @@ impl GlContext {
         .map_err(|e| Error::render("eglMakeCurrent", e))
     }
 
+    /// The address of a GL entry point that glow does not load
+    /// (`eglGetProcAddress`; null when EGL has none), for the extension
+    /// functions of `render::external`. Callers check the extension string
+    /// first: Mesa returns a stub for any name.
+    pub(crate) fn proc_address(&self, name: &str) -> *const c_void {
+        self.shared
+            .egl
+            .get_proc_address(name)
+            .map_or(std::ptr::null(), |f| f as *const c_void)
+    }
+
     /// EGL version, vendor and platform, for [`Renderer::gl_info`](super::Renderer::gl_info).
     pub(crate) fn describe(&self) -> String {
         let egl = &self.shared.egl;

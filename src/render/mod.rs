@@ -46,6 +46,7 @@ mod context;
 mod draw_clip;
 mod draw_mesh;
 pub mod edges;
+pub mod external;
 mod frame;
 mod lines;
 mod programs;

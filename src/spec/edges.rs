@@ -73,84 +73,11 @@ impl std::str::FromStr for CapMode {
     }
 }
 
-/// What `--interop` asked for: CL-GL buffer sharing between the edges stage
-/// and the renderer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum InteropMode {
-    /// Use CL-GL sharing when the device offers it, the host path otherwise.
-    Auto,
-    /// Require CL-GL sharing.
-    On,
-    /// Always copy through the host.
-    Off,
-}
-
-impl InteropMode {
-    /// Every mode, in `--help` order.
-    pub const ALL: [InteropMode; 3] = [InteropMode::Auto, InteropMode::On, InteropMode::Off];
-
-    /// The name used on the command line and in stats.
-    pub fn name(self) -> &'static str {
-        match self {
-            InteropMode::Auto => "auto",
-            InteropMode::On => "on",
-            InteropMode::Off => "off",
-        }
-    }
-}
-
-crate::spec::choice!(InteropMode);
-
-/// The interop path chosen and why.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct InteropDecision {
-    /// `true`: share GL buffers; `false`: read outputs back and upload to GL.
-    pub shared: bool,
-    /// Why, in words (for stats).
-    pub reason: String,
-}
-
-/// Decides the interop path from the mode and the device's extension string
-/// alone (`DeviceInfo::gl_sharing`): nothing is probed, because calling
-/// `clCreateFromGLBuffer` on a device without `cl_khr_gl_sharing` (PoCL)
-/// terminates the process.
-///
-/// It lives here, not in `render/`, because it is a pure function of an
-/// option and a device flag, with no GL in it: the CLI decides before it
-/// loads anything (so `--interop on` fails first), and the stage's module
-/// can keep re-exporting it without importing the renderer.
-///
-/// This build has no shared-buffer path yet, so `auto` and `on` with the
-/// extension also use the host path, and say so.
-///
-/// # Errors
-/// [`Error::DeviceUnsupported`] for `on` when the device lacks
-/// `cl_khr_gl_sharing` ([`Error::gl_sharing_required`]; exit code 3).
-pub fn decide_interop(
-    mode: InteropMode,
-    gl_sharing: bool,
-    device: &str,
-) -> Result<InteropDecision> {
-    let host = |reason: String| {
-        Ok(InteropDecision {
-            shared: false,
-            reason,
-        })
-    };
-    match (mode, gl_sharing) {
-        (InteropMode::Off, _) => host("host path: --interop off".into()),
-        (InteropMode::On, false) => Err(Error::gl_sharing_required(device)),
-        (InteropMode::Auto, false) => host(format!(
-            "host path: device '{device}' does not report cl_khr_gl_sharing"
-        )),
-        (_, true) => host(
-            "host path: the device reports cl_khr_gl_sharing, but this build has no shared-buffer \
-             path (the renderer's EGL surfaceless context is not shareable with OpenCL)"
-                .into(),
-        ),
-    }
-}
+// The interop option and decision live in `spec::interop`; the edges
+// frame is the first path that uses them, so they are named here too.
+pub use crate::spec::interop::{
+    InteropDecision, InteropMode, InteropOffer, InteropRoute, decide_interop,
+};
 
 /// The crease angle of a user's `degrees`: 180 or more finds no crease
 /// (`None`), otherwise it must be in (0, 180).

@@ -13,6 +13,7 @@ pub mod ao;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
+pub mod interop;
 pub mod kernels;
 pub mod limits;
 pub mod marching_cubes;

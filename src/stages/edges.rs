@@ -103,6 +103,21 @@ struct AdjacencyCaps {
     drawn: usize,
 }
 
+/// What [`EdgeStage::compact_into`] wrote into a shared buffer.
+#[derive(Clone, Debug, Default)]
+pub struct SharedDrawn {
+    /// Kind bits per edge (read back: counts and stats).
+    pub kind: Vec<u32>,
+    /// Drawn edges: quads at vertices `0..4 * edges`.
+    pub edges: usize,
+    /// McGuire-Hughes half-caps follow: `4e..7e` and `7e..10e`.
+    pub mh: bool,
+    /// First vertex of the adjacency caps.
+    pub caps_at: usize,
+    /// Drawn adjacency caps (4 vertices each) from `caps_at`.
+    pub adjacency_caps: usize,
+}
+
 /// Kernels and buffers of [`EdgeStage::read_drawn`]'s compaction.
 struct Compactor {
     k_flags: Kernel,
@@ -518,6 +533,116 @@ impl EdgeStage {
                 out.cap_mh1 = vecs.next().unwrap_or_default();
             }
         }
+        Ok(out)
+    }
+
+    /// Vertices [`compact_into`](Self::compact_into) may write for `mode`:
+    /// edge-out and the half-caps (10 per edge) for McGuire-Hughes caps,
+    /// else edge-out (4 per edge) and the adjacency caps (4 per pair).
+    pub fn shared_vertices(&self, mode: CapMode) -> usize {
+        match mode {
+            CapMode::Mh => 10 * self.n_edges,
+            CapMode::None => 4 * self.n_edges,
+            CapMode::Adjacency => 4 * self.n_edges + 4 * self.n_caps,
+        }
+    }
+
+    /// What [`read_drawn`](Self::read_drawn) reads back, written instead
+    /// into `dst` on the device (a buffer GL draws from: the external-memory
+    /// route), with `kind` alone read back: edge-out compacted from vertex
+    /// 0, then for McGuire-Hughes caps both half-cap lists, then the drawn
+    /// adjacency caps (copied on the device). `dst` holds at least
+    /// [`shared_vertices`](Self::shared_vertices) vertices of the last
+    /// run's mode. Returns `kind` and the drawn edges and caps.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a `dst` too small; device failures.
+    pub fn compact_into(
+        &mut self,
+        dst: &mut Buffer<f32>,
+        dst_vertices: usize,
+    ) -> Result<SharedDrawn> {
+        let need = self.shared_vertices(self.last_mode);
+        if dst_vertices < need {
+            return Err(Error::InvalidArgument(format!(
+                "edges: a shared buffer of {dst_vertices} vertices is smaller than the {need} \
+                 this topology may draw"
+            )));
+        }
+        // The read-back compaction's kernels and flags, made once.
+        if self.compact.is_none() {
+            let g = self.gpu.clone();
+            let prog = g.program(&kernel_files::EDGES, "")?;
+            self.compact = Some(Compactor {
+                k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
+                k_edges: g.entry(&prog, EdgesKernel::CompactEdges)?,
+                slots: g.buffer(self.n_edges.max(1))?,
+                dst: g.buffer(4)?,
+                dst_len: 1,
+                last_ms: 0.0,
+            });
+        }
+        self.ensure_scan()?;
+        let g = self.gpu.clone();
+        let ne = self.n_edges;
+        let c = self.compact.as_mut().expect("made above");
+        let scan = self.scan.as_mut().expect("made above");
+        let mut out = SharedDrawn::default();
+        let mut events = Vec::new();
+        let mut ms = 0.0;
+        if ne > 0 {
+            events.extend(launch(
+                &g,
+                &c.k_flags,
+                ne,
+                &[Arg::U32(ne as u32), buf(&self.kind), buf(&c.slots)],
+            )?);
+            out.edges = scan.exclusive_at(&c.slots, &c.slots, ne, &[])?.0 as usize;
+            ms += scan.last_ms();
+        }
+        let mut srcs: Vec<(&Buffer<f32>, u32)> = vec![(&self.edge_out, 4)];
+        if let (CapMode::Mh, Some([m0, m1])) = (self.last_mode, &self.cap_mh) {
+            srcs.push((m0, 3));
+            srcs.push((m1, 3));
+            out.mh = true;
+        }
+        let mut at_v = 0usize;
+        for (src, per) in srcs {
+            if out.edges > 0 {
+                events.extend(launch(
+                    &g,
+                    &c.k_edges,
+                    ne,
+                    &[
+                        Arg::U32(ne as u32),
+                        Arg::U32(per),
+                        buf(src),
+                        buf(&self.kind),
+                        buf(&c.slots),
+                        Arg::U32(at_v as u32),
+                        buf(&*dst),
+                    ],
+                )?);
+            }
+            at_v += per as usize * out.edges;
+        }
+        out.caps_at = at_v;
+        if let (CapMode::Adjacency, Some(a)) = (self.last_mode, &self.cap_adj)
+            && a.drawn > 0
+        {
+            out.adjacency_caps = a.drawn;
+            // SAFETY: both ranges lie inside their buffers (the caps' room,
+            // and `dst` holds `need` ≥ 4E + 4C vertices).
+            unsafe {
+                g.queue()
+                    .enqueue_copy_buffer(&a.out, dst, 0, 16 * at_v, 16 * 4 * a.drawn, &[])
+                    .map_err(|e| Error::cl("clEnqueueCopyBuffer (adjacency caps)", e))?;
+            }
+        }
+        out.kind = vec![0u32; ne];
+        g.read(&self.kind, &mut out.kind)?;
+        ms += events.iter().map(event_ms).sum::<f64>();
+        c.last_ms = ms;
         Ok(out)
     }
 
