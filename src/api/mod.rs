@@ -36,6 +36,7 @@ use std::time::Instant;
 
 mod curvature;
 mod edges;
+mod lines;
 mod strokes;
 
 pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
@@ -43,6 +44,11 @@ pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, cur
 pub use edges::{
     EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
     feature_edges_picture_on,
+};
+
+pub use lines::{
+    Hidden, LinesPicture, LinesPictureOptions, family_style, hidden_id, lines_picture,
+    lines_picture_on, wanted,
 };
 
 pub use strokes::{
