@@ -446,3 +446,150 @@ fn family_names_round_trip_and_lists_parse() {
         "{e}"
     );
 }
+
+#[test]
+fn each_family_runs_only_its_passes_and_reports_its_kernel_time() {
+    use shapecue::spec::timing::Step;
+    let m = common::shared_mesh("stanford-bunny.obj")
+        .unwrap_or_else(|| mesh::torus(1.0, 0.4, 200, 100));
+    let x = inputs(&m);
+    let fs = mesh::feature_size(&m.positions, &m.faces) as f32;
+    let view = View::from_eye([0.3, 0.2, 1.0], true);
+    let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
+    println!("family | steps | kernel ms | segments");
+    for f in LineFamily::ALL[2..].iter().copied() {
+        ex.pose_changed();
+        let (s, st) = ex
+            .extract(&x.inputs(), view, fs, only(&[f], |_| {}))
+            .unwrap();
+        let t = &st.timing;
+        let pose = [
+            LineFamily::Ridges,
+            LineFamily::Valleys,
+            LineFamily::PrincipalHighlights,
+            LineFamily::KZero,
+            LineFamily::HZero,
+        ]
+        .contains(&f);
+        let view_pass = [
+            LineFamily::ApparentRidges,
+            LineFamily::PrincipalHighlights,
+            LineFamily::Isophotes,
+        ]
+        .contains(&f);
+        assert_eq!(t.ran(&[Step::LinesPose]), pose, "{}: pose pass", f.name());
+        assert_eq!(
+            t.ran(&[Step::LinesView]),
+            view_pass,
+            "{}: view pass",
+            f.name()
+        );
+        assert_eq!(
+            t.ran(&[Step::LinesDt1q1]),
+            f == LineFamily::ApparentRidges,
+            "{}",
+            f.name()
+        );
+        assert!(
+            t.ran(&[Step::LinesCurves]) && !t.ran(&[Step::LinesFace]),
+            "{}",
+            f.name()
+        );
+        let steps = [
+            Step::LinesVertex,
+            Step::LinesPose,
+            Step::LinesView,
+            Step::LinesDt1q1,
+            Step::LinesCurves,
+        ];
+        println!(
+            "{} | {} | {:.3} | {}",
+            f.name(),
+            steps
+                .iter()
+                .filter(|s| t.ran(&[**s]))
+                .map(|s| s.kernel())
+                .collect::<Vec<_>>()
+                .join(" "),
+            t.ms(&steps),
+            s.len()
+        );
+    }
+    // A second view of the same pose reuses the pose terms; a new pose
+    // (after pose_changed) recomputes them.
+    let copts = CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        precision: Precision::F32,
+        compat: Compat::Exact,
+        dcurv: true,
+        lanes: 0,
+    };
+    let mut est = shapecue::stages::curvature::CurvatureEstimator::new(
+        gpu(),
+        m.n_vertices(),
+        &m.faces,
+        copts,
+    )
+    .unwrap();
+    est.set_positions(&m.positions).unwrap();
+    est.run().unwrap();
+    ex.pose_changed();
+    let opts = only(&[LineFamily::Ridges], |_| {});
+    let side = View::from_eye([1.0, 0.2, 0.3], true);
+    let ran = |ex: &mut LineExtractor, v: View| {
+        let (s, st) = ex.extract_device(&est, v, fs, opts).unwrap();
+        assert!(finite(&s));
+        st.timing.ran(&[Step::LinesPose])
+    };
+    assert!(ran(&mut ex, view), "first view of a pose");
+    assert!(!ran(&mut ex, side), "second view of the same pose");
+    ex.pose_changed();
+    assert!(ran(&mut ex, side), "after a new pose");
+}
+
+#[test]
+fn the_command_writes_a_group_per_family_and_the_segments() {
+    let d = common::scratch("lines-cli");
+    let svg = d.join("t.svg");
+    let json = d.join("t.json");
+    let out = common::run_cli([
+        "lines",
+        "torus",
+        "--vertices",
+        "4000",
+        "--lines",
+        "contours,ridges,isophotes,k-zero",
+        "--hidden",
+        "dashed",
+        "-o",
+        svg.to_str().unwrap(),
+        "--segments",
+        json.to_str().unwrap(),
+    ]);
+    if common::cli_gl_missing(&out) {
+        return;
+    }
+    common::assert_succeeded(&out);
+    let t = std::fs::read_to_string(&svg).unwrap();
+    for id in ["contours", "ridges", "isophotes", "k-zero", "k-zero-hidden"] {
+        assert!(t.contains(&format!("<g id=\"{id}\"")), "{id}");
+    }
+    assert!(t.contains("stroke-dasharray"));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let segs = j["segments"].as_array().unwrap();
+    assert!(segs.iter().any(|s| s["family"] == "k-zero"));
+    assert!(segs.iter().all(|s| s["strength"].as_f64().is_some()));
+    let bad = common::run_cli([
+        "lines",
+        "torus",
+        "--lines",
+        "ridges,creases",
+        "-o",
+        svg.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("creases"), "{err}");
+}

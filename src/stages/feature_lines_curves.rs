@@ -155,12 +155,13 @@ impl CurveStage {
         });
         let needs_dt = fams.has(LineFamily::ApparentRidges);
         let grads = opts.hermite;
-        // The view pass reads dmax from the pose terms.
+        // The view pass reads dmax from the pose terms, used only by the
+        // principal highlights, which need the pose pass anyway.
         let pose_ok = match self.pose_done {
             Some(g) => g || !grads,
             None => false,
         };
-        if (needs_pose || needs_view) && !pose_ok {
+        if needs_pose && !pose_ok {
             let e = launch(
                 &g,
                 &self.kernels[0],
