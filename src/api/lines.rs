@@ -15,6 +15,7 @@ use crate::render::{MeshStyle, RenderOptions, Renderer};
 use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
 use crate::spec::feature_lines::{LineFamily, LineInputs, Segment};
 use crate::spec::timing::Timing;
+use crate::spec::view::View;
 use crate::stages::curvature::estimate;
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use glam::Vec3;
@@ -151,41 +152,10 @@ pub fn lines_picture_on(
         bounds,
         w as f32 / h as f32,
     )?;
-    let copts = CurvatureOptions {
-        accumulate: Accumulate::Atomic,
-        precision: Precision::F32,
-        compat: Compat::Exact,
-        dcurv: true,
-        lanes: 0,
-    };
-    let run = estimate(gpu.clone(), mesh, copts)?;
-    let f = &run.field;
-    let c3 = |v: &[[f64; 3]]| -> Vec<[f32; 3]> { v.iter().map(|p| p.map(|c| c as f32)).collect() };
-    let pos = c3(&mesh.positions);
-    let (nrm, d1, d2) = (c3(&f.normals), c3(&f.d1), c3(&f.d2));
-    let k: Vec<[f32; 2]> =
-        f.k1.iter()
-            .zip(&f.k2)
-            .map(|(a, b)| [*a as f32, *b as f32])
-            .collect();
-    let dk: Vec<[f32; 4]> = f.dk.iter().map(|d| d.map(|c| c as f32)).collect();
-    let x = LineInputs {
-        pos: &pos,
-        nrm: &nrm,
-        d1: &d1,
-        d2: &d2,
-        k: &k,
-        dk: &dk,
-    };
-    let fs = match crate::mesh::feature_size(&mesh.positions, &mesh.faces) {
-        s if s > 0.0 => s as f32,
-        _ => 1.0,
-    };
-    let mut ex = LineExtractor::new(gpu.clone(), mesh.n_vertices(), &mesh.faces)?;
-    let (segments, st) = ex.extract(&x, cam.view(w, h), fs, opts.lines)?;
-    let mut timing = run.timing.clone();
-    timing.extend(&st.timing);
-
+    let ls = line_segments_on(gpu, mesh, cam.view(w, h), &opts.lines)?;
+    let (segments, timing, fs) = (ls.segments, ls.timing, ls.feature_size);
+    let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+    let nrm = crate::mesh::topology::vertex_normals(mesh);
     let families = wanted(&opts.lines);
     let mut r = Renderer::new(RenderOptions {
         width: w,
@@ -226,6 +196,66 @@ pub fn lines_picture_on(
         layers,
         timing,
         camera: cam,
+        feature_size: fs,
+    })
+}
+
+/// The segments of [`line_segments_on`].
+pub struct LineSegments {
+    /// Every segment, world coordinates, with its family (`kind`) and strength.
+    pub segments: Vec<Segment>,
+    /// Kernel ms of curvature and line steps.
+    pub timing: Timing,
+    /// The feature size the thresholds were scaled by (median edge length).
+    pub feature_size: f32,
+}
+
+/// The line segments of `mesh` seen from `view` (no picture, no GL):
+/// curvature with its derivative (f32, on the device), then every family
+/// `opts` asks for, thresholds scaled by the median edge length.
+pub fn line_segments_on(
+    gpu: &Arc<Gpu>,
+    mesh: &Mesh,
+    view: View,
+    opts: &LineOptions,
+) -> Result<LineSegments> {
+    let copts = CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        precision: Precision::F32,
+        compat: Compat::Exact,
+        dcurv: true,
+        lanes: 0,
+    };
+    let run = estimate(gpu.clone(), mesh, copts)?;
+    let f = &run.field;
+    let c3 = |v: &[[f64; 3]]| -> Vec<[f32; 3]> { v.iter().map(|p| p.map(|c| c as f32)).collect() };
+    let pos = c3(&mesh.positions);
+    let (nrm, d1, d2) = (c3(&f.normals), c3(&f.d1), c3(&f.d2));
+    let k: Vec<[f32; 2]> =
+        f.k1.iter()
+            .zip(&f.k2)
+            .map(|(a, b)| [*a as f32, *b as f32])
+            .collect();
+    let dk: Vec<[f32; 4]> = f.dk.iter().map(|d| d.map(|c| c as f32)).collect();
+    let x = LineInputs {
+        pos: &pos,
+        nrm: &nrm,
+        d1: &d1,
+        d2: &d2,
+        k: &k,
+        dk: &dk,
+    };
+    let fs = match crate::mesh::feature_size(&mesh.positions, &mesh.faces) {
+        s if s > 0.0 => s as f32,
+        _ => 1.0,
+    };
+    let mut ex = LineExtractor::new(gpu.clone(), mesh.n_vertices(), &mesh.faces)?;
+    let (segments, st) = ex.extract(&x, view, fs, *opts)?;
+    let mut timing = run.timing.clone();
+    timing.extend(&st.timing);
+    Ok(LineSegments {
+        segments,
+        timing,
         feature_size: fs,
     })
 }

@@ -47,8 +47,8 @@ pub use edges::{
 };
 
 pub use lines::{
-    Hidden, LinesPicture, LinesPictureOptions, family_style, hidden_id, lines_picture,
-    lines_picture_on, wanted,
+    Hidden, LineSegments, LinesPicture, LinesPictureOptions, family_style, hidden_id,
+    line_segments_on, lines_picture, lines_picture_on, wanted,
 };
 
 pub use strokes::{
