@@ -14,6 +14,7 @@ use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::spec::ao::AoMode;
+use crate::spec::feature_lines::{CurveOptions, FamilySet, LineFamily};
 use crate::spec::timing::Family;
 use crate::stages::feature_lines::LineOptions;
 use crate::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
@@ -100,6 +101,35 @@ fn model(
             n += ev.len();
         }
     }
+    // Each curvature line family alone, then every family at once: the
+    // feature-lines kernels of one view per pose (the pose terms once per
+    // pose), over the same poses.
+    let mut fam_ms: Vec<(String, f64)> = Vec::new();
+    let every = FamilySet(LineFamily::ALL.iter().fold(0, |m, f| m | f.bit()));
+    let sets: Vec<(String, FamilySet)> = LineFamily::ALL[2..]
+        .iter()
+        .map(|f| (format!("lines: {}", f.name()), FamilySet::of(&[*f])))
+        .chain(std::iter::once(("lines: every family".to_string(), every)))
+        .collect();
+    for (label, set) in sets {
+        let opts = LineOptions {
+            contours: set.has(LineFamily::Contours),
+            suggestive: set.has(LineFamily::Suggestive),
+            curves: CurveOptions {
+                families: set.curves(),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let mut ms = Vec::new();
+        for mats in &poses {
+            p.skin(mats)?;
+            p.curvature()?;
+            let (_, st) = p.lines(view, size, opts)?;
+            ms.push(st.timing.family_ms(Family::FeatureLines));
+        }
+        fam_ms.push((label, median(&mut ms)));
+    }
     let rms = |se: f64| (se / n.max(1) as f64).sqrt();
     let med = |f: &dyn Fn(&PassTimes) -> f64| median(&mut t.iter().map(f).collect::<Vec<_>>());
     let name = gltf.file_name().map_or_else(
@@ -165,6 +195,10 @@ fn model(
         Cell::empty(),
     );
     let (kernel, wall) = (med(&|x| x.kernel_ms), med(&|x| x.wall_ms));
+    for (label, ms) in &fam_ms {
+        // Beside the frame, not in its total (bold-wrapped: no bar).
+        row(&format!("**{label}**"), *ms, Cell::empty());
+    }
     row(
         "**total (skin+curv+dcurv+ao lut+lines)**",
         kernel,

@@ -126,10 +126,12 @@ impl CurveStage {
         opts.check()?;
         let fams = opts.families.curves();
         let g = self.gpu.clone();
-        let mut timing = Timing::default();
+        // Profiling times are read once the blocking read of the counter
+        // has finished every launch before it.
+        let mut events: Vec<(Step, opencl3::event::Event)> = Vec::new();
         let mut time = |step: Step, e: Option<opencl3::event::Event>| {
-            if let Some(e) = &e {
-                timing.add(step, event_ms(e));
+            if let Some(e) = e {
+                events.push((step, e));
             }
         };
         let nv = self.nv as u32;
@@ -267,7 +269,12 @@ impl CurveStage {
             g.read(&self.counter, &mut c)?;
             let found = c[0] as usize;
             if found <= self.cap {
-                return Ok((self.read(found)?, timing));
+                let segs = self.read(found)?;
+                let mut timing = Timing::default();
+                for (step, e) in &events {
+                    timing.add(*step, event_ms(e));
+                }
+                return Ok((segs, timing));
             }
             self.grow(found)?;
         }
