@@ -346,7 +346,7 @@ pub fn hidden_id(f: LineFamily) -> &'static str {
 /// `p` in image pixels (origin top left), or `None` behind the eye.
 fn pixel(vp: glam::Mat4, p: [f32; 3], w: u32, h: u32) -> Option<[f32; 2]> {
     let c = vp * glam::Vec4::new(p[0], p[1], p[2], 1.0);
-    if !(c.w > 0.0) {
+    if c.w.is_nan() || c.w <= 0.0 {
         return None;
     }
     let (x, y) = (c.x / c.w, c.y / c.w);
