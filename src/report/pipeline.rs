@@ -62,6 +62,11 @@ const KEYS: [&str; 8] = [
     "passes", "passes_2", "passes_3", "passes_4", "passes_5", "passes_6", "passes_7", "passes_8",
 ];
 
+/// The keys of the line-family tables, one per model.
+const LINE_KEYS: [&str; 8] = [
+    "lines", "lines_2", "lines_3", "lines_4", "lines_5", "lines_6", "lines_7", "lines_8",
+];
+
 /// The most models one report times.
 pub const MAX_MODELS: usize = KEYS.len();
 
@@ -195,10 +200,6 @@ fn model(
         Cell::empty(),
     );
     let (kernel, wall) = (med(&|x| x.kernel_ms), med(&|x| x.wall_ms));
-    for (label, ms) in &fam_ms {
-        // Beside the frame, not in its total (bold-wrapped: no bar).
-        row(&format!("**{label}**"), *ms, Cell::empty());
-    }
     row(
         "**total (skin+curv+dcurv+ao lut+lines)**",
         kernel,
@@ -209,6 +210,26 @@ fn model(
         last.cells[0].text = "**total (skin+curv+dcurv+ao lut+lines)**".into();
     }
     r.blocks.push(Block::Table(table));
+    // The line families, beside the frame (not in its total): the
+    // feature-lines kernels of one view per pose, each family alone, then
+    // every family at once.
+    let mut lines_table = Table::new(
+        LINE_KEYS[index.min(LINE_KEYS.len() - 1)],
+        vec![
+            Column::new("line families", "families"),
+            Column::new("median kernel ms", "kernel_ms"),
+            Column::hidden("model"),
+        ],
+    );
+    for (label, ms) in &fam_ms {
+        lines_table.rows.push(Row::new(vec![
+            Cell::text(label.trim_start_matches("lines: ")),
+            Cell::num(*ms, format!("{ms:.3}")),
+            Cell::text(name.clone()),
+        ]));
+    }
+    r.text("\nFeature-line kernels per view (pose terms once per pose), by family:\n".to_string());
+    r.blocks.push(Block::Table(lines_table));
     let verdict = |ms: f64| if ms <= 16.0 { "met" } else { "NOT met" };
     r.text(format!(
         "\nwall ms per frame (median, matrices up, segments back): {wall:.3}\n\
