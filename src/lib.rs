@@ -49,10 +49,10 @@ pub struct ReadmeDoctests;
 
 pub use api::{
     CurvatureJob, CurvaturePhases, CurvatureRun, EdgePicture, EdgePictureOptions, IsoOptions,
-    Isosurface, MeshSource, PictureOptions, Strokes, StrokesInput, StrokesOptions, curvature,
-    curvature_of, curvature_on, feature_edges, feature_edges_on, feature_edges_picture,
-    feature_edges_picture_on, isosurface, isosurface_on, render_scene, render_scene_on, strokes,
-    strokes_on,
+    Isosurface, LinesPicture, LinesPictureOptions, MeshSource, PictureOptions, Strokes,
+    StrokesInput, StrokesOptions, curvature, curvature_of, curvature_on, feature_edges,
+    feature_edges_on, feature_edges_picture, feature_edges_picture_on, isosurface, isosurface_on,
+    lines_picture, lines_picture_on, render_scene, render_scene_on, strokes, strokes_on,
 };
 pub use error::{Error, Result};
 pub use mesh::Mesh;

@@ -49,6 +49,12 @@ enum Cmd {
     /// caps, to PNG (and SVG). Exit code 3: `--interop on` without a shared
     /// route (CL-GL sharing or external memory; PoCL has neither); 1: any other error.
     Edges(cli::edges::EdgesArgs),
+    /// Line drawings with every line family of rtsc (Rusinkiewicz and
+    /// DeCarlo): occluding and suggestive contours, ridges and valleys
+    /// (Ohtake et al.), apparent ridges (Judd et al.), suggestive and
+    /// principal highlights, isophotes, K = 0, H = 0, D_w κr = 0 and
+    /// boundaries, to PNG or SVG (a group per family).
+    Lines(cli::lines::LinesArgs),
     /// Render scene files (TOML): only the passes the scene's cues need run;
     /// images (PNG, SVG) and a JSON report of the passes that ran go to the
     /// scene's output folder. See `scenes/` and the README.
@@ -80,6 +86,7 @@ fn main() {
         Cmd::BuildKernels(a) => cli::kernels::run(device, a),
         Cmd::Isosurface(a) => cli::isosurface::run(device, a),
         Cmd::Edges(a) => cli::edges::run(device, a),
+        Cmd::Lines(a) => cli::lines::run(device, a),
         Cmd::Render(a) => cli::render::run(device, a),
         Cmd::Strokes(a) => cli::strokes::run(device, a),
         Cmd::Report(a) => cli::report::run(device, a),

@@ -197,6 +197,7 @@ fn suggestive_contours_respect_the_threshold_and_facing() {
         suggestive: true,
         threshold: t,
         fade: 0.2,
+        ..Default::default()
     };
     let loose = device(&m, &x, view, only_sc(0.0));
     let strict = device(&m, &x, view, only_sc(0.5));

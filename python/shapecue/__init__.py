@@ -38,6 +38,7 @@ __all__ = [
     "DeviceError",
     "FeatureEdges",
     "Isosurface",
+    "Lines",
     "RenderError",
     "Volume",
     "build_kernels",
@@ -45,6 +46,7 @@ __all__ = [
     "devices",
     "feature_edges",
     "isosurface",
+    "lines",
     "load_mesh",
     "load_volume",
     "render",
@@ -487,6 +489,90 @@ def render(
     else:
         text = _shapecue.render_file(os.fspath(scene), out, bool(force), _device(device))
     return json.loads(text)
+
+
+@dataclass
+class Lines:
+    """Line segments of :func:`lines`: ``segments`` (S, 2, 3) float32 end
+    points, ``family`` (S,) family names, ``kind`` (S,) their indices,
+    ``strength`` (S,) in [0, 1], and the feature size the thresholds were
+    scaled by (the median edge length)."""
+
+    segments: np.ndarray
+    kind: np.ndarray
+    family: np.ndarray
+    strength: np.ndarray
+    feature_size: float
+    kernel_ms: float
+    device: str
+
+    def of(self, family: str) -> np.ndarray:
+        """The (n, 2, 3) segments of one family."""
+        return self.segments[self.family == family]
+
+
+def lines(
+    vertices: Any,
+    faces: Any = None,
+    *,
+    lines: Union[str, Sequence[str]] = "contours,suggestive",
+    eye: Optional[Sequence[float]] = None,
+    direction: Sequence[float] = (1.0, 1.0, 1.0),
+    ortho: bool = False,
+    sc_threshold: float = 0.05,
+    rv_threshold: float = 0.1,
+    ar_threshold: float = 0.1,
+    ph_threshold: float = 0.04,
+    sh_threshold: float = 0.02,
+    isophotes: int = 20,
+    light: Sequence[float] = (0.0, 0.0, 1.0),
+    cull: bool = True,
+    test: bool = True,
+    fade: bool = True,
+    hermite: bool = False,
+    device: Union[int, str, None] = None,
+) -> Lines:
+    """The line families of rtsc (Rusinkiewicz and DeCarlo) on a mesh seen
+    from ``eye`` (a point; with ``ortho``, the direction towards the viewer),
+    by default three bounding radii from the centre along ``direction``.
+
+    ``lines``: names among contours, suggestive, ridges, valleys,
+    apparent-ridges, suggestive-highlights, principal-highlights, isophotes,
+    k-zero, h-zero, dwkr-zero, boundaries. Thresholds are dimensionless,
+    scaled by the feature size as in ``shapecue lines``.
+    """
+    v, f = _mesh_arrays(vertices, faces)
+    names = lines if isinstance(lines, str) else ",".join(lines)
+    if eye is None:
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        d = np.asarray(direction, dtype=np.float64)
+        if d.shape != (3,) or not np.all(np.isfinite(d)) or not np.any(d):
+            raise ValueError("direction: expected three finite numbers, not all zero")
+        d = d / np.linalg.norm(d)
+        r = 0.5 * float(np.linalg.norm(hi - lo))
+        eye = d if ortho else 0.5 * (lo + hi) + 3.0 * max(r, 1e-30) * d
+    e = tuple(float(c) for c in eye)
+    l3 = tuple(float(c) for c in light)
+    if len(e) != 3 or len(l3) != 3:
+        raise ValueError("eye and light: expected three numbers")
+    d = _shapecue.lines(
+        v,
+        f,
+        names,
+        e,
+        bool(ortho),
+        (float(sc_threshold), float(rv_threshold), float(ar_threshold), float(ph_threshold), float(sh_threshold)),
+        int(isophotes),
+        l3,
+        bool(cull),
+        bool(test),
+        bool(fade),
+        bool(hermite),
+        _device(device),
+    )
+    fam_names = np.asarray(d.pop("family_names"))
+    kind = d["kind"]
+    return Lines(family=fam_names[kind] if len(kind) else np.asarray([], dtype=str), **d)
 
 
 def load_mesh(path: Union[str, os.PathLike], *, weld: bool = False) -> Tuple[np.ndarray, np.ndarray]:

@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
+mod lines;
 mod scene;
 
 create_exception!(
@@ -672,6 +673,7 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::feature_edges, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_text, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::lines, m)?)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(load_volume, m)?)?;
     m.add_class::<PyEstimator>()?;

@@ -37,6 +37,7 @@ use std::time::Instant;
 mod curvature;
 mod edges;
 pub mod interop;
+mod lines;
 mod strokes;
 
 pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
@@ -44,6 +45,11 @@ pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, cur
 pub use edges::{
     EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
     feature_edges_picture_on,
+};
+
+pub use lines::{
+    Hidden, LineSegments, LinesPicture, LinesPictureOptions, family_style, hidden_id,
+    line_segments_on, lines_picture, lines_picture_on, wanted,
 };
 
 pub use strokes::{

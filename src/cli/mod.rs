@@ -8,6 +8,7 @@ pub mod devices;
 pub mod edges;
 pub mod isosurface;
 pub mod kernels;
+pub mod lines;
 pub mod render;
 pub mod report;
 pub mod strokes;

@@ -1,5 +1,6 @@
-//! SVG export of drawn lines: feature edges (House & Li) and occluding and
-//! suggestive contours (DeCarlo et al. 2003), one SVG group per cue (its own
+//! SVG export of drawn lines: feature edges (House & Li), occluding and
+//! suggestive contours (DeCarlo et al. 2003) and every other line family of
+//! `shapecue lines`, one SVG group per cue or family (its own
 //! id, class, colour and stroke width, so that users can restyle each cue).
 //! Which parts of the lines are visible, joined into polylines, the renderer
 //! finds against its depth buffer ([`crate::render::visibility`], whose items
@@ -25,6 +26,8 @@ pub struct SvgLayer {
     pub color: [f32; 3],
     /// The joined visible lines.
     pub lines: Vec<SvgPolyline>,
+    /// Dashed strokes (hidden parts drawn dashed).
+    pub dashed: bool,
 }
 
 fn hex(c: [f32; 3]) -> String {
@@ -88,10 +91,19 @@ pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
         let _ = writeln!(
             s,
             "<g id=\"{id}\" class=\"{id}\" fill=\"none\" stroke=\"{c}\" stroke-width=\"{w}\" \
-             stroke-linecap=\"round\" stroke-linejoin=\"round\">",
+             stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
             id = layer.id,
             c = hex(layer.color),
-            w = layer.stroke_width
+            w = layer.stroke_width,
+            dash = if layer.dashed {
+                format!(
+                    " stroke-dasharray=\"{:.1} {:.1}\"",
+                    3.0 * layer.stroke_width,
+                    2.0 * layer.stroke_width
+                )
+            } else {
+                String::new()
+            }
         );
         for l in &layer.lines {
             push_polyline(&mut s, &l.points, Some(l.opacity));
@@ -136,6 +148,7 @@ mod tests {
                     points: vec![[0.0, 0.0], [1.0, 1.0]],
                     opacity: 1.0,
                 }],
+                dashed: false,
             },
             SvgLayer {
                 id: "suggestive-contours",
@@ -145,6 +158,7 @@ mod tests {
                     points: vec![[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]],
                     opacity: 0.5,
                 }],
+                dashed: true,
             },
         ];
         let t = svg_layers_text(&layers, 8, 8);
@@ -152,5 +166,7 @@ mod tests {
         assert!(t.contains("id=\"suggestive-contours\" class=\"suggestive-contours\" fill=\"none\" stroke=\"#ff8000\" stroke-width=\"1.5\""));
         assert!(t.contains("points=\"0.00,0.00 1.00,1.00 2.00,0.00\" stroke-opacity=\"0.50\""));
         assert!(t.contains("points=\"0.00,0.00 1.00,1.00\"/>"));
+        assert!(t.contains("stroke-dasharray=\"4.5 3.0\""));
+        assert_eq!(t.matches("stroke-dasharray").count(), 1);
     }
 }

@@ -14,6 +14,7 @@ use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::spec::ao::AoMode;
+use crate::spec::feature_lines::{CurveOptions, FamilySet, LineFamily};
 use crate::spec::timing::Family;
 use crate::stages::feature_lines::LineOptions;
 use crate::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
@@ -61,6 +62,11 @@ const KEYS: [&str; 8] = [
     "passes", "passes_2", "passes_3", "passes_4", "passes_5", "passes_6", "passes_7", "passes_8",
 ];
 
+/// The keys of the line-family tables, one per model.
+const LINE_KEYS: [&str; 8] = [
+    "lines", "lines_2", "lines_3", "lines_4", "lines_5", "lines_6", "lines_7", "lines_8",
+];
+
 /// The most models one report times.
 pub const MAX_MODELS: usize = KEYS.len();
 
@@ -99,6 +105,35 @@ fn model(
             }
             n += ev.len();
         }
+    }
+    // Each curvature line family alone, then every family at once: the
+    // feature-lines kernels of one view per pose (the pose terms once per
+    // pose), over the same poses.
+    let mut fam_ms: Vec<(String, f64)> = Vec::new();
+    let every = FamilySet(LineFamily::ALL.iter().fold(0, |m, f| m | f.bit()));
+    let sets: Vec<(String, FamilySet)> = LineFamily::ALL[2..]
+        .iter()
+        .map(|f| (format!("lines: {}", f.name()), FamilySet::of(&[*f])))
+        .chain(std::iter::once(("lines: every family".to_string(), every)))
+        .collect();
+    for (label, set) in sets {
+        let opts = LineOptions {
+            contours: set.has(LineFamily::Contours),
+            suggestive: set.has(LineFamily::Suggestive),
+            curves: CurveOptions {
+                families: set.curves(),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let mut ms = Vec::new();
+        for mats in &poses {
+            p.skin(mats)?;
+            p.curvature()?;
+            let (_, st) = p.lines(view, size, opts)?;
+            ms.push(st.timing.family_ms(Family::FeatureLines));
+        }
+        fam_ms.push((label, median(&mut ms)));
     }
     let rms = |se: f64| (se / n.max(1) as f64).sqrt();
     let med = |f: &dyn Fn(&PassTimes) -> f64| median(&mut t.iter().map(f).collect::<Vec<_>>());
@@ -175,6 +210,26 @@ fn model(
         last.cells[0].text = "**total (skin+curv+dcurv+ao lut+lines)**".into();
     }
     r.blocks.push(Block::Table(table));
+    // The line families, beside the frame (not in its total): the
+    // feature-lines kernels of one view per pose, each family alone, then
+    // every family at once.
+    let mut lines_table = Table::new(
+        LINE_KEYS[index.min(LINE_KEYS.len() - 1)],
+        vec![
+            Column::new("line families", "families"),
+            Column::new("median kernel ms", "kernel_ms"),
+            Column::hidden("model"),
+        ],
+    );
+    for (label, ms) in &fam_ms {
+        lines_table.rows.push(Row::new(vec![
+            Cell::text(label.trim_start_matches("lines: ")),
+            Cell::num(*ms, format!("{ms:.3}")),
+            Cell::text(name.clone()),
+        ]));
+    }
+    r.text("\nFeature-line kernels per view (pose terms once per pose), by family:\n".to_string());
+    r.blocks.push(Block::Table(lines_table));
     let verdict = |ms: f64| if ms <= 16.0 { "met" } else { "NOT met" };
     r.text(format!(
         "\nwall ms per frame (median, matrices up, segments back): {wall:.3}\n\

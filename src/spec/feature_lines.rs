@@ -47,3 +47,281 @@ crate::spec::kernels::kernel_entries! {
         Face = "lines_face",
     }
 }
+
+/// A family of lines: the `kind` of a [`Segment`] is its index. Occluding
+/// and suggestive contours come from `kernels/feature_lines.cl`, the others
+/// from `kernels/feature_lines_curves.cl`; the set is that of rtsc
+/// (Rusinkiewicz and DeCarlo's real-time suggestive contours program).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LineFamily {
+    /// Occluding contours, n·v = 0.
+    Contours = 0,
+    /// Suggestive contours (DeCarlo et al. 2003).
+    Suggestive = 1,
+    /// Ridges (Ohtake, Belyaev and Seidel 2004): maxima of the larger
+    /// principal curvature along its direction, where it is positive.
+    Ridges = 2,
+    /// Valleys: the same where the curvature of larger magnitude is negative.
+    Valleys = 3,
+    /// Apparent ridges (Judd, Durand and Adelson 2007): maxima of the
+    /// view-dependent curvature.
+    ApparentRidges = 4,
+    /// Suggestive highlights (DeCarlo and Rusinkiewicz 2007).
+    SuggestiveHighlights = 5,
+    /// Principal highlights (DeCarlo and Rusinkiewicz 2007).
+    PrincipalHighlights = 6,
+    /// Isophotes: n·l at evenly spaced levels.
+    Isophotes = 7,
+    /// Parabolic lines, K = 0.
+    KZero = 8,
+    /// Lines of zero mean curvature, H = 0.
+    HZero = 9,
+    /// D_w κr = 0: the zero set of the suggestive-contour test.
+    DwkrZero = 10,
+    /// Mesh boundaries (edges with one face).
+    Boundaries = 11,
+}
+
+impl LineFamily {
+    /// Every family, by index.
+    pub const ALL: [LineFamily; 12] = [
+        LineFamily::Contours,
+        LineFamily::Suggestive,
+        LineFamily::Ridges,
+        LineFamily::Valleys,
+        LineFamily::ApparentRidges,
+        LineFamily::SuggestiveHighlights,
+        LineFamily::PrincipalHighlights,
+        LineFamily::Isophotes,
+        LineFamily::KZero,
+        LineFamily::HZero,
+        LineFamily::DwkrZero,
+        LineFamily::Boundaries,
+    ];
+
+    /// The family's name in files, scenes and the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            LineFamily::Contours => "contours",
+            LineFamily::Suggestive => "suggestive",
+            LineFamily::Ridges => "ridges",
+            LineFamily::Valleys => "valleys",
+            LineFamily::ApparentRidges => "apparent-ridges",
+            LineFamily::SuggestiveHighlights => "suggestive-highlights",
+            LineFamily::PrincipalHighlights => "principal-highlights",
+            LineFamily::Isophotes => "isophotes",
+            LineFamily::KZero => "k-zero",
+            LineFamily::HZero => "h-zero",
+            LineFamily::DwkrZero => "dwkr-zero",
+            LineFamily::Boundaries => "boundaries",
+        }
+    }
+
+    /// The family of a segment kind.
+    pub fn from_kind(kind: u32) -> Option<LineFamily> {
+        LineFamily::ALL.get(kind as usize).copied()
+    }
+
+    /// This family's bit in a [`FamilySet`].
+    pub const fn bit(self) -> u32 {
+        1 << self as u32
+    }
+
+    /// Whether the family reads the view-dependent curvature (q1, t1, D_t1 q1).
+    pub fn needs_view_curvature(self) -> bool {
+        self == LineFamily::ApparentRidges
+    }
+
+    /// Whether the family reads the curvature derivative (dcurv).
+    pub fn needs_dcurv(self) -> bool {
+        matches!(
+            self,
+            LineFamily::Suggestive
+                | LineFamily::Ridges
+                | LineFamily::Valleys
+                | LineFamily::SuggestiveHighlights
+                | LineFamily::DwkrZero
+        )
+    }
+
+    /// Whether the family needs only normals (no curvature).
+    pub fn needs_only_normals(self) -> bool {
+        matches!(
+            self,
+            LineFamily::Contours | LineFamily::Isophotes | LineFamily::Boundaries
+        )
+    }
+}
+
+crate::spec::named_choice!(LineFamily, "line family");
+
+/// A set of [`LineFamily`]s (a bit per family index).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct FamilySet(pub u32);
+
+impl FamilySet {
+    /// No family.
+    pub const NONE: FamilySet = FamilySet(0);
+
+    /// The set of `families`.
+    pub fn of(families: &[LineFamily]) -> FamilySet {
+        FamilySet(families.iter().fold(0, |m, f| m | f.bit()))
+    }
+
+    /// Whether `f` is in the set.
+    pub fn has(self, f: LineFamily) -> bool {
+        self.0 & f.bit() != 0
+    }
+
+    /// The families in the set, by index.
+    pub fn iter(self) -> impl Iterator<Item = LineFamily> {
+        LineFamily::ALL.into_iter().filter(move |f| self.has(*f))
+    }
+
+    /// Parses a comma-separated list of family names.
+    pub fn parse(list: &str) -> crate::error::Result<FamilySet> {
+        let mut s = FamilySet::NONE;
+        for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+            let f: LineFamily = name.parse()?;
+            s.0 |= f.bit();
+        }
+        Ok(s)
+    }
+
+    /// The set with the occluding and suggestive contours removed (the
+    /// families of `kernels/feature_lines_curves.cl`).
+    pub fn curves(self) -> FamilySet {
+        FamilySet(self.0 & !(LineFamily::Contours.bit() | LineFamily::Suggestive.bit()))
+    }
+}
+
+/// The controls of the curvature line families (rtsc's): thresholds are
+/// dimensionless, multiplied by the mesh's feature size s: ridges, valleys
+/// and apparent ridges keep |k| > t / s, principal highlights
+/// (k1² − k2²)(n·v) > t / s², suggestive highlights −D_w κr / (n·v) > t / s².
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct CurveOptions {
+    /// The families to draw besides the contours.
+    pub families: FamilySet,
+    /// Ridge and valley threshold (rtsc's default 0.1).
+    pub ridge_threshold: f32,
+    /// Apparent-ridge threshold (rtsc's default 0.1).
+    pub apparent_threshold: f32,
+    /// Principal-highlight threshold (rtsc's default 0.04).
+    pub principal_threshold: f32,
+    /// Suggestive-highlight threshold (rtsc's default 0.02).
+    pub highlight_threshold: f32,
+    /// Isophotes: levels n·l = j / N for |j| < N (rtsc's default N = 20).
+    pub isophotes: u32,
+    /// Unit direction towards the light, world coordinates.
+    pub light: [f32; 3],
+    /// Back-face culling: no segment on a face whose corners all face away.
+    pub cull: bool,
+    /// The extremum and threshold tests (off: every zero crossing).
+    pub test: bool,
+    /// Strength fades with the test's margin above the threshold.
+    pub fade: bool,
+    /// Hermite (cubic) placement of the K = 0 and H = 0 crossings, from the
+    /// curvature gradients, instead of linear interpolation.
+    pub hermite: bool,
+}
+
+impl Default for CurveOptions {
+    fn default() -> Self {
+        CurveOptions {
+            families: FamilySet::NONE,
+            ridge_threshold: 0.1,
+            apparent_threshold: 0.1,
+            principal_threshold: 0.04,
+            highlight_threshold: 0.02,
+            isophotes: 20,
+            light: [0.0, 0.0, 1.0],
+            cull: true,
+            test: true,
+            fade: true,
+            hermite: false,
+        }
+    }
+}
+
+impl CurveOptions {
+    /// The kernel's flag bits: culling, tests, fading, Hermite.
+    pub fn flags(&self) -> u32 {
+        u32::from(self.cull)
+            | (u32::from(self.test) << 1)
+            | (u32::from(self.fade) << 2)
+            | (u32::from(self.hermite) << 3)
+    }
+
+    /// Checks the thresholds and the light.
+    pub fn check(&self) -> crate::error::Result<()> {
+        for (what, t) in [
+            ("ridge", self.ridge_threshold),
+            ("apparent-ridge", self.apparent_threshold),
+            ("principal-highlight", self.principal_threshold),
+            ("suggestive-highlight", self.highlight_threshold),
+        ] {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(crate::error::Error::InvalidArgument(format!(
+                    "the {what} threshold must be finite and at least 0, got {t}"
+                )));
+            }
+        }
+        let l = self.light;
+        let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        if !(n.is_finite() && n > 0.0) {
+            return Err(crate::error::Error::InvalidArgument(
+                "the light direction must be finite and non-zero".into(),
+            ));
+        }
+        if self.isophotes > 1000 {
+            return Err(crate::error::Error::InvalidArgument(format!(
+                "at most 1000 isophote levels, got {}",
+                self.isophotes
+            )));
+        }
+        Ok(())
+    }
+
+    /// The light direction, unit.
+    pub fn unit_light(&self) -> [f32; 3] {
+        let l = self.light;
+        let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        l.map(|c| c / n)
+    }
+}
+
+/// First estimate of the segments the curve pass emits on `faces` faces for
+/// `families`: the most a face can emit per family (three for the
+/// ridge-like families, whose crossings may meet at the face centre; two
+/// isophote levels). The kernel counts everything, and the host grows the
+/// buffer and reruns the pass when a mesh needs more (many isophote levels
+/// across one face).
+pub fn curve_segments_estimate(faces: usize, families: FamilySet) -> usize {
+    let per_face: usize = families
+        .curves()
+        .iter()
+        .map(|f| match f {
+            LineFamily::Ridges | LineFamily::Valleys | LineFamily::ApparentRidges => 3,
+            LineFamily::Boundaries => 3,
+            LineFamily::Isophotes => 2,
+            _ => 1,
+        })
+        .sum();
+    (per_face * faces).max(1)
+}
+
+crate::spec::kernels::kernel_entries! {
+    /// The entry points of `kernels/feature_lines_curves.cl`.
+    pub enum LinesCurvesKernel {
+        /// Per vertex, per pose: kmax, its derivative and direction, K, H.
+        Pose = "lines_pose",
+        /// Per vertex, per view: q1, t1, principal-highlight terms, n·l.
+        View = "lines_view",
+        /// Per vertex, per view: D_t1 q1.
+        Dt1q1 = "lines_dt1q1",
+        /// Per face: the segments of every requested curve family.
+        Curves = "lines_curves",
+    }
+}

@@ -7,7 +7,7 @@
 use super::ao::AoKernel;
 use super::curvature::CurvKernel;
 use super::edges::EdgesKernel;
-use super::feature_lines::LinesKernel;
+use super::feature_lines::{LinesCurvesKernel, LinesKernel};
 use super::marching_cubes::McKernel;
 use super::mesh_sdf::MsdfKernel;
 use super::sdf_lines::SdflKernel;
@@ -53,6 +53,10 @@ impl Step {
             Step::SkinLbs => SkinKernel::Lbs.name(),
             Step::LinesVertex => LinesKernel::Vertex.name(),
             Step::LinesFace => LinesKernel::Face.name(),
+            Step::LinesPose => LinesCurvesKernel::Pose.name(),
+            Step::LinesView => LinesCurvesKernel::View.name(),
+            Step::LinesDt1q1 => LinesCurvesKernel::Dt1q1.name(),
+            Step::LinesCurves => LinesCurvesKernel::Curves.name(),
             Step::AoVertex => AoKernel::Vertex.name(),
             Step::SdflDense => SdflKernel::Dense.name(),
             Step::SdflThin => SdflKernel::ThinPhase.name(),

@@ -119,6 +119,14 @@ pub enum Step {
     LinesVertex,
     /// `lines_face`: one contour / suggestive-contour segment per face.
     LinesFace,
+    /// `lines_pose`: per-pose terms of the curvature line families.
+    LinesPose,
+    /// `lines_view`: view-dependent curvature and highlight terms.
+    LinesView,
+    /// `lines_dt1q1`: the derivative of the view-dependent curvature.
+    LinesDt1q1,
+    /// `lines_curves`: segments of the curvature line families.
+    LinesCurves,
     /// `ao_vertex`: ambient occlusion from (k1, k2).
     AoVertex,
     /// `sdfl_dense`: sign changes between neighbouring voxels (the
@@ -189,7 +197,9 @@ impl Step {
             RadixSortPairs => Family::RadixSort,
             EdgesDetect | CapsMh | CapsAdjacency | EdgesCompact => Family::Edges,
             SkinLbs => Family::Skinning,
-            LinesVertex | LinesFace => Family::FeatureLines,
+            LinesVertex | LinesFace | LinesPose | LinesView | LinesDt1q1 | LinesCurves => {
+                Family::FeatureLines
+            }
             AoVertex => Family::Ao,
             SdflDense | SdflThin | SdflGradient | SdflCurvature | SdflRange | SdflTrace
             | SdflStrips | SdflSweep => Family::SdfLines,

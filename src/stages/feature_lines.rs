@@ -12,10 +12,11 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
-use crate::spec::feature_lines::{LineInputs, Segment, segments_bound};
+use crate::spec::feature_lines::{CurveOptions, LineInputs, Segment, segments_bound};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::feature_lines_curves::{CurveArgs, CurveStage};
 use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -33,6 +34,9 @@ pub struct LineOptions {
     pub threshold: f32,
     /// n·v below which suggestive contours fade (strength = n·v / fade).
     pub fade: f32,
+    /// The curvature line families beside the contours (none by default)
+    /// and their controls.
+    pub curves: CurveOptions,
 }
 
 impl Default for LineOptions {
@@ -42,6 +46,7 @@ impl Default for LineOptions {
             suggestive: true,
             threshold: 0.05,
             fade: 0.2,
+            curves: CurveOptions::default(),
         }
     }
 }
@@ -51,7 +56,8 @@ impl Default for LineOptions {
 pub struct LineStats {
     /// Segments found.
     pub segments: usize,
-    /// Kernel ms of `lines_vertex` and `lines_face`.
+    /// Kernel ms of `lines_vertex`, `lines_face` and the curve families'
+    /// steps (`lines_pose`, `lines_view`, `lines_dt1q1`, `lines_curves`).
     pub timing: Timing,
 }
 
@@ -68,6 +74,9 @@ pub struct LineExtractor {
     seg: Buffer<f32>,
     ends: Buffer<u32>,
     counter: Buffer<u32>,
+    /// The faces, kept to build the curve stage when first asked for.
+    host_faces: Vec<[u32; 3]>,
+    curves: Option<CurveStage>,
 }
 
 impl LineExtractor {
@@ -95,6 +104,8 @@ impl LineExtractor {
             seg: gpu.buffer(8 * segments_bound(faces.len()))?,
             ends: gpu.buffer(4 * segments_bound(faces.len()))?,
             counter: gpu.buffer(1)?,
+            host_faces: faces.to_vec(),
+            curves: None,
             gpu,
             nv,
             nf: faces.len(),
@@ -135,8 +146,25 @@ impl LineExtractor {
         g.write(&mut self.inputs[3], x.d2.as_flattened())?;
         g.write(&mut self.inputs[4], x.k.as_flattened())?;
         g.write(&mut self.inputs[5], x.dk.as_flattened())?;
+        self.pose_changed();
         let inputs = self.inputs.each_ref().map(buf);
         self.run(inputs, view, feature_size, opts)
+    }
+
+    /// The curve families' stage, once a run has asked for one of them.
+    pub fn curve_stage(&self) -> Option<&CurveStage> {
+        self.curves.as_ref()
+    }
+
+    /// Marks the per-pose terms of the curve families stale. Host inputs
+    /// ([`LineExtractor::extract`]) do it themselves; a caller that reruns
+    /// the curvature estimator between [`LineExtractor::extract_device`]
+    /// calls does it after each run (the pose pipeline and the scene
+    /// executor do), so that many views of one pose compute them once.
+    pub fn pose_changed(&mut self) {
+        if let Some(c) = self.curves.as_mut() {
+            c.pose_changed();
+        }
     }
 
     /// Extracts the lines of the estimator's last run seen from `view`,
@@ -232,27 +260,34 @@ impl LineExtractor {
         args.extend(self.terms.iter().map(buf));
         let e1 = launch(&g, &self.vertex, n, &args)?;
         let cap = segments_bound(self.nf);
-        let e2 = launch(
-            &g,
-            &self.face,
-            self.nf,
-            &[
-                Arg::U32(self.nf as u32),
-                buf(&self.faces),
-                inputs[0],
-                buf(&self.terms[0]),
-                buf(&self.terms[1]),
-                buf(&self.terms[2]),
-                Arg::U32(u32::from(opts.contours)),
-                Arg::U32(u32::from(opts.suggestive)),
-                Arg::F32(opts.threshold / (feature_size * feature_size)),
-                Arg::F32(opts.fade),
-                Arg::U32(cap as u32),
-                buf(&self.seg),
-                buf(&self.ends),
-                buf(&self.counter),
-            ],
-        )?;
+        let curve_fams = opts.curves.families.curves();
+        let contours = opts.contours || opts.suggestive || curve_fams == Default::default();
+        let e2 = if !contours {
+            g.zero(&mut self.counter, 1)?;
+            None
+        } else {
+            launch(
+                &g,
+                &self.face,
+                self.nf,
+                &[
+                    Arg::U32(self.nf as u32),
+                    buf(&self.faces),
+                    inputs[0],
+                    buf(&self.terms[0]),
+                    buf(&self.terms[1]),
+                    buf(&self.terms[2]),
+                    Arg::U32(u32::from(opts.contours)),
+                    Arg::U32(u32::from(opts.suggestive)),
+                    Arg::F32(opts.threshold / (feature_size * feature_size)),
+                    Arg::F32(opts.fade),
+                    Arg::U32(cap as u32),
+                    buf(&self.seg),
+                    buf(&self.ends),
+                    buf(&self.counter),
+                ],
+            )?
+        };
         let mut c = [0u32];
         g.read(&self.counter, &mut c)?;
         let found = c[0] as usize;
@@ -265,7 +300,7 @@ impl LineExtractor {
         g.read(&self.seg, &mut raw)?;
         let mut ends = vec![0u32; 4 * found];
         g.read(&self.ends, &mut ends)?;
-        let segs = raw
+        let mut segs: Vec<Segment> = raw
             .chunks_exact(8)
             .zip(ends.chunks_exact(4))
             .map(|(s, e)| {
@@ -285,8 +320,26 @@ impl LineExtractor {
         if let Some(e) = &e2 {
             timing.add(Step::LinesFace, event_ms(e));
         }
+        if curve_fams != Default::default() {
+            if self.curves.is_none() {
+                self.curves = Some(CurveStage::new(g.clone(), n, &self.host_faces)?);
+            }
+            let args = CurveArgs {
+                inputs,
+                terms: [
+                    buf(&self.terms[0]),
+                    buf(&self.terms[1]),
+                    buf(&self.terms[2]),
+                ],
+                faces: buf(&self.faces),
+            };
+            let stage = self.curves.as_mut().expect("built above");
+            let (more, t) = stage.run(&args, view, feature_size, &opts.curves)?;
+            timing.extend(&t);
+            segs.extend(more);
+        }
         let stats = LineStats {
-            segments: found,
+            segments: segs.len(),
             timing,
         };
         Ok((segs, stats))

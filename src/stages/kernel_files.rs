@@ -59,6 +59,14 @@ pub const FEATURE_LINES: KernelFile = plain(
     include_str!("../../kernels/feature_lines.cl"),
 );
 
+/// `kernels/feature_lines_curves.cl`: the curvature line families (ridges,
+/// valleys, apparent ridges, highlights, isophotes, K = 0, H = 0, D_w κr = 0,
+/// boundaries).
+pub const FEATURE_LINES_CURVES: KernelFile = plain(
+    "kernels/feature_lines_curves.cl",
+    include_str!("../../kernels/feature_lines_curves.cl"),
+);
+
 /// `kernels/marching_cubes.cl`: the soup variants and gradient normals.
 pub const MARCHING_CUBES: KernelFile = KernelFile {
     name: "kernels/marching_cubes.cl",

@@ -206,6 +206,11 @@ impl PosePipeline {
             ));
         };
         est.set_positions_device(&self.skinner.out, [1.0; 3], [0.0; 3], self.norm)?;
+        // A new pose: the curve families' per-pose terms are recomputed once,
+        // at the first view that needs them.
+        if let Some(l) = self.lines.as_mut() {
+            l.pose_changed();
+        }
         est.run()
     }
 

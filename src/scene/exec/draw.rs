@@ -243,6 +243,7 @@ fn svg_layers(
             stroke_width: width,
             color,
             lines: visible_joined(&clip, image, DEFAULT_BIAS),
+            dashed: false,
         });
     }
     if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
@@ -252,6 +253,7 @@ fn svg_layers(
             stroke_width: fx.edge.0,
             color: fx.edge.1,
             lines: visible_joined(&clip, image, DEFAULT_BIAS),
+            dashed: false,
         });
     }
     layers

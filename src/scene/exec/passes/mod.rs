@@ -156,6 +156,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             suggestive: has(Pass::SuggestiveContours),
             threshold: fx.suggestive_threshold,
             fade: fx.suggestive_fade,
+            curves: Default::default(),
         };
         let pipe = match &loaded {
             Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(

@@ -1,0 +1,212 @@
+//! `shapecue lines`: every line family of rtsc (Rusinkiewicz and DeCarlo's
+//! real-time suggestive contours program) on one mesh from one camera, by
+//! one front-door call ([`shapecue::lines_picture_on`]): a PNG of the lines
+//! over the mesh, or an SVG with a group per family, and optionally the 3-D
+//! segments (family, strength) as JSON.
+
+use super::{check_outputs, write_json};
+use anyhow::{Result, bail};
+use clap::Args;
+use shapecue::LinesPictureOptions;
+use shapecue::api::Hidden;
+use shapecue::gpu::Gpu;
+use shapecue::mesh::LoadOptions;
+use shapecue::spec::feature_lines::{FamilySet, LineFamily};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The arguments of `shapecue lines`.
+#[derive(Args)]
+pub struct LinesArgs {
+    /// Input mesh (.obj, .ply, .off), or a generated one: torus, sphere,
+    /// ellipsoid, cylinder or plane (with --vertices).
+    mesh: String,
+    /// Vertices of a generated mesh (about).
+    #[arg(long, default_value_t = 20000)]
+    vertices: usize,
+    /// The families, comma-separated: contours, suggestive, ridges, valleys,
+    /// apparent-ridges, suggestive-highlights, principal-highlights,
+    /// isophotes, k-zero, h-zero, dwkr-zero, boundaries.
+    #[arg(long, default_value = "contours,suggestive")]
+    lines: String,
+    /// Eye position, e.g. 5,5,5 (default: from direction 1,1,1, framed).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    eye: Option<Vec<f32>>,
+    /// Point looked at (default: the centre of the bounding box).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    target: Option<Vec<f32>>,
+    /// Up direction (default +Y, or +Z when looking along Y).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    up: Option<Vec<f32>>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 40.0)]
+    fov: f32,
+    /// Orthographic projection.
+    #[arg(long)]
+    ortho: bool,
+    /// Image size, e.g. 800x600.
+    #[arg(long, default_value = "800x600")]
+    size: String,
+    /// Line width in pixels.
+    #[arg(long, default_value_t = 2.0)]
+    width: f32,
+    /// Suggestive-contour threshold (times the feature size squared).
+    #[arg(long, default_value_t = 0.05)]
+    sc_threshold: f32,
+    /// Ridge and valley threshold (times 1 / feature size).
+    #[arg(long, default_value_t = 0.1)]
+    rv_threshold: f32,
+    /// Apparent-ridge threshold (times 1 / feature size).
+    #[arg(long, default_value_t = 0.1)]
+    ar_threshold: f32,
+    /// Principal-highlight threshold (times 1 / feature size squared).
+    #[arg(long, default_value_t = 0.04)]
+    ph_threshold: f32,
+    /// Suggestive-highlight threshold (times 1 / feature size squared).
+    #[arg(long, default_value_t = 0.02)]
+    sh_threshold: f32,
+    /// Isophote levels N: n·l = j/N for |j| < N.
+    #[arg(long, default_value_t = 20)]
+    isophotes: u32,
+    /// Direction towards the light (isophotes), e.g. 0,0,1.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    light: Option<Vec<f32>>,
+    /// Keep lines on back faces.
+    #[arg(long)]
+    no_cull: bool,
+    /// Draw every zero crossing (no extremum or threshold test).
+    #[arg(long)]
+    no_test: bool,
+    /// Full-strength lines (no fading by the test's margin).
+    #[arg(long)]
+    no_fade: bool,
+    /// Hermite (cubic) placement of the K = 0 and H = 0 crossings.
+    #[arg(long)]
+    hermite: bool,
+    /// Hidden parts in the SVG: remove, faded or dashed.
+    #[arg(long, value_parser = super::choice::<Hidden>(), default_value = "remove")]
+    hidden: Hidden,
+    /// Output: .png (picture) or .svg (a group per family).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write the 3-D segments (family, strength, ends) as JSON.
+    #[arg(long)]
+    segments: Option<PathBuf>,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    force: bool,
+}
+
+fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
+        }
+        Some(_) => bail!("--{what} needs three finite numbers X,Y,Z"),
+    }
+}
+
+/// Runs `shapecue lines`.
+pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
+    let (w, h) = super::size_arg(&a.size)?;
+    let fams = FamilySet::parse(&a.lines)?;
+    if fams == FamilySet::NONE {
+        bail!("--lines names no family");
+    }
+    if !(a.width.is_finite() && a.width > 0.0) {
+        bail!("--width must be a positive number of pixels");
+    }
+    let svg = match a.output.extension().and_then(|e| e.to_str()) {
+        Some("svg") => true,
+        Some("png") => false,
+        _ => bail!("--output must end in .png or .svg"),
+    };
+    let path = PathBuf::from(&a.mesh);
+    let generated = !path.exists() && shapecue::mesh::generated_by_name(&a.mesh, 4).is_some();
+    let inputs: Vec<&std::path::Path> = if generated {
+        vec![]
+    } else {
+        vec![path.as_path()]
+    };
+    let outputs: Vec<&std::path::Path> = std::iter::once(a.output.as_path())
+        .chain(a.segments.as_deref())
+        .collect();
+    check_outputs(inputs, outputs, a.force)?;
+    let mesh = if generated {
+        shapecue::mesh::generated_by_name(&a.mesh, a.vertices)
+            .expect("checked above")
+            .1
+    } else {
+        shapecue::mesh::load(&path, &LoadOptions::default())?
+    };
+    let mut opts = LinesPictureOptions {
+        eye: vec3_arg(&a.eye, "eye")?,
+        target: vec3_arg(&a.target, "target")?,
+        up: vec3_arg(&a.up, "up")?,
+        fov_deg: a.fov,
+        ortho: a.ortho,
+        width: w,
+        height: h,
+        line_width: a.width,
+        hidden: a.hidden,
+        svg,
+        ..Default::default()
+    };
+    let l = &mut opts.lines;
+    l.contours = fams.has(LineFamily::Contours);
+    l.suggestive = fams.has(LineFamily::Suggestive);
+    l.threshold = a.sc_threshold;
+    let c = &mut l.curves;
+    c.families = fams.curves();
+    c.ridge_threshold = a.rv_threshold;
+    c.apparent_threshold = a.ar_threshold;
+    c.principal_threshold = a.ph_threshold;
+    c.highlight_threshold = a.sh_threshold;
+    c.isophotes = a.isophotes;
+    if let Some(l) = vec3_arg(&a.light, "light")? {
+        c.light = l.to_array();
+    }
+    c.cull = !a.no_cull;
+    c.test = !a.no_test;
+    c.fade = !a.no_fade;
+    c.hermite = a.hermite;
+    let gpu = Arc::new(Gpu::new(device)?);
+    let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
+    match &pic.layers {
+        Some(layers) => shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?,
+        None => pic.frame.save_png(&a.output)?,
+    }
+    if let Some(p) = &a.segments {
+        let segs: Vec<serde_json::Value> = pic
+            .segments
+            .iter()
+            .map(|s| {
+                let fam = LineFamily::from_kind(s.2).map_or("unknown", |f| f.name());
+                serde_json::json!({"family": fam, "strength": s.3, "a": s.0, "b": s.1})
+            })
+            .collect();
+        write_json(
+            p,
+            &serde_json::json!({
+                "feature_size": pic.feature_size,
+                "segments": segs,
+            }),
+        )?;
+    }
+    let mut counts = std::collections::BTreeMap::<&str, usize>::new();
+    for s in &pic.segments {
+        if let Some(f) = LineFamily::from_kind(s.2) {
+            *counts.entry(f.name()).or_default() += 1;
+        }
+    }
+    let list: Vec<String> = counts.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    super::print(format_args!(
+        "{}: {} segments ({}), kernels {:.2} ms",
+        a.output.display(),
+        pic.segments.len(),
+        list.join(", "),
+        pic.timing.kernel_ms
+    ))?;
+    Ok(())
+}

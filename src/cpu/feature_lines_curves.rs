@@ -1,0 +1,622 @@
+//! CPU reference of `kernels/feature_lines_curves.cl` (same steps, same f32
+//! arithmetic): [`lines_pose`] once per pose, [`lines_view`] and
+//! [`lines_dt1q1`] once per view, then [`lines_curves`] per face. The
+//! per-view inputs n·v, κr and the suggestive test come from
+//! [`super::feature_lines::lines_vertex`]. Segments come out in face order;
+//! the device's order is that of its atomic counter, so tests compare sorted
+//! lists.
+
+use super::feature_lines::VertexTerms;
+use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
+use crate::spec::view::View;
+
+type V3 = [f32; 3];
+
+fn dot(a: V3, b: V3) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn mul(s: f32, a: V3) -> V3 {
+    a.map(|c| s * c)
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn lerp(a: V3, b: V3, t: f32) -> V3 {
+    add(a, mul(t, sub(b, a)))
+}
+
+/// Per-pose terms of `lines_pose`, per vertex.
+#[derive(Clone, Debug, Default)]
+pub struct PoseTerms {
+    /// The principal curvature of larger magnitude.
+    pub kmax: Vec<f32>,
+    /// Its derivative along its own direction (C111 or C222).
+    pub emax: Vec<f32>,
+    /// Its direction.
+    pub dmax: Vec<V3>,
+    /// Gaussian curvature k1·k2.
+    pub gauss: Vec<f32>,
+    /// Mean curvature (k1 + k2)/2.
+    pub mean: Vec<f32>,
+    /// ∇K and ∇H (empty unless asked for).
+    pub grad: Vec<[V3; 2]>,
+}
+
+/// `lines_pose`: kmax, emax, dmax, K, H and, with `grads`, ∇K and ∇H.
+pub fn lines_pose(x: &LineInputs, grads: bool) -> PoseTerms {
+    let mut t = PoseTerms::default();
+    for i in 0..x.k.len() {
+        let [k1, k2] = x.k[i];
+        let c = x.dk[i];
+        let first = k1.abs() >= k2.abs();
+        t.kmax.push(if first { k1 } else { k2 });
+        t.emax.push(if first { c[0] } else { c[3] });
+        t.dmax.push(if first { x.d1[i] } else { x.d2[i] });
+        t.gauss.push(k1 * k2);
+        t.mean.push(0.5 * (k1 + k2));
+        if grads {
+            let g1 = add(mul(c[0], x.d1[i]), mul(c[1], x.d2[i]));
+            let g2 = add(mul(c[2], x.d1[i]), mul(c[3], x.d2[i]));
+            t.grad
+                .push([add(mul(k2, g1), mul(k1, g2)), mul(0.5, add(g1, g2))]);
+        }
+    }
+    t
+}
+
+/// Per-view terms of `lines_view`, per vertex.
+#[derive(Clone, Debug, Default)]
+pub struct ViewTerms {
+    /// Largest view-dependent curvature q1 (≥ 0).
+    pub q1: Vec<f32>,
+    /// Its direction t1, world coordinates (sign arbitrary).
+    pub t1: Vec<V3>,
+    /// v · dmax.
+    pub phdot: Vec<f32>,
+    /// |k1² − k2²| (n·v), the principal-highlight strength.
+    pub phtest: Vec<f32>,
+    /// n·l.
+    pub ndl: Vec<f32>,
+}
+
+/// `lines_view` from `view`, with n·v from `lines_vertex` and the unit
+/// light direction `light`.
+pub fn lines_view(
+    x: &LineInputs,
+    pose: &PoseTerms,
+    t: &VertexTerms,
+    view: View,
+    light: V3,
+) -> ViewTerms {
+    let (eye, ortho) = (view.line_eye(), view.ortho);
+    let mut o = ViewTerms::default();
+    for i in 0..x.pos.len() {
+        let mut v = if ortho { eye } else { sub(eye, x.pos[i]) };
+        let l = dot(v, v).sqrt();
+        v = if l > 0.0 { v.map(|c| c / l) } else { [0.0; 3] };
+        let (e1, e2) = (x.d1[i], x.d2[i]);
+        let [k1, k2] = x.k[i];
+        let nd = t.ndv[i];
+        let (u, w) = (dot(v, e1), dot(v, e2));
+        let s2 = u * u + w * w;
+        let inv = if s2 > 1e-12 { 1.0 / s2 } else { 0.0 };
+        let (a, b, c) = (u * u * inv, u * w * inv, w * w * inv);
+        let sm1 = 1.0 / nd.abs().max(1e-4) - 1.0;
+        let (q11, q12) = (k1 * (1.0 + sm1 * a), k1 * sm1 * b);
+        let (q21, q22) = (k2 * sm1 * b, k2 * (1.0 + sm1 * c));
+        let m1 = q11 * q11 + q21 * q21;
+        let m12 = q11 * q12 + q21 * q22;
+        let m2 = q12 * q12 + q22 * q22;
+        let lam = 0.5 * (m1 + m2) + (0.25 * (m1 - m2) * (m1 - m2) + m12 * m12).sqrt();
+        let (mut tx, mut ty) = (m12, lam - m1);
+        let (ox, oy) = (lam - m2, m12);
+        if ox * ox + oy * oy > tx * tx + ty * ty {
+            (tx, ty) = (ox, oy);
+        }
+        let tl = (tx * tx + ty * ty).sqrt();
+        (tx, ty) = if tl > 0.0 {
+            (tx / tl, ty / tl)
+        } else {
+            (1.0, 0.0)
+        };
+        o.q1.push(lam.max(0.0).sqrt());
+        o.t1.push(add(mul(tx, e1), mul(ty, e2)));
+        o.phdot.push(dot(v, pose.dmax[i]));
+        o.phtest.push((k1 * k1 - k2 * k2).abs() * nd);
+        o.ndl.push(dot(x.nrm[i], light));
+    }
+    o
+}
+
+/// `lines_dt1q1`: D_t1 q1 per vertex, from the faces around each vertex
+/// (`off`, `ring`: [`crate::mesh::topology::one_rings`]).
+pub fn lines_dt1q1(
+    faces: &[[u32; 3]],
+    x: &LineInputs,
+    off: &[u32],
+    ring: &[u32],
+    vt: &ViewTerms,
+    t: &VertexTerms,
+) -> Vec<f32> {
+    (0..x.pos.len())
+        .map(|i| {
+            let p0 = x.pos[i];
+            let q0 = vt.q1[i];
+            let t1 = vt.t1[i];
+            let t2 = cross(x.nrm[i], t1);
+            let (p0t2, anv) = (dot(p0, t2), t.ndv[i].abs());
+            let (mut sum, mut n) = (0.0f32, 0);
+            for &r in &ring[off[i] as usize..off[i + 1] as usize] {
+                if n >= 2 {
+                    break;
+                }
+                let (f, c) = ((r / 3) as usize, (r % 3) as usize);
+                let (i1, i2) = (
+                    faces[f][(c + 1) % 3] as usize,
+                    faces[f][(c + 2) % 3] as usize,
+                );
+                let (p1, p2) = (x.pos[i1], x.pos[i2]);
+                let (a1, a2) = (dot(p1, t2), dot(p2, t2));
+                let w1 = (a2 - p0t2) / (a2 - a1);
+                if !((0.0..1.0).contains(&w1)) {
+                    continue;
+                }
+                let w2 = 1.0 - w1;
+                let q = add(mul(w1, p1), mul(w2, p2));
+                let dist = dot(sub(q, p0), t1) * anv;
+                if dist.abs().is_nan() || dist.abs() <= 0.0 {
+                    continue;
+                }
+                sum += (w1 * vt.q1[i1] + w2 * vt.q1[i2] - q0) / dist;
+                n += 1;
+            }
+            if n == 2 { 0.5 * sum } else { sum }
+        })
+        .collect()
+}
+
+/// Marks the boundary edges of each face: bit j when edge (v[j], v[j+1])
+/// belongs to no other face (computed once per topology).
+pub fn boundary_mask(faces: &[[u32; 3]]) -> Vec<u32> {
+    let mut count: std::collections::HashMap<(u32, u32), u32> = Default::default();
+    for f in faces {
+        for j in 0..3 {
+            let (a, b) = (f[j], f[(j + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    faces
+        .iter()
+        .map(|f| {
+            (0..3).fold(0, |m, j| {
+                let (a, b) = (f[j], f[(j + 1) % 3]);
+                if count[&(a.min(b), a.max(b))] == 1 {
+                    m | 1 << j
+                } else {
+                    m
+                }
+            })
+        })
+        .collect()
+}
+
+/// Everything `lines_curves` reads besides the faces and positions.
+pub struct CurveTerms<'a> {
+    /// `lines_vertex`'s output.
+    pub vertex: &'a VertexTerms,
+    /// `lines_pose`'s output.
+    pub pose: &'a PoseTerms,
+    /// `lines_view`'s output.
+    pub view: &'a ViewTerms,
+    /// `lines_dt1q1`'s output.
+    pub dt: &'a [f32],
+    /// [`boundary_mask`].
+    pub bnd: &'a [u32],
+}
+
+/// Thresholds of `lines_curves`, already divided by the feature size:
+/// ridge/valley, apparent ridge, principal and suggestive highlight.
+#[derive(Clone, Copy, Debug)]
+pub struct ScaledThresholds {
+    /// Ridges and valleys (|k| > rv).
+    pub rv: f32,
+    /// Apparent ridges (q1 > ar).
+    pub ar: f32,
+    /// Principal highlights.
+    pub ph: f32,
+    /// Suggestive highlights.
+    pub sh: f32,
+}
+
+impl ScaledThresholds {
+    /// The options' thresholds for a mesh of feature size `s`.
+    pub fn of(o: &CurveOptions, s: f32) -> ScaledThresholds {
+        ScaledThresholds {
+            rv: o.ridge_threshold / s,
+            ar: o.apparent_threshold / s,
+            ph: o.principal_threshold / (s * s),
+            sh: o.highlight_threshold / (s * s),
+        }
+    }
+}
+
+struct Out<'a> {
+    segs: &'a mut Vec<Segment>,
+}
+
+impl Out<'_> {
+    fn emit(&mut self, a: V3, b: V3, fam: LineFamily, s: f32, e: [[u32; 2]; 2]) {
+        self.segs.push((a, b, fam as u32, s, e));
+    }
+}
+
+const CENTER: u32 = u32::MAX;
+
+fn edge_of(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
+fn ridge_strength(k: f32, thr: f32, fade: bool) -> f32 {
+    let x = (k - thr).max(0.0);
+    if fade {
+        if x + thr > 0.0 { x / (x + thr) } else { 0.0 }
+    } else if x > 0.0 {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+fn ridge_w(ea: f32, eb: f32) -> f32 {
+    let s = ea.abs() + eb.abs();
+    if s > 0.0 { ea.abs() / s } else { 0.5 }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn ridge_segment(
+    out: &mut Out,
+    f: u32,
+    vi: [u32; 3],
+    e: [f32; 3],
+    kk: [f32; 3],
+    pos: &[V3],
+    thr: f32,
+    fade: bool,
+    centre: bool,
+    fam: LineFamily,
+) {
+    let p = vi.map(|i| pos[i as usize]);
+    let w10 = ridge_w(e[0], e[1]);
+    let pa = add(p[0], mul(w10, sub(p[1], p[0])));
+    let ka = (kk[0] + w10 * (kk[1] - kk[0])).abs();
+    let (pb, kb, eb) = if centre {
+        (
+            add(add(p[0], p[1]), p[2]).map(|c| c / 3.0),
+            (kk[0] + kk[1] + kk[2]).abs() / 3.0,
+            [CENTER, f],
+        )
+    } else {
+        let w21 = ridge_w(e[1], e[2]);
+        (
+            add(p[1], mul(w21, sub(p[2], p[1]))),
+            (kk[1] + w21 * (kk[2] - kk[1])).abs(),
+            edge_of(vi[1], vi[2]),
+        )
+    };
+    if ka.partial_cmp(&thr) != Some(std::cmp::Ordering::Greater)
+        && kb.partial_cmp(&thr) != Some(std::cmp::Ordering::Greater)
+    {
+        return;
+    }
+    let s = 0.5 * (ridge_strength(ka, thr, fade) + ridge_strength(kb, thr, fade));
+    out.emit(pa, pb, fam, s, [edge_of(vi[0], vi[1]), eb]);
+}
+
+fn rot1<T: Copy>(a: [T; 3]) -> [T; 3] {
+    [a[1], a[2], a[0]]
+}
+fn rot2<T: Copy>(a: [T; 3]) -> [T; 3] {
+    [a[2], a[0], a[1]]
+}
+
+#[allow(clippy::too_many_arguments)]
+fn ridge_face(
+    out: &mut Out,
+    f: u32,
+    v: [u32; 3],
+    e: [f32; 3],
+    t: [V3; 3],
+    kk: [f32; 3],
+    pos: &[V3],
+    test: bool,
+    thr: f32,
+    fade: bool,
+    fam: LineFamily,
+) {
+    let mut z01 = dot(t[0], t[1]) <= 0.0;
+    let mut z12 = dot(t[1], t[2]) <= 0.0;
+    let mut z20 = dot(t[2], t[0]) <= 0.0;
+    if (z01 as u32 + z12 as u32 + z20 as u32) < 2 {
+        return;
+    }
+    if test {
+        let p = v.map(|i| pos[i as usize]);
+        let (d01, d12, d20) = (sub(p[1], p[0]), sub(p[2], p[1]), sub(p[0], p[2]));
+        z01 = z01 && (dot(t[0], d01) >= 0.0 || dot(t[1], d01) <= 0.0);
+        z12 = z12 && (dot(t[1], d12) >= 0.0 || dot(t[2], d12) <= 0.0);
+        z20 = z20 && (dot(t[2], d20) >= 0.0 || dot(t[0], d20) <= 0.0);
+        if (z01 as u32 + z12 as u32 + z20 as u32) < 2 {
+            return;
+        }
+    }
+    let (r1, e1, k1) = (rot1(v), rot1(e), rot1(kk));
+    let (r2, e2, k2) = (rot2(v), rot2(e), rot2(kk));
+    if !z01 {
+        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, false, fam);
+    } else if !z12 {
+        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, false, fam);
+    } else if !z20 {
+        ridge_segment(out, f, v, e, kk, pos, thr, fade, false, fam);
+    } else {
+        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, true, fam);
+        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, true, fam);
+        ridge_segment(out, f, v, e, kk, pos, thr, fade, true, fam);
+    }
+}
+
+fn zero_linear(fa: f32, fb: f32) -> f32 {
+    let d = fa - fb;
+    (if d != 0.0 { fa / d } else { 0.5 }).clamp(0.0, 1.0)
+}
+
+/// The cubic Hermite crossing on an edge (rtsc's bisection).
+pub fn zero_hermite(fa: f32, fb: f32, da: f32, db: f32) -> f32 {
+    if fa == fb {
+        return 0.5;
+    }
+    let a = 2.0 * (fa - fb) + da + db;
+    let b = 3.0 * (fb - fa) - 2.0 * da - db;
+    let (c, d) = (da, fa);
+    let (mut sl, mut sr, mut vl) = (0.0f32, 1.0f32, fa);
+    let disc = 4.0 * b * b - 12.0 * a * c;
+    if disc > 0.0 && a != 0.0 {
+        let q = disc.sqrt();
+        let (r1, r2) = ((-2.0 * b + q) / (6.0 * a), (-2.0 * b - q) / (6.0 * a));
+        if (0.0..=1.0).contains(&r1) && (0.0..=1.0).contains(&r2) {
+            let v1 = ((a * r1 + b) * r1 + c) * r1 + d;
+            let v2 = ((a * r2 + b) * r2 + c) * r2 + d;
+            if (v1 < 0.0 && v2 >= 0.0) || (v1 > 0.0 && v2 <= 0.0) {
+                sl = r1.min(r2);
+                sr = r1.max(r2);
+                vl = if r1 < r2 { v1 } else { v2 };
+            }
+        }
+    }
+    for _ in 0..10 {
+        let m = 0.5 * (sl + sr);
+        let vm = ((a * m + b) * m + c) * m + d;
+        if (vl < 0.0 && vm >= 0.0) || (vl > 0.0 && vm <= 0.0) {
+            sr = m;
+        } else {
+            sl = m;
+            vl = vm;
+        }
+    }
+    0.5 * (sl + sr)
+}
+
+fn odd_corner(f: [f32; 3]) -> Option<usize> {
+    let s = f.map(|x| x >= 0.0);
+    if s[0] == s[1] && s[1] == s[2] {
+        None
+    } else if s[0] == s[1] {
+        Some(2)
+    } else if s[0] == s[2] {
+        Some(1)
+    } else {
+        Some(0)
+    }
+}
+
+fn iso_params(
+    v: [u32; 3],
+    f: [f32; 3],
+    c: usize,
+    pos: &[V3],
+    grad: Option<(&[[V3; 2]], usize)>,
+) -> (f32, f32) {
+    let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+    match grad {
+        None => (zero_linear(f[c], f[a]), zero_linear(f[c], f[b])),
+        Some((g, sel)) => {
+            let (ic, ia, ib) = (v[c] as usize, v[a] as usize, v[b] as usize);
+            let pc = pos[ic];
+            let (ea, eb) = (sub(pos[ia], pc), sub(pos[ib], pc));
+            let gc = g[ic][sel];
+            (
+                zero_hermite(f[c], f[a], dot(ea, gc), dot(ea, g[ia][sel])),
+                zero_hermite(f[c], f[b], dot(eb, gc), dot(eb, g[ib][sel])),
+            )
+        }
+    }
+}
+
+fn iso_emit(
+    out: &mut Out,
+    v: [u32; 3],
+    c: usize,
+    tt: (f32, f32),
+    pos: &[V3],
+    fam: LineFamily,
+    s: f32,
+) {
+    let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+    let pc = pos[v[c] as usize];
+    out.emit(
+        lerp(pc, pos[v[a] as usize], tt.0),
+        lerp(pc, pos[v[b] as usize], tt.1),
+        fam,
+        s,
+        [edge_of(v[c], v[a]), edge_of(v[c], v[b])],
+    );
+}
+
+/// `lines_curves`: the segments of `o.families` (the contours excluded).
+pub fn lines_curves(
+    faces: &[[u32; 3]],
+    pos: &[V3],
+    x: &CurveTerms,
+    o: &CurveOptions,
+    thr: ScaledThresholds,
+) -> Vec<Segment> {
+    let mut segs = Vec::new();
+    let mut out = Out { segs: &mut segs };
+    let want = o.families;
+    let (test, fade) = (o.test, o.fade);
+    let (vt, pt, wt) = (x.vertex, x.pose, x.view);
+    for (fi, face) in faces.iter().enumerate() {
+        let v = *face;
+        let g = |a: &[f32]| v.map(|i| a[i as usize]);
+        let nd = g(&vt.ndv);
+        if want.has(LineFamily::Boundaries) {
+            for j in 0..3 {
+                if x.bnd[fi] & (1 << j) != 0 {
+                    let (ia, ib) = (v[j], v[(j + 1) % 3]);
+                    out.emit(
+                        pos[ia as usize],
+                        pos[ib as usize],
+                        LineFamily::Boundaries,
+                        1.0,
+                        [[ia, ia], [ib, ib]],
+                    );
+                }
+            }
+        }
+        if o.cull && nd.iter().all(|&n| n <= 0.0) {
+            continue;
+        }
+        let km = g(&pt.kmax);
+        let dm = v.map(|i| pt.dmax[i as usize]);
+        for (fam, sg) in [(LineFamily::Ridges, 1.0f32), (LineFamily::Valleys, -1.0)] {
+            if !want.has(fam) || !km.iter().all(|&k| sg * k > 0.0) {
+                continue;
+            }
+            let em = g(&pt.emax);
+            let t = [0, 1, 2].map(|i| mul(sg * em[i], dm[i]));
+            ridge_face(
+                &mut out, fi as u32, v, em, t, km, pos, test, thr.rv, fade, fam,
+            );
+        }
+        if want.has(LineFamily::ApparentRidges) {
+            let q = g(&wt.q1);
+            let e = g(x.dt);
+            if q.iter().any(|&qq| qq > thr.ar) {
+                let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
+                let fam = LineFamily::ApparentRidges;
+                ridge_face(
+                    &mut out, fi as u32, v, e, t, q, pos, test, thr.ar, fade, fam,
+                );
+            }
+        }
+        if want.has(LineFamily::PrincipalHighlights) {
+            let mut r = 0;
+            for i in 1..3 {
+                if km[i].abs() > km[r].abs() {
+                    r = i;
+                }
+            }
+            let mut ok = true;
+            let mut dots = g(&wt.phdot);
+            for i in 0..3 {
+                let c = dot(dm[i], dm[r]);
+                if c < 0.0 {
+                    dots[i] *= -1.0;
+                }
+                ok = ok && c.abs() >= std::f32::consts::FRAC_1_SQRT_2;
+            }
+            let tst = g(&wt.phtest);
+            let kmin = km[0].min(km[1]).min(km[2]);
+            let kmax = km[0].max(km[1]).max(km[2]);
+            let flavour = !test || kmin >= 0.0 || kmax <= 0.0;
+            let z01 = dots[0] * dots[1] <= 0.0;
+            let z12 = dots[1] * dots[2] <= 0.0;
+            let z20 = dots[2] * dots[0] <= 0.0;
+            if ok && flavour && (z01 as u32 + z12 as u32 + z20 as u32) >= 2 {
+                let fam = LineFamily::PrincipalHighlights;
+                let f = fi as u32;
+                let (rv, rd, rt) = if !z01 {
+                    (rot1(v), rot1(dots), rot1(tst))
+                } else if !z12 {
+                    (rot2(v), rot2(dots), rot2(tst))
+                } else {
+                    (v, dots, tst)
+                };
+                if !(z01 && z12 && z20) {
+                    ridge_segment(&mut out, f, rv, rd, rt, pos, thr.ph, fade, false, fam);
+                }
+            }
+        }
+        if want.has(LineFamily::SuggestiveHighlights) {
+            let f = g(&vt.kr);
+            if let Some(c) = odd_corner(f) {
+                let tt = iso_params(v, f, c, pos, None);
+                let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+                let s3 = g(&vt.sc);
+                let ndm = 0.5 * (nd[c] + tt.0 * (nd[a] - nd[c]) + nd[c] + tt.1 * (nd[b] - nd[c]));
+                let num = -0.5 * (s3[c] + tt.0 * (s3[a] - s3[c]) + s3[c] + tt.1 * (s3[b] - s3[c]));
+                if ndm > 0.0 && (!test || num > thr.sh * ndm) {
+                    let xx = num / ndm - thr.sh;
+                    let s = if !fade {
+                        1.0
+                    } else if xx + thr.sh > 0.0 {
+                        xx.max(0.0) / (xx + thr.sh)
+                    } else {
+                        0.0
+                    };
+                    iso_emit(&mut out, v, c, tt, pos, LineFamily::SuggestiveHighlights, s);
+                }
+            }
+        }
+        for fam in [LineFamily::KZero, LineFamily::HZero, LineFamily::DwkrZero] {
+            if !want.has(fam) {
+                continue;
+            }
+            let f = match fam {
+                LineFamily::KZero => g(&pt.gauss),
+                LineFamily::HZero => g(&pt.mean),
+                _ => g(&vt.sc),
+            };
+            let Some(c) = odd_corner(f) else { continue };
+            let grad = (o.hermite && fam != LineFamily::DwkrZero)
+                .then(|| (&pt.grad[..], if fam == LineFamily::KZero { 0 } else { 1 }));
+            let tt = iso_params(v, f, c, pos, grad);
+            iso_emit(&mut out, v, c, tt, pos, fam, 1.0);
+        }
+        if want.has(LineFamily::Isophotes) && o.isophotes > 0 {
+            let nl = g(&wt.ndl);
+            let n = o.isophotes as f32;
+            let lo = nl[0].min(nl[1]).min(nl[2]);
+            let hi = nl[0].max(nl[1]).max(nl[2]);
+            let j0 = ((lo * n).floor() as i32).max(1 - o.isophotes as i32);
+            let j1 = ((hi * n).ceil() as i32).min(o.isophotes as i32 - 1);
+            for j in j0..=j1 {
+                let f = nl.map(|c| c - j as f32 / n);
+                if let Some(c) = odd_corner(f) {
+                    let tt = iso_params(v, f, c, pos, None);
+                    iso_emit(&mut out, v, c, tt, pos, LineFamily::Isophotes, 1.0);
+                }
+            }
+        }
+    }
+    segs
+}
