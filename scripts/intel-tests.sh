@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The curvature test suite on a second CPU runtime: Intel's OpenCL runtime
+# The whole device test suite on a second CPU runtime: Intel's OpenCL runtime
 # for CPUs, installed from PyPI by scripts/setup-intel-opencl.sh into
 # target/intel-opencl (beside PoCL, which `cargo test --release` uses).
 # .ci/run runs it after the PoCL tests. The suite's device is chosen by
@@ -21,4 +21,5 @@ case "$default" in
 *Intel*) ;;
 *) echo "intel-tests: SHAPECUE_DEVICE=intel did not select Intel's runtime" >&2; exit 1 ;;
 esac
-cargo test --release --test curvature --test curvature_schemes --test curvature_hard_cases
+# Every test binary (the library's unit tests and doctests need no device).
+cargo test --release --tests
