@@ -3,7 +3,8 @@
 // one face, or a block of SC_LANES faces, per work-item; no atomics, no inner
 // loops) writes its three corners' contributions to the corner buffer, and a
 // per-vertex kernel (curv_*_sum) adds the corners of its one-ring in face
-// order (CSR lists built once on the host). Included by kernels/curvature.cl
+// order (CSR lists built once, on the host or, on GPUs, by curv_ring_count,
+// a scan, curv_ring_fill and curv_ring_order). Included by kernels/curvature.cl
 // when built with -DSC_GATHER; the types, the per-vertex passes and the face
 // geometry are there and in common/curvature_face.h. CPU twin:
 // src/cpu/curvature.rs (the same sums in face order); host:
@@ -261,4 +262,50 @@ __kernel void curv_dcurv_sum(uint nv, __global const uint *ring_off, __global co
     dk[4 * gid + 1] = s.y;
     dk[4 * gid + 2] = s.z;
     dk[4 * gid + 3] = s.w;
+}
+
+// ---------------------------------------------------------------------------
+// The one-ring lists on the device (GPUs; the host builds them on CPU
+// devices): the same lists as mesh::topology::one_rings_into, its twin.
+// Corners per vertex, counted; count[V] stays 0 so that its exclusive scan
+// (kernels/scan.cl) gives ring_off[0..V] in one.
+__kernel void curv_ring_count(uint nf, __global const uint *faces, volatile __global uint *count)
+{
+    GID_OR_RETURN(nf);
+    for (int c = 0; c < 3; c++)
+        atomic_inc(&count[faces[3 * gid + c]]);
+}
+
+// Each corner into its vertex's list, in any order (cursor: zeros).
+__kernel void curv_ring_fill(uint nf, __global const uint *faces, __global const uint *ring_off,
+                             volatile __global uint *cursor, __global uint *ring)
+{
+    GID_OR_RETURN(nf);
+    for (uint c = 0; c < 3; c++) {
+        const uint v = faces[3 * gid + c];
+        ring[ring_off[v] + atomic_inc(&cursor[v])] = 3 * gid + c;
+    }
+}
+
+// Each list sorted (face·3 + corner ascending is face order, as the host's),
+// and the owner, its last face; padding vertices up to nvp get -1.
+__kernel void curv_ring_order(uint nv, uint nvp, __global const uint *ring_off,
+                              __global uint *ring, __global int *owner)
+{
+    GID_OR_RETURN(nvp);
+    if (gid >= nv) {
+        owner[gid] = -1;
+        return;
+    }
+    const uint a = ring_off[gid], b = ring_off[gid + 1];
+    for (uint i = a + 1; i < b; i++) {
+        const uint x = ring[i];
+        uint j = i;
+        while (j > a && ring[j - 1] > x) {
+            ring[j] = ring[j - 1];
+            j--;
+        }
+        ring[j] = x;
+    }
+    owner[gid] = b > a ? (int)(ring[b - 1] / 3) : -1;
 }

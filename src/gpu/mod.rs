@@ -432,7 +432,11 @@ impl Gpu {
         let target = opencl3::memory::ClMem::get(buf);
         for (i, part) in bytes.chunks(chunk).enumerate() {
             // The map waits for the previous chunk's device copy (in order).
-            let view = self.map(&staging, opencl3::memory::CL_MAP_WRITE_INVALIDATE_REGION, part.len())?;
+            let view = self.map(
+                &staging,
+                opencl3::memory::CL_MAP_WRITE_INVALIDATE_REGION,
+                part.len(),
+            )?;
             // SAFETY: the map made `part.len()` bytes writable at this pointer
             // until the unmap; `part` does not overlap them.
             unsafe {

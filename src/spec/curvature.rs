@@ -607,6 +607,12 @@ crate::spec::kernels::kernel_entries! {
         DcurvSum = "curv_dcurv_sum",
         /// Vertices left without a usable face, counted.
         CountEmpty = "curv_count_empty",
+        /// Corners per vertex counted, for the one-ring lists on the device (gather).
+        RingCount = "curv_ring_count",
+        /// Each corner into its vertex's one-ring list (gather).
+        RingFill = "curv_ring_fill",
+        /// Each one-ring list in face order, and the owner faces (gather).
+        RingOrder = "curv_ring_order",
         /// Positions from a device buffer (isosurfaces) into the records.
         LoadPositions = "curv_load_positions",
         /// Vertex normals given by the caller (gradient normals) over the computed ones.

@@ -2,8 +2,10 @@
 //! per-face kernel that writes its corners' contributions, then a per-vertex
 //! kernel that adds the corners of its one-ring in face order, so the
 //! results are the same bits on every run (`Accumulate::Gather`). The
-//! one-ring lists are built once on the host ([`crate::mesh::topology`]),
-//! and the owning faces are their last entries.
+//! one-ring lists are built once, on the host ([`crate::mesh::topology`])
+//! or on GPUs by `curv_ring_count`, a scan, `curv_ring_fill` and
+//! `curv_ring_order` ([`Gather::new_on_device`], the same lists), and the
+//! owning faces are their last entries.
 
 use super::{OneRing, Pass};
 use crate::error::{Error, Result};
@@ -101,6 +103,76 @@ impl Gather {
                 })
             })
         })????;
+        Ok(Gather {
+            k,
+            ring_off,
+            ring,
+            corner: gpu.buffer::<u8>(corner_reals_bound(nf) * real)?,
+            cw: gpu.buffer::<u8>(corner_weights_bound(nf) * real)?,
+        })
+    }
+
+    /// As [`Gather::new`], with the one-ring lists and owners built on the
+    /// device from the faces already there (`faces_b`, `nf` faces): a count
+    /// per vertex, its exclusive scan, a fill in any order and a sort of each
+    /// list into face order. Linear work in parallel, where the host build
+    /// would write scattered entries through a mapping of device memory.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn new_on_device(
+        gpu: &std::sync::Arc<Gpu>,
+        k: Kernels,
+        program: &Program,
+        faces_b: &Buffer<u32>,
+        nf: usize,
+        nv: usize,
+        owner: &mut Buffer<i32>,
+        real: usize,
+        fills: impl FnOnce() -> Result<()>,
+    ) -> Result<Self> {
+        fills()?;
+        let nvp = padded_vertices(nv);
+        let mut count = gpu.buffer::<u32>(nv + 1)?;
+        gpu.zero(&mut count, nv + 1)?;
+        let ring_off = gpu.buffer::<u32>(nv + 1)?;
+        let ring_len = one_ring_len_bound(nf);
+        let mut ring = gpu.buffer::<u32>(ring_len)?;
+        gpu.zero(&mut ring, ring_len)?;
+        let kernel = |e| gpu.entry(program, e);
+        launch(
+            gpu,
+            &kernel(CurvKernel::RingCount)?,
+            nf,
+            &[Arg::U32(nf as u32), buf(faces_b), buf(&count)],
+        )?;
+        // 3F corners fit u32 (check_faces): no overflow check needed.
+        let scan = crate::stages::scan::Scan::new(gpu.clone())?;
+        scan.enqueue(&count, &ring_off, nv + 1)?;
+        gpu.zero(&mut count, nv + 1)?;
+        launch(
+            gpu,
+            &kernel(CurvKernel::RingFill)?,
+            nf,
+            &[
+                Arg::U32(nf as u32),
+                buf(faces_b),
+                buf(&ring_off),
+                buf(&count),
+                buf(&ring),
+            ],
+        )?;
+        launch(
+            gpu,
+            &kernel(CurvKernel::RingOrder)?,
+            nvp,
+            &[
+                Arg::U32(nv as u32),
+                Arg::U32(nvp as u32),
+                buf(&ring_off),
+                buf(&ring),
+                buf(&*owner),
+            ],
+        )?;
+        gpu.finish()?;
         Ok(Gather {
             k,
             ring_off,
