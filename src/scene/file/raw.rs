@@ -4,11 +4,12 @@
 //! keys.
 
 use serde::{Deserialize, Deserializer};
+use super::lines::{IsophoteSpec, PlainLineSpec, ThresholdLineSpec};
 use toml::Spanned;
 
 /// An optional fixed-length array that must have exactly `N` entries:
 /// `size = [64, 64, 64]` is an error at its line, not a silent `[64, 64]`.
-fn exact<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+pub(super) fn exact<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
 where
     D: Deserializer<'de>,
     T: Deserialize<'de>,
@@ -168,6 +169,26 @@ pub struct EffectsSpec {
     pub feature_edges: Option<EdgeSpec>,
     /// Curvature-directed strokes (volume inputs only).
     pub curvature_strokes: Option<StrokeSpec>,
+    /// Ridges.
+    pub ridges: Option<ThresholdLineSpec>,
+    /// Valleys.
+    pub valleys: Option<ThresholdLineSpec>,
+    /// Apparent ridges.
+    pub apparent_ridges: Option<ThresholdLineSpec>,
+    /// Suggestive highlights.
+    pub suggestive_highlights: Option<ThresholdLineSpec>,
+    /// Principal highlights.
+    pub principal_highlights: Option<ThresholdLineSpec>,
+    /// Isophotes.
+    pub isophotes: Option<IsophoteSpec>,
+    /// Parabolic lines, K = 0.
+    pub k_zero: Option<PlainLineSpec>,
+    /// Lines of zero mean curvature, H = 0.
+    pub h_zero: Option<PlainLineSpec>,
+    /// D_w κr = 0.
+    pub dwkr_zero: Option<PlainLineSpec>,
+    /// Mesh boundaries as a line family.
+    pub boundaries: Option<PlainLineSpec>,
 }
 
 /// `[effects.shading]`.
