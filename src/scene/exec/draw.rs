@@ -175,7 +175,7 @@ pub(super) fn draw_view(
     // The curvature line families, each in its cue's style; with fading,
     // in the same four opacity bins of their strength.
     let fade = fx.lines.curves.fade;
-    for st in &fx.lines.styles {
+    for st in &fx.lines.styles_for(&fx.cues) {
         let kind = st.family as u32;
         for (bi, &alpha) in BINS.iter().enumerate() {
             let pts: Vec<[f32; 3]> = lines
@@ -270,7 +270,7 @@ fn svg_layers(
     // The curvature line families as `shapecue lines` writes them: a group
     // per family, under it (as its `hidden` asks) the hidden parts.
     let fade = fx.lines.curves.fade;
-    for st in &fx.lines.styles {
+    for st in &fx.lines.styles_for(&fx.cues) {
         let kind = st.family as u32;
         let clip = segment_lines(vp, lines.segments, kind, |s| {
             if fade { alpha(s) } else { 1.0 }

@@ -117,6 +117,48 @@ impl Default for LineEffects {
     }
 }
 
+impl LineStyle {
+    /// A family's default stroke (that of `shapecue lines`, 1.5 px wide).
+    pub fn default_for(family: LineFamily) -> LineStyle {
+        let (color, factor) = family_style(family);
+        LineStyle {
+            family,
+            width: 1.5 * factor,
+            color,
+            hidden: Hidden::Remove,
+        }
+    }
+}
+
+impl LineEffects {
+    /// The strokes of the line family cues among `cues`, in family order:
+    /// the scene's own, or the default for a cue switched on that the
+    /// scene file did not give (as the viewer does).
+    pub fn styles_for(&self, cues: &[Cue]) -> Vec<LineStyle> {
+        let mut fams: Vec<LineFamily> = cues.iter().filter_map(|c| c.family()).collect();
+        fams.sort();
+        fams.dedup();
+        fams.into_iter()
+            .map(|f| {
+                self.styles
+                    .iter()
+                    .find(|s| s.family == f)
+                    .copied()
+                    .unwrap_or_else(|| LineStyle::default_for(f))
+            })
+            .collect()
+    }
+
+    /// The feature-line stage's options for the line family cues among `cues`.
+    pub fn curves_for(&self, cues: &[Cue]) -> CurveOptions {
+        let fams: Vec<LineFamily> = cues.iter().filter_map(|c| c.family()).collect();
+        CurveOptions {
+            families: FamilySet::of(&fams),
+            ..self.curves
+        }
+    }
+}
+
 /// What every table has in common.
 struct Common<'a> {
     width: Option<f32>,
@@ -218,9 +260,9 @@ pub(super) fn resolve(
         let family = cue.family().expect("a line family cue");
         cues.push(cue);
         families.push(family);
-        let (default_color, factor) = family_style(family);
-        let width = super::positive(c.width, 1.5 * factor, &format!("{key}.width"))?;
-        let color = super::color(c.color, default_color, &format!("{key}.color"))?;
+        let d = LineStyle::default_for(family);
+        let width = super::positive(c.width, d.width, &format!("{key}.width"))?;
+        let color = super::color(c.color, d.color, &format!("{key}.color"))?;
         let hidden = match c.hidden {
             None => Hidden::Remove,
             Some(h) => h.parse::<Hidden>().map_err(|_| {

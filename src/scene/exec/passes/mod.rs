@@ -159,7 +159,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             threshold: fx.suggestive_threshold,
             fade: fx.suggestive_fade,
             // The curvature line cues' families and controls.
-            curves: fx.lines.curves,
+            curves: fx.lines.curves_for(&fx.cues),
         };
         let pipe = match &loaded {
             Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(

@@ -65,12 +65,8 @@ impl Executor<'_, '_> {
                          launched with the pose's first view",
                     );
                 }
-                let families: Vec<&str> = self
-                    .scene
-                    .effects
-                    .lines
-                    .styles
-                    .iter()
+                let fx = &self.scene.effects;
+                let families: Vec<&str> = (fx.lines.styles_for(&fx.cues).iter())
                     .map(|s| s.family.name())
                     .collect();
                 let contours = self.plan.contains(Pass::Contours)
@@ -150,7 +146,8 @@ impl Executor<'_, '_> {
                 );
                 self.segments[0] += drawn[0];
                 self.segments[1] += drawn[1];
-                for st in &self.scene.effects.lines.styles {
+                let fx = &self.scene.effects;
+                for st in &fx.lines.styles_for(&fx.cues) {
                     let kind = st.family as u32;
                     let n = self.segs.iter().filter(|s| s.2 == kind).count();
                     *self.line_segments.entry(st.family.name()).or_default() += n;
