@@ -193,3 +193,74 @@ fn line_cue_keys_are_checked_with_the_file_and_the_key() {
     assert_eq!(c.families.iter().count(), 4);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn every_line_cue_on_a_nasty_open_mesh_far_from_the_origin_gives_finite_lines() {
+    // A torus with a strip of faces cut away (a boundary), far from the
+    // origin, with a zero-area face and an unreferenced vertex at 1e30.
+    let dir = scratch("line-cues-nasty");
+    let m = shapecue::mesh::torus(1.0, 0.4, 32, 16);
+    let mut obj = String::new();
+    for p in &m.positions {
+        obj.push_str(&format!("v {} {} {}\n", 1e5 + p[0], -2e5 + p[1], p[2]));
+    }
+    obj.push_str("v 1e30 1e30 1e30\n");
+    for t in m.faces.iter().skip(40) {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    let f0 = m.faces[50];
+    obj.push_str(&format!("f {} {} {}\n", f0[0] + 1, f0[0] + 1, f0[1] + 1));
+    std::fs::write(dir.join("nasty.obj"), obj).unwrap();
+    let fx: String = Cue::LINE_FAMILIES
+        .iter()
+        .map(|c| format!("{} = {{ hidden = \"faded\" }}\n", c.key()))
+        .collect();
+    let s = scene(
+        &dir,
+        &format!(
+            "[input]\nmesh = \"nasty.obj\"\n[[camera]]\ndirection = [0.0, 0.3, 1.0]\n\
+             [effects]\n{fx}[output]\nsize = [64, 64]\nmsaa = 0\nformats = [\"png\", \"svg\"]\n"
+        ),
+    );
+    let Some(r) = run(&s, &dir) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "nasty lines");
+    assert!(r.lines["boundaries"] > 0, "{:?}", r.lines);
+    for p in &r.outputs {
+        if p.extension().is_some_and(|e| e == "svg") {
+            let t = std::fs::read_to_string(p).unwrap();
+            assert!(!t.contains("NaN") && !t.contains("inf"), "{}", p.display());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_skinned_scene_runs_the_pose_terms_per_frame() {
+    let Some(gltf) = common::model_path("RiggedSimple.glb") else {
+        return;
+    };
+    let dir = scratch("line-cues-skinned");
+    let s = scene(
+        &dir,
+        &format!(
+            "[input]\ngltf = {:?}\n[frames]\nend = 6\nstep = 2\n[[camera]]\norbit = 2\n\
+             [effects]\nvalleys = {{}}\nh_zero = {{}}\nsuggestive_highlights = {{}}\n\
+             contours = {{}}\n[output]\nsize = [64, 48]\n",
+            gltf.display().to_string()
+        ),
+    );
+    let Some(r) = run(&s, &dir) else {
+        return;
+    };
+    let r = r.unwrap();
+    check_minimal(&r, "skinned lines");
+    let runs = |p: Pass| r.passes.iter().find(|x| x.pass == p).map(|x| x.runs);
+    assert_eq!(runs(Pass::Skinning), Some(3));
+    assert_eq!(runs(Pass::LinesPose), Some(3));
+    assert_eq!(runs(Pass::LinesCurves), Some(6));
+    assert_eq!(runs(Pass::LinesView), None, "no family here reads the view terms");
+    let _ = std::fs::remove_dir_all(&dir);
+}
