@@ -180,7 +180,10 @@ fn line_family_cues_plan_only_what_they_read_with_their_lifetimes() {
     use Pass::*;
     let st = Input::Static;
     let iso = plan(&[Cue::Isophotes], st);
-    assert_eq!(iso.passes, vec![VertexNormals, LinesView, LinesCurves, Render]);
+    assert_eq!(
+        iso.passes,
+        vec![VertexNormals, LinesView, LinesCurves, Render]
+    );
     let b = plan(&[Cue::Boundaries], st);
     assert_eq!(b.passes, vec![VertexNormals, LinesCurves, Render]);
     let ar = plan(&[Cue::ApparentRidges], st);
@@ -215,7 +218,9 @@ fn line_family_cues_plan_only_what_they_read_with_their_lifetimes() {
     }
     let text = plan(&[Cue::Ridges], Input::Flipbook).explain(3, 2);
     assert!(
-        text.contains("lines_pose") && text.contains("lines_curves") && !text.contains("lines_view"),
+        text.contains("lines_pose")
+            && text.contains("lines_curves")
+            && !text.contains("lines_view"),
         "{text}"
     );
 }

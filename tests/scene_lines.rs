@@ -64,7 +64,10 @@ fn each_line_cue_runs_exactly_its_passes_and_draws_its_family() {
     ]);
     for cues in sets {
         let dir = scratch("line-cues");
-        let fx: String = cues.iter().map(|c| format!("{} = {{}}\n", c.key())).collect();
+        let fx: String = cues
+            .iter()
+            .map(|c| format!("{} = {{}}\n", c.key()))
+            .collect();
         let s = scene(
             &dir,
             &format!(
@@ -78,7 +81,11 @@ fn each_line_cue_runs_exactly_its_passes_and_draws_its_family() {
         };
         let r = r.unwrap();
         let what = format!("{cues:?}");
-        assert_eq!(r.plan, plan_with(&cues, Input::Static, s.effects.caps), "{what}");
+        assert_eq!(
+            r.plan,
+            plan_with(&cues, Input::Static, s.effects.caps),
+            "{what}"
+        );
         check_minimal(&r, &what);
         assert_eq!(r.outputs.len(), 4, "2 views × png + svg");
         let svg = std::fs::read_to_string(
@@ -135,7 +142,11 @@ fn a_flipbook_runs_the_pose_terms_once_per_pose_and_the_view_terms_per_view() {
     let r = r.unwrap();
     check_minimal(&r, "flipbook lines");
     let runs = |p: Pass| r.passes.iter().find(|x| x.pass == p).map(|x| x.runs);
-    assert_eq!(runs(Pass::LinesPose), Some(3), "once per pose, 3 views each");
+    assert_eq!(
+        runs(Pass::LinesPose),
+        Some(3),
+        "once per pose, 3 views each"
+    );
     assert_eq!(runs(Pass::LinesView), Some(9));
     assert_eq!(runs(Pass::LinesDt1q1), Some(9));
     assert_eq!(runs(Pass::LinesCurves), Some(9));
@@ -162,7 +173,10 @@ fn line_cue_keys_are_checked_with_the_file_and_the_key() {
         ),
         ("isophotes = { count = 0 }", vec!["isophotes.count"]),
         ("isophotes = { light = [0, 0, 0] }", vec!["isophotes.light"]),
-        ("boundaries = { hidden = \"grey\" }", vec!["boundaries.hidden", "dashed"]),
+        (
+            "boundaries = { hidden = \"grey\" }",
+            vec!["boundaries.hidden", "dashed"],
+        ),
         ("k_zero = { threshold = 0.1 }", vec!["threshold"]),
         ("h_zero = { width = -2 }", vec!["h_zero.width"]),
     ] {
@@ -261,6 +275,10 @@ fn a_skinned_scene_runs_the_pose_terms_per_frame() {
     assert_eq!(runs(Pass::Skinning), Some(3));
     assert_eq!(runs(Pass::LinesPose), Some(3));
     assert_eq!(runs(Pass::LinesCurves), Some(6));
-    assert_eq!(runs(Pass::LinesView), None, "no family here reads the view terms");
+    assert_eq!(
+        runs(Pass::LinesView),
+        None,
+        "no family here reads the view terms"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -55,7 +55,8 @@ mod raw;
 pub use lines::{LineEffects, LineStyle};
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
-    LineSpec, OutputSpec, SamplingSpec, SceneFile, ShadingSpec, StrokeSpec, SuggestiveSpec,
+    IsophoteSpec, LineSpec, OutputSpec, PlainLineSpec, SamplingSpec, SceneFile, ShadingSpec,
+    StrokeSpec, SuggestiveSpec, ThresholdLineSpec,
 };
 
 /// Where a scene's geometry comes from, resolved.

@@ -272,9 +272,14 @@ fn svg_layers(
     let fade = fx.lines.curves.fade;
     for st in &fx.lines.styles_for(&fx.cues) {
         let kind = st.family as u32;
-        let clip = segment_lines(vp, lines.segments, kind, |s| {
-            if fade { alpha(s) } else { 1.0 }
-        });
+        let clip = segment_lines(
+            vp,
+            lines.segments,
+            kind,
+            |s| {
+                if fade { alpha(s) } else { 1.0 }
+            },
+        );
         if st.hidden != Hidden::Remove {
             let hidden: Vec<SvgPolyline> = lines
                 .segments

@@ -1,5 +1,5 @@
 //! The curvature line cues of `[effects]` (every line family of rtsc beside
-//! the contours): their tables as written and their resolution into the
+//! the contours): their tables (as written, in `raw`) resolved into the
 //! feature-line stage's options and each family's stroke style.
 //!
 //! ```toml
@@ -21,69 +21,9 @@
 //! finds every family, so `fade` and `cull` are shared: tables that give
 //! them must agree, and so must the thresholds of ridges and valleys.
 
-use super::raw::exact;
+use super::raw::{PlainLineSpec, ThresholdLineSpec};
 use crate::scene::planner::Cue;
 use crate::spec::feature_lines::{CurveOptions, FamilySet, Hidden, LineFamily, family_style};
-use serde::Deserialize;
-
-/// `[effects.ridges]`, `valleys`, `apparent_ridges`, `suggestive_highlights`
-/// and `principal_highlights`: the families with a threshold.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ThresholdLineSpec {
-    /// Line width in pixels.
-    pub width: Option<f32>,
-    /// RGB.
-    #[serde(default, deserialize_with = "exact")]
-    pub color: Option<[f32; 3]>,
-    /// Dimensionless threshold, times the mesh's feature size.
-    pub threshold: Option<f32>,
-    /// Strength (opacity) fades with the test's margin (default true).
-    pub fade: Option<bool>,
-    /// Back-face culling (default true).
-    pub cull: Option<bool>,
-    /// Hidden parts in the SVG: `remove` (default), `faded` or `dashed`.
-    pub hidden: Option<String>,
-}
-
-/// `[effects.isophotes]`.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct IsophoteSpec {
-    /// Line width in pixels.
-    pub width: Option<f32>,
-    /// RGB.
-    #[serde(default, deserialize_with = "exact")]
-    pub color: Option<[f32; 3]>,
-    /// Levels n·l = j / count for |j| < count (default 20).
-    pub count: Option<u32>,
-    /// Direction towards the light, world coordinates (default +Z).
-    #[serde(default, deserialize_with = "exact")]
-    pub light: Option<[f32; 3]>,
-    /// Strength fades (default true).
-    pub fade: Option<bool>,
-    /// Back-face culling (default true).
-    pub cull: Option<bool>,
-    /// Hidden parts in the SVG.
-    pub hidden: Option<String>,
-}
-
-/// `[effects.k_zero]`, `h_zero`, `dwkr_zero` and `boundaries`.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PlainLineSpec {
-    /// Line width in pixels.
-    pub width: Option<f32>,
-    /// RGB.
-    #[serde(default, deserialize_with = "exact")]
-    pub color: Option<[f32; 3]>,
-    /// Strength fades (default true).
-    pub fade: Option<bool>,
-    /// Back-face culling (default true).
-    pub cull: Option<bool>,
-    /// Hidden parts in the SVG.
-    pub hidden: Option<String>,
-}
 
 /// One curvature line cue's stroke.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,22 +39,13 @@ pub struct LineStyle {
 }
 
 /// The curvature line cues of a scene, resolved.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct LineEffects {
     /// One style per asked family, in family order.
     pub styles: Vec<LineStyle>,
     /// The feature-line stage's options (families, thresholds, isophotes,
     /// light, culling, fading).
     pub curves: CurveOptions,
-}
-
-impl Default for LineEffects {
-    fn default() -> Self {
-        LineEffects {
-            styles: Vec::new(),
-            curves: CurveOptions::default(),
-        }
-    }
 }
 
 impl LineStyle {
@@ -191,10 +122,7 @@ fn shared(
 /// Resolves the curvature line cues of `fx`, pushing them onto `cues`.
 /// Errors name the key (`ridges.threshold`) and the problem; the caller
 /// adds the scene file and line.
-pub(super) fn resolve(
-    fx: &super::EffectsSpec,
-    cues: &mut Vec<Cue>,
-) -> Result<LineEffects, String> {
+pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<LineEffects, String> {
     let mut curves = CurveOptions::default();
     let mut styles = Vec::new();
     let (mut fade, mut cull) = (None, None);
@@ -265,9 +193,9 @@ pub(super) fn resolve(
         let color = super::color(c.color, d.color, &format!("{key}.color"))?;
         let hidden = match c.hidden {
             None => Hidden::Remove,
-            Some(h) => h.parse::<Hidden>().map_err(|_| {
-                format!("{key}.hidden {h:?}: expected remove, faded or dashed")
-            })?,
+            Some(h) => h
+                .parse::<Hidden>()
+                .map_err(|_| format!("{key}.hidden {h:?}: expected remove, faded or dashed"))?,
         };
         shared(&mut fade, c.fade, key, "fade")?;
         shared(&mut cull, c.cull, key, "cull")?;

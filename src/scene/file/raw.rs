@@ -4,12 +4,11 @@
 //! keys.
 
 use serde::{Deserialize, Deserializer};
-use super::lines::{IsophoteSpec, PlainLineSpec, ThresholdLineSpec};
 use toml::Spanned;
 
 /// An optional fixed-length array that must have exactly `N` entries:
 /// `size = [64, 64, 64]` is an error at its line, not a silent `[64, 64]`.
-pub(super) fn exact<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+fn exact<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
 where
     D: Deserializer<'de>,
     T: Deserialize<'de>,
@@ -313,4 +312,63 @@ pub struct OutputSpec {
     /// Background RGB (default white).
     #[serde(default, deserialize_with = "exact")]
     pub background: Option<[f32; 3]>,
+}
+
+/// `[effects.ridges]`, `valleys`, `apparent_ridges`, `suggestive_highlights`
+/// and `principal_highlights`: the families with a threshold.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThresholdLineSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Dimensionless threshold, times the mesh's feature size.
+    pub threshold: Option<f32>,
+    /// Strength (opacity) fades with the test's margin (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG: `remove` (default), `faded` or `dashed`.
+    pub hidden: Option<String>,
+}
+
+/// `[effects.isophotes]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsophoteSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Levels n·l = j / count for |j| < count (default 20).
+    pub count: Option<u32>,
+    /// Direction towards the light, world coordinates (default +Z).
+    #[serde(default, deserialize_with = "exact")]
+    pub light: Option<[f32; 3]>,
+    /// Strength fades (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG.
+    pub hidden: Option<String>,
+}
+
+/// `[effects.k_zero]`, `h_zero`, `dwkr_zero` and `boundaries`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlainLineSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Strength fades (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG.
+    pub hidden: Option<String>,
 }

@@ -76,8 +76,7 @@ impl Executor<'_, '_> {
                         "lines_curves ({}); lines_vertex counted with the contours",
                         families.join(", ")
                     );
-                    self.rec
-                        .kernels_of(pass, &t, &[Step::LinesCurves], &how);
+                    self.rec.kernels_of(pass, &t, &[Step::LinesCurves], &how);
                 } else {
                     let how = format!("lines_vertex + lines_curves ({})", families.join(", "));
                     self.rec.kernels(pass, &t, &how);
