@@ -39,6 +39,47 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
         // isosurface (shaded, or flat to hide the strokes behind it).
         Cue::CurvatureStrokes if input == Input::Volume => vec![SdfLines, Isosurface, Render],
         Cue::CurvatureStrokes => vec![SdfLines, Render],
+        // Curvature line families: the pose terms read curvature and dcurv;
+        // apparent ridges read curvature (no dcurv) per view; isophotes and
+        // boundaries only the normals (n·l, and n·v for culling).
+        Cue::Ridges | Cue::Valleys | Cue::KZero | Cue::HZero => vec![
+            OneRings,
+            VertexNormals,
+            Curvature,
+            Dcurv,
+            LinesPose,
+            LinesCurves,
+            Render,
+        ],
+        Cue::ApparentRidges => vec![
+            OneRings,
+            VertexNormals,
+            Curvature,
+            LinesView,
+            LinesDt1q1,
+            LinesCurves,
+            Render,
+        ],
+        Cue::PrincipalHighlights => vec![
+            OneRings,
+            VertexNormals,
+            Curvature,
+            Dcurv,
+            LinesPose,
+            LinesView,
+            LinesCurves,
+            Render,
+        ],
+        Cue::SuggestiveHighlights | Cue::DwkrZero => vec![
+            OneRings,
+            VertexNormals,
+            Curvature,
+            Dcurv,
+            LinesCurves,
+            Render,
+        ],
+        Cue::Isophotes => vec![VertexNormals, LinesView, LinesCurves, Render],
+        Cue::Boundaries => vec![VertexNormals, LinesCurves, Render],
     };
     let needs_geometry = v.iter().any(|p| {
         matches!(
@@ -130,6 +171,56 @@ fn run_counts_follow_the_lifetimes() {
     let text = plan(&[Cue::AmbientOcclusion], Input::Skinned).explain(3, 2);
     assert!(
         text.contains(" ao ") && text.contains("skinning") && !text.contains("dcurv"),
+        "{text}"
+    );
+}
+
+#[test]
+fn line_family_cues_plan_only_what_they_read_with_their_lifetimes() {
+    use Pass::*;
+    let st = Input::Static;
+    let iso = plan(&[Cue::Isophotes], st);
+    assert_eq!(
+        iso.passes,
+        vec![VertexNormals, LinesView, LinesCurves, Render]
+    );
+    let b = plan(&[Cue::Boundaries], st);
+    assert_eq!(b.passes, vec![VertexNormals, LinesCurves, Render]);
+    let ar = plan(&[Cue::ApparentRidges], st);
+    assert!(ar.contains(LinesDt1q1) && ar.contains(Curvature));
+    assert!(!ar.contains(Dcurv) && !ar.contains(LinesPose));
+    let r = plan(&[Cue::Ridges, Cue::Valleys], st);
+    assert!(r.contains(Dcurv) && r.contains(LinesPose) && !r.contains(LinesView));
+    // Lifetimes: pose terms once per pose, view terms and segments per view.
+    for input in INPUTS {
+        assert_eq!(LinesPose.lifetime(input), Lifetime::Pose);
+        for p in [LinesView, LinesDt1q1, LinesCurves] {
+            assert_eq!(p.lifetime(input), Lifetime::View);
+        }
+    }
+    let all = plan(&Cue::LINE_FAMILIES, Input::Skinned);
+    assert_eq!(all.runs(LinesPose, 10, 4), 10);
+    assert_eq!(all.runs(LinesView, 10, 4), 40);
+    assert_eq!(all.runs(LinesDt1q1, 10, 4), 40);
+    assert_eq!(all.runs(LinesCurves, 10, 4), 40);
+    let all = plan(&Cue::LINE_FAMILIES, st);
+    assert_eq!(all.runs(LinesPose, 10, 4), 1, "a static mesh has one pose");
+    // Each pass names its kernels, joined to the timing by typed id.
+    let names = |p: Pass| -> Vec<&str> { p.kernels().iter().map(|k| k.kernel()).collect() };
+    assert_eq!(names(LinesPose), ["lines_pose"]);
+    assert_eq!(names(LinesView), ["lines_view"]);
+    assert_eq!(names(LinesDt1q1), ["lines_dt1q1"]);
+    assert_eq!(names(LinesCurves), ["lines_vertex", "lines_curves"]);
+    // Every line cue is a family, with its scene key.
+    for c in Cue::LINE_FAMILIES {
+        let f = c.family().expect("a family");
+        assert_eq!(c.key(), f.name().replace('-', "_"), "{c:?}");
+    }
+    let text = plan(&[Cue::Ridges], Input::Flipbook).explain(3, 2);
+    assert!(
+        text.contains("lines_pose")
+            && text.contains("lines_curves")
+            && !text.contains("lines_view"),
         "{text}"
     );
 }

@@ -13,6 +13,7 @@ use crate::mesh::Mesh;
 use crate::render::{Camera, Frame, Placement, framed};
 use crate::render::{MeshStyle, RenderOptions, Renderer};
 use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+pub use crate::spec::feature_lines::{Hidden, family_style, hidden_id};
 use crate::spec::feature_lines::{LineFamily, LineInputs, Segment};
 use crate::spec::timing::Timing;
 use crate::spec::view::View;
@@ -20,34 +21,6 @@ use crate::stages::curvature::estimate;
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use glam::Vec3;
 use std::sync::Arc;
-
-/// How the hidden parts of lines appear in the SVG (rtsc's "draw hidden
-/// lines"): left out, drawn faded, or drawn dashed, under the visible parts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum Hidden {
-    /// Visible parts only.
-    Remove,
-    /// Hidden parts at a third of the opacity.
-    Faded,
-    /// Hidden parts dashed.
-    Dashed,
-}
-
-impl Hidden {
-    /// Every choice.
-    pub const ALL: [Hidden; 3] = [Hidden::Remove, Hidden::Faded, Hidden::Dashed];
-
-    /// The choice's name.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Hidden::Remove => "remove",
-            Hidden::Faded => "faded",
-            Hidden::Dashed => "dashed",
-        }
-    }
-}
-
-crate::spec::named_choice!(Hidden, "hidden-line mode");
 
 /// What [`lines_picture`] draws and how (the `shapecue lines` options).
 #[derive(Clone, Debug, PartialEq)]
@@ -108,22 +81,6 @@ pub struct LinesPicture {
     pub camera: Camera,
     /// The feature size the thresholds were scaled by (median edge length).
     pub feature_size: f32,
-}
-
-/// Each family's stroke colour and width factor in pictures and SVG.
-pub fn family_style(f: LineFamily) -> ([f32; 3], f32) {
-    match f {
-        LineFamily::Contours => ([0.0, 0.0, 0.0], 1.25),
-        LineFamily::Suggestive => ([0.0, 0.0, 0.8], 1.0),
-        LineFamily::Ridges => ([0.3, 0.0, 0.3], 1.0),
-        LineFamily::Valleys => ([0.5, 0.3, 0.2], 1.0),
-        LineFamily::ApparentRidges => ([0.4, 0.4, 0.0], 1.0),
-        LineFamily::SuggestiveHighlights => ([0.5, 0.0, 0.0], 1.0),
-        LineFamily::PrincipalHighlights => ([0.8, 0.2, 0.0], 1.0),
-        LineFamily::Isophotes => ([0.4, 0.7, 0.4], 0.5),
-        LineFamily::KZero | LineFamily::HZero | LineFamily::DwkrZero => ([1.0, 0.0, 0.0], 0.75),
-        LineFamily::Boundaries => ([0.05, 0.05, 0.05], 1.0),
-    }
 }
 
 /// [`lines_picture_on`] on the default device.
@@ -323,24 +280,6 @@ fn svg_layers(
         });
     }
     layers
-}
-
-/// The id of a family's hidden-parts group.
-pub fn hidden_id(f: LineFamily) -> &'static str {
-    match f {
-        LineFamily::Contours => "contours-hidden",
-        LineFamily::Suggestive => "suggestive-hidden",
-        LineFamily::Ridges => "ridges-hidden",
-        LineFamily::Valleys => "valleys-hidden",
-        LineFamily::ApparentRidges => "apparent-ridges-hidden",
-        LineFamily::SuggestiveHighlights => "suggestive-highlights-hidden",
-        LineFamily::PrincipalHighlights => "principal-highlights-hidden",
-        LineFamily::Isophotes => "isophotes-hidden",
-        LineFamily::KZero => "k-zero-hidden",
-        LineFamily::HZero => "h-zero-hidden",
-        LineFamily::DwkrZero => "dwkr-zero-hidden",
-        LineFamily::Boundaries => "boundaries-hidden",
-    }
 }
 
 /// `p` in image pixels (origin top left), or `None` behind the eye.

@@ -342,6 +342,7 @@ fn render_all(
             }
         },
         segments: ex.segments,
+        lines: std::mem::take(&mut ex.line_segments),
         strokes: ex.stroke_count,
         notes,
         outputs: std::mem::take(&mut ex.outputs),

@@ -30,6 +30,7 @@
 //! feature_edges = { crease = 30, caps = "adjacency" }
 //! curvature_strokes = { spacing = 0.05, sampling = "auto", color = [0.1, 0.1, 0.2], width = 0.01 }
 //!                              # volume and sdf inputs only
+//! ridges = { threshold = 0.1 } # and every other line family of rtsc: see [`lines`]
 //!
 //! [output]
 //! dir = "out/brainstem"        # `--out DIR` on the command line overrides it
@@ -49,10 +50,13 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+pub mod lines;
 mod raw;
+pub use lines::{LineEffects, LineStyle};
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
-    LineSpec, OutputSpec, SamplingSpec, SceneFile, ShadingSpec, StrokeSpec, SuggestiveSpec,
+    IsophoteSpec, LineSpec, OutputSpec, PlainLineSpec, SamplingSpec, SceneFile, ShadingSpec,
+    StrokeSpec, SuggestiveSpec, ThresholdLineSpec,
 };
 
 /// Where a scene's geometry comes from, resolved.
@@ -150,6 +154,8 @@ pub struct Effects {
     pub edge_boundaries: bool,
     /// Curvature-directed strokes.
     pub strokes: StrokeEffect,
+    /// The curvature line cues (ridges, valleys, ..., boundaries).
+    pub lines: LineEffects,
 }
 
 /// The `curvature_strokes` cue's parameters (world units; `None`: the
@@ -678,10 +684,12 @@ impl Scene {
             color: color(st.color, [0.05, 0.05, 0.1], "curvature_strokes.color").map_err(e)?,
             width: world(st.width, "width").map_err(e)?,
         };
+        let lines = lines::resolve(&fx, &mut cues).map_err(e)?;
         if cues.is_empty() {
             return Err(e(
                 "[effects] asks for no cue: add shading, curvature_colors, ao, contours, \
-                 suggestive_contours, feature_edges or curvature_strokes"
+                 suggestive_contours, feature_edges, curvature_strokes or a line family \
+                 (ridges, valleys, isophotes, ...)"
                     .into(),
             ));
         }
@@ -711,6 +719,7 @@ impl Scene {
             edge_contours: fe.contours.unwrap_or(true),
             edge_boundaries: fe.boundaries.unwrap_or(true),
             strokes,
+            lines,
         };
 
         // Output.

@@ -5,13 +5,15 @@
 //! Lifetimes: *topology* passes (edge buffer, one-rings and owning faces,
 //! adjacency cap buffer) run once per mesh topology; *pose* passes (skin or
 //! load the frame, normals, curvature, dcurv, AO) once per pose; *view*
-//! passes (contours, suggestive contours, edge detection, caps, render) once
-//! per camera and frame. Across the cameras of one frame the pose passes run
+//! passes (contours, suggestive contours, the curvature line families' view
+//! terms and segments, edge detection, caps, render) once per camera and
+//! frame. Across the cameras of one frame the pose passes run
 //! once; across the frames of a static mesh they run once in all. An
 //! isosurface changes topology with every pose, so its topology passes are
 //! pose passes.
 
 use crate::spec::edges::CapMode;
+use crate::spec::feature_lines::LineFamily;
 use crate::spec::timing::Step;
 use serde::Serialize;
 
@@ -35,11 +37,31 @@ pub enum Cue {
     /// strokes, curvature from the Hessian after Kindlmann et al. 2003):
     /// volume inputs only ([`Cue::accepts`]).
     CurvatureStrokes,
+    /// Ridges (Ohtake, Belyaev and Seidel 2004, as rtsc draws them).
+    Ridges,
+    /// Valleys.
+    Valleys,
+    /// Apparent ridges (Judd, Durand and Adelson 2007).
+    ApparentRidges,
+    /// Suggestive highlights (DeCarlo and Rusinkiewicz 2007).
+    SuggestiveHighlights,
+    /// Principal highlights (DeCarlo and Rusinkiewicz 2007).
+    PrincipalHighlights,
+    /// Isophotes: n·l at evenly spaced levels.
+    Isophotes,
+    /// Parabolic lines, K = 0.
+    KZero,
+    /// Lines of zero mean curvature, H = 0.
+    HZero,
+    /// D_w κr = 0.
+    DwkrZero,
+    /// Mesh boundaries (edges with one face), as a line family.
+    Boundaries,
 }
 
 impl Cue {
     /// Every cue.
-    pub const ALL: [Cue; 7] = [
+    pub const ALL: [Cue; 17] = [
         Cue::Shading,
         Cue::CurvatureColors,
         Cue::AmbientOcclusion,
@@ -47,7 +69,49 @@ impl Cue {
         Cue::SuggestiveContours,
         Cue::FeatureEdges,
         Cue::CurvatureStrokes,
+        Cue::Ridges,
+        Cue::Valleys,
+        Cue::ApparentRidges,
+        Cue::SuggestiveHighlights,
+        Cue::PrincipalHighlights,
+        Cue::Isophotes,
+        Cue::KZero,
+        Cue::HZero,
+        Cue::DwkrZero,
+        Cue::Boundaries,
     ];
+
+    /// The curvature line families (`kernels/feature_lines_curves.cl`),
+    /// one cue each.
+    pub const LINE_FAMILIES: [Cue; 10] = [
+        Cue::Ridges,
+        Cue::Valleys,
+        Cue::ApparentRidges,
+        Cue::SuggestiveHighlights,
+        Cue::PrincipalHighlights,
+        Cue::Isophotes,
+        Cue::KZero,
+        Cue::HZero,
+        Cue::DwkrZero,
+        Cue::Boundaries,
+    ];
+
+    /// The line family this cue draws, for the curvature line cues.
+    pub fn family(self) -> Option<LineFamily> {
+        Some(match self {
+            Cue::Ridges => LineFamily::Ridges,
+            Cue::Valleys => LineFamily::Valleys,
+            Cue::ApparentRidges => LineFamily::ApparentRidges,
+            Cue::SuggestiveHighlights => LineFamily::SuggestiveHighlights,
+            Cue::PrincipalHighlights => LineFamily::PrincipalHighlights,
+            Cue::Isophotes => LineFamily::Isophotes,
+            Cue::KZero => LineFamily::KZero,
+            Cue::HZero => LineFamily::HZero,
+            Cue::DwkrZero => LineFamily::DwkrZero,
+            Cue::Boundaries => LineFamily::Boundaries,
+            _ => return None,
+        })
+    }
 
     /// Whether the cue can be drawn on an input kind: curvature-directed
     /// strokes are traced on a scalar field, so they need a volume input
@@ -71,11 +135,31 @@ impl Cue {
             Cue::SuggestiveContours => "suggestive_contours",
             Cue::FeatureEdges => "feature_edges",
             Cue::CurvatureStrokes => "curvature_strokes",
+            Cue::Ridges => "ridges",
+            Cue::Valleys => "valleys",
+            Cue::ApparentRidges => "apparent_ridges",
+            Cue::SuggestiveHighlights => "suggestive_highlights",
+            Cue::PrincipalHighlights => "principal_highlights",
+            Cue::Isophotes => "isophotes",
+            Cue::KZero => "k_zero",
+            Cue::HZero => "h_zero",
+            Cue::DwkrZero => "dwkr_zero",
+            Cue::Boundaries => "boundaries",
         }
     }
 
-    /// The passes this cue reads directly.
+    /// The passes this cue reads directly. The curvature line cues all end
+    /// in the per-view segment pass (`lines_curves`); before it, ridges,
+    /// valleys, K = 0, H = 0 and principal highlights read the per-pose
+    /// terms (`lines_pose`, from curvature and dcurv); apparent ridges the
+    /// view-dependent curvature and its derivative (`lines_view`,
+    /// `lines_dt1q1`); principal highlights and isophotes the per-view
+    /// terms (`lines_view`; isophotes need only normals there); suggestive
+    /// highlights and D_w κr = 0 the radial curvature and its derivative
+    /// (dcurv); boundaries only the boundary edges, listed once per
+    /// topology, and the normals the segment pass culls with.
     pub fn needs(self) -> &'static [Pass] {
+        use Pass::{Curvature, Dcurv, LinesCurves, LinesDt1q1, LinesPose, LinesView, Render};
         match self {
             Cue::Shading => &[Pass::VertexNormals, Pass::Render],
             Cue::CurvatureColors => &[Pass::Curvature, Pass::Render],
@@ -84,6 +168,14 @@ impl Cue {
             Cue::SuggestiveContours => &[Pass::SuggestiveContours, Pass::Render],
             Cue::FeatureEdges => &[Pass::Edges, Pass::Caps, Pass::Render],
             Cue::CurvatureStrokes => &[Pass::SdfLines, Pass::Render],
+            Cue::Ridges | Cue::Valleys | Cue::KZero | Cue::HZero => {
+                &[LinesPose, LinesCurves, Render]
+            }
+            Cue::ApparentRidges => &[Curvature, LinesView, LinesDt1q1, LinesCurves, Render],
+            Cue::PrincipalHighlights => &[LinesPose, LinesView, LinesCurves, Render],
+            Cue::SuggestiveHighlights | Cue::DwkrZero => &[Dcurv, LinesCurves, Render],
+            Cue::Isophotes => &[LinesView, LinesCurves, Render],
+            Cue::Boundaries => &[LinesCurves, Render],
         }
     }
 }
@@ -140,6 +232,10 @@ pub enum Pass {
     Dcurv,
     /// Ambient occlusion from curvature.
     Ao,
+    /// Per-pose terms of the curvature line families (`lines_pose`: the
+    /// larger principal curvature, its derivative along its direction, K,
+    /// H), once per pose however many views.
+    LinesPose,
     /// Curvature-directed strokes traced on the volume itself (family
     /// `sdf_lines`): dense samples, Poisson-disk seeds, curvature from the
     /// Hessian, RK4 tracing along d1, tapered strips. Reads no mesh pass.
@@ -148,6 +244,16 @@ pub enum Pass {
     Contours,
     /// Suggestive contours (zero crossings of radial curvature, with dk).
     SuggestiveContours,
+    /// Per-view terms of the curvature line families (`lines_view`: the
+    /// view-dependent curvature q1 and its direction t1, the
+    /// principal-highlight terms, n·l).
+    LinesView,
+    /// The derivative of the view-dependent curvature along t1
+    /// (`lines_dt1q1`, apparent ridges).
+    LinesDt1q1,
+    /// The segments of every requested curvature line family
+    /// (`lines_curves`, with the `lines_vertex` terms n·v, κr and D_w κr).
+    LinesCurves,
     /// Feature-edge detection into the edge-out buffer (family `edges`).
     Edges,
     /// Cap geometry into the cap-out buffers.
@@ -219,6 +325,10 @@ impl Pass {
             Pass::Curvature => "curvature",
             Pass::Dcurv => "dcurv",
             Pass::Ao => "ao",
+            Pass::LinesPose => "lines_pose",
+            Pass::LinesView => "lines_view",
+            Pass::LinesDt1q1 => "lines_dt1q1",
+            Pass::LinesCurves => "lines_curves",
             Pass::SdfLines => "sdf_lines",
             Pass::Contours => "contours",
             Pass::SuggestiveContours => "suggestive_contours",
@@ -231,7 +341,9 @@ impl Pass {
     /// The device steps this pass launches (empty for host passes), by
     /// which the executor joins a stage's [`crate::spec::timing::Timing`]
     /// to the plan. Contours and suggestive contours share one
-    /// `lines_vertex` + `lines_face` launch.
+    /// `lines_vertex` + `lines_face` launch; the curvature line families'
+    /// segment pass runs `lines_vertex` too, whose time the contours count
+    /// when they are planned.
     pub fn kernels(self) -> &'static [Step] {
         use Step::*;
         match self {
@@ -266,6 +378,10 @@ impl Pass {
                 SdflStrips,
             ],
             Pass::Contours | Pass::SuggestiveContours => &[LinesVertex, LinesFace],
+            Pass::LinesPose => &[LinesPose],
+            Pass::LinesView => &[LinesView],
+            Pass::LinesDt1q1 => &[LinesDt1q1],
+            Pass::LinesCurves => &[LinesVertex, LinesCurves],
             Pass::Edges => &[EdgesDetect],
             Pass::Caps => &[CapsMh, CapsAdjacency],
             Pass::LoadFrame
@@ -302,6 +418,11 @@ impl Pass {
             Pass::Ao => vec![Pass::Curvature],
             Pass::Contours => vec![Pass::VertexNormals],
             Pass::SuggestiveContours => vec![Pass::Dcurv, Pass::VertexNormals],
+            Pass::LinesPose => vec![Pass::Dcurv],
+            Pass::LinesView => vec![Pass::VertexNormals],
+            Pass::LinesDt1q1 => vec![Pass::LinesView],
+            // n·v per vertex, for back-face culling and fading.
+            Pass::LinesCurves => vec![Pass::VertexNormals],
             Pass::Edges => vec![Pass::EdgeBuffer, Pass::FaceNormals],
             Pass::Caps => vec![Pass::Edges, Pass::CapBuffer],
             // The strokes are traced on the field, not on the isosurface.
@@ -321,9 +442,14 @@ impl Pass {
             Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer if input != Input::Volume => {
                 Lifetime::Topology
             }
-            Pass::Contours | Pass::SuggestiveContours | Pass::Edges | Pass::Caps | Pass::Render => {
-                Lifetime::View
-            }
+            Pass::Contours
+            | Pass::SuggestiveContours
+            | Pass::LinesView
+            | Pass::LinesDt1q1
+            | Pass::LinesCurves
+            | Pass::Edges
+            | Pass::Caps
+            | Pass::Render => Lifetime::View,
             _ => Lifetime::Pose,
         }
     }

@@ -325,3 +325,65 @@ crate::spec::kernels::kernel_entries! {
         Curves = "lines_curves",
     }
 }
+
+/// How the hidden parts of lines appear in the SVG (rtsc's "draw hidden
+/// lines"): left out, drawn faded, or drawn dashed, under the visible parts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Hidden {
+    /// Visible parts only.
+    Remove,
+    /// Hidden parts at a third of the opacity.
+    Faded,
+    /// Hidden parts dashed.
+    Dashed,
+}
+
+impl Hidden {
+    /// Every choice.
+    pub const ALL: [Hidden; 3] = [Hidden::Remove, Hidden::Faded, Hidden::Dashed];
+
+    /// The choice's name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Hidden::Remove => "remove",
+            Hidden::Faded => "faded",
+            Hidden::Dashed => "dashed",
+        }
+    }
+}
+
+crate::spec::named_choice!(Hidden, "hidden-line mode");
+
+/// Each family's stroke colour and width factor in pictures and SVG.
+pub fn family_style(f: LineFamily) -> ([f32; 3], f32) {
+    match f {
+        LineFamily::Contours => ([0.0, 0.0, 0.0], 1.25),
+        LineFamily::Suggestive => ([0.0, 0.0, 0.8], 1.0),
+        LineFamily::Ridges => ([0.3, 0.0, 0.3], 1.0),
+        LineFamily::Valleys => ([0.5, 0.3, 0.2], 1.0),
+        LineFamily::ApparentRidges => ([0.4, 0.4, 0.0], 1.0),
+        LineFamily::SuggestiveHighlights => ([0.5, 0.0, 0.0], 1.0),
+        LineFamily::PrincipalHighlights => ([0.8, 0.2, 0.0], 1.0),
+        LineFamily::Isophotes => ([0.4, 0.7, 0.4], 0.5),
+        LineFamily::KZero | LineFamily::HZero | LineFamily::DwkrZero => ([1.0, 0.0, 0.0], 0.75),
+        LineFamily::Boundaries => ([0.05, 0.05, 0.05], 1.0),
+    }
+}
+
+/// The id of a family's hidden-parts group.
+pub fn hidden_id(f: LineFamily) -> &'static str {
+    match f {
+        LineFamily::Contours => "contours-hidden",
+        LineFamily::Suggestive => "suggestive-hidden",
+        LineFamily::Ridges => "ridges-hidden",
+        LineFamily::Valleys => "valleys-hidden",
+        LineFamily::ApparentRidges => "apparent-ridges-hidden",
+        LineFamily::SuggestiveHighlights => "suggestive-highlights-hidden",
+        LineFamily::PrincipalHighlights => "principal-highlights-hidden",
+        LineFamily::Isophotes => "isophotes-hidden",
+        LineFamily::KZero => "k-zero-hidden",
+        LineFamily::HZero => "h-zero-hidden",
+        LineFamily::DwkrZero => "dwkr-zero-hidden",
+        LineFamily::Boundaries => "boundaries-hidden",
+    }
+}

@@ -172,6 +172,26 @@ pub(super) fn draw_view(
         }
         drawn[kind as usize] += n;
     }
+    // The curvature line families, each in its cue's style; with fading,
+    // in the same four opacity bins of their strength.
+    let fade = fx.lines.curves.fade;
+    for st in &fx.lines.styles_for(&fx.cues) {
+        let kind = st.family as u32;
+        for (bi, &alpha) in BINS.iter().enumerate() {
+            let pts: Vec<[f32; 3]> = lines
+                .segments
+                .iter()
+                .filter(|s| s.2 == kind && (!fade || strength_bin(s.3) == bi))
+                .flat_map(|s| [s.0, s.1])
+                .collect();
+            if pts.is_empty() || (!fade && bi > 0) {
+                continue;
+            }
+            let [r, g, b] = st.color;
+            let a = if fade { alpha } else { 1.0 };
+            renderer.draw_lines(&pts, [r, g, b, a], st.width)?;
+        }
+    }
     if let Some(eo) = lines.edges {
         let [r, g, b] = fx.edge.1;
         draw_edges(renderer, eo, [r, g, b, 1.0])?;
@@ -207,7 +227,7 @@ pub(super) fn draw_view(
 }
 
 /// The SVG groups of one view: one per line cue the scene asks for (contours,
-/// suggestive contours, feature edges), each with the cue's colour and width,
+/// suggestive contours, each curvature line family, feature edges), each with the cue's colour and width,
 /// visible parts only (against `image`'s depth), joined into polylines.
 fn svg_layers(
     scene: &Scene,
@@ -216,7 +236,8 @@ fn svg_layers(
     lines: &ViewLines<'_>,
     image: &Frame,
 ) -> Vec<crate::export::svg::SvgLayer> {
-    use crate::export::svg::{DEFAULT_BIAS, SvgLayer, segment_lines, visible_joined};
+    use crate::export::svg::{DEFAULT_BIAS, SvgLayer, SvgPolyline, segment_lines, visible_joined};
+    use crate::spec::feature_lines::{Hidden, hidden_id};
     let fx = &scene.effects;
     let [w, h] = scene.size;
     let vp = cam.view_proj(w as f32 / h as f32);
@@ -246,6 +267,47 @@ fn svg_layers(
             dashed: false,
         });
     }
+    // The curvature line families as `shapecue lines` writes them: a group
+    // per family, under it (as its `hidden` asks) the hidden parts.
+    let fade = fx.lines.curves.fade;
+    for st in &fx.lines.styles_for(&fx.cues) {
+        let kind = st.family as u32;
+        let clip = segment_lines(
+            vp,
+            lines.segments,
+            kind,
+            |s| {
+                if fade { alpha(s) } else { 1.0 }
+            },
+        );
+        if st.hidden != Hidden::Remove {
+            let hidden: Vec<SvgPolyline> = lines
+                .segments
+                .iter()
+                .filter(|s| s.2 == kind)
+                .filter_map(|s| {
+                    Some(SvgPolyline {
+                        points: vec![pixel(vp, s.0, w, h)?, pixel(vp, s.1, w, h)?],
+                        opacity: if st.hidden == Hidden::Faded { 0.3 } else { 1.0 },
+                    })
+                })
+                .collect();
+            layers.push(SvgLayer {
+                id: hidden_id(st.family),
+                stroke_width: 0.5 * st.width,
+                color: st.color,
+                lines: hidden,
+                dashed: st.hidden == Hidden::Dashed,
+            });
+        }
+        layers.push(SvgLayer {
+            id: st.family.name(),
+            stroke_width: st.width,
+            color: st.color,
+            lines: visible_joined(&clip, image, DEFAULT_BIAS),
+            dashed: false,
+        });
+    }
     if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
         let clip = crate::export::svg::edge_out_lines(&eo.edge_out);
         layers.push(SvgLayer {
@@ -257,4 +319,14 @@ fn svg_layers(
         });
     }
     layers
+}
+
+/// `p` in image pixels (origin top left), or `None` behind the eye.
+fn pixel(vp: glam::Mat4, p: [f32; 3], w: u32, h: u32) -> Option<[f32; 2]> {
+    let c = vp * glam::Vec4::new(p[0], p[1], p[2], 1.0);
+    if c.w.is_nan() || c.w <= 0.0 {
+        return None;
+    }
+    let (x, y) = (c.x / c.w, c.y / c.w);
+    Some([0.5 * (x + 1.0) * w as f32, 0.5 * (1.0 - y) * h as f32])
 }

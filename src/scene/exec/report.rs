@@ -4,7 +4,7 @@
 //! wall time.
 
 use crate::scene::planner::{Input, Lifetime, Pass, Plan};
-use crate::spec::timing::Timing;
+use crate::spec::timing::{Step, Timing};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -59,6 +59,9 @@ pub struct RunReport {
     pub gl_uploads: crate::render::Uploads,
     /// Contour and suggestive-contour segments over all views.
     pub segments: [usize; 2],
+    /// Segments of each curvature line cue's family over all views, by
+    /// family name.
+    pub lines: BTreeMap<&'static str, usize>,
     /// Curvature-directed strokes over all poses (traced once per pose).
     pub strokes: usize,
     /// Notes (e.g. what skinning weights were dropped).
@@ -113,6 +116,12 @@ impl Recorder {
     /// One run of a device pass: the kernel ms of its steps in `t`.
     pub(super) fn kernels(&mut self, pass: Pass, t: &Timing, how: &str) {
         self.add(pass, t.ms(pass.kernels()), "kernel", how);
+    }
+
+    /// One run of a device pass counting only `steps` of `t` (the rest of
+    /// its launch is counted by another pass).
+    pub(super) fn kernels_of(&mut self, pass: Pass, t: &Timing, steps: &[Step], how: &str) {
+        self.add(pass, t.ms(steps), "kernel", how);
     }
 
     /// One run of a device pass whose kernels ran in another pass's launch

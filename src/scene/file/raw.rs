@@ -168,6 +168,26 @@ pub struct EffectsSpec {
     pub feature_edges: Option<EdgeSpec>,
     /// Curvature-directed strokes (volume inputs only).
     pub curvature_strokes: Option<StrokeSpec>,
+    /// Ridges.
+    pub ridges: Option<ThresholdLineSpec>,
+    /// Valleys.
+    pub valleys: Option<ThresholdLineSpec>,
+    /// Apparent ridges.
+    pub apparent_ridges: Option<ThresholdLineSpec>,
+    /// Suggestive highlights.
+    pub suggestive_highlights: Option<ThresholdLineSpec>,
+    /// Principal highlights.
+    pub principal_highlights: Option<ThresholdLineSpec>,
+    /// Isophotes.
+    pub isophotes: Option<IsophoteSpec>,
+    /// Parabolic lines, K = 0.
+    pub k_zero: Option<PlainLineSpec>,
+    /// Lines of zero mean curvature, H = 0.
+    pub h_zero: Option<PlainLineSpec>,
+    /// D_w κr = 0.
+    pub dwkr_zero: Option<PlainLineSpec>,
+    /// Mesh boundaries as a line family.
+    pub boundaries: Option<PlainLineSpec>,
 }
 
 /// `[effects.shading]`.
@@ -292,4 +312,63 @@ pub struct OutputSpec {
     /// Background RGB (default white).
     #[serde(default, deserialize_with = "exact")]
     pub background: Option<[f32; 3]>,
+}
+
+/// `[effects.ridges]`, `valleys`, `apparent_ridges`, `suggestive_highlights`
+/// and `principal_highlights`: the families with a threshold.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThresholdLineSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Dimensionless threshold, times the mesh's feature size.
+    pub threshold: Option<f32>,
+    /// Strength (opacity) fades with the test's margin (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG: `remove` (default), `faded` or `dashed`.
+    pub hidden: Option<String>,
+}
+
+/// `[effects.isophotes]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsophoteSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Levels n·l = j / count for |j| < count (default 20).
+    pub count: Option<u32>,
+    /// Direction towards the light, world coordinates (default +Z).
+    #[serde(default, deserialize_with = "exact")]
+    pub light: Option<[f32; 3]>,
+    /// Strength fades (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG.
+    pub hidden: Option<String>,
+}
+
+/// `[effects.k_zero]`, `h_zero`, `dwkr_zero` and `boundaries`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlainLineSpec {
+    /// Line width in pixels.
+    pub width: Option<f32>,
+    /// RGB.
+    #[serde(default, deserialize_with = "exact")]
+    pub color: Option<[f32; 3]>,
+    /// Strength fades (default true).
+    pub fade: Option<bool>,
+    /// Back-face culling (default true).
+    pub cull: Option<bool>,
+    /// Hidden parts in the SVG.
+    pub hidden: Option<String>,
 }

@@ -128,6 +128,8 @@ pub(super) struct Executor<'s, 'g> {
     edges_ran: Option<(Timing, EdgeOutput)>,
     /// Contour and suggestive-contour segments over all views.
     pub(super) segments: [usize; 2],
+    /// Segments of each curvature line cue's family over all views.
+    pub(super) line_segments: std::collections::BTreeMap<&'static str, usize>,
     /// Files written.
     pub(super) outputs: Vec<PathBuf>,
 }
@@ -156,7 +158,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             suggestive: has(Pass::SuggestiveContours),
             threshold: fx.suggestive_threshold,
             fade: fx.suggestive_fade,
-            curves: Default::default(),
+            // The curvature line cues' families and controls.
+            curves: fx.lines.curves_for(&fx.cues),
         };
         let pipe = match &loaded {
             Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(
@@ -234,6 +237,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             lines_ran: None,
             edges_ran: None,
             segments: [0; 2],
+            line_segments: Default::default(),
             outputs: Vec::new(),
         })
     }
@@ -472,7 +476,22 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             Pass::Ao => self.ao(frame)?,
             Pass::SdfLines => self.sdf_lines()?,
-            Pass::Contours | Pass::SuggestiveContours | Pass::Edges | Pass::Caps | Pass::Render => {
+            Pass::LinesPose => {
+                // The curvature run of this pose makes the extractor's pose
+                // terms stale: `lines_pose` runs again in the first view's
+                // line launch, and only there (recorded by that view).
+                if let Some(lx) = self.topo.as_mut().and_then(|t| t.lines.as_mut()) {
+                    lx.pose_changed();
+                }
+            }
+            Pass::Contours
+            | Pass::SuggestiveContours
+            | Pass::LinesView
+            | Pass::LinesDt1q1
+            | Pass::LinesCurves
+            | Pass::Edges
+            | Pass::Caps
+            | Pass::Render => {
                 unreachable!("{pass:?} is a view pass")
             }
         }

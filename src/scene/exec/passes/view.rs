@@ -44,6 +44,44 @@ impl Executor<'_, '_> {
                     );
                 }
             }
+            Pass::LinesView | Pass::LinesDt1q1 => {
+                let t = self.lines(cam)?;
+                let how = if pass == Pass::LinesView {
+                    "lines_view (view-dependent curvature q1 and t1, highlight terms, n·l)"
+                } else {
+                    "lines_dt1q1 (derivative of q1 along t1)"
+                };
+                self.rec.kernels(pass, &t, how);
+            }
+            Pass::LinesCurves => {
+                let t = self.lines(cam)?;
+                // The pose terms run in the first view's launch after a
+                // curvature run: recorded where they ran, once per pose.
+                if t.ran(Pass::LinesPose.kernels()) {
+                    self.rec.kernels(
+                        Pass::LinesPose,
+                        &t,
+                        "lines_pose (larger principal curvature, its derivative, K, H), \
+                         launched with the pose's first view",
+                    );
+                }
+                let fx = &self.scene.effects;
+                let families: Vec<&str> = (fx.lines.styles_for(&fx.cues).iter())
+                    .map(|s| s.family.name())
+                    .collect();
+                let contours = self.plan.contains(Pass::Contours)
+                    || self.plan.contains(Pass::SuggestiveContours);
+                if contours {
+                    let how = format!(
+                        "lines_curves ({}); lines_vertex counted with the contours",
+                        families.join(", ")
+                    );
+                    self.rec.kernels_of(pass, &t, &[Step::LinesCurves], &how);
+                } else {
+                    let how = format!("lines_vertex + lines_curves ({})", families.join(", "));
+                    self.rec.kernels(pass, &t, &how);
+                }
+            }
             Pass::Edges => {
                 let fx = &self.scene.effects;
                 let [w, h] = self.scene.size;
@@ -107,6 +145,12 @@ impl Executor<'_, '_> {
                 );
                 self.segments[0] += drawn[0];
                 self.segments[1] += drawn[1];
+                let fx = &self.scene.effects;
+                for st in &fx.lines.styles_for(&fx.cues) {
+                    let kind = st.family as u32;
+                    let n = self.segs.iter().filter(|s| s.2 == kind).count();
+                    *self.line_segments.entry(st.family.name()).or_default() += n;
+                }
                 self.outputs.extend(paths.iter().map(|p| (*p).clone()));
             }
             _ => unreachable!("{pass:?} is not a view pass"),
@@ -114,9 +158,10 @@ impl Executor<'_, '_> {
         Ok(())
     }
 
-    /// Contours and suggestive contours of this view, found once per view
-    /// (one launch finds both): on the device from the curvature buffers,
-    /// or from host normals when no curvature is planned.
+    /// Contours, suggestive contours and the curvature line families of
+    /// this view, found once per view (one extraction finds them all): on
+    /// the device from the curvature buffers, or from host normals when no
+    /// curvature is planned (contours, isophotes, boundaries).
     fn lines(&mut self, cam: &Camera) -> Result<Timing> {
         if let Some(t) = &self.lines_ran {
             return Ok(t.clone());
