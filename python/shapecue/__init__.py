@@ -102,8 +102,8 @@ def _mesh_arrays(vertices: Any, faces: Any) -> Tuple[np.ndarray, np.ndarray]:
 
 def _accumulate(accumulate: str) -> str:
     # "auto": the command line's default, decided for the device by the
-    # library: gather on CPU devices (the faster exact scheme there, and
-    # bitwise reproducible), float atomics on GPUs.
+    # library: gather (the faster exact scheme on CPU devices and GPUs
+    # measured, and bitwise reproducible).
     return accumulate
 
 
@@ -216,8 +216,8 @@ def curvature(
     handled (counted in the result); NaN coordinates, out-of-range indices and
     empty meshes raise :class:`ValueError`.
 
-    ``accumulate``: "auto" (gather on CPU devices, float atomics on GPUs:
-    the faster exact scheme of each), "atomic" (Griffin et al.'s float
+    ``accumulate``: "auto" (gather, the faster exact scheme on CPU devices
+    and GPUs measured), "atomic" (Griffin et al.'s float
     atomics) or "gather" (bitwise reproducible). ``precision``: "f32" or "f64" (needs fp64).
     ``compat``: None/"exact" or "trimesh2" (trimesh2 2.16's solve and
     ordering). ``reference=True`` computes with the single-threaded f64 CPU
