@@ -1,7 +1,8 @@
 //! `shapecue view` driven by `--script` under Xvfb: the screenshot of the
 //! window equals the headless renderer's image of the same scene (camera and
 //! cues); switching a cue changes exactly the passes the plan adds; a
-//! volume's iso slider re-extracts the isosurface. Without a display the
+//! camera move reruns only the view passes and a frame step only the pose
+//! and view passes; a volume's iso slider re-extracts the isosurface. Without a display the
 //! command fails with exit code 4 and says why.
 //!
 //! Needs `xvfb-run` (Debian's xvfb package), OpenCL (PoCL) and GL; without
@@ -15,7 +16,7 @@
 mod common;
 
 use common::{assert_succeeded, cli, cli_gl_missing, gl_required, scratch};
-use shapecue::scene::planner::{Cue, Input, Pass, plan_with};
+use shapecue::scene::planner::{Cue, Input, Lifetime, Pass, plan_with};
 use shapecue::spec::edges::CapMode;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -205,6 +206,50 @@ fn a_cue_switch_changes_exactly_its_passes() {
         .collect();
     assert_eq!(added, want);
     assert!(added.contains("suggestive_contours") && added.contains("curvature"));
+}
+
+/// The passes of `plan` whose lifetime `keep` accepts for `input`.
+fn of_lifetime(plan: &[Pass], input: Input, keep: impl Fn(Lifetime) -> bool) -> BTreeSet<String> {
+    (plan.iter())
+        .filter(|p| keep(p.lifetime(input)))
+        .map(|p| p.name().to_string())
+        .collect()
+}
+
+#[test]
+fn a_camera_move_reruns_the_view_passes_and_a_frame_step_the_pose_passes() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-lifetimes");
+    let fox = data("Fox.glb");
+    // The Fox's first clip: skinning, curvature and AO per pose; contours
+    // and the render per view.
+    let script = "cue ao on\ncue curvature_colors on\npasses\norbit 30 0\npasses\n\
+                  zoom 0.8\npasses\nframe next\npasses\nframe prev\npasses\n";
+    let Some(out) = view(&dir, &[fox.to_str().unwrap(), "--size", "200x150"], script) else {
+        return;
+    };
+    let seen = passes(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(seen.len(), 5, "{stdout}");
+    use Cue::*;
+    let cues = [Shading, CurvatureColors, AmbientOcclusion, Contours];
+    let plan = plan_with(&cues, Input::Skinned, CapMode::Adjacency).passes;
+    let sk = Input::Skinned;
+    // The first frame of the setup runs the whole plan.
+    assert_eq!(seen[0], names(&plan), "{stdout}");
+    // Camera moves: the view passes only.
+    let view_passes = of_lifetime(&plan, sk, |l| l == Lifetime::View);
+    assert!(view_passes.contains("contours") && view_passes.contains("render"));
+    assert_eq!(seen[1], view_passes, "{stdout}");
+    assert_eq!(seen[2], view_passes, "{stdout}");
+    // Frame steps: the pose passes and the view passes, not the topology's.
+    let pose_view = of_lifetime(&plan, sk, |l| l != Lifetime::Topology);
+    assert!(pose_view.contains("skinning") && pose_view.contains("ao"));
+    assert!(pose_view.len() < plan.len(), "{plan:?}");
+    assert_eq!(seen[3], pose_view, "{stdout}");
+    assert_eq!(seen[4], pose_view, "{stdout}");
 }
 
 #[test]

@@ -31,6 +31,10 @@
 //! size differs. Within a scene the mesh goes to GL once per topology (its
 //! faces) and once per pose (positions, normals, colours), not once per view.
 //!
+//! A front end that draws one camera and frame at a time holds a scene
+//! live ([`Session::live`], in `live`): a camera move reruns only the view
+//! passes, a new frame only the pose passes and the view passes.
+//!
 //! The plan is the program: [`run`] walks the plan's passes in order,
 //! filtered by lifetime (topology passes on a new topology, pose passes per
 //! pose, view passes per camera), one arm per pass
@@ -39,10 +43,12 @@
 //! (`report`).
 
 mod draw;
+mod live;
 mod load;
 mod passes;
 mod report;
 
+pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
 

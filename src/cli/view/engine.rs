@@ -1,14 +1,16 @@
 //! The viewer's compute thread: it owns the OpenCL device and the headless
 //! renderer (one [`Session`] of the scene executor, so the device's programs
 //! and the GL context are made once) and draws each frame the window asks
-//! for through the executor, exactly as `shapecue render` would draw it.
+//! for through the executor's live scene, with the passes `shapecue render`
+//! would run, less those whose results still hold: a camera move reruns
+//! the view passes only, a new frame the pose passes and the view passes.
 //!
 //! Requests carry a whole scene (one camera, one frame, the cues and
 //! sliders of the moment). The thread always takes the newest request and
 //! drops the ones that a newer one made stale, so a slow frame never queues
 //! up behind the mouse; the window's event loop never waits for it.
 
-use shapecue::scene::exec::{ExecOptions, PassRecord, Session, output_paths};
+use shapecue::scene::exec::{ExecOptions, LiveRequest, PassRecord, Session};
 use shapecue::scene::file::Scene;
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -100,75 +102,66 @@ impl Drop for Engine {
     }
 }
 
-/// The thread's loop: newest request first, stale ones dropped.
-fn serve(rx: Receiver<Request>, tx: Sender<Reply>, opts: ExecOptions, wake: Box<dyn Fn() + Send>) {
-    let mut session = Session::new();
-    while let Ok(mut req) = rx.recv() {
-        let mut dropped = 0;
-        loop {
-            match rx.try_recv() {
-                Ok(newer) => {
-                    dropped += 1;
-                    let svg = req.svg || newer.svg;
-                    req = newer;
-                    req.svg = svg;
-                }
-                Err(TryRecvError::Empty) => break,
-                Err(TryRecvError::Disconnected) => return,
+/// The newest of the requests waiting (blocking for one when none is),
+/// and how many older ones it made stale; `None` once the window is gone.
+/// A dropped request's SVG goes on with the newer one.
+fn newest(rx: &Receiver<Request>) -> Option<(Request, u64)> {
+    let mut req = rx.recv().ok()?;
+    let mut dropped = 0;
+    loop {
+        match rx.try_recv() {
+            Ok(newer) => {
+                dropped += 1;
+                let svg = req.svg || newer.svg;
+                req = newer;
+                req.svg = svg;
             }
+            Err(TryRecvError::Empty) => return Some((req, dropped)),
+            Err(TryRecvError::Disconnected) => return None,
         }
-        let id = req.id;
-        let reply = match draw(&mut session, req, &opts) {
-            Ok(mut d) => {
-                d.dropped = dropped;
-                Reply::Frame(Box::new(d))
-            }
-            Err(e) => Reply::Failed(id, e),
-        };
-        if tx.send(reply).is_err() {
-            return;
-        }
-        wake();
     }
 }
 
-/// Draws one request through the executor and reads its image back.
-fn draw(session: &mut Session, req: Request, opts: &ExecOptions) -> Result<Done, String> {
-    let t0 = Instant::now();
-    let id = req.id;
+/// The request as the executor's live scene takes it: the image in
+/// memory, the SVG (when asked for) under a name of its own, so that the
+/// next frame does not overwrite it before the window copies it.
+fn live_request(req: Request, dir: &std::path::Path) -> LiveRequest {
     let mut scene = req.scene;
-    scene.png = true;
-    scene.svg = req.svg;
-    let report = session
-        .run(&scene, opts, &mut |_, _| {})
-        .map_err(|e| e.to_string())?;
+    scene.png = false;
+    scene.svg = false;
+    LiveRequest {
+        svg: req.svg.then(|| dir.join(format!("lines-{}.svg", req.id))),
+        scene,
+    }
+}
+
+/// The thread's loop: the scene held live by the executor (a camera move
+/// reruns only the view passes, a new frame the pose passes), newest
+/// request first, stale ones dropped.
+fn serve(rx: Receiver<Request>, tx: Sender<Reply>, opts: ExecOptions, wake: Box<dyn Fn() + Send>) {
     let dir = opts.out_dir.clone().unwrap_or_default();
-    let (images, _) = output_paths(&scene, &report.frames, &dir);
-    let is = |p: &PathBuf, ext: &str| p.extension().is_some_and(|e| e == ext);
-    let png = images
-        .iter()
-        .map(|i| &i.2)
-        .find(|p| is(p, "png"))
-        .ok_or("the executor wrote no image")?;
-    let image = image::open(png)
-        .map_err(|e| format!("{}: {e}", png.display()))?
-        .to_rgba8();
-    // A name of its own, so that the next frame does not overwrite it before
-    // the window copies it.
-    let svg = match images.iter().map(|i| &i.2).find(|p| is(p, "svg")) {
-        Some(p) => {
-            let own = dir.join(format!("lines-{id}.svg"));
-            std::fs::rename(p, &own).map_err(|e| format!("{}: {e}", p.display()))?;
-            Some(own)
-        }
-        None => None,
+    let Some((first, mut dropped)) = newest(&rx) else {
+        return;
     };
-    Ok(Done {
-        id,
-        image,
-        passes: report.passes,
-        wall_ms: t0.elapsed().as_secs_f64() * 1e3,
-        svg,
-        dropped: 0,
-    })
+    let mut id = first.id;
+    let mut t0 = Instant::now();
+    let mut session = Session::new();
+    session.live(&opts, live_request(first, &dir), &mut |result| {
+        let reply = match result {
+            Ok(f) => Reply::Frame(Box::new(Done {
+                id,
+                image: f.image.to_image(),
+                passes: f.passes,
+                wall_ms: t0.elapsed().as_secs_f64() * 1e3,
+                svg: f.svg,
+                dropped,
+            })),
+            Err(e) => Reply::Failed(id, e.to_string()),
+        };
+        tx.send(reply).ok()?;
+        wake();
+        let (req, d) = newest(&rx)?;
+        (id, dropped, t0) = (req.id, d, Instant::now());
+        Some(live_request(req, &dir))
+    });
 }

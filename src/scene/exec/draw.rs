@@ -117,7 +117,8 @@ pub(super) struct ViewLines<'a> {
 
 /// Draws one view (the mesh the renderer holds, line quads, edge quads),
 /// reads it back and writes its images to `paths`. Returns the contour and
-/// suggestive-contour segments drawn.
+/// suggestive-contour segments drawn, and the image read back (with depth
+/// when an SVG was asked for).
 pub(super) fn draw_view(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -125,7 +126,7 @@ pub(super) fn draw_view(
     cam: &Camera,
     lines: ViewLines<'_>,
     paths: &[&PathBuf],
-) -> Result<[usize; 2]> {
+) -> Result<([usize; 2], Frame)> {
     let fx = &scene.effects;
     let [w, h] = scene.size;
     renderer.begin(cam)?;
@@ -223,7 +224,7 @@ pub(super) fn draw_view(
             crate::export::svg::write_svg_layers(path, &layers, w, h)?;
         }
     }
-    Ok(drawn)
+    Ok((drawn, image))
 }
 
 /// The SVG groups of one view: one per line cue the scene asks for (contours,

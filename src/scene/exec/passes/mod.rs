@@ -83,6 +83,9 @@ struct Framing {
     /// pose), so that a mesh far from the world origin keeps its f32
     /// precision in the renderer.
     origin: [f64; 3],
+    /// Bounds of the first pose's used vertices (scene frame), which fitted
+    /// cameras frame.
+    bounds: ([f64; 3], [f64; 3]),
     cameras: Vec<Camera>,
     ao_radius: f32,
 }
@@ -132,6 +135,11 @@ pub(super) struct Executor<'s, 'g> {
     pub(super) line_segments: std::collections::BTreeMap<&'static str, usize>,
     /// Files written.
     pub(super) outputs: Vec<PathBuf>,
+    /// Keep each view's image in [`Executor::image`] (a live scene hands
+    /// it to its caller instead of writing a PNG).
+    pub(super) keep_image: bool,
+    /// The last view's image, when kept.
+    pub(super) image: Option<crate::render::Frame>,
 }
 
 impl<'s, 'g> Executor<'s, 'g> {
@@ -239,6 +247,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             segments: [0; 2],
             line_segments: Default::default(),
             outputs: Vec::new(),
+            keep_image: false,
+            image: None,
         })
     }
 
@@ -255,6 +265,20 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// The renderer, for the next scene of the session.
     pub(super) fn into_renderer(self) -> Renderer {
         self.renderer
+    }
+
+    /// The loaded input and the renderer, for the next executor of a live
+    /// scene whose input stays.
+    pub(super) fn into_parts(self) -> (Loaded, Renderer) {
+        (self.loaded, self.renderer)
+    }
+
+    /// The camera of a view resolved as the first pose resolved the
+    /// scene's own (same origin, same bounds for a fitted view).
+    pub(super) fn camera_of(&self, v: &crate::scene::file::ViewSpec) -> Result<Camera> {
+        let f = self.framing.as_ref().expect("a pose ran");
+        let [w, h] = self.scene.size;
+        draw::camera(v, f.bounds, w as f32 / h as f32, f.origin)
     }
 
     /// Vertices and faces of the current topology.
@@ -374,6 +398,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 .collect::<Result<_>>()?;
             self.framing = Some(Framing {
                 origin: o,
+                bounds: b,
                 cameras,
                 ao_radius: (self.scene.effects.ao_radius as f64 * diag.max(1e-30)) as f32,
             });

@@ -136,8 +136,11 @@ impl Executor<'_, '_> {
                     // interpolated surface, which marching cubes cuts as chords.
                     stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
                 };
-                let drawn =
+                let (drawn, image) =
                     draw::draw_view(&mut self.renderer, self.scene, self.plan, cam, lines, paths)?;
+                if self.keep_image {
+                    self.image = Some(image);
+                }
                 self.rec.wall(
                     pass,
                     ms_since(t0),

@@ -1,0 +1,224 @@
+//! A scene held live for an interactive front end (`shapecue view`): one
+//! request after another, each the scene of one camera and one frame, drawn
+//! into memory. What a request changes decides what runs again:
+//!
+//! - only the camera: the plan's *view* passes;
+//! - the frame of an animation: its *pose* passes, then the view passes;
+//! - anything else (cues, sliders, the image size, the iso value): a new
+//!   plan and new stages, every pass of the plan. The loaded input is kept
+//!   when the input itself (file, isovalue, weld, glTF rate) stays.
+//!
+//! Nothing is written but the SVG a request asks for: no report, no PNG
+//! (the image comes back in the [`LiveFrame`]). Each frame reports the
+//! passes that ran for it, as the run report does for a whole run.
+
+use super::load::{Loaded, load};
+use super::passes::Executor;
+use super::report::{PassRecord, Recorder};
+use super::{ExecOptions, Session, frame_indices};
+use crate::error::{Error, Result};
+use crate::render::{Frame, RenderOptions};
+use crate::scene::file::Scene;
+use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
+use std::path::PathBuf;
+
+/// One frame to draw: the scene with the camera (its first view) and the
+/// frame (the first of its `frames`) of the moment.
+#[derive(Clone, Debug)]
+pub struct LiveRequest {
+    /// The scene of this frame.
+    pub scene: Scene,
+    /// Also write the lines of the frame as SVG here.
+    pub svg: Option<PathBuf>,
+}
+
+/// What a request changed, and so what ran for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Change {
+    /// A new plan or input: every pass of the plan ran.
+    Scene,
+    /// Another frame of the animation: its pose passes and the view passes.
+    Pose,
+    /// Only the camera (or nothing): the view passes.
+    View,
+}
+
+/// A drawn frame.
+pub struct LiveFrame {
+    /// The image (RGBA, row 0 at the top).
+    pub image: Frame,
+    /// The passes that ran for this frame, in plan order, with their ms.
+    pub passes: Vec<PassRecord>,
+    /// What the request changed.
+    pub change: Change,
+    /// The SVG written, when the request asked for one.
+    pub svg: Option<PathBuf>,
+}
+
+/// The scene with what a frame may change without new stages (camera,
+/// frame, outputs) set aside: two requests of equal setups share stages.
+fn setup(s: &Scene) -> Scene {
+    let mut k = s.clone();
+    k.views.clear();
+    k.frames = (0, None, 1);
+    k.png = false;
+    k.svg = false;
+    k.prefix.clear();
+    k.out_dir = PathBuf::new();
+    k
+}
+
+/// Whether two scenes load the same input.
+fn same_input(a: &Scene, b: &Scene) -> bool {
+    a.source == b.source && a.weld == b.weld && a.fps == b.fps
+}
+
+impl Session {
+    /// Draws `first`, hands the frame to `next`, and draws what `next`
+    /// returns, until it returns `None`. A failed request is handed to
+    /// `next` as its error; the scene is set up anew for the request after
+    /// it. The device and the renderer stay with the session.
+    pub fn live(
+        &mut self,
+        opts: &ExecOptions,
+        first: LiveRequest,
+        next: &mut dyn FnMut(Result<LiveFrame>) -> Option<LiveRequest>,
+    ) {
+        let mut req = first;
+        let mut held: Option<(Scene, Loaded)> = None;
+        loop {
+            let scene = setup(&req.scene);
+            let outcome = self.live_setup(opts, &scene, &mut held, req, next);
+            req = match outcome {
+                Ok(Some(r)) => r,
+                Ok(None) => return,
+                Err(e) => match next(Err(e)) {
+                    Some(r) => r,
+                    None => return,
+                },
+            };
+        }
+    }
+
+    /// The requests of one setup (`scene`): stages built once, then pose
+    /// and view passes as requests change the frame and the camera. Returns
+    /// the first request of another setup, keeping the input in `held`
+    /// for it.
+    fn live_setup(
+        &mut self,
+        opts: &ExecOptions,
+        scene: &Scene,
+        held: &mut Option<(Scene, Loaded)>,
+        first: LiveRequest,
+        next: &mut dyn FnMut(Result<LiveFrame>) -> Option<LiveRequest>,
+    ) -> Result<Option<LiveRequest>> {
+        let loaded = match held.take() {
+            Some((s, l)) if same_input(&s, scene) => l,
+            _ => load(scene, &mut Vec::new())?,
+        };
+        let fx = &scene.effects;
+        let input = scene.source.input();
+        let plan = plan_with(&fx.cues, input, fx.caps);
+        let gpu = self.gpu(opts)?;
+        let [w, h] = scene.size;
+        let [br, bg, bb] = scene.background;
+        let renderer = self.renderer(RenderOptions {
+            width: w,
+            height: h,
+            msaa: scene.msaa,
+            background: [br, bg, bb, 1.0],
+        })?;
+        let n_frames = loaded.frames();
+        let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
+        ex.keep_image = true;
+        let mut live = Live {
+            plan: &plan,
+            input,
+            n_frames,
+            pose: None,
+        };
+        let mut req = first;
+        loop {
+            let frame = live.frame(&mut ex, &req)?;
+            match next(Ok(frame)) {
+                None => {
+                    self.renderer = Some(ex.into_renderer());
+                    return Ok(None);
+                }
+                Some(r) if setup(&r.scene) == *scene => req = r,
+                Some(r) => {
+                    let (loaded, renderer) = ex.into_parts();
+                    self.renderer = Some(renderer);
+                    *held = Some((scene.clone(), loaded));
+                    return Ok(Some(r));
+                }
+            }
+        }
+    }
+}
+
+/// The state of one setup across its requests.
+struct Live<'p> {
+    plan: &'p Plan,
+    input: Input,
+    n_frames: usize,
+    /// The frame whose pose passes ran last.
+    pose: Option<usize>,
+}
+
+impl Live<'_> {
+    /// The plan's passes of the lifetimes `keep` accepts, in plan order.
+    fn passes(&self, keep: impl Fn(Lifetime) -> bool) -> Vec<Pass> {
+        (self.plan.passes.iter().copied())
+            .filter(|p| keep(p.lifetime(self.input)))
+            .collect()
+    }
+
+    /// Draws one request: pose passes when its frame is not the last one
+    /// drawn (all but the view passes on the first), then the view passes.
+    fn frame(&mut self, ex: &mut Executor<'_, '_>, req: &LiveRequest) -> Result<LiveFrame> {
+        let frame = *frame_indices(&req.scene, self.n_frames)?
+            .first()
+            .ok_or_else(|| {
+                Error::InvalidArgument(format!(
+                    "{}: the frame range is empty",
+                    req.scene.path.display()
+                ))
+            })?;
+        let view = req.scene.views.first().ok_or_else(|| {
+            Error::InvalidArgument(format!("{}: no camera", req.scene.path.display()))
+        })?;
+        ex.rec = Recorder::new(self.input);
+        let change = match self.pose {
+            None => Change::Scene,
+            Some(f) if f != frame && self.input != Input::Static => Change::Pose,
+            Some(_) => Change::View,
+        };
+        if change != Change::View {
+            let passes = match change {
+                Change::Scene => self.passes(|l| l != Lifetime::View),
+                _ => self.passes(|l| l == Lifetime::Pose),
+            };
+            // A failure ends the setup: the next request builds it anew.
+            ex.begin_pose();
+            for p in passes {
+                ex.pose_pass(p, frame)?;
+            }
+            ex.end_pose(frame)?;
+            self.pose = Some(frame);
+        }
+        let cam = ex.camera_of(view)?;
+        let paths: Vec<&PathBuf> = req.svg.iter().collect();
+        ex.begin_view();
+        for p in self.passes(|l| l == Lifetime::View) {
+            ex.view_pass(p, &cam, &paths)?;
+        }
+        let image = ex.image.take().expect("the render pass is in every plan");
+        Ok(LiveFrame {
+            image,
+            passes: ex.rec.in_plan_order(self.plan),
+            change,
+            svg: req.svg.clone(),
+        })
+    }
+}
