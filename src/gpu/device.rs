@@ -140,7 +140,9 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
 }
 
 /// Picks a device: `selector` (or `SHAPECUE_DEVICE`) as an index or a
-/// case-insensitive substring of "platform device"; by default the first GPU,
+/// case-insensitive substring of the platform's name (first), else of
+/// "platform device" (so "intel" picks Intel's runtime rather than PoCL's
+/// device named after an Intel processor); by default the first GPU,
 /// else the first CPU device, else the first device.
 pub fn select(selector: Option<&str>) -> Result<DeviceInfo> {
     let all = list_devices()?;
@@ -169,11 +171,12 @@ pub(crate) fn pick(all: &[DeviceInfo], sel: Option<&str>) -> Result<DeviceInfo> 
                 });
             }
             let needle = s.to_lowercase();
+            let has = |t: &str| t.to_lowercase().contains(&needle);
             all.iter()
-                .find(|d| {
-                    format!("{} {}", d.platform, d.name)
-                        .to_lowercase()
-                        .contains(&needle)
+                .find(|d| has(&d.platform))
+                .or_else(|| {
+                    all.iter()
+                        .find(|d| has(&format!("{} {}", d.platform, d.name)))
                 })
                 .cloned()
                 .ok_or_else(|| Error::NoDevice {
@@ -195,9 +198,13 @@ mod tests {
     use super::*;
 
     fn dev(index: usize, kind: &str, name: &str) -> DeviceInfo {
+        on("Plat", index, kind, name)
+    }
+
+    fn on(platform: &str, index: usize, kind: &str, name: &str) -> DeviceInfo {
         DeviceInfo {
             index,
-            platform: "Plat".into(),
+            platform: platform.into(),
             name: name.into(),
             kind: kind.into(),
             version: String::new(),
@@ -244,5 +251,25 @@ mod tests {
         assert!(e.contains("'7'") && e.contains("1: NVIDIA H100"), "{e}");
         let e = pick(&all, Some("radeon")).unwrap_err().to_string();
         assert!(e.contains("radeon") && e.contains("available"), "{e}");
+    }
+
+    #[test]
+    fn a_platform_name_wins_over_a_device_name() {
+        // PoCL names its device after the processor: "intel" must still pick
+        // Intel's runtime, listed after it.
+        let all = [
+            on(
+                "Portable Computing Language",
+                0,
+                "CPU",
+                "pthread-skylake-avx512-Intel(R) Xeon(R)",
+            ),
+            on("Intel(R) OpenCL", 1, "CPU", "Intel(R) Xeon(R) Processor"),
+        ];
+        assert_eq!(pick(&all, Some("intel")).unwrap().index, 1);
+        assert_eq!(pick(&all, Some("portable")).unwrap().index, 0);
+        assert_eq!(pick(&all, Some("skylake")).unwrap().index, 0);
+        let pocl_only = [all[0].clone()];
+        assert_eq!(pick(&pocl_only, Some("intel")).unwrap().index, 0);
     }
 }
