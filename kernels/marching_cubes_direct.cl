@@ -538,6 +538,11 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
     uint k[12];
     uint n = 0;
     for (uint x = lo; x < hi && x + 1 < nx; ++x) {
+        // Uniform 16-cell chunks of mc_direct_count's grid skipped whole.
+        if ((x & 15) == 0 && x + 16 < nx && chunk_uniform(vol, b00, b10, b01, b11, x, iso)) {
+            x += 15;
+            continue;
+        }
         const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
         if (cas == 0 || cas >= 255)
             continue;

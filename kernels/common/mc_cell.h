@@ -48,12 +48,13 @@ inline uint cell_case(__global const float *vol, ulong b00, ulong b10, ulong b01
     v[5] = vol[b01 + x + 1];
     v[6] = vol[b11 + x];
     v[7] = vol[b11 + x + 1];
-    uint cas = 0;
-    bool ok = true;
-    for (uint c = 0; c < 8; ++c) {
-        cas |= (uint)(v[c] < iso) << c;
-        ok = ok && isfinite(v[c]);
-    }
+    // Branch-free and unrolled: the corners' sides and finiteness as bits.
+    const uint cas = (uint)(v[0] < iso) | ((uint)(v[1] < iso) << 1) | ((uint)(v[2] < iso) << 2) |
+                     ((uint)(v[3] < iso) << 3) | ((uint)(v[4] < iso) << 4) |
+                     ((uint)(v[5] < iso) << 5) | ((uint)(v[6] < iso) << 6) |
+                     ((uint)(v[7] < iso) << 7);
+    const int ok = isfinite(v[0]) & isfinite(v[1]) & isfinite(v[2]) & isfinite(v[3]) &
+                   isfinite(v[4]) & isfinite(v[5]) & isfinite(v[6]) & isfinite(v[7]);
     return ok ? cas : 256;
 }
 
