@@ -71,8 +71,9 @@ fn bench(c: &mut Criterion) {
             g.finish();
             let st = ex.extract(iso, fusion).expect("extract");
             let k = median(&mut kernel);
-            // VTK's vtkFlyingEdges3D, 2 threads, same volume (the 2-core
-            // machine's figures; re-measure them with the bench's machine).
+            // VTK's vtkFlyingEdges3D, 2 threads, same volume, as measured
+            // once on the 2-core machine: scripts/isosurface-table.py times
+            // Flying Edges beside shapecue in the same run, for fair ratios.
             let fe = match name.as_str() {
                 "sphere-256" => Some(18.2),
                 "gyroid-256" => Some(61.7),

@@ -102,6 +102,10 @@ inline uint count_owned(__global const float *vol, ulong b00, ulong b10, ulong b
 inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
                           uint x, float iso, float16 *a, bool *finite)
 {
+    ROW_PREFETCH(vol + b00 + x);
+    ROW_PREFETCH(vol + b10 + x);
+    ROW_PREFETCH(vol + b01 + x);
+    ROW_PREFETCH(vol + b11 + x);
     a[0] = vload16(0, vol + b00 + x);
     a[1] = vload16(0, vol + b00 + x + 1);
     a[2] = vload16(0, vol + b10 + x);
@@ -230,6 +234,7 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
     uint xl = nx, xr = 0, x = 0, last = nx;
     int m[16];
     for (; x + 16 < nx; x += 16) {
+        ROW_PREFETCH(vol + b + x);
         const float16 a = vload16(0, vol + b + x), c = vload16(0, vol + b + x + 1);
         const int16 bad = ~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16));
         if (any(bad)) {

@@ -4,7 +4,7 @@
 the same raw volumes, and prints a Markdown table with the ratios.
 
     python3 scripts/isosurface-table.py [--bin target/release/shapecue] [--runs 11]
-        [--sizes 256,512] [--small-only] [--passes]
+        [--rounds 3] [--sizes 256,512] [--small-only] [--passes]
 
 Volumes: the sphere SDF and the gyroid at each size of --sizes (the values of
 `shapecue isosurface --sdf NAME --resolution N`, written as raw f32 into a
@@ -18,6 +18,11 @@ values in memory, normals, gradients and scalars off, the STDThread backend
 with 1 and 2 threads, the median of N Update() calls after one untimed call.
 Flying Edges is timed only when `import vtk` works (pip install vtk); the
 script says so otherwise and prints shapecue's times alone.
+
+Each volume is timed in --rounds rounds, shapecue and Flying Edges in turn,
+and the table gives the median of the rounds' medians (this kind of shared
+2-core machine drifts by a third from minute to minute; taking the programs
+in turn keeps the ratio fair).
 
 The ratio is Flying Edges' best (fewer ms of 1 or 2 threads) over shapecue's
 kernel median: above 1, shapecue is faster. --passes adds each pass's median.
@@ -125,6 +130,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "shapecue"))
     ap.add_argument("--runs", type=int, default=11)
+    ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--sizes", default="256,512")
     ap.add_argument("--small-only", action="store_true", help="only Bucky and ironProt")
     ap.add_argument("--passes", action="store_true", help="print each pass's median too")
@@ -170,16 +176,25 @@ def main():
             args = [raw, "--dims", f"{nx},{ny},{nz}", "--type", kind, "--iso", str(iso)]
             if kind == "f32":
                 args += ["--inside", "below"]
-            k, passes, q = shapecue(a.bin, args, a.runs, tmp)
+            ks, f1, f2, per = [], [], [], []
+            for _ in range(max(1, a.rounds)):
+                k, passes, q = shapecue(a.bin, args, a.runs, tmp)
+                ks.append(k)
+                per.append(passes)
+                if have_vtk:
+                    f1.append(flying_edges(arr, iso, a.runs, 1))
+                    f2.append(flying_edges(arr, iso, a.runs, 2))
+            k = statistics.median(ks)
+            passes = {p: statistics.median(r[p] for r in per) for p in per[0]}
             fe1 = fe2 = None
             if have_vtk:
-                fe1 = flying_edges(arr, iso, a.runs, 1)
-                fe2 = flying_edges(arr, iso, a.runs, 2)
+                fe1 = (statistics.median(f[0] for f in f1),) + f1[0][1:]
+                fe2 = (statistics.median(f[0] for f in f2),) + f2[0][1:]
             rows.append((label, k, passes, q, fe1, fe2))
             os.remove(raw)
             print(f"{label}: shapecue {k:.2f} ms", file=sys.stderr)
 
-    print(f"`{' '.join(sys.argv)}`, medians of {a.runs}\n")
+    print(f"`{' '.join(sys.argv)}`: medians of {a.runs} runs, median of {a.rounds} rounds\n")
     print("| volume | shapecue `direct` ms | vertices, faces | Flying Edges 1 thread | 2 threads "
           "| FE vertices, faces | FE best / shapecue |")
     print("|---|---|---|---|---|---|---|")

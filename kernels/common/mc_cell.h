@@ -10,6 +10,16 @@
 // b00, b10, b01, b11 are the offsets of the four value rows of a cell row:
 // (y, z), (y+1, z), (y, z+1), (y+1, z+1).
 
+// On CPU devices the host builds with -DSC_CPU_PREFETCH=N: rows streamed by
+// one work-item after another are fetched N values ahead of their loads (the
+// loads otherwise wait on memory; docs/notes/peer-comparisons.md). A hint
+// only: results do not change.
+#ifdef SC_CPU_PREFETCH
+#define ROW_PREFETCH(p) __builtin_prefetch((p) + SC_CPU_PREFETCH)
+#else
+#define ROW_PREFETCH(p)
+#endif
+
 // True when the 16 cells x .. x+15 of a row are all inside or all outside
 // (and finite): they emit nothing. Explicit float16 code (PoCL compiles it
 // for the host CPU, two 8-wide AVX2 halves here, where its work-item loop
@@ -20,6 +30,10 @@
 inline bool chunk_uniform(__global const float *vol, ulong b00, ulong b10, ulong b01, ulong b11,
                           uint x, float iso)
 {
+    ROW_PREFETCH(vol + b00 + x);
+    ROW_PREFETCH(vol + b10 + x);
+    ROW_PREFETCH(vol + b01 + x);
+    ROW_PREFETCH(vol + b11 + x);
     const float16 a = vload16(0, vol + b00 + x), b = vload16(0, vol + b10 + x);
     const float16 c = vload16(0, vol + b01 + x), d = vload16(0, vol + b11 + x);
     const float4 t = (float4)(vol[b00 + x + 16], vol[b10 + x + 16], vol[b01 + x + 16],

@@ -60,7 +60,8 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
          × FE: kernel ms over VTK's vtkFlyingEdges3D with 2 threads on the same volume, as \
          measured once on a 2-core machine of this kind (sphere 256³ 18.2 ms, gyroid 256³ \
          61.7, gyroid 512³ 448, Bucky 0.33). The same machine type has run up to 3× slower \
-         on other days: for a fair ratio, time Flying Edges in the same session.",
+         on other days: for a fair ratio, `scripts/isosurface-table.py` times Flying Edges and \
+         shapecue in turn in the same run.",
         gpu.info.name, gpu.info.platform
     ));
     let col = Column::new;
