@@ -567,38 +567,23 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
 // final indices (a hit corner: edge_vertices + the rank of its point among
 // the sorted, unique hit points); triangles with a hit corner are also listed
 // in `side` (face, corners, in a grid plane) for the host's twin check.
-__kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
-                                  __global const float *vol, float iso,
-                                  __constant uchar *counts, __constant uchar *tris,
-                                  __constant uchar *flat, __global const uint *off,
-                                  __global const uint *split, __global const uint *trim,
-                                  __global const uint *toff, uint tshift, uint tbase,
-                                  uint edge_vertices, uint nh, __global const uint *hit_keys,
-                                  __global float *pos, __global uint *faces, uint side_cap,
-                                  __global uint *side, volatile __global uint *side_n)
+// The cells of one cell row of mc_direct_triangles (from its kernel's row
+// setup); row_hits false compiles a copy without the hit-point searches,
+// for the rows whose four grid rows own no hit (nearly all of them).
+__attribute__((always_inline)) inline void
+triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint z, ulong b00,
+              ulong b10, ulong b01, ulong b11, float iso, __constant uchar *counts,
+              __constant uchar *tris, __constant uchar *flat, uint lo, uint hi, uint bx00,
+              uint by00, uint bz00, uint bx10, uint bz10, uint bx01, uint by01, uint bx11, uint out,
+              uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
+              __global uint *faces, uint side_cap, __global uint *side,
+              volatile __global uint *side_n, const bool row_hits)
 {
-    GID_OR_RETURN(grid_rows);
-    GRID_ROW_SETUP
-    if (!(hy && hz))
-        return;
-    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
-    if (lo >= hi)
-        return;
-    const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
-    // First vertex of each row's x, y and z edges (those a cell row uses).
-    const uint bx00 = off[gid], by00 = bx00 + split[2 * gid], bz00 = bx00 + split[2 * gid + 1];
-    const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
-    const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
-    const uint bx11 = off[r11];
     // Interior vertices met so far per (row, axis): x00 y00 z00 x10 z10 x01 y01 x11.
     uint n00x = 0, n00y = 0, n00z = 0, n10x = 0, n10z = 0, n01x = 0, n01y = 0, n11x = 0;
     // The last cell row of y (z) also writes the vertices of row 10 (01),
     // which is not a cell row; the last cell of a row those at x = nx − 1.
     const bool wy = y + 2 == ny, wz = z + 2 == nz;
-    // First triangle of the row: toff[tshift + r] − tbase (the triangles'
-    // part of off, which starts at edge_vertices, or the scan of the
-    // recount where there are hits).
-    uint out = 3 * (toff[tshift + gid] - tbase);
     const float fy = (float)y, fz = (float)z;
     float v[8], c[12];
     uint k[12], id[12];
@@ -650,7 +635,7 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
         id[11] = id[10] + (k[10] == EV_IN);
         // Corners of this cell on grid points (collapses need two).
         uint ch = 0;
-        if (nh != 0) {
+        if (row_hits) {
             for (uint e = 0; e < 12; ++e) {
                 if (k[e] >= EV_LO) {
                     id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
@@ -735,6 +720,50 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
         n00z += k[8] == EV_IN;
         n10z += k[10] == EV_IN;
     }
+}
+
+__kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
+                                  __global const float *vol, float iso,
+                                  __constant uchar *counts, __constant uchar *tris,
+                                  __constant uchar *flat, __global const uint *off,
+                                  __global const uint *split, __global const uint *trim,
+                                  __global const uint *toff, uint tshift, uint tbase,
+                                  uint edge_vertices, uint nh, __global const uint *hit_keys,
+                                  __global float *pos, __global uint *faces, uint side_cap,
+                                  __global uint *side, volatile __global uint *side_n)
+{
+    GID_OR_RETURN(grid_rows);
+    GRID_ROW_SETUP
+    if (!(hy && hz))
+        return;
+    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    if (lo >= hi)
+        return;
+    const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
+    // First vertex of each row's x, y and z edges (those a cell row uses).
+    const uint bx00 = off[gid], by00 = bx00 + split[2 * gid], bz00 = bx00 + split[2 * gid + 1];
+    const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
+    const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
+    const uint bx11 = off[r11];
+    // Hits on the edges of this cell row: only on those its four grid rows
+    // own, so a row whose four have none skips the search per cell.
+    const uint G = grid_rows;
+    const bool row_hits = nh != 0 && (off[2 * G + gid + 1] != off[2 * G + gid] ||
+                                      off[2 * G + r10 + 1] != off[2 * G + r10] ||
+                                      off[2 * G + r01 + 1] != off[2 * G + r01] ||
+                                      off[2 * G + r11 + 1] != off[2 * G + r11]);
+    // First triangle of the row: toff[tshift + r] − tbase (the triangles'
+    // part of off, which starts at edge_vertices, or the scan of the
+    // recount where there are hits).
+    const uint out = 3 * (toff[tshift + gid] - tbase);
+    if (row_hits)
+        triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
+                      hi, bx00, by00, bz00, bx10, bz10, bx01, by01, bx11, out, edge_vertices,
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, true);
+    else
+        triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
+                      hi, bx00, by00, bz00, bx10, bz10, bx01, by01, bx11, out, edge_vertices,
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, false);
 }
 
 __kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,
