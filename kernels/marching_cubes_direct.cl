@@ -513,6 +513,19 @@ inline bool collapses(uint ea, uint eb, uint ec, const uint *k, uint x, uint y, 
     return pa == pb || pb == pc || pa == pc;
 }
 
+// True when one of the four grid rows of cell row gid (gid, gid + 1,
+// gid + ny, gid + ny + 1) owns an edge whose vertex lands on a grid point:
+// only those rows' edges are the row's cells' edges. From the hits' part of
+// the scanned counts (off[2G + r] .. off[2G + r + 1]).
+inline bool cell_row_has_hits(__global const uint *off, uint G, uint gid, uint ny)
+{
+    const uint rows[4] = {gid, gid + 1, gid + ny, gid + ny + 1};
+    bool any_hit = false;
+    for (uint i = 0; i < 4; ++i)
+        any_hit = any_hit || off[2 * G + rows[i] + 1] != off[2 * G + rows[i]];
+    return any_hit;
+}
+
 // Only where there are hits: the triangles of each cell row that are kept
 // (twins across faces and collapsing triangles dropped) into tcount[r]; rows
 // whose four grid rows have no hit keep their count from the first scan.
@@ -529,12 +542,8 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
         tcount[gid] = 0;
         return;
     }
-    const uint rows[4] = {gid, gid + 1, gid + ny, gid + ny + 1};
-    uint rh = 0;
-    for (uint i = 0; i < 4; ++i)
-        rh += off[2 * G + rows[i] + 1] - off[2 * G + rows[i]];
     const uint before = off[G + gid + 1] - off[G + gid];
-    if (rh == 0) {
+    if (!cell_row_has_hits(off, G, gid, ny)) {
         tcount[gid] = before;
         return;
     }
@@ -745,13 +754,8 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
     const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
     const uint bx11 = off[r11];
-    // Hits on the edges of this cell row: only on those its four grid rows
-    // own, so a row whose four have none skips the search per cell.
-    const uint G = grid_rows;
-    const bool row_hits = nh != 0 && (off[2 * G + gid + 1] != off[2 * G + gid] ||
-                                      off[2 * G + r10 + 1] != off[2 * G + r10] ||
-                                      off[2 * G + r01 + 1] != off[2 * G + r01] ||
-                                      off[2 * G + r11 + 1] != off[2 * G + r11]);
+    // A row whose four grid rows own no hit skips the search per cell.
+    const bool row_hits = nh != 0 && cell_row_has_hits(off, grid_rows, gid, ny);
     // First triangle of the row: toff[tshift + r] − tbase (the triangles'
     // part of off, which starts at edge_vertices, or the scan of the
     // recount where there are hits).
