@@ -165,8 +165,8 @@ def main():
             )
         if os.path.exists(iron):
             vols.append(("ironProt 68³ u8, iso 128", lambda: vtk_volume(iron)[0], 128.0))
-        if len(vols) == 0 or (not os.path.isdir(SHARED)):
-            print(f"{SHARED} is absent: Bucky and ironProt are skipped.", file=sys.stderr)
+        if not (os.path.exists(bucky) and os.path.exists(iron)):
+            print(f"{SHARED} lacks Bucky.raw or ironProt.vtk: they are skipped.", file=sys.stderr)
         for label, make, iso in vols:
             arr = make()
             raw = os.path.join(tmp, "v.raw")
