@@ -23,8 +23,9 @@
 //                                      final indices; those with a hit corner
 //                                      also listed in `side`
 //   mc_direct_points     per hit       positions of the hit slots
-// One work-item walks one row, 16 cells at a time where it can (float16 loads),
-// reading nothing outside the row's trim range.
+// One work-item walks one row, 16 cells at a time (float16 loads), reading
+// nothing outside the row's trim range but the 16-cell chunk that ends at the
+// row's end, which stands in for a scalar tail (lanes already seen masked).
 //
 // Buffers: vol float[N]; counts, tris, flat: the case table (flat: the
 // triangles lying in a cube face); info uint[4G]; rowc uint[4G] (scanned in
@@ -257,6 +258,26 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
             --i;
         xr = last + i + 1;
     }
+    if (x + 1 < nx && nx >= 17) {
+        // The tail: the chunk that ends at the row's end, lanes before x off.
+        const uint tb = nx - 17;
+        const float16 a = vload16(0, vol + b + tb), c = vload16(0, vol + b + tb + 1);
+        const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+        const int16 mine = isgreaterequal(lane, (float16)((float)(x - tb)));
+        const int16 bad = (~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16))) & mine;
+        if (any(bad)) {
+            vstore16(bad, 0, m);
+            uint i = 0;
+            while (!m[i])
+                ++i;
+            xl = min(xl, tb + i);
+            i = 15;
+            while (!m[i])
+                --i;
+            xr = tb + i + 1;
+        }
+        x = nx;
+    }
     for (; x + 1 < nx; ++x) {
         const float a = vol[b + x], c = vol[b + x + 1];
         if (!(isfinite(a) && isfinite(c)) || ((a < iso) != (c < iso))) {
@@ -368,7 +389,53 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
         n2 += (packed >> 16) & 0xFF;
         hits += packed >> 24;
     }
-    if (x < pend && !tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
+    // The tail (cells x .. nx − 2, fewer than 16): one chunk that overlaps
+    // the last one, ending at the row's end, with the lanes of cells before
+    // x masked off; the y- and z-edges at nx − 1 (corners of the last cell,
+    // so uniform with it) added alone.
+    bool tail_done = false;
+    if (x < pend && x + 1 < nx && nx >= 17) {
+        bool fin;
+        const uint tb = nx - 17;
+        const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, tb, iso, a, &fin);
+        if (fin) {
+            tail_done = true;
+            const int16 mine = isgreaterequal(lane, (float16)((float)(x - tb)));
+            const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
+            if (!all(triv | ~mine)) {
+                lo = min(lo, x);
+                hi = nx;
+                int16 in;
+                const int16 hx = edge_kinds16(a[0], a[1], iso, (float16)((float)tb) + lane, &in);
+                hits += lanes_set(hx & mine);
+                n0 += lanes_set(in & mine);
+                hits += lanes_set(edge_kinds16(a[0], a[2], iso, (float16)((float)y), &in) & mine);
+                n1 += lanes_set(in & mine);
+                hits += lanes_set(edge_kinds16(a[0], a[4], iso, (float16)((float)z), &in) & mine);
+                n2 += lanes_set(in & mine);
+                const uint packed = count_owned(vol, b00, b10, b01, nx - 1, nx, y, z, iso);
+                n1 += (packed >> 8) & 0xFF;
+                n2 += (packed >> 16) & 0xFF;
+                hits += packed >> 24;
+                if (cell) {
+                    uint cs[16];
+                    vstore16(cv, 0, cs);
+                    uint fl = 0;
+                    for (uint i = x - tb; i < 16; ++i) {
+                        ntri += counts[cs[i]];
+                        fl |= flat[cs[i]];
+                    }
+                    for (uint i = x - tb; fl != 0 && i < 16; ++i) {
+                        const uint tw = twins_of(vol, tb + i, y, z, nx, ny, nz, iso, cs[i],
+                                                 counts, tris, flat);
+                        ntri -= tw;
+                        twins += tw;
+                    }
+                }
+            }
+        }
+    }
+    if (!tail_done && x < pend && !tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
         lo = min(lo, x);
         hi = nx;
         for (uint i = x; i < nx; ++i) {
@@ -438,6 +505,9 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
         for (uint i = x; i < x + 16; ++i)
             hit_owned(vol, b00, b10, b01, i, nx, ny, y, z, iso, keys, &o);
     }
+    // The tail, unless the chunk that ends at the row's end is uniform.
+    if (x < hi && x + 1 < nx && nx >= 17 && chunk_uniform(vol, b00, b10, b01, b11, nx - 17, iso))
+        return;
     for (; x < hi; ++x)
         hit_owned(vol, b00, b10, b01, x, nx, ny, y, z, iso, keys, &o);
 }
@@ -557,6 +627,10 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
             x += 15;
             continue;
         }
+        // The tail: skipped whole when the chunk ending at the row's end is.
+        if ((x & 15) == 0 && x + 16 >= nx && nx >= 17 &&
+            chunk_uniform(vol, b00, b10, b01, b11, nx - 17, iso))
+            break;
         const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
         if (cas == 0 || cas >= 255)
             continue;
@@ -603,17 +677,18 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
     uint x = lo;
     for (; x < hi && x + 1 < nx; ++x) {
         // The chunks of mc_direct_count: 16 cells from each multiple of 16
-        // that has 16 more values after it (lo is one of them, or the tail).
+        // that has 16 more values after it (lo is one of them, or the tail),
+        // and for the tail the chunk that ends at the row's end.
         if ((x & 15) == 0) {
             skip = 0;
-            base = x;
-            if (x + 16 < nx) {
+            base = x + 16 < nx ? x : (nx >= 17 ? nx - 17 : x);
+            if (x + 16 < nx || nx >= 17) {
                 bool fin;
-                const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
+                const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, base, iso, a, &fin);
                 if (fin) {
                     const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
                     if (all(triv)) {
-                        x += 15;
+                        x = base + 15;
                         continue;
                     }
                     int tv[16];

@@ -126,6 +126,40 @@ fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
 }
 
 #[test]
+fn row_ends_of_every_length_match_the_twin() {
+    // The last 16-cell chunk of a row overlaps the one before it (rows of
+    // 17 values and more): rows that end on a chunk, one value or one cell
+    // past it, and shorter than one chunk; with surfaces crossing the ends.
+    let mut r = rng(11);
+    for nx in [15, 16, 17, 18, 32, 33, 34, 47, 48, 49] {
+        for kind in 0..3 {
+            let n = [nx, 3, 4];
+            let vals: Vec<f32> = (0..nx * 12)
+                .map(|i| match kind {
+                    0 => r() - 0.5,
+                    1 => (r() * 4.0).floor(),
+                    _ if i % 29 == 5 => f32::NAN,
+                    _ => r() - 0.5,
+                })
+                .collect();
+            let vol = Volume::new(n, vals, "row ends").unwrap();
+            let iso = if kind == 1 { 2.0 } else { 0.0123 };
+            check_same(&vol, iso, &format!("row ends {n:?} kind {kind}"));
+        }
+        // Uniform but for the row's last value: only the tail crosses.
+        let mut vals = vec![1.0f32; nx * 12];
+        for y in 0..3 {
+            for z in 0..4 {
+                vals[nx - 1 + nx * (y + 3 * z)] = -1.0;
+            }
+        }
+        let vol = Volume::new([nx, 3, 4], vals, "last value").unwrap();
+        check_same(&vol, 0.0, &format!("last value inside, nx {nx}"));
+        assert!(!mc::direct_mesh(&vol, 0.0).faces.is_empty());
+    }
+}
+
+#[test]
 fn a_few_exact_hits_cost_no_fusion_clean_up() {
     // A sphere SDF with a handful of voxels next to the surface set exactly
     // to the iso value: every crossing edge there rounds onto the grid
