@@ -95,6 +95,16 @@ pub enum Error {
         /// What is missing.
         what: String,
     },
+    /// A device returned a result that contradicts itself (a face naming a
+    /// vertex that does not exist): a faulty driver or compiler, caught
+    /// before the result is written or drawn.
+    #[error("the OpenCL device returned an inconsistent {what}: {detail}")]
+    DeviceResult {
+        /// Which result.
+        what: String,
+        /// What is wrong with it.
+        detail: String,
+    },
     /// A caller passed an argument that makes no sense.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),

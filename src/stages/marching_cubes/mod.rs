@@ -284,6 +284,7 @@ impl Isosurfacer {
         let mut faces = vec![[0u32; 3]; nf];
         self.gpu.read(p, pos.as_flattened_mut())?;
         self.gpu.read(f, faces.as_flattened_mut())?;
+        check_faces(&faces, nv)?;
         Ok((pos, faces))
     }
 
@@ -304,6 +305,25 @@ impl Isosurfacer {
                 .collect(),
             faces,
         }
+    }
+}
+
+/// Every corner of `faces` names one of the `nv` vertices; else the device's
+/// mesh is refused before anything writes, draws or indexes it.
+fn check_faces(faces: &[[u32; 3]], nv: usize) -> Result<()> {
+    match faces
+        .iter()
+        .enumerate()
+        .find(|(_, f)| f.iter().any(|&v| v as usize >= nv))
+    {
+        None => Ok(()),
+        Some((i, f)) => Err(Error::DeviceResult {
+            what: "isosurface".into(),
+            detail: format!(
+                "face {i} has corners {}, {}, {} but the mesh has {nv} vertices",
+                f[0], f[1], f[2]
+            ),
+        }),
     }
 }
 
@@ -342,4 +362,21 @@ pub fn curvature(
     }
     let timing = est.run()?;
     Ok((est, timing))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_face_naming_a_missing_vertex_is_refused_with_its_number() {
+        assert!(check_faces(&[[0, 1, 2], [2, 1, 3]], 4).is_ok());
+        let e = check_faces(&[[0, 1, 2], [2, 1, 4]], 4).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the OpenCL device returned an inconsistent isosurface: \
+             face 1 has corners 2, 1, 4 but the mesh has 4 vertices"
+        );
+        assert!(check_faces(&[], 0).is_ok());
+    }
 }
