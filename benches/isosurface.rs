@@ -10,6 +10,7 @@
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use shapecue::report::isosurface::flying_edges_ms;
 use shapecue::report::metrics::median;
 use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
@@ -74,13 +75,13 @@ fn bench(c: &mut Criterion) {
             // VTK's vtkFlyingEdges3D, 2 threads, same volume, as measured
             // once on the 2-core machine: scripts/isosurface-table.py times
             // Flying Edges beside shapecue in the same run, for fair ratios.
-            let fe = match name.as_str() {
-                "sphere-256" => Some(18.2),
-                "gyroid-256" => Some(61.7),
-                "Bucky.raw" => Some(0.33),
-                "ironProt.vtk" => Some(0.62),
-                _ => None,
-            };
+            let fe = flying_edges_ms(match name.as_str() {
+                "sphere-256" => "sphere 256",
+                "gyroid-256" => "gyroid 256",
+                "Bucky.raw" => "bucky 32",
+                "ironProt.vtk" => "ironprot 68",
+                _ => "",
+            });
             let ratio = fe.map_or(String::new(), |fe: f64| {
                 format!(" ({:.2}× Flying Edges' {fe} ms)", k / fe)
             });

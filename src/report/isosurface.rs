@@ -47,6 +47,27 @@ fn ms(v: f64) -> Cell {
     Cell::num(v, format!("{v:.2}"))
 }
 
+/// VTK's vtkFlyingEdges3D with 2 threads, volume in memory, as timed by
+/// `scripts/isosurface-table.py` beside shapecue on a 2-core AVX-512 machine
+/// on 2026-12-05 (median ms; key: volume and resolution). The machine type
+/// drifts by a third between runs, so ratios to these are indicative only.
+pub const FLYING_EDGES_2T_MS: [(&str, f64); 6] = [
+    ("sphere 256", 36.4),
+    ("gyroid 256", 85.5),
+    ("sphere 512", 199.5),
+    ("gyroid 512", 539.1),
+    ("bucky 32", 0.42),
+    ("ironprot 68", 0.65),
+];
+
+/// [`FLYING_EDGES_2T_MS`] of `key`.
+pub fn flying_edges_ms(key: &str) -> Option<f64> {
+    FLYING_EDGES_2T_MS
+        .iter()
+        .find(|(k, _)| *k == key)
+        .map(|&(_, ms)| ms)
+}
+
 /// Measures the report on `gpu`.
 ///
 /// # Errors
@@ -58,10 +79,10 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         "device: {} ({})\n\n\
          ## Extraction + fusion (volume on the device; median kernel ms / wall ms)\n\
          × FE: kernel ms over VTK's vtkFlyingEdges3D with 2 threads on the same volume, as \
-         measured once on a 2-core machine of this kind (sphere 256³ 18.2 ms, gyroid 256³ \
-         61.7, gyroid 512³ 448, Bucky 0.33). The same machine type has run up to 3× slower \
-         on other days: for a fair ratio, `scripts/isosurface-table.py` times Flying Edges and \
-         shapecue in turn in the same run.",
+         measured once beside shapecue on a 2-core machine of this kind (sphere 256³ 36.4 ms, \
+         gyroid 256³ 85.5, gyroid 512³ 539, Bucky 0.42). The same machine type drifts by a \
+         third between runs and days: for a fair ratio, `scripts/isosurface-table.py` times \
+         Flying Edges and shapecue in turn in the same run.",
         gpu.info.name, gpu.info.platform
     ));
     let col = Column::new;
@@ -85,15 +106,16 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         ],
     );
     let mut inputs: Vec<(String, crate::volume::Volume, f32, Option<f64>)> = Vec::new();
-    for (kind, res, fe) in [
-        (Sdf::Sphere, 128, None),
-        (Sdf::Sphere, 256, Some(18.2)),
-        (Sdf::Gyroid, 128, None),
-        (Sdf::Gyroid, 256, Some(61.7)),
-        (Sdf::Gyroid, 512, Some(448.0)),
+    for (kind, res) in [
+        (Sdf::Sphere, 128),
+        (Sdf::Sphere, 256),
+        (Sdf::Gyroid, 128),
+        (Sdf::Gyroid, 256),
+        (Sdf::Gyroid, 512),
     ] {
         if res <= max_res {
             let name = format!("{kind:?} {res}³").to_lowercase();
+            let fe = flying_edges_ms(&format!("{kind:?} {res}").to_lowercase());
             inputs.push((name, sdf::sdf(kind, res), 0.0, fe));
         }
     }
@@ -102,7 +124,7 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/bucky.nhdr")),
         None,
     ) {
-        inputs.push(("bucky 32³ @51".into(), b, 51.0, Some(0.33)));
+        inputs.push(("bucky 32³ @51".into(), b, 51.0, flying_edges_ms("bucky 32")));
     }
     let mut bars: Vec<(String, Vec<f64>)> = Fusion::ALL
         .iter()
@@ -254,4 +276,19 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         series,
     });
     Ok(r)
+}
+
+#[cfg(test)]
+mod fe_tests {
+    use super::*;
+
+    #[test]
+    fn flying_edges_figures_are_found_by_the_report_names() {
+        for (kind, res) in [(Sdf::Sphere, 256), (Sdf::Gyroid, 256), (Sdf::Gyroid, 512)] {
+            let key = format!("{kind:?} {res}").to_lowercase();
+            assert!(flying_edges_ms(&key).is_some(), "{key}");
+        }
+        assert!(flying_edges_ms("bucky 32").is_some());
+        assert_eq!(flying_edges_ms("sphere 128"), None);
+    }
 }
