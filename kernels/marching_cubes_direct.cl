@@ -561,6 +561,26 @@ inline void put3(__global float *pos, uint v, float a, float b, float c)
     k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);                                  \
     k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
 
+// CELL_EDGES where no edge of the cell can round onto a grid point (the
+// hit-free rows of mc_direct_triangles): the kinds only, EV_IN where an edge
+// crosses with finite ends, as edge_kind returns there; the coordinates of
+// the few edges whose vertices are written come from EDGE_C.
+#define CELL_KINDS                                                                  \
+    {                                                                               \
+        const uint ends[24] = {0, 1, 2, 3, 4, 5, 6, 7, 0, 2, 1, 3,                  \
+                               4, 6, 5, 7, 0, 4, 1, 5, 2, 6, 3, 7};                 \
+        for (uint e = 0; e < 12; ++e) {                                             \
+            const float p = v[ends[2 * e]], q = v[ends[2 * e + 1]];                 \
+            k[e] = (isfinite(p) && isfinite(q) && ((p < iso) != (q < iso))) ? EV_IN \
+                                                                           : EV_NONE; \
+        }                                                                           \
+    }
+
+// Coordinate along its axis of the EV_IN vertex of edge e (ends i0, i1 of
+// v[8], lower coordinate f): c[e] from CELL_EDGES, or computed here, the
+// same float arithmetic as edge_kind, where CELL_KINDS ran.
+#define EDGE_C(e, i0, i1, f) (row_hits ? c[e] : (f) + mc_edge_t(v[i0], v[i1], iso))
+
 // Grid index of the point that the vertex of edge e (kind EV_LO or EV_HI) of
 // cell (x, y, z) rounds onto.
 inline uint hit_point(uint e, uint kind, uint x, uint y, uint z, uint nx, uint ny)
@@ -704,7 +724,12 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
         // All corners finite and on one side: nothing to write or count.
         if (cas == 0 || cas == 255)
             continue;
-        CELL_EDGES
+        const float fx = (float)x;
+        if (row_hits) {
+            CELL_EDGES
+        } else {
+            CELL_KINDS
+        }
         id[0] = bx00 + n00x;
         id[1] = bx10 + n10x;
         id[2] = bx01 + n01x;
@@ -728,36 +753,35 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
                 }
             }
         }
-        const float fx = (float)x;
         if (k[0] == EV_IN)
-            put3(pos, id[0], c[0], fy, fz);
+            put3(pos, id[0], EDGE_C(0, 0, 1, fx), fy, fz);
         if (k[4] == EV_IN)
-            put3(pos, id[4], fx, c[4], fz);
+            put3(pos, id[4], fx, EDGE_C(4, 0, 2, fy), fz);
         if (k[8] == EV_IN)
-            put3(pos, id[8], fx, fy, c[8]);
+            put3(pos, id[8], fx, fy, EDGE_C(8, 0, 4, fz));
         if (wy) {
             if (k[1] == EV_IN)
-                put3(pos, id[1], c[1], fy + 1.0f, fz);
+                put3(pos, id[1], EDGE_C(1, 2, 3, fx), fy + 1.0f, fz);
             if (k[10] == EV_IN)
-                put3(pos, id[10], fx, fy + 1.0f, c[10]);
+                put3(pos, id[10], fx, fy + 1.0f, EDGE_C(10, 2, 6, fz));
         }
         if (wz) {
             if (k[2] == EV_IN)
-                put3(pos, id[2], c[2], fy, fz + 1.0f);
+                put3(pos, id[2], EDGE_C(2, 4, 5, fx), fy, fz + 1.0f);
             if (k[6] == EV_IN)
-                put3(pos, id[6], fx, c[6], fz + 1.0f);
+                put3(pos, id[6], fx, EDGE_C(6, 4, 6, fy), fz + 1.0f);
         }
         if (wy && wz && k[3] == EV_IN)
-            put3(pos, id[3], c[3], fy + 1.0f, fz + 1.0f);
+            put3(pos, id[3], EDGE_C(3, 6, 7, fx), fy + 1.0f, fz + 1.0f);
         if (x + 2 == nx) {
             if (k[5] == EV_IN)
-                put3(pos, id[5], fx + 1.0f, c[5], fz);
+                put3(pos, id[5], fx + 1.0f, EDGE_C(5, 1, 3, fy), fz);
             if (k[9] == EV_IN)
-                put3(pos, id[9], fx + 1.0f, fy, c[9]);
+                put3(pos, id[9], fx + 1.0f, fy, EDGE_C(9, 1, 5, fz));
             if (wy && k[11] == EV_IN)
-                put3(pos, id[11], fx + 1.0f, fy + 1.0f, c[11]);
+                put3(pos, id[11], fx + 1.0f, fy + 1.0f, EDGE_C(11, 3, 7, fz));
             if (wz && k[7] == EV_IN)
-                put3(pos, id[7], fx + 1.0f, c[7], fz + 1.0f);
+                put3(pos, id[7], fx + 1.0f, EDGE_C(7, 5, 7, fy), fz + 1.0f);
         }
         if (cas < 256) {
             const uint nt = counts[cas], fl = flat[cas];
