@@ -39,7 +39,7 @@
 // clean-up only when it would change the mesh (docs/notes/isosurface-kernels.md).
 
 #define EV_NONE 0u
-#define EV_IN 1u
+#define EV_IN 1u // CELL_KINDS relies on it being 1
 #define EV_LO 2u
 #define EV_HI 3u
 
@@ -563,16 +563,23 @@ inline void put3(__global float *pos, uint v, float a, float b, float c)
 
 // CELL_EDGES where no edge of the cell can round onto a grid point (the
 // hit-free rows of mc_direct_triangles): the kinds only, EV_IN where an edge
-// crosses with finite ends, as edge_kind returns there; the coordinates of
-// the few edges whose vertices are written come from EDGE_C.
+// crosses with finite ends, as edge_kind returns there (from the case's bits
+// when all corners are finite); the coordinates of the few edges whose
+// vertices are written come from EDGE_C.
 #define CELL_KINDS                                                                  \
     {                                                                               \
         const uint ends[24] = {0, 1, 2, 3, 4, 5, 6, 7, 0, 2, 1, 3,                  \
                                4, 6, 5, 7, 0, 4, 1, 5, 2, 6, 3, 7};                 \
-        for (uint e = 0; e < 12; ++e) {                                             \
-            const float p = v[ends[2 * e]], q = v[ends[2 * e + 1]];                 \
-            k[e] = (isfinite(p) && isfinite(q) && ((p < iso) != (q < iso))) ? EV_IN \
-                                                                           : EV_NONE; \
+        if (cas < 256) {                                                            \
+            for (uint e = 0; e < 12; ++e)                                           \
+                k[e] = ((cas >> ends[2 * e]) ^ (cas >> ends[2 * e + 1])) & 1u;      \
+        } else {                                                                    \
+            for (uint e = 0; e < 12; ++e) {                                         \
+                const float p = v[ends[2 * e]], q = v[ends[2 * e + 1]];             \
+                k[e] = (isfinite(p) && isfinite(q) && ((p < iso) != (q < iso)))     \
+                           ? EV_IN                                                  \
+                           : EV_NONE;                                               \
+            }                                                                       \
         }                                                                           \
     }
 
