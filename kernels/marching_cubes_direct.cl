@@ -583,10 +583,13 @@ inline void put3(__global float *pos, uint v, float a, float b, float c)
         }                                                                           \
     }
 
-// Coordinate along its axis of the EV_IN vertex of edge e (ends i0, i1 of
-// v[8], lower coordinate f): c[e] from CELL_EDGES, or computed here, the
-// same float arithmetic as edge_kind, where CELL_KINDS ran.
-#define EDGE_C(e, i0, i1, f) (row_hits ? c[e] : (f) + mc_edge_t(v[i0], v[i1], iso))
+// Coordinate along its axis of the EV_IN vertex of edge e (between corners
+// i0 and i1, lower coordinate f): c[e] from CELL_EDGES, or computed here from
+// the corners' values, the same float arithmetic as edge_kind, where
+// CELL_KINDS ran.
+#define EDGE_C(e, i0, i1, f) (row_hits ? c[e] : (f) + mc_edge_t(CORNER(i0), CORNER(i1), iso))
+// Value of corner i of cell x of the cell row (rows b00, b10, b01, b11).
+#define CORNER(i) vol[((i) & 4 ? ((i) & 2 ? b11 : b01) : ((i) & 2 ? b10 : b00)) + x + ((i) & 1)]
 
 // Grid index of the point that the vertex of edge e (kind EV_LO or EV_HI) of
 // cell (x, y, z) rounds onto.
@@ -701,6 +704,9 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
     // Cells of the current chunk known (from its vector cases) to be finite
     // with all corners on one side: bit x − base.
     uint skip = 0, base = lo;
+    // The current chunk's cases, when it is finite (chunk_fin).
+    uint cs[16];
+    bool chunk_fin = false;
     uint x = lo;
     for (; x < hi && x + 1 < nx; ++x) {
         // The chunks of mc_direct_count: 16 cells from each multiple of 16
@@ -708,6 +714,7 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
         // and for the tail the chunk that ends at the row's end.
         if ((x & 15) == 0) {
             skip = 0;
+            chunk_fin = false;
             base = x + 16 < nx ? x : (nx >= 17 ? nx - 17 : x);
             if (x + 16 < nx || nx >= 17) {
                 bool fin;
@@ -722,12 +729,17 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
                     vstore16(triv, 0, tv);
                     for (uint i = 0; i < 16; ++i)
                         skip |= (uint)(tv[i] & 1) << i;
+                    vstore16(cv, 0, cs);
+                    chunk_fin = true;
                 }
             }
         }
         if ((skip >> (x - base)) & 1)
             continue;
-        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+        // A hit-free row of a finite chunk reads only the corner values it
+        // needs (EDGE_C), its case known from the chunk.
+        const uint cas = !row_hits && chunk_fin ? cs[x - base]
+                                                : cell_case(vol, b00, b10, b01, b11, x, iso, v);
         // All corners finite and on one side: nothing to write or count.
         if (cas == 0 || cas == 255)
             continue;
