@@ -19,6 +19,7 @@ const REAL_H: Source = COMMON_HEADERS[0];
 const HASH_H: Source = source!("common/hash.h");
 const MC_EDGE_H: Source = source!("common/mc_edge.h");
 const MC_CELL_H: Source = source!("common/mc_cell.h");
+const MC_DIRECT_H: Source = source!("common/mc_direct.h");
 
 /// `kernels/curvature.cl`: the shared passes, then (by `#include`) the face
 /// arithmetic, the lane loads, and one accumulation scheme's file
@@ -75,11 +76,12 @@ pub const MARCHING_CUBES: KernelFile = KernelFile {
     includes: &[],
 };
 
-/// `kernels/marching_cubes_direct.cl`: direct numbering.
+/// `kernels/marching_cubes_direct.cl`: direct numbering (its cell helpers
+/// in `common/mc_direct.h`).
 pub const MARCHING_CUBES_DIRECT: KernelFile = KernelFile {
     name: "kernels/marching_cubes_direct.cl",
     source: include_str!("../../kernels/marching_cubes_direct.cl"),
-    headers: &[REAL_H, MC_EDGE_H, MC_CELL_H],
+    headers: &[REAL_H, MC_EDGE_H, MC_CELL_H, MC_DIRECT_H],
     includes: &[],
 };
 
