@@ -320,8 +320,17 @@ while IFS= read -r hit; do
     status=1
 done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu)\b' src/cli/view 2>/dev/null | grep -v -E ':[0-9]+:\s*//' || true)
 
+# No source file over 800 lines (ARCHITECTURE.md, "Files over 700 lines").
+while IFS= read -r f; do
+    n=$(wc -l < "$f")
+    if [ "$n" -gt 800 ]; then
+        echo "$f: $n lines, over the 800-line limit (split it along its parts)"
+        status=1
+    fi
+done < <(find src kernels tests benches python/src -type f \( -name '*.rs' -o -name '*.cl' -o -name '*.h' \) 2>/dev/null | sort)
+
 if [ "$status" -ne 0 ]; then
-    echo "check-layers: the layering above is broken; see ARCHITECTURE.md (move the shared type into src/spec/, or the drawing into src/render/; break a cycle by moving the shared piece into the module both use)" >&2
+    echo "check-layers: the layering or file sizes above are broken; see ARCHITECTURE.md (split a long file along its parts; move the shared type into src/spec/, or the drawing into src/render/; break a cycle by moving the shared piece into the module both use)" >&2
     exit 1
 fi
-echo "check-layers: ok (each layer imports only what it may; no cycle between modules)"
+echo "check-layers: ok (each layer imports only what it may; no cycle between modules; no file over 800 lines)"

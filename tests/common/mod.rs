@@ -25,6 +25,8 @@ use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
 
+pub mod sdf_fields;
+
 // ---- the device ----
 
 static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
