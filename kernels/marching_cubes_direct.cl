@@ -56,7 +56,7 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
         ROW_PREFETCH(vol + b + x);
         const float16 a = vload16(0, vol + b + x), c = vload16(0, vol + b + x + 1);
         const int16 bad = ~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16));
-        if (any(bad)) {
+        if (any16(bad)) {
             if (xl == nx) {
                 vstore16(bad, 0, m);
                 uint i = 0;
@@ -83,7 +83,7 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
         const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
         const int16 mine = isgreaterequal(lane, (float16)((float)(x - tb)));
         const int16 bad = (~(isfinite(a) & isfinite(c)) | (isless(a, i16) ^ isless(c, i16))) & mine;
-        if (any(bad)) {
+        if (any16(bad)) {
             vstore16(bad, 0, m);
             uint i = 0;
             while (!m[i])
@@ -151,7 +151,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     for (; x + 16 < nx && x < pend; x += 16) {
         bool fin;
         const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, x, iso, a, &fin);
-        if (fin && all((cv == (uint16)(0)) | (cv == (uint16)(255))))
+        if (fin && all16((cv == (uint16)(0)) | (cv == (uint16)(255))))
             continue;
         lo = min(lo, x);
         hi = x + 16;
@@ -220,7 +220,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
             tail_done = true;
             const int16 mine = isgreaterequal(lane, (float16)((float)(x - tb)));
             const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
-            if (!all(triv | ~mine)) {
+            if (!all16(triv | ~mine)) {
                 lo = min(lo, x);
                 hi = nx;
                 int16 in;
@@ -539,7 +539,7 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
                 const uint16 cv = chunk_cases(vol, b00, b10, b01, b11, base, iso, a, &fin);
                 if (fin) {
                     const int16 triv = (cv == (uint16)(0)) | (cv == (uint16)(255));
-                    if (all(triv)) {
+                    if (all16(triv)) {
                         x = base + 15;
                         continue;
                     }

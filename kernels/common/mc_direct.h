@@ -90,7 +90,7 @@ inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong
         fin &= isfinite(a[c]);
         cas |= as_uint16(isless(a[c], i16)) & (uint16)(1u << c);
     }
-    *finite = all(fin);
+    *finite = all16(fin);
     return cas;
 }
 
