@@ -19,7 +19,8 @@
 //   (scan.cl)                          one exclusive scan of rowc[0..4G)
 //   mc_direct_hits       per grid row  only with hits: the hit points' grid indices
 //                                      (sorted and made unique on the host)
-//   mc_direct_recount    per cell row  only then: kept triangles (collapsing dropped)
+//   mc_direct_recount    per cell row  only then: kept triangles (collapsing dropped;
+//                                      only the cells with a corner on a hit point)
 //   mc_direct_triangles  per cell row  owned vertices' positions, triangles with
 //                                      final indices; those with a hit corner
 //                                      also listed in `side`
@@ -330,19 +331,73 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
         hit_owned(vol, b00, b10, b01, x, nx, ny, y, z, iso, keys, &o);
 }
 
-// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
-// sorted, unique hit points.
-inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
+// The first of the nh sorted keys that is not below g.
+inline uint lower_bound_keys(__global const uint *keys, uint nh, ulong g)
 {
     uint lo = 0, hi = nh;
     while (lo < hi) {
         const uint m = lo + (hi - lo) / 2;
-        if (keys[m] < g)
+        if ((ulong)keys[m] < g)
             lo = m + 1;
         else
             hi = m;
     }
-    return edge_vertices + lo;
+    return lo;
+}
+
+// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
+// sorted, unique hit points.
+inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
+{
+    return edge_vertices + lower_bound_keys(keys, nh, g);
+}
+
+// The hit points on the four grid rows of a cell row, walked in x order: a
+// cell has an edge whose vertex lands on a grid point only when one of its
+// corners is a hit point, so only those cells need the hit-aware steps (the
+// others are hit-free even in a row with hits). p[i] .. e[i] are the keys of
+// grid row i, whose first grid index is g[i].
+typedef struct {
+    uint p[4], e[4];
+    ulong g[4];
+} HitCursor;
+
+// The first key at or after p that is not below g (a short walk: a grid
+// row holds few hit points, and at worst nx).
+inline uint keys_from(__global const uint *keys, uint nh, uint p, ulong g)
+{
+    while (p < nh && (ulong)keys[p] < g)
+        ++p;
+    return p;
+}
+
+// Rows r00 and r10 = r00 + 1 are neighbours in grid order, as are r01 and
+// r11 = r01 + 1: one search each pair, then walks.
+inline void hits_begin(HitCursor *h, __global const uint *keys, uint nh, uint nx, uint r00,
+                       uint r01)
+{
+    for (uint i = 0; i < 4; i += 2) {
+        const ulong g = (ulong)(i == 0 ? r00 : r01) * nx;
+        h->g[i] = g;
+        h->g[i + 1] = g + nx;
+        h->p[i] = lower_bound_keys(keys, nh, g);
+        h->e[i] = h->p[i + 1] = keys_from(keys, nh, h->p[i], g + nx);
+        h->e[i + 1] = keys_from(keys, nh, h->p[i + 1], g + 2 * (ulong)nx);
+    }
+}
+
+// The least x ≥ x0 of a hit point on the four rows (0xFFFFFFFF if none),
+// the rows' hits below x0 passed for good.
+inline uint hits_from(HitCursor *h, __global const uint *keys, uint x0)
+{
+    uint m = 0xFFFFFFFFu;
+    for (uint i = 0; i < 4; ++i) {
+        while (h->p[i] < h->e[i] && keys[h->p[i]] - h->g[i] < x0)
+            ++h->p[i];
+        if (h->p[i] < h->e[i])
+            m = min(m, (uint)(keys[h->p[i]] - h->g[i]));
+    }
+    return m;
 }
 
 // Coordinate q of the vertex of edge e of cell (x, y, z), of kind k (not
@@ -405,7 +460,7 @@ inline void put3(__global float *pos, uint v, float a, float b, float c)
 // i0 and i1, lower coordinate f): c[e] from CELL_EDGES, or computed here from
 // the corners' values, the same float arithmetic as edge_kind, where
 // CELL_KINDS ran.
-#define EDGE_C(e, i0, i1, f) (row_hits ? c[e] : (f) + mc_edge_t(CORNER(i0), CORNER(i1), iso))
+#define EDGE_C(e, i0, i1, f) (hc ? c[e] : (f) + mc_edge_t(CORNER(i0), CORNER(i1), iso))
 // Value of corner i of cell x of the cell row (rows b00, b10, b01, b11).
 #define CORNER(i) vol[((i) & 4 ? ((i) & 2 ? b11 : b01) : ((i) & 2 ? b10 : b00)) + x + ((i) & 1)]
 
@@ -451,7 +506,7 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
                                 __global const float *vol, float iso, __constant uchar *counts,
                                 __constant uchar *tris, __constant uchar *flat,
                                 __global const uint *off, __global const uint *trim,
-                                __global uint *tcount)
+                                __global uint *tcount, uint nh, __global const uint *keys)
 {
     GID_OR_RETURN(grid_rows);
     GRID_ROW_SETUP
@@ -465,59 +520,208 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
         tcount[gid] = before;
         return;
     }
+    // Only a cell with a corner on a hit point can lose a collapsing
+    // triangle: the count of the first scan less those, cell by cell over
+    // the hit points of the row's four grid rows (cells hx − 1 and hx of a
+    // hit at hx), each cell once.
     const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    HitCursor h;
+    hits_begin(&h, keys, nh, nx, gid, gid + ny);
     float v[8], c[12];
     uint k[12];
-    uint n = 0;
-    for (uint x = lo; x < hi && x + 1 < nx; ++x) {
-        // Uniform 16-cell chunks of mc_direct_count's grid skipped whole.
-        if ((x & 15) == 0 && x + 16 < nx && chunk_uniform(vol, b00, b10, b01, b11, x, iso)) {
-            x += 15;
-            continue;
-        }
-        // The tail: skipped whole when the chunk ending at the row's end is.
-        if ((x & 15) == 0 && x + 16 >= nx && nx >= 17 &&
-            chunk_uniform(vol, b00, b10, b01, b11, nx - 17, iso))
+    uint dropped = 0;
+    for (uint from = 0;;) {
+        const uint hx = hits_from(&h, keys, from);
+        if (hx == 0xFFFFFFFFu)
             break;
-        const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
-        if (cas == 0 || cas >= 255)
-            continue;
+        for (uint x = max(from, max(hx, 1u) - 1); x <= hx; ++x) {
+            if (x < lo || x >= hi || x + 1 >= nx)
+                continue;
+            const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+            if (cas == 0 || cas >= 255)
+                continue;
+            CELL_EDGES
+            const uint nt = counts[cas], fl = flat[cas];
+            for (uint j = 0; j < nt; ++j) {
+                if (((fl >> j) & 1) &&
+                    has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
+                    continue;
+                dropped += collapses(tris[16 * cas + 3 * j], tris[16 * cas + 3 * j + 1],
+                                     tris[16 * cas + 3 * j + 2], k, x, y, z, nx, ny);
+            }
+        }
+        from = hx + 1;
+    }
+    const uint n = before - dropped;
+    tcount[gid] = n;
+}
+
+// One cell of mc_direct_triangles: the positions of the vertices it owns
+// and its triangles from faces[out] on. i00x .. i10z are the indices of the
+// next interior vertex of each (row, axis) the cell row uses: x00 x10 x01
+// x11 y00 y01 z00 z10. Returns the triangles written (bits 8..) and which
+// of the edges 0, 1, 2, 3, 4, 6, 8, 10 hold an interior vertex (bits 0..7,
+// for the caller's counts). hc: a corner of the cell is a hit point (the
+// kinds and coordinates of every edge, hit vertices by search, collapsing
+// triangles dropped, triangles with a hit corner listed in `side`); else
+// the kinds from the case alone and only the written coordinates.
+__attribute__((always_inline)) inline uint
+emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, uint z,
+          ulong b00, ulong b10, ulong b01, ulong b11, float iso, __constant uchar *counts,
+          __constant uchar *tris, __constant uchar *flat, uint cas, const float *v, uint i00x,
+          uint i10x, uint i01x, uint i11x, uint i00y, uint i01y, uint i00z, uint i10z,
+          uint out, uint edge_vertices, uint nh, __global const uint *hit_keys,
+          __global float *pos, __global uint *faces, uint side_cap, __global uint *side,
+          volatile __global uint *side_n, const bool hc)
+{
+    // The last cell row of y (z) also writes the vertices of row 10 (01),
+    // which is not a cell row; the last cell of a row those at x = nx − 1.
+    const bool wy = y + 2 == ny, wz = z + 2 == nz;
+    const float fx = (float)x, fy = (float)y, fz = (float)z;
+    float c[12];
+    uint k[12], id[12];
+    if (hc) {
         CELL_EDGES
+    } else {
+        CELL_KINDS
+    }
+    id[0] = i00x;
+    id[1] = i10x;
+    id[2] = i01x;
+    id[3] = i11x;
+    id[4] = i00y;
+    id[5] = id[4] + (k[4] == EV_IN);
+    id[6] = i01y;
+    id[7] = id[6] + (k[6] == EV_IN);
+    id[8] = i00z;
+    id[9] = id[8] + (k[8] == EV_IN);
+    id[10] = i10z;
+    id[11] = id[10] + (k[10] == EV_IN);
+    // Corners of this cell on grid points (collapses need two).
+    uint ch = 0;
+    if (hc) {
+        for (uint e = 0; e < 12; ++e) {
+            if (k[e] >= EV_LO) {
+                id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
+                                   edge_vertices);
+                ++ch;
+            }
+        }
+    }
+    if (k[0] == EV_IN)
+        put3(pos, id[0], EDGE_C(0, 0, 1, fx), fy, fz);
+    if (k[4] == EV_IN)
+        put3(pos, id[4], fx, EDGE_C(4, 0, 2, fy), fz);
+    if (k[8] == EV_IN)
+        put3(pos, id[8], fx, fy, EDGE_C(8, 0, 4, fz));
+    if (wy) {
+        if (k[1] == EV_IN)
+            put3(pos, id[1], EDGE_C(1, 2, 3, fx), fy + 1.0f, fz);
+        if (k[10] == EV_IN)
+            put3(pos, id[10], fx, fy + 1.0f, EDGE_C(10, 2, 6, fz));
+    }
+    if (wz) {
+        if (k[2] == EV_IN)
+            put3(pos, id[2], EDGE_C(2, 4, 5, fx), fy, fz + 1.0f);
+        if (k[6] == EV_IN)
+            put3(pos, id[6], fx, EDGE_C(6, 4, 6, fy), fz + 1.0f);
+    }
+    if (wy && wz && k[3] == EV_IN)
+        put3(pos, id[3], EDGE_C(3, 6, 7, fx), fy + 1.0f, fz + 1.0f);
+    if (x + 2 == nx) {
+        if (k[5] == EV_IN)
+            put3(pos, id[5], fx + 1.0f, EDGE_C(5, 1, 3, fy), fz);
+        if (k[9] == EV_IN)
+            put3(pos, id[9], fx + 1.0f, fy, EDGE_C(9, 1, 5, fz));
+        if (wy && k[11] == EV_IN)
+            put3(pos, id[11], fx + 1.0f, fy + 1.0f, EDGE_C(11, 3, 7, fz));
+        if (wz && k[7] == EV_IN)
+            put3(pos, id[7], fx + 1.0f, EDGE_C(7, 5, 7, fy), fz + 1.0f);
+    }
+    uint written = 0;
+    if (cas < 256) {
         const uint nt = counts[cas], fl = flat[cas];
         for (uint j = 0; j < nt; ++j) {
             if (((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
                 continue;
-            n += !collapses(tris[16 * cas + 3 * j], tris[16 * cas + 3 * j + 1],
-                            tris[16 * cas + 3 * j + 2], k, x, y, z, nx, ny);
+            const uint ea = tris[16 * cas + 3 * j], eb = tris[16 * cas + 3 * j + 1],
+                       ec = tris[16 * cas + 3 * j + 2];
+            if (ch >= 2 && collapses(ea, eb, ec, k, x, y, z, nx, ny))
+                continue;
+            faces[out] = id[ea];
+            faces[out + 1] = id[eb];
+            faces[out + 2] = id[ec];
+            // A triangle with a corner on a grid point may have a twin:
+            // listed (face, corners, in a grid plane) for the host to decide
+            // whether the clean-up must run.
+            if (ch != 0 && (k[ea] >= EV_LO || k[eb] >= EV_LO || k[ec] >= EV_LO)) {
+                uint plane = 0;
+                for (uint q = 0; q < 3; ++q) {
+                    const float pa = corner_coord(ea, k[ea], c[ea], x, y, z, q);
+                    const float pb = corner_coord(eb, k[eb], c[eb], x, y, z, q);
+                    const float pc = corner_coord(ec, k[ec], c[ec], x, y, z, q);
+                    plane |= pa == pb && pb == pc && pa == floor(pa);
+                }
+                const uint o = atomic_inc(&side_n[0]);
+                if (o < side_cap) {
+                    side[5 * o] = out / 3;
+                    side[5 * o + 1] = id[ea];
+                    side[5 * o + 2] = id[eb];
+                    side[5 * o + 3] = id[ec];
+                    side[5 * o + 4] = plane;
+                }
+            }
+            out += 3;
+            ++written;
         }
     }
-    tcount[gid] = n;
+    return (written << 8) | (uint)(k[0] == EV_IN) | ((uint)(k[1] == EV_IN) << 1) |
+           ((uint)(k[2] == EV_IN) << 2) | ((uint)(k[3] == EV_IN) << 3) |
+           ((uint)(k[4] == EV_IN) << 4) | ((uint)(k[6] == EV_IN) << 5) |
+           ((uint)(k[8] == EV_IN) << 6) | ((uint)(k[10] == EV_IN) << 7);
 }
 
-// Per cell row: positions of the vertices the row owns and its triangles with
-// final indices (a hit corner: edge_vertices + the rank of its point among
-// the sorted, unique hit points); triangles with a hit corner are also listed
-// in `side` (face, corners, in a grid plane) for the host's twin check.
-// The cells of one cell row of mc_direct_triangles (from its kernel's row
-// setup); row_hits false compiles a copy without the hit-point searches,
-// for the rows whose four grid rows own no hit (nearly all of them).
+// emit_cell for a cell with a corner on a hit point, its case and values
+// read here: a call, so that the loop of the hit-free cells stays as lean in
+// a row with hits as in one without.
+__attribute__((noinline)) uint
+emit_hit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, uint z,
+              ulong b00, ulong b10, ulong b01, ulong b11, float iso, __constant uchar *counts,
+              __constant uchar *tris, __constant uchar *flat, uint i00x, uint i10x, uint i01x,
+              uint i11x, uint i00y, uint i01y, uint i00z, uint i10z, uint out,
+              uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
+              __global uint *faces, uint side_cap, __global uint *side,
+              volatile __global uint *side_n)
+{
+    float v[8];
+    const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
+    if (cas == 0 || cas == 255)
+        return 0;
+    return emit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris, flat, cas,
+                     v, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices, nh,
+                     hit_keys, pos, faces, side_cap, side, side_n, true);
+}
+
+// The cells of one cell row of mc_direct_triangles, from the row's first
+// vertex indices (i00x .. i10z, see emit_cell) and first triangle (out).
 __attribute__((always_inline)) inline void
 triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint z, ulong b00,
               ulong b10, ulong b01, ulong b11, float iso, __constant uchar *counts,
-              __constant uchar *tris, __constant uchar *flat, uint lo, uint hi, uint bx00,
-              uint by00, uint bz00, uint bx10, uint bz10, uint bx01, uint by01, uint bx11, uint out,
-              uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
-              __global uint *faces, uint side_cap, __global uint *side,
-              volatile __global uint *side_n, const bool row_hits)
+              __constant uchar *tris, __constant uchar *flat, uint lo, uint hi, uint i00x,
+              uint i10x, uint i01x, uint i11x, uint i00y, uint i01y, uint i00z, uint i10z,
+              uint out, uint edge_vertices, uint nh, __global const uint *hit_keys,
+              __global float *pos, __global uint *faces, uint side_cap, __global uint *side,
+              volatile __global uint *side_n, uint gid, const bool row_hits)
 {
-    // Interior vertices met so far per (row, axis): x00 y00 z00 x10 z10 x01 y01 x11.
-    uint n00x = 0, n00y = 0, n00z = 0, n10x = 0, n10z = 0, n01x = 0, n01y = 0, n11x = 0;
-    // The last cell row of y (z) also writes the vertices of row 10 (01),
-    // which is not a cell row; the last cell of a row those at x = nx − 1.
-    const bool wy = y + 2 == ny, wz = z + 2 == nz;
-    const float fy = (float)y, fz = (float)z;
-    float v[8], c[12];
-    uint k[12], id[12];
+    // The least x' ≥ x of a hit point on the four grid rows (hits_from),
+    // found again only once x passes it.
+    HitCursor h;
+    uint hnext = 0xFFFFFFFFu;
+    if (row_hits) {
+        hits_begin(&h, hit_keys, nh, nx, gid, gid + ny);
+        hnext = hits_from(&h, hit_keys, lo);
+    }
+    float v[8];
     float16 a[8];
     // Cells of the current chunk known (from its vector cases) to be finite
     // with all corners on one side: bit x − base.
@@ -525,8 +729,7 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
     // The current chunk's cases, when it is finite (chunk_fin).
     uint cs[16];
     bool chunk_fin = false;
-    uint x = lo;
-    for (; x < hi && x + 1 < nx; ++x) {
+    for (uint x = lo; x < hi && x + 1 < nx; ++x) {
         // The chunks of mc_direct_count: 16 cells from each multiple of 16
         // that has 16 more values after it (lo is one of them, or the tail),
         // and for the tail the chunk that ends at the row's end.
@@ -554,119 +757,45 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
         }
         if ((skip >> (x - base)) & 1)
             continue;
-        // A hit-free row of a finite chunk reads only the corner values it
-        // needs (EDGE_C), its case known from the chunk.
-        const uint cas = !row_hits && chunk_fin ? cs[x - base]
-                                                : cell_case(vol, b00, b10, b01, b11, x, iso, v);
-        // All corners finite and on one side: nothing to write or count.
-        if (cas == 0 || cas == 255)
-            continue;
-        const float fx = (float)x;
-        if (row_hits) {
-            CELL_EDGES
+        if (row_hits && x > hnext)
+            hnext = hits_from(&h, hit_keys, x);
+        uint r;
+        if (row_hits && hnext <= x + 1) {
+            r = emit_hit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris,
+                              flat, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out,
+                              edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n);
         } else {
-            CELL_KINDS
+            // A cell of a finite chunk reads only the corner values it needs
+            // (EDGE_C), its case known from the chunk.
+            const uint cas = chunk_fin ? cs[x - base] : cell_case(vol, b00, b10, b01, b11, x, iso, v);
+            // All corners finite and on one side: nothing to write or count.
+            if (cas == 0 || cas == 255)
+                continue;
+            r = emit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris, flat,
+                          cas, v, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out,
+                          edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n,
+                          false);
         }
-        id[0] = bx00 + n00x;
-        id[1] = bx10 + n10x;
-        id[2] = bx01 + n01x;
-        id[3] = bx11 + n11x;
-        id[4] = by00 + n00y;
-        id[5] = id[4] + (k[4] == EV_IN);
-        id[6] = by01 + n01y;
-        id[7] = id[6] + (k[6] == EV_IN);
-        id[8] = bz00 + n00z;
-        id[9] = id[8] + (k[8] == EV_IN);
-        id[10] = bz10 + n10z;
-        id[11] = id[10] + (k[10] == EV_IN);
-        // Corners of this cell on grid points (collapses need two).
-        uint ch = 0;
-        if (row_hits) {
-            for (uint e = 0; e < 12; ++e) {
-                if (k[e] >= EV_LO) {
-                    id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
-                                       edge_vertices);
-                    ++ch;
-                }
-            }
-        }
-        if (k[0] == EV_IN)
-            put3(pos, id[0], EDGE_C(0, 0, 1, fx), fy, fz);
-        if (k[4] == EV_IN)
-            put3(pos, id[4], fx, EDGE_C(4, 0, 2, fy), fz);
-        if (k[8] == EV_IN)
-            put3(pos, id[8], fx, fy, EDGE_C(8, 0, 4, fz));
-        if (wy) {
-            if (k[1] == EV_IN)
-                put3(pos, id[1], EDGE_C(1, 2, 3, fx), fy + 1.0f, fz);
-            if (k[10] == EV_IN)
-                put3(pos, id[10], fx, fy + 1.0f, EDGE_C(10, 2, 6, fz));
-        }
-        if (wz) {
-            if (k[2] == EV_IN)
-                put3(pos, id[2], EDGE_C(2, 4, 5, fx), fy, fz + 1.0f);
-            if (k[6] == EV_IN)
-                put3(pos, id[6], fx, EDGE_C(6, 4, 6, fy), fz + 1.0f);
-        }
-        if (wy && wz && k[3] == EV_IN)
-            put3(pos, id[3], EDGE_C(3, 6, 7, fx), fy + 1.0f, fz + 1.0f);
-        if (x + 2 == nx) {
-            if (k[5] == EV_IN)
-                put3(pos, id[5], fx + 1.0f, EDGE_C(5, 1, 3, fy), fz);
-            if (k[9] == EV_IN)
-                put3(pos, id[9], fx + 1.0f, fy, EDGE_C(9, 1, 5, fz));
-            if (wy && k[11] == EV_IN)
-                put3(pos, id[11], fx + 1.0f, fy + 1.0f, EDGE_C(11, 3, 7, fz));
-            if (wz && k[7] == EV_IN)
-                put3(pos, id[7], fx + 1.0f, EDGE_C(7, 5, 7, fy), fz + 1.0f);
-        }
-        if (cas < 256) {
-            const uint nt = counts[cas], fl = flat[cas];
-            for (uint j = 0; j < nt; ++j) {
-                if (((fl >> j) & 1) &&
-                    has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris))
-                    continue;
-                const uint ea = tris[16 * cas + 3 * j], eb = tris[16 * cas + 3 * j + 1],
-                           ec = tris[16 * cas + 3 * j + 2];
-                if (ch >= 2 && collapses(ea, eb, ec, k, x, y, z, nx, ny))
-                    continue;
-                faces[out] = id[ea];
-                faces[out + 1] = id[eb];
-                faces[out + 2] = id[ec];
-                // A triangle with a corner on a grid point may have a twin:
-                // listed (face, corners, in a grid plane) for the host to
-                // decide whether the clean-up must run.
-                if (ch != 0 && (k[ea] >= EV_LO || k[eb] >= EV_LO || k[ec] >= EV_LO)) {
-                    uint plane = 0;
-                    for (uint q = 0; q < 3; ++q) {
-                        const float pa = corner_coord(ea, k[ea], c[ea], x, y, z, q);
-                        const float pb = corner_coord(eb, k[eb], c[eb], x, y, z, q);
-                        const float pc = corner_coord(ec, k[ec], c[ec], x, y, z, q);
-                        plane |= pa == pb && pb == pc && pa == floor(pa);
-                    }
-                    const uint o = atomic_inc(&side_n[0]);
-                    if (o < side_cap) {
-                        side[5 * o] = out / 3;
-                        side[5 * o + 1] = id[ea];
-                        side[5 * o + 2] = id[eb];
-                        side[5 * o + 3] = id[ec];
-                        side[5 * o + 4] = plane;
-                    }
-                }
-                out += 3;
-            }
-        }
-        n00x += k[0] == EV_IN;
-        n10x += k[1] == EV_IN;
-        n01x += k[2] == EV_IN;
-        n11x += k[3] == EV_IN;
-        n00y += k[4] == EV_IN;
-        n01y += k[6] == EV_IN;
-        n00z += k[8] == EV_IN;
-        n10z += k[10] == EV_IN;
+        out += 3 * (r >> 8);
+        i00x += r & 1;
+        i10x += (r >> 1) & 1;
+        i01x += (r >> 2) & 1;
+        i11x += (r >> 3) & 1;
+        i00y += (r >> 4) & 1;
+        i01y += (r >> 5) & 1;
+        i00z += (r >> 6) & 1;
+        i10z += (r >> 7) & 1;
     }
 }
 
+// Per cell row: positions of the vertices the row owns and its triangles with
+// final indices (a hit corner: edge_vertices + the rank of its point among
+// the sorted, unique hit points); triangles with a hit corner are also listed
+// in `side` (face, corners, in a grid plane) for the host's twin check. Only
+// the cells with a corner on a hit point take the hit-aware steps
+// (emit_hit_cell, a call); the rows whose four grid rows own no hit (nearly
+// all of them) run a copy of the loop compiled without the hit cursor and
+// the call (triangles_row with row_hits false).
 __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
                                   __global const float *vol, float iso,
                                   __constant uchar *counts, __constant uchar *tris,
@@ -685,25 +814,24 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     if (lo >= hi)
         return;
     const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
-    // First vertex of each row's x, y and z edges (those a cell row uses).
-    const uint bx00 = off[gid], by00 = bx00 + split[2 * gid], bz00 = bx00 + split[2 * gid + 1];
-    const uint bx10 = off[r10], bz10 = bx10 + split[2 * r10 + 1];
-    const uint bx01 = off[r01], by01 = bx01 + split[2 * r01];
-    const uint bx11 = off[r11];
-    // A row whose four grid rows own no hit skips the search per cell.
-    const bool row_hits = nh != 0 && cell_row_has_hits(off, grid_rows, gid, ny);
+    // Next interior vertex of each row's x, y and z edges (those a cell row
+    // uses), from the first: x00 y00 z00 x10 z10 x01 y01 x11.
+    const uint i00x = off[gid], i00y = i00x + split[2 * gid], i00z = i00x + split[2 * gid + 1];
+    const uint i10x = off[r10], i10z = i10x + split[2 * r10 + 1];
+    const uint i01x = off[r01], i01y = i01x + split[2 * r01];
+    const uint i11x = off[r11];
     // First triangle of the row: toff[tshift + r] − tbase (the triangles'
     // part of off, which starts at edge_vertices, or the scan of the
     // recount where there are hits).
     const uint out = 3 * (toff[tshift + gid] - tbase);
-    if (row_hits)
+    if (nh != 0 && cell_row_has_hits(off, grid_rows, gid, ny))
         triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
-                      hi, bx00, by00, bz00, bx10, bz10, bx01, by01, bx11, out, edge_vertices,
-                      nh, hit_keys, pos, faces, side_cap, side, side_n, true);
+                      hi, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices,
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, true);
     else
         triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
-                      hi, bx00, by00, bz00, bx10, bz10, bx01, by01, bx11, out, edge_vertices,
-                      nh, hit_keys, pos, faces, side_cap, side, side_n, false);
+                      hi, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices,
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, false);
 }
 
 __kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,

@@ -185,7 +185,13 @@ impl Isosurfacer {
                 st.timing.add(Step::McDirectHits, event_ms(e));
             }
             let mut a = [&common[..], &tables[..]].concat();
-            a.extend([buf(&d.rowc), buf(&d.trim), buf(&d.tcount)]);
+            a.extend([
+                buf(&d.rowc),
+                buf(&d.trim),
+                buf(&d.tcount),
+                Arg::U32(u as u32),
+                buf(&d.hit_keys.buf),
+            ]);
             let e = launch(&g, &d.recount, gr, &a)?;
             tk = self.scan.exclusive(&d.tcount, &d.tcount, gr)? as usize;
             if let Some(e) = &e {
