@@ -1,10 +1,12 @@
 // mc_direct.h: direct numbering's cell helpers (marching_cubes_direct.cl):
 // the kinds of an edge's vertex (inside the edge, or rounding onto a grid
 // point), a grid row's offsets, a chunk of 16 cells' cases and edge kinds in
-// lanes, the owned edges of a row position, and the twin test of triangles
-// lying in a cube face. Uses mc_edge.h (the edge rule) and mc_cell.h (cell
-// cases, edge numbering). CPU twin: src/cpu/marching_cubes.rs (edge_vertex,
-// has_twin).
+// lanes, the owned edges of a row position, the twin test of triangles
+// lying in a cube face, the twelve edges' kinds and coordinates of the
+// triangle pass, and the steps of the cells with a corner on a hit point
+// (the sorted hit points, their cursor over a cell row, collapses). Uses
+// mc_edge.h (the edge rule) and mc_cell.h (cell cases, edge numbering). CPU
+// twin: src/cpu/marching_cubes.rs (edge_vertex, has_twin).
 
 #define EV_NONE 0u
 #define EV_IN 1u // CELL_KINDS relies on it being 1
@@ -187,4 +189,174 @@ inline uint twins_of(__global const float *vol, uint x, uint y, uint z, uint nx,
             n += ((fl >> j) & 1) && has_twin(vol, x, y, z, nx, ny, nz, iso, cas, j, counts, tris);
     }
     return n;
+}
+
+// ---- hit points: the vertices that land on a grid point ----
+
+// The first of the nh sorted keys that is not below g.
+inline uint lower_bound_keys(__global const uint *keys, uint nh, ulong g)
+{
+    uint lo = 0, hi = nh;
+    while (lo < hi) {
+        const uint m = lo + (hi - lo) / 2;
+        if ((ulong)keys[m] < g)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo;
+}
+
+// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
+// sorted, unique hit points.
+inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
+{
+    return edge_vertices + lower_bound_keys(keys, nh, g);
+}
+
+// The hit points on the four grid rows of a cell row, walked in x order: a
+// cell has an edge whose vertex lands on a grid point only when one of its
+// corners is a hit point, so only those cells need the hit-aware steps (the
+// others are hit-free even in a row with hits). p[i] .. e[i] are the keys of
+// grid row i, whose first grid index is g[i].
+typedef struct {
+    uint p[4], e[4];
+    ulong g[4];
+} HitCursor;
+
+// The first key at or after p that is not below g (a short walk: a grid
+// row holds few hit points, and at worst nx).
+inline uint keys_from(__global const uint *keys, uint nh, uint p, ulong g)
+{
+    while (p < nh && (ulong)keys[p] < g)
+        ++p;
+    return p;
+}
+
+// Rows r00 and r10 = r00 + 1 are neighbours in grid order, as are r01 and
+// r11 = r01 + 1: one search each pair, then walks.
+inline void hits_begin(HitCursor *h, __global const uint *keys, uint nh, uint nx, uint r00,
+                       uint r01)
+{
+    for (uint i = 0; i < 4; i += 2) {
+        const ulong g = (ulong)(i == 0 ? r00 : r01) * nx;
+        h->g[i] = g;
+        h->g[i + 1] = g + nx;
+        h->p[i] = lower_bound_keys(keys, nh, g);
+        h->e[i] = h->p[i + 1] = keys_from(keys, nh, h->p[i], g + nx);
+        h->e[i + 1] = keys_from(keys, nh, h->p[i + 1], g + 2 * (ulong)nx);
+    }
+}
+
+// The least x ≥ x0 of a hit point on the four rows (0xFFFFFFFF if none),
+// the rows' hits below x0 passed for good.
+inline uint hits_from(HitCursor *h, __global const uint *keys, uint x0)
+{
+    uint m = 0xFFFFFFFFu;
+    for (uint i = 0; i < 4; ++i) {
+        while (h->p[i] < h->e[i] && keys[h->p[i]] - h->g[i] < x0)
+            ++h->p[i];
+        if (h->p[i] < h->e[i])
+            m = min(m, (uint)(keys[h->p[i]] - h->g[i]));
+    }
+    return m;
+}
+
+// Coordinate q of the vertex of edge e of cell (x, y, z), of kind k (not
+// EV_NONE) and, for EV_IN, coordinate cc along the edge.
+inline float corner_coord(uint e, uint k, float cc, uint x, uint y, uint z, uint q)
+{
+    const uint axis = e >> 2, c0 = edge_lo_corner(e);
+    const uint g = (q == 0 ? x : (q == 1 ? y : z)) + ((c0 >> q) & 1);
+    if (q != axis)
+        return (float)g;
+    return k == EV_IN ? cc : (float)(k == EV_HI ? g + 1 : g);
+}
+
+inline void put3(__global float *pos, uint v, float a, float b, float c)
+{
+    pos[3 * v] = a;
+    pos[3 * v + 1] = b;
+    pos[3 * v + 2] = c;
+}
+
+// The kinds k[12] and coordinates c[12] of the twelve edges of cell (x, y,
+// z) in table order (common/mc_cell.h's edge numbering), from its values v[8].
+#define CELL_EDGES                                                                  \
+    k[0] = edge_kind(v[0], v[1], iso, x, &c[0]);                                    \
+    k[1] = edge_kind(v[2], v[3], iso, x, &c[1]);                                    \
+    k[2] = edge_kind(v[4], v[5], iso, x, &c[2]);                                    \
+    k[3] = edge_kind(v[6], v[7], iso, x, &c[3]);                                    \
+    k[4] = edge_kind(v[0], v[2], iso, y, &c[4]);                                    \
+    k[5] = edge_kind(v[1], v[3], iso, y, &c[5]);                                    \
+    k[6] = edge_kind(v[4], v[6], iso, y, &c[6]);                                    \
+    k[7] = edge_kind(v[5], v[7], iso, y, &c[7]);                                    \
+    k[8] = edge_kind(v[0], v[4], iso, z, &c[8]);                                    \
+    k[9] = edge_kind(v[1], v[5], iso, z, &c[9]);                                    \
+    k[10] = edge_kind(v[2], v[6], iso, z, &c[10]);                                  \
+    k[11] = edge_kind(v[3], v[7], iso, z, &c[11]);
+
+// CELL_EDGES where no edge of the cell can round onto a grid point (the
+// hit-free rows of mc_direct_triangles): the kinds only, EV_IN where an edge
+// crosses with finite ends, as edge_kind returns there (from the case's bits
+// when all corners are finite); the coordinates of the few edges whose
+// vertices are written come from EDGE_C.
+#define CELL_KINDS                                                                  \
+    {                                                                               \
+        const uint ends[24] = {0, 1, 2, 3, 4, 5, 6, 7, 0, 2, 1, 3,                  \
+                               4, 6, 5, 7, 0, 4, 1, 5, 2, 6, 3, 7};                 \
+        if (cas < 256) {                                                            \
+            for (uint e = 0; e < 12; ++e)                                           \
+                k[e] = ((cas >> ends[2 * e]) ^ (cas >> ends[2 * e + 1])) & 1u;      \
+        } else {                                                                    \
+            for (uint e = 0; e < 12; ++e) {                                         \
+                const float p = v[ends[2 * e]], q = v[ends[2 * e + 1]];             \
+                k[e] = (isfinite(p) && isfinite(q) && ((p < iso) != (q < iso)))     \
+                           ? EV_IN                                                  \
+                           : EV_NONE;                                               \
+            }                                                                       \
+        }                                                                           \
+    }
+
+// Coordinate along its axis of the EV_IN vertex of edge e (between corners
+// i0 and i1, lower coordinate f): c[e] from CELL_EDGES, or computed here from
+// the corners' values, the same float arithmetic as edge_kind, where
+// CELL_KINDS ran.
+#define EDGE_C(e, i0, i1, f) (hc ? c[e] : (f) + mc_edge_t(CORNER(i0), CORNER(i1), iso))
+// Value of corner i of cell x of the cell row (rows b00, b10, b01, b11).
+#define CORNER(i) vol[((i) & 4 ? ((i) & 2 ? b11 : b01) : ((i) & 2 ? b10 : b00)) + x + ((i) & 1)]
+
+// Grid index of the point that the vertex of edge e (kind EV_LO or EV_HI) of
+// cell (x, y, z) rounds onto.
+inline uint hit_point(uint e, uint kind, uint x, uint y, uint z, uint nx, uint ny)
+{
+    const uint c0 = edge_lo_corner(e);
+    const uint cn = kind == EV_LO ? c0 : (c0 | (1u << (e >> 2)));
+    return grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2), nx, ny);
+}
+
+// True when two corners of the triangle on edges ea, eb, ec of cell (x, y, z)
+// round onto the same grid point (the triangle collapses: dropped).
+inline bool collapses(uint ea, uint eb, uint ec, const uint *k, uint x, uint y, uint z,
+                      uint nx, uint ny)
+{
+    const uint ka = k[ea], kb = k[eb], kc = k[ec];
+    const uint none = 0xFFFFFFFFu;
+    const uint pa = ka >= EV_LO ? hit_point(ea, ka, x, y, z, nx, ny) : none;
+    const uint pb = kb >= EV_LO ? hit_point(eb, kb, x, y, z, nx, ny) : none - 1;
+    const uint pc = kc >= EV_LO ? hit_point(ec, kc, x, y, z, nx, ny) : none - 2;
+    return pa == pb || pb == pc || pa == pc;
+}
+
+// True when one of the four grid rows of cell row gid (gid, gid + 1,
+// gid + ny, gid + ny + 1) owns an edge whose vertex lands on a grid point:
+// only those rows' edges are the row's cells' edges. From the hits' part of
+// the scanned counts (off[2G + r] .. off[2G + r + 1]).
+inline bool cell_row_has_hits(__global const uint *off, uint G, uint gid, uint ny)
+{
+    const uint rows[4] = {gid, gid + 1, gid + ny, gid + ny + 1};
+    bool any_hit = false;
+    for (uint i = 0; i < 4; ++i)
+        any_hit = any_hit || off[2 * G + rows[i] + 1] != off[2 * G + rows[i]];
+    return any_hit;
 }
