@@ -32,7 +32,7 @@
 //
 // Buffers: vol float[N]; counts, tris, flat: the case table (flat: the
 // triangles lying in a cube face); info uint[4G]; rowc uint[4G] (scanned in
-// place into off); split uint[2G]; trim uint[2G]; tcount uint[G]; hit_keys
+// place into off); split uint[2G]; trim uint[3G]; tcount uint[G]; hit_keys
 // uint[H] (sorted, unique: U); pos float[3(V+U)]; faces uint[3T]; side
 // uint[5·20H]; V, T, H the scan's first three partial totals.
 //
@@ -116,9 +116,10 @@ __kernel void mc_direct_rows(uint grid_rows, uint nx, __global const float *vol,
 // nothing read); there, rowc[r] vertices inside its owned edges, rowc[G+r]
 // triangles of cell row r, rowc[2G+r] vertices rounding onto a grid point
 // ("hits"), rowc[3G+r] triangles dropped as twins across a cube face
-// (has_twin); split[2r..] the first y and z vertex of the row; trim[2r..] the
+// (has_twin); split[2r..] the first y and z vertex of the row; trim[3r..] the
 // x range of its non-uniform chunks (Flying Edges' trimming: the later passes
-// read nothing outside it).
+// read nothing outside it) and their chunk mask (chunk_shift: the triangle
+// pass skips the uniform chunks inside the range without reading them).
 __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
                               __global const float *vol, float iso, __constant uchar *counts,
                               __constant uchar *tris, __constant uchar *flat,
@@ -145,6 +146,8 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     // packed counts of count_owned add up without carries over a 16-cell
     // chunk, so they are unpacked once per chunk (and per tail position).
     uint n0 = 0, n1 = 0, n2 = 0, hits = 0, ntri = 0, twins = 0, lo = nx, hi = 0;
+    uint mask = 0;
+    const uint cshift = chunk_shift(nx);
     float v[8];
     float16 a[8];
     const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -157,6 +160,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
             continue;
         lo = min(lo, x);
         hi = x + 16;
+        mask |= 1u << ((x >> 4) >> cshift);
         if (fin) {
             // All finite: the owned edges 16 at a time (corner 0 to 1, 2, 4).
             int16 in;
@@ -225,6 +229,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
             if (!all16(triv | ~mine)) {
                 lo = min(lo, x);
                 hi = nx;
+                mask |= 1u << ((x >> 4) >> cshift);
                 int16 in;
                 const int16 hx = edge_kinds16(a[0], a[1], iso, (float16)((float)tb) + lane, &in);
                 hits += lanes_set(hx & mine);
@@ -258,6 +263,7 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     if (!tail_done && x < pend && !tail_uniform(vol, b00, b10, b01, b11, x, nx, iso)) {
         lo = min(lo, x);
         hi = nx;
+        mask |= 1u << ((x >> 4) >> cshift);
         for (uint i = x; i < nx; ++i) {
             const uint packed = count_owned(vol, b00, b10, b01, i, nx, y, z, iso);
             n0 += packed & 0xFF;
@@ -281,8 +287,9 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     rowc[3 * grid_rows + gid] = twins;
     split[2 * gid] = n0;
     split[2 * gid + 1] = n0 + n1;
-    trim[2 * gid] = lo;
-    trim[2 * gid + 1] = hi;
+    trim[3 * gid] = lo;
+    trim[3 * gid + 1] = hi;
+    trim[3 * gid + 2] = mask;
 }
 
 inline void hit_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
@@ -312,7 +319,7 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
 {
     GID_OR_RETURN(grid_rows);
     GRID_ROW_SETUP
-    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    const uint lo = trim[3 * gid], hi = trim[3 * gid + 1];
     const uint first = off[2 * grid_rows + gid];
     const uint end = gid + 1 < grid_rows ? off[2 * grid_rows + gid + 1] : hit_end;
     if (first == end)
@@ -357,7 +364,7 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
     // triangle: the count of the first scan less those, cell by cell over
     // the hit points of the row's four grid rows (cells hx − 1 and hx of a
     // hit at hx), each cell once.
-    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    const uint lo = trim[3 * gid], hi = trim[3 * gid + 1];
     HitCursor h;
     hits_begin(&h, keys, nh, nx, gid, gid + ny);
     float v[8], c[12];
@@ -544,8 +551,9 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
               uint i10x, uint i01x, uint i11x, uint i00y, uint i01y, uint i00z, uint i10z,
               uint out, uint edge_vertices, uint nh, __global const uint *hit_keys,
               __global float *pos, __global uint *faces, uint side_cap, __global uint *side,
-              volatile __global uint *side_n, uint gid, const bool row_hits)
+              volatile __global uint *side_n, uint gid, uint mask, const bool row_hits)
 {
+    const uint cshift = chunk_shift(nx);
     // The least x' ≥ x of a hit point on the four grid rows (hits_from),
     // found again only once x passes it.
     HitCursor h;
@@ -567,6 +575,11 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
         // that has 16 more values after it (lo is one of them, or the tail),
         // and for the tail the chunk that ends at the row's end.
         if ((x & 15) == 0) {
+            // A chunk the count pass found uniform: not read again.
+            if (!((mask >> ((x >> 4) >> cshift)) & 1)) {
+                x += 15;
+                continue;
+            }
             skip = 0;
             chunk_fin = false;
             base = x + 16 < nx ? x : (nx >= 17 ? nx - 17 : x);
@@ -643,7 +656,7 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     GRID_ROW_SETUP
     if (!(hy && hz))
         return;
-    const uint lo = trim[2 * gid], hi = trim[2 * gid + 1];
+    const uint lo = trim[3 * gid], hi = trim[3 * gid + 1];
     if (lo >= hi)
         return;
     const uint r10 = gid + 1, r01 = gid + ny, r11 = gid + ny + 1;
@@ -660,11 +673,11 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
     if (nh != 0 && cell_row_has_hits(off, grid_rows, gid, ny))
         triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
                       hi, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices,
-                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, true);
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, trim[3 * gid + 2], true);
     else
         triangles_row(vol, nx, ny, nz, y, z, b00, b10, b01, b11, iso, counts, tris, flat, lo,
                       hi, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices,
-                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, false);
+                      nh, hit_keys, pos, faces, side_cap, side, side_n, gid, trim[3 * gid + 2], false);
 }
 
 __kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,

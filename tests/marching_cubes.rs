@@ -160,6 +160,29 @@ fn row_ends_of_every_length_match_the_twin() {
 }
 
 #[test]
+fn long_rows_with_uniform_chunks_inside_the_trim_range_match_the_twin() {
+    // The count pass marks which 16-cell chunks of a row are not uniform
+    // and the triangle pass skips the others unread; past 32 chunks a mark
+    // covers 2, 4, ... chunks. Rows of 33, 64 and 130 chunks crossing in a
+    // few chunks far apart (a uniform stretch between them), once with a
+    // crossing in the last chunk only next to a marked group.
+    let mut r = rng(17);
+    for nx in [530usize, 1030, 2083] {
+        let n = [nx, 3, 3];
+        let mut vals = vec![1.0f32; nx * 9];
+        for (i, v) in vals.iter_mut().enumerate() {
+            let x = i % nx;
+            if (40..44).contains(&x) || (nx / 2..nx / 2 + 3).contains(&x) || x + 2 >= nx {
+                *v = r() - 0.5;
+            }
+        }
+        let vol = Volume::new(n, vals, "long rows").unwrap();
+        check_same(&vol, 0.0123, &format!("long rows {n:?}"));
+        assert!(!mc::direct_mesh(&vol, 0.0123).faces.is_empty());
+    }
+}
+
+#[test]
 fn a_few_exact_hits_cost_no_fusion_clean_up() {
     // A sphere SDF with a handful of voxels next to the surface set exactly
     // to the iso value: every crossing edge there rounds onto the grid

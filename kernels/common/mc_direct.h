@@ -27,6 +27,19 @@ inline uint edge_kind(float v0, float v1, float iso, uint a, float *c)
     return cc == fa ? EV_LO : (cc == (float)(a + 1) ? EV_HI : EV_IN);
 }
 
+// A row's chunk mask (trim[3r + 2]): chunk c of the row (cells 16c ..
+// 16c + 15, the last one ending at the row's end) is bit c >> chunk_shift(nx),
+// so that a row of more than 32 chunks shares a bit among 2, 4, ... of them;
+// a bit is set when one of its chunks is not finite and uniform.
+inline uint chunk_shift(uint nx)
+{
+    const uint last = nx >= 2 ? (nx - 2) >> 4 : 0;
+    uint s = 0;
+    while ((last >> s) >= 32)
+        ++s;
+    return s;
+}
+
 // Grid row gid; rows past the volume's last y or z alias row 00, so their
 // "edges" join a value to itself and never cross.
 #define GRID_ROW_SETUP                                                              \

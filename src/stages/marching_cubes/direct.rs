@@ -57,7 +57,7 @@ impl Direct {
             rowc: gpu.buffer::<u32>(4 * grid_rows)?,
             info: gpu.buffer::<u32>(4 * grid_rows)?,
             split: gpu.buffer::<u32>(2 * grid_rows)?,
-            trim: gpu.buffer::<u32>(2 * grid_rows)?,
+            trim: gpu.buffer::<u32>(3 * grid_rows)?,
             hit_keys: Grow::new(gpu)?,
             tcount: gpu.buffer::<u32>(grid_rows)?,
             side: Grow::new(gpu)?,
@@ -70,7 +70,7 @@ impl Direct {
 
     /// Device bytes held now (`grid_rows` grid rows).
     pub(super) fn device_bytes(&self, grid_rows: u64) -> u64 {
-        52 * grid_rows
+        56 * grid_rows
             + self.side.bytes()
             + self.hit_keys.bytes()
             + self.pos.bytes()
