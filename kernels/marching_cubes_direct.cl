@@ -163,13 +163,15 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
         mask |= 1u << ((x >> 4) >> cshift);
         if (fin) {
             // All finite: the owned edges 16 at a time (corner 0 to 1, 2, 4).
-            int16 in;
-            hits += lanes_set(edge_kinds16(a[0], a[1], iso, (float16)((float)x) + lane, &in));
-            n0 += lanes_set(in);
-            hits += lanes_set(edge_kinds16(a[0], a[2], iso, (float16)((float)y), &in));
-            n1 += lanes_set(in);
-            hits += lanes_set(edge_kinds16(a[0], a[4], iso, (float16)((float)z), &in));
-            n2 += lanes_set(in);
+            int16 ix, iy, iz;
+            const int16 hx = edge_kinds16(a[0], a[1], iso, (float16)((float)x) + lane, &ix);
+            const int16 hy = edge_kinds16(a[0], a[2], iso, (float16)((float)y), &iy);
+            const int16 hz = edge_kinds16(a[0], a[4], iso, (float16)((float)z), &iz);
+            const uint p = owned16(hx, hy, hz, ix, iy, iz, (int16)(-1));
+            n0 += p & 0xFF;
+            n1 += (p >> 8) & 0xFF;
+            n2 += (p >> 16) & 0xFF;
+            hits += p >> 24;
             if (cell) {
                 uint cs[16];
                 vstore16(cv, 0, cs);
@@ -230,18 +232,17 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
                 lo = min(lo, x);
                 hi = nx;
                 mask |= 1u << ((x >> 4) >> cshift);
-                int16 in;
-                const int16 hx = edge_kinds16(a[0], a[1], iso, (float16)((float)tb) + lane, &in);
-                hits += lanes_set(hx & mine);
-                n0 += lanes_set(in & mine);
-                hits += lanes_set(edge_kinds16(a[0], a[2], iso, (float16)((float)y), &in) & mine);
-                n1 += lanes_set(in & mine);
-                hits += lanes_set(edge_kinds16(a[0], a[4], iso, (float16)((float)z), &in) & mine);
-                n2 += lanes_set(in & mine);
-                const uint packed = count_owned(vol, b00, b10, b01, nx - 1, nx, y, z, iso);
-                n1 += (packed >> 8) & 0xFF;
-                n2 += (packed >> 16) & 0xFF;
-                hits += packed >> 24;
+                int16 ix, iy, iz;
+                const int16 hx = edge_kinds16(a[0], a[1], iso, (float16)((float)tb) + lane, &ix);
+                const int16 hy = edge_kinds16(a[0], a[2], iso, (float16)((float)y), &iy);
+                const int16 hz = edge_kinds16(a[0], a[4], iso, (float16)((float)z), &iz);
+                // With the y- and z-edges at nx − 1 (no x-edge there).
+                const uint p = owned16(hx, hy, hz, ix, iy, iz, mine) +
+                               count_owned(vol, b00, b10, b01, nx - 1, nx, y, z, iso);
+                n0 += p & 0xFF;
+                n1 += (p >> 8) & 0xFF;
+                n2 += (p >> 16) & 0xFF;
+                hits += p >> 24;
                 if (cell) {
                     uint cs[16];
                     vstore16(cv, 0, cs);

@@ -109,13 +109,23 @@ inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong
     return cas;
 }
 
-// Lanes set in a mask of a relational built-in (−1 = true).
-inline uint lanes_set(int16 m)
+// The owned edges of 16 positions at once, as count_owned packs them
+// (interior vertices along x, y, z in bits 0, 8, 16, hits in bits 24..),
+// from the masks of edge_kinds16 (hx, hy, hz: hits; ix, iy, iz: inside),
+// lanes outside `mine` left out: one horizontal sum for all six counts
+// (at most 16, and 48 hits, per field: no carries).
+inline uint owned16(int16 hx, int16 hy, int16 hz, int16 ix, int16 iy, int16 iz, int16 mine)
 {
-    const int8 s8 = m.lo + m.hi;
-    const int4 s4 = s8.lo + s8.hi;
-    const int2 s2 = s4.lo + s4.hi;
-    return (uint)(-(s2.x + s2.y));
+    const uint16 one = (uint16)(1);
+    const uint16 p = ((as_uint16(ix) & one) | ((as_uint16(iy) & one) << 8) |
+                      ((as_uint16(iz) & one) << 16) |
+                      (((as_uint16(hx) & one) + (as_uint16(hy) & one) + (as_uint16(hz) & one))
+                       << 24)) &
+                     as_uint16(mine);
+    const uint8 s8 = p.lo + p.hi;
+    const uint4 s4 = s8.lo + s8.hi;
+    const uint2 s2 = s4.lo + s4.hi;
+    return s2.x + s2.y;
 }
 
 // edge_kind for 16 edges at once, all ends finite: *inside gets the lanes
