@@ -593,10 +593,7 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
                         x = base + 15;
                         continue;
                     }
-                    int tv[16];
-                    vstore16(triv, 0, tv);
-                    for (uint i = 0; i < 16; ++i)
-                        skip |= (uint)(tv[i] & 1) << i;
+                    skip = lanes_bits(triv);
                     vstore16(cv, 0, cs);
                     chunk_fin = true;
                 }

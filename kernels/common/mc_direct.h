@@ -109,6 +109,19 @@ inline uint16 chunk_cases(__global const float *vol, ulong b00, ulong b10, ulong
     return cas;
 }
 
+// Bit i set when lane i of a relational built-in's mask is (−1 = true):
+// disjoint bits summed in four halving steps.
+inline uint lanes_bits(int16 m)
+{
+    const uint16 p = as_uint16(m) & (uint16)(1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5,
+                                          1u << 6, 1u << 7, 1u << 8, 1u << 9, 1u << 10,
+                                          1u << 11, 1u << 12, 1u << 13, 1u << 14, 1u << 15);
+    const uint8 s8 = p.lo | p.hi;
+    const uint4 s4 = s8.lo | s8.hi;
+    const uint2 s2 = s4.lo | s4.hi;
+    return s2.x | s2.y;
+}
+
 // The owned edges of 16 positions at once, as count_owned packs them
 // (interior vertices along x, y, z in bits 0, 8, 16, hits in bits 24..),
 // from the masks of edge_kinds16 (hx, hy, hz: hits; ix, iy, iz: inside),
