@@ -185,29 +185,32 @@ impl Fuser {
     }
 
     /// How many of the `nv` vertices the `nt` triangles of `faces` use
-    /// (`fuse_clear`, `fuse_mark` with every triangle kept, scan): direct
-    /// numbering's check that dropping triangles left no vertex unused.
+    /// (`fuse_clear`, `fuse_mark` with every triangle kept, scan), with the
+    /// kernel times: direct numbering's check that dropping triangles left
+    /// no vertex unused. Leaves the marks and new indices for
+    /// [`Fuser::compact_referenced`].
     pub(crate) fn count_referenced(
         &mut self,
         faces: &Buffer<u32>,
         nv: usize,
         nt: usize,
-    ) -> Result<usize> {
+    ) -> Result<(usize, Timing)> {
         let g = self.gpu.clone();
+        let mut t = Timing::default();
         if nt == 0 {
-            return Ok(0);
+            return Ok((0, t));
         }
         self.referenced.reserve(&g, nv)?;
         self.vert_id.reserve(&g, nv)?;
         self.keep.reserve(&g, nt)?;
         g.fill(&mut self.keep.buf, &[1u32], nt)?;
-        launch(
+        let e_clear = launch(
             &g,
             &self.clear,
             nv,
             &[Arg::U32(nv as u32), buf(&self.referenced.buf)],
         )?;
-        launch(
+        let e_mark = launch(
             &g,
             &self.mark,
             nt,
@@ -218,9 +221,83 @@ impl Fuser {
                 buf(&self.referenced.buf),
             ],
         )?;
-        Ok(self
+        let used = self
             .scan
-            .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)? as usize)
+            .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)? as usize;
+        // `fuse_clear` is counted in the marking it prepares.
+        for e in [&e_clear, &e_mark].into_iter().flatten() {
+            t.add(Step::FuseMark, event_ms(e));
+        }
+        t.add(Step::ScanExclusive, self.scan.last_ms());
+        Ok((used, t))
+    }
+
+    /// After [`Fuser::count_referenced`] on the same `faces`: every triangle
+    /// kept, the vertices some triangle uses compacted in index order into
+    /// [`Fuser::out_pos`] and the faces renumbered into
+    /// [`Fuser::out_faces`] (`fuse_compact_vertices`, `fuse_compact_faces`).
+    /// The same result as [`Fuser::finish`] where no triangle repeats a
+    /// corner and none has an opposite twin, without their search.
+    pub(crate) fn compact_referenced(
+        &mut self,
+        faces: &Buffer<u32>,
+        pos: &Buffer<f32>,
+        nv: usize,
+        nt: usize,
+        used: usize,
+    ) -> Result<(FusionCounts, Timing)> {
+        let g = self.gpu.clone();
+        let mut t = Timing::default();
+        if nt == 0 {
+            return Ok((FusionCounts::default(), t));
+        }
+        self.face_off.reserve(&g, nt)?;
+        // Every triangle is kept: the face offsets are 0, 1, 2, ...
+        self.scan
+            .exclusive(&self.keep.buf, &self.face_off.buf, nt)?;
+        t.add(Step::ScanExclusive, self.scan.last_ms());
+        self.out_pos.reserve(&g, 3 * used)?;
+        self.out_faces.reserve(&g, 3 * nt)?;
+        let e_v = launch(
+            &g,
+            &self.compact_vertices,
+            nv,
+            &[
+                Arg::U32(nv as u32),
+                buf(&self.referenced.buf),
+                buf(&self.vert_id.buf),
+                buf(pos),
+                buf(&self.out_pos.buf),
+            ],
+        )?;
+        let e_f = launch(
+            &g,
+            &self.compact_faces,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                buf(faces),
+                buf(&self.keep.buf),
+                buf(&self.face_off.buf),
+                buf(&self.vert_id.buf),
+                buf(&self.out_faces.buf),
+            ],
+        )?;
+        g.finish()?;
+        if let Some(e) = &e_v {
+            t.add(Step::FuseCompactVertices, event_ms(e));
+        }
+        if let Some(e) = &e_f {
+            t.add(Step::FuseCompactFaces, event_ms(e));
+        }
+        Ok((
+            FusionCounts {
+                vertices: used,
+                faces: nt,
+                dropped: 0,
+            },
+            t,
+        ))
     }
 
     /// The steps after `fuse_index`, shared with direct numbering

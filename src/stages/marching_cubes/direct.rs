@@ -257,26 +257,40 @@ impl Isosurfacer {
                 hit_twins(&rec)
             };
         }
-        if !full && (collapsed > 0 || twins > 0) {
-            // Dropped triangles may have been a vertex's only ones.
-            full = self.fuser.count_referenced(&d.faces.buf, nv, tk)? < nv;
-        }
         let dropped = twins + collapsed;
+        // Dropped triangles may have been a vertex's only ones: then the
+        // vertices still used are compacted (no triangle to drop or cancel).
+        let mut used = None;
+        if !full && (collapsed > 0 || twins > 0) {
+            let (n, t) = self.fuser.count_referenced(&d.faces.buf, nv, tk)?;
+            Self::add_events(st, &e_tri, &e_pts);
+            st.timing.extend(&t);
+            used = (n < nv).then_some(n);
+        } else {
+            g.finish()?;
+            Self::add_events(st, &e_tri, &e_pts);
+        }
         if full {
             let (c, ft) = self.fuser.finish(&d.faces.buf, &d.pos.buf, nv, tk)?;
             st.vertices = c.vertices;
             st.faces = c.faces;
             st.degenerate_dropped = dropped + c.dropped;
             self.result = Some((Holder::Fused, c.vertices, c.faces));
-            Self::add_events(st, &e_tri, &e_pts);
+            st.timing.extend(&ft);
+        } else if let Some(n) = used {
+            let (c, ft) = self
+                .fuser
+                .compact_referenced(&d.faces.buf, &d.pos.buf, nv, tk, n)?;
+            st.vertices = c.vertices;
+            st.faces = c.faces;
+            st.degenerate_dropped = dropped;
+            self.result = Some((Holder::Fused, c.vertices, c.faces));
             st.timing.extend(&ft);
         } else {
-            g.finish()?;
             st.vertices = nv;
             st.faces = tk;
             st.degenerate_dropped = dropped;
             self.result = Some((Holder::Direct, nv, tk));
-            Self::add_events(st, &e_tri, &e_pts);
         }
         Ok(())
     }
