@@ -252,10 +252,9 @@ impl Fuser {
             return Ok((FusionCounts::default(), t));
         }
         self.face_off.reserve(&g, nt)?;
-        // Every triangle is kept: the face offsets are 0, 1, 2, ...
-        self.scan
-            .exclusive(&self.keep.buf, &self.face_off.buf, nt)?;
-        t.add(Step::ScanExclusive, self.scan.last_ms());
+        // Every triangle is kept: the face offsets are 0, 1, 2, ... (nt
+        // itself the total, so no wait for it).
+        let e_scan = self.scan.enqueue(&self.keep.buf, &self.face_off.buf, nt)?;
         self.out_pos.reserve(&g, 3 * used)?;
         self.out_faces.reserve(&g, 3 * nt)?;
         let e_v = launch(
@@ -284,6 +283,7 @@ impl Fuser {
             ],
         )?;
         g.finish()?;
+        t.add(Step::ScanExclusive, e_scan.iter().map(event_ms).sum());
         if let Some(e) = &e_v {
             t.add(Step::FuseCompactVertices, event_ms(e));
         }
