@@ -24,7 +24,7 @@
 //                                      only the cells with a corner on a hit point)
 //   mc_direct_triangles  per cell row  owned vertices' positions, triangles with
 //                                      final indices; those with a hit corner
-//                                      also listed in `side`
+//                                      lying in a grid plane also listed in `side`
 //   mc_direct_points     per hit       positions of the hit slots
 // One work-item walks one row, 16 cells at a time (float16 loads), reading
 // nothing outside the row's trim range but the 16-cell chunk that ends at the
@@ -34,7 +34,7 @@
 // triangles lying in a cube face); info uint[4G]; rowc uint[4G] (scanned in
 // place into off); split uint[2G]; trim uint[3G]; tcount uint[G]; hit_keys
 // uint[H] (sorted, unique: U); pos float[3(V+U)]; faces uint[3T]; side
-// uint[5·20H]; V, T, H the scan's first three partial totals.
+// uint[3·20H]; V, T, H the scan's first three partial totals.
 //
 // With no hit and a finite volume no triangle can collapse and the only twins
 // (a flat triangle and its mirror across the face) are found by has_twin;
@@ -492,9 +492,9 @@ emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, 
             faces[out] = id[ea];
             faces[out + 1] = id[eb];
             faces[out + 2] = id[ec];
-            // A triangle with a corner on a grid point may have a twin:
-            // listed (face, corners, in a grid plane) for the host to decide
-            // whether the clean-up must run.
+            // A triangle with a corner on a grid point lying in a grid plane
+            // may have a twin (the cell's across the plane): its corners
+            // listed for the host to decide whether the clean-up must run.
             if (ch != 0 && (k[ea] >= EV_LO || k[eb] >= EV_LO || k[ec] >= EV_LO)) {
                 uint plane = 0;
                 for (uint q = 0; q < 3; ++q) {
@@ -503,13 +503,13 @@ emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, 
                     const float pc = corner_coord(ec, k[ec], c[ec], x, y, z, q);
                     plane |= pa == pb && pb == pc && pa == floor(pa);
                 }
-                const uint o = atomic_inc(&side_n[0]);
-                if (o < side_cap) {
-                    side[5 * o] = out / 3;
-                    side[5 * o + 1] = id[ea];
-                    side[5 * o + 2] = id[eb];
-                    side[5 * o + 3] = id[ec];
-                    side[5 * o + 4] = plane;
+                if (plane) {
+                    const uint o = atomic_inc(&side_n[0]);
+                    if (o < side_cap) {
+                        side[3 * o] = id[ea];
+                        side[3 * o + 1] = id[eb];
+                        side[3 * o + 2] = id[ec];
+                    }
                 }
             }
             out += 3;
@@ -634,8 +634,8 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
 
 // Per cell row: positions of the vertices the row owns and its triangles with
 // final indices (a hit corner: edge_vertices + the rank of its point among
-// the sorted, unique hit points); triangles with a hit corner are also listed
-// in `side` (face, corners, in a grid plane) for the host's twin check. Only
+// the sorted, unique hit points); triangles with a hit corner lying in a grid
+// plane are also listed in `side` (their corners) for the host's twin check. Only
 // the cells with a corner on a hit point take the hit-aware steps
 // (emit_hit_cell, a call); the rows whose four grid rows own no hit (nearly
 // all of them) run a copy of the loop compiled without the hit cursor and

@@ -71,10 +71,11 @@ pub struct FusionCounts {
 /// Bytes of device memory direct numbering needs beyond the volume, for
 /// `grid_rows` grid rows, `vertices` edge vertices, `hits` grid-point hits,
 /// `triangles` triangles and room for `side_records` triangles with a hit
-/// corner: row summaries and counts (4 each per row), splits (2 each), trims
-/// (3 each: range and chunk mask), the recount (1), hit keys (4 bytes per hit), the list (5 words per
-/// record), positions, faces, and the clean-up of vertex fusion when there
-/// are hits or non-finite voxels (`cleanup`).
+/// corner in a grid plane: row summaries and counts (4 each per row),
+/// splits (2 each), trims (3 each: range and chunk mask), the recount (1),
+/// hit keys (4 bytes per hit), the list (3 words per record), positions,
+/// faces, and the clean-up of vertex fusion when there are hits or
+/// non-finite voxels (`cleanup`).
 pub fn direct_device_bytes_bound(
     grid_rows: usize,
     vertices: usize,
@@ -86,7 +87,7 @@ pub fn direct_device_bytes_bound(
     let slots = (vertices + hits) as u64;
     let t = triangles as u64;
     let mut b =
-        56 * grid_rows as u64 + 4 * hits as u64 + 20 * side_records as u64 + 12 * slots + 12 * t;
+        56 * grid_rows as u64 + 4 * hits as u64 + 12 * side_records as u64 + 12 * slots + 12 * t;
     if cleanup {
         // rep is the faces buffer; referenced + vert_id per slot; keep,
         // face_off, cand, cand_off per triangle; candidate keys and their

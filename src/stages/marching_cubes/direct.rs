@@ -206,7 +206,7 @@ impl Isosurfacer {
         if h > 0 {
             // Only written where there are hits (a blocking write otherwise
             // would be a second wait of the extraction).
-            d.side.reserve(&g, 5 * side_cap)?;
+            d.side.reserve(&g, 3 * side_cap)?;
             g.write(&mut d.side_n, &[0])?;
         }
         let (toff, tshift, tbase) = if h > 0 {
@@ -252,7 +252,7 @@ impl Isosurfacer {
             g.read(&d.side_n, &mut n)?;
             let n = n[0] as usize;
             full = n > side_cap || {
-                let mut rec = vec![0u32; 5 * n];
+                let mut rec = vec![0u32; 3 * n];
                 g.read(&d.side.buf, &mut rec)?;
                 hit_twins(&rec)
             };
@@ -310,13 +310,13 @@ impl Isosurfacer {
     }
 }
 
-/// True when triangles with a corner on a grid point (records of
-/// `mc_direct_triangles`: face, three corners, 1 if in a grid plane) include
-/// an opposite twin pair: the same three vertices, both windings.
+/// True when the triangles with a corner on a grid point that lie in a grid
+/// plane (records of `mc_direct_triangles`: three corners each) include an
+/// opposite twin pair: the same three vertices, both windings.
 fn hit_twins(rec: &[u32]) -> bool {
     let mut seen: std::collections::HashMap<[u32; 3], u8> = Default::default();
-    for r in rec.chunks_exact(5).filter(|r| r[4] != 0) {
-        let (set, even) = crate::cpu::vertex_fusion::tri_set([r[1], r[2], r[3]]);
+    for r in rec.chunks_exact(3) {
+        let (set, even) = crate::cpu::vertex_fusion::tri_set([r[0], r[1], r[2]]);
         let w = seen.entry(set).or_default();
         *w |= if even { 1 } else { 2 };
         if *w == 3 {
@@ -326,9 +326,10 @@ fn hit_twins(rec: &[u32]) -> bool {
     false
 }
 
-/// Room for the list of triangles with a corner on a grid point, which the
-/// host checks for twins: at most 5 per cell and 4 cells per hit edge, and
-/// at most every triangle; capped at 2^21 records (40 MB), past which the
+/// Room for the list of triangles with a corner on a grid point lying in a
+/// grid plane, which the host checks for twins: at most 5 per cell and 4
+/// cells per hit edge, and at most every triangle; capped at 2^21 records
+/// (24 MB), past which the
 /// list overflows and the fusion clean-up runs instead (volumes with that
 /// many hits, such as integer data at a voxel value, need it anyway).
 fn side_records(hits: usize, triangles: usize) -> usize {
@@ -338,12 +339,14 @@ fn side_records(hits: usize, triangles: usize) -> usize {
 #[cfg(test)]
 mod tests {
     #[test]
-    fn hit_twins_finds_opposite_windings_in_grid_planes_only() {
+    fn hit_twins_finds_opposite_windings() {
         use super::hit_twins;
-        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 1]));
-        assert!(hit_twins(&[0, 1, 2, 3, 1, 9, 2, 1, 3, 0, 7, 1, 3, 2, 1]));
-        // Same winding (rotations), or not in a grid plane: no twins.
-        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 2, 3, 1, 1]));
-        assert!(!hit_twins(&[0, 1, 2, 3, 1, 9, 3, 2, 1, 0]));
+        assert!(hit_twins(&[1, 2, 3, 3, 2, 1]));
+        assert!(hit_twins(&[1, 2, 3, 4, 5, 6, 2, 1, 3]));
+        assert!(hit_twins(&[1, 2, 3, 7, 1, 3, 2, 1, 3]));
+        // Same winding (rotations), or other vertices: no twins.
+        assert!(!hit_twins(&[1, 2, 3, 2, 3, 1, 3, 1, 2]));
+        assert!(!hit_twins(&[1, 2, 3, 3, 2, 4]));
+        assert!(!hit_twins(&[]));
     }
 }
