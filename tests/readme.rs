@@ -125,7 +125,7 @@ fn every_example_runs_as_written() {
                 }
                 d
             })
-            .clone()
+            .to_path_buf()
     };
     let bin = Path::new(env!("CARGO_BIN_EXE_shapecue")).parent().unwrap();
     let path = format!(

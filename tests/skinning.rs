@@ -127,4 +127,5 @@ fn bad_requests_are_errors() {
     std::fs::write(&junk, b"{ not json").unwrap();
     let e = load_gltf(&junk).unwrap_err().to_string();
     assert!(e.contains("shapecue-junk"), "{e}");
+    let _ = std::fs::remove_file(&junk);
 }

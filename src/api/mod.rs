@@ -266,6 +266,7 @@ pub fn feature_edges_on(
 /// };
 /// let report = shapecue::render_scene("scenes/torus.toml".as_ref(), &opts)?;
 /// println!("{} passes ran", report.passes.len());
+/// # std::fs::remove_dir_all(opts.out_dir.unwrap()).ok();
 /// # Ok::<(), shapecue::Error>(())
 /// ```
 ///

@@ -696,5 +696,6 @@ mod missing_tests {
             "{e}"
         );
         assert_eq!(e.matches("No such file").count(), 1, "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

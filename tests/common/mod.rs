@@ -133,7 +133,9 @@ pub fn model_path(name: &str) -> Option<PathBuf> {
 
 /// A fresh, empty folder for one test, unique to this test binary, process
 /// and call (`tag` names it for a reader), under the system's temp folder.
-pub fn scratch(tag: &str) -> PathBuf {
+/// Removed when the returned guard drops, unless the test is failing (then
+/// it stays for a look, and the failure's message names it).
+pub fn scratch(tag: &str) -> Scratch {
     static N: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
         "shapecue-tests-{}-{}-{tag}-{}",
@@ -143,7 +145,33 @@ pub fn scratch(tag: &str) -> PathBuf {
     ));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
+    Scratch(dir)
+}
+
+/// A test's scratch folder (see [`scratch`]): a `Path` by dereference.
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("scratch folder kept: {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 /// OBJ text of `positions` and 0-based `faces` (positions printed so they
