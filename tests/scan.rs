@@ -1,6 +1,7 @@
-//! Exclusive scan: device vs CPU reference over sizes around the work-group
-//! and chunk boundaries, in place and out of place, and overflow of the
-//! total reported as an error with the output left unchanged.
+//! Exclusive scan (and the sum alone): device vs CPU reference over sizes
+//! around the work-group and chunk boundaries, in place and out of place,
+//! and overflow of the total reported as an error with the output left
+//! unchanged.
 
 mod common;
 
@@ -21,6 +22,7 @@ fn check(scan: &mut Scan, data: &[u32]) {
 
     let input = upload(&g, data);
     let output = g.buffer::<u32>(n).unwrap();
+    assert_eq!(scan.sum(&input, n).unwrap(), want_total, "sum, n = {n}");
     let total = scan.exclusive(&input, &output, n).unwrap();
     assert_eq!(total, want_total, "n = {n}");
     assert_eq!(download(&g, &output, n), want, "out of place, n = {n}");

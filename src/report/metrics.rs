@@ -210,11 +210,19 @@ pub fn runs_stats(stats: &mut serde_json::Value, timed: &[Timing], first_wall_ms
         wall.iter().copied().fold(f64::INFINITY, f64::min),
     );
     let wall_median = median(&mut wall);
+    // Each step once (a step that ran several times, such as the scan, is
+    // one entry with its summed time), in the order it first ran.
+    let mut seen = Vec::new();
     let per_pass: Vec<serde_json::Value> = timed
         .first()
         .map(|t| &t.steps[..])
         .unwrap_or_default()
         .iter()
+        .filter(|s| {
+            let first = !seen.contains(&s.step);
+            seen.push(s.step);
+            first
+        })
         .map(|s| {
             let mut ms: Vec<f64> = timed.iter().map(|t| t.ms(&[s.step])).collect();
             serde_json::json!({ "pass": s.step.name(), "kernel_ms": median(&mut ms) })

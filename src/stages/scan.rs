@@ -147,6 +147,24 @@ impl Scan {
         Ok((total[0], vals))
     }
 
+    /// The sum of `input[0..n]` alone (the scan's first two kernels, no
+    /// output written), waiting for it; [`Scan::last_ms`] gives their time.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] when `input` holds fewer than `n` values.
+    pub fn sum(&mut self, input: &Buffer<u32>, n: usize) -> Result<u64> {
+        self.last_ms = 0.0;
+        check_len("sum", n, &[("input", input)])?;
+        let events = self.enqueue_sums(input, n)?;
+        if events.is_empty() {
+            return Ok(0);
+        }
+        let mut t = [0u64; 1];
+        self.gpu.read(&self.total, &mut t)?;
+        self.last_ms = events.iter().map(event_ms).sum();
+        Ok(t[0])
+    }
+
     /// Enqueues the three kernels without waiting and without reading the
     /// total back (for callers that know the total cannot overflow, like the
     /// radix sort's histogram of `n` keys). `n` must be checked by the caller.
@@ -156,6 +174,29 @@ impl Scan {
         output: &Buffer<u32>,
         n: usize,
     ) -> Result<Vec<Event>> {
+        let mut events = self.enqueue_sums(input, n)?;
+        if events.is_empty() {
+            return Ok(events);
+        }
+        let (chunk, chunks) = crate::spec::scan::chunking(n);
+        let (n32, chunk32, chunks32) = (n as u32, chunk as u32, chunks as u32);
+        let (partials, total) = (buf(&self.partials), buf(&self.total));
+        let args = [
+            Arg::U32(n32),
+            Arg::U32(chunk32),
+            Arg::U32(chunks32),
+            buf(input),
+            buf(output),
+            partials,
+            total,
+        ];
+        events.extend(launch(&self.gpu, &self.apply, chunks, &args)?);
+        Ok(events)
+    }
+
+    /// The first two kernels (each chunk's sum, then the partials' scan and
+    /// the total), not waited for; none for `n = 0`.
+    fn enqueue_sums(&self, input: &Buffer<u32>, n: usize) -> Result<Vec<Event>> {
         let (chunk, chunks) = crate::spec::scan::chunking(n);
         if chunks == 0 {
             return Ok(Vec::new());
@@ -174,16 +215,6 @@ impl Scan {
         events.extend(launch(g, &self.block_sums, chunks, &args)?);
         let args = [Arg::U32(chunks32), partials, total];
         events.extend(launch(g, &self.partials_kernel, 1, &args)?);
-        let args = [
-            Arg::U32(n32),
-            Arg::U32(chunk32),
-            Arg::U32(chunks32),
-            buf(input),
-            buf(output),
-            partials,
-            total,
-        ];
-        events.extend(launch(g, &self.apply, chunks, &args)?);
         Ok(events)
     }
 

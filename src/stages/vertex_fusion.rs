@@ -185,9 +185,9 @@ impl Fuser {
     }
 
     /// How many of the `nv` vertices the `nt` triangles of `faces` use
-    /// (`fuse_clear`, `fuse_mark` with every triangle kept, scan), with the
-    /// kernel times: direct numbering's check that dropping triangles left
-    /// no vertex unused. Leaves the marks and new indices for
+    /// (`fuse_clear`, `fuse_mark` with every triangle kept, their sum), with
+    /// the kernel times: direct numbering's check that dropping triangles
+    /// left no vertex unused. Leaves the marks for
     /// [`Fuser::compact_referenced`].
     pub(crate) fn count_referenced(
         &mut self,
@@ -221,9 +221,7 @@ impl Fuser {
                 buf(&self.referenced.buf),
             ],
         )?;
-        let used = self
-            .scan
-            .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)? as usize;
+        let used = self.scan.sum(&self.referenced.buf, nv)? as usize;
         // `fuse_clear` is counted in the marking it prepares.
         for e in [&e_clear, &e_mark].into_iter().flatten() {
             t.add(Step::FuseMark, event_ms(e));
@@ -251,6 +249,10 @@ impl Fuser {
         if nt == 0 {
             return Ok((FusionCounts::default(), t));
         }
+        // The used vertices' new indices (the check only summed the marks).
+        self.scan
+            .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)?;
+        t.add(Step::ScanExclusive, self.scan.last_ms());
         self.face_off.reserve(&g, nt)?;
         // Every triangle is kept: the face offsets are 0, 1, 2, ... (nt
         // itself the total, so no wait for it).
