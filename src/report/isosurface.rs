@@ -77,15 +77,21 @@ pub fn flying_edges_ms(key: &str) -> Option<f64> {
 pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
     let (max_res, runs) = (o.max_resolution, o.runs);
     let mut r = Report::new("isosurface", gpu.info.name.clone());
+    let fe = |k: &str| flying_edges_ms(k).unwrap_or(f64::NAN);
     r.text(format!(
         "device: {} ({})\n\n\
          ## Extraction + fusion (volume on the device; median kernel ms / wall ms)\n\
          × FE: kernel ms over VTK's vtkFlyingEdges3D with 2 threads on the same volume, as \
-         measured once beside shapecue on a 2-core machine of this kind (sphere 256³ 36.4 ms, \
-         gyroid 256³ 85.5, gyroid 512³ 539, Bucky 0.42). The same machine type drifts by a \
+         measured beside shapecue on a 2-core machine of this kind (sphere 256³ {} ms, \
+         gyroid 256³ {}, gyroid 512³ {}, Bucky {}). The same machine type drifts by a \
          third between runs and days: for a fair ratio, `scripts/isosurface-table.py` times \
          Flying Edges and shapecue in turn in the same run.",
-        gpu.info.name, gpu.info.platform
+        gpu.info.name,
+        gpu.info.platform,
+        fe("sphere 256"),
+        fe("gyroid 256"),
+        fe("gyroid 512"),
+        fe("bucky 32"),
     ));
     let col = Column::new;
     let mut t = Table::new(
