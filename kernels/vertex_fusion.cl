@@ -57,11 +57,20 @@ __kernel void fuse_clear(uint n, __global uint *flags)
     flags[gid] = 0;
 }
 
-__kernel void fuse_triangles(uint nt, __global const uint *rep, __global const float *pos,
-                             __global uint *keep, __global uint *cand)
+// A corner index at or past n (a broken producer) is never followed: the
+// triangle is kept with no twin search, fuse_mark skips that corner and
+// fuse_compact_faces writes it as 0xFFFFFFFF, which the host's check of the
+// faces reports, naming the face.
+__kernel void fuse_triangles(uint nt, uint n, __global const uint *rep,
+                             __global const float *pos, __global uint *keep, __global uint *cand)
 {
     GID_OR_RETURN(nt);
     const uint a = rep[3 * gid], b = rep[3 * gid + 1], c = rep[3 * gid + 2];
+    if (a >= n || b >= n || c >= n) {
+        keep[gid] = 1;
+        cand[gid] = 0;
+        return;
+    }
     const uint k = (a != b) & (b != c) & (a != c);
     keep[gid] = k;
     // A kept triangle lying in a grid plane (one integral coordinate shared
@@ -136,15 +145,18 @@ __kernel void fuse_cancel(uint nc, __global const uint *ckeys, __global const ui
         keep[t] = 0;
 }
 
-__kernel void fuse_mark(uint nt, __global const uint *rep, __global const uint *keep,
+__kernel void fuse_mark(uint nt, uint n, __global const uint *rep, __global const uint *keep,
                         __global uint *ref)
 {
     GID_OR_RETURN(nt);
     if (keep[gid]) {
-        // Benign race: every writer stores 1.
-        ref[rep[3 * gid]] = 1;
-        ref[rep[3 * gid + 1]] = 1;
-        ref[rep[3 * gid + 2]] = 1;
+        // Benign race: every writer stores 1. Corners past n: see
+        // fuse_triangles.
+        for (uint q = 0; q < 3; ++q) {
+            const uint v = rep[3 * gid + q];
+            if (v < n)
+                ref[v] = 1;
+        }
     }
 }
 
@@ -161,15 +173,17 @@ __kernel void fuse_compact_vertices(uint n, __global const uint *ref,
     }
 }
 
-__kernel void fuse_compact_faces(uint nt, __global const uint *rep, __global const uint *keep,
-                                 __global const uint *face_off, __global const uint *vert_id,
-                                 __global uint *out_faces)
+__kernel void fuse_compact_faces(uint nt, uint n, __global const uint *rep,
+                                 __global const uint *keep, __global const uint *face_off,
+                                 __global const uint *vert_id, __global uint *out_faces)
 {
     GID_OR_RETURN(nt);
     if (keep[gid]) {
         const uint o = face_off[gid];
-        out_faces[3 * o] = vert_id[rep[3 * gid]];
-        out_faces[3 * o + 1] = vert_id[rep[3 * gid + 1]];
-        out_faces[3 * o + 2] = vert_id[rep[3 * gid + 2]];
+        // Corners past n: see fuse_triangles.
+        for (uint q = 0; q < 3; ++q) {
+            const uint v = rep[3 * gid + q];
+            out_faces[3 * o + q] = v < n ? vert_id[v] : 0xFFFFFFFFu;
+        }
     }
 }

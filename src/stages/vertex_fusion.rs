@@ -216,6 +216,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
+                Arg::U32(nv as u32),
                 buf(faces),
                 buf(&self.keep.buf),
                 buf(&self.referenced.buf),
@@ -277,6 +278,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
+                Arg::U32(nv as u32),
                 buf(faces),
                 buf(&self.keep.buf),
                 buf(&self.face_off.buf),
@@ -356,6 +358,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
+                Arg::U32(n as u32),
                 buf(rep),
                 buf(pos),
                 buf(&self.keep.buf),
@@ -415,6 +418,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
+                Arg::U32(n as u32),
                 buf(rep),
                 buf(&self.keep.buf),
                 buf(&self.referenced.buf),
@@ -464,6 +468,7 @@ impl Fuser {
             nt,
             &[
                 Arg::U32(nt as u32),
+                Arg::U32(n as u32),
                 buf(rep),
                 buf(&self.keep.buf),
                 buf(&self.face_off.buf),
@@ -486,5 +491,46 @@ impl Fuser {
             },
             t,
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Faces from a broken producer (a corner past the vertices) are never
+    /// followed as indices (no write or read out of bounds): the corner
+    /// comes out of range, for the caller's check of the faces to report,
+    /// through the whole clean-up and through the compaction alone.
+    #[test]
+    fn a_corner_past_the_vertices_comes_out_of_range_and_is_not_followed() {
+        let gpu = match Gpu::new(None) {
+            Ok(g) => Arc::new(g),
+            Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
+        };
+        let pos_host: [f32; 12] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let mut pos = gpu.buffer::<f32>(12).unwrap();
+        gpu.write(&mut pos, &pos_host).unwrap();
+        for bad in [1000u32, 4, u32::MAX] {
+            let faces_host = [0, 1, 2, 0, bad, 3, 2, 1, 3];
+            let mut faces = gpu.buffer::<u32>(9).unwrap();
+            gpu.write(&mut faces, &faces_host).unwrap();
+            let mut f = Fuser::new(gpu.clone()).unwrap();
+            let (c, _) = f.finish(&faces, &pos, 4, 3).unwrap();
+            assert_eq!(c.faces, 3, "corner {bad}");
+            let mut out = vec![0u32; 9];
+            gpu.read(&f.out_faces.buf, &mut out).unwrap();
+            assert_eq!(out[4], u32::MAX, "corner {bad}: {out:?}");
+            assert!(
+                out.iter().enumerate().all(|(i, &v)| i == 4 || v < 4),
+                "{out:?}"
+            );
+            let (used, _) = f.count_referenced(&faces, 4, 3).unwrap();
+            assert_eq!(used, 4, "corner {bad}");
+            let (c, _) = f.compact_referenced(&faces, &pos, 4, 3, used).unwrap();
+            assert_eq!(c.faces, 3);
+            gpu.read(&f.out_faces.buf, &mut out).unwrap();
+            assert_eq!(out[4], u32::MAX, "corner {bad}: {out:?}");
+        }
     }
 }
