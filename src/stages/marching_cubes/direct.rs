@@ -329,9 +329,9 @@ fn hit_twins(rec: &[u32]) -> bool {
 /// Room for the list of triangles with a corner on a grid point lying in a
 /// grid plane, which the host checks for twins: at most 5 per cell and 4
 /// cells per hit edge, and at most every triangle; capped at 2^21 records
-/// (24 MB), past which the
-/// list overflows and the fusion clean-up runs instead (volumes with that
-/// many hits, such as integer data at a voxel value, need it anyway).
+/// (24 MB), past which the list overflows and the fusion clean-up runs
+/// instead (volumes with that many hits, such as integer data at a voxel
+/// value, need it anyway).
 fn side_records(hits: usize, triangles: usize) -> usize {
     (20 * hits).min(triangles).min(1 << 21)
 }
