@@ -201,7 +201,6 @@ impl Fuser {
             return Ok((0, t));
         }
         self.referenced.reserve(&g, nv)?;
-        self.vert_id.reserve(&g, nv)?;
         self.keep.reserve(&g, nt)?;
         g.fill(&mut self.keep.buf, &[1u32], nt)?;
         let e_clear = launch(
@@ -251,6 +250,7 @@ impl Fuser {
             return Ok((FusionCounts::default(), t));
         }
         // The used vertices' new indices (the check only summed the marks).
+        self.vert_id.reserve(&g, nv)?;
         self.scan
             .exclusive(&self.referenced.buf, &self.vert_id.buf, nv)?;
         t.add(Step::ScanExclusive, self.scan.last_ms());
@@ -260,40 +260,7 @@ impl Fuser {
         let e_scan = self.scan.enqueue(&self.keep.buf, &self.face_off.buf, nt)?;
         self.out_pos.reserve(&g, 3 * used)?;
         self.out_faces.reserve(&g, 3 * nt)?;
-        let e_v = launch(
-            &g,
-            &self.compact_vertices,
-            nv,
-            &[
-                Arg::U32(nv as u32),
-                buf(&self.referenced.buf),
-                buf(&self.vert_id.buf),
-                buf(pos),
-                buf(&self.out_pos.buf),
-            ],
-        )?;
-        let e_f = launch(
-            &g,
-            &self.compact_faces,
-            nt,
-            &[
-                Arg::U32(nt as u32),
-                Arg::U32(nv as u32),
-                buf(faces),
-                buf(&self.keep.buf),
-                buf(&self.face_off.buf),
-                buf(&self.vert_id.buf),
-                buf(&self.out_faces.buf),
-            ],
-        )?;
-        g.finish()?;
-        t.add(Step::ScanExclusive, e_scan.iter().map(event_ms).sum());
-        if let Some(e) = &e_v {
-            t.add(Step::FuseCompactVertices, event_ms(e));
-        }
-        if let Some(e) = &e_f {
-            t.add(Step::FuseCompactFaces, event_ms(e));
-        }
+        self.compact(faces, pos, nv, nt, e_scan, &mut t)?;
         Ok((
             FusionCounts {
                 vertices: used,
@@ -450,12 +417,41 @@ impl Fuser {
         debug_assert!(vertices <= n && faces <= nt);
         self.out_pos.reserve(&g, 3 * vertices)?;
         self.out_faces.reserve(&g, 3 * faces)?;
+        self.compact(rep, pos, n, nt, Vec::new(), &mut t)?;
+        Ok((
+            FusionCounts {
+                vertices,
+                faces,
+                dropped: nt - faces,
+            },
+            t,
+        ))
+    }
+
+    /// The last two steps of [`Fuser::finish`] and
+    /// [`Fuser::compact_referenced`]: the marked vertices of `pos` (`n`
+    /// slots) into [`Fuser::out_pos`] and the kept triangles of
+    /// `rep` (`nt`) renumbered into [`Fuser::out_faces`], from the marks,
+    /// new indices, keep flags and face offsets already on the device (the
+    /// outputs reserved by the caller); waits, then adds to `t` the time of
+    /// `scans` (scans enqueued for this step and not yet counted) and of
+    /// the two kernels.
+    fn compact(
+        &self,
+        rep: &Buffer<u32>,
+        pos: &Buffer<f32>,
+        n: usize,
+        nt: usize,
+        scans: Vec<opencl3::event::Event>,
+        t: &mut Timing,
+    ) -> Result<()> {
+        let g = &*self.gpu;
         let e_v = launch(
-            &g,
+            g,
             &self.compact_vertices,
             n,
             &[
-                Arg::U32(n32),
+                Arg::U32(n as u32),
                 buf(&self.referenced.buf),
                 buf(&self.vert_id.buf),
                 buf(pos),
@@ -463,7 +459,7 @@ impl Fuser {
             ],
         )?;
         let e_f = launch(
-            &g,
+            g,
             &self.compact_faces,
             nt,
             &[
@@ -477,20 +473,16 @@ impl Fuser {
             ],
         )?;
         g.finish()?;
+        if !scans.is_empty() {
+            t.add(Step::ScanExclusive, scans.iter().map(event_ms).sum());
+        }
         if let Some(e) = &e_v {
             t.add(Step::FuseCompactVertices, event_ms(e));
         }
         if let Some(e) = &e_f {
             t.add(Step::FuseCompactFaces, event_ms(e));
         }
-        Ok((
-            FusionCounts {
-                vertices,
-                faces,
-                dropped: nt - faces,
-            },
-            t,
-        ))
+        Ok(())
     }
 }
 
