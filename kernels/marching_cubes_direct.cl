@@ -686,3 +686,93 @@ __kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, 
     put3(pos, edge_vertices + gid, (float)(g % nx), (float)((g / nx) % ny),
          (float)(g / (nx * ny)));
 }
+
+// The check that dropped triangles (twins across a cube face, collapses onto
+// hit points) left no vertex unused, made near them: a vertex of grid row g
+// is used by cells of the four cell rows around g only, so only the grid
+// rows of a cell row that dropped triangles can own an unused vertex, and
+// only the cell rows around those can use it.
+//   mc_direct_unused_rows   per grid row     the cell rows that dropped
+//                                            triangles, listed (at most D, the
+//                                            dropped triangles)
+//   mc_direct_unused_clear  4 per listed row the marks of its grid rows'
+//                                            vertices (edge vertices, hit points)
+//   mc_direct_unused_mark   9 per listed row the vertices that the kept
+//                                            triangles of the 3 × 3 cell rows
+//                                            around it use
+//   mc_direct_unused_count  4 per listed row its grid rows' marks still clear,
+//                                            each grid row counted once
+// toff[tshift + r] − tbase: the first kept triangle of cell row r (as for
+// mc_direct_triangles); list[0]: the listed rows, list[1]: the unused count,
+// list[2..]: the rows (row_drops, listed_grid_row, GRID_ROW_MARKS in
+// common/mc_direct.h). Twin:
+// cpu::marching_cubes::direct_unused_near.
+
+__kernel void mc_direct_unused_rows(uint grid_rows, uint ny, uint nz, __global const uint *off,
+                                    __global const uint *toff, uint tshift, uint cap,
+                                    volatile __global uint *list)
+{
+    GID_OR_RETURN(grid_rows);
+    if (row_drops(off, toff, tshift, grid_rows, ny, nz, gid % ny, gid / ny) == 0)
+        return;
+    const uint o = atomic_inc(&list[0]);
+    if (o < cap)
+        list[2 + o] = gid;
+}
+
+__kernel void mc_direct_unused_clear(uint grid_rows, uint nx, uint ny, uint nz,
+                                     __global const uint *off, uint nh,
+                                     __global const uint *keys, uint cap,
+                                     __global const uint *list, __global uint *mark)
+{
+    const uint g = listed_grid_row(list, cap, ny, get_global_id(0));
+    if (g == 0xFFFFFFFFu)
+        return;
+#define CLEAR(i) mark[i] = 0
+    GRID_ROW_MARKS(CLEAR)
+#undef CLEAR
+}
+
+__kernel void mc_direct_unused_mark(uint grid_rows, uint ny, uint nz, __global const uint *toff,
+                                    uint tshift, uint tbase, uint nv, __global const uint *faces,
+                                    uint cap, __global const uint *list, __global uint *mark)
+{
+    const uint w = get_global_id(0);
+    if (w / 9 >= min(list[0], cap))
+        return;
+    const uint r = list[2 + w / 9];
+    const int y = (int)(r % ny) + (int)(w % 3) - 1, z = (int)(r / ny) + (int)((w / 3) % 3) - 1;
+    if (y < 0 || z < 0 || y + 1 >= (int)ny || z + 1 >= (int)nz)
+        return;
+    const uint c = (uint)y + ny * (uint)z;
+    const uint a = 3 * (toff[tshift + c] - tbase), b = 3 * (toff[tshift + c + 1] - tbase);
+    for (uint i = a; i < b; ++i)
+        if (faces[i] < nv)
+            mark[faces[i]] = 1;
+}
+
+__kernel void mc_direct_unused_count(uint grid_rows, uint nx, uint ny, uint nz,
+                                     __global const uint *off, __global const uint *toff,
+                                     uint tshift, uint nh, __global const uint *keys,
+                                     __global const uint *mark, uint cap,
+                                     __global uint *list)
+{
+    const uint w = get_global_id(0);
+    const uint g = listed_grid_row(list, cap, ny, w);
+    if (g == 0xFFFFFFFFu)
+        return;
+    // Counted by the first of g's cell rows (y − 1, z − 1), (y, z − 1),
+    // (y − 1, z), (y, z) that dropped triangles: w's own is the (3 − j)th.
+    const int y = g % ny, z = g / ny;
+    const uint j = w % 4;
+    for (uint q = 0; q < 3 - j; ++q)
+        if (row_drops(off, toff, tshift, grid_rows, ny, nz, y - 1 + (int)(q & 1),
+                      z - 1 + (int)(q >> 1)) != 0)
+            return;
+    uint n = 0;
+#define COUNT(i) n += mark[i] == 0
+    GRID_ROW_MARKS(COUNT)
+#undef COUNT
+    if (n != 0)
+        atomic_add(&list[1], n);
+}

@@ -8,7 +8,7 @@ use common::gpu;
 use shapecue::cpu::marching_cubes as mc;
 use shapecue::cpu::vertex_fusion::{Fused, fuse};
 use shapecue::mesh::quality;
-use shapecue::spec::marching_cubes::{END, table};
+use shapecue::spec::marching_cubes::{END, table, unused_check_near};
 use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
 use shapecue::volume::Volume;
@@ -136,6 +136,60 @@ fn direct_numbering_matches_its_twin_and_edge_fusion_on_random_volumes() {
     // vertices still used are compacted without vertex fusion's search
     // (same bits as the twin, checked above).
     assert!(compacted_only > 0, "no volume took the compaction alone");
+}
+
+#[test]
+fn few_dropped_triangles_are_checked_near_them_with_the_twin_s_bits() {
+    // A plane through a large grid with a block of small integers at an
+    // integer iso against two of its faces: the few collapses there are checked for
+    // unused vertices near them (not over every triangle), and where they
+    // leave a vertex unused (one of these seeded trials) the used ones are
+    // compacted; the mesh is the twin's.
+    let mut r = rng(5);
+    let (mut near, mut compacted) = (0, 0);
+    for trial in 0..24 {
+        let n = [6, 80, 80];
+        let w = 4 + trial % 4;
+        let vals: Vec<f32> = (0..n[0] * n[1] * n[2])
+            .map(|i| {
+                let (x, y, z) = (i % n[0], i / n[0] % n[1], i / (n[0] * n[1]));
+                let block = (16..16 + w).contains(&y) && z < w;
+                if block {
+                    (r() * 4.0).floor()
+                } else {
+                    x as f32 * 0.31 + y as f32 * 0.07 + z as f32 * 0.013 - 0.123
+                }
+            })
+            .collect();
+        let vol = Volume::new(n, vals, "block").unwrap();
+        check_same(&vol, 2.0, &format!("block {trial}"));
+        let mut s = Isosurfacer::new(gpu(), &vol).unwrap();
+        let st = s.extract(2.0, Fusion::Direct).unwrap();
+        let names: Vec<&str> = st.timing.steps.iter().map(|s| s.step.name()).collect();
+        if st.degenerate_dropped > 0 && !names.contains(&"candidates") {
+            let rows = shapecue::spec::marching_cubes::cell_rows(n);
+            assert_eq!(
+                names.contains(&"direct_unused_mark"),
+                unused_check_near(st.degenerate_dropped, rows),
+                "trial {trial}: {names:?}"
+            );
+            if !names.contains(&"direct_unused_mark") {
+                continue;
+            }
+            near += 1;
+            // Marks over every triangle only for the compaction.
+            assert_eq!(
+                names.contains(&"mark"),
+                names.contains(&"compact_vertices"),
+                "trial {trial}: {names:?}"
+            );
+            compacted += names.contains(&"compact_vertices") as usize;
+        }
+    }
+    assert!(
+        near > 0 && compacted > 0 && compacted < near,
+        "{near} checked near, {compacted} compacted"
+    );
 }
 
 #[test]

@@ -4,7 +4,8 @@
 // lanes, the owned edges of a row position, the twin test of triangles
 // lying in a cube face, the twelve edges' kinds and coordinates of the
 // triangle pass, and the steps of the cells with a corner on a hit point
-// (the sorted hit points, their cursor over a cell row, collapses). Uses
+// (the sorted hit points, their cursor over a cell row, collapses), and the
+// dropped triangles per cell row of the check for unused vertices. Uses
 // mc_edge.h (the edge rule) and mc_cell.h (cell cases, edge numbering). CPU
 // twin: src/cpu/marching_cubes.rs (edge_vertex, has_twin).
 
@@ -396,3 +397,35 @@ inline bool cell_row_has_hits(__global const uint *off, uint G, uint gid, uint n
         any_hit = any_hit || off[2 * G + rows[i] + 1] != off[2 * G + rows[i]];
     return any_hit;
 }
+
+// Triangles dropped in cell row (y, z): the count pass's triangles and twins
+// less those kept; 0 for a row that is not a cell row.
+inline uint row_drops(__global const uint *off, __global const uint *toff, uint tshift, uint G,
+                      uint ny, uint nz, int y, int z)
+{
+    if (y < 0 || z < 0 || y + 1 >= (int)ny || z + 1 >= (int)nz)
+        return 0;
+    const uint r = (uint)y + ny * (uint)z;
+    return off[3 * G + r + 1] - off[3 * G + r] + (off[G + r + 1] - off[G + r]) -
+           (toff[tshift + r + 1] - toff[tshift + r]);
+}
+
+// Grid row j (0 .. 3: 00, 10, 01, 11) of listed cell row i = w / 4, or
+// 0xFFFFFFFF past the list.
+inline uint listed_grid_row(__global const uint *list, uint cap, uint ny, uint w)
+{
+    if (w / 4 >= min(list[0], cap))
+        return 0xFFFFFFFFu;
+    const uint j = w % 4;
+    return list[2 + w / 4] + (j & 1) + ny * (j >> 1);
+}
+
+// The marks of grid row g's vertices: its own edge vertices off[g] ..
+// off[g + 1], then the hit points on it (after the V edge vertices).
+#define GRID_ROW_MARKS(STEP)                                                        \
+    for (uint i = off[g]; i < off[g + 1]; ++i)                                      \
+        STEP(i);                                                                    \
+    const uint v = off[grid_rows];                                                  \
+    const ulong g0 = (ulong)g * nx;                                                 \
+    for (uint k = lower_bound_keys(keys, nh, g0); k < nh && (ulong)keys[k] < g0 + nx; ++k) \
+        STEP(v + k);

@@ -351,6 +351,9 @@ pub struct Direct {
     pub hits: usize,
     /// Triangles dropped with an opposite twin across a cube face.
     pub twins: usize,
+    /// Triangles of each cell row in `faces` (per grid row `y + ny z`, 0
+    /// where it is not a cell row), collapsed ones included.
+    pub row_faces: Vec<u32>,
 }
 
 /// `mc_direct_hits` (the hit points, sorted), `mc_direct_triangles` and
@@ -405,8 +408,10 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
     }
     let t = table();
     let mut faces = Vec::new();
+    let mut row_faces = vec![0u32; ny * nz];
     for z in 0..nz.saturating_sub(1) {
         for y in 0..ny.saturating_sub(1) {
+            let first = faces.len();
             for x in 0..nx - 1 {
                 let Some(case) = cell_case(vol, iso, x, y, z) else {
                     continue;
@@ -436,6 +441,7 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
                     ]);
                 }
             }
+            row_faces[y + ny * z] = (faces.len() - first) as u32;
         }
     }
     Direct {
@@ -444,7 +450,73 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
         edge_vertices,
         hits,
         twins: counts.rows.iter().map(|r| r[3] as usize).sum(),
+        row_faces,
     }
+}
+
+/// `mc_direct_unused_rows`, `_clear`, `_mark` and `_count`: how many
+/// vertices of `d` (of `vol`'s dims, with the row counts `counts`) no kept
+/// triangle uses once collapsed triangles (two corners on one hit point) are
+/// dropped, looked for only where triangles were dropped: in the grid rows
+/// of the cell rows that dropped some (twins across a face or collapses),
+/// marked by the kept triangles of the 3 × 3 cell rows around each. Every
+/// other vertex keeps the triangles of the cells it was made for, so this is
+/// the count of all unused vertices.
+pub fn direct_unused_near(dims: [usize; 3], d: &Direct, counts: &DirectCounts) -> usize {
+    let [nx, ny, nz] = dims;
+    let g = ny * nz;
+    let collapsed = |f: &[u32; 3]| f[0] == f[1] || f[1] == f[2] || f[0] == f[2];
+    // Each cell row's faces in `d.faces`, and its dropped triangles.
+    let mut first = vec![0usize; g + 1];
+    for r in 0..g {
+        first[r + 1] = first[r] + d.row_faces[r] as usize;
+    }
+    let row = |r: usize| &d.faces[first[r]..first[r + 1]];
+    let drops =
+        |r: usize| counts.rows[r][3] as usize + row(r).iter().filter(|f| collapsed(f)).count();
+    let cell_row = |y: isize, z: isize| {
+        (y >= 0 && z >= 0 && (y as usize) + 1 < ny && (z as usize) + 1 < nz)
+            .then(|| y as usize + ny * z as usize)
+    };
+    let listed: Vec<usize> = (0..g)
+        .filter(|&r| cell_row((r % ny) as isize, (r / ny) as isize).is_some() && drops(r) > 0)
+        .collect();
+    let mut checked = vec![false; g];
+    let mut used = vec![false; d.positions.len()];
+    for &r in &listed {
+        for j in 0..4 {
+            checked[r + (j & 1) + ny * (j >> 1)] = true;
+        }
+        let (y, z) = ((r % ny) as isize, (r / ny) as isize);
+        for (dy, dz) in (-1..=1).flat_map(|dz| (-1..=1).map(move |dy| (dy, dz))) {
+            if let Some(c) = cell_row(y + dy, z + dz) {
+                for f in row(c).iter().filter(|f| !collapsed(f)) {
+                    for &v in f {
+                        used[v as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+    // Grid row r owns edge vertices off[r] .. off[r + 1]; the hit points
+    // follow all edge vertices, in grid index order.
+    let mut unused = 0;
+    let mut off = 0;
+    for (row, &check) in counts.rows.iter().zip(&checked) {
+        let n = row[0] as usize;
+        if check {
+            unused += (off..off + n).filter(|&v| !used[v]).count();
+        }
+        off += n;
+    }
+    for (v, p) in d.positions.iter().enumerate().skip(d.edge_vertices) {
+        let r = p[1] as usize + ny * p[2] as usize;
+        debug_assert!((p[0] as usize) < nx);
+        if checked[r] && !used[v] {
+            unused += 1;
+        }
+    }
+    unused
 }
 
 /// Direct numbering, whole: [`mc_direct`] (twins across cube faces already

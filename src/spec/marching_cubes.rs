@@ -286,5 +286,24 @@ crate::spec::kernels::kernel_entries! {
         DirectTriangles = "mc_direct_triangles",
         /// Vertex positions, each made once by its edge.
         DirectPoints = "mc_direct_points",
+        /// The cell rows that dropped triangles, listed.
+        DirectUnusedRows = "mc_direct_unused_rows",
+        /// Near dropped triangles: the marks of the vertices that may be unused.
+        DirectUnusedClear = "mc_direct_unused_clear",
+        /// Near dropped triangles: the vertices the kept triangles use.
+        DirectUnusedMark = "mc_direct_unused_mark",
+        /// Near dropped triangles: the vertices left unused, counted.
+        DirectUnusedCount = "mc_direct_unused_count",
     }
+}
+
+/// Whether direct numbering checks that every vertex is still used only near
+/// the cell rows that dropped triangles (`mc_direct_unused_*`: the vertices
+/// of their grid rows, marked by the kept triangles of the 3 × 3 cell rows
+/// around each) rather than over every triangle (vertex fusion's marks and
+/// their sum, which the compaction needs anyway): when the kept triangles of
+/// those blocks, at most 9 cell rows per dropped triangle of about
+/// `triangles / cell_rows` each, are at most a quarter of the `triangles`.
+pub fn unused_check_near(dropped: usize, cell_rows: usize) -> bool {
+    36 * dropped as u64 <= cell_rows as u64
 }

@@ -36,6 +36,7 @@ impl Step {
             Step::McDirectTriangles => McKernel::DirectTriangles.name(),
             Step::McDirectPoints => McKernel::DirectPoints.name(),
             Step::McDirectRecount => McKernel::DirectRecount.name(),
+            Step::McDirectUnused => McKernel::DirectUnusedMark.name(),
             Step::McGradientNormals => McKernel::GradientNormals.name(),
             Step::FuseIndex => FuseKernel::Index.name(),
             Step::FuseTriangles => FuseKernel::Triangles.name(),

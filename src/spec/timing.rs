@@ -83,6 +83,10 @@ pub enum Step {
     McDirectPoints,
     /// `mc_direct_recount`: kept triangles of the rows with hits.
     McDirectRecount,
+    /// `mc_direct_unused_mark` (with `mc_direct_unused_rows`,
+    /// `mc_direct_unused_clear` and `mc_direct_unused_count`): the check,
+    /// near the dropped triangles, that every vertex is still used.
+    McDirectUnused,
     /// `mc_gradient_normals`: normals from the volume gradient.
     McGradientNormals,
     /// `fuse_index`: representative per sorted key.
@@ -190,7 +194,7 @@ impl Step {
             | CurvPrincipal | CurvDcurv => Family::Curvature,
             McClassify | McTriangles | McIota | McGradientNormals | McDirectRows
             | McDirectCount | McDirectHits | McDirectTriangles | McDirectPoints
-            | McDirectRecount => Family::MarchingCubes,
+            | McDirectRecount | McDirectUnused => Family::MarchingCubes,
             FuseIndex | FuseTriangles | FuseCandidates | FuseCancel | FuseMark
             | FuseCompactVertices | FuseCompactFaces => Family::VertexFusion,
             ScanExclusive => Family::Scan,

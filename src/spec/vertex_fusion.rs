@@ -89,10 +89,11 @@ pub fn direct_device_bytes_bound(
     let mut b =
         56 * grid_rows as u64 + 4 * hits as u64 + 12 * side_records as u64 + 12 * slots + 12 * t;
     if cleanup {
-        // rep is the faces buffer; referenced + vert_id per slot; keep,
+        // rep is the faces buffer; referenced + vert_id per slot, and direct
+        // numbering's own marks of the check for unused vertices; keep,
         // face_off, cand, cand_off per triangle; candidate keys and their
         // sort; the compacted outputs.
-        b += 8 * slots + 16 * t + 16 * t + 12 * slots + 12 * t;
+        b += 12 * slots + 16 * t + 16 * t + 12 * slots + 12 * t;
     }
     b
 }

@@ -3,13 +3,15 @@
 //! (the scan's partial totals, which size the outputs); where vertices land
 //! on grid points also hits → (host sort) → recount → scan → points, the
 //! twin check of the listed triangles, and vertex fusion's clean-up only if
-//! it would change the mesh. CPU twin:
+//! it would change the mesh; where triangles were dropped, the check that
+//! every vertex is still used (near them where they are few), and the
+//! compaction of the used ones only if one is not. CPU twin:
 //! [`crate::cpu::marching_cubes::mc_direct`].
 
 use super::{Holder, IsoStats, Isosurfacer};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
-use crate::spec::marching_cubes::McKernel;
+use crate::spec::marching_cubes::{McKernel, cell_rows, unused_check_near};
 use crate::spec::timing::Step;
 use crate::stages::vertex_fusion::Grow;
 use opencl3::kernel::Kernel;
@@ -24,6 +26,10 @@ pub(super) struct Direct {
     triangles: Kernel,
     points: Kernel,
     recount: Kernel,
+    unused_rows: Kernel,
+    unused_clear: Kernel,
+    unused_mark: Kernel,
+    unused_count: Kernel,
     /// Per grid row counts (scanned in place), splits, trims.
     rowc: Buffer<u32>,
     info: Buffer<u32>,
@@ -35,6 +41,13 @@ pub(super) struct Direct {
     /// Triangles with a corner on a grid point: (face, a, b, c, in a grid plane).
     side: Grow<u32>,
     side_n: Buffer<u32>,
+    /// Marks of the vertices near dropped triangles; the cell rows that
+    /// dropped triangles (their count, the unused count, the rows).
+    unused: Grow<u32>,
+    unused_list: Grow<u32>,
+    /// What the check for unused vertices needs of the last extraction
+    /// (`None` when it dropped no triangle).
+    pub(super) last_drops: Option<Drops>,
     /// The mesh: positions (3 floats per vertex, index space) and faces.
     pub(super) pos: Grow<f32>,
     pub(super) faces: Grow<u32>,
@@ -54,6 +67,10 @@ impl Direct {
             triangles: gpu.entry(p, McKernel::DirectTriangles)?,
             points: gpu.entry(p, McKernel::DirectPoints)?,
             recount: gpu.entry(p, McKernel::DirectRecount)?,
+            unused_rows: gpu.entry(p, McKernel::DirectUnusedRows)?,
+            unused_clear: gpu.entry(p, McKernel::DirectUnusedClear)?,
+            unused_mark: gpu.entry(p, McKernel::DirectUnusedMark)?,
+            unused_count: gpu.entry(p, McKernel::DirectUnusedCount)?,
             rowc: gpu.buffer::<u32>(4 * grid_rows)?,
             info: gpu.buffer::<u32>(4 * grid_rows)?,
             split: gpu.buffer::<u32>(2 * grid_rows)?,
@@ -62,6 +79,9 @@ impl Direct {
             tcount: gpu.buffer::<u32>(grid_rows)?,
             side: Grow::new(gpu)?,
             side_n: gpu.buffer::<u32>(1)?,
+            unused: Grow::new(gpu)?,
+            unused_list: Grow::new(gpu)?,
+            last_drops: None,
             pos: Grow::new(gpu)?,
             faces: Grow::new(gpu)?,
             nonfinite,
@@ -73,6 +93,8 @@ impl Direct {
         56 * grid_rows
             + self.side.bytes()
             + self.hit_keys.bytes()
+            + self.unused.bytes()
+            + self.unused_list.bytes()
             + self.pos.bytes()
             + self.faces.bytes()
     }
@@ -258,13 +280,36 @@ impl Isosurfacer {
             };
         }
         let dropped = twins + collapsed;
+        let drops = Drops {
+            vertices: nv,
+            hit_points: u,
+            recounted: h > 0,
+            dropped,
+        };
+        d.last_drops = (dropped > 0).then_some(drops);
         // Dropped triangles may have been a vertex's only ones: then the
         // vertices still used are compacted (no triangle to drop or cancel).
         let mut used = None;
-        if !full && (collapsed > 0 || twins > 0) {
-            let (n, t) = self.fuser.count_referenced(&d.faces.buf, nv, tk)?;
-            Self::add_events(st, &e_tri, &e_pts);
-            st.timing.extend(&t);
+        if !full && dropped > 0 {
+            let mut n = nv;
+            let mut all = true;
+            if unused_check_near(dropped, cell_rows(self.dims)) {
+                let (unused, t) = d.count_unused_near(&g, self.dims, &drops)?;
+                Self::add_events(st, &e_tri, &e_pts);
+                st.timing.extend(&t);
+                all = unused > 0;
+                n = nv - unused;
+            }
+            if all {
+                // The marks of every vertex, which the compaction numbers.
+                let (m, t) = self.fuser.count_referenced(&d.faces.buf, nv, tk)?;
+                if n == nv {
+                    Self::add_events(st, &e_tri, &e_pts);
+                }
+                st.timing.extend(&t);
+                debug_assert!(n == nv || n == m, "unused near {} all {}", nv - n, nv - m);
+                n = m;
+            }
             used = (n < nv).then_some(n);
         } else {
             g.finish()?;
@@ -295,7 +340,8 @@ impl Isosurfacer {
         Ok(())
     }
 
-    /// Adds the kernel times of `mc_direct_triangles` and `mc_direct_points`.
+    /// Adds the kernel times of `mc_direct_triangles` and `mc_direct_points`
+    /// (once they have run).
     fn add_events(
         st: &mut IsoStats,
         tri: &Option<opencl3::event::Event>,
@@ -307,6 +353,113 @@ impl Isosurfacer {
         if let Some(e) = pts {
             st.timing.add(Step::McDirectPoints, event_ms(e));
         }
+    }
+}
+
+/// What the last extraction's triangle pass left, for the check that the
+/// dropped triangles left no vertex unused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Drops {
+    /// Vertices (edge vertices, then the hit points).
+    pub(super) vertices: usize,
+    /// Hit points (sorted, unique).
+    pub(super) hit_points: usize,
+    /// The kept triangles' offsets are the recount's (there were hits),
+    /// else the count pass's.
+    pub(super) recounted: bool,
+    /// Triangles dropped (twins across a face, collapses): at least the
+    /// cell rows that dropped some.
+    pub(super) dropped: usize,
+}
+
+impl Direct {
+    /// `mc_direct_unused_rows`, `_clear`, `_mark`, `_count`: how many of the
+    /// `nv` vertices the kept triangles no longer use, looked for only in the
+    /// grid rows of the cell rows that dropped triangles (every other vertex
+    /// keeps the triangles it was made for), after the triangle pass that
+    /// left `drops`. Waits for the count.
+    pub(super) fn count_unused_near(
+        &mut self,
+        g: &Gpu,
+        dims: [usize; 3],
+        drops: &Drops,
+    ) -> Result<(usize, crate::spec::timing::Timing)> {
+        let [nx, ny, nz] = dims;
+        let (nv, u) = (drops.vertices, drops.hit_points);
+        let gr = ny * nz;
+        let v = nv - u;
+        let (toff, tshift, tbase) = if drops.recounted {
+            (&self.tcount, 0, 0)
+        } else {
+            (&self.rowc, gr as u32, v as u32)
+        };
+        let cap = drops.dropped.min(gr);
+        self.unused.reserve(g, nv)?;
+        self.unused_list.reserve(g, 2 + cap)?;
+        g.zero(&mut self.unused_list.buf, 2)?;
+        let (gr32, nx32, ny32, nz32, cap32) = (
+            Arg::U32(gr as u32),
+            Arg::U32(nx as u32),
+            Arg::U32(ny as u32),
+            Arg::U32(nz as u32),
+            Arg::U32(cap as u32),
+        );
+        let (off, toff, list, marks) = (
+            buf(&self.rowc),
+            buf(toff),
+            buf(&self.unused_list.buf),
+            buf(&self.unused.buf),
+        );
+        let (tshift, nh, keys) = (
+            Arg::U32(tshift),
+            Arg::U32(u as u32),
+            buf(&self.hit_keys.buf),
+        );
+        let e_rows = launch(
+            g,
+            &self.unused_rows,
+            gr,
+            &[gr32, ny32, nz32, off, toff, tshift, cap32, list],
+        )?;
+        let e_clear = launch(
+            g,
+            &self.unused_clear,
+            4 * cap,
+            &[gr32, nx32, ny32, nz32, off, nh, keys, cap32, list, marks],
+        )?;
+        let e_mark = launch(
+            g,
+            &self.unused_mark,
+            9 * cap,
+            &[
+                gr32,
+                ny32,
+                nz32,
+                toff,
+                tshift,
+                Arg::U32(tbase),
+                Arg::U32(nv as u32),
+                buf(&self.faces.buf),
+                cap32,
+                list,
+                marks,
+            ],
+        )?;
+        let e_count = launch(
+            g,
+            &self.unused_count,
+            4 * cap,
+            &[
+                gr32, nx32, ny32, nz32, off, toff, tshift, nh, keys, marks, cap32, list,
+            ],
+        )?;
+        let mut n = [0u32; 2];
+        g.read(&self.unused_list.buf, &mut n)?;
+        let mut t = crate::spec::timing::Timing::default();
+        for e in [&e_rows, &e_clear, &e_mark, &e_count].into_iter().flatten() {
+            t.add(Step::McDirectUnused, event_ms(e));
+        }
+        Ok((n[1] as usize, t))
     }
 }
 
@@ -338,6 +491,78 @@ fn side_records(hits: usize, triangles: usize) -> usize {
 
 #[cfg(test)]
 mod tests {
+    use super::super::Isosurfacer;
+    use crate::cpu::marching_cubes as mc;
+    use crate::gpu::Gpu;
+    use crate::spec::vertex_fusion::Fusion;
+    use crate::volume::Volume;
+    use std::sync::Arc;
+
+    /// The device's count of unused vertices near the dropped triangles
+    /// equals its CPU twin's and the count over every vertex, on volumes of
+    /// small integers at an integer iso (collapses everywhere, some leaving
+    /// vertices unused) and on smooth fields with a small block of them
+    /// (few cell rows drop triangles), whichever check the extraction chose.
+    #[test]
+    fn unused_vertices_near_dropped_triangles_match_the_twin_and_the_full_count() {
+        let gpu = match Gpu::new(None) {
+            Ok(g) => Arc::new(g),
+            Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
+        };
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rnd = move |n: u64| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s % n) as f32
+        };
+        let (mut some, mut none) = (0, 0);
+        for trial in 0..40 {
+            let n = if trial % 2 == 0 {
+                [5 + trial % 7, 4 + trial % 5, 3 + trial % 4]
+            } else {
+                [9, 20 + trial % 3, 18]
+            };
+            let vals: Vec<f32> = (0..n[0] * n[1] * n[2])
+                .map(|i| {
+                    let (x, y, z) = (i % n[0], i / n[0] % n[1], i / (n[0] * n[1]));
+                    if trial % 2 == 0 || (x < 4 && (8..12).contains(&y) && (8..12).contains(&z)) {
+                        rnd(4)
+                    } else {
+                        x as f32 * 0.37 + y as f32 * 0.11 - 1.05
+                    }
+                })
+                .collect();
+            let vol = Volume::new(n, vals, "random").unwrap();
+            let iso = 2.0;
+            let mut iz = Isosurfacer::new(gpu.clone(), &vol).unwrap();
+            iz.extract(iso, Fusion::Direct).unwrap();
+            let Some(drops) = iz.direct.last_drops else {
+                continue;
+            };
+            let (got, _) = iz.direct.count_unused_near(&gpu, iz.dims, &drops).unwrap();
+            let d = mc::mc_direct(&vol, iso);
+            let twin = mc::direct_unused_near(n, &d, &mc::mc_direct_count(&vol, iso));
+            let mut used = vec![false; d.positions.len()];
+            for f in &d.faces {
+                if f[0] != f[1] && f[1] != f[2] && f[0] != f[2] {
+                    f.iter().for_each(|&v| used[v as usize] = true);
+                }
+            }
+            let all = used.iter().filter(|&&u| !u).count();
+            assert_eq!((got, twin), (all, all), "trial {trial} {n:?}");
+            if all > 0 {
+                some += 1;
+            } else {
+                none += 1;
+            }
+        }
+        assert!(
+            some > 0 && none > 0,
+            "unused in {some} trials, none in {none}"
+        );
+    }
+
     #[test]
     fn hit_twins_finds_opposite_windings() {
         use super::hit_twins;
