@@ -6,7 +6,7 @@ the device for each accumulation scheme, and a fresh
 `shapecue curvature IN -o OUT.ply` process end to end, beside trimesh2.
 
     python3 scripts/curvature-table.py [--bin target/release/shapecue] [--runs 7] [--rounds 3]
-        [--trimesh2-bench CMD] [--trimesh2-process CMD]
+        [--trimesh2-bench CMD] [--trimesh2-process CMD] [--only NAMES] [--lanes N]
 
 Meshes: the Stanford bunny and lucy (from ../shared/data/meshes, skipped when
 absent) and generated tori of 500k and 2M vertices. Per mesh and runtime: one
@@ -21,6 +21,11 @@ fills shapecue's own kernel cache; an ordinary run fills it on Intel's runtime
 but not on PoCL), and on the bunny one process with empty kernel caches
 (nothing built) and one after `shapecue build-kernels` with PoCL's own cache
 empty (the first run after an install that ran it).
+
+PoCL compiles for the machine it runs on. To see the code an AVX2 CPU gets
+(8 float lanes) on an AVX-512 machine, run the script with
+POCL_LLVM_CPU_NAME=znver2 POCL_KERNELLIB_NAME=avx2 in its environment and
+--lanes 8 (PoCL still reports the host's vector width, 16).
 
 trimesh2 is timed in the same run when you give programs built from it
 (this script does not build trimesh2):
@@ -101,6 +106,9 @@ def main():
     ap.add_argument("--trimesh2-bench", help="command timing trimesh2's kernels (see above)")
     ap.add_argument("--trimesh2-process", help="command running trimesh2's whole job (see above)")
     ap.add_argument("--only", help="comma-separated mesh names to time (bunny,lucy,torus 500k,...)")
+    ap.add_argument("--lanes", type=int,
+                    help="faces per work-item of the N-face schemes (default: the device's native "
+                         "float width)")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="shapecue-curvature-table-")
     base_env = dict(os.environ)
@@ -164,12 +172,13 @@ def main():
             out, stats = os.path.join(tmp, "o.ply"), os.path.join(tmp, "s.json")
             base = [a.bin, "curvature", path, "-o", out, "--force"]
             run(base, env)  # warm the kernel cache
+            lanes = ["--lanes", str(a.lanes)] if a.lanes else []
             schemes = [("atomic 1", ["--accumulate", "atomic", "--lanes", "1"]),
-                       ("atomic", ["--accumulate", "atomic"]),
-                       ("atomic-native", ["--accumulate", "atomic-native"]),
+                       ("atomic", ["--accumulate", "atomic", *lanes]),
+                       ("atomic-native", ["--accumulate", "atomic-native", *lanes]),
                        ("gather 1", ["--accumulate", "gather", "--lanes", "1"]),
-                       ("gather", ["--accumulate", "gather"]),
-                       ("gather input", ["--accumulate", "gather", "--order", "input"])]
+                       ("gather", ["--accumulate", "gather", *lanes]),
+                       ("gather input", ["--accumulate", "gather", "--order", "input", *lanes])]
             # Rounds through every scheme in turn, so that a slow spell of
             # the machine does not fall on one scheme: the median over the
             # rounds of each process's median.
