@@ -49,17 +49,17 @@ fn ms(v: f64) -> Cell {
 
 /// VTK's vtkFlyingEdges3D with 2 threads, volume in memory, as timed by
 /// `scripts/isosurface-table.py` beside shapecue on a 2-core AVX-512 machine
-/// (VTK 9.7.2; median of three runs of the script on 2026-12-05/06, median
-/// ms; key: volume and resolution). The machine type drifts by a third
-/// between runs, so ratios to these are indicative only; the script times
-/// both in the same run.
+/// (AMD EPYC; VTK 9.7.2; median of three runs of the script on 2026-12-06,
+/// median ms; key: volume and resolution). The machine type drifts by a
+/// third between runs, so ratios to these are indicative only; the script
+/// times both in the same run.
 pub const FLYING_EDGES_2T_MS: [(&str, f64); 6] = [
-    ("sphere 256", 22.5),
-    ("gyroid 256", 74.8),
-    ("sphere 512", 208.4),
-    ("gyroid 512", 477.1),
-    ("bucky 32", 0.40),
-    ("ironprot 68", 0.60),
+    ("sphere 256", 23.05),
+    ("gyroid 256", 86.16),
+    ("sphere 512", 206.38),
+    ("gyroid 512", 520.23),
+    ("bucky 32", 0.34),
+    ("ironprot 68", 0.55),
 ];
 
 /// [`FLYING_EDGES_2T_MS`] of `key`.
