@@ -403,9 +403,10 @@ __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
 // x11 y00 y01 z00 z10. Returns the triangles written (bits 8..) and which
 // of the edges 0, 1, 2, 3, 4, 6, 8, 10 hold an interior vertex (bits 0..7,
 // for the caller's counts). hc: a corner of the cell is a hit point (the
-// kinds and coordinates of every edge, hit vertices by search, collapsing
-// triangles dropped, triangles with a hit corner listed in `side`); else
-// the kinds from the case alone and only the written coordinates.
+// kinds and coordinates of every edge, hit vertices' ranks read off the row's
+// hit cursor hcur, collapsing triangles dropped, triangles with a hit corner
+// listed in `side`); else the kinds from the case alone and only the
+// written coordinates.
 __attribute__((always_inline)) inline uint
 emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, uint z,
           ulong b00, ulong b10, ulong b01, ulong b11, float iso, __constant uchar *counts,
@@ -413,7 +414,7 @@ emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, 
           uint i10x, uint i01x, uint i11x, uint i00y, uint i01y, uint i00z, uint i10z,
           uint out, uint edge_vertices, uint nh, __global const uint *hit_keys,
           __global float *pos, __global uint *faces, uint side_cap, __global uint *side,
-          volatile __global uint *side_n, const bool hc)
+          volatile __global uint *side_n, const HitCursor *hcur, const bool hc)
 {
     // The last cell row of y (z) also writes the vertices of row 10 (01),
     // which is not a cell row; the last cell of a row those at x = nx − 1.
@@ -443,8 +444,7 @@ emit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint y, 
     if (hc) {
         for (uint e = 0; e < 12; ++e) {
             if (k[e] >= EV_LO) {
-                id[e] = hit_vertex(hit_point(e, k[e], x, y, z, nx, ny), hit_keys, nh,
-                                   edge_vertices);
+                id[e] = hit_vertex_at(hcur, hit_keys, e, k[e], x, edge_vertices);
                 ++ch;
             }
         }
@@ -532,7 +532,7 @@ emit_hit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint
               uint i11x, uint i00y, uint i01y, uint i00z, uint i10z, uint out,
               uint edge_vertices, uint nh, __global const uint *hit_keys, __global float *pos,
               __global uint *faces, uint side_cap, __global uint *side,
-              volatile __global uint *side_n)
+              volatile __global uint *side_n, const HitCursor *hcur)
 {
     float v[8];
     const uint cas = cell_case(vol, b00, b10, b01, b11, x, iso, v);
@@ -540,7 +540,7 @@ emit_hit_cell(__global const float *vol, uint nx, uint ny, uint nz, uint x, uint
         return 0;
     return emit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris, flat, cas,
                      v, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out, edge_vertices, nh,
-                     hit_keys, pos, faces, side_cap, side, side_n, true);
+                     hit_keys, pos, faces, side_cap, side, side_n, hcur, true);
 }
 
 // The cells of one cell row of mc_direct_triangles, from the row's first
@@ -607,7 +607,8 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
         if (row_hits && hnext <= x + 1) {
             r = emit_hit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris,
                               flat, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out,
-                              edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n);
+                              edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n,
+                              &h);
         } else {
             // A cell of a finite chunk reads only the corner values it needs
             // (EDGE_C), its case known from the chunk.
@@ -617,7 +618,7 @@ triangles_row(__global const float *vol, uint nx, uint ny, uint nz, uint y, uint
                 continue;
             r = emit_cell(vol, nx, ny, nz, x, y, z, b00, b10, b01, b11, iso, counts, tris, flat,
                           cas, v, i00x, i10x, i01x, i11x, i00y, i01y, i00z, i10z, out,
-                          edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n,
+                          edge_vertices, nh, hit_keys, pos, faces, side_cap, side, side_n, 0,
                           false);
         }
         out += 3 * (r >> 8);

@@ -244,13 +244,6 @@ inline uint lower_bound_keys(__global const uint *keys, uint nh, ulong g)
     return lo;
 }
 
-// Vertex of a hit: edge_vertices + the rank of grid point g among the nh
-// sorted, unique hit points.
-inline uint hit_vertex(uint g, __global const uint *keys, uint nh, uint edge_vertices)
-{
-    return edge_vertices + lower_bound_keys(keys, nh, g);
-}
-
 // The hit points on the four grid rows of a cell row, walked in x order: a
 // cell has an edge whose vertex lands on a grid point only when one of its
 // corners is a hit point, so only those cells need the hit-aware steps (the
@@ -370,6 +363,22 @@ inline uint hit_point(uint e, uint kind, uint x, uint y, uint z, uint nx, uint n
     const uint c0 = edge_lo_corner(e);
     const uint cn = kind == EV_LO ? c0 : (c0 | (1u << (e >> 2)));
     return grid_index(x + (cn & 1), y + ((cn >> 1) & 1), z + (cn >> 2), nx, ny);
+}
+
+// The vertex of the hit on edge e (kind EV_LO or EV_HI) of cell x of the
+// cursor's cell row: edge_vertices + the rank of that corner's grid point
+// among the sorted, unique hit points, read off the cursor without a search.
+// Each of the cursor's rows starts at its first hit point at or after x (as
+// in mc_direct_triangles' hit cells), so the point of corner x is its row's
+// first and that of corner x + 1 the first or the next.
+inline uint hit_vertex_at(const HitCursor *h, __global const uint *keys, uint e, uint kind,
+                          uint x, uint edge_vertices)
+{
+    const uint c0 = edge_lo_corner(e);
+    const uint cn = kind == EV_LO ? c0 : (c0 | (1u << (e >> 2)));
+    const uint i = ((cn >> 1) & 1) + 2 * (cn >> 2), p = h->p[i];
+    const ulong g = h->g[i] + x + (cn & 1);
+    return edge_vertices + ((ulong)keys[p] == g ? p : p + 1);
 }
 
 // True when two corners of the triangle on edges ea, eb, ec of cell (x, y, z)
