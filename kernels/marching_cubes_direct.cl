@@ -293,26 +293,6 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     trim[3 * gid + 2] = mask;
 }
 
-inline void hit_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
-                      uint nx, uint ny, uint y, uint z, float iso, __global uint *keys, uint *o)
-{
-    float c;
-    const float a = vol[b00 + i];
-    const uint g = grid_index(i, y, z, nx, ny);
-    uint k;
-    if (i + 1 < nx) {
-        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
-        if (k >= EV_LO)
-            keys[(*o)++] = k == EV_LO ? g : g + 1;
-    }
-    k = edge_kind(a, vol[b10 + i], iso, y, &c);
-    if (k >= EV_LO)
-        keys[(*o)++] = k == EV_LO ? g : g + nx;
-    k = edge_kind(a, vol[b01 + i], iso, z, &c);
-    if (k >= EV_LO)
-        keys[(*o)++] = k == EV_LO ? g : g + nx * ny;
-}
-
 __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
                              __global const float *vol, float iso, __global const uint *off,
                              __global const uint *trim, uint hit_base, uint hit_end,
@@ -326,13 +306,31 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
     if (first == end)
         return;
     uint o = first - hit_base;
+    const uint done = end - hit_base;
+    const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     uint x = lo;
-    for (; x + 16 < nx && x < hi; x += 16) {
-        if (chunk_uniform(vol, b00, b10, b01, b11, x, iso))
+    // 16 positions at a time: where their owned edges' ends are finite, the
+    // hits in lanes (the keys' order is free: the host sorts them); the row
+    // done once its count of hits is written.
+    for (; x + 16 < nx && x < hi && o < done; x += 16) {
+        const float16 a = vload16(0, vol + b00 + x), ax = vload16(0, vol + b00 + x + 1);
+        const float16 ay = vload16(0, vol + b10 + x), az = vload16(0, vol + b01 + x);
+        if (!all16(isfinite(a) & isfinite(ax) & isfinite(ay) & isfinite(az))) {
+            for (uint i = x; i < x + 16; ++i)
+                hit_owned(vol, b00, b10, b01, i, nx, ny, y, z, iso, keys, &o);
             continue;
-        for (uint i = x; i < x + 16; ++i)
-            hit_owned(vol, b00, b10, b01, i, nx, ny, y, z, iso, keys, &o);
+        }
+        const uint g = grid_index(x, y, z, nx, ny);
+        uint ux, uy, uz;
+        put_hits(hit_ends16(a, ax, iso, (float16)((float)x) + lane, &ux), g, keys, &o);
+        put_hits(ux, g + 1, keys, &o);
+        put_hits(hit_ends16(a, ay, iso, (float16)((float)y), &uy), g, keys, &o);
+        put_hits(uy, g + nx, keys, &o);
+        put_hits(hit_ends16(a, az, iso, (float16)((float)z), &uz), g, keys, &o);
+        put_hits(uz, g + nx * ny, keys, &o);
     }
+    if (o >= done)
+        return;
     // The tail, unless the chunk that ends at the row's end is uniform.
     if (x < hi && x + 1 < nx && nx >= 17 && chunk_uniform(vol, b00, b10, b01, b11, nx - 17, iso))
         return;

@@ -4,8 +4,10 @@
 // lanes, the owned edges of a row position, the twin test of triangles
 // lying in a cube face, the twelve edges' kinds and coordinates of the
 // triangle pass, and the steps of the cells with a corner on a hit point
-// (the sorted hit points, their cursor over a cell row, collapses), and the
-// dropped triangles per cell row of the check for unused vertices. Uses
+// (the hit points a grid row's owned edges round onto, in lanes or one
+// position at a time; the sorted hit points, their cursor over a cell row,
+// collapses), and the dropped triangles per cell row of the check for
+// unused vertices. Uses
 // mc_edge.h (the edge rule) and mc_cell.h (cell cases, edge numbering). CPU
 // twin: src/cpu/marching_cubes.rs (edge_vertex, has_twin).
 
@@ -142,20 +144,39 @@ inline uint owned16(int16 hx, int16 hy, int16 hz, int16 ix, int16 iy, int16 iz, 
     return s2.x + s2.y;
 }
 
+// The vertex coordinate fa + t of 16 edges at once, all ends finite, as
+// edge_kind computes it; *cross the lanes whose ends are on either side.
+inline float16 edge_c16(float16 v0, float16 v1, float iso, float16 fa, int16 *cross)
+{
+    const float16 i16 = (float16)(iso);
+    *cross = isless(v0, i16) ^ isless(v1, i16);
+    float16 t = (i16 - v0) / (v1 - v0);
+    t = select((float16)(0.0f), t, isgreaterequal(t, (float16)(0.0f)));
+    t = select(t, (float16)(1.0f), isgreater(t, (float16)(1.0f)));
+    return fa + t;
+}
+
 // edge_kind for 16 edges at once, all ends finite: *inside gets the lanes
 // with a vertex inside the edge, the return value the lanes that round onto
 // an end. fa is the edges' lower coordinate along their axis.
 inline int16 edge_kinds16(float16 v0, float16 v1, float iso, float16 fa, int16 *inside)
 {
-    const float16 i16 = (float16)(iso);
-    const int16 cross = isless(v0, i16) ^ isless(v1, i16);
-    float16 t = (i16 - v0) / (v1 - v0);
-    t = select((float16)(0.0f), t, isgreaterequal(t, (float16)(0.0f)));
-    t = select(t, (float16)(1.0f), isgreater(t, (float16)(1.0f)));
-    const float16 c = fa + t;
+    int16 cross;
+    const float16 c = edge_c16(v0, v1, iso, fa, &cross);
     const int16 hit = cross & ((c == fa) | (c == fa + 1.0f));
     *inside = cross & ~hit;
     return hit;
+}
+
+// The hits of 16 edges at once, all ends finite (as edge_kinds16), as lane
+// bits: the return value the lanes whose vertex rounds onto the lower end,
+// *up those that round onto the upper end.
+inline uint hit_ends16(float16 v0, float16 v1, float iso, float16 fa, uint *up)
+{
+    int16 cross;
+    const float16 c = edge_c16(v0, v1, iso, fa, &cross);
+    *up = lanes_bits(cross & (c == fa + 1.0f));
+    return lanes_bits(cross & (c == fa));
 }
 
 // True when triangle j of cell (x, y, z) of case cas, flagged as lying in a
@@ -242,6 +263,36 @@ inline uint lower_bound_keys(__global const uint *keys, uint nh, ulong g)
             hi = m;
     }
     return lo;
+}
+
+// The hit points that grid row (y, z)'s owned edges at position i round
+// onto (mc_direct_hits), appended to keys from *o.
+inline void hit_owned(__global const float *vol, ulong b00, ulong b10, ulong b01, uint i,
+                      uint nx, uint ny, uint y, uint z, float iso, __global uint *keys, uint *o)
+{
+    float c;
+    const float a = vol[b00 + i];
+    const uint g = grid_index(i, y, z, nx, ny);
+    uint k;
+    if (i + 1 < nx) {
+        k = edge_kind(a, vol[b00 + i + 1], iso, i, &c);
+        if (k >= EV_LO)
+            keys[(*o)++] = k == EV_LO ? g : g + 1;
+    }
+    k = edge_kind(a, vol[b10 + i], iso, y, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx;
+    k = edge_kind(a, vol[b01 + i], iso, z, &c);
+    if (k >= EV_LO)
+        keys[(*o)++] = k == EV_LO ? g : g + nx * ny;
+}
+
+// Appends g + i for each lane bit i of `bits`.
+inline void put_hits(uint bits, uint g, __global uint *keys, uint *o)
+{
+    for (uint i = 0; bits != 0; ++i, bits >>= 1)
+        if (bits & 1)
+            keys[(*o)++] = g + i;
 }
 
 // The hit points on the four grid rows of a cell row, walked in x order: a
