@@ -46,12 +46,7 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
     ] {
         assert!(stats.get(key).is_some(), "stats lack {key}: {stats}");
     }
-    let passes: Vec<&str> = stats["passes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p["pass"].as_str().unwrap())
-        .collect();
+    let passes = pass_names(&stats["passes"]);
     assert_eq!(
         passes,
         [
@@ -79,6 +74,15 @@ fn curvature_writes_ply_with_the_documented_properties_and_stats() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--force"));
+}
+
+/// The `pass` of each entry of a `--stats` list of passes, in order.
+fn pass_names(list: &serde_json::Value) -> Vec<&str> {
+    list.as_array()
+        .expect("a list of passes")
+        .iter()
+        .map(|p| p["pass"].as_str().expect("a pass name"))
+        .collect()
 }
 
 #[test]
@@ -751,12 +755,7 @@ fn isosurface_runs_time_the_extraction() {
     let s: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("g.json")).unwrap()).unwrap();
     assert!(s["extraction"]["exact_hits"].as_u64().unwrap() > 0, "{s}");
-    let names: Vec<&str> = s["passes_median"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p["pass"].as_str().unwrap())
-        .collect();
+    let names = pass_names(&s["passes_median"]);
     let mut unique = names.clone();
     unique.sort_unstable();
     unique.dedup();

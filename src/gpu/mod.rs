@@ -745,3 +745,13 @@ impl Drop for Gpu {
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|p| p.into_inner())
 }
+
+/// The device the library's unit tests run on (the default pick, as for the
+/// integration tests), or a panic saying that they need one.
+#[cfg(test)]
+pub(crate) fn test_gpu() -> Arc<Gpu> {
+    match Gpu::new(None) {
+        Ok(g) => Arc::new(g),
+        Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
+    }
+}

@@ -668,10 +668,7 @@ mod tests {
     /// `offsetof` as the device compiler sees them.
     #[test]
     fn param_block_layout_matches_the_kernel() {
-        let gpu = match Gpu::new(None) {
-            Ok(g) => g,
-            Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
-        };
+        let gpu = crate::gpu::test_gpu();
         let fields = EdgeParamBlock::field_offsets();
         let mut probe = String::from("\n__kernel void edges_probe_layout(__global uint* out) {\n");
         for (i, (name, _)) in fields.iter().enumerate() {

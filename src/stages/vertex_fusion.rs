@@ -496,10 +496,7 @@ mod tests {
     /// through the whole clean-up and through the compaction alone.
     #[test]
     fn a_corner_past_the_vertices_comes_out_of_range_and_is_not_followed() {
-        let gpu = match Gpu::new(None) {
-            Ok(g) => Arc::new(g),
-            Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
-        };
+        let gpu = crate::gpu::test_gpu();
         let pos_host: [f32; 12] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
         let mut pos = gpu.buffer::<f32>(12).unwrap();
         gpu.write(&mut pos, &pos_host).unwrap();

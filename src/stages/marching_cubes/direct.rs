@@ -12,7 +12,7 @@ use super::{Holder, IsoStats, Isosurfacer};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::marching_cubes::{McKernel, cell_rows, unused_check_near};
-use crate::spec::timing::Step;
+use crate::spec::timing::{Step, Timing};
 use crate::stages::vertex_fusion::Grow;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
@@ -383,7 +383,7 @@ impl Direct {
         g: &Gpu,
         dims: [usize; 3],
         drops: &Drops,
-    ) -> Result<(usize, crate::spec::timing::Timing)> {
+    ) -> Result<(usize, Timing)> {
         let [nx, ny, nz] = dims;
         let (nv, u) = (drops.vertices, drops.hit_points);
         let gr = ny * nz;
@@ -455,7 +455,7 @@ impl Direct {
         )?;
         let mut n = [0u32; 2];
         g.read(&self.unused_list.buf, &mut n)?;
-        let mut t = crate::spec::timing::Timing::default();
+        let mut t = Timing::default();
         for e in [&e_rows, &e_clear, &e_mark, &e_count].into_iter().flatten() {
             t.add(Step::McDirectUnused, event_ms(e));
         }
@@ -493,10 +493,8 @@ fn side_records(hits: usize, triangles: usize) -> usize {
 mod tests {
     use super::super::Isosurfacer;
     use crate::cpu::marching_cubes as mc;
-    use crate::gpu::Gpu;
     use crate::spec::vertex_fusion::Fusion;
     use crate::volume::Volume;
-    use std::sync::Arc;
 
     /// The device's count of unused vertices near the dropped triangles
     /// equals its CPU twin's and the count over every vertex, on volumes of
@@ -505,10 +503,7 @@ mod tests {
     /// (few cell rows drop triangles), whichever check the extraction chose.
     #[test]
     fn unused_vertices_near_dropped_triangles_match_the_twin_and_the_full_count() {
-        let gpu = match Gpu::new(None) {
-            Ok(g) => Arc::new(g),
-            Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
-        };
+        let gpu = crate::gpu::test_gpu();
         let mut s = 0x9E37_79B9_7F4A_7C15u64;
         let mut rnd = move |n: u64| {
             s ^= s << 13;
