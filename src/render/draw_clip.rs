@@ -105,23 +105,54 @@ impl Renderer {
                 "{what}: {prims} primitives are too many for one draw"
             )));
         }
+        let quads = if per == 4 { prims } else { 0 };
+        // SAFETY: the context is current (`frame`); clip_vao is this
+        // renderer's own clip-vertex array.
+        unsafe { self.clip_state(self.clip_vao, color, quads) };
         let gl = &self.gl;
         // SAFETY: the context is current (`frame`); every index of the
         // pattern's first `index_count` is < 4 * prims = kept.len().
         unsafe {
-            gl.use_program(Some(self.clip_prog));
-            let [r, g, b, a] = color;
-            gl.uniform_4_f32(self.clip_color.as_ref(), r, g, b, a);
-            gl.bind_vertex_array(Some(self.clip_vao));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.clip_bufs[0]));
             gl.buffer_data_u8_slice(
                 glow::ARRAY_BUFFER,
                 bytemuck::cast_slice(kept),
                 glow::STREAM_DRAW,
             );
-            if per == 4 && prims > self.quad_pattern {
-                // Doubling keeps the uploads of a growing edge count rare.
-                let quads = prims.max(2 * self.quad_pattern).min(u32::MAX as usize / 4);
+            if per == 4 {
+                gl.draw_elements(glow::TRIANGLES, index_count as i32, glow::UNSIGNED_INT, 0);
+            } else {
+                gl.draw_arrays(glow::TRIANGLES, 0, index_count as i32);
+            }
+            gl.bind_vertex_array(None);
+        }
+        check(gl, &format!("{what} ({prims} primitives)"))
+    }
+
+    /// Binds the clip program with `color` and the vertex array `vao`, grows
+    /// the quad index pattern that every clip-vertex array shares (0 1 2 0 2 3
+    /// per quad, at least doubled when it grows, so that the uploads of a
+    /// growing edge count stay rare) to cover `quads` quads, turns blending on
+    /// for a color with alpha below 1, and sets the depth test.
+    ///
+    /// # Safety
+    /// The context must be current and `vao` one of this renderer's
+    /// clip-vertex arrays (bound to the shared element buffer).
+    pub(super) unsafe fn clip_state(
+        &mut self,
+        vao: glow::VertexArray,
+        color: [f32; 4],
+        quads: usize,
+    ) {
+        let gl = &self.gl;
+        let [r, g, b, a] = color;
+        // SAFETY: the caller's contract.
+        unsafe {
+            gl.use_program(Some(self.clip_prog));
+            gl.uniform_4_f32(self.clip_color.as_ref(), r, g, b, a);
+            gl.bind_vertex_array(Some(vao));
+            if quads > self.quad_pattern {
+                let quads = quads.max(2 * self.quad_pattern).min(u32::MAX as usize / 4);
                 let pattern: Vec<u32> = (0..quads as u32)
                     .flat_map(|q| [0, 1, 2, 0, 2, 3].map(|k| 4 * q + k))
                     .collect();
@@ -138,13 +169,6 @@ impl Renderer {
                 gl.disable(glow::BLEND);
             }
             gl.depth_func(glow::LEQUAL);
-            if per == 4 {
-                gl.draw_elements(glow::TRIANGLES, index_count as i32, glow::UNSIGNED_INT, 0);
-            } else {
-                gl.draw_arrays(glow::TRIANGLES, 0, index_count as i32);
-            }
-            gl.bind_vertex_array(None);
         }
-        check(gl, &format!("{what} ({prims} primitives)"))
     }
 }

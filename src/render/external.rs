@@ -295,35 +295,15 @@ impl Renderer {
                 "{what}: {prims} primitives are too many for one draw"
             )));
         };
+        let quads = if per == 4 { prims } else { 0 };
+        // SAFETY: the context is current (`frame`); an imported buffer's
+        // vertex array is a clip-vertex array of this renderer.
+        unsafe { self.clip_state(b.vao, color, quads) };
         let gl = &self.gl;
         // SAFETY: the context is current (`frame`); the pattern covers
-        // `prims` quads (grown below) and every index it yields, offset by
+        // `prims` quads (clip_state) and every index it yields, offset by
         // `first`, is < first + count ≤ the buffer's vertices.
         unsafe {
-            gl.use_program(Some(self.clip_prog));
-            let [r, g, bl, a] = color;
-            gl.uniform_4_f32(self.clip_color.as_ref(), r, g, bl, a);
-            gl.bind_vertex_array(Some(b.vao));
-            if per == 4 && prims > self.quad_pattern {
-                // The same pattern and growth as `draw_clip`'s (0 1 2 0 2 3
-                // per quad, doubled), in the element buffer both arrays use.
-                let quads = prims.max(2 * self.quad_pattern).min(u32::MAX as usize / 4);
-                let pattern: Vec<u32> = (0..quads as u32)
-                    .flat_map(|q| [0, 1, 2, 0, 2, 3].map(|k| 4 * q + k))
-                    .collect();
-                gl.buffer_data_u8_slice(
-                    glow::ELEMENT_ARRAY_BUFFER,
-                    bytemuck::cast_slice(&pattern),
-                    glow::STATIC_DRAW,
-                );
-                self.quad_pattern = quads;
-            }
-            if a < 1.0 {
-                gl.enable(glow::BLEND);
-            } else {
-                gl.disable(glow::BLEND);
-            }
-            gl.depth_func(glow::LEQUAL);
             if per == 4 {
                 gl.draw_elements_base_vertex(glow::TRIANGLES, n, glow::UNSIGNED_INT, 0, first_i);
             } else {
