@@ -187,3 +187,43 @@ impl Error {
         }
     }
 }
+
+/// Values as a message shows them, in place of Rust's debug form: each
+/// value's plain `Display` (`1`, `2.5`, `NaN`), joined by `sep` (", " for a
+/// tuple in prose, " " for a header's own field syntax).
+pub(crate) fn values<T: std::fmt::Display>(
+    items: impl IntoIterator<Item = T>,
+    sep: &str,
+) -> String {
+    items
+        .into_iter()
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>()
+        .join(sep)
+}
+
+/// The choices a message offers, in words: `sphere, torus or gyroid`.
+pub(crate) fn one_of(names: &[&str]) -> String {
+    match names.split_last() {
+        None => String::new(),
+        Some((last, [])) => last.to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+    }
+}
+
+#[cfg(test)]
+mod message_tests {
+    use super::*;
+
+    #[test]
+    fn values_and_choices_read_as_words() {
+        assert_eq!(values([1.0f32, 2.5, f32::NAN], ", "), "1, 2.5, NaN");
+        assert_eq!(values([0i64, 31, 0], " "), "0 31 0");
+        assert_eq!(
+            one_of(&["sphere", "torus", "gyroid"]),
+            "sphere, torus or gyroid"
+        );
+        assert_eq!(one_of(&["png"]), "png");
+        assert_eq!(one_of(&[]), "");
+    }
+}

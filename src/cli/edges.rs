@@ -104,7 +104,13 @@ fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
         Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
             Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
         }
-        Some(v) => bail!("--{what} needs three finite numbers X,Y,Z, got {v:?}"),
+        Some(v) => bail!(
+            "--{what} needs three finite numbers X,Y,Z, got {}",
+            v.iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        ),
     }
 }
 

@@ -142,7 +142,13 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
             Some(glam::Vec3::new(v[0], v[1], v[2]))
         }
-        Some(v) => bail!("--eye needs three finite numbers X,Y,Z, got {v:?}"),
+        Some(v) => bail!(
+            "--eye needs three finite numbers X,Y,Z, got {}",
+            v.iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        ),
     };
     let opts = StrokesOptions {
         iso,

@@ -174,8 +174,10 @@ impl Flipbook {
                 name,
                 format!("face {k}"),
                 format!(
-                    "vertices {f:?}, but face {k} of the first frame ({first}) is {g:?} \
-                     (frames must share one topology)"
+                    "vertices {}, but face {k} of the first frame ({first}) is {} \
+                     (frames must share one topology)",
+                    crate::error::values(f, " "),
+                    crate::error::values(g, " ")
                 ),
             ));
         }
@@ -192,7 +194,9 @@ impl Flipbook {
                         format!("vertex {v}"),
                         format!(
                             "welded with vertex {u} in the first frame ({first}), but here \
-                             at {p:?} instead of {q:?}"
+                             at ({}) instead of ({})",
+                            crate::error::values(p, ", "),
+                            crate::error::values(q, ", ")
                         ),
                     ));
                 }

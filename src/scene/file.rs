@@ -371,7 +371,11 @@ impl Scene {
             if !NAMES.contains(&g.get_ref().as_str()) {
                 return Err(ck.err(
                     g.span(),
-                    format!("generate = {:?}: expected one of {NAMES:?}", g.get_ref()),
+                    format!(
+                        "generate = {:?}: expected {}",
+                        g.get_ref(),
+                        crate::error::one_of(&NAMES)
+                    ),
                 ));
             }
             Source::Generate(g.get_ref().clone(), inp.resolution.unwrap_or(40_000))
@@ -397,7 +401,11 @@ impl Scene {
             if !KINDS.contains(&s.get_ref().as_str()) {
                 return Err(ck.err(
                     s.span(),
-                    format!("sdf = {:?}: expected one of {KINDS:?}", s.get_ref()),
+                    format!(
+                        "sdf = {:?}: expected {}",
+                        s.get_ref(),
+                        crate::error::one_of(&KINDS)
+                    ),
                 ));
             }
             let res = inp.resolution.unwrap_or(128);

@@ -351,7 +351,8 @@ impl LineExtractor {
 fn check_view((eye, ortho): ([f32; 3], bool), feature_size: f32) -> Result<()> {
     if eye.iter().any(|c| !c.is_finite()) || (ortho && eye == [0.0; 3]) {
         return Err(Error::InvalidArgument(format!(
-            "feature lines: invalid view {eye:?} (finite eye; a non-zero direction when orthographic)"
+            "feature lines: invalid view ({}) (finite eye; a non-zero direction when orthographic)",
+            crate::error::values(eye, ", ")
         )));
     }
     if !(feature_size.is_finite() && feature_size > 0.0) {

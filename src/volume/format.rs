@@ -317,7 +317,10 @@ pub(super) fn oriented(
         Error::input(
             source,
             "geometry",
-            format!("{what} {v:?} must be finite and non-zero"),
+            format!(
+                "{what} ({}) must be finite and non-zero",
+                crate::error::values(v, ", ")
+            ),
         )
     };
     if !steps.iter().all(|s| s.is_finite() && *s != 0.0) {

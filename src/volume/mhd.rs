@@ -180,8 +180,9 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             let d = diagonal(axes).ok_or_else(|| Error::UnsupportedFormat {
                 path: path.to_path_buf(),
                 problem: format!(
-                    "TransformMatrix {m:?} is not axis-aligned: shapecue reads grids whose \
-                     axes follow x, y and z (resample the volume first)"
+                    "TransformMatrix = {} is not axis-aligned: shapecue reads grids whose \
+                     axes follow x, y and z (resample the volume first)",
+                    crate::error::values(m, " ")
                 ),
             })?;
             std::array::from_fn(|i| spacing[i] * d[i])

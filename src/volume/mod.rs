@@ -117,12 +117,14 @@ impl Volume {
     pub fn with_geometry(mut self, spacing: [f64; 3], origin: [f64; 3]) -> Result<Volume> {
         if let Some(s) = spacing.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
             return Err(Error::InvalidArgument(format!(
-                "volume spacing {spacing:?}: {s} is not a finite positive number"
+                "volume spacing ({}): {s} is not a finite positive number",
+                crate::error::values(spacing, ", ")
             )));
         }
         if !origin.iter().all(|o| o.is_finite()) {
             return Err(Error::InvalidArgument(format!(
-                "volume origin {origin:?} is not finite"
+                "volume origin ({}) is not finite",
+                crate::error::values(origin, ", ")
             )));
         }
         self.spacing = spacing;

@@ -91,8 +91,12 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
         (Some(axes), _) => diagonal(axes).ok_or_else(|| Error::UnsupportedFormat {
             path: path.to_path_buf(),
             problem: format!(
-                "space directions {axes:?} are not axis-aligned: shapecue reads grids whose \
-                 axes follow x, y and z (resample the volume first)"
+                "space directions: {} are not axis-aligned: shapecue reads grids whose \
+                 axes follow x, y and z (resample the volume first)",
+                axes.iter()
+                    .map(|a| format!("({})", crate::error::values(a, ",")))
+                    .collect::<Vec<_>>()
+                    .join(" ")
             ),
         })?,
         (None, Some(s)) => s,

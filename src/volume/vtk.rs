@@ -306,7 +306,9 @@ pub(super) fn load_xml(path: &Path) -> Result<Volume> {
     }
     if let Some(p) = x.piece_extent.filter(|p| *p != e) {
         return Err(unsupported(format!(
-            "a Piece with Extent {p:?} smaller than the WholeExtent {e:?} is not supported"
+            "a Piece with Extent \"{}\" smaller than the WholeExtent \"{}\" is not supported",
+            crate::error::values(p, " "),
+            crate::error::values(e, " ")
         )));
     }
     let array = x
@@ -377,9 +379,9 @@ pub(super) fn load_xml(path: &Path) -> Result<Volume> {
     ];
     let d = diagonal(axes).ok_or_else(|| {
         unsupported(format!(
-            "Direction {:?} is not axis-aligned: shapecue reads grids whose axes follow x, y \
-             and z (resample the volume first)",
-            x.direction
+            "Direction \"{}\" is not axis-aligned: shapecue reads grids whose axes follow x, \
+             y and z (resample the volume first)",
+            crate::error::values(x.direction, " ")
         ))
     })?;
     let steps: [f64; 3] = std::array::from_fn(|i| x.spacing[i] * d[i]);

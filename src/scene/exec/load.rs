@@ -72,8 +72,12 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
                         p.display().to_string(),
                         format!("clip {n:?}"),
                         format!(
-                            "no such clip; the file has {:?}",
-                            m.clips.iter().map(|c| c.name.as_str()).collect::<Vec<_>>()
+                            "no such clip; the file has {}",
+                            m.clips
+                                .iter()
+                                .map(|c| format!("\"{}\"", c.name))
+                                .collect::<Vec<_>>()
+                                .join(", ")
                         ),
                     )
                 })?,

@@ -59,6 +59,10 @@ fn sources_must_be_exactly_one_and_files_must_exist() {
     assert!(e.contains("clip"), "{e}");
     let e = err("[input]\ngenerate = \"cube\"\n[effects]\nshading = {}\n");
     assert!(e.contains("line 2") && e.contains("cube"), "{e}");
+    // The choices in words, not a Rust list.
+    assert!(e.contains("torus") && !e.contains("[\""), "{e}");
+    let e = err("[input]\nsdf = \"cube\"\n[effects]\nshading = {}\n");
+    assert!(e.contains("expected sphere, torus or gyroid"), "{e}");
 }
 
 #[test]
