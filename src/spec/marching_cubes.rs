@@ -18,6 +18,8 @@
 
 use std::sync::OnceLock;
 
+use crate::error::{Error, Result};
+
 /// Most triangles one cell can emit (checked when the table is built).
 pub const MAX_CELL_TRIANGLES: usize = 5;
 /// Table row terminator.
@@ -149,6 +151,35 @@ pub fn common_face(a: usize, b: usize, c: usize) -> Option<(usize, usize)> {
 pub fn table() -> &'static McTable {
     static T: OnceLock<McTable> = OnceLock::new();
     T.get_or_init(build_table)
+}
+
+/// Most grid points along one axis. The kernels (and their CPU twins) place
+/// a vertex in grid-index space in `f32`, where integers above 2^24 are not
+/// all representable: beyond it an edge's two ends round to one value and a
+/// crossing would be counted once but listed as two grid points.
+pub const MAX_AXIS_POINTS: usize = 1 << 24;
+
+/// Checks that a volume of `dims` grid points can be extracted: each axis at
+/// most [`MAX_AXIS_POINTS`] and fewer than 2^32 voxels in all (the kernels'
+/// 32-bit vertex and grid indices). The error names the axis or the count.
+pub fn check_dims(dims: [usize; 3]) -> Result<()> {
+    for (axis, &d) in ["x", "y", "z"].iter().zip(&dims) {
+        if d > MAX_AXIS_POINTS {
+            return Err(Error::InvalidArgument(format!(
+                "volume of {}×{}×{} voxels: {d} along {axis}; marching cubes places \
+                 vertices in single precision and takes at most {MAX_AXIS_POINTS} \
+                 (2^24) along an axis",
+                dims[0], dims[1], dims[2]
+            )));
+        }
+    }
+    let n = dims.iter().map(|&d| d as u64).product::<u64>();
+    if n >= 1 << 32 {
+        return Err(Error::InvalidArgument(format!(
+            "volume of {n} voxels: at most 2^32 − 1 voxels"
+        )));
+    }
+    Ok(())
 }
 
 /// Number of cell rows (one row: every cell with the same y and z).
@@ -306,4 +337,24 @@ crate::spec::kernels::kernel_entries! {
 /// `triangles / cell_rows` each, are at most a quarter of the `triangles`.
 pub fn unused_check_near(dropped: usize, cell_rows: usize) -> bool {
     36 * dropped as u64 <= cell_rows as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dims_beyond_single_precision_or_32_bit_indices_are_refused() {
+        assert!(check_dims([MAX_AXIS_POINTS, 2, 2]).is_ok());
+        for (dims, word) in [
+            ([MAX_AXIS_POINTS + 1, 2, 2], "along x"),
+            ([17, MAX_AXIS_POINTS + 17, 2], "along y"),
+            ([2, 2, usize::MAX], "along z"),
+            ([65_536, 65_536, 2], "2^32"),
+        ] {
+            let e = check_dims(dims).unwrap_err().to_string();
+            assert!(e.contains(word), "{dims:?}: {e}");
+        }
+        assert!(check_dims([65_536, 65_535, 1]).is_ok());
+    }
 }

@@ -35,10 +35,12 @@ impl<T> Grow<T> {
         })
     }
     /// Makes room for `n` elements (grows by 1/8 extra to avoid re-allocating
-    /// for every slightly larger frame).
+    /// for every slightly larger frame, but never past the device's largest
+    /// buffer, so that what fits is not refused for the slack).
     pub(crate) fn reserve(&mut self, gpu: &Gpu, n: usize) -> Result<()> {
         if n > self.len {
-            let len = n + n / 8;
+            let most = gpu.info.max_alloc / std::mem::size_of::<T>().max(1) as u64;
+            let len = (n + n / 8).min(usize::try_from(most).unwrap_or(usize::MAX).max(n));
             self.buf = gpu.buffer::<T>(len)?;
             self.len = len;
         }

@@ -166,8 +166,17 @@ impl Isosurfacer {
         }
         let cleanup = h > 0 || d.nonfinite;
         let side_cap = side_records(h, t);
+        // Twins alone (no hit, a finite volume) can still drop triangles and
+        // leave a vertex unused, which takes the compaction's buffers too.
         let need = 4 * voxels as u64
-            + crate::spec::vertex_fusion::direct_device_bytes_bound(gr, v, h, t, side_cap, cleanup);
+            + crate::spec::vertex_fusion::direct_device_bytes_bound(
+                gr,
+                v,
+                h,
+                t,
+                side_cap,
+                cleanup || twins > 0,
+            );
         if need > g.info.global_mem {
             return Err(Error::DeviceUnsupported {
                 device: g.info.name.clone(),
@@ -220,7 +229,10 @@ impl Isosurfacer {
                 st.timing.add(Step::McDirectRecount, event_ms(e));
             }
             st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-            collapsed = t - tk;
+            collapsed = t.checked_sub(tk).ok_or_else(|| Error::DeviceResult {
+                what: "triangle recount".into(),
+                detail: format!("{tk} kept triangles of {t}"),
+            })?;
         }
         let nv = v + u;
         d.pos.reserve(&g, 3 * nv)?;
@@ -298,7 +310,10 @@ impl Isosurfacer {
                 Self::add_events(st, &e_tri, &e_pts);
                 st.timing.extend(&t);
                 all = unused > 0;
-                n = nv - unused;
+                n = nv.checked_sub(unused).ok_or_else(|| Error::DeviceResult {
+                    what: "count of unused vertices".into(),
+                    detail: format!("{unused} unused of {nv}"),
+                })?;
             }
             if all {
                 // The marks of every vertex, which the compaction numbers.

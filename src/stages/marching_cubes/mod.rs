@@ -18,7 +18,7 @@ use crate::gpu::{Arg, Gpu, buf, launch};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureOptions, Normalization};
 use crate::spec::marching_cubes::McKernel;
-use crate::spec::marching_cubes::{cell_rows, edge_key_bits, table};
+use crate::spec::marching_cubes::{cell_rows, check_dims, edge_key_bits, table};
 use crate::spec::timing::Timing;
 use crate::spec::vertex_fusion::Fusion;
 use crate::stages::curvature::CurvatureEstimator;
@@ -121,12 +121,8 @@ impl Isosurfacer {
                 ),
             });
         }
+        check_dims(vol.dims)?;
         let n = vol.voxel_count();
-        if vol.dims.iter().any(|&d| d > u32::MAX as usize) || n as u64 >= (1u64 << 32) {
-            return Err(Error::InvalidArgument(format!(
-                "volume of {n} voxels: at most 2^32 − 1 voxels"
-            )));
-        }
         let mut opts = build_options(collide_mask);
         if gpu.info.kind == "CPU" {
             // Software prefetch of the streamed rows (common/mc_cell.h): on
