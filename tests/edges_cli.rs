@@ -193,3 +193,61 @@ fn cli_without_an_eye_frames_the_mesh() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--target needs --eye"));
 }
+
+/// The visible polyline length of an SVG's `points` attributes, in pixels.
+fn svg_visible_length(svg: &std::path::Path) -> f64 {
+    let t = std::fs::read_to_string(svg).unwrap();
+    let mut total = 0.0;
+    for part in t.split("points=\"").skip(1) {
+        let pts: Vec<(f64, f64)> = part[..part.find('"').unwrap()]
+            .split_whitespace()
+            .map(|p| {
+                let (x, y) = p.split_once(',').unwrap();
+                (x.parse().unwrap(), y.parse().unwrap())
+            })
+            .collect();
+        total += pts
+            .windows(2)
+            .map(|w| (w[1].0 - w[0].0).hypot(w[1].1 - w[0].1))
+            .sum::<f64>();
+    }
+    total
+}
+
+#[test]
+fn svg_visibility_does_not_depend_on_the_stroke_width() {
+    // Wide strokes once hid the lines beside them: their quads were in the
+    // depth buffer the SVG's visibility test reads (a width of 50 kept a
+    // seventh of Spot's contours). Only the surface may hide a line.
+    let d = scratch("svg-width");
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
+    for cmd in ["lines", "edges"] {
+        let mut lengths = Vec::new();
+        for width in ["2", "50"] {
+            let svg = d.join(format!("{cmd}-{width}.svg"));
+            let png = d.join(format!("{cmd}-{width}.png"));
+            let args: Vec<&str> = if cmd == "lines" {
+                vec!["lines", spot, "-o", svg.to_str().unwrap(), "--width", width]
+            } else {
+                let (p, s) = (png.to_str().unwrap(), svg.to_str().unwrap());
+                vec!["edges", spot, "-o", p, "--svg", s, "--width", width]
+            };
+            let out = run_cli(&args);
+            if cli_gl_missing(&out) {
+                return;
+            }
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            lengths.push(svg_visible_length(&svg));
+        }
+        let (thin, wide) = (lengths[0], lengths[1]);
+        assert!(thin > 100.0, "{cmd}: {thin} px of visible lines");
+        assert!(
+            (wide - thin).abs() <= 0.02 * thin,
+            "{cmd}: {thin} px visible at width 2, {wide} px at width 50"
+        );
+    }
+}

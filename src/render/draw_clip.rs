@@ -124,7 +124,7 @@ impl Renderer {
             } else {
                 gl.draw_arrays(glow::TRIANGLES, 0, index_count as i32);
             }
-            gl.bind_vertex_array(None);
+            self.clip_done();
         }
         check(gl, &format!("{what} ({prims} primitives)"))
     }
@@ -133,7 +133,11 @@ impl Renderer {
     /// the quad index pattern that every clip-vertex array shares (0 1 2 0 2 3
     /// per quad, at least doubled when it grows, so that the uploads of a
     /// growing edge count stay rare) to cover `quads` quads, turns blending on
-    /// for a color with alpha below 1, and sets the depth test.
+    /// for a color with alpha below 1, and sets the depth test against the
+    /// surface without writing depth: the depth buffer keeps only the
+    /// surfaces, so that the SVG visibility test (`visibility.rs`) sees a
+    /// line hidden by the surface and never by another line's wide quad.
+    /// [`Renderer::clip_done`] turns depth writes back on.
     ///
     /// # Safety
     /// The context must be current and `vao` one of this renderer's
@@ -169,6 +173,20 @@ impl Renderer {
                 gl.disable(glow::BLEND);
             }
             gl.depth_func(glow::LEQUAL);
+            gl.depth_mask(false);
+        }
+    }
+
+    /// Undoes what [`Renderer::clip_state`] changed that later surface draws
+    /// rely on: depth writes on, no vertex array bound.
+    ///
+    /// # Safety
+    /// The context must be current.
+    pub(super) unsafe fn clip_done(&self) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            self.gl.depth_mask(true);
+            self.gl.bind_vertex_array(None);
         }
     }
 }

@@ -309,7 +309,7 @@ impl Renderer {
             } else {
                 gl.draw_arrays(glow::TRIANGLES, first_i, n);
             }
-            gl.bind_vertex_array(None);
+            self.clip_done();
         }
         check(gl, &format!("{what} ({prims} primitives)"))
     }

@@ -20,8 +20,9 @@
 //! and its window depth is at most the farthest depth of the 3×3 pixels around
 //! it (faces beside a crease may be nearer than the edge a fraction of a pixel
 //! away) plus `bias` plus the edge's depth change over 1.5 pixels (the stored
-//! sample need not sit at the pixel centre); the edge quads were drawn into
-//! that depth buffer, so an unoccluded edge sees its own depth there.
+//! sample need not sit at the pixel centre). Lines are drawn without writing
+//! depth, so the depth buffer holds the surfaces only: a line is hidden by
+//! the mesh, never by another line's quad, whatever the stroke width.
 
 use std::collections::HashMap;
 
