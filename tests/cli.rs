@@ -708,6 +708,28 @@ fn jpeg_names_and_huge_widths_are_refused() {
     assert!(!jpg.exists());
     let e = run(&["edges", "missing.obj", "--width", "1e30", "-o", "x.png"]);
     assert!(e.contains("--width") && e.contains("at most"), "{e}");
+    // The lines command checks the same, and its generated meshes' size,
+    // before allocating (a huge --vertices aborted on allocation).
+    let svg = d.join("l.svg");
+    let s = svg.to_str().unwrap();
+    let e = run(&["lines", "torus", "--width", "1e9", "-o", s]);
+    assert!(e.contains("--width") && e.contains("at most"), "{e}");
+    let e = run(&["lines", "torus", "--vertices", "100000000000", "-o", s]);
+    assert!(e.contains("--vertices") && e.contains("limit"), "{e}");
+    let e = run(&["lines", "torus", "--vertices", "0", "-o", s]);
+    assert!(e.contains("--vertices") && e.contains("at least 3"), "{e}");
+    let e = run(&[
+        "lines",
+        "torus",
+        "--vertices",
+        "2000",
+        "--sc-threshold",
+        "nan",
+        "-o",
+        s,
+    ]);
+    assert!(e.contains("suggestive-contour threshold"), "{e}");
+    assert!(!svg.exists());
 }
 
 /// `isosurface --runs N`: N more extractions through the library's call

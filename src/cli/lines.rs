@@ -114,8 +114,13 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if fams == FamilySet::NONE {
         bail!("--lines names no family");
     }
-    if !(a.width.is_finite() && a.width > 0.0) {
-        bail!("--width must be a positive number of pixels");
+    let widest = w.max(h) as f32;
+    if !(a.width.is_finite() && a.width > 0.0 && a.width <= widest) {
+        bail!(
+            "--width {}: the line width must be a positive number of pixels, at most the \
+             image's larger side ({widest} pixels)",
+            a.width
+        );
     }
     let svg = match a.output.extension().and_then(|e| e.to_str()) {
         Some("svg") => true,
@@ -132,6 +137,9 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let outputs: Vec<&std::path::Path> = std::iter::once(a.output.as_path())
         .chain(a.segments.as_deref())
         .collect();
+    if generated {
+        shapecue::spec::limits::check_mesh_vertices("--vertices", a.vertices)?;
+    }
     check_outputs(inputs, outputs, a.force)?;
     let mesh = if generated {
         shapecue::mesh::generated_by_name(&a.mesh, a.vertices)

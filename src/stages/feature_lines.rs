@@ -51,6 +51,26 @@ impl Default for LineOptions {
     }
 }
 
+impl LineOptions {
+    /// Checks the suggestive-contour threshold (finite, at least 0) and fade
+    /// (finite, above 0), then the curvature families' controls.
+    pub fn check(&self) -> Result<()> {
+        if !(self.threshold.is_finite() && self.threshold >= 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "the suggestive-contour threshold must be finite and at least 0, got {}",
+                self.threshold
+            )));
+        }
+        if !(self.fade.is_finite() && self.fade > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "the suggestive-contour fade must be a finite number above 0, got {}",
+                self.fade
+            )));
+        }
+        self.curves.check()
+    }
+}
+
 /// Kernel times and counts of one extraction.
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct LineStats {
@@ -245,6 +265,7 @@ impl LineExtractor {
         feature_size: f32,
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
+        opts.check()?;
         let n = self.nv;
         let g = self.gpu.clone();
         g.zero(&mut self.counter, 1)?;
