@@ -73,7 +73,8 @@ fn refuse(msg: String) -> Error {
     Error::InvalidArgument(msg)
 }
 
-/// Checks a run's outputs before it starts, then creates their folders.
+/// Checks a run's outputs before it starts, then creates their folders and
+/// checks that each can take a new file.
 ///
 /// `inputs` are every file the run reads (mesh, volume header *and* its
 /// detached data files, marked-edge lists, scene files); `outputs` every file
@@ -155,6 +156,20 @@ pub fn check_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Result
                 source,
             })?;
         }
+        // Each folder must take a new file now, so that a run with several
+        // outputs does not write the first and then fail on a later one (a
+        // read-only folder, one of /proc or /sys): the probe is the hidden
+        // temporary file `write_atomic` would make, removed at once.
+        let probe = temp_path(out);
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&probe)
+            .map_err(|source| Error::Write {
+                path: out.to_path_buf(),
+                source,
+            })?;
+        let _ = std::fs::remove_file(&probe);
     }
     Ok(())
 }
@@ -416,6 +431,27 @@ mod tests {
         assert_eq!(names.len(), 1, "{names:?}");
         write_bytes_atomic(&a, b"new").unwrap();
         assert_eq!(std::fs::read_to_string(&a).unwrap(), "new");
+    }
+
+    #[test]
+    fn a_folder_that_takes_no_file_is_refused_before_anything_is_written() {
+        // /proc/self takes no new file, even as root: a run whose second
+        // output goes there must fail before its first is written.
+        let d = dir("probe");
+        let first = d.join("first.png");
+        let proc = Path::new("/proc/self/x.svg");
+        if Path::new("/proc/self").is_dir() {
+            let e = check_outputs(&[], &[&first, proc], false)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("/proc/self/x.svg"), "{e}");
+        }
+        check_outputs(&[], &[&first], false).unwrap();
+        let names: Vec<_> = std::fs::read_dir(&*d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert!(names.is_empty(), "the probe was left behind: {names:?}");
     }
 
     #[test]
