@@ -477,6 +477,37 @@ fn nan_and_infinite_voxels_never_make_nan_vertices() {
 }
 
 #[test]
+fn values_whose_differences_overflow_place_vertices_as_scaled_down_ones() {
+    // Random values in ±3 scaled by 2^126 (up to ±2.6e38): most edge
+    // differences overflow f32. Scaling by a power of two commutes with
+    // rounding, so the crossings must be exactly those of the unscaled
+    // volume (they were all snapped to an edge's lower end, dropping half
+    // the triangles as collapsed).
+    let mut r = rng(0x5eed_0ff3);
+    let small = Volume::new(
+        [11, 9, 13],
+        (0..11 * 9 * 13).map(|_| 6.0 * r() - 3.0).collect(),
+        "noise",
+    )
+    .unwrap();
+    let scale = 2f32.powi(126);
+    let big = Volume::new(
+        small.dims,
+        small.values.iter().map(|v| v * scale).collect(),
+        "noise × 2^126",
+    )
+    .unwrap();
+    assert!(big.values.iter().any(|v| v.abs() > 1.7e38));
+    check_same(&big, 0.0, "values near the f32 limit");
+    for f in ALL {
+        let (a, _) = device(&small, 0.0, f, None);
+        let (b, _) = device(&big, 0.0, f, None);
+        assert_eq!(a.faces.len(), b.faces.len(), "{f:?}: faces");
+        assert!(a == b, "{f:?}: the scaled volume gives another mesh");
+    }
+}
+
+#[test]
 fn sdf_surfaces_are_closed_manifolds_on_the_device() {
     for (kind, chi) in [(Sdf::Sphere, 2), (Sdf::Torus, 0)] {
         let (m, _) = device(&sdf(kind, 64), 0.0, Fusion::Hash, None);

@@ -572,3 +572,21 @@ fn gyroid_calibration() {
         "{edges} edges"
     );
 }
+
+#[test]
+fn max_finite_abs_skips_nan_and_infinities_in_every_lane_and_the_tail() {
+    for n in [1usize, 15, 16, 17, 33, 100] {
+        for at in [0, n / 2, n - 1] {
+            let mut v = vec![0.5f32; n];
+            v[at] = -7.25;
+            if n > 2 {
+                v[(at + 1) % n] = f32::NAN;
+                v[(at + 2) % n] = f32::NEG_INFINITY;
+            }
+            let vol = Volume::new([n, 1, 1], v, "lanes").unwrap();
+            assert_eq!(vol.max_finite_abs(), 7.25, "n {n}, at {at}");
+        }
+    }
+    let all_bad = Volume::new([3, 1, 1], vec![f32::NAN, f32::INFINITY, f32::NAN], "bad").unwrap();
+    assert_eq!(all_bad.max_finite_abs(), 0.0);
+}

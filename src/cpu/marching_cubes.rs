@@ -60,10 +60,16 @@ pub fn mc_classify(vol: &Volume, iso: f32) -> Vec<u32> {
 
 /// The interpolation parameter of the crossing of `iso` between values `v0`
 /// and `v1`, clamped to [0, 1] (the kernels' `mc_edge_t`). NaN (from ±inf
-/// voxels or overflowing differences) fails the test too: the vertex goes to
-/// the lower end.
+/// voxels) fails the test too: the vertex goes to the lower end. Where a
+/// difference of finite values overflows (beyond ±1.7e38), both differences
+/// are taken of the halved values, which halving leaves exact.
 pub fn edge_t(v0: f32, v1: f32, iso: f32) -> f32 {
-    let mut t = (iso - v0) / (v1 - v0);
+    let (mut n, mut d) = (iso - v0, v1 - v0);
+    if n.is_infinite() || d.is_infinite() {
+        n = iso * 0.5 - v0 * 0.5;
+        d = v1 * 0.5 - v0 * 0.5;
+    }
+    let mut t = n / d;
     if t.is_nan() || t < 0.0 {
         t = 0.0;
     }

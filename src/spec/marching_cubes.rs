@@ -182,6 +182,20 @@ pub fn check_dims(dims: [usize; 3]) -> Result<()> {
     Ok(())
 }
 
+/// Finite sample magnitude from which an edge's value difference can
+/// overflow `f32` (2^126, about 8.5e37): volumes with such values build the
+/// marching-cubes kernels with `SC_MC_HALVE`, whose lane code takes the
+/// halved differences where one overflows, as `mc_edge_t` always does (and
+/// the CPU twin's `edge_t`). Below it no difference on a crossing edge
+/// overflows, so both give the same bits.
+pub const HALVE_FROM: f32 = (1u128 << 126) as f32;
+
+/// Whether a volume whose largest finite magnitude is `max_abs` needs
+/// `SC_MC_HALVE` ([`HALVE_FROM`]).
+pub fn halves_differences(max_abs: f32) -> bool {
+    max_abs >= HALVE_FROM
+}
+
 /// Number of cell rows (one row: every cell with the same y and z).
 pub fn cell_rows(dims: [usize; 3]) -> usize {
     if dims.iter().any(|&d| d < 2) {
@@ -356,5 +370,15 @@ mod tests {
             assert!(e.contains(word), "{dims:?}: {e}");
         }
         assert!(check_dims([65_536, 65_535, 1]).is_ok());
+    }
+
+    #[test]
+    fn below_halve_from_no_difference_overflows() {
+        assert_eq!(HALVE_FROM, 2f32.powi(126));
+        let below = f32::from_bits(HALVE_FROM.to_bits() - 1);
+        assert!((below - -below).is_finite());
+        assert!((HALVE_FROM - -HALVE_FROM).is_finite());
+        assert!((f32::MAX - -HALVE_FROM).is_infinite());
+        assert!(!halves_differences(below) && halves_differences(HALVE_FROM));
     }
 }

@@ -162,6 +162,28 @@ impl Volume {
         Some(it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v))))
     }
 
+    /// The largest magnitude of a finite sample (0 when there is none).
+    pub fn max_finite_abs(&self) -> f32 {
+        // Sixteen running maxima of plain selects (not f32::max, whose NaN
+        // rule keeps the loop scalar), so that it vectorises: infinities
+        // and NaN fail `a < INFINITY` and count as 0.
+        fn keep(m: f32, v: f32) -> f32 {
+            let a = v.abs();
+            let a = if a < f32::INFINITY { a } else { 0.0 };
+            if a > m { a } else { m }
+        }
+        let mut acc = [0f32; 16];
+        let chunks = self.values.chunks_exact(16);
+        let tail = chunks.remainder();
+        for c in chunks {
+            for (m, &v) in acc.iter_mut().zip(c) {
+                *m = keep(*m, v);
+            }
+        }
+        let m = tail.iter().fold(0f32, |m, &v| keep(m, v));
+        acc.iter().fold(m, |a, &b| if b > a { b } else { a })
+    }
+
     /// Size of the samples in memory, in bytes.
     pub fn bytes(&self) -> u64 {
         (self.values.len() as u64) * std::mem::size_of::<f32>() as u64

@@ -18,7 +18,9 @@ use crate::gpu::{Arg, Gpu, buf, launch};
 use crate::mesh::Mesh;
 use crate::spec::curvature::{CurvatureOptions, Normalization};
 use crate::spec::marching_cubes::McKernel;
-use crate::spec::marching_cubes::{cell_rows, check_dims, edge_key_bits, table};
+use crate::spec::marching_cubes::{
+    cell_rows, check_dims, edge_key_bits, halves_differences, table,
+};
 use crate::spec::timing::Timing;
 use crate::spec::vertex_fusion::Fusion;
 use crate::stages::curvature::CurvatureEstimator;
@@ -124,6 +126,9 @@ impl Isosurfacer {
         check_dims(vol.dims)?;
         let n = vol.voxel_count();
         let mut opts = build_options(collide_mask);
+        if halves_differences(vol.max_finite_abs()) {
+            opts.push_str(" -DSC_MC_HALVE");
+        }
         if gpu.info.kind == "CPU" {
             // Software prefetch of the streamed rows (common/mc_cell.h): on
             // PoCL the row, count and triangle passes otherwise wait on memory.
