@@ -730,6 +730,25 @@ fn jpeg_names_and_huge_widths_are_refused() {
     ]);
     assert!(e.contains("suggestive-contour threshold"), "{e}");
     assert!(!svg.exists());
+    // Strokes with no surface say why in the user's terms: an open mesh,
+    // or the range of the values as given (density volumes are negated
+    // inside, which the range once showed).
+    let tri = d.join("tri.obj");
+    std::fs::write(&tri, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let png = d.join("s.png");
+    let p = png.to_str().unwrap();
+    let e = run(&["strokes", tri.to_str().unwrap(), "-o", p]);
+    assert!(e.contains("closed"), "{e}");
+    let raw = d.join("ramp.raw");
+    let ramp: Vec<u8> = (0..512u32)
+        .flat_map(|i| (1.0 + (i % 8) as f32).to_le_bytes())
+        .collect();
+    std::fs::write(&raw, ramp).unwrap();
+    let r = raw.to_str().unwrap();
+    let dims = ["--dims", "8,8,8", "--type", "f32"];
+    let e = run(&[&["strokes", r, "--iso", "20", "-o", p][..], &dims[..]].concat());
+    assert!(e.contains("span 1 to 8"), "{e}");
+    assert!(!png.exists());
 }
 
 /// `isosurface --runs N`: N more extractions through the library's call

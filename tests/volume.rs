@@ -78,7 +78,10 @@ fn bucky_raw_through_rawspec() {
     // Without a spec a .raw file cannot be read.
     let (e, msg) = err(&path, None);
     assert!(matches!(e, Error::UnsupportedFormat { .. }), "{msg}");
-    assert!(msg.contains("RawSpec"), "{msg}");
+    assert!(msg.contains("--dims") && !msg.contains("RawSpec"), "{msg}");
+    // A folder is named as one.
+    let (_, msg) = err(path.parent().unwrap(), None);
+    assert!(msg.contains("a folder"), "{msg}");
     // A wrong spec is reported with both sizes.
     let (_, msg) = err(&path, Some(&RawSpec::new([32, 32, 33], ScalarType::U8)));
     assert!(

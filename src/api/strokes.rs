@@ -207,7 +207,11 @@ pub fn strokes_on(
     let (surface, picture) = match &opts.picture {
         None => (None, None),
         Some(p) => {
-            let (mesh, picture) = draw_picture(gpu, &vol, iso_below, opts.iso, &out.strokes, p)?;
+            let what = match input {
+                StrokesInput::Mesh(..) => Surface::OfMesh,
+                _ => Surface::Iso(volume, opts.iso),
+            };
+            let (mesh, picture) = draw_picture(gpu, &vol, iso_below, what, &out.strokes, p)?;
             (Some(mesh), Some(picture))
         }
     };
@@ -224,12 +228,20 @@ pub fn strokes_on(
     })
 }
 
+/// What the surface under the strokes is, for the message when it is empty:
+/// the zero set of a mesh's distance field, or an isosurface of the user's
+/// volume (as given, before orienting) at the user's iso value.
+enum Surface<'a> {
+    OfMesh,
+    Iso(&'a Volume, f32),
+}
+
 /// The isosurface under the strokes and the picture of both.
 fn draw_picture(
     gpu: &Arc<Gpu>,
     vol: &Volume,
     iso_below: f32,
-    iso: f32,
+    what: Surface<'_>,
     world_strokes: &[Stroke],
     p: &PictureOptions,
 ) -> Result<(Mesh, Picture)> {
@@ -238,14 +250,19 @@ fn draw_picture(
     let (ipos, faces) = ex.read_index_space()?;
     let mesh = ex.world_mesh(&ipos, faces);
     if mesh.n_faces() == 0 {
-        let span = vol
-            .range()
-            .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
-                format!("the values span {lo} to {hi}")
-            });
-        return Err(Error::InvalidArgument(format!(
-            "the isosurface at iso {iso} is empty ({span})"
-        )));
+        return Err(Error::InvalidArgument(match what {
+            Surface::OfMesh => "the mesh's distance field has no inside, so there is no \
+                                surface to draw strokes on: is the mesh closed?"
+                .to_string(),
+            Surface::Iso(volume, iso) => {
+                let span = volume
+                    .range()
+                    .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
+                        format!("the values span {lo} to {hi}")
+                    });
+                format!("the isosurface at iso {iso} is empty ({span})")
+            }
+        }));
     }
     let normals = crate::cpu::marching_cubes::gradient_normals(vol, &ipos);
 

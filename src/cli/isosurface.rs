@@ -128,7 +128,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         },
     };
     if !iso.is_finite() {
-        bail!("--iso {iso} must be finite");
+        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
     }
     check_outputs(
         a.input

@@ -123,7 +123,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         (None, _) => 0.0,
     };
     if !iso.is_finite() {
-        bail!("--iso {iso} must be finite");
+        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
     }
     let inside: Inside = match &a.inside {
         Some(s) => s.parse()?,

@@ -52,9 +52,14 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Mesh> {
             });
         }
         None => {
+            let what = if path.is_dir() {
+                "a folder, not a mesh file"
+            } else {
+                "no file extension"
+            };
             return Err(Error::UnsupportedFormat {
                 path: path.to_path_buf(),
-                problem: "no file extension (shapecue reads .obj, .ply and .off)".into(),
+                problem: format!("{what} (shapecue reads .obj, .ply and .off)"),
             });
         }
     };

@@ -8,7 +8,7 @@ use super::{Volume, mhd, nrrd, raw, slc, vtk};
 use crate::error::{Error, Result};
 
 /// File extensions [`load`] recognises, for messages.
-const EXTENSIONS: &str = ".raw (with a RawSpec), .nrrd, .nhdr, .mhd, .mha, .vtk, .vti and .slc";
+const EXTENSIONS: &str = ".raw (with its dimensions and voxel type given), .nrrd, .nhdr, .mhd, .mha, .vtk, .vti and .slc";
 
 /// Loads a volume. With `raw` given, the file is read as headerless samples
 /// whatever its extension; otherwise the format follows the extension
@@ -38,13 +38,18 @@ pub fn load(path: &Path, raw: Option<&RawSpec>) -> Result<Volume> {
         Some("slc") => slc::load(path),
         Some("raw") => Err(Error::UnsupportedFormat {
             path: path.to_path_buf(),
-            problem: "a .raw file has no header: give its dimensions and scalar type \
-                      (a RawSpec)"
+            problem: "a .raw file has no header: give its dimensions and voxel type \
+                      (on the command line --dims and --type), or convert it to NRRD or \
+                      MetaImage with a header"
                 .into(),
         }),
         Some(other) => Err(Error::UnsupportedFormat {
             path: path.to_path_buf(),
             problem: format!("unknown extension '.{other}' (shapecue reads {EXTENSIONS})"),
+        }),
+        None if path.is_dir() => Err(Error::UnsupportedFormat {
+            path: path.to_path_buf(),
+            problem: format!("a folder, not a volume file (shapecue reads {EXTENSIONS})"),
         }),
         None => Err(Error::UnsupportedFormat {
             path: path.to_path_buf(),
