@@ -689,68 +689,6 @@ fn strokes_from_a_field_and_from_a_mesh() {
     assert!(status.success(), "{err}");
 }
 
-/// An image name that is not `.png` is refused (the bytes would be PNG),
-/// and a width past the image is refused.
-#[test]
-fn jpeg_names_and_huge_widths_are_refused() {
-    let d = scratch("refusals");
-    let run = |args: &[&str]| {
-        let o = cli().args(args).output().unwrap();
-        assert!(!o.status.success(), "{args:?} should fail");
-        String::from_utf8_lossy(&o.stderr).to_string()
-    };
-    let jpg = d.join("o.jpg");
-    let j = jpg.to_str().unwrap();
-    let e = run(&["strokes", "--sdf", "sphere", "--resolution", "16", "-o", j]);
-    assert!(e.contains(".png"), "{e}");
-    let e = run(&["edges", "missing.obj", "-o", j]);
-    assert!(e.contains(".png"), "{e}");
-    assert!(!jpg.exists());
-    let e = run(&["edges", "missing.obj", "--width", "1e30", "-o", "x.png"]);
-    assert!(e.contains("--width") && e.contains("at most"), "{e}");
-    // The lines command checks the same, and its generated meshes' size,
-    // before allocating (a huge --vertices aborted on allocation).
-    let svg = d.join("l.svg");
-    let s = svg.to_str().unwrap();
-    let e = run(&["lines", "torus", "--width", "1e9", "-o", s]);
-    assert!(e.contains("--width") && e.contains("at most"), "{e}");
-    let e = run(&["lines", "torus", "--vertices", "100000000000", "-o", s]);
-    assert!(e.contains("--vertices") && e.contains("limit"), "{e}");
-    let e = run(&["lines", "torus", "--vertices", "0", "-o", s]);
-    assert!(e.contains("--vertices") && e.contains("at least 3"), "{e}");
-    let e = run(&[
-        "lines",
-        "torus",
-        "--vertices",
-        "2000",
-        "--sc-threshold",
-        "nan",
-        "-o",
-        s,
-    ]);
-    assert!(e.contains("suggestive-contour threshold"), "{e}");
-    assert!(!svg.exists());
-    // Strokes with no surface say why in the user's terms: an open mesh,
-    // or the range of the values as given (density volumes are negated
-    // inside, which the range once showed).
-    let tri = d.join("tri.obj");
-    std::fs::write(&tri, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    let png = d.join("s.png");
-    let p = png.to_str().unwrap();
-    let e = run(&["strokes", tri.to_str().unwrap(), "-o", p]);
-    assert!(e.contains("closed"), "{e}");
-    let raw = d.join("ramp.raw");
-    let ramp: Vec<u8> = (0..512u32)
-        .flat_map(|i| (1.0 + (i % 8) as f32).to_le_bytes())
-        .collect();
-    std::fs::write(&raw, ramp).unwrap();
-    let r = raw.to_str().unwrap();
-    let dims = ["--dims", "8,8,8", "--type", "f32"];
-    let e = run(&[&["strokes", r, "--iso", "20", "-o", p][..], &dims[..]].concat());
-    assert!(e.contains("span 1 to 8"), "{e}");
-    assert!(!png.exists());
-}
-
 /// `isosurface --runs N`: N more extractions through the library's call
 /// after the one written; the stats give their count and medians, per pass
 /// too, and the summary says so.

@@ -369,14 +369,8 @@ impl Scene {
         } else if let Some(g) = &inp.generate {
             use crate::mesh::GENERATED_NAMES as NAMES;
             if !NAMES.contains(&g.get_ref().as_str()) {
-                return Err(ck.err(
-                    g.span(),
-                    format!(
-                        "generate = {:?}: expected {}",
-                        g.get_ref(),
-                        crate::error::one_of(&NAMES)
-                    ),
-                ));
+                let (got, want) = (g.get_ref(), crate::error::one_of(&NAMES));
+                return Err(ck.err(g.span(), format!("generate = {got:?}: expected {want}")));
             }
             Source::Generate(g.get_ref().clone(), inp.resolution.unwrap_or(40_000))
         } else if let Some(g) = &inp.gltf {
@@ -399,14 +393,8 @@ impl Scene {
             let s = inp.sdf.as_ref().expect("one source is given");
             const KINDS: [&str; 3] = ["sphere", "torus", "gyroid"];
             if !KINDS.contains(&s.get_ref().as_str()) {
-                return Err(ck.err(
-                    s.span(),
-                    format!(
-                        "sdf = {:?}: expected {}",
-                        s.get_ref(),
-                        crate::error::one_of(&KINDS)
-                    ),
-                ));
+                let (got, want) = (s.get_ref(), crate::error::one_of(&KINDS));
+                return Err(ck.err(s.span(), format!("sdf = {got:?}: expected {want}")));
             }
             let res = inp.resolution.unwrap_or(128);
             if !(4..=1024).contains(&res) {
