@@ -52,12 +52,15 @@ use toml::Spanned;
 
 pub mod lines;
 mod raw;
+mod toml_words;
+
 pub use lines::{LineEffects, LineStyle};
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
     IsophoteSpec, LineSpec, OutputSpec, PlainLineSpec, SamplingSpec, SceneFile, ShadingSpec,
     StrokeSpec, SuggestiveSpec, ThresholdLineSpec,
 };
+use toml_words::plain_toml_message;
 
 /// Where a scene's geometry comes from, resolved.
 #[derive(Debug, Clone, PartialEq)]
@@ -289,7 +292,7 @@ impl Scene {
         let ck = Checker { path, text };
         let file: SceneFile = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            ck.err(span, e.message().trim().to_string())
+            ck.err(span, plain_toml_message(e.message().trim()))
         })?;
         let name = path
             .file_stem()
