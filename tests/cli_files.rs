@@ -259,5 +259,19 @@ fn jpeg_names_and_huge_widths_are_refused() {
     let dims = ["--dims", "8,8,8", "--type", "f32"];
     let e = run(&[&["strokes", r, "--iso", "20", "-o", p][..], &dims[..]].concat());
     assert!(e.contains("span 1 to 8"), "{e}");
+    // A field of view out of range is named as such, not as an infinite eye.
+    for fov in ["0", "nan"] {
+        let e = run(&[
+            "lines",
+            "torus",
+            "--vertices",
+            "2000",
+            "--fov",
+            fov,
+            "-o",
+            p,
+        ]);
+        assert!(e.contains("field of view") && !e.contains("inf"), "{e}");
+    }
     assert!(!png.exists());
 }

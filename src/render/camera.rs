@@ -141,6 +141,14 @@ impl Camera {
     /// non-positive orthographic height, near ≤ 0 or far ≤ near.
     pub fn validate(&self) -> Result<()> {
         let bad = |problem: String| Err(Error::InvalidArgument(format!("camera: {problem}")));
+        // First, as a framed camera's eye is placed from it: a bad field of
+        // view shows as an infinite eye otherwise.
+        if self.ortho_height.is_none() && !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return bad(format!(
+                "field of view {}° must be in (0°, 180°)",
+                self.fov_y_deg
+            ));
+        }
         let finite = self.eye.is_finite()
             && self.target.is_finite()
             && self.up.is_finite()
@@ -172,15 +180,10 @@ impl Camera {
                 self.up, dir
             ));
         }
-        match self.ortho_height {
-            Some(h) if h <= 0.0 => return bad(format!("orthographic height {h} must be > 0")),
-            None if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) => {
-                return bad(format!(
-                    "field of view {}° must be in (0°, 180°)",
-                    self.fov_y_deg
-                ));
-            }
-            _ => {}
+        if let Some(h) = self.ortho_height
+            && h <= 0.0
+        {
+            return bad(format!("orthographic height {h} must be > 0"));
         }
         if self.near <= 0.0 {
             return bad(format!("near {} must be > 0", self.near));
