@@ -209,11 +209,15 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         }
     }
     let list: Vec<String> = counts.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    let n = pic.segments.len();
+    let found = match n {
+        0 => "no segments: no line of the chosen families is in view".to_string(),
+        1 => format!("1 segment ({})", list.join(", ")),
+        _ => format!("{n} segments ({})", list.join(", ")),
+    };
     super::print(format_args!(
-        "{}: {} segments ({}), kernels {:.2} ms",
+        "{}: {found}, kernels {:.2} ms",
         a.output.display(),
-        pic.segments.len(),
-        list.join(", "),
         pic.timing.kernel_ms
     ))?;
     Ok(())
