@@ -98,22 +98,6 @@ pub struct EdgesArgs {
     runs: Option<usize>,
 }
 
-fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
-    match v {
-        None => Ok(None),
-        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
-            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
-        }
-        Some(v) => bail!(
-            "--{what} needs three finite numbers X,Y,Z, got {}",
-            v.iter()
-                .map(|c| c.to_string())
-                .collect::<Vec<_>>()
-                .join(",")
-        ),
-    }
-}
-
 fn ms_since(t: std::time::Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -125,19 +109,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let mode: CapMode = a.caps.parse()?;
     let (w, h) = super::size_arg(&a.size)?;
     // Checked before any table or drawing: the message names the flag.
-    if !(a.width.is_finite() && a.width > 0.0) {
-        bail!(
-            "--width {}: the edge width must be a positive number of pixels",
-            a.width
-        );
-    }
-    let widest = w.max(h) as f32;
-    if a.width > widest {
-        bail!(
-            "--width {}: the edge width must be at most the image's larger side ({widest} pixels)",
-            a.width
-        );
-    }
+    super::width_arg(a.width, (w, h), "edge")?;
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
@@ -162,14 +134,14 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let t_load = std::time::Instant::now();
     let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
     let load_ms = ms_since(t_load);
-    let eye = vec3_arg(&a.eye, "eye")?;
+    let eye = super::vec3_arg(&a.eye, "eye")?;
     if eye.is_none() && a.target.is_some() {
         bail!("--target needs --eye (without both, the view is fitted around the mesh)");
     }
     let opts = EdgePictureOptions {
         eye,
-        target: vec3_arg(&a.target, "target")?,
-        up: vec3_arg(&a.up, "up")?,
+        target: super::vec3_arg(&a.target, "target")?,
+        up: super::vec3_arg(&a.up, "up")?,
         fov_deg: a.fov,
         ortho: a.ortho,
         width: w,

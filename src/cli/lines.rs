@@ -97,16 +97,6 @@ pub struct LinesArgs {
     force: bool,
 }
 
-fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> Result<Option<glam::Vec3>> {
-    match v {
-        None => Ok(None),
-        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
-            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
-        }
-        Some(_) => bail!("--{what} needs three finite numbers X,Y,Z"),
-    }
-}
-
 /// Runs `shapecue lines`.
 pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let (w, h) = super::size_arg(&a.size)?;
@@ -114,14 +104,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if fams == FamilySet::NONE {
         bail!("--lines names no family");
     }
-    let widest = w.max(h) as f32;
-    if !(a.width.is_finite() && a.width > 0.0 && a.width <= widest) {
-        bail!(
-            "--width {}: the line width must be a positive number of pixels, at most the \
-             image's larger side ({widest} pixels)",
-            a.width
-        );
-    }
+    super::width_arg(a.width, (w, h), "line")?;
     let svg = match a.output.extension().and_then(|e| e.to_str()) {
         Some("svg") => true,
         Some("png") => false,
@@ -149,9 +132,9 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         shapecue::mesh::load(&path, &LoadOptions::default())?
     };
     let mut opts = LinesPictureOptions {
-        eye: vec3_arg(&a.eye, "eye")?,
-        target: vec3_arg(&a.target, "target")?,
-        up: vec3_arg(&a.up, "up")?,
+        eye: super::vec3_arg(&a.eye, "eye")?,
+        target: super::vec3_arg(&a.target, "target")?,
+        up: super::vec3_arg(&a.up, "up")?,
         fov_deg: a.fov,
         ortho: a.ortho,
         width: w,
@@ -172,7 +155,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     c.principal_threshold = a.ph_threshold;
     c.highlight_threshold = a.sh_threshold;
     c.isophotes = a.isophotes;
-    if let Some(l) = vec3_arg(&a.light, "light")? {
+    if let Some(l) = super::vec3_arg(&a.light, "light")? {
         c.light = l.to_array();
     }
     c.cull = !a.no_cull;

@@ -117,6 +117,41 @@ pub fn note_double(out: &Path, w: &shapecue::export::ply::PlyWritten) {
     }
 }
 
+/// Checks `--width` of drawn lines or edges (`what`: "line", "edge") in an
+/// image of `size` pixels: positive, finite and at most the larger side.
+pub fn width_arg(width: f32, size: (u32, u32), what: &str) -> anyhow::Result<()> {
+    if !(width.is_finite() && width > 0.0) {
+        anyhow::bail!("--width {width}: the {what} width must be a positive number of pixels");
+    }
+    let widest = size.0.max(size.1) as f32;
+    if width > widest {
+        anyhow::bail!(
+            "--width {width}: the {what} width must be at most the image's larger side \
+             ({widest} pixels)"
+        );
+    }
+    Ok(())
+}
+
+/// A point or direction given as `X,Y,Z` (`--eye`, `--target`, `--up`,
+/// `--light`): three finite numbers, or an error naming the option and what
+/// was given.
+pub fn vec3_arg(v: &Option<Vec<f32>>, what: &str) -> anyhow::Result<Option<glam::Vec3>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+            Ok(Some(glam::Vec3::new(v[0], v[1], v[2])))
+        }
+        Some(v) => anyhow::bail!(
+            "--{what} needs three finite numbers X,Y,Z, got {}",
+            v.iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        ),
+    }
+}
+
 /// Parses `--size WIDTHxHEIGHT` within the shared image limits
 /// ([`shapecue::spec::limits::check_image_size`]).
 pub fn size_arg(s: &str) -> anyhow::Result<(u32, u32)> {

@@ -252,16 +252,7 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
             out,
         } => {
             let (w, h) = super::size_arg(&size)?;
-            if !(width.is_finite() && width > 0.0) {
-                bail!("--width {width}: the edge width must be a positive number of pixels");
-            }
-            let widest = w.max(h) as f32;
-            if width > widest {
-                bail!(
-                    "--width {width}: the edge width must be at most the image's larger side \
-                     ({widest} pixels)"
-                );
-            }
+            super::width_arg(width, (w, h), "edge")?;
             check(&[], &out)?;
             let o = report::caps::CapsReportOptions {
                 size: (w, h),

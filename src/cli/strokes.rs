@@ -137,19 +137,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
             _ => bail!("--sampling {s:?}: expected auto or a positive distance in world units"),
         },
     };
-    let eye = match &a.eye {
-        None => None,
-        Some(v) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
-            Some(glam::Vec3::new(v[0], v[1], v[2]))
-        }
-        Some(v) => bail!(
-            "--eye needs three finite numbers X,Y,Z, got {}",
-            v.iter()
-                .map(|c| c.to_string())
-                .collect::<Vec<_>>()
-                .join(",")
-        ),
-    };
+    let eye = super::vec3_arg(&a.eye, "eye")?;
     let opts = StrokesOptions {
         iso,
         inside,
