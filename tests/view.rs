@@ -317,3 +317,116 @@ fn a_bad_script_fails_before_the_window() {
         "{err}"
     );
 }
+
+/// Runs `shapecue view INPUT --script s.txt [extra]` in `dir` with no display
+/// (the script's outputs are checked before the window opens).
+fn view_refused(dir: &Path, input: &Path, script: &str, extra: &[&str]) -> Output {
+    std::fs::write(dir.join("s.txt"), script).unwrap();
+    cli()
+        .args(["view", input.to_str().unwrap(), "--script", "s.txt"])
+        .args(extra)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn script_outputs_never_overwrite_an_input_or_an_existing_file() {
+    let dir = scratch("view-outputs");
+    let input = dir.join("in.obj");
+    std::fs::copy(data("spot.obj"), &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    // The viewer's own input: refused by its extension first ...
+    let out = view_refused(&dir, &input, "screenshot in.obj\n", &[]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("s.txt line 1") && err.contains(".png"),
+        "{err}"
+    );
+    // ... and by being the input under a PNG name, even with --force.
+    let png = dir.join("in.png");
+    std::fs::copy(&input, &png).unwrap();
+    std::fs::remove_file(&input).unwrap();
+    std::os::unix::fs::symlink(&png, &input).unwrap();
+    for force in [&[][..], &["--force"][..]] {
+        let out = view_refused(&dir, &input, "svg a.svg\nscreenshot in.png\n", force);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("it is the input file"), "{err}");
+    }
+    assert_eq!(std::fs::read(&png).unwrap(), before);
+    // An existing output without --force; one name twice; a .jpg name.
+    std::fs::write(dir.join("old.png"), b"keep").unwrap();
+    let out = view_refused(&dir, &input, "screenshot old.png\n", &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("old.png exists") && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(dir.join("old.png")).unwrap(), b"keep");
+    let out = view_refused(&dir, &input, "screenshot a.png\ncapture ./a.png\n", &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("name the same output file"), "{err}");
+    let out = view_refused(&dir, &input, "screenshot out.jpg\n", &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("out.jpg") && err.contains(".png"), "{err}");
+    // With --force an existing output may be replaced: the check passes and
+    // the command goes on to open the window (none here: exit code 4).
+    let out = view_refused(&dir, &input, "screenshot old.png\n", &["--force"]);
+    assert_eq!(
+        out.status.code(),
+        Some(4),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn a_script_with_every_cue_off_fails_instead_of_hanging() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-nocue");
+    let s = dir.join("script.txt");
+    std::fs::write(
+        &s,
+        "screenshot a.png\nsvg a.svg\ncue contours off\ncue shading off\nwait\n",
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_shapecue");
+    // `timeout` ends a hang (exit 124) instead of the test run.
+    let out = std::process::Command::new("timeout")
+        .args([
+            "120",
+            "xvfb-run",
+            "-a",
+            "-s",
+            "-screen 0 1280x1024x24",
+            bin,
+            "view",
+        ])
+        .arg(data("spot.obj"))
+        .args(["--size", "240x180", "--script"])
+        .arg(&s)
+        .current_dir(&dir)
+        .output()
+        .expect("run xvfb-run");
+    if cli_gl_missing(&out) {
+        return;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(4) && !gl_required() {
+        eprintln!("skipping window test: {err}");
+        return;
+    }
+    assert_ne!(out.status.code(), Some(124), "the viewer hung");
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("line 5") && err.contains("no cue is switched on"),
+        "{err}"
+    );
+    assert!(dir.join("a.png").is_file() && dir.join("a.svg").is_file());
+}

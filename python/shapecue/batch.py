@@ -169,6 +169,23 @@ def process_one(
     return rec
 
 
+def _check_resources(client: Any, resources: Dict[str, float]) -> None:
+    """Raises where no worker of the cluster offers every resource a task
+    asks for: Dask would hold the tasks forever, waiting for one."""
+    workers = client.scheduler_info().get("workers", {})
+    offered = [w.get("resources") or {} for w in workers.values()]
+    if any(all(r.get(k, 0) >= v for k, v in resources.items()) for r in offered):
+        return
+    want = ", ".join(f"{k}={v:g}" for k, v in resources.items())
+    seen = sorted({f"{k}={v:g}" for r in offered for k, v in r.items()})
+    have = ", ".join(seen) if seen else "none"
+    raise ValueError(
+        f"no worker of the cluster offers the resources {want} that each task asks for "
+        f"({len(workers)} worker(s); resources offered: {have}); start workers with "
+        f"'dask worker ... --resources \"{want.replace(', ', ' ')}\"', or leave resources out"
+    )
+
+
 def run(
     inputs: Union[str, Iterable[str]],
     out_dir: Union[str, os.PathLike],
@@ -189,9 +206,14 @@ def run(
     e.g. ``{"GPU": 1}``, are passed to ``client.submit`` so that each task
     takes one unit of a worker resource (start workers with
     ``dask worker ... --resources GPU=1`` and ``SHAPECUE_DEVICE=<index>``).
+    A client's cluster with no worker that offers them is refused at once
+    (Dask would wait for one forever); the ``LocalCluster`` made without a
+    client gives each of its workers those resources.
     """
     if task not in TASKS:
         raise ValueError(f"unknown task {task!r}: expected one of {', '.join(TASKS)}")
+    if task == "isosurface" and "iso" not in (options or {}):
+        raise ValueError('the isosurface task needs options={"iso": value}')
     out_dir = os.path.abspath(os.fspath(out_dir))
     os.makedirs(out_dir, exist_ok=True)
     paths = _inputs(inputs)
@@ -224,13 +246,20 @@ def run(
 
             client = get_client()
         except ValueError:
+            # Each local worker offers the resources asked for, so that
+            # the tasks can be scheduled on it.
             own = LocalCluster(
-                n_workers=min(2, os.cpu_count() or 1), threads_per_worker=1, dashboard_address=None
+                n_workers=min(2, os.cpu_count() or 1),
+                threads_per_worker=1,
+                dashboard_address=None,
+                resources=dict(resources) if resources else None,
             )
             client = Client(own)
     records = []
     manifest = os.path.join(out_dir, MANIFEST)
     try:
+        if resources and own is None:
+            _check_resources(client, resources)
         # Keys unique per run: a key the cluster still holds would hand back
         # that earlier result instead of running the task again.
         run_id = uuid.uuid4().hex[:8]

@@ -205,7 +205,7 @@ fn options(
 ) -> PyResult<CurvatureOptions> {
     Ok(CurvatureOptions {
         accumulate: if accumulate == "auto" {
-            shapecue::spec::curvature::Accumulate::Gather
+            shapecue::spec::curvature::Accumulate::default()
         } else {
             parse(accumulate)?
         },
@@ -217,12 +217,12 @@ fn options(
     })
 }
 
-/// `opts` with an `accumulate = "auto"` resolved for `gpu`: gather on CPU
-/// devices, atomic elsewhere (`Accumulate::default_for`).
-fn device_options(opts: CurvatureOptions, accumulate: &str, gpu: &Gpu) -> CurvatureOptions {
+/// `opts` with an `accumulate = "auto"` resolved: the library's default
+/// scheme (`Accumulate::default`, gather on every device).
+fn device_options(opts: CurvatureOptions, accumulate: &str, _gpu: &Gpu) -> CurvatureOptions {
     if accumulate == "auto" {
         CurvatureOptions {
-            accumulate: shapecue::spec::curvature::Accumulate::default_for(&gpu.info.kind),
+            accumulate: shapecue::spec::curvature::Accumulate::default(),
             ..opts
         }
     } else {
@@ -350,7 +350,7 @@ fn build_kernels<'py>(
             let gpu = Arc::new(Gpu::new(device.as_deref())?);
             let accumulate: Vec<Accumulate> = accumulate
                 .iter()
-                .map(|a| a.unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind)))
+                .map(|a| a.unwrap_or_default())
                 .collect();
             // lanes 0: by device type, as on the command line
             let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, 0);

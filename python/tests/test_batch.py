@@ -84,8 +84,10 @@ def test_isosurface_batch(device, client, tmp_path):
     for r in recs:
         d = np.load(r["output"])
         assert d["vertices"].shape[1] == 3 and len(d["curvature_k1"]) == len(d["vertices"])
-    bad = batch.run(paths[:1], tmp_path / "out2", task="isosurface", client=client)
-    assert bad[0]["status"] == "error" and "iso" in bad[0]["error"]
+    # Without an iso value the whole call is refused before any task runs.
+    with pytest.raises(ValueError, match="iso"):
+        batch.run(paths[:1], tmp_path / "out2", task="isosurface", client=client)
+    assert not (tmp_path / "out2" / "manifest.jsonl").exists()
     (tmp_path / "other").mkdir()
     twin = tmp_path / "other" / "ball0.nrrd"
     twin.write_bytes(open(paths[0], "rb").read())
@@ -93,3 +95,29 @@ def test_isosurface_batch(device, client, tmp_path):
         batch.run([paths[0], str(twin)], tmp_path / "out4", task="isosurface", client=client)
     with pytest.raises(ValueError, match="unknown task"):
         batch.run(paths, tmp_path / "out3", task="sculpt", client=client)
+
+
+def test_resources_no_worker_offers_are_refused_at_once(device, client, tmp_path):
+    """Dask holds a task whose resources no worker offers forever: the call
+    says so at once instead."""
+    import time
+
+    from shapecue import batch
+
+    v, f = torus(12, 8)
+    write_obj(tmp_path / "t.obj", v, f)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="no worker of the cluster offers the resources GPU=1"):
+        batch.run([str(tmp_path / "t.obj")], tmp_path / "out", client=client, resources={"GPU": 1})
+    assert time.perf_counter() - t0 < 30
+
+
+def test_resources_without_a_client(device, tmp_path):
+    """Without a client, the LocalCluster made for the call offers the
+    resources asked for, so the documented call runs instead of hanging."""
+    from shapecue import batch
+
+    v, f = torus(12, 8)
+    write_obj(tmp_path / "t.obj", v, f)
+    recs = batch.run([str(tmp_path / "t.obj")], tmp_path / "out", resources={"GPU": 1})
+    assert [r["status"] for r in recs] == ["ok"], recs

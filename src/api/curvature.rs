@@ -53,10 +53,9 @@ pub struct CurvatureJob {
     /// The device (`SHAPECUE_DEVICE` or the first GPU, else CPU, when `None`).
     pub device: Option<String>,
     /// The options; `accumulate` is replaced by [`CurvatureJob::accumulate`]
-    /// or the device type's default.
+    /// or the default.
     pub opts: CurvatureOptions,
-    /// The accumulation variant; `None`: the device type's default
-    /// ([`Accumulate::default_for`]).
+    /// The accumulation variant; `None`: the default ([`Accumulate::default`]).
     pub accumulate: Option<Accumulate>,
     /// The memory order the device computes in.
     pub order: MeshOrder,
@@ -155,7 +154,7 @@ fn prepare_device(
     let t = Instant::now();
     let gpu = Arc::new(Gpu::new(device)?);
     let device_ms = ms_since(t);
-    opts.accumulate = accumulate.unwrap_or_else(|| Accumulate::default_for(&gpu.info.kind));
+    opts.accumulate = accumulate.unwrap_or_default();
     let t = Instant::now();
     let _ = CurvatureEstimator::prepare(&gpu, &opts);
     Ok(Prepared {

@@ -174,11 +174,6 @@ pub fn isosurface_on(
     let stats = ex.extract(iso, opts.fusion)?;
     let curvature = match opts.curvature {
         Some(o) => {
-            let o = CurvatureOptions {
-                accumulate: crate::spec::curvature::Accumulate::Atomic,
-                compat: crate::spec::curvature::Compat::Exact,
-                ..o
-            };
             let (est, timing) = mcs::curvature(&ex, o, opts.curvature_normals)?;
             let field = est.read()?;
             if !field.all_finite() {

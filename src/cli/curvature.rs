@@ -93,7 +93,7 @@ pub struct CurvatureArgs {
 /// Runs `shapecue curvature`.
 pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let mut opts = CurvatureOptions {
-        accumulate: a.accumulate.unwrap_or(Accumulate::Gather),
+        accumulate: a.accumulate.unwrap_or_default(),
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,

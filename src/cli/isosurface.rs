@@ -69,6 +69,13 @@ pub struct IsoArgs {
     /// Curvature precision.
     #[arg(long, value_parser = super::choice::<Precision>(), default_value = "f32")]
     precision: Precision,
+    /// Curvature's one-ring accumulation, as for `shapecue curvature`
+    /// (default: gather, bitwise reproducible).
+    #[arg(long, value_parser = super::choice::<Accumulate>())]
+    accumulate: Option<Accumulate>,
+    /// Curvature's least squares: exact, or trimesh2 2.16's.
+    #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
+    compat: Compat,
     /// Vertex normals of the curvature passes: the volume gradient (accurate
     /// on marching-cubes meshes) or the mesh's own face normals (the paper's).
     #[arg(long, value_parser = super::choice::<IsoNormals>(), default_value = "gradient")]
@@ -140,9 +147,9 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     )?;
     let gpu = Arc::new(Gpu::new(device)?);
     let curvature = a.curvature.then_some(CurvatureOptions {
-        accumulate: Accumulate::Atomic,
+        accumulate: a.accumulate.unwrap_or_default(),
         precision: a.precision,
-        compat: Compat::Exact,
+        compat: a.compat,
         dcurv: !a.no_dcurv,
         lanes: 0,
     });

@@ -39,7 +39,7 @@ pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
     let gpu = Arc::new(Gpu::new(device)?);
     let lanes = a.lanes.as_deref().map_or(Ok(0), str::parse)?;
     let accumulate = if a.accumulate.is_empty() {
-        vec![Accumulate::default_for(&gpu.info.kind)]
+        vec![Accumulate::default()]
     } else {
         a.accumulate.clone()
     };

@@ -407,8 +407,9 @@ pub struct LbsAnimation {
     pub anim_path: PathBuf,
 }
 
-/// The sibling files of a libigl set, by its naming.
-fn siblings(obj: &Path) -> [PathBuf; 3] {
+/// The sibling files of a libigl set, by its naming: `<stem>.tgf`,
+/// `<stem>-weights.dmat` and `<stem>-anim.dmat` beside the rest mesh.
+pub fn siblings(obj: &Path) -> [PathBuf; 3] {
     let stem = obj
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -45,6 +45,7 @@
 use crate::error::{Error, Result};
 use crate::scene::planner::{Cue, Input};
 use crate::spec::ao::AoMode;
+use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::CapMode;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -208,6 +209,9 @@ pub struct Scene {
     pub msaa: u32,
     /// Background.
     pub background: [f32; 3],
+    /// The curvature estimator's scheme, precision and least squares
+    /// (`[curvature]`; the derivative is on where a pass needs it).
+    pub curvature: CurvatureOptions,
 }
 
 /// 1-based line and column of a byte offset.
@@ -768,7 +772,27 @@ impl Scene {
                 "output.name {prefix:?} must be a non-empty file name prefix"
             )));
         }
+        let mut curvature = CurvatureOptions::default();
+        if let Some(c) = &file.curvature {
+            fn pick<T: std::str::FromStr<Err = Error>>(
+                ck: &Checker<'_>,
+                v: &Option<Spanned<String>>,
+                into: &mut T,
+            ) -> Result<()> {
+                if let Some(v) = v {
+                    *into = v
+                        .get_ref()
+                        .parse()
+                        .map_err(|x: Error| ck.err(v.span(), format!("curvature: {x}")))?;
+                }
+                Ok(())
+            }
+            pick(&ck, &c.accumulate, &mut curvature.accumulate)?;
+            pick(&ck, &c.precision, &mut curvature.precision)?;
+            pick(&ck, &c.compat, &mut curvature.compat)?;
+        }
         Ok(Scene {
+            curvature,
             path: path.to_path_buf(),
             out_dir: out
                 .dir

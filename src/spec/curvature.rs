@@ -148,7 +148,6 @@ impl CurvatureField {
 pub enum Accumulate {
     /// One work-item per face adds into its vertices with float atomics
     /// (compare-and-swap), as in Griffin et al. Summation order varies run to run.
-    #[default]
     Atomic,
     /// As `Atomic`, with the device's own float atomic add
     /// (`cl_ext_float_atomics`, OpenCL C 3.0 `atomic_fetch_add_explicit`,
@@ -158,7 +157,10 @@ pub enum Accumulate {
     AtomicNative,
     /// Per-face kernels write each corner's contribution to a buffer (12
     /// reals per face, no atomics); per-vertex kernels sum their one-ring
-    /// (built once) in face order. Bitwise identical from run to run.
+    /// (built once) in face order. Bitwise identical from run to run. The
+    /// default everywhere (command line, scenes, the viewer, lines,
+    /// isosurfaces, Python): [`Accumulate::why_default`] says why.
+    #[default]
     Gather,
 }
 
@@ -170,20 +172,10 @@ impl Accumulate {
         Accumulate::Gather,
     ];
 
-    /// The default scheme for an OpenCL device type (`CL_DEVICE_TYPE` as
-    /// [`crate::gpu::DeviceInfo::kind`] spells it: "CPU", "GPU", ...), the
-    /// rule the command line and the Python package use when no scheme is
-    /// given (the library's [`CurvatureOptions::default`] stays atomic, the
-    /// paper's scheme). Gather on every device class, from measurements
-    /// ([`Accumulate::why_default`] says which); it is also the one scheme
-    /// whose results are bitwise reproducible.
-    pub fn default_for(device_kind: &str) -> Accumulate {
-        let _ = device_kind;
-        Accumulate::Gather
-    }
-
-    /// Why [`Accumulate::default_for`] picks its scheme for a device type,
-    /// with the figures it rests on (printed by `--stats`).
+    /// Why gather is the default scheme ([`Accumulate::default`], the one
+    /// place it is decided) on a device of this type (`CL_DEVICE_TYPE` as
+    /// [`crate::gpu::DeviceInfo::kind`] spells it), with the figures it
+    /// rests on (printed by `--stats`).
     pub fn why_default(device_kind: &str) -> &'static str {
         if device_kind.eq_ignore_ascii_case("CPU") {
             "gather: on CPU devices it took less time than the compare-and-swap atomics \
@@ -329,7 +321,7 @@ impl CurvatureOptions {
 impl Default for CurvatureOptions {
     fn default() -> Self {
         CurvatureOptions {
-            accumulate: Accumulate::Atomic,
+            accumulate: Accumulate::default(),
             precision: Precision::F32,
             compat: Compat::Exact,
             dcurv: true,

@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Gpu, wait_ms};
 use crate::mesh::skinned::SkinnedMesh;
 use crate::spec::ao::AoMode;
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use crate::spec::curvature::{CurvatureOptions, Normalization, Precision};
 use crate::spec::feature_lines::Segment;
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
@@ -45,17 +45,12 @@ pub struct PipelineOptions {
 }
 
 impl Default for PipelineOptions {
-    /// The default pipeline: atomic f32 curvature with dcurv, `lut` AO with a
-    /// radius of a tenth of the model's RMS radius.
+    /// The default pipeline: the default curvature (gather, f32, exact
+    /// solve) with dcurv, `lut` AO with a radius of a tenth of the model's
+    /// RMS radius.
     fn default() -> Self {
         PipelineOptions {
-            curvature: CurvatureOptions {
-                accumulate: Accumulate::Atomic,
-                precision: Precision::F32,
-                compat: Compat::Exact,
-                dcurv: true,
-                lanes: 0,
-            },
+            curvature: CurvatureOptions::default(),
             ao_mode: AoMode::Lut,
             ao_radius: 0.1,
         }

@@ -24,8 +24,10 @@ pub struct App {
     script: Option<Running>,
     /// Folder of the screenshots the keys save.
     out: PathBuf,
-    /// The last request sent, and whether the state changed since.
+    /// The last request sent, the last one answered (a frame or a failure),
+    /// and whether the state changed since.
     sent: u64,
+    answered: u64,
     dirty: bool,
     /// Ask the next request for the SVG (and where to copy it).
     svg_to: Option<PathBuf>,
@@ -57,6 +59,7 @@ impl App {
             script: script.map(|script| Running { script, next: 0 }),
             out,
             sent: 0,
+            answered: 0,
             dirty: true,
             svg_to: None,
             shown: None,
@@ -74,10 +77,17 @@ impl App {
     }
 
     /// Whether the event loop should repaint at once (a state not sent yet,
-    /// a window capture asked for). Frames from the compute thread wake it
+    /// a window capture asked for, a script that waits on no frame: one
+    /// whose request was refused before it reached the compute thread, as
+    /// with every cue switched off). Frames from the compute thread wake it
     /// by themselves, so it does not spin while one is drawn.
     pub fn wants_frames(&self) -> bool {
-        self.dirty || self.capture.is_some()
+        self.dirty || self.capture.is_some() || (self.script.is_some() && !self.in_flight())
+    }
+
+    /// Whether a request is out that the compute thread has not answered.
+    fn in_flight(&self) -> bool {
+        self.answered < self.sent
     }
 
     /// How long to wait before the next animation step, while playing.
@@ -95,7 +105,11 @@ impl App {
     /// Sends the state to the compute thread.
     fn send(&mut self, svg: bool) {
         if self.state.enabled().is_empty() {
-            // Nothing to draw: no request (the planner would plan no pass).
+            // Nothing to draw: no request (the planner would plan no pass);
+            // the state counts as sent and failed at once, so that a script
+            // waiting for its frame stops with this error.
+            self.sent += 1;
+            self.answered = self.sent;
             self.dirty = false;
             self.error = Some("no cue is switched on".into());
             self.failed = Some(self.sent);
@@ -115,6 +129,7 @@ impl App {
         while let Ok(r) = self.engine.rx.try_recv() {
             match r {
                 Reply::Frame(d) => {
+                    self.answered = self.answered.max(d.id);
                     self.times.push(d.wall_ms);
                     self.error = None;
                     self.failed = None;
@@ -129,6 +144,7 @@ impl App {
                     self.fresh = true;
                 }
                 Reply::Failed(id, e) => {
+                    self.answered = self.answered.max(id);
                     self.error = Some(e);
                     self.failed = Some(id);
                 }

@@ -49,9 +49,14 @@ pub struct ViewArgs {
     /// Isovalue of a volume input (default: the middle of its values).
     #[arg(long, allow_hyphen_values = true)]
     iso: Option<f32>,
-    /// Folder of the screenshots the S and V keys save.
+    /// Folder of the screenshots the S, V and C keys save (each under a new
+    /// name, never over a file).
     #[arg(long, default_value = ".")]
     out: PathBuf,
+    /// Let the script's screenshot, svg and capture commands replace files
+    /// that exist (never the viewer's input).
+    #[arg(long)]
+    force: bool,
 }
 
 /// Extensions of volume files.
@@ -107,6 +112,31 @@ fn scene_of_input(input: &str, iso: Option<f32>) -> Result<Scene> {
     Ok(Scene::from_str(&cwd.join("view.toml"), &text)?)
 }
 
+/// Checks the files a script writes before the window opens, as every
+/// command checks its outputs: none is an input of the viewer (the scene file
+/// or any file its input is read from, even with `--force`), none is named
+/// twice, and none exists unless `--force`.
+fn check_script_outputs(
+    script: &script::Script,
+    scene: &Scene,
+    probe: &probe::Probe,
+    force: bool,
+) -> Result<()> {
+    let outputs = script.outputs();
+    let mut inputs: Vec<&Path> = probe.files.iter().map(PathBuf::as_path).collect();
+    if scene.path.exists() {
+        inputs.push(scene.path.as_path());
+    }
+    inputs.push(script.path.as_path());
+    let paths: Vec<&Path> = outputs.iter().map(|o| o.2).collect();
+    super::check_outputs(inputs, paths, force).with_context(|| {
+        format!(
+            "{}: a file its screenshot, svg or capture commands would write",
+            script.path.display()
+        )
+    })
+}
+
 /// Runs `shapecue view`.
 pub fn run(device: Option<&str>, a: ViewArgs) -> Result<()> {
     let script = a.script.as_deref().map(script::Script::load).transpose()?;
@@ -123,6 +153,9 @@ pub fn run(device: Option<&str>, a: ViewArgs) -> Result<()> {
         scene.size = [w, h];
     }
     let probe = probe::probe(&scene)?;
+    if let Some(script) = &script {
+        check_script_outputs(script, &scene, &probe, a.force)?;
+    }
     let view = scene
         .views
         .first()

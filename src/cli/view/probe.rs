@@ -17,6 +17,8 @@ pub struct Probe {
     pub bounds: ([f64; 3], [f64; 3]),
     /// The value range of a volume (for the iso slider).
     pub values: Option<(f32, f32)>,
+    /// Every file the input is read from (so that no output overwrites one).
+    pub files: Vec<std::path::PathBuf>,
 }
 
 /// Bounds of the vertices that faces use.
@@ -42,8 +44,10 @@ fn volume_bounds(v: &shapecue::volume::Volume) -> ([f64; 3], [f64; 3]) {
 pub fn probe(scene: &Scene) -> Result<Probe> {
     let opts = LoadOptions { weld: scene.weld };
     let mut values = None;
+    let mut files = Vec::new();
     let (available, bounds) = match &scene.source {
         Source::Mesh(p) => {
+            files.push(p.clone());
             let m = shapecue::mesh::load(p, &opts)?;
             (1, mesh_bounds(&m.positions, &m.faces))
         }
@@ -56,6 +60,7 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
             }
         },
         Source::Gltf(p, clip) => {
+            files.push(p.clone());
             let m = shapecue::mesh::skinned::load_gltf(p)?;
             let idx = match clip {
                 Some(ClipRef::Index(i)) => Some(*i),
@@ -68,17 +73,21 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
             (frames, mesh_bounds(&m.rest.positions, &m.rest.faces))
         }
         Source::Lbs(p) => {
+            files.push(p.clone());
+            files.extend(shapecue::mesh::libigl::siblings(p));
             let a = shapecue::mesh::libigl::load_elephant_set(p)?;
             let (m, _) = a.to_skinned();
             (a.frames, mesh_bounds(&m.rest.positions, &m.rest.faces))
         }
         Source::Flipbook(pattern) => {
             let fb = shapecue::mesh::flipbook::Flipbook::open(pattern, Path::new(""), &opts)?;
+            files.extend(fb.frames.iter().cloned());
             let first = fb.frame(0)?;
             (fb.frames.len(), mesh_bounds(&first, &fb.faces))
         }
         Source::Volume(p, ..) => {
-            let v = shapecue::volume::load(p, None)?;
+            let (v, read) = shapecue::volume::load_with_files(p, None)?;
+            files.extend(read);
             values = v.range();
             (1, volume_bounds(&v))
         }
@@ -93,5 +102,6 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
         frames,
         bounds,
         values,
+        files,
     })
 }

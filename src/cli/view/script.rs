@@ -77,6 +77,20 @@ fn finite(v: f32, what: &str) -> Result<f32> {
     Ok(v)
 }
 
+/// A file name of a writing command, whose extension must say what is
+/// written (any case): PNG for `screenshot` and `capture`, SVG for `svg`.
+fn named(p: PathBuf, cmd: &str, ext: &str) -> Result<PathBuf> {
+    let ok = p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !ok {
+        bail!(
+            "{cmd} {}: it writes {}; give a name ending in .{ext}",
+            p.display(),
+            ext.to_ascii_uppercase()
+        );
+    }
+    Ok(p)
+}
+
 /// Parses one line (without its comment); `None` for an empty line.
 fn parse_line(line: &str, base: &Path) -> Result<Option<Command>> {
     let mut w = line.split_whitespace();
@@ -128,10 +142,10 @@ fn parse_line(line: &str, base: &Path) -> Result<Option<Command>> {
             s => FrameMove::To(num(s, "frame")?),
         }),
         "wait" => Command::Wait,
-        "screenshot" => Command::Screenshot(path(w.next())?),
-        "svg" => Command::Svg(path(w.next())?),
+        "screenshot" => Command::Screenshot(named(path(w.next())?, "screenshot", "png")?),
+        "svg" => Command::Svg(named(path(w.next())?, "svg", "svg")?),
         "passes" => Command::Passes,
-        "capture" => Command::Capture(path(w.next())?),
+        "capture" => Command::Capture(named(path(w.next())?, "capture", "png")?),
         other => bail!(
             "unknown command {other} (orbit, pan, zoom, reset, cue, set, frame, wait, \
              screenshot, svg, passes, capture)"
@@ -144,6 +158,20 @@ fn parse_line(line: &str, base: &Path) -> Result<Option<Command>> {
 }
 
 impl Script {
+    /// The files the script writes, with the command of each (`screenshot`,
+    /// `svg`, `capture`), in script order.
+    pub fn outputs(&self) -> Vec<(usize, &'static str, &Path)> {
+        self.commands
+            .iter()
+            .filter_map(|(line, c)| match c {
+                Command::Screenshot(p) => Some((*line, "screenshot", p.as_path())),
+                Command::Svg(p) => Some((*line, "svg", p.as_path())),
+                Command::Capture(p) => Some((*line, "capture", p.as_path())),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Reads and checks a script; file names in it are relative to the
     /// current folder.
     pub fn load(path: &Path) -> Result<Script> {
@@ -185,5 +213,18 @@ mod tests {
         assert!(parse_line("fly 1 2", Path::new("")).is_err());
         assert!(parse_line("reset now", Path::new("")).is_err());
         assert_eq!(parse_line("   ", Path::new("")).unwrap(), None);
+        // The extension says what is written, in any case.
+        assert_eq!(p("screenshot A.PNG"), Command::Screenshot("A.PNG".into()));
+        assert_eq!(p("svg lines.Svg"), Command::Svg("lines.Svg".into()));
+        for bad in [
+            "screenshot out.jpg",
+            "screenshot in.obj",
+            "svg a.png",
+            "capture w",
+            "capture w.svg",
+        ] {
+            let e = parse_line(bad, Path::new("")).unwrap_err().to_string();
+            assert!(e.contains("give a name ending in"), "{bad}: {e}");
+        }
     }
 }

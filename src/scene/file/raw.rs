@@ -40,6 +40,21 @@ pub struct SceneFile {
     /// Images and report.
     #[serde(default)]
     pub output: Option<Spanned<OutputSpec>>,
+    /// How curvature is computed (scheme, precision, least squares).
+    #[serde(default)]
+    pub curvature: Option<CurvatureSpec>,
+}
+
+/// `[curvature]`: the estimator's options, by their command-line names.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurvatureSpec {
+    /// `"gather"` (default), `"atomic"` or `"atomic-native"`.
+    pub accumulate: Option<Spanned<String>>,
+    /// `"f32"` (default) or `"f64"`.
+    pub precision: Option<Spanned<String>>,
+    /// `"exact"` (default) or `"trimesh2"`.
+    pub compat: Option<Spanned<String>>,
 }
 
 /// `[input]`: exactly one of the source keys.

@@ -273,10 +273,12 @@ impl CurvatureEstimator {
     }
 
     /// Like [`CurvatureEstimator::new`] for a mesh whose faces are already on
-    /// the device (e.g. a fused isosurface): no host round trip. Every vertex
-    /// must be used by a face (as after vertex fusion's compaction). The
-    /// gather variant needs one-ring lists built on the host and is refused
-    /// here; positions come from [`CurvatureEstimator::set_positions_device`].
+    /// the device (e.g. a fused isosurface). Every vertex must be used by a
+    /// face (as after vertex fusion's compaction). The atomic schemes copy
+    /// the faces on the device, with no host round trip; gather builds its
+    /// one-ring lists on the host, so it reads the faces back once (12 bytes
+    /// a face) and then runs as [`CurvatureEstimator::new`]. Positions come
+    /// from [`CurvatureEstimator::set_positions_device`].
     pub fn from_device(
         gpu: Arc<Gpu>,
         n_vertices: usize,
@@ -285,11 +287,9 @@ impl CurvatureEstimator {
         opts: CurvatureOptions,
     ) -> Result<Self> {
         if opts.accumulate == Accumulate::Gather {
-            return Err(Error::InvalidArgument(
-                "curvature of a device-resident mesh uses --accumulate atomic \
-                 (the gather variant builds its one-ring lists on the host)"
-                    .into(),
-            ));
+            let mut host = vec![[0u32; 3]; n_faces];
+            gpu.read(faces, &mut bytemuck::cast_slice_mut(&mut host)[..])?;
+            return Self::new(gpu, n_vertices, &host, opts);
         }
         let mut faces_b = gpu.buffer::<u32>(3 * n_faces)?;
         if n_faces > 0 {

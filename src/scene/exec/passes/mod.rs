@@ -26,7 +26,7 @@ use crate::render::colormap::curvature_scale;
 use crate::render::{Camera, Renderer};
 use crate::scene::file::Scene;
 use crate::scene::planner::{Pass, Plan};
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Normalization, Precision};
+use crate::spec::curvature::{CurvatureOptions, Normalization};
 use crate::spec::edges::{EdgeOutput, EdgeParams};
 use crate::spec::feature_lines::{LineInputs, Segment};
 use crate::spec::marching_cubes::IsoNormals;
@@ -155,11 +155,8 @@ impl<'s, 'g> Executor<'s, 'g> {
         let fx = &scene.effects;
         let has = |p: Pass| plan.contains(p);
         let curv_opts = CurvatureOptions {
-            accumulate: Accumulate::Atomic,
-            precision: Precision::F32,
-            compat: Compat::Exact,
             dcurv: has(Pass::Dcurv),
-            lanes: 0,
+            ..scene.curvature
         };
         let line_opts = LineOptions {
             contours: has(Pass::Contours),
