@@ -6,19 +6,22 @@
 //                              (u, v: the view vector in the (d1, d2) frame) and
 //                              the suggestive-contour test num = sinθ·D_w κr =
 //                              C(w,w,w)/|w|² − 2(n·v)τr²,  τr = (k2 − k1)uv/|w|²
-//   lines_face     per face    zero crossings of n·v (contours) and of κr where
-//                              the test holds (suggestive), linearly interpolated
-//                              on the face's edges → one segment per face and kind
+//   lines_face     per face    zero crossings of n·v (contours) and of κr
+//                              (suggestive), linearly interpolated on the face's
+//                              edges, cut where rtsc's test fails (isoline.h)
 // Buffers (V vertices, F faces, S segment capacity):
 //   pos, nrm, d1, d2 float[3V]; k float[2V] (k1, k2); dk float[4V] (C111 C112 C122 C222)
 //   ndv, kr, sc float[V] (lines_vertex output)
-//   seg float[8S]: x0 y0 z0 x1 y1 z1, kind (0 contour, 1 suggestive), strength
-//   counter uint[1]: segments found (all are counted; only the first S written)
+//   seg float[8S]: x0 y0 z0 x1 y1 z1, kind (0 contour, 1 suggestive), strength;
+//   ends uint[4S] (isoline.h); counter uint[1]: segments found (all are
+//   counted; only the first S written)
 // Camera: eye (perspective) or, with ortho = 1, the constant direction `eye`
 // towards the viewer. A vertex with n·v exactly 0 counts as front-facing.
-// Suggestive contours are kept on front faces where num / (n·v) exceeds
-// `sc_thresh` (already divided by the mesh's feature size on the host), and
-// their strength fades with n·v: min(1, (n·v)/fade).
+// With the test (rtsc's defaults), contours keep their parts with κr ≥ 0
+// and suggestive contours, on faces with a corner facing the viewer, their
+// parts with sinθ·D_w κr / (n·v) ≥ `sc_thresh` (the threshold already
+// divided by the square of the feature size on the host), each faded by
+// r / (r + fade) (`fade` likewise scaled; 0: no fade).
 
 inline void view_at(float px, float py, float pz, float ex, float ey, float ez, uint ortho,
                     float *vx, float *vy, float *vz)
@@ -35,7 +38,7 @@ __kernel void lines_vertex(uint nv, __global const float *pos, __global const fl
                            __global const float *d1, __global const float *d2,
                            __global const float *k, __global const float *dk, float ex, float ey,
                            float ez, uint ortho, __global float *ndv, __global float *kr,
-                           __global float *sc)
+                           __global float *sc, uint hermite, __global float *gkr)
 {
     GID_OR_RETURN(nv);
     float vx, vy, vz;
@@ -54,6 +57,14 @@ __kernel void lines_vertex(uint nv, __global const float *pos, __global const fl
     ndv[gid] = nd;
     kr[gid] = k1 * u2 + k2 * v2;
     sc[gid] = w2 > 1e-12f ? cwww * inv - 2.0f * nd * tr * tr : 0.0f;
+    if (hermite) {
+        const float3 p = vload3(gid, pos);
+        const float3 dv = (float3)(ex, ey, ez) - p;
+        const float dl = sqrt(dot3s(dv, dv));
+        const float rlen = ortho ? 0.0f : (dl > 0.0f ? 1.0f / dl : 0.0f);
+        vstore3(grad_kr(vload3(gid, d1), vload3(gid, d2), nd, u, v, k1, k2, vload4(gid, dk), rlen),
+                gid, gkr);
+    }
 }
 
 // Interpolation parameter of the zero crossing of f on the edge a → b.
@@ -66,7 +77,8 @@ inline float cross_t(float fa, float fb)
 
 __kernel void lines_face(uint nf, __global const uint *faces, __global const float *pos,
                          __global const float *ndv, __global const float *kr,
-                         __global const float *sc, uint want_contours, uint want_suggestive,
+                         __global const float *sc, __global const float *gkr,
+                         uint want_contours, uint want_suggestive, uint test, uint hermite,
                          float sc_thresh, float fade, uint cap, __global float *seg,
                          __global uint *ends, volatile __global uint *counter)
 {
@@ -85,40 +97,47 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
         const bool s0 = f[0] >= 0.0f, s1 = f[1] >= 0.0f, s2 = f[2] >= 0.0f;
         if (s0 == s1 && s1 == s2)
             continue;
+        // Suggestive contours: none on a face that faces away at every corner.
+        if (kind == 1 && ndv[v[0]] <= 0.0f && ndv[v[1]] <= 0.0f && ndv[v[2]] <= 0.0f)
+            continue;
         const uint c = (s0 == s1) ? 2 : ((s0 == s2) ? 1 : 0);
         const uint a = (c + 1) % 3, b = (c + 2) % 3;
-        const float ta = cross_t(f[c], f[a]), tb = cross_t(f[c], f[b]);
-        float p[6];
-        float strength = 1.0f;
-        for (uint i = 0; i < 3; ++i) {
-            const float pc = pos[3 * v[c] + i];
-            p[i] = pc + ta * (pos[3 * v[a] + i] - pc);
-            p[3 + i] = pc + tb * (pos[3 * v[b] + i] - pc);
+        const float3 pc = vload3(v[c], pos), ea3 = vload3(v[a], pos) - pc;
+        const float3 eb3 = vload3(v[b], pos) - pc;
+        float ta, tb;
+        if (kind == 1 && hermite) {
+            // rtsc's use_hermite: the cubic through κr sin²θ and its gradient.
+            const float3 gc = vload3(v[c], gkr);
+            ta = zero_hermite(f[c], f[a], dot3s(ea3, gc), dot3s(ea3, vload3(v[a], gkr)));
+            tb = zero_hermite(f[c], f[b], dot3s(eb3, gc), dot3s(eb3, vload3(v[b], gkr)));
+        } else {
+            ta = cross_t(f[c], f[a]);
+            tb = cross_t(f[c], f[b]);
         }
-        if (kind == 1) {
-            // Test and facing interpolated to the segment's midpoint.
-            const float nda = ndv[v[c]] + ta * (ndv[v[a]] - ndv[v[c]]);
-            const float ndb = ndv[v[c]] + tb * (ndv[v[b]] - ndv[v[c]]);
-            const float sca = sc[v[c]] + ta * (sc[v[a]] - sc[v[c]]);
-            const float scb = sc[v[c]] + tb * (sc[v[b]] - sc[v[c]]);
-            const float nd = 0.5f * (nda + ndb), num = 0.5f * (sca + scb);
-            if (!(nd > 0.0f) || !(num > sc_thresh * nd))
-                continue;
-            strength = fade > 0.0f ? min(1.0f, nd / fade) : 1.0f;
+        const float3 pa = pc + ta * ea3, pb = pc + tb * eb3;
+        // The test at the segment's ends: contours keep κr ≥ 0 (num κr sin²θ,
+        // den 1); suggestive contours num = sinθ D_w κr − t (n·v), den = n·v.
+        float nc, na, nb, dc = 1.0f, da = 1.0f, db = 1.0f;
+        if (kind == 0) {
+            nc = kr[v[c]];
+            na = kr[v[a]];
+            nb = kr[v[b]];
+        } else {
+            dc = ndv[v[c]];
+            da = ndv[v[a]];
+            db = ndv[v[b]];
+            nc = sc[v[c]] - sc_thresh * dc;
+            na = sc[v[a]] - sc_thresh * da;
+            nb = sc[v[b]] - sc_thresh * db;
         }
-        const uint o = atomic_inc(counter);
-        if (o < cap) {
-            for (uint i = 0; i < 6; ++i)
-                seg[8 * o + i] = p[i];
-            seg[8 * o + 6] = (float)kind;
-            seg[8 * o + 7] = strength;
-            // The mesh edges the two endpoints lie on, as sorted vertex pairs:
-            // neighbouring faces give the same pair for a shared crossing, so
-            // segments chain into polylines exactly, by edge.
-            ends[4 * o] = min(v[c], v[a]);
-            ends[4 * o + 1] = max(v[c], v[a]);
-            ends[4 * o + 2] = min(v[c], v[b]);
-            ends[4 * o + 3] = max(v[c], v[b]);
-        }
+        const float n0 = nc + ta * (na - nc), n1 = nc + tb * (nb - nc);
+        const float d0 = dc + ta * (da - dc), d1 = dc + tb * (db - dc);
+        // The mesh edges the two endpoints lie on, as sorted vertex pairs:
+        // neighbouring faces give the same pair for a shared crossing, so
+        // segments chain into polylines exactly, by edge.
+        const uint2 ea = (uint2)(min(v[c], v[a]), max(v[c], v[a]));
+        const uint2 eb = (uint2)(min(v[c], v[b]), max(v[c], v[b]));
+        emit_tested(pa, pb, ea, eb, gid, n0, n1, d0, d1, test, kind == 0 ? 0.0f : fade, kind,
+                    cap, seg, ends, counter);
     }
 }

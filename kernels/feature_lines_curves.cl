@@ -15,9 +15,14 @@
 //   lines_curves per face: the segments of every requested family
 // Ridges and valleys follow Ohtake, Belyaev & Seidel 2004 as rtsc draws them:
 // zero crossings of emax where |kmax| is extremal. Apparent ridges are the
-// same test on (D_t1 q1, t1, q1). The isoline families (suggestive
-// highlights, K = 0, H = 0, D_w κr = 0, isophotes) interpolate a per-vertex
-// value's zero crossing on the face's edges.
+// same crossings of (D_t1 q1, t1) with q1 the largest eigenvalue of QᵀQ (a
+// squared curvature, as in Judd et al.'s code), Judd's test (q1 increases
+// towards the segment at every corner) and no back-face culling. The isoline
+// families interpolate a per-vertex value's zero crossing on the face's
+// edges: suggestive highlights (κr, cut where −sinθ D_w κr / (n·v) falls
+// below its threshold, isoline.h), K = 0, H = 0, D_w κr = 0 (rtsc's: the zero
+// set of sinθ D_w κr − t (n·v), t the suggestive-contour threshold) and
+// isophotes.
 // Buffers (V vertices, F faces, S segment capacity):
 //   pos, nrm, d1, d2 float[3V]; k float[2V]; dk float[4V] (C111 C112 C122 C222)
 //   ndv, kr, sc float[V]: lines_vertex's n·v, κr sin²θ and suggestive test
@@ -27,10 +32,15 @@
 //   bnd uint[F]: bit j set when edge (v[j], v[j+1]) has no other face
 //   seg float[8S]: x0 y0 z0 x1 y1 z1 family strength; ends uint[4S]: the
 //   sorted vertex pair of each endpoint's mesh edge ((v, v) at a vertex,
-//   (0xffffffff, face) at a face centre); counter uint[1]: all counted
+//   (0xffffffff, face) at a face centre, (LINE_FREE, face) where a test cut
+//   the segment); counter uint[1]: all counted
 // flags: bit 0 back-face culling, 1 the extremum / test checks, 2 fading by
-// test strength, 3 Hermite placement of the K = 0 and H = 0 crossings.
-// Thresholds arrive already divided by the feature size (or its square).
+// test strength, 3 Hermite placement of the K = 0 and H = 0 crossings (from
+// grad), 4 of the suggestive highlights' κr = 0 crossings (rtsc's, from gkr:
+// lines_vertex's gradient of κr sin²θ, float[3V]).
+// Thresholds arrive already divided by the feature size (rv) or its square
+// (ar, ph, sh, sc), and so does the fade of suggestive highlights (sh_fade,
+// 0 for none).
 
 #define LF_RIDGES 2u
 #define LF_VALLEYS 3u
@@ -43,6 +53,7 @@
 #define LF_DWKR_ZERO 10u
 #define LF_BOUNDARIES 11u
 #define CENTER 0xffffffffu
+#define Z3 ((float3)(0.0f))
 
 inline float3 ld3(__global const float *a, uint i) { return vload3(i, a); }
 
@@ -113,7 +124,9 @@ __kernel void lines_view(uint nv, __global const float *pos, __global const floa
     }
     const float3 t1 = tx * e1 + ty * e2;
     const float3 dm = vload3(0, pose + 8 * gid + 2);
-    view[8 * gid] = sqrt(fmax(lam, 0.0f));
+    // q1 as rtsc (Judd et al.'s code) keeps it: the largest eigenvalue of
+    // QᵀQ, the square of the view-dependent curvature's magnitude.
+    view[8 * gid] = fmax(lam, 0.0f);
     view[8 * gid + 1] = t1.x;
     view[8 * gid + 2] = t1.y;
     view[8 * gid + 3] = t1.z;
@@ -156,19 +169,6 @@ __kernel void lines_dt1q1(uint nv, __global const uint *faces, __global const fl
     dt[gid] = n == 2 ? 0.5f * sum : sum;
 }
 
-inline void emit(float3 a, float3 b, uint fam, float s, uint4 e, uint cap, __global float *seg,
-                 __global uint *ends, volatile __global uint *counter)
-{
-    const uint o = atomic_inc(counter);
-    if (o >= cap)
-        return;
-    vstore3(a, 0, seg + 8 * o);
-    vstore3(b, 0, seg + 8 * o + 3);
-    seg[8 * o + 6] = (float)fam;
-    seg[8 * o + 7] = s;
-    vstore4(e, o, ends);
-}
-
 inline uint2 edge_of(uint a, uint b) { return (uint2)(min(a, b), max(a, b)); }
 
 // Strength of a ridge-like end: |k| above the threshold, faded as rtsc.
@@ -186,10 +186,13 @@ inline float ridge_w(float ea, float eb)
 }
 
 // One ridge-like segment from the crossing on edge i0–i1 to the one on
-// i1–i2 (or to the face centre).
+// i1–i2 (or to the face centre). With `judd`, Judd et al.'s test of apparent
+// ridges: the direction of increasing q1 (t0, t1, t2 at i0, i1, i2) points
+// towards the segment at every corner, so the segment is a maximum.
 inline void ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const float *pos,
-                          float thr, uint fade, bool centre, uint fam, uint cap,
-                          __global float *seg, __global uint *ends, volatile __global uint *counter)
+                          float thr, uint fade, bool centre, uint fam, bool judd, float3 t0,
+                          float3 t1, float3 t2, uint cap, __global float *seg,
+                          __global uint *ends, volatile __global uint *counter)
 {
     const float3 p0 = ld3(pos, vi.x), p1 = ld3(pos, vi.y), p2 = ld3(pos, vi.z);
     const float w10 = ridge_w(e.x, e.y);
@@ -210,22 +213,33 @@ inline void ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const 
     }
     if (!(ka > thr) && !(kb > thr))
         return;
+    if (judd) {
+        // Towards i1 across the segment, in the face's plane.
+        const float3 perp = cross(cross(p1 - p0, p2 - p0), pa - pb);
+        if (!(dot(t0, perp) > 0.0f && dot(t1, perp) < 0.0f && dot(t2, perp) > 0.0f))
+            return;
+    }
     const float s = 0.5f * (ridge_strength(ka, thr, fade) + ridge_strength(kb, thr, fade));
     const uint2 ea = edge_of(vi.x, vi.y);
     emit(pa, pb, fam, s, (uint4)(ea, eb), cap, seg, ends, counter);
 }
 
 // Zero crossings of t_i = sgn·e_i·dir_i across the face (Ohtake et al.'s
-// test as rtsc writes it), with the extremum check and the threshold on |k|.
+// test as rtsc writes it), with the threshold on |k| and, with `test`, the
+// extremum check: rtsc's lenient one for ridges and valleys (the direction
+// at either end of a crossed edge points across it the right way), Judd et
+// al.'s for apparent ridges (`judd`: every corner's direction points towards
+// the segment).
 inline void ridge_face(uint f, uint3 v, float3 e, float3 t0, float3 t1, float3 t2, float3 kk,
                        __global const float *pos, uint test, float thr, uint fade, uint fam,
-                       uint cap, __global float *seg, __global uint *ends,
+                       bool judd, uint cap, __global float *seg, __global uint *ends,
                        volatile __global uint *counter)
 {
     bool z01 = dot(t0, t1) <= 0.0f, z12 = dot(t1, t2) <= 0.0f, z20 = dot(t2, t0) <= 0.0f;
     if ((uint)z01 + (uint)z12 + (uint)z20 < 2)
         return;
-    if (test) {
+    const bool jt = judd && test;
+    if (test && !judd) {
         const float3 p0 = ld3(pos, v.x), p1 = ld3(pos, v.y), p2 = ld3(pos, v.z);
         z01 = z01 && (dot(t0, p1 - p0) >= 0.0f || dot(t1, p1 - p0) <= 0.0f);
         z12 = z12 && (dot(t1, p2 - p1) >= 0.0f || dot(t2, p2 - p1) <= 0.0f);
@@ -236,15 +250,21 @@ inline void ridge_face(uint f, uint3 v, float3 e, float3 t0, float3 t1, float3 t
     const uint3 r1 = v.yzx, r2 = v.zxy;
     const float3 e1 = e.yzx, e2 = e.zxy, k1 = kk.yzx, k2 = kk.zxy;
     if (!z01)
-        ridge_segment(f, r1, e1, k1, pos, thr, fade, false, fam, cap, seg, ends, counter);
+        ridge_segment(f, r1, e1, k1, pos, thr, fade, false, fam, jt, t1, t2, t0, cap, seg, ends,
+                      counter);
     else if (!z12)
-        ridge_segment(f, r2, e2, k2, pos, thr, fade, false, fam, cap, seg, ends, counter);
+        ridge_segment(f, r2, e2, k2, pos, thr, fade, false, fam, jt, t2, t0, t1, cap, seg, ends,
+                      counter);
     else if (!z20)
-        ridge_segment(f, v, e, kk, pos, thr, fade, false, fam, cap, seg, ends, counter);
+        ridge_segment(f, v, e, kk, pos, thr, fade, false, fam, jt, t0, t1, t2, cap, seg, ends,
+                      counter);
     else {
-        ridge_segment(f, r1, e1, k1, pos, thr, fade, true, fam, cap, seg, ends, counter);
-        ridge_segment(f, r2, e2, k2, pos, thr, fade, true, fam, cap, seg, ends, counter);
-        ridge_segment(f, v, e, kk, pos, thr, fade, true, fam, cap, seg, ends, counter);
+        ridge_segment(f, r1, e1, k1, pos, thr, fade, true, fam, jt, t1, t2, t0, cap, seg, ends,
+                      counter);
+        ridge_segment(f, r2, e2, k2, pos, thr, fade, true, fam, jt, t2, t0, t1, cap, seg, ends,
+                      counter);
+        ridge_segment(f, v, e, kk, pos, thr, fade, true, fam, jt, t0, t1, t2, cap, seg, ends,
+                      counter);
     }
 }
 
@@ -254,43 +274,6 @@ inline float zero_linear(float fa, float fb)
 {
     const float d = fa - fb;
     return clamp(d != 0.0f ? fa / d : 0.5f, 0.0f, 1.0f);
-}
-
-// Zero crossing of the cubic Hermite interpolant with end values fa, fb and
-// end derivatives da, db (per unit of the edge parameter), by bisection as
-// rtsc: the middle root where the cubic has three in [0, 1].
-inline float zero_hermite(float fa, float fb, float da, float db)
-{
-    if (fa == fb)
-        return 0.5f;
-    const float a = 2.0f * (fa - fb) + da + db, b = 3.0f * (fb - fa) - 2.0f * da - db;
-    const float c = da, d = fa;
-    float sl = 0.0f, sr = 1.0f, vl = fa;
-    const float disc = 4.0f * b * b - 12.0f * a * c;
-    if (disc > 0.0f && a != 0.0f) {
-        const float q = sqrt(disc);
-        const float r1 = (-2.0f * b + q) / (6.0f * a), r2 = (-2.0f * b - q) / (6.0f * a);
-        if (r1 >= 0.0f && r1 <= 1.0f && r2 >= 0.0f && r2 <= 1.0f) {
-            const float v1 = ((a * r1 + b) * r1 + c) * r1 + d;
-            const float v2 = ((a * r2 + b) * r2 + c) * r2 + d;
-            if ((v1 < 0.0f && v2 >= 0.0f) || (v1 > 0.0f && v2 <= 0.0f)) {
-                sl = min(r1, r2);
-                sr = max(r1, r2);
-                vl = r1 < r2 ? v1 : v2;
-            }
-        }
-    }
-    for (uint it = 0; it < 10; ++it) {
-        const float m = 0.5f * (sl + sr);
-        const float vm = ((a * m + b) * m + c) * m + d;
-        if ((vl < 0.0f && vm >= 0.0f) || (vl > 0.0f && vm <= 0.0f)) {
-            sr = m;
-        } else {
-            sl = m;
-            vl = vm;
-        }
-    }
-    return 0.5f * (sl + sr);
 }
 
 // The corner whose sign differs from the other two, or 3 when none does.
@@ -307,18 +290,19 @@ inline uint compu(uint3 a, uint i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z);
 
 // The zero-crossing segment of f on face v (odd corner c): its ends' edge
 // parameters from corner c towards a = c+1 and b = c+2. With gradients
-// (hermite), the cubic crossing; else linear.
+// (hermite; vertex i's at float3 index gstride·i + gsel of g), the cubic
+// crossing; else linear.
 inline float2 iso_params(uint3 v, float3 f, uint c, __global const float *pos,
-                         __global const float *g, uint gsel, uint hermite)
+                         __global const float *g, uint gstride, uint gsel, uint hermite)
 {
     const uint a = (c + 1) % 3, b = (c + 2) % 3;
     const float fc = comp(f, c), fa = comp(f, a), fb = comp(f, b);
     if (!hermite)
         return (float2)(zero_linear(fc, fa), zero_linear(fc, fb));
     const uint ic = compu(v, c), ia = compu(v, a), ib = compu(v, b);
-    const float3 pc = ld3(pos, ic), gc = ld3(g, 2 * ic + gsel);
+    const float3 pc = ld3(pos, ic), gc = ld3(g, gstride * ic + gsel);
     const float3 ea = ld3(pos, ia) - pc, eb = ld3(pos, ib) - pc;
-    const float3 ga = ld3(g, 2 * ia + gsel), gb = ld3(g, 2 * ib + gsel);
+    const float3 ga = ld3(g, gstride * ia + gsel), gb = ld3(g, gstride * ib + gsel);
     return (float2)(zero_hermite(fc, fa, dot(ea, gc), dot(ea, ga)),
                     zero_hermite(fc, fb, dot(eb, gc), dot(eb, gb)));
 }
@@ -345,17 +329,19 @@ inline float3 gather3(__global const float *a, uint stride, uint off, uint3 v)
 
 __kernel void lines_curves(uint nf, __global const uint *faces, __global const float *pos,
                            __global const float *ndv, __global const float *kr,
-                           __global const float *sc, __global const float *pose,
+                           __global const float *sc, __global const float *gkr,
+                           __global const float *pose,
                            __global const float *grad, __global const float *view,
                            __global const float *dt, __global const uint *bnd, uint want,
                            uint flags, float rv_thr, float ar_thr, float ph_thr, float sh_thr,
-                           uint iso_n, uint cap, __global float *seg, __global uint *ends,
+                           float sc_thr, float sh_fade, uint iso_n, uint cap,
+                           __global float *seg, __global uint *ends,
                            volatile __global uint *counter)
 {
     GID_OR_RETURN(nf);
     const uint3 v = vload3(gid, faces);
     const uint cull = flags & 1u, test = (flags >> 1) & 1u, fade = (flags >> 2) & 1u;
-    const uint hermite = (flags >> 3) & 1u;
+    const uint hermite = (flags >> 3) & 1u, hermite_sh = (flags >> 4) & 1u;
     const float3 nd = gather3(ndv, 1, 0, v);
     const bool back = cull && nd.x <= 0.0f && nd.y <= 0.0f && nd.z <= 0.0f;
     if (want & (1u << LF_BOUNDARIES)) {
@@ -367,6 +353,17 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const uint ia = compu(v, j), ib = compu(v, (j + 1) % 3);
             emit(ld3(pos, ia), ld3(pos, ib), LF_BOUNDARIES, 1.0f, (uint4)(ia, ia, ib, ib), cap,
                  seg, ends, counter);
+        }
+    }
+    if (want & (1u << LF_APPARENT)) {
+        // No back-face culling, as in rtsc (apparent ridges reach contours
+        // across faces that are just barely back-facing).
+        const float3 q = gather3(view, 8, 0, v), e = gather3(dt, 1, 0, v);
+        if (q.x > ar_thr || q.y > ar_thr || q.z > ar_thr) {
+            const float3 t0 = vload3(0, view + 8 * v.x + 1), t1 = vload3(0, view + 8 * v.y + 1);
+            const float3 t2 = vload3(0, view + 8 * v.z + 1);
+            ridge_face(gid, v, e, e.x * t0, e.y * t1, e.z * t2, q, pos, test, ar_thr, fade,
+                       LF_APPARENT, true, cap, seg, ends, counter);
         }
     }
     if (back)
@@ -383,16 +380,7 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             if (!(sg * km.x > 0.0f && sg * km.y > 0.0f && sg * km.z > 0.0f))
                 continue;
             ridge_face(gid, v, em, sg * em.x * d0, sg * em.y * d1, sg * em.z * d2, km, pos,
-                       test, rv_thr, fade, fam, cap, seg, ends, counter);
-        }
-    }
-    if (want & (1u << LF_APPARENT)) {
-        const float3 q = gather3(view, 8, 0, v), e = gather3(dt, 1, 0, v);
-        if (q.x > ar_thr || q.y > ar_thr || q.z > ar_thr) {
-            const float3 t0 = vload3(0, view + 8 * v.x + 1), t1 = vload3(0, view + 8 * v.y + 1);
-            const float3 t2 = vload3(0, view + 8 * v.z + 1);
-            ridge_face(gid, v, e, e.x * t0, e.y * t1, e.z * t2, q, pos, test, ar_thr, fade,
-                       LF_APPARENT, cap, seg, ends, counter);
+                       test, rv_thr, fade, fam, false, cap, seg, ends, counter);
         }
     }
     if (want & (1u << LF_PRIN_HL)) {
@@ -424,34 +412,34 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
         if (ok && flavour && (uint)z01 + (uint)z12 + (uint)z20 >= 2) {
             if (!z01)
                 ridge_segment(gid, v.yzx, dots.yzx, tst.yzx, pos, ph_thr, fade, false,
-                              LF_PRIN_HL, cap, seg, ends, counter);
+                              LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
             else if (!z12)
                 ridge_segment(gid, v.zxy, dots.zxy, tst.zxy, pos, ph_thr, fade, false,
-                              LF_PRIN_HL, cap, seg, ends, counter);
+                              LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
             else if (!z20)
-                ridge_segment(gid, v, dots, tst, pos, ph_thr, fade, false, LF_PRIN_HL, cap, seg,
-                              ends, counter);
+                ridge_segment(gid, v, dots, tst, pos, ph_thr, fade, false, LF_PRIN_HL, false,
+                              Z3, Z3, Z3, cap, seg, ends, counter);
         }
     }
     if (want & (1u << LF_SUG_HL)) {
-        // κr = 0 where the suggestive test is negated: −D_w κr / (n·v) above
-        // the threshold, on front faces (the maxima of n·v).
+        // κr = 0 where the suggestive test is negated (rtsc's suggestive
+        // highlights): −sinθ D_w κr / (n·v) ≥ the threshold, cut at the
+        // test's zero crossings and faded as suggestive contours.
         const float3 f = gather3(kr, 1, 0, v);
         const uint c = odd_corner(f);
         if (c < 3) {
-            const float2 tt = iso_params(v, f, c, pos, grad, 0, 0);
+            const float2 tt = iso_params(v, f, c, pos, gkr, 1, 0, hermite_sh);
             const uint a = (c + 1) % 3, b = (c + 2) % 3;
-            const float3 s3 = gather3(sc, 1, 0, v);
-            const float ndm = 0.5f * (comp(nd, c) + tt.x * (comp(nd, a) - comp(nd, c)) +
-                                      comp(nd, c) + tt.y * (comp(nd, b) - comp(nd, c)));
-            const float num = -0.5f * (comp(s3, c) + tt.x * (comp(s3, a) - comp(s3, c)) +
-                                       comp(s3, c) + tt.y * (comp(s3, b) - comp(s3, c)));
-            if (ndm > 0.0f && (!test || num > sh_thr * ndm)) {
-                const float x = num / ndm - sh_thr;
-                const float s = fade ? (x + sh_thr > 0.0f ? fmax(x, 0.0f) / (x + sh_thr) : 0.0f)
-                                     : 1.0f;
-                iso_emit(v, c, tt, pos, LF_SUG_HL, s, cap, seg, ends, counter);
-            }
+            const uint ic = compu(v, c), ia = compu(v, a), ib = compu(v, b);
+            const float3 num = -gather3(sc, 1, 0, v) - sh_thr * nd;
+            const float n0 = comp(num, c) + tt.x * (comp(num, a) - comp(num, c));
+            const float n1 = comp(num, c) + tt.y * (comp(num, b) - comp(num, c));
+            const float d0 = comp(nd, c) + tt.x * (comp(nd, a) - comp(nd, c));
+            const float d1 = comp(nd, c) + tt.y * (comp(nd, b) - comp(nd, c));
+            const float3 pc = ld3(pos, ic);
+            emit_tested(lerp3(pc, ld3(pos, ia), tt.x), lerp3(pc, ld3(pos, ib), tt.y),
+                        edge_of(ic, ia), edge_of(ic, ib), gid, n0, n1, d0, d1, test, sh_fade,
+                        LF_SUG_HL, cap, seg, ends, counter);
         }
     }
     for (uint fam = LF_K_ZERO; fam <= LF_DWKR_ZERO; ++fam) {
@@ -459,12 +447,12 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             continue;
         const float3 f = fam == LF_K_ZERO   ? gather3(pose, 8, 5, v)
                          : fam == LF_H_ZERO ? gather3(pose, 8, 6, v)
-                                            : gather3(sc, 1, 0, v);
+                                            : gather3(sc, 1, 0, v) - sc_thr * nd;
         const uint c = odd_corner(f);
         if (c == 3)
             continue;
         const uint h = hermite && fam != LF_DWKR_ZERO;
-        const float2 tt = iso_params(v, f, c, pos, grad, fam == LF_K_ZERO ? 0 : 1, h);
+        const float2 tt = iso_params(v, f, c, pos, grad, 2, fam == LF_K_ZERO ? 0 : 1, h);
         iso_emit(v, c, tt, pos, fam, 1.0f, cap, seg, ends, counter);
     }
     if ((want & (1u << LF_ISOPHOTES)) && iso_n > 0) {
@@ -479,7 +467,7 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const uint c = odd_corner(f);
             if (c == 3)
                 continue;
-            iso_emit(v, c, iso_params(v, f, c, pos, grad, 0, 0), pos, LF_ISOPHOTES, 1.0f, cap,
+            iso_emit(v, c, iso_params(v, f, c, pos, grad, 2, 0, 0), pos, LF_ISOPHOTES, 1.0f, cap,
                      seg, ends, counter);
         }
     }

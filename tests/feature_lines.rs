@@ -167,17 +167,35 @@ fn device_matches_cpu_twin() {
         let (lo, hi) = m.bounds();
         let c: [f32; 3] = std::array::from_fn(|i| (0.5 * (lo[i] + hi[i])) as f32);
         let d = (0..3).map(|i| (hi[i] - lo[i]) as f32).fold(0.0, f32::max);
-        let opts = LineOptions {
-            threshold: 0.0,
-            ..Default::default()
-        };
-        for view in [
-            View::from_eye([c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d], false),
-            View::from_eye([0.3, 1.0, 0.2], true),
+        for (view, hermite) in [
+            (
+                View::from_eye([c[0] + 2.0 * d, c[1] + 0.7 * d, c[2] + 1.3 * d], false),
+                false,
+            ),
+            (View::from_eye([0.3, 1.0, 0.2], true), false),
+            (
+                View::from_eye([c[0] - 1.5 * d, c[1] + 0.4 * d, c[2] + 2.0 * d], false),
+                true,
+            ),
+            (View::from_eye([0.3, 1.0, 0.2], true), true),
         ] {
+            let mut opts = LineOptions {
+                threshold: 0.0,
+                ..Default::default()
+            };
+            opts.curves.hermite = hermite;
             let dev = device(&m, &x, view, opts);
             let t = lines_vertex(&li(&x), view);
-            let cpu = lines_face(&m.faces, &x.pos, &t, [true, true], 0.0, opts.fade);
+            let cpu = lines_face(
+                &m.faces,
+                &x.pos,
+                &t,
+                [true, true],
+                true,
+                hermite,
+                0.0,
+                opts.scaled_fade(1.0),
+            );
             assert!(
                 cpu.iter().any(|s| s.2 == 0) && cpu.iter().any(|s| s.2 == 1),
                 "{name}: both kinds"
@@ -185,6 +203,17 @@ fn device_matches_cpu_twin() {
             same(dev, cpu, name);
         }
     }
+}
+
+fn length(s: &[Segment]) -> f32 {
+    s.iter()
+        .map(|s| {
+            (0..3)
+                .map(|i| (s.1[i] - s.0[i]).powi(2))
+                .sum::<f32>()
+                .sqrt()
+        })
+        .sum()
 }
 
 #[test]
@@ -196,23 +225,201 @@ fn suggestive_contours_respect_the_threshold_and_facing() {
         contours: false,
         suggestive: true,
         threshold: t,
-        fade: 0.2,
         ..Default::default()
     };
     let loose = device(&m, &x, view, only_sc(0.0));
     let strict = device(&m, &x, view, only_sc(0.5));
     assert!(!loose.is_empty());
+    // A higher threshold cuts the lines shorter (rtsc cuts, not drops).
     assert!(
-        strict.len() < loose.len(),
+        length(&strict) < 0.95 * length(&loose),
         "{} vs {}",
-        strict.len(),
-        loose.len()
+        length(&strict),
+        length(&loose)
     );
-    assert!(loose.iter().all(|s| s.2 == 1 && s.3 > 0.0 && s.3 <= 1.0));
+    assert!(loose.iter().all(|s| s.2 == 1 && (0.0..=1.0).contains(&s.3)));
     // A sphere is convex everywhere: radial curvature never crosses zero.
     let sphere = mesh::icosphere(1.0, 4);
     let xs = inputs(&sphere);
     assert!(device(&sphere, &xs, view, only_sc(0.0)).is_empty());
+}
+
+/// A flat grid over [-1, 1]² with curvature inputs made up so that, seen
+/// along (1, 0, 1) (orthographic): κr sin²θ = x / 2 (zero on x = 0) and
+/// sinθ D_w κr = y / √2, so rtsc's test D_w κr tanθ ≥ t holds for y ≥ t.
+fn made_up_grid(n: usize) -> (Vec<[u32; 3]>, LineArrays) {
+    let mut pos = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            // Columns off x = 0, so that the zero set crosses faces.
+            let xx = -1.0 + 2.0 * (i as f32 + 0.37) / (n as f32 + 1.0);
+            pos.push([xx, -1.0 + 2.0 * j as f32 / n as f32, 0.0]);
+        }
+    }
+    let mut faces = Vec::new();
+    let w = (n + 1) as u32;
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * w + i;
+            faces.push([a, a + 1, a + w + 1]);
+            faces.push([a, a + w + 1, a + w]);
+        }
+    }
+    let nv = pos.len();
+    let x = LineArrays {
+        nrm: vec![[0.0, 0.0, 1.0]; nv],
+        d1: vec![[1.0, 0.0, 0.0]; nv],
+        d2: vec![[0.0, 1.0, 0.0]; nv],
+        k: pos.iter().map(|p| [p[0], 0.0]).collect(),
+        dk: pos.iter().map(|p| [p[1], 0.0, 0.0, 0.0]).collect(),
+        pos,
+    };
+    (faces, x)
+}
+
+#[test]
+fn suggestive_contours_are_cut_where_the_test_crosses_its_threshold() {
+    let (faces, x) = made_up_grid(40);
+    let mut ex = LineExtractor::new(gpu(), x.pos.len(), &faces).unwrap();
+    let view = View::from_eye([1.0, 0.0, 1.0], true);
+    for t in [0.3f32, 0.05] {
+        let opts = LineOptions {
+            contours: false,
+            suggestive: true,
+            threshold: t,
+            ..Default::default()
+        };
+        let (s, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
+        assert!(!s.is_empty());
+        let ys: Vec<f32> = s.iter().flat_map(|s| [s.0[1], s.1[1]]).collect();
+        let lo = ys.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = ys.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        // On x = 0, from y = t (the cut, exact: the test is linear) to 1.
+        assert!(s.iter().all(|s| s.0[0].abs() < 1e-5 && s.1[0].abs() < 1e-5));
+        assert!(
+            (lo - t).abs() < 1e-5 && (hi - 1.0).abs() < 1e-5,
+            "{lo} {hi}"
+        );
+        assert!((length(&s) - (1.0 - t)).abs() < 1e-4, "{}", length(&s));
+        // One end is cut inside a face; every other end lies on an edge.
+        let free: Vec<_> = s
+            .iter()
+            .flat_map(|s| [(s.0, s.4[0]), (s.1, s.4[1])])
+            .filter(|(_, e)| e[0] == shapecue::spec::feature_lines::LINE_FREE)
+            .collect();
+        assert_eq!(free.len(), 1, "{free:?}");
+        assert!((free[0].0[1] - t).abs() < 1e-5);
+        // rtsc's fade r / (r + 0.03) with r = y − t: 0 at the cut, rising.
+        let mut by_y: Vec<&Segment> = s.iter().collect();
+        by_y.sort_by(|a, b| (a.0[1] + a.1[1]).total_cmp(&(b.0[1] + b.1[1])));
+        for seg in &by_y {
+            let r0 = (seg.0[1] - t).max(0.0);
+            let r1 = (seg.1[1] - t).max(0.0);
+            let want = 0.5 * (r0 / (r0 + 0.03) + r1 / (r1 + 0.03));
+            assert!((seg.3 - want).abs() < 1e-4, "{} vs {want}", seg.3);
+        }
+        // The twin cuts at the same place.
+        let terms = lines_vertex(&li(&x), view);
+        let cpu = lines_face(&faces, &x.pos, &terms, [false, true], true, false, t, 0.03);
+        same(s.clone(), cpu, "made-up grid");
+        // Without the test: the whole zero set of κr (rtsc's κr = 0 loops).
+        let (all, _) = ex
+            .extract(
+                &li(&x),
+                view,
+                1.0,
+                LineOptions {
+                    curves: shapecue::spec::feature_lines::CurveOptions {
+                        test: false,
+                        ..Default::default()
+                    },
+                    ..opts
+                },
+            )
+            .unwrap();
+        assert!((length(&all) - 2.0).abs() < 1e-4, "{}", length(&all));
+        assert!(all.iter().all(|s| s.3 == 1.0));
+    }
+}
+
+#[test]
+fn contours_keep_their_parts_with_positive_radial_curvature() {
+    // A torus seen obliquely: its contour crosses the saddle-shaped inside,
+    // where κr < 0 on parts that a closed surface hides; rtsc's test drops
+    // them, cutting the contour where κr = 0.
+    let m = mesh::torus(1.0, 0.4, 160, 80);
+    let x = inputs(&m);
+    let view = View::from_eye([3.0, 0.4, 2.0], false);
+    let tested = device(
+        &m,
+        &x,
+        view,
+        LineOptions {
+            suggestive: false,
+            ..Default::default()
+        },
+    );
+    let all = device(
+        &m,
+        &x,
+        view,
+        LineOptions {
+            suggestive: false,
+            curves: shapecue::spec::feature_lines::CurveOptions {
+                test: false,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+    );
+    assert!(
+        length(&tested) < 0.98 * length(&all),
+        "{} {}",
+        length(&tested),
+        length(&all)
+    );
+    assert!(length(&tested) > 0.3 * length(&all));
+    // Every kept end has κr ≥ 0 (barycentric in its face, or on its edge).
+    let t = lines_vertex(&li(&x), view);
+    let kr_at = |p: [f32; 3], e: [u32; 2]| -> f32 {
+        if e[0] == shapecue::spec::feature_lines::LINE_FREE {
+            let f = m.faces[e[1] as usize].map(|i| i as usize);
+            let q = f.map(|i| x.pos[i]);
+            let area = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
+                let (u, v) = (
+                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                );
+                let n = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            };
+            let w = [
+                area(p, q[1], q[2]),
+                area(q[0], p, q[2]),
+                area(q[0], q[1], p),
+            ];
+            let sw: f32 = w.iter().sum();
+            (0..3).map(|k| w[k] / sw * t.kr[f[k]]).sum()
+        } else {
+            let (a, b) = (x.pos[e[0] as usize], x.pos[e[1] as usize]);
+            let d: f32 = (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f32>().sqrt();
+            let s: f32 = (0..3).map(|i| (p[i] - a[i]).powi(2)).sum::<f32>().sqrt() / d;
+            t.kr[e[0] as usize] + s * (t.kr[e[1] as usize] - t.kr[e[0] as usize])
+        }
+    };
+    let scale = t.kr.iter().map(|k| k.abs()).fold(0.0, f32::max);
+    let mut cut = 0;
+    for s in &tested {
+        for (p, e) in [(s.0, s.4[0]), (s.1, s.4[1])] {
+            assert!(kr_at(p, e) >= -1e-4 * scale, "κr {} at {p:?}", kr_at(p, e));
+            cut += usize::from(e[0] == shapecue::spec::feature_lines::LINE_FREE);
+        }
+    }
+    assert!(cut >= 2, "{cut} cut ends");
 }
 
 #[test]

@@ -131,6 +131,7 @@ fn device_matches_cpu_twin_step_by_step() {
         ] {
             let opts = only(&all, |o| {
                 o.hermite = hermite;
+                o.hermite_kh = hermite;
                 o.light = [0.2, 0.5, 1.0];
                 o.isophotes = 6;
             });
@@ -206,7 +207,11 @@ fn device_matches_cpu_twin_step_by_step() {
                 &x.pos,
                 &terms,
                 &opts.curves,
-                ScaledThresholds::of(&opts.curves, fs),
+                ScaledThresholds::of(
+                    &opts.curves,
+                    fs,
+                    (opts.scaled_threshold(fs), opts.scaled_fade(fs)),
+                ),
             );
             assert!(finite(&dev), "{name}: finite");
             for f in LineFamily::ALL[2..].iter().copied() {
@@ -301,7 +306,7 @@ fn torus_parabolic_error(hermite: bool) -> (f64, f64, usize) {
     let x = inputs(&m);
     let opts = only(&[LineFamily::KZero], |o| {
         o.cull = false;
-        o.hermite = hermite;
+        o.hermite_kh = hermite;
     });
     let mut ex = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
     let view = View::from_eye([0.0, 0.0, 4.0], false);
@@ -407,6 +412,7 @@ fn hard_cases_give_finite_segments() {
             ] {
                 let opts = only(&all, |o| {
                     o.hermite = hermite;
+                    o.hermite_kh = hermite;
                     o.cull = false;
                     o.test = false;
                 });

@@ -205,7 +205,8 @@ fn a_cue_switch_changes_exactly_its_passes() {
         .cloned()
         .collect();
     assert_eq!(added, want);
-    assert!(added.contains("suggestive_contours") && added.contains("curvature"));
+    // Contours already need curvature (rtsc's κr test); the derivative is new.
+    assert!(added.contains("suggestive_contours") && added.contains("dcurv"));
 }
 
 /// The passes of `plan` whose lifetime `keep` accepts for `input`.

@@ -519,17 +519,22 @@ def lines(
     eye: Optional[Sequence[float]] = None,
     direction: Sequence[float] = (1.0, 1.0, 1.0),
     ortho: bool = False,
-    sc_threshold: float = 0.05,
+    sc_threshold: float = 0.01,
     rv_threshold: float = 0.1,
     ar_threshold: float = 0.1,
     ph_threshold: float = 0.04,
     sh_threshold: float = 0.02,
+    sc_fade: float = 0.03,
     isophotes: int = 20,
     light: Sequence[float] = (0.0, 0.0, 1.0),
     cull: bool = True,
     test: bool = True,
     fade: bool = True,
     hermite: bool = False,
+    hermite_kh: bool = False,
+    feature_size: Union[str, float] = "rtsc",
+    compat: str = "exact",
+    accumulate: str = "auto",
     device: Union[int, str, None] = None,
 ) -> Lines:
     """The line families of rtsc (Rusinkiewicz and DeCarlo) on a mesh seen
@@ -538,8 +543,13 @@ def lines(
 
     ``lines``: names among contours, suggestive, ridges, valleys,
     apparent-ridges, suggestive-highlights, principal-highlights, isophotes,
-    k-zero, h-zero, dwkr-zero, boundaries. Thresholds are dimensionless,
-    scaled by the feature size as in ``shapecue lines``.
+    k-zero, h-zero, dwkr-zero, boundaries. The defaults are rtsc's: its
+    thresholds (dimensionless, scaled by the feature size as in ``shapecue
+    lines``), its fade ``sc_fade`` of suggestive contours and highlights, its
+    tests (``test``), its Hermite placement (``hermite``; ``hermite_kh`` is
+    shapecue's for K = 0 and H = 0) and its feature size (``feature_size``:
+    "rtsc", "edge" for the median edge length, or a length). ``compat =
+    "trimesh2"`` computes the curvature as trimesh2 (and so rtsc) does.
     """
     v, f = _mesh_arrays(vertices, faces)
     names = lines if isinstance(lines, str) else ",".join(lines)
@@ -561,13 +571,18 @@ def lines(
         names,
         e,
         bool(ortho),
-        (float(sc_threshold), float(rv_threshold), float(ar_threshold), float(ph_threshold), float(sh_threshold)),
+        (
+            float(sc_threshold),
+            float(rv_threshold),
+            float(ar_threshold),
+            float(ph_threshold),
+            float(sh_threshold),
+            float(sc_fade),
+        ),
         int(isophotes),
         l3,
-        bool(cull),
-        bool(test),
-        bool(fade),
-        bool(hermite),
+        (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh)),
+        (str(feature_size), str(compat), str(accumulate)),
         _device(device),
     )
     fam_names = np.asarray(d.pop("family_names"))

@@ -4,14 +4,20 @@
 //! strength, no picture.
 
 use super::*;
-use shapecue::spec::feature_lines::{CurveOptions, FamilySet, LineFamily};
+use shapecue::api::LineSetup;
+use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
 use shapecue::spec::view::View;
 use shapecue::stages::feature_lines::LineOptions;
 
 /// lines(vertices, faces, families, eye, ortho, thresholds, isophotes,
-/// light, cull, test, fade, hermite, device) -> dict
+/// light, switches, setup, device) -> dict
+///
+/// thresholds: (sc, rv, ar, ph, sh, fade); switches: (cull, test, fade,
+/// hermite, hermite_kh); setup: (feature_size, compat, accumulate) by their
+/// command-line names ("rtsc" | "edge" | a length; "exact" | "trimesh2";
+/// "auto" | a scheme).
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, families, eye, ortho, thresholds, isophotes, light, cull, test, fade, hermite, device))]
+#[pyo3(signature = (vertices, faces, families, eye, ortho, thresholds, isophotes, light, switches, setup, device))]
 #[allow(clippy::too_many_arguments)]
 pub fn lines<'py>(
     py: Python<'py>,
@@ -20,22 +26,22 @@ pub fn lines<'py>(
     families: &str,
     eye: [f32; 3],
     ortho: bool,
-    thresholds: [f32; 5],
+    thresholds: [f32; 6],
     isophotes: u32,
     light: [f32; 3],
-    cull: bool,
-    test: bool,
-    fade: bool,
-    hermite: bool,
+    switches: [bool; 5],
+    setup: (String, String, String),
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mesh = read_mesh(vertices, faces)?;
     let fams = FamilySet::parse(families).map_err(to_py)?;
-    let [sc, rv, ar, ph, sh] = thresholds;
+    let [sc, rv, ar, ph, sh, sc_fade] = thresholds;
+    let [cull, test, fade, hermite, hermite_kh] = switches;
     let opts = LineOptions {
         contours: fams.has(LineFamily::Contours),
         suggestive: fams.has(LineFamily::Suggestive),
         threshold: sc,
+        fade: sc_fade,
         curves: CurveOptions {
             families: fams.curves(),
             ridge_threshold: rv,
@@ -48,14 +54,27 @@ pub fn lines<'py>(
             test,
             fade,
             hermite,
+            hermite_kh,
         },
-        ..Default::default()
+    };
+    let (feature_size, compat, accumulate) = setup;
+    let setup = LineSetup {
+        curvature: CurvatureOptions {
+            accumulate: if accumulate == "auto" {
+                Default::default()
+            } else {
+                parse(&accumulate)?
+            },
+            compat: parse(&compat)?,
+            ..Default::default()
+        },
+        feature_size: feature_size.parse::<FeatureSize>().map_err(to_py)?,
     };
     let view = View::from_eye(eye, ortho);
     let (ls, name) = py
         .detach(|| {
             let gpu = open_gpu(device.as_deref())?;
-            let ls = shapecue::api::line_segments_on(&gpu, &mesh, view, &opts)?;
+            let ls = shapecue::api::line_segments_on(&gpu, &mesh, view, &opts, &setup)?;
             Ok::<_, Error>((ls, gpu.info.name.clone()))
         })
         .map_err(to_py)?;

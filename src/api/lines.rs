@@ -12,9 +12,9 @@ use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame, Placement, framed};
 use crate::render::{MeshStyle, RenderOptions, Renderer};
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use crate::spec::curvature::CurvatureOptions;
+use crate::spec::feature_lines::{FeatureSize, LineFamily, LineInputs, Segment};
 pub use crate::spec::feature_lines::{Hidden, family_style, hidden_id};
-use crate::spec::feature_lines::{LineFamily, LineInputs, Segment};
 use crate::spec::timing::Timing;
 use crate::spec::view::View;
 use crate::stages::curvature::estimate;
@@ -47,6 +47,20 @@ pub struct LinesPictureOptions {
     pub hidden: Hidden,
     /// Also find the SVG groups.
     pub svg: bool,
+    /// The curvature and the feature size the lines are found with.
+    pub setup: LineSetup,
+}
+
+/// What the line families are computed from besides the view: the
+/// curvature estimator's options (the derivative is always on) and the
+/// feature size the thresholds are scaled by.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LineSetup {
+    /// Scheme, precision and least squares of the curvature (default:
+    /// gather, f32, the exact solve; `Compat::Trimesh2` gives rtsc's own).
+    pub curvature: CurvatureOptions,
+    /// The thresholds' scale (default: rtsc's).
+    pub feature_size: FeatureSize,
 }
 
 impl Default for LinesPictureOptions {
@@ -63,6 +77,7 @@ impl Default for LinesPictureOptions {
             line_width: 2.0,
             hidden: Hidden::Remove,
             svg: false,
+            setup: LineSetup::default(),
         }
     }
 }
@@ -79,7 +94,7 @@ pub struct LinesPicture {
     pub timing: Timing,
     /// The camera.
     pub camera: Camera,
-    /// The feature size the thresholds were scaled by (median edge length).
+    /// The feature size the thresholds were scaled by.
     pub feature_size: f32,
 }
 
@@ -109,7 +124,7 @@ pub fn lines_picture_on(
         bounds,
         w as f32 / h as f32,
     )?;
-    let ls = line_segments_on(gpu, mesh, cam.view(w, h), &opts.lines)?;
+    let ls = line_segments_on(gpu, mesh, cam.view(w, h), &opts.lines, &opts.setup)?;
     let (segments, timing, fs) = (ls.segments, ls.timing, ls.feature_size);
     let pos: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
     let nrm = crate::mesh::topology::vertex_normals(mesh);
@@ -163,25 +178,24 @@ pub struct LineSegments {
     pub segments: Vec<Segment>,
     /// Kernel ms of curvature and line steps.
     pub timing: Timing,
-    /// The feature size the thresholds were scaled by (median edge length).
+    /// The feature size the thresholds were scaled by.
     pub feature_size: f32,
 }
 
 /// The line segments of `mesh` seen from `view` (no picture, no GL):
-/// curvature with its derivative (f32, on the device), then every family
-/// `opts` asks for, thresholds scaled by the median edge length.
+/// curvature with its derivative (on the device, as `setup` asks), then
+/// every family `opts` asks for, thresholds scaled by `setup`'s feature
+/// size.
 pub fn line_segments_on(
     gpu: &Arc<Gpu>,
     mesh: &Mesh,
     view: View,
     opts: &LineOptions,
+    setup: &LineSetup,
 ) -> Result<LineSegments> {
     let copts = CurvatureOptions {
-        accumulate: Accumulate::Atomic,
-        precision: Precision::F32,
-        compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        ..setup.curvature
     };
     let run = estimate(gpu.clone(), mesh, copts)?;
     let f = &run.field;
@@ -202,10 +216,12 @@ pub fn line_segments_on(
         k: &k,
         dk: &dk,
     };
-    let fs = match crate::mesh::feature_size(&mesh.positions, &mesh.faces) {
-        s if s > 0.0 => s as f32,
-        _ => 1.0,
-    };
+    let fs = crate::mesh::feature_size::resolve(
+        setup.feature_size,
+        &mesh.positions,
+        &mesh.faces,
+        Some((&f.k1, &f.k2)),
+    ) as f32;
     let mut ex = LineExtractor::new(gpu.clone(), mesh.n_vertices(), &mesh.faces)?;
     let (segments, st) = ex.extract(&x, view, fs, *opts)?;
     let mut timing = run.timing.clone();

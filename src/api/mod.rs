@@ -48,7 +48,7 @@ pub use edges::{
 };
 
 pub use lines::{
-    Hidden, LineSegments, LinesPicture, LinesPictureOptions, family_style, hidden_id,
+    Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
     line_segments_on, lines_picture, lines_picture_on, wanted,
 };
 

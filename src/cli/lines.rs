@@ -8,9 +8,11 @@ use super::{check_outputs, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::LinesPictureOptions;
-use shapecue::api::Hidden;
+use shapecue::api::{Hidden, LineSetup};
 use shapecue::gpu::Gpu;
 use shapecue::mesh::LoadOptions;
+use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions};
+use shapecue::spec::feature_lines::FeatureSize;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -21,9 +23,9 @@ pub struct LinesArgs {
     /// Input mesh (.obj, .ply, .off), or a generated one: torus, sphere,
     /// ellipsoid, cylinder or plane (with --vertices).
     mesh: String,
-    /// Vertices of a generated mesh (about).
-    #[arg(long, default_value_t = 20000)]
-    vertices: usize,
+    /// Vertices of a generated mesh (about; default 20000).
+    #[arg(long)]
+    vertices: Option<usize>,
     /// The families, comma-separated: contours, suggestive, ridges, valleys,
     /// apparent-ridges, suggestive-highlights, principal-highlights,
     /// isophotes, k-zero, h-zero, dwkr-zero, boundaries.
@@ -47,16 +49,24 @@ pub struct LinesArgs {
     /// Image size, e.g. 800x600.
     #[arg(long, default_value = "800x600")]
     size: String,
-    /// Line width in pixels.
-    #[arg(long, default_value_t = 2.0)]
-    width: f32,
-    /// Suggestive-contour threshold (times the feature size squared).
-    #[arg(long, default_value_t = 0.05)]
+    /// Line width in pixels (default 2, or the image's larger side if less).
+    #[arg(long)]
+    width: Option<f32>,
+    /// Suggestive-contour threshold: D_w κr tanθ above it, times 1 / feature
+    /// size squared (rtsc's default). D_w κr = 0 is drawn at this offset, as
+    /// rtsc draws it.
+    #[arg(long, default_value_t = 0.01)]
     sc_threshold: f32,
+    /// Fade of suggestive contours and highlights: strength r / (r + fade)
+    /// for a margin r above the threshold, times 1 / feature size squared
+    /// (rtsc's default).
+    #[arg(long, default_value_t = 0.03)]
+    fade: f32,
     /// Ridge and valley threshold (times 1 / feature size).
     #[arg(long, default_value_t = 0.1)]
     rv_threshold: f32,
-    /// Apparent-ridge threshold (times 1 / feature size).
+    /// Apparent-ridge threshold on q1, a squared curvature (times 1 /
+    /// feature size squared).
     #[arg(long, default_value_t = 0.1)]
     ar_threshold: f32,
     /// Principal-highlight threshold (times 1 / feature size squared).
@@ -71,18 +81,39 @@ pub struct LinesArgs {
     /// Direction towards the light (isophotes), e.g. 0,0,1.
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     light: Option<Vec<f32>>,
+    /// The length the thresholds are scaled by: rtsc (rtsc's feature size:
+    /// 0.01 over the 10th percentile of |k1| and |k2| at 500 sampled
+    /// vertices, at most 5 % of the bounding sphere's radius), edge (the
+    /// median edge length), or a length in the mesh's units.
+    #[arg(long, default_value = "rtsc")]
+    feature_size: String,
+    /// Curvature's least squares: exact, or trimesh2 2.16's (the curvature
+    /// rtsc itself computes).
+    #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
+    compat: Compat,
+    /// Curvature's one-ring accumulation (default: gather, bitwise
+    /// reproducible).
+    #[arg(long, value_parser = super::choice::<Accumulate>())]
+    accumulate: Option<Accumulate>,
     /// Keep lines on back faces.
     #[arg(long)]
     no_cull: bool,
-    /// Draw every zero crossing (no extremum or threshold test).
+    /// rtsc's tests off: every zero crossing (contours without the κr > 0
+    /// test, suggestive contours as the κr = 0 loops, highlights and
+    /// ridge-like lines without their threshold and extremum checks).
     #[arg(long)]
     no_test: bool,
     /// Full-strength lines (no fading by the test's margin).
     #[arg(long)]
     no_fade: bool,
-    /// Hermite (cubic) placement of the K = 0 and H = 0 crossings.
+    /// rtsc's Hermite placement of suggestive contours and highlights (a
+    /// cubic through κr sin²θ and its gradient).
     #[arg(long)]
     hermite: bool,
+    /// Hermite (cubic) placement of the K = 0 and H = 0 crossings, from the
+    /// curvature gradients (shapecue's addition to rtsc).
+    #[arg(long)]
+    hermite_kh: bool,
     /// Hidden parts in the SVG: remove, faded or dashed.
     #[arg(long, value_parser = super::choice::<Hidden>(), default_value = "remove")]
     hidden: Hidden,
@@ -104,14 +135,40 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if fams == FamilySet::NONE {
         bail!("--lines names no family");
     }
-    super::width_arg(a.width, (w, h), "line")?;
-    let svg = match a.output.extension().and_then(|e| e.to_str()) {
+    let width = a.width.unwrap_or(2.0f32.min(w.max(h) as f32));
+    super::width_arg(width, (w, h), "line")?;
+    let ext = a
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let svg = match ext.as_deref() {
         Some("svg") => true,
         Some("png") => false,
-        _ => bail!("--output must end in .png or .svg"),
+        _ => bail!(
+            "--output {}: give a name ending in .png (a picture) or .svg (a group per family)",
+            a.output.display()
+        ),
     };
+    if !svg && a.hidden != Hidden::Remove {
+        bail!(
+            "--hidden {}: hidden parts are drawn in SVG output only; a PNG shows the visible lines",
+            a.hidden.name()
+        );
+    }
+    if fams.has(LineFamily::Isophotes) && a.isophotes == 0 {
+        bail!("--isophotes 0: isophotes need at least 1 level");
+    }
+    let feature_size: FeatureSize = a.feature_size.parse()?;
     let path = PathBuf::from(&a.mesh);
     let generated = !path.exists() && shapecue::mesh::generated_by_name(&a.mesh, 4).is_some();
+    if !generated && a.vertices.is_some() {
+        bail!(
+            "--vertices is for generated meshes (torus, sphere, ellipsoid, cylinder, plane); {} is a file",
+            a.mesh
+        );
+    }
+    let vertices = a.vertices.unwrap_or(20_000);
     let inputs: Vec<&std::path::Path> = if generated {
         vec![]
     } else {
@@ -121,11 +178,11 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         .chain(a.segments.as_deref())
         .collect();
     if generated {
-        shapecue::spec::limits::check_mesh_vertices("--vertices", a.vertices)?;
+        shapecue::spec::limits::check_mesh_vertices("--vertices", vertices)?;
     }
     check_outputs(inputs, outputs, a.force)?;
     let mesh = if generated {
-        shapecue::mesh::generated_by_name(&a.mesh, a.vertices)
+        shapecue::mesh::generated_by_name(&a.mesh, vertices)
             .expect("checked above")
             .1
     } else {
@@ -139,15 +196,24 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         ortho: a.ortho,
         width: w,
         height: h,
-        line_width: a.width,
+        line_width: width,
         hidden: a.hidden,
         svg,
+        setup: LineSetup {
+            curvature: CurvatureOptions {
+                accumulate: a.accumulate.unwrap_or_default(),
+                compat: a.compat,
+                ..Default::default()
+            },
+            feature_size,
+        },
         ..Default::default()
     };
     let l = &mut opts.lines;
     l.contours = fams.has(LineFamily::Contours);
     l.suggestive = fams.has(LineFamily::Suggestive);
     l.threshold = a.sc_threshold;
+    l.fade = a.fade;
     let c = &mut l.curves;
     c.families = fams.curves();
     c.ridge_threshold = a.rv_threshold;
@@ -162,6 +228,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     c.test = !a.no_test;
     c.fade = !a.no_fade;
     c.hermite = a.hermite;
+    c.hermite_kh = a.hermite_kh;
     let gpu = Arc::new(Gpu::new(device)?);
     let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
     match &pic.layers {

@@ -123,11 +123,12 @@ pub fn width_arg(width: f32, size: (u32, u32), what: &str) -> anyhow::Result<()>
     if !(width.is_finite() && width > 0.0) {
         anyhow::bail!("--width {width}: the {what} width must be a positive number of pixels");
     }
-    let widest = size.0.max(size.1) as f32;
-    if width > widest {
+    let widest = size.0.max(size.1);
+    if width > widest as f32 {
+        let px = if widest == 1 { "pixel" } else { "pixels" };
         anyhow::bail!(
             "--width {width}: the {what} width must be at most the image's larger side \
-             ({widest} pixels)"
+             ({widest} {px})"
         );
     }
     Ok(())

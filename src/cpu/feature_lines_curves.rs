@@ -6,7 +6,8 @@
 //! the device's order is that of its atomic counter, so tests compare sorted
 //! lists.
 
-use super::feature_lines::VertexTerms;
+pub use super::feature_lines::zero_hermite;
+use super::feature_lines::{VertexTerms, emit_tested};
 use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
 use crate::spec::view::View;
 
@@ -77,7 +78,8 @@ pub fn lines_pose(x: &LineInputs, grads: bool) -> PoseTerms {
 /// Per-view terms of `lines_view`, per vertex.
 #[derive(Clone, Debug, Default)]
 pub struct ViewTerms {
-    /// Largest view-dependent curvature q1 (≥ 0).
+    /// q1 as rtsc and Judd et al.'s code keep it: the largest eigenvalue
+    /// of QᵀQ, the square of the view-dependent curvature's magnitude (≥ 0).
     pub q1: Vec<f32>,
     /// Its direction t1, world coordinates (sign arbitrary).
     pub t1: Vec<V3>,
@@ -129,7 +131,7 @@ pub fn lines_view(
         } else {
             (1.0, 0.0)
         };
-        o.q1.push(lam.max(0.0).sqrt());
+        o.q1.push(lam.max(0.0));
         o.t1.push(add(mul(tx, e1), mul(ty, e2)));
         o.phdot.push(dot(v, pose.dmax[i]));
         o.phtest.push((k1 * k1 - k2 * k2).abs() * nd);
@@ -224,28 +226,39 @@ pub struct CurveTerms<'a> {
     pub bnd: &'a [u32],
 }
 
-/// Thresholds of `lines_curves`, already divided by the feature size:
-/// ridge/valley, apparent ridge, principal and suggestive highlight.
+/// Thresholds of `lines_curves`, divided by the feature size s as rtsc
+/// scales them: ridge/valley (÷ s), apparent ridge, principal and suggestive
+/// highlight, suggestive contour (÷ s²), and the fade of suggestive
+/// highlights (÷ s², 0 for none).
 #[derive(Clone, Copy, Debug)]
 pub struct ScaledThresholds {
     /// Ridges and valleys (|k| > rv).
     pub rv: f32,
-    /// Apparent ridges (q1 > ar).
+    /// Apparent ridges (q1 > ar, q1 a squared curvature).
     pub ar: f32,
     /// Principal highlights.
     pub ph: f32,
     /// Suggestive highlights.
     pub sh: f32,
+    /// The suggestive-contour threshold (D_w κr = 0 is the zero set of
+    /// sinθ D_w κr − sc (n·v)).
+    pub sc: f32,
+    /// The fade of suggestive highlights.
+    pub sh_fade: f32,
 }
 
 impl ScaledThresholds {
-    /// The options' thresholds for a mesh of feature size `s`.
-    pub fn of(o: &CurveOptions, s: f32) -> ScaledThresholds {
+    /// The options' thresholds for a mesh of feature size `s`, with the
+    /// suggestive-contour threshold and fade `sc` already scaled (as
+    /// [`crate::stages::feature_lines::LineOptions`] scales them).
+    pub fn of(o: &CurveOptions, s: f32, sc: (f32, f32)) -> ScaledThresholds {
         ScaledThresholds {
             rv: o.ridge_threshold / s,
-            ar: o.apparent_threshold / s,
+            ar: o.apparent_threshold / (s * s),
             ph: o.principal_threshold / (s * s),
             sh: o.highlight_threshold / (s * s),
+            sc: sc.0,
+            sh_fade: sc.1,
         }
     }
 }
@@ -282,6 +295,8 @@ fn ridge_w(ea: f32, eb: f32) -> f32 {
     if s > 0.0 { ea.abs() / s } else { 0.5 }
 }
 
+/// One ridge-like segment; with `judd` (the directions of increasing q1 at
+/// the three corners), Judd et al.'s test of apparent ridges.
 #[allow(clippy::too_many_arguments)]
 fn ridge_segment(
     out: &mut Out,
@@ -294,6 +309,7 @@ fn ridge_segment(
     fade: bool,
     centre: bool,
     fam: LineFamily,
+    judd: Option<[V3; 3]>,
 ) {
     let p = vi.map(|i| pos[i as usize]);
     let w10 = ridge_w(e[0], e[1]);
@@ -317,6 +333,12 @@ fn ridge_segment(
         && kb.partial_cmp(&thr) != Some(std::cmp::Ordering::Greater)
     {
         return;
+    }
+    if let Some(t) = judd {
+        let perp = cross(cross(sub(p[1], p[0]), sub(p[2], p[0])), sub(pa, pb));
+        if !(dot(t[0], perp) > 0.0 && dot(t[1], perp) < 0.0 && dot(t[2], perp) > 0.0) {
+            return;
+        }
     }
     let s = 0.5 * (ridge_strength(ka, thr, fade) + ridge_strength(kb, thr, fade));
     out.emit(pa, pb, fam, s, [edge_of(vi[0], vi[1]), eb]);
@@ -342,6 +364,7 @@ fn ridge_face(
     thr: f32,
     fade: bool,
     fam: LineFamily,
+    judd: bool,
 ) {
     let mut z01 = dot(t[0], t[1]) <= 0.0;
     let mut z12 = dot(t[1], t[2]) <= 0.0;
@@ -349,7 +372,7 @@ fn ridge_face(
     if (z01 as u32 + z12 as u32 + z20 as u32) < 2 {
         return;
     }
-    if test {
+    if test && !judd {
         let p = v.map(|i| pos[i as usize]);
         let (d01, d12, d20) = (sub(p[1], p[0]), sub(p[2], p[1]), sub(p[0], p[2]));
         z01 = z01 && (dot(t[0], d01) >= 0.0 || dot(t[1], d01) <= 0.0);
@@ -361,58 +384,24 @@ fn ridge_face(
     }
     let (r1, e1, k1) = (rot1(v), rot1(e), rot1(kk));
     let (r2, e2, k2) = (rot2(v), rot2(e), rot2(kk));
+    let jt = |t: [V3; 3]| (judd && test).then_some(t);
+    let (j0, j1, j2) = (jt(t), jt(rot1(t)), jt(rot2(t)));
     if !z01 {
-        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, false, fam);
+        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, false, fam, j1);
     } else if !z12 {
-        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, false, fam);
+        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, false, fam, j2);
     } else if !z20 {
-        ridge_segment(out, f, v, e, kk, pos, thr, fade, false, fam);
+        ridge_segment(out, f, v, e, kk, pos, thr, fade, false, fam, j0);
     } else {
-        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, true, fam);
-        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, true, fam);
-        ridge_segment(out, f, v, e, kk, pos, thr, fade, true, fam);
+        ridge_segment(out, f, r1, e1, k1, pos, thr, fade, true, fam, j1);
+        ridge_segment(out, f, r2, e2, k2, pos, thr, fade, true, fam, j2);
+        ridge_segment(out, f, v, e, kk, pos, thr, fade, true, fam, j0);
     }
 }
 
 fn zero_linear(fa: f32, fb: f32) -> f32 {
     let d = fa - fb;
     (if d != 0.0 { fa / d } else { 0.5 }).clamp(0.0, 1.0)
-}
-
-/// The cubic Hermite crossing on an edge (rtsc's bisection).
-pub fn zero_hermite(fa: f32, fb: f32, da: f32, db: f32) -> f32 {
-    if fa == fb {
-        return 0.5;
-    }
-    let a = 2.0 * (fa - fb) + da + db;
-    let b = 3.0 * (fb - fa) - 2.0 * da - db;
-    let (c, d) = (da, fa);
-    let (mut sl, mut sr, mut vl) = (0.0f32, 1.0f32, fa);
-    let disc = 4.0 * b * b - 12.0 * a * c;
-    if disc > 0.0 && a != 0.0 {
-        let q = disc.sqrt();
-        let (r1, r2) = ((-2.0 * b + q) / (6.0 * a), (-2.0 * b - q) / (6.0 * a));
-        if (0.0..=1.0).contains(&r1) && (0.0..=1.0).contains(&r2) {
-            let v1 = ((a * r1 + b) * r1 + c) * r1 + d;
-            let v2 = ((a * r2 + b) * r2 + c) * r2 + d;
-            if (v1 < 0.0 && v2 >= 0.0) || (v1 > 0.0 && v2 <= 0.0) {
-                sl = r1.min(r2);
-                sr = r1.max(r2);
-                vl = if r1 < r2 { v1 } else { v2 };
-            }
-        }
-    }
-    for _ in 0..10 {
-        let m = 0.5 * (sl + sr);
-        let vm = ((a * m + b) * m + c) * m + d;
-        if (vl < 0.0 && vm >= 0.0) || (vl > 0.0 && vm <= 0.0) {
-            sr = m;
-        } else {
-            sl = m;
-            vl = vm;
-        }
-    }
-    0.5 * (sl + sr)
 }
 
 fn odd_corner(f: [f32; 3]) -> Option<usize> {
@@ -502,6 +491,18 @@ pub fn lines_curves(
                 }
             }
         }
+        if want.has(LineFamily::ApparentRidges) {
+            // Not culled, as in rtsc.
+            let q = g(&wt.q1);
+            let e = g(x.dt);
+            if q.iter().any(|&qq| qq > thr.ar) {
+                let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
+                let fam = LineFamily::ApparentRidges;
+                ridge_face(
+                    &mut out, fi as u32, v, e, t, q, pos, test, thr.ar, fade, fam, true,
+                );
+            }
+        }
         if o.cull && nd.iter().all(|&n| n <= 0.0) {
             continue;
         }
@@ -514,19 +515,8 @@ pub fn lines_curves(
             let em = g(&pt.emax);
             let t = [0, 1, 2].map(|i| mul(sg * em[i], dm[i]));
             ridge_face(
-                &mut out, fi as u32, v, em, t, km, pos, test, thr.rv, fade, fam,
+                &mut out, fi as u32, v, em, t, km, pos, test, thr.rv, fade, fam, false,
             );
-        }
-        if want.has(LineFamily::ApparentRidges) {
-            let q = g(&wt.q1);
-            let e = g(x.dt);
-            if q.iter().any(|&qq| qq > thr.ar) {
-                let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
-                let fam = LineFamily::ApparentRidges;
-                ridge_face(
-                    &mut out, fi as u32, v, e, t, q, pos, test, thr.ar, fade, fam,
-                );
-            }
         }
         if want.has(LineFamily::PrincipalHighlights) {
             let mut r = 0;
@@ -562,29 +552,49 @@ pub fn lines_curves(
                     (v, dots, tst)
                 };
                 if !(z01 && z12 && z20) {
-                    ridge_segment(&mut out, f, rv, rd, rt, pos, thr.ph, fade, false, fam);
+                    ridge_segment(&mut out, f, rv, rd, rt, pos, thr.ph, fade, false, fam, None);
                 }
             }
         }
         if want.has(LineFamily::SuggestiveHighlights) {
             let f = g(&vt.kr);
             if let Some(c) = odd_corner(f) {
-                let tt = iso_params(v, f, c, pos, None);
+                let tt = if o.hermite {
+                    // rtsc's Hermite placement from the gradient of κr sin²θ.
+                    let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+                    let (ic, ia, ib) = (v[c] as usize, v[a] as usize, v[b] as usize);
+                    let (ea, eb) = (sub(pos[ia], pos[ic]), sub(pos[ib], pos[ic]));
+                    let gk = &vt.gkr;
+                    (
+                        zero_hermite(f[c], f[a], dot(ea, gk[ic]), dot(ea, gk[ia])),
+                        zero_hermite(f[c], f[b], dot(eb, gk[ic]), dot(eb, gk[ib])),
+                    )
+                } else {
+                    iso_params(v, f, c, pos, None)
+                };
                 let (a, b) = ((c + 1) % 3, (c + 2) % 3);
                 let s3 = g(&vt.sc);
-                let ndm = 0.5 * (nd[c] + tt.0 * (nd[a] - nd[c]) + nd[c] + tt.1 * (nd[b] - nd[c]));
-                let num = -0.5 * (s3[c] + tt.0 * (s3[a] - s3[c]) + s3[c] + tt.1 * (s3[b] - s3[c]));
-                if ndm > 0.0 && (!test || num > thr.sh * ndm) {
-                    let xx = num / ndm - thr.sh;
-                    let s = if !fade {
-                        1.0
-                    } else if xx + thr.sh > 0.0 {
-                        xx.max(0.0) / (xx + thr.sh)
-                    } else {
-                        0.0
-                    };
-                    iso_emit(&mut out, v, c, tt, pos, LineFamily::SuggestiveHighlights, s);
-                }
+                let num: [f32; 3] = std::array::from_fn(|i| -s3[i] - thr.sh * nd[i]);
+                let ends = [
+                    num[c] + tt.0 * (num[a] - num[c]),
+                    num[c] + tt.1 * (num[b] - num[c]),
+                    nd[c] + tt.0 * (nd[a] - nd[c]),
+                    nd[c] + tt.1 * (nd[b] - nd[c]),
+                ];
+                let pc = pos[v[c] as usize];
+                emit_tested(
+                    out.segs,
+                    (
+                        lerp(pc, pos[v[a] as usize], tt.0),
+                        lerp(pc, pos[v[b] as usize], tt.1),
+                    ),
+                    (edge_of(v[c], v[a]), edge_of(v[c], v[b])),
+                    fi as u32,
+                    ends,
+                    test,
+                    thr.sh_fade,
+                    LineFamily::SuggestiveHighlights as u32,
+                );
             }
         }
         for fam in [LineFamily::KZero, LineFamily::HZero, LineFamily::DwkrZero] {
@@ -594,10 +604,13 @@ pub fn lines_curves(
             let f = match fam {
                 LineFamily::KZero => g(&pt.gauss),
                 LineFamily::HZero => g(&pt.mean),
-                _ => g(&vt.sc),
+                _ => {
+                    let s3 = g(&vt.sc);
+                    std::array::from_fn(|i| s3[i] - thr.sc * nd[i])
+                }
             };
             let Some(c) = odd_corner(f) else { continue };
-            let grad = (o.hermite && fam != LineFamily::DwkrZero)
+            let grad = (o.hermite_kh && fam != LineFamily::DwkrZero)
                 .then(|| (&pt.grad[..], if fam == LineFamily::KZero { 0 } else { 1 }));
             let tt = iso_params(v, f, c, pos, grad);
             iso_emit(&mut out, v, c, tt, pos, fam, 1.0);

@@ -7,6 +7,7 @@
 //! centres and scales it before rounding to the device's precision.
 
 pub mod edges;
+pub mod feature_size;
 pub mod flipbook;
 mod generate;
 pub mod libigl;

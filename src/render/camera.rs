@@ -166,8 +166,9 @@ impl Camera {
         let scale = self.eye.abs().max(self.target.abs()).max_element().max(1.0);
         if dir.length() <= 1e-6 * scale {
             return bad(format!(
-                "eye {} and target {} coincide",
-                self.eye, self.target
+                "eye ({}) and target ({}) coincide",
+                crate::error::values(self.eye.to_array(), ", "),
+                crate::error::values(self.target.to_array(), ", ")
             ));
         }
         let up = self.up.normalize_or_zero();
@@ -176,8 +177,9 @@ impl Camera {
         }
         if dir.normalize().cross(up).length() < 1e-4 {
             return bad(format!(
-                "up {} is parallel to the view direction {}",
-                self.up, dir
+                "up ({}) is parallel to the view direction ({}); give another --up",
+                crate::error::values(self.up.to_array(), ", "),
+                crate::error::values(dir.to_array(), ", ")
             ));
         }
         if let Some(h) = self.ortho_height

@@ -29,7 +29,7 @@ use std::collections::HashMap;
 use glam::Mat4;
 
 use super::{Frame, clip_segment};
-use crate::spec::feature_lines::{Segment, edge_key};
+use crate::spec::feature_lines::{LINE_FREE, Segment, edge_key};
 
 /// Default depth bias (window depth units) of [`visible_polylines`].
 pub const DEFAULT_BIAS: f32 = 1e-3;
@@ -108,8 +108,9 @@ pub fn segment_lines(
         let Some((a, b, cut)) = clip_segment(view_proj, s.0, s.1) else {
             continue;
         };
-        // A cut end no longer lies on its mesh edge.
-        let edge = |i: usize| (!cut[i]).then(|| edge_key(s.4[i]));
+        // A cut end no longer lies on its mesh edge; an end that a line's
+        // test cut inside a face never lay on one.
+        let edge = |i: usize| (!cut[i] && s.4[i][0] != LINE_FREE).then(|| edge_key(s.4[i]));
         out.push(ClipLine {
             ends: [a.to_array(), b.to_array()],
             edges: [edge(0), edge(1)],

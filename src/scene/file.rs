@@ -26,7 +26,7 @@
 //! curvature_colors = { scale = 2.0 }
 //! ao = { level = "lut", radius = 0.05 }
 //! contours = { width = 2 }
-//! suggestive_contours = { threshold = 0.05, fade = 0.2 }
+//! suggestive_contours = { threshold = 0.01, fade = 0.03 }
 //! feature_edges = { crease = 30, caps = "adjacency" }
 //! curvature_strokes = { spacing = 0.05, sampling = "auto", color = [0.1, 0.1, 0.2], width = 0.01 }
 //!                              # volume and sdf inputs only
@@ -47,14 +47,18 @@ use crate::scene::planner::{Cue, Input};
 use crate::spec::ao::AoMode;
 use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::CapMode;
+use crate::spec::feature_lines::FeatureSize;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod effects;
 pub mod lines;
 mod raw;
+mod settings;
 mod toml_words;
 
+pub use effects::{Effects, StrokeEffect};
 pub use lines::{LineEffects, LineStyle};
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
@@ -121,59 +125,6 @@ pub struct ViewSpec {
     pub fov: f32,
     /// Orthographic.
     pub ortho: bool,
-}
-
-/// Curvature colour, AO, line and edge parameters, resolved with defaults.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Effects {
-    /// The cues asked for.
-    pub cues: Vec<Cue>,
-    /// Shading base colour.
-    pub base_color: [f32; 3],
-    /// Ambient term.
-    pub ambient: f32,
-    /// Curvature colour scale (None: from the first pose).
-    pub curvature_scale: Option<f32>,
-    /// AO level.
-    pub ao_mode: AoMode,
-    /// AO radius as a fraction of the bounding-box diagonal.
-    pub ao_radius: f32,
-    /// Contour width and colour.
-    pub contour: (f32, [f32; 3]),
-    /// Suggestive contour width and colour.
-    pub suggestive: (f32, [f32; 3]),
-    /// Suggestive threshold and fade.
-    pub suggestive_threshold: f32,
-    /// n·v fade.
-    pub suggestive_fade: f32,
-    /// Edge width, colour.
-    pub edge: (f32, [f32; 3]),
-    /// Crease angle (None: off).
-    pub crease: Option<f32>,
-    /// Caps.
-    pub caps: CapMode,
-    /// Edge contours.
-    pub edge_contours: bool,
-    /// Edge boundaries.
-    pub edge_boundaries: bool,
-    /// Curvature-directed strokes.
-    pub strokes: StrokeEffect,
-    /// The curvature line cues (ridges, valleys, ..., boundaries).
-    pub lines: LineEffects,
-}
-
-/// The `curvature_strokes` cue's parameters (world units; `None`: the
-/// `sdf_lines` default, a multiple of the sampling distance).
-#[derive(Debug, Clone, PartialEq)]
-pub struct StrokeEffect {
-    /// Poisson-disk seed spacing.
-    pub spacing: Option<f64>,
-    /// Hessian sampling distance (`None`: automatic).
-    pub sampling: Option<f64>,
-    /// RGB.
-    pub color: [f32; 3],
-    /// Stroke width at the largest κ1.
-    pub width: Option<f64>,
 }
 
 /// A checked scene.
@@ -621,13 +572,18 @@ impl Scene {
             positive(sc.width, 1.5, "suggestive_contours.width").map_err(e)?,
             color(sc.color, [0.15; 3], "suggestive_contours.color").map_err(e)?,
         );
-        let suggestive_threshold = sc.threshold.unwrap_or(0.05);
+        let suggestive_threshold = sc.threshold.unwrap_or(0.01);
         if !(suggestive_threshold.is_finite() && suggestive_threshold >= 0.0) {
             return Err(e(format!(
                 "suggestive_contours.threshold {suggestive_threshold} must be ≥ 0"
             )));
         }
-        let suggestive_fade = positive(sc.fade, 0.2, "suggestive_contours.fade").map_err(e)?;
+        let suggestive_fade = sc.fade.unwrap_or(0.03);
+        if !(suggestive_fade.is_finite() && suggestive_fade >= 0.0) {
+            return Err(e(format!(
+                "suggestive_contours.fade {suggestive_fade} must be ≥ 0 (0: no fade)"
+            )));
+        }
         let fe = fx.feature_edges.clone().unwrap_or_default();
         if fx.feature_edges.is_some() {
             cues.push(Cue::FeatureEdges);
@@ -723,6 +679,7 @@ impl Scene {
             edge_boundaries: fe.boundaries.unwrap_or(true),
             strokes,
             lines,
+            feature_size: FeatureSize::default(),
         };
 
         // Output.
@@ -772,25 +729,14 @@ impl Scene {
                 "output.name {prefix:?} must be a non-empty file name prefix"
             )));
         }
-        let mut curvature = CurvatureOptions::default();
-        if let Some(c) = &file.curvature {
-            fn pick<T: std::str::FromStr<Err = Error>>(
-                ck: &Checker<'_>,
-                v: &Option<Spanned<String>>,
-                into: &mut T,
-            ) -> Result<()> {
-                if let Some(v) = v {
-                    *into = v
-                        .get_ref()
-                        .parse()
-                        .map_err(|x: Error| ck.err(v.span(), format!("curvature: {x}")))?;
-                }
-                Ok(())
-            }
-            pick(&ck, &c.accumulate, &mut curvature.accumulate)?;
-            pick(&ck, &c.precision, &mut curvature.precision)?;
-            pick(&ck, &c.compat, &mut curvature.compat)?;
+        let mut effects = effects;
+        if let Some(l) = &file.lines {
+            settings::lines(&ck, l, &mut effects)?;
         }
+        let curvature = match &file.curvature {
+            Some(c) => settings::curvature(&ck, c)?,
+            None => CurvatureOptions::default(),
+        };
         Ok(Scene {
             curvature,
             path: path.to_path_buf(),

@@ -416,7 +416,8 @@ impl Pass {
             Pass::Curvature => vec![Pass::OneRings, Pass::VertexNormals],
             Pass::Dcurv => vec![Pass::Curvature],
             Pass::Ao => vec![Pass::Curvature],
-            Pass::Contours => vec![Pass::VertexNormals],
+            // rtsc's contour test keeps the parts with κr > 0.
+            Pass::Contours => vec![Pass::Curvature, Pass::VertexNormals],
             Pass::SuggestiveContours => vec![Pass::Dcurv, Pass::VertexNormals],
             Pass::LinesPose => vec![Pass::Dcurv],
             Pass::LinesView => vec![Pass::VertexNormals],

@@ -7,13 +7,19 @@
 /// A segment: endpoints, kind (0 contour, 1 suggestive), strength, and the
 /// mesh edge each endpoint lies on (sorted vertex pairs). The segments of two
 /// faces sharing an edge meet on it, so chaining by these edges is exact
-/// (see [`edge_key`]).
+/// (see [`edge_key`]). An end inside a face has no edge: `[LINE_FREE, face]`
+/// where a test cut the segment, `[u32::MAX, face]` at a face centre.
 pub type Segment = ([f32; 3], [f32; 3], u32, f32, [[u32; 2]; 2]);
 
 /// One number per mesh edge (a sorted vertex pair), for chaining segments.
 pub fn edge_key(e: [u32; 2]) -> u64 {
     (u64::from(e[0]) << 32) | u64::from(e[1])
 }
+
+/// The first entry of a segment end's "edge" where a test cut the segment
+/// inside a face (the second is the face): such an end chains with no
+/// other by its edge.
+pub const LINE_FREE: u32 = 0xffff_fffe;
 
 /// Inputs of the stage, f32 per vertex.
 pub struct LineInputs<'a> {
@@ -31,11 +37,12 @@ pub struct LineInputs<'a> {
     pub dk: &'a [[f32; 4]],
 }
 
-/// Segments the face pass can emit for `faces` faces: one of each kind per
-/// face (a plane crosses a triangle in at most one segment), the capacity of
-/// the device's segment buffer.
+/// Segments the face pass can emit for `faces` faces: two of each kind per
+/// face (a plane crosses a triangle in at most one segment, and rtsc's test
+/// cuts it into at most two pieces), the capacity of the device's segment
+/// buffer.
 pub fn segments_bound(faces: usize) -> usize {
-    2 * faces
+    4 * faces
 }
 
 crate::spec::kernels::kernel_entries! {
@@ -196,10 +203,11 @@ impl FamilySet {
     }
 }
 
-/// The controls of the curvature line families (rtsc's): thresholds are
-/// dimensionless, multiplied by the mesh's feature size s: ridges, valleys
-/// and apparent ridges keep |k| > t / s, principal highlights
-/// (k1² − k2²)(n·v) > t / s², suggestive highlights −D_w κr / (n·v) > t / s².
+/// The controls of the curvature line families, with rtsc's defaults and
+/// meanings: thresholds are dimensionless and scaled by the feature size s
+/// as rtsc scales them: ridges and valleys keep |k| > t / s, apparent
+/// ridges q1 > t / s² (q1 a squared curvature), principal highlights
+/// (k1² − k2²)(n·v) > t / s², suggestive highlights −D_w κr tanθ > t / s².
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct CurveOptions {
     /// The families to draw besides the contours.
@@ -216,15 +224,24 @@ pub struct CurveOptions {
     pub isophotes: u32,
     /// Unit direction towards the light, world coordinates.
     pub light: [f32; 3],
-    /// Back-face culling: no segment on a face whose corners all face away.
+    /// Back-face culling: no segment on a face whose corners all face away
+    /// (apparent ridges are never culled, as in rtsc).
     pub cull: bool,
-    /// The extremum and threshold tests (off: every zero crossing).
+    /// rtsc's tests (its `test_c`, `test_sc`, `test_sh`, `test_rv`,
+    /// `test_ph`, `test_ar`): contours keep κr ≥ 0, suggestive contours and
+    /// highlights their threshold, ridge-like families their extremum check.
+    /// Off: every zero crossing (suggestive contours become the κr = 0 loops).
     pub test: bool,
-    /// Strength fades with the test's margin above the threshold.
+    /// Strength fades with the test's margin above the threshold (rtsc's
+    /// "draw faded").
     pub fade: bool,
-    /// Hermite (cubic) placement of the K = 0 and H = 0 crossings, from the
-    /// curvature gradients, instead of linear interpolation.
+    /// rtsc's `use_hermite`: the κr = 0 crossings of suggestive contours and
+    /// highlights placed by a cubic Hermite fit from the gradient of
+    /// κr sin²θ instead of linear interpolation.
     pub hermite: bool,
+    /// shapecue's addition: the same cubic placement for the K = 0 and
+    /// H = 0 crossings, from the curvature gradients.
+    pub hermite_kh: bool,
 }
 
 impl Default for CurveOptions {
@@ -241,17 +258,20 @@ impl Default for CurveOptions {
             test: true,
             fade: true,
             hermite: false,
+            hermite_kh: false,
         }
     }
 }
 
 impl CurveOptions {
-    /// The kernel's flag bits: culling, tests, fading, Hermite.
+    /// The kernel's flag bits: culling, tests, fading, Hermite placement of
+    /// K = 0 and H = 0 (bit 3) and of suggestive highlights (bit 4).
     pub fn flags(&self) -> u32 {
         u32::from(self.cull)
             | (u32::from(self.test) << 1)
             | (u32::from(self.fade) << 2)
-            | (u32::from(self.hermite) << 3)
+            | (u32::from(self.hermite_kh) << 3)
+            | (u32::from(self.hermite) << 4)
     }
 
     /// Checks the thresholds and the light.
@@ -326,6 +346,54 @@ crate::spec::kernels::kernel_entries! {
     }
 }
 
+/// The length that scales the line families' thresholds (rtsc's "feature
+/// size"): thresholds are dimensionless, divided by it or its square.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FeatureSize {
+    /// rtsc's (`compute_feature_size` in rtsc.cc): min(0.01 / p, 0.05 r),
+    /// p the 10th percentile of |k1| and |k2| at 500 vertices its generator
+    /// draws, r the radius of the smallest sphere around the vertices
+    /// (`crate::mesh::feature_size::resolve`).
+    #[default]
+    Rtsc,
+    /// The median edge length.
+    Edge,
+    /// This length, in the mesh's units.
+    Value(f32),
+}
+
+impl FeatureSize {
+    /// The words a file or the command line may use.
+    pub const HELP: &'static str = "rtsc, edge or a length";
+}
+
+impl std::fmt::Display for FeatureSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FeatureSize::Rtsc => f.write_str("rtsc"),
+            FeatureSize::Edge => f.write_str("edge"),
+            FeatureSize::Value(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+impl std::str::FromStr for FeatureSize {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<FeatureSize> {
+        match s {
+            "rtsc" => Ok(FeatureSize::Rtsc),
+            "edge" => Ok(FeatureSize::Edge),
+            _ => match s.parse::<f32>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(FeatureSize::Value(v)),
+                _ => Err(crate::error::Error::InvalidArgument(format!(
+                    "feature size {s}: expected rtsc, edge or a positive length"
+                ))),
+            },
+        }
+    }
+}
+
 /// How the hidden parts of lines appear in the SVG (rtsc's "draw hidden
 /// lines"): left out, drawn faded, or drawn dashed, under the visible parts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -354,7 +422,11 @@ impl Hidden {
 
 crate::spec::named_choice!(Hidden, "hidden-line mode");
 
-/// Each family's stroke colour and width factor in pictures and SVG.
+/// Each family's stroke colour and width factor in pictures and SVG: rtsc's
+/// colours (its `draw_colors` mode) where they tell families apart, and
+/// others where rtsc gives two families one colour (it draws K = 0, H = 0
+/// and D_w κr = 0 all red, both highlights dark red) or draws boundaries
+/// almost as black as contours. No two families share a colour.
 pub fn family_style(f: LineFamily) -> ([f32; 3], f32) {
     match f {
         LineFamily::Contours => ([0.0, 0.0, 0.0], 1.25),
@@ -363,10 +435,12 @@ pub fn family_style(f: LineFamily) -> ([f32; 3], f32) {
         LineFamily::Valleys => ([0.5, 0.3, 0.2], 1.0),
         LineFamily::ApparentRidges => ([0.4, 0.4, 0.0], 1.0),
         LineFamily::SuggestiveHighlights => ([0.5, 0.0, 0.0], 1.0),
-        LineFamily::PrincipalHighlights => ([0.8, 0.2, 0.0], 1.0),
+        LineFamily::PrincipalHighlights => ([0.9, 0.45, 0.0], 1.0),
         LineFamily::Isophotes => ([0.4, 0.7, 0.4], 0.5),
-        LineFamily::KZero | LineFamily::HZero | LineFamily::DwkrZero => ([1.0, 0.0, 0.0], 0.75),
-        LineFamily::Boundaries => ([0.05, 0.05, 0.05], 1.0),
+        LineFamily::KZero => ([0.9, 0.0, 0.0], 0.75),
+        LineFamily::HZero => ([0.0, 0.55, 0.7], 0.75),
+        LineFamily::DwkrZero => ([0.8, 0.2, 0.7], 0.75),
+        LineFamily::Boundaries => ([0.55, 0.55, 0.55], 1.0),
     }
 }
 
@@ -385,5 +459,42 @@ pub fn hidden_id(f: LineFamily) -> &'static str {
         LineFamily::HZero => "h-zero-hidden",
         LineFamily::DwkrZero => "dwkr-zero-hidden",
         LineFamily::Boundaries => "boundaries-hidden",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_family_has_its_own_colour() {
+        for (i, a) in LineFamily::ALL.iter().enumerate() {
+            for b in &LineFamily::ALL[i + 1..] {
+                let (ca, cb) = (family_style(*a).0, family_style(*b).0);
+                let d: f32 = (0..3).map(|k| (ca[k] - cb[k]).powi(2)).sum::<f32>().sqrt();
+                assert!(
+                    d > 0.15,
+                    "{} and {} look alike: {ca:?} {cb:?}",
+                    a.name(),
+                    b.name()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn feature_sizes_parse_and_print() {
+        assert_eq!("rtsc".parse::<FeatureSize>().unwrap(), FeatureSize::Rtsc);
+        assert_eq!("edge".parse::<FeatureSize>().unwrap(), FeatureSize::Edge);
+        assert_eq!(
+            "0.5".parse::<FeatureSize>().unwrap(),
+            FeatureSize::Value(0.5)
+        );
+        for bad in ["0", "-1", "nan", "inf", "median", ""] {
+            let e = bad.parse::<FeatureSize>().unwrap_err().to_string();
+            assert!(e.contains("rtsc, edge or a positive length"), "{bad}: {e}");
+        }
+        assert_eq!(FeatureSize::Value(0.25).to_string(), "0.25");
+        assert_eq!(FeatureSize::default().to_string(), "rtsc");
     }
 }

@@ -3,8 +3,8 @@
 //! each call uploads the per-vertex inputs ([`LineExtractor::extract`]) or
 //! reads them from a curvature estimator's device buffers
 //! ([`LineExtractor::extract_device`]) and runs `lines_vertex` and
-//! `lines_face`. The segment buffer holds two segments per face (one of each
-//! kind), the most a face can emit ([`segments_bound`]), and the kernel still
+//! `lines_face`. The segment buffer holds four segments per face (two pieces
+//! of each kind), the most a face can emit ([`segments_bound`]), and the kernel still
 //! counts and refuses what does not fit. CPU twin:
 //! [`crate::cpu::feature_lines`]. Views are [`crate::spec::view::View`]s
 //! (made by the renderer's camera, or [`View::from_eye`] for lines alone).
@@ -29,10 +29,14 @@ pub struct LineOptions {
     pub contours: bool,
     /// Suggestive contours.
     pub suggestive: bool,
-    /// Suggestive-contour threshold, dimensionless: segments are kept where
-    /// sinθ·D_w κr · s² > `threshold` · n·v, with s the mesh's feature size.
+    /// Suggestive-contour threshold, dimensionless (rtsc's `sug_thresh`,
+    /// default 0.01): segments are kept, and cut, where
+    /// D_w κr · tanθ · s² ≥ `threshold`, with s the feature size.
     pub threshold: f32,
-    /// n·v below which suggestive contours fade (strength = n·v / fade).
+    /// rtsc's fade of suggestive contours and highlights, dimensionless
+    /// (default 0.03): a point with r = D_w κr · tanθ − threshold / s² above
+    /// the threshold has strength r / (r + fade / s²). Applied where
+    /// [`CurveOptions::fade`] is on (rtsc's "draw faded"); 0: no fade.
     pub fade: f32,
     /// The curvature line families beside the contours (none by default)
     /// and their controls.
@@ -44,16 +48,31 @@ impl Default for LineOptions {
         LineOptions {
             contours: true,
             suggestive: true,
-            threshold: 0.05,
-            fade: 0.2,
+            threshold: 0.01,
+            fade: 0.03,
             curves: CurveOptions::default(),
         }
     }
 }
 
 impl LineOptions {
-    /// Checks the suggestive-contour threshold (finite, at least 0) and fade
-    /// (finite, above 0), then the curvature families' controls.
+    /// The suggestive-contour threshold for a feature size `s`: threshold / s².
+    pub fn scaled_threshold(&self, s: f32) -> f32 {
+        self.threshold / (s * s)
+    }
+
+    /// The fade of suggestive contours and highlights for a feature size `s`:
+    /// fade / s², or 0 where fading is off.
+    pub fn scaled_fade(&self, s: f32) -> f32 {
+        if self.curves.fade {
+            self.fade / (s * s)
+        } else {
+            0.0
+        }
+    }
+
+    /// Checks the suggestive-contour threshold and fade (finite, at least 0),
+    /// then the curvature families' controls.
     pub fn check(&self) -> Result<()> {
         if !(self.threshold.is_finite() && self.threshold >= 0.0) {
             return Err(Error::InvalidArgument(format!(
@@ -61,9 +80,9 @@ impl LineOptions {
                 self.threshold
             )));
         }
-        if !(self.fade.is_finite() && self.fade > 0.0) {
+        if !(self.fade.is_finite() && self.fade >= 0.0) {
             return Err(Error::InvalidArgument(format!(
-                "the suggestive-contour fade must be a finite number above 0, got {}",
+                "the suggestive-contour fade must be finite and at least 0, got {}",
                 self.fade
             )));
         }
@@ -90,7 +109,9 @@ pub struct LineExtractor {
     face: Kernel,
     faces: Buffer<u32>,
     inputs: [Buffer<f32>; 6],
-    terms: [Buffer<f32>; 3],
+    /// n·v, κr sin²θ, sinθ D_w κr (one per vertex) and the gradient of
+    /// κr sin²θ (three per vertex, written for Hermite placement only).
+    terms: [Buffer<f32>; 4],
     seg: Buffer<f32>,
     ends: Buffer<u32>,
     counter: Buffer<u32>,
@@ -120,7 +141,12 @@ impl LineExtractor {
                 gpu.buffer(2 * nv)?,
                 gpu.buffer(4 * nv)?,
             ],
-            terms: [gpu.buffer(nv)?, gpu.buffer(nv)?, gpu.buffer(nv)?],
+            terms: [
+                gpu.buffer(nv.max(1))?,
+                gpu.buffer(nv.max(1))?,
+                gpu.buffer(nv.max(1))?,
+                gpu.buffer(3 * nv.max(1))?,
+            ],
             seg: gpu.buffer(8 * segments_bound(faces.len()))?,
             ends: gpu.buffer(4 * segments_bound(faces.len()))?,
             counter: gpu.buffer(1)?,
@@ -194,10 +220,11 @@ impl LineExtractor {
     /// into the estimator's normalized coordinates (an orthographic direction
     /// is unchanged), the feature size is divided by the scale, and the
     /// segments are mapped back to world coordinates (`p·scale + center`).
-    /// Contours need only the normals: a run up to
-    /// [`crate::stages::curvature::Pass::Frames`] is enough for
-    /// `contours`-only options. Needs an f32 estimator of this topology's
-    /// vertex count.
+    /// Contours without rtsc's test need only the normals: a run up to
+    /// [`crate::stages::curvature::Pass::Frames`] is enough for them (the
+    /// zeroed curvature reads as κr = 0, which the test keeps); the test
+    /// reads κr, so tested contours need the principal curvatures and
+    /// directions. Needs an f32 estimator of this topology's vertex count.
     pub fn extract_device(
         &mut self,
         est: &CurvatureEstimator,
@@ -278,7 +305,11 @@ impl LineExtractor {
             Arg::F32(ez),
             Arg::U32(u32::from(ortho)),
         ]);
-        args.extend(self.terms.iter().map(buf));
+        args.extend(self.terms[..3].iter().map(buf));
+        args.extend([
+            Arg::U32(u32::from(opts.curves.hermite)),
+            buf(&self.terms[3]),
+        ]);
         let e1 = launch(&g, &self.vertex, n, &args)?;
         let cap = segments_bound(self.nf);
         let curve_fams = opts.curves.families.curves();
@@ -298,10 +329,13 @@ impl LineExtractor {
                     buf(&self.terms[0]),
                     buf(&self.terms[1]),
                     buf(&self.terms[2]),
+                    buf(&self.terms[3]),
                     Arg::U32(u32::from(opts.contours)),
                     Arg::U32(u32::from(opts.suggestive)),
-                    Arg::F32(opts.threshold / (feature_size * feature_size)),
-                    Arg::F32(opts.fade),
+                    Arg::U32(u32::from(opts.curves.test)),
+                    Arg::U32(u32::from(opts.curves.hermite)),
+                    Arg::F32(opts.scaled_threshold(feature_size)),
+                    Arg::F32(opts.scaled_fade(feature_size)),
                     Arg::U32(cap as u32),
                     buf(&self.seg),
                     buf(&self.ends),
@@ -347,15 +381,15 @@ impl LineExtractor {
             }
             let args = CurveArgs {
                 inputs,
-                terms: [
-                    buf(&self.terms[0]),
-                    buf(&self.terms[1]),
-                    buf(&self.terms[2]),
-                ],
+                terms: self.terms.each_ref().map(buf),
                 faces: buf(&self.faces),
             };
             let stage = self.curves.as_mut().expect("built above");
-            let (more, t) = stage.run(&args, view, feature_size, &opts.curves)?;
+            let sc = (
+                opts.scaled_threshold(feature_size),
+                opts.scaled_fade(feature_size),
+            );
+            let (more, t) = stage.run(&args, view, feature_size, sc, &opts.curves)?;
             timing.extend(&t);
             segs.extend(more);
         }

@@ -23,12 +23,12 @@ use std::sync::Arc;
 
 /// The per-vertex inputs of the stage as kernel arguments, in one
 /// coordinate system: pos, nrm, d1, d2, k, dk; then lines_vertex's ndv, kr,
-/// sc; then the faces.
+/// sc, gkr; then the faces.
 pub struct CurveArgs {
     /// pos, nrm, d1, d2, k, dk.
     pub inputs: [Arg; 6],
-    /// ndv, kr, sc.
-    pub terms: [Arg; 3],
+    /// ndv, kr, sc, and the gradient of κr sin²θ.
+    pub terms: [Arg; 4],
     /// The faces (uint[3F]).
     pub faces: Arg,
 }
@@ -115,12 +115,15 @@ impl CurveStage {
 
     /// Runs the passes `opts.families` need and reads their segments back.
     /// `view` is the eye (or direction, `ortho`) and `feature_size` the
-    /// thresholds' scale, both in the inputs' coordinates.
+    /// thresholds' scale, both in the inputs' coordinates; `sc` the
+    /// suggestive-contour threshold and fade, already scaled (D_w κr = 0 and
+    /// the suggestive highlights' fade use them).
     pub fn run(
         &mut self,
         a: &CurveArgs,
         view: ([f32; 3], bool),
         feature_size: f32,
+        sc_scaled: (f32, f32),
         opts: &CurveOptions,
     ) -> Result<(Vec<Segment>, Timing)> {
         opts.check()?;
@@ -136,7 +139,7 @@ impl CurveStage {
         };
         let nv = self.nv as u32;
         let [pos, nrm, d1, d2, k, dk] = a.inputs;
-        let [ndv, kr, sc] = a.terms;
+        let [ndv, kr, sc, gkr] = a.terms;
         let needs_pose = fams.iter().any(|f| {
             matches!(
                 f,
@@ -156,7 +159,7 @@ impl CurveStage {
             )
         });
         let needs_dt = fams.has(LineFamily::ApparentRidges);
-        let grads = opts.hermite;
+        let grads = opts.hermite_kh;
         // The view pass reads dmax from the pose terms, used only by the
         // principal highlights, which need the pose pass anyway.
         let pose_ok = match self.pose_done {
@@ -229,7 +232,7 @@ impl CurveStage {
             )?;
             time(Step::LinesDt1q1, e);
         }
-        let thr = ScaledThresholds::of(opts, feature_size);
+        let thr = ScaledThresholds::of(opts, feature_size, sc_scaled);
         self.grow(curve_segments_estimate(self.nf, fams))?;
         // Twice at most: a first pass that overflows reports the count it
         // needs, and the second has room for it.
@@ -246,6 +249,7 @@ impl CurveStage {
                     ndv,
                     kr,
                     sc,
+                    gkr,
                     buf(&self.pose),
                     buf(&self.grad),
                     buf(&self.view),
@@ -257,6 +261,8 @@ impl CurveStage {
                     Arg::F32(thr.ar),
                     Arg::F32(thr.ph),
                     Arg::F32(thr.sh),
+                    Arg::F32(thr.sc),
+                    Arg::F32(thr.sh_fade),
                     Arg::U32(opts.isophotes),
                     Arg::U32(self.cap as u32),
                     buf(&self.seg),

@@ -54,19 +54,31 @@ pub const SKINNING: KernelFile = plain(
 /// `kernels/ao.cl`: ambient occlusion from curvature.
 pub const AO: KernelFile = plain("kernels/ao.cl", include_str!("../../kernels/ao.cl"));
 
+/// The headers of both feature-line files: the common ones and isoline.h
+/// (segment writes, rtsc's tested isolines).
+const FEATURE_LINE_HEADERS: &[Source] = &[
+    COMMON_HEADERS[0],
+    COMMON_HEADERS[1],
+    source!("common/isoline.h"),
+];
+
 /// `kernels/feature_lines.cl`: occluding and suggestive contours.
-pub const FEATURE_LINES: KernelFile = plain(
-    "kernels/feature_lines.cl",
-    include_str!("../../kernels/feature_lines.cl"),
-);
+pub const FEATURE_LINES: KernelFile = KernelFile {
+    name: "kernels/feature_lines.cl",
+    source: include_str!("../../kernels/feature_lines.cl"),
+    headers: FEATURE_LINE_HEADERS,
+    includes: &[],
+};
 
 /// `kernels/feature_lines_curves.cl`: the curvature line families (ridges,
 /// valleys, apparent ridges, highlights, isophotes, K = 0, H = 0, D_w κr = 0,
 /// boundaries).
-pub const FEATURE_LINES_CURVES: KernelFile = plain(
-    "kernels/feature_lines_curves.cl",
-    include_str!("../../kernels/feature_lines_curves.cl"),
-);
+pub const FEATURE_LINES_CURVES: KernelFile = KernelFile {
+    name: "kernels/feature_lines_curves.cl",
+    source: include_str!("../../kernels/feature_lines_curves.cl"),
+    headers: FEATURE_LINE_HEADERS,
+    includes: &[],
+};
 
 /// `kernels/marching_cubes.cl`: the soup variants and gradient normals.
 pub const MARCHING_CUBES: KernelFile = KernelFile {

@@ -43,6 +43,23 @@ pub struct SceneFile {
     /// How curvature is computed (scheme, precision, least squares).
     #[serde(default)]
     pub curvature: Option<CurvatureSpec>,
+    /// What every line family shares (feature size, tests, Hermite).
+    #[serde(default)]
+    pub lines: Option<Spanned<LinesSpec>>,
+}
+
+/// `[lines]`: the settings every line family shares.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinesSpec {
+    /// `"rtsc"` (default), `"edge"` or a length.
+    pub feature_size: Option<toml::Value>,
+    /// rtsc's tests (default true).
+    pub test: Option<bool>,
+    /// rtsc's Hermite placement of suggestive contours and highlights.
+    pub hermite: Option<bool>,
+    /// Hermite placement of K = 0 and H = 0.
+    pub hermite_kh: Option<bool>,
 }
 
 /// `[curvature]`: the estimator's options, by their command-line names.

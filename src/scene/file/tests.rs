@@ -216,3 +216,48 @@ fn fixed_length_arrays_need_exactly_their_length() {
     let s = parse(&format!("{MIN}[output]\nsize = [64, 48]\n")).unwrap();
     assert_eq!(s.size, [64, 48]);
 }
+
+#[test]
+fn curvature_and_lines_tables_choose_the_estimator_and_feature_size() {
+    use crate::spec::curvature::{Accumulate, Compat, Precision};
+    let s = parse(MIN).unwrap();
+    // rtsc's defaults, and the one curvature default (gather).
+    assert_eq!(s.curvature, CurvatureOptions::default());
+    assert_eq!(s.curvature.accumulate, Accumulate::Gather);
+    assert_eq!(s.effects.feature_size, FeatureSize::Rtsc);
+    assert_eq!(s.effects.suggestive_threshold, 0.01);
+    assert_eq!(s.effects.suggestive_fade, 0.03);
+    assert!(s.effects.lines.curves.test && !s.effects.lines.curves.hermite);
+    let s = parse(&format!(
+        "{MIN}[curvature]\naccumulate = \"atomic\"\nprecision = \"f64\"\ncompat = \"trimesh2\"\n\
+         [lines]\nfeature_size = 0.5\ntest = false\nhermite = true\nhermite_kh = true\n"
+    ))
+    .unwrap();
+    assert_eq!(
+        (
+            s.curvature.accumulate,
+            s.curvature.precision,
+            s.curvature.compat
+        ),
+        (Accumulate::Atomic, Precision::F64, Compat::Trimesh2)
+    );
+    assert_eq!(s.effects.feature_size, FeatureSize::Value(0.5));
+    let c = s.effects.lines.curves;
+    assert!(!c.test && c.hermite && c.hermite_kh);
+    assert_eq!(
+        parse(&format!("{MIN}[lines]\nfeature_size = \"edge\"\n"))
+            .unwrap()
+            .effects
+            .feature_size,
+        FeatureSize::Edge
+    );
+    let e = err(&format!("{MIN}[curvature]\naccumulate = \"sum\"\n"));
+    assert!(e.contains("line 6") && e.contains("gather"), "{e}");
+    let e = err(&format!("{MIN}[lines]\nfeature_size = \"median\"\n"));
+    assert!(
+        e.contains("line 5") && e.contains("rtsc, edge or a positive length"),
+        "{e}"
+    );
+    let e = err(&format!("{MIN}[lines]\nfeature_size = -2\n"));
+    assert!(e.contains("positive length"), "{e}");
+}

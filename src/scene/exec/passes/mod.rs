@@ -26,7 +26,7 @@ use crate::render::colormap::curvature_scale;
 use crate::render::{Camera, Renderer};
 use crate::scene::file::Scene;
 use crate::scene::planner::{Pass, Plan};
-use crate::spec::curvature::{CurvatureOptions, Normalization};
+use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::{EdgeOutput, EdgeParams};
 use crate::spec::feature_lines::{LineInputs, Segment};
 use crate::spec::marching_cubes::IsoNormals;
@@ -46,9 +46,10 @@ use std::time::Instant;
 /// Per-topology state.
 struct Topology {
     mesh: Mesh,
-    /// Median edge length ([`crate::mesh::feature_size`]) of the topology's
-    /// first pose: the scale of the suggestive-contour threshold.
-    feature_size: f32,
+    /// The scale of the line families' thresholds, as the scene asks for it
+    /// ([`crate::mesh::feature_size::resolve`]), from the topology's first
+    /// pose and its curvature; found by the first view's lines.
+    feature_size: Option<f32>,
     /// Which vertices faces use.
     used: Vec<bool>,
     /// The curvature estimator of an unskinned input.
@@ -60,13 +61,8 @@ struct Topology {
 impl Topology {
     fn new(mesh: Mesh) -> Self {
         let used = crate::mesh::referenced(mesh.n_vertices(), &mesh.faces);
-        let fs = match crate::mesh::feature_size(&mesh.positions, &mesh.faces) {
-            // No edge length: the RMS radius of the used vertices.
-            fs if fs <= 0.0 => Normalization::of_masked(&mesh.positions, Some(&used)).scale,
-            fs => fs,
-        };
         Topology {
-            feature_size: fs as f32,
+            feature_size: None,
             used,
             mesh,
             est: None,

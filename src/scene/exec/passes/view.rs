@@ -192,7 +192,27 @@ impl Executor<'_, '_> {
                 &mesh.faces,
             )?),
         };
-        let feature_size = *feature_size;
+        let feature_size = match *feature_size {
+            Some(fs) => fs,
+            None => {
+                // Once per topology: rtsc's size reads the curvature of the
+                // first pose (world units), else the median edge length.
+                let field = match est {
+                    Some(_) if !self.plan.contains(Pass::Curvature) => None,
+                    Some(e) => Some(e.read()?),
+                    None => None,
+                };
+                let k = field.as_ref().map(|f| (&f.k1[..], &f.k2[..]));
+                let fs = crate::mesh::feature_size::resolve(
+                    self.scene.effects.feature_size,
+                    &mesh.positions,
+                    &mesh.faces,
+                    k,
+                ) as f32;
+                *feature_size = Some(fs);
+                fs
+            }
+        };
         let (s, stats) = match est {
             Some(est) => lx.extract_device_at(est, v, feature_size, opts, origin)?,
             None => {

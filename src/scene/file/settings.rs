@@ -1,0 +1,67 @@
+//! The scene tables that set how things are computed rather than which cues
+//! run: `[curvature]` (the estimator's scheme, precision and least squares)
+//! and `[lines]` (the feature size, tests and Hermite placement every line
+//! family shares).
+//!
+//! ```toml
+//! [curvature]
+//! accumulate = "gather"      # atomic | atomic-native | gather
+//! precision = "f32"          # f32 | f64
+//! compat = "exact"           # exact | trimesh2 (rtsc's own curvature)
+//!
+//! [lines]
+//! feature_size = "rtsc"      # rtsc | edge | a length
+//! test = true                # rtsc's tests
+//! hermite = false            # rtsc's Hermite placement of suggestive lines
+//! hermite_kh = false         # the same for K = 0 and H = 0
+//! ```
+
+use super::raw::{CurvatureSpec, LinesSpec};
+use super::{Checker, Effects};
+use crate::error::{Error, Result};
+use crate::spec::curvature::CurvatureOptions;
+use toml::Spanned;
+
+/// `[curvature]`, over the defaults.
+pub(super) fn curvature(ck: &Checker<'_>, c: &CurvatureSpec) -> Result<CurvatureOptions> {
+    fn pick<T: std::str::FromStr<Err = Error>>(
+        ck: &Checker<'_>,
+        v: &Option<Spanned<String>>,
+        into: &mut T,
+    ) -> Result<()> {
+        if let Some(v) = v {
+            *into = v
+                .get_ref()
+                .parse()
+                .map_err(|x: Error| ck.err(v.span(), format!("curvature: {x}")))?;
+        }
+        Ok(())
+    }
+    let mut o = CurvatureOptions::default();
+    pick(ck, &c.accumulate, &mut o.accumulate)?;
+    pick(ck, &c.precision, &mut o.precision)?;
+    pick(ck, &c.compat, &mut o.compat)?;
+    Ok(o)
+}
+
+/// `[lines]`, into the effects.
+pub(super) fn lines(ck: &Checker<'_>, l: &Spanned<LinesSpec>, fx: &mut Effects) -> Result<()> {
+    let span = l.span();
+    let l = l.get_ref();
+    if let Some(v) = &l.feature_size {
+        let text = match v {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Float(x) => x.to_string(),
+            toml::Value::Integer(i) => i.to_string(),
+            other => other.to_string(),
+        };
+        fx.feature_size = text
+            .parse()
+            .map_err(|x: Error| ck.err(span.clone(), format!("lines.feature_size: {x}")))?;
+    }
+    let c = &mut fx.lines.curves;
+    c.test = l.test.unwrap_or(c.test);
+    c.hermite = l.hermite.unwrap_or(c.hermite);
+    c.hermite_kh = l.hermite_kh.unwrap_or(c.hermite_kh);
+    Ok(())
+}
