@@ -10,7 +10,6 @@
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shapecue::report::isosurface::flying_edges_ms;
 use shapecue::report::metrics::median;
 use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::stages::marching_cubes::Isosurfacer;
@@ -72,21 +71,8 @@ fn bench(c: &mut Criterion) {
             g.finish();
             let st = ex.extract(iso, fusion).expect("extract");
             let k = median(&mut kernel);
-            // VTK's vtkFlyingEdges3D, 2 threads, same volume, as measured
-            // once on the 2-core machine: scripts/isosurface-table.py times
-            // Flying Edges beside shapecue in the same run, for fair ratios.
-            let fe = flying_edges_ms(match name.as_str() {
-                "sphere-256" => "sphere 256",
-                "gyroid-256" => "gyroid 256",
-                "Bucky.raw" => "bucky 32",
-                "ironProt.vtk" => "ironprot 68",
-                _ => "",
-            });
-            let ratio = fe.map_or(String::new(), |fe: f64| {
-                format!(" ({:.2}× Flying Edges' {fe} ms)", k / fe)
-            });
             eprintln!(
-                "isosurface/{}/{name}: kernel median {k:.2} ms{ratio}; {} soup vertices → {} vertices, {} faces, {} dropped",
+                "isosurface/{}/{name}: kernel median {k:.2} ms; {} soup vertices → {} vertices, {} faces, {} dropped",
                 fusion.name(),
                 st.soup_vertices,
                 st.vertices,

@@ -77,11 +77,13 @@ enum Cmd {
 }
 
 fn main() {
-    shapecue::export::output::install_interrupt_cleanup();
+    shapecue::export::output::install_interrupt_cleanup(
+        "; a render's report is written when its scenes finish, so an interrupted render has none",
+    );
     let cli = Cli::try_parse().unwrap_or_else(|e| cli::report::parse_error(e));
     let device = cli.device.as_deref();
     let result = match cli.cmd {
-        Cmd::Devices { json } => cli::devices::run(json),
+        Cmd::Devices { json } => cli::devices::run(device, json),
         Cmd::Curvature(a) => cli::curvature::run(device, a),
         Cmd::BuildKernels(a) => cli::kernels::run(device, a),
         Cmd::Isosurface(a) => cli::isosurface::run(device, a),
@@ -92,6 +94,11 @@ fn main() {
         Cmd::Report(a) => cli::report::run(device, a),
         Cmd::View(a) => cli::view::run(device, a),
     };
+    // An interrupt that arrived while the last output was being finished:
+    // the handler is exiting with 130, and so does the command.
+    if shapecue::export::output::interrupted() {
+        std::process::exit(130);
+    }
     if let Err(e) = result {
         std::process::exit(cli::fail(&e));
     }

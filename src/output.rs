@@ -29,6 +29,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Distinguishes temporary files of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
+/// Set by the interrupt handler before it cleans up.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// The identity of an existing file: device and inode where the platform has
 /// them, else its canonical path.
@@ -316,18 +318,32 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Removes the temporary files of unfinished [`write_atomic`] calls when the
-/// process is interrupted (SIGINT, SIGTERM, SIGHUP), then exits with status
-/// 130. Call once, early in `main`; a second call does nothing.
-pub fn install_interrupt_cleanup() {
+/// process is interrupted (SIGINT, SIGTERM, SIGHUP), says so on standard
+/// error (files finished before are whole; the one being written is gone;
+/// `note` adds what the command leaves unwritten, e.g. a report written at
+/// its end), then exits with status 130. Call once, early in `main`; a second
+/// call does nothing. A command that finishes while the handler runs still
+/// ends with 130 ([`interrupted`]).
+pub fn install_interrupt_cleanup(note: &'static str) {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // If a handler cannot be installed (another one exists), writes are
         // still atomic; only a leftover hidden `.partial` file is possible.
-        let _ = ctrlc::set_handler(|| {
+        let _ = ctrlc::set_handler(move || {
+            INTERRUPTED.store(true, Ordering::SeqCst);
             remove_pending();
+            eprintln!(
+                "interrupted: files finished before the interrupt are whole, the one being \
+                 written was removed{note}"
+            );
             std::process::exit(130);
         });
     });
+}
+
+/// Whether the interrupt handler of [`install_interrupt_cleanup`] has run.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
 }
 
 /// Removes every temporary file still being written (for an interrupt handler).

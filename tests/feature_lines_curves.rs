@@ -664,3 +664,23 @@ fn a_skinned_frame_gives_the_lines_of_the_static_mesh_in_the_same_pose() {
         same(&a, &b, 0.1 * fs, slack, fam.name());
     }
 }
+
+#[test]
+fn the_default_solve_draws_analytic_lines_at_least_as_well_as_rtsc_s() {
+    use shapecue::report::lines::analytic_errors;
+    use shapecue::spec::curvature::Compat;
+    let exact = analytic_errors(&gpu(), Compat::Exact).unwrap();
+    let rtsc = analytic_errors(&gpu(), Compat::Trimesh2).unwrap();
+    println!("solve | torus K = 0 error | ellipsoid ridge error");
+    println!(
+        "exact | {:.3e} | {:.3e}",
+        exact.torus_k_zero, exact.ellipsoid_ridges
+    );
+    println!(
+        "trimesh2 | {:.3e} | {:.3e}",
+        rtsc.torus_k_zero, rtsc.ellipsoid_ridges
+    );
+    assert!(exact.torus_k_zero < 0.02 && exact.ellipsoid_ridges < 0.05);
+    assert!(exact.torus_k_zero <= rtsc.torus_k_zero * 1.001);
+    assert!(exact.ellipsoid_ridges <= rtsc.ellipsoid_ridges * 1.001);
+}

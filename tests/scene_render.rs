@@ -605,3 +605,28 @@ fn scenes_in_one_session_share_the_device_and_the_gl_context_and_draw_the_same()
         );
     }
 }
+
+#[test]
+fn the_isosurface_pass_counts_every_step_of_an_extraction() {
+    // A scene's isosurface pass joins its kernel time to the plan by steps:
+    // each step a direct-numbering extraction runs must be one of them, or
+    // the report under-counts the pass (it once counted 0.04 of 9.2 ms).
+    use shapecue::spec::vertex_fusion::Fusion;
+    use shapecue::stages::marching_cubes::Isosurfacer;
+    let gpu = common::gpu();
+    for (kind, iso) in [("gyroid", 0.0f32), ("sphere", 0.0)] {
+        let v = shapecue::volume::sdf::sdf_by_name(kind, 48).unwrap();
+        let mut ex = Isosurfacer::new(gpu.clone(), &v).unwrap();
+        for fusion in [Fusion::Direct, Fusion::Edge, Fusion::Hash] {
+            let s = ex.extract(iso, fusion).unwrap();
+            assert!(s.timing.kernel_ms > 0.0);
+            for st in &s.timing.steps {
+                assert!(
+                    Pass::Isosurface.kernels().contains(&st.step),
+                    "{kind} {fusion:?}: {:?} is not counted in the isosurface pass",
+                    st.step
+                );
+            }
+        }
+    }
+}

@@ -129,3 +129,30 @@ fn bad_requests_are_errors() {
     assert!(e.contains("shapecue-junk"), "{e}");
     let _ = std::fs::remove_file(&junk);
 }
+
+#[test]
+fn welding_a_gltf_skin_joins_its_seams() {
+    // Fox.glb splits its vertices along UV seams: unwelded, most of its
+    // edges are boundaries (a wireframe in an edges picture).
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/Fox.glb");
+    let m = shapecue::mesh::skinned::load_gltf(&path).unwrap();
+    let boundary = |faces: &[[u32; 3]]| -> f64 {
+        let mask = shapecue::cpu::feature_lines_curves::boundary_mask(faces);
+        let edges: u32 = mask.iter().map(|b| b.count_ones()).sum();
+        f64::from(edges) / (3 * faces.len()) as f64
+    };
+    let (w, differ) = m.welded();
+    assert!(w.rest.n_vertices() < m.rest.n_vertices() / 2);
+    assert_eq!(w.rest.n_faces(), m.rest.n_faces());
+    assert_eq!(
+        (w.joints.len(), w.weights.len()),
+        (w.rest.n_vertices(), w.rest.n_vertices())
+    );
+    let (before, after) = (boundary(&m.rest.faces), boundary(&w.rest.faces));
+    assert!(
+        before > 0.5 && after < 0.05,
+        "boundary edges {before} -> {after}"
+    );
+    // Seams split one skinned vertex: the merged copies carry its weights.
+    assert_eq!(differ, 0);
+}

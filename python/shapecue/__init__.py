@@ -151,12 +151,13 @@ class Curvature:
 
 
 def devices() -> list:
-    """The OpenCL devices of every platform, as dicts with ``index``,
-    ``platform``, ``name``, ``type`` ("GPU", "CPU", ...), ``version``,
-    ``compute_units``, ``global_mem``, ``max_alloc``, ``fp64``,
-    ``gl_sharing``, ``int64_atomics`` and ``default`` (the device used
-    without ``device=``). Raises :class:`DeviceError` without any platform."""
-    return _shapecue.devices()
+    """The OpenCL devices of every platform, as dicts with the fields of
+    ``shapecue devices --json`` (``index``, ``platform``, ``name``, ``kind``
+    ("GPU", "CPU", ...), ``version``, ``compute_units``, ``global_mem``,
+    ``max_alloc``, ``fp64``, ``gl_sharing``, ``int64_atomics``, ...) and
+    ``default`` (the device used without ``device=``). Raises
+    :class:`DeviceError` without any platform."""
+    return json.loads(_shapecue.devices())
 
 
 def build_kernels(

@@ -287,12 +287,10 @@ fn curvature_dict<'py>(
     Ok(d)
 }
 
-/// devices() -> list[dict]
-///
-/// Every OpenCL device of every platform, with `default` true on the one a
-/// call without `device=` uses.
+/// devices() -> str: the devices as `shapecue devices --json` writes them
+/// (the same fields), each with `default` added; the package parses it.
 #[pyfunction]
-fn devices(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+fn devices(py: Python<'_>) -> PyResult<String> {
     let (all, default) = py
         .detach(|| {
             let all = shapecue::gpu::list_devices()?;
@@ -300,24 +298,16 @@ fn devices(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             Ok::<_, Error>((all, default))
         })
         .map_err(to_py)?;
-    let out = PyList::empty(py);
+    let mut list = Vec::with_capacity(all.len());
     for d in all {
-        let e = PyDict::new(py);
-        e.set_item("index", d.index)?;
-        e.set_item("platform", &d.platform)?;
-        e.set_item("name", &d.name)?;
-        e.set_item("type", &d.kind)?;
-        e.set_item("version", &d.version)?;
-        e.set_item("compute_units", d.compute_units)?;
-        e.set_item("global_mem", d.global_mem)?;
-        e.set_item("max_alloc", d.max_alloc)?;
-        e.set_item("fp64", d.fp64)?;
-        e.set_item("gl_sharing", d.gl_sharing)?;
-        e.set_item("int64_atomics", d.int64_atomics)?;
-        e.set_item("default", Some(d.index) == default)?;
-        out.append(e)?;
+        let mut v = serde_json::to_value(&d)
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+        if let Some(m) = v.as_object_mut() {
+            m.insert("default".into(), (Some(d.index) == default).into());
+        }
+        list.push(v);
     }
-    Ok(out)
+    Ok(serde_json::Value::Array(list).to_string())
 }
 
 /// build_kernels(accumulate, precision, compat, device) -> list[dict]

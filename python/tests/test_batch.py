@@ -92,7 +92,8 @@ def test_isosurface_batch(device, client, tmp_path):
     twin = tmp_path / "other" / "ball0.nrrd"
     twin.write_bytes(open(paths[0], "rb").read())
     with pytest.raises(ValueError, match="would both write"):
-        batch.run([paths[0], str(twin)], tmp_path / "out4", task="isosurface", client=client)
+        batch.run([paths[0], str(twin)], tmp_path / "out4", task="isosurface", client=client,
+                  options={"iso": 0.0})
     with pytest.raises(ValueError, match="unknown task"):
         batch.run(paths, tmp_path / "out3", task="sculpt", client=client)
 
@@ -114,10 +115,21 @@ def test_resources_no_worker_offers_are_refused_at_once(device, client, tmp_path
 
 def test_resources_without_a_client(device, tmp_path):
     """Without a client, the LocalCluster made for the call offers the
-    resources asked for, so the documented call runs instead of hanging."""
-    from shapecue import batch
+    resources asked for, so the documented call runs instead of hanging.
+    In a process of its own: this module's client would be found and used."""
+    import subprocess
+    import sys
 
     v, f = torus(12, 8)
     write_obj(tmp_path / "t.obj", v, f)
-    recs = batch.run([str(tmp_path / "t.obj")], tmp_path / "out", resources={"GPU": 1})
-    assert [r["status"] for r in recs] == ["ok"], recs
+    code = (
+        "from shapecue import batch\n"
+        f"recs = batch.run([{str(tmp_path / 't.obj')!r}], {str(tmp_path / 'out')!r}, "
+        "resources={'GPU': 1})\n"
+        "assert [r['status'] for r in recs] == ['ok'], recs\n"
+        "print('ran', len(recs))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0 and "ran 1" in out.stdout, out.stderr[-2000:]

@@ -115,7 +115,7 @@ def test_trimesh_object(device):
 def test_auto_accumulation_is_gather_on_cpu_devices_and_atomic_elsewhere(device):
     v, f = torus(24, 12)
     auto = shapecue.curvature(v, f)
-    kind = next(d["type"] for d in device if d["default"])
+    kind = next(d["kind"] for d in device if d["default"])
     if kind == "CPU":
         same(auto, shapecue.curvature(v, f, accumulate="gather"))
         same(shapecue.CurvatureEstimator(f, len(v)).run(v), auto)

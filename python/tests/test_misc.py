@@ -1,7 +1,10 @@
 """Devices, mesh loading, feature edges and scene rendering through the
 binding."""
 
+import json
 import os
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -12,9 +15,15 @@ from conftest import REPO, torus, write_obj
 
 def test_devices(device):
     assert device and all(isinstance(d, dict) for d in device)
-    for key in ("index", "platform", "name", "type", "fp64", "gl_sharing", "default"):
+    for key in ("index", "platform", "name", "kind", "fp64", "gl_sharing", "default"):
         assert key in device[0]
     assert sum(d["default"] for d in device) == 1
+    # The same fields as the command line's JSON.
+    cli = shutil.which("shapecue") or str(REPO / "target" / "release" / "shapecue")
+    if os.path.exists(cli):
+        out = subprocess.run([cli, "devices", "--json"], capture_output=True, text=True)
+        listed = json.loads(out.stdout)
+        assert [sorted(d) for d in listed] == [sorted(k for k in d if k != "default") for d in device]
 
 
 def test_load_mesh(tmp_path):

@@ -285,10 +285,16 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     );
     let mostly_degenerate = counts.mostly_degenerate(mesh.n_faces());
     if mostly_degenerate {
+        // The advice to compute in f64 only where that is not already so.
+        let advice = if opts.precision == Precision::F64 {
+            "the mesh's faces are degenerate even in double precision"
+        } else {
+            "for a mesh far from the origin or finely detailed, try --precision f64"
+        };
         eprintln!(
             "warning: {name}: {} of {} faces were skipped as degenerate, so most curvature \
                  values are zero. Faces are judged against the rounding of the precision computed \
-                 in: for a mesh far from the origin or finely detailed, try --precision f64",
+                 in: {advice}",
             counts.degenerate_faces,
             mesh.n_faces()
         );

@@ -4,14 +4,21 @@ use super::out;
 use anyhow::Result;
 use shapecue::gpu::{Gpu, list_devices};
 
-/// Lists the devices; `*` marks the one a command would use by default.
-pub fn run(json: bool) -> Result<()> {
+/// Lists the devices; `*` marks the one a command would use: `device` (which
+/// must exist) or the default.
+pub fn run(device: Option<&str>, json: bool) -> Result<()> {
     let devs = list_devices()?;
+    // A device given with --device (or SHAPECUE_DEVICE) must exist: it is
+    // the one marked, in place of the default.
+    let chosen = match device {
+        Some(d) => Some(Gpu::new(Some(d))?.info.index),
+        None => None,
+    };
     if json {
         out!("{}", serde_json::to_string_pretty(&devs)?);
         return Ok(());
     }
-    let default = Gpu::new(None).ok().map(|g| g.info.index);
+    let default = chosen.or_else(|| Gpu::new(None).ok().map(|g| g.info.index));
     out!(
         "{:>3}  {:<4} {:>3} {:>9} {:>4} {:>10} {:>9} {:>10} {:>5}  platform / device",
         "#",

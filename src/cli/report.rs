@@ -205,6 +205,12 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
             max_resolution,
             out,
         } => {
+            if !(32..=1024).contains(&max_resolution) {
+                bail!(
+                    "--max-resolution {max_resolution}: the sweep's grids are 32³, 64³, 128³ and \
+                     256³; give 32 or more (at most 1024)"
+                );
+            }
             check(&[], &out)?;
             let o = report::strokes::StrokesReportOptions { max_resolution };
             (report::strokes::report(&gpu()?, o)?, out)

@@ -622,6 +622,39 @@ fn sample(ch: &Channel, t: f32) -> [f32; 4] {
 }
 
 impl SkinnedMesh {
+    /// The mesh with vertices at bit-identical rest positions merged into
+    /// one ([`Mesh::weld`]), each keeping the joints and weights of the
+    /// first of them, and how many merged vertices had other weights (they
+    /// move as the first does). glTF files split vertices along UV and
+    /// normal seams; welding joins the surface again, so that its edges are
+    /// not all boundaries.
+    pub fn welded(&self) -> (SkinnedMesh, usize) {
+        let (rest, remap) = self.rest.weld();
+        let n = rest.n_vertices();
+        let mut first: Vec<Option<usize>> = vec![None; n];
+        let mut differ = 0;
+        for (old, &new) in remap.iter().enumerate() {
+            match first[new as usize] {
+                None => first[new as usize] = Some(old),
+                Some(f) => {
+                    differ += usize::from(
+                        self.joints[f] != self.joints[old] || self.weights[f] != self.weights[old],
+                    );
+                }
+            }
+        }
+        let pick = |i: usize| first[i].expect("every new vertex has an old one");
+        (
+            SkinnedMesh {
+                joints: (0..n).map(|i| self.joints[pick(i)]).collect(),
+                weights: (0..n).map(|i| self.weights[pick(i)]).collect(),
+                rest,
+                ..self.clone()
+            },
+            differ,
+        )
+    }
+
     /// Joint matrices (global joint transform × inverse bind) of `clip` at
     /// time `t` seconds; `clip = None` gives the rest pose.
     pub fn joint_matrices(&self, clip: Option<usize>, t: f32) -> Result<Vec<Mat4>> {

@@ -210,5 +210,6 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
         y_label: "k1 RMS error vs analytic".into(),
         series,
     });
+    super::lines::table(gpu, &mut r)?;
     Ok(r)
 }

@@ -1,7 +1,7 @@
 //! `shapecue report isosurface`: (1) extraction + fusion time of every
 //! fusion variant on the procedural fields at 128³ … 512³ (up to
 //! `max_resolution`) and the bundled buckyball at a voxel value, with the
-//! mesh quality each leaves and the ratio to VTK's Flying Edges; (2) the
+//! mesh quality each leaves; (2) the
 //! resolution sweep 64³ … `max_resolution`³ of the sphere and torus SDFs:
 //! extraction time, curvature time (f32 and f64, on the device, no host
 //! round trip) and the RMS error of k1, k2 against the analytic values,
@@ -11,7 +11,7 @@ use super::metrics::{analytic_rms, measure_isosurface, median};
 use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use crate::spec::curvature::{CurvatureOptions, Precision};
 use crate::spec::marching_cubes::IsoNormals;
 use crate::spec::vertex_fusion::Fusion;
 use crate::stages::marching_cubes::{self as mcs, Isosurfacer};
@@ -47,29 +47,6 @@ fn ms(v: f64) -> Cell {
     Cell::num(v, format!("{v:.2}"))
 }
 
-/// VTK's vtkFlyingEdges3D with 2 threads, volume in memory, as timed by
-/// `scripts/isosurface-table.py` beside shapecue on a 2-core AVX-512 machine
-/// (AMD EPYC; VTK 9.7.2; median of three runs of the script on 2026-12-06,
-/// median ms; key: volume and resolution). The machine type drifts by a
-/// third between runs, so ratios to these are indicative only; the script
-/// times both in the same run.
-pub const FLYING_EDGES_2T_MS: [(&str, f64); 6] = [
-    ("sphere 256", 23.05),
-    ("gyroid 256", 86.16),
-    ("sphere 512", 206.38),
-    ("gyroid 512", 520.23),
-    ("bucky 32", 0.34),
-    ("ironprot 68", 0.55),
-];
-
-/// [`FLYING_EDGES_2T_MS`] of `key`.
-pub fn flying_edges_ms(key: &str) -> Option<f64> {
-    FLYING_EDGES_2T_MS
-        .iter()
-        .find(|(k, _)| *k == key)
-        .map(|&(_, ms)| ms)
-}
-
 /// Measures the report on `gpu`.
 ///
 /// # Errors
@@ -77,21 +54,13 @@ pub fn flying_edges_ms(key: &str) -> Option<f64> {
 pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
     let (max_res, runs) = (o.max_resolution, o.runs);
     let mut r = Report::new("isosurface", gpu.info.name.clone());
-    let fe = |k: &str| flying_edges_ms(k).unwrap_or(f64::NAN);
     r.text(format!(
         "device: {} ({})\n\n\
          ## Extraction + fusion (volume on the device; median kernel ms / wall ms)\n\
-         × FE: kernel ms over VTK's vtkFlyingEdges3D with 2 threads on the same volume, as \
-         measured beside shapecue on a 2-core machine of this kind (sphere 256³ {} ms, \
-         gyroid 256³ {}, gyroid 512³ {}, Bucky {}). The same machine type drifts by a \
-         third between runs and days: for a fair ratio, `scripts/isosurface-table.py` times \
-         Flying Edges and shapecue in turn in the same run.",
-        gpu.info.name,
-        gpu.info.platform,
-        fe("sphere 256"),
-        fe("gyroid 256"),
-        fe("gyroid 512"),
-        fe("bucky 32"),
+         Against VTK's Flying Edges: `scripts/isosurface-table.py` times both on the same \
+         volumes in the same run and gives N× faster = Flying Edges' ms ÷ shapecue's \
+         (docs/notes/peer-comparisons.md); this report times shapecue alone.",
+        gpu.info.name, gpu.info.platform,
     ));
     let col = Column::new;
     let mut t = Table::new(
@@ -101,7 +70,6 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
             col("fuse", "fusion"),
             col("kernel", "kernel_ms"),
             col("wall", "wall_ms"),
-            col("× FE", "flying_edges_ratio"),
             col("soup v", "soup_vertices"),
             col("vertices", "vertices"),
             col("faces", "faces"),
@@ -113,7 +81,7 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
             col("euler", "euler"),
         ],
     );
-    let mut inputs: Vec<(String, crate::volume::Volume, f32, Option<f64>)> = Vec::new();
+    let mut inputs: Vec<(String, crate::volume::Volume, f32)> = Vec::new();
     for (kind, res) in [
         (Sdf::Sphere, 128),
         (Sdf::Sphere, 256),
@@ -123,8 +91,7 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
     ] {
         if res <= max_res {
             let name = format!("{kind:?} {res}³").to_lowercase();
-            let fe = flying_edges_ms(&format!("{kind:?} {res}").to_lowercase());
-            inputs.push((name, sdf::sdf(kind, res), 0.0, fe));
+            inputs.push((name, sdf::sdf(kind, res), 0.0));
         }
     }
     // The bundled buckyball (32³ u8) at 51, a voxel value: the exact-hit case.
@@ -132,14 +99,14 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/bucky.nhdr")),
         None,
     ) {
-        inputs.push(("bucky 32³ @51".into(), b, 51.0, flying_edges_ms("bucky 32")));
+        inputs.push(("bucky 32³ @51".into(), b, 51.0));
     }
     let mut bars: Vec<(String, Vec<f64>)> = Fusion::ALL
         .iter()
         .map(|f| (f.name().to_string(), Vec::new()))
         .collect();
     let mut groups = Vec::new();
-    for (name, vol, iso, fe) in inputs {
+    for (name, vol, iso) in inputs {
         let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
         groups.push(name.clone());
         for (i, fusion) in Fusion::ALL.into_iter().enumerate() {
@@ -147,16 +114,11 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
             let (p, f) = ex.read_index_space()?;
             let q = crate::mesh::quality(&p, &f);
             bars[i].1.push(k);
-            let ratio = match fe {
-                Some(fe) => Cell::num(k / fe, format!("{:.2}", k / fe)),
-                None => Cell::empty(),
-            };
             t.rows.push(Row::new(vec![
                 Cell::text(name.clone()),
                 Cell::text(fusion.name()),
                 ms(k),
                 ms(wall),
-                ratio,
                 Cell::int(st.soup_vertices),
                 Cell::int(st.vertices),
                 Cell::int(st.faces),
@@ -240,11 +202,8 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
             ];
             for (i, (name, precision, normals)) in SWEEP.into_iter().enumerate() {
                 let opts = CurvatureOptions {
-                    accumulate: Accumulate::Atomic,
                     precision,
-                    compat: Compat::Exact,
-                    dcurv: true,
-                    lanes: 0,
+                    ..Default::default()
                 };
                 let mut times = Vec::new();
                 let (mut est, _) = mcs::curvature(&ex, opts, normals)?;
@@ -284,19 +243,4 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         series,
     });
     Ok(r)
-}
-
-#[cfg(test)]
-mod fe_tests {
-    use super::*;
-
-    #[test]
-    fn flying_edges_figures_are_found_by_the_report_names() {
-        for (kind, res) in [(Sdf::Sphere, 256), (Sdf::Gyroid, 256), (Sdf::Gyroid, 512)] {
-            let key = format!("{kind:?} {res}").to_lowercase();
-            assert!(flying_edges_ms(&key).is_some(), "{key}");
-        }
-        assert!(flying_edges_ms("bucky 32").is_some());
-        assert_eq!(flying_edges_ms("sphere 128"), None);
-    }
 }

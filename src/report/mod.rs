@@ -11,6 +11,7 @@
 pub mod caps;
 pub mod curvature;
 pub mod isosurface;
+pub mod lines;
 pub mod memory;
 pub mod metrics;
 pub mod pipeline;
@@ -383,12 +384,15 @@ pub fn utc_string(secs: u64) -> String {
     )
 }
 
-/// The shared data folder: `$SHAPECUE_SHARED_DATA`, else `../shared/data`
-/// next to the crate.
+/// The folder of the larger data sets some reports use (scans, skinned
+/// animations; docs/performance.md): `$SHAPECUE_SHARED_DATA`, else
+/// `../shared/data` from the current folder (beside a clone of the
+/// repository, run from its root). Nothing of the build machine is kept in
+/// the binary.
 pub fn shared_data() -> PathBuf {
     std::env::var_os("SHAPECUE_SHARED_DATA")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"))
+        .unwrap_or_else(|| PathBuf::from("../shared/data"))
 }
 
 /// The meshes of the edges tables (House & Li's comparison): generated

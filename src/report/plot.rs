@@ -7,6 +7,7 @@
 use super::{Chart, Report};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
+use plotters::coord::combinators::{BindKeyPoints, WithKeyPoints};
 use plotters::prelude::*;
 
 /// Width of the SVG in pixels.
@@ -18,8 +19,10 @@ const HEADER: u32 = 48;
 const FONT: &str = "sans-serif";
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+/// A log axis with its ticks chosen by [`log_ticks`].
+type LogAxis = WithKeyPoints<LogCoord<f64>>;
 /// A chart with log axes on both sides, drawn into an [`Area`].
-type LogLog<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+type LogLog<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogAxis, LogAxis>>;
 
 fn err(e: impl std::fmt::Display) -> Error {
     Error::Render {
@@ -95,20 +98,61 @@ fn log_range(v: impl Iterator<Item = f64>, pad: f64) -> Option<std::ops::Range<f
     (lo <= hi).then(|| lo / pad..hi * pad)
 }
 
-/// A tick label: plain decimals from 0.001 to 9999, else `1e5`-style.
+/// The ticks of a log axis over `r`: 1, 2 and 5 times each power of ten
+/// inside it; where that gives fewer than four (a range within a decade or
+/// two), every digit times the powers of ten; where that still gives fewer
+/// than three (a narrow range), evenly spaced round values (1, 2 or 5 times
+/// a power of ten apart, at least four of them).
+pub fn log_ticks(r: &std::ops::Range<f64>) -> Vec<f64> {
+    let (lo, hi) = (r.start.min(r.end), r.start.max(r.end));
+    if !(lo > 0.0 && hi.is_finite()) {
+        return Vec::new();
+    }
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (k0..=k1)
+            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9))
+            .collect()
+    };
+    let t = within(&[1.0, 2.0, 5.0]);
+    if t.len() >= 4 {
+        return t;
+    }
+    let t = within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    if t.len() >= 3 {
+        return t;
+    }
+    let raw = (hi - lo) / 4.0;
+    let p = 10f64.powf(raw.log10().floor());
+    let step = [5.0, 2.0, 1.0]
+        .iter()
+        .map(|m| m * p)
+        .find(|s| *s <= raw)
+        .unwrap_or(p);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last)
+        .map(|i| i as f64 * step)
+        .filter(|v| *v > 0.0)
+        .collect()
+}
+
+/// A tick label: at most three significant digits, plain decimals from
+/// 0.001 to 99999, else `1e5`-style.
 fn tick(v: &f64) -> String {
     let a = v.abs();
-    let s = if a == 0.0 {
+    if a == 0.0 {
         return "0".into();
-    } else if !(1e-3..1e4).contains(&a) {
-        return format!("{v:.0e}");
-    } else if a >= 100.0 {
-        format!("{v:.0}")
-    } else if a >= 1.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.4}")
-    };
+    }
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:.2e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        return format!("{m}e{e}");
+    }
+    let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
@@ -140,7 +184,10 @@ fn log_log<'a, 'b>(
         .margin(16)
         .x_label_area_size(44)
         .y_label_area_size(80)
-        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+        .build_cartesian_2d(
+            xr.clone().log_scale().with_key_points(log_ticks(&xr)),
+            yr.clone().log_scale().with_key_points(log_ticks(&yr)),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
@@ -241,9 +288,11 @@ fn convergence(
         .map_err(err)?
         .label("h² slope")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
+    // Errors fall with h, so the data and the slope run from the lower left
+    // to the upper right: the legend goes in the empty upper left.
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(SeriesLabelPosition::UpperLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font((FONT, 12))
@@ -344,7 +393,10 @@ fn bars(
         let (lo, hi) = (lo / 2.0, hi * 2.0);
         draw!(
             builder
-                .build_cartesian_2d(x, (lo..hi).log_scale())
+                .build_cartesian_2d(
+                    x,
+                    (lo..hi).log_scale().with_key_points(log_ticks(&(lo..hi)))
+                )
                 .map_err(err)?,
             lo
         );
@@ -357,4 +409,51 @@ fn bars(
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_axes_get_one_two_five_ticks_or_finer() {
+        // Three decades: 1-2-5.
+        let close = |a: Vec<f64>, b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12 * y)
+        };
+        let t = log_ticks(&(0.15..60.0));
+        assert!(
+            close(t.clone(), &[0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0]),
+            "{t:?}"
+        );
+        // 1.9 to 9 ms (the curvature chart): every digit.
+        let t = log_ticks(&(1.9..9.0));
+        assert!(
+            close(t.clone(), &[2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]),
+            "{t:?}"
+        );
+        // Narrow: round steps inside the range.
+        let t = log_ticks(&(0.0412..0.0433));
+        assert!(
+            t.len() >= 3 && t.iter().all(|v| (0.0412..=0.0433).contains(v)),
+            "{t:?}"
+        );
+        assert!(log_ticks(&(0.0..1.0)).is_empty());
+    }
+
+    #[test]
+    fn tick_labels_are_short_and_distinct() {
+        assert_eq!(tick(&0.1), "0.1");
+        assert_eq!(tick(&0.12), "0.12");
+        assert_eq!(tick(&0.125), "0.125");
+        assert_eq!(tick(&2.0), "2");
+        assert_eq!(tick(&1500.0), "1500");
+        assert_eq!(tick(&2e-5), "2e-5");
+        assert_eq!(tick(&1.5e6), "1.5e6");
+        let t = log_ticks(&(0.0412..0.0433));
+        let labels: Vec<String> = t.iter().map(tick).collect();
+        let mut unique = labels.clone();
+        unique.dedup();
+        assert_eq!(labels, unique, "{labels:?}");
+    }
 }

@@ -98,7 +98,8 @@ pub fn report(gpu: &Arc<Gpu>, o: StrokesReportOptions) -> Result<Report> {
             let (k50, k95) = (quantile(&mut ke, 0.5), quantile(&mut ke, 0.95));
             let (d50, d95) = (quantile(&mut de, 0.5), quantile(&mut de, 0.95));
             let kms = out.stats.ms.total;
-            points.push((format!("{res}³ h={hv}v"), kms, k50));
+            let voxels = if hv == 1.0 { "voxel" } else { "voxels" };
+            points.push((format!("{res}³, h = {hv} {voxels}"), kms, k50));
             t.rows.push(Row::new(vec![
                 Cell::int(res),
                 Cell::num(hv, format!("{hv:.1}")),

@@ -320,7 +320,11 @@ impl Scene {
         };
         only(
             "weld",
-            !inp.weld || inp.mesh.is_some() || inp.flipbook.is_some(),
+            !inp.weld
+                || inp.mesh.is_some()
+                || inp.flipbook.is_some()
+                || inp.gltf.is_some()
+                || inp.lbs.is_some(),
         )?;
         let source = if let Some(m) = &inp.mesh {
             Source::Mesh(ck.existing(m)?)

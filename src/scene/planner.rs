@@ -347,7 +347,16 @@ impl Pass {
     pub fn kernels(self) -> &'static [Step] {
         use Step::*;
         match self {
+            // Every step of an extraction, by either numbering (scenes use
+            // direct numbering; the soup's steps for the other fusions).
             Pass::Isosurface => &[
+                McDirectRows,
+                McDirectCount,
+                McDirectHits,
+                McDirectTriangles,
+                McDirectPoints,
+                McDirectRecount,
+                McDirectUnused,
                 McClassify,
                 ScanExclusive,
                 McTriangles,

@@ -139,6 +139,11 @@ fn check_script_outputs(
 
 /// Runs `shapecue view`.
 pub fn run(device: Option<&str>, a: ViewArgs) -> Result<()> {
+    if let Some(iso) = a.iso
+        && !iso.is_finite()
+    {
+        anyhow::bail!("--iso {iso}: the isovalue must be a finite number");
+    }
     let script = a.script.as_deref().map(script::Script::load).transpose()?;
     let mut scene = if a.input.ends_with(".toml") {
         if a.iso.is_some() {

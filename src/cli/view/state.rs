@@ -167,7 +167,11 @@ impl State {
                 if s.key == "iso"
                     && let Some((lo, hi)) = values
                 {
-                    (s.min, s.max) = (f64::from(lo), f64::from(hi));
+                    // At the extreme values the surface is empty: the
+                    // slider stops 1 % of the range inside them.
+                    let (lo, hi) = (f64::from(lo), f64::from(hi));
+                    let pad = 0.01 * (hi - lo);
+                    (s.min, s.max) = (lo + pad, hi - pad);
                 }
                 s
             })
@@ -308,7 +312,21 @@ mod tests {
         assert!(v.cues.iter().any(|c| c.0 == Cue::CurvatureStrokes));
         v.set("iso", "0.25").unwrap();
         assert!(matches!(v.scene.source, Source::Sdf(_, _, iso, _) if iso == 0.25));
+        // Clamped inside the field's values, where the surface is not empty.
         v.set("iso", "9").unwrap();
-        assert!(matches!(v.scene.source, Source::Sdf(_, _, iso, _) if iso == 2.0));
+        let Source::Sdf(_, _, iso, _) = v.scene.source else {
+            unreachable!()
+        };
+        let (lo, hi) = v
+            .sliders
+            .iter()
+            .find(|s| s.key == "iso")
+            .map(|s| (s.min, s.max))
+            .unwrap();
+        assert!(
+            (lo + 1.96).abs() < 1e-12 && (hi - 1.96).abs() < 1e-12,
+            "{lo}..{hi}"
+        );
+        assert_eq!(f64::from(iso), f64::from(hi as f32));
     }
 }

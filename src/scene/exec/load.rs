@@ -38,6 +38,33 @@ impl Loaded {
     }
 }
 
+/// A skinned mesh welded where the scene asks for it, with a note of what
+/// welding merged.
+fn weld_skinned(
+    m: SkinnedMesh,
+    weld: bool,
+    path: &std::path::Path,
+    notes: &mut Vec<String>,
+) -> SkinnedMesh {
+    if !weld {
+        return m;
+    }
+    let before = m.rest.n_vertices();
+    let (w, differ) = m.welded();
+    let mut note = format!(
+        "{}: welded {before} vertices into {}",
+        path.display(),
+        w.rest.n_vertices()
+    );
+    if differ > 0 {
+        note.push_str(&format!(
+            " ({differ} merged vertices had other skin weights and follow the first)"
+        ));
+    }
+    notes.push(note);
+    w
+}
+
 /// Loads the scene's input; what was assumed or dropped goes to `notes`.
 pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
     let opts = LoadOptions { weld: scene.weld };
@@ -52,7 +79,7 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
             }
         },
         Source::Gltf(p, clip) => {
-            let m = crate::mesh::skinned::load_gltf(p)?;
+            let m = weld_skinned(crate::mesh::skinned::load_gltf(p)?, scene.weld, p, notes);
             if m.clips.is_empty() && clip.is_none() {
                 notes.push(format!(
                     "{}: no animation; the rest pose is the one frame",
@@ -109,6 +136,7 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         Source::Lbs(p) => {
             let a = crate::mesh::libigl::load_elephant_set(p)?;
             let (m, trunc) = a.to_skinned();
+            let m = weld_skinned(m, scene.weld, p, notes);
             notes.push(format!(
                 "{}: {} bones, weights cut to the 4 largest per vertex ({} vertices had more \
                  than four, {} more than four above {}; largest dropped weight sum {:.3}, \

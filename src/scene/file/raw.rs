@@ -103,19 +103,34 @@ pub struct InputSpec {
     /// (distance fields; the default for SDFs). Normals point out of the
     /// object, so convex parts of it have positive curvature.
     pub inside: Option<Spanned<String>>,
-    /// Weld coincident vertices of mesh and flipbook files.
+    /// Weld coincident vertices of mesh, flipbook, glTF and libigl inputs
+    /// (skinned vertices keep the weights of the first of those merged).
     #[serde(default)]
     pub weld: bool,
 }
 
 /// A glTF clip by index or by name.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[serde(try_from = "toml::Value")]
 pub enum ClipRef {
     /// The clip's index.
     Index(usize),
     /// The clip's name.
     Name(String),
+}
+
+impl TryFrom<toml::Value> for ClipRef {
+    type Error = String;
+    fn try_from(v: toml::Value) -> Result<ClipRef, String> {
+        match v {
+            toml::Value::String(s) => Ok(ClipRef::Name(s)),
+            toml::Value::Integer(i) if i >= 0 => Ok(ClipRef::Index(i as usize)),
+            other => Err(format!(
+                "clip = {other}: expected a clip's index (a whole number of 0 or more) or its \
+                 name in quotes"
+            )),
+        }
+    }
 }
 
 /// `[frames]`.

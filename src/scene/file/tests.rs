@@ -261,3 +261,26 @@ fn curvature_and_lines_tables_choose_the_estimator_and_feature_size() {
     let e = err(&format!("{MIN}[lines]\nfeature_size = -2\n"));
     assert!(e.contains("positive length"), "{e}");
 }
+
+#[test]
+fn a_bad_clip_reads_as_toml_words() {
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/data/Fox.glb");
+    for (clip, bad) in [("-1", "-1"), ("1.5", "1.5"), ("true", "true")] {
+        let e = err(&format!(
+            "[input]\ngltf = {fox:?}\nclip = {clip}\n[effects]\nshading = {{}}\n"
+        ));
+        assert!(
+            e.contains("line 3") && e.contains(&format!("clip = {bad}")) && e.contains("index"),
+            "{e}"
+        );
+        assert!(!e.contains("untagged") && !e.contains("variant"), "{e}");
+    }
+    let s = parse(&format!(
+        "[input]\ngltf = {fox:?}\nclip = \"Walk\"\n[effects]\nshading = {{}}\n"
+    ))
+    .unwrap();
+    assert_eq!(
+        s.source,
+        Source::Gltf(fox.into(), Some(ClipRef::Name("Walk".into())))
+    );
+}

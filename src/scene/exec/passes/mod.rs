@@ -558,18 +558,35 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// topology; an isosurface's faces stay on the device and its estimator
     /// runs here, with normals from the volume gradient.
     fn one_rings(&mut self, frame: usize) -> Result<()> {
-        let how = "one-ring lists or owning faces (atomic_max); includes the first program build";
+        // What the pass's wall time holds: the topology, and the program
+        // only where it was built or loaded for this estimator.
+        let how = |est: &CurvatureEstimator| {
+            let build = est.build_ms();
+            let program = if build >= 0.05 {
+                format!(
+                    "; includes {build:.1} ms getting the curvature program (built or from the cache)"
+                )
+            } else {
+                String::new()
+            };
+            format!("one-ring lists or owning faces (atomic_max){program}")
+        };
         if let Some(p) = &self.pipe {
             let est = p.estimator().expect("built for the one-rings pass");
             let ms = est.topology_ms();
             self.rec
-                .wall(Pass::OneRings, ms, &format!("upload faces, {how}"));
+                .wall(Pass::OneRings, ms, &format!("upload faces, {}", how(est)));
             return Ok(());
         }
         if let Some(ex) = self.iso.as_ref() {
             let (est, timing) =
                 crate::stages::marching_cubes::curvature(ex, self.curv_opts, IsoNormals::Gradient)?;
-            let how = format!("faces copied on the device, {how}");
+            let faces = if self.curv_opts.accumulate.scatters() {
+                "faces copied on the device"
+            } else {
+                "faces read back once for the gather scheme's one-rings"
+            };
+            let how = format!("{faces}, {}", how(&est));
             self.rec.wall(Pass::OneRings, est.topology_ms(), &how);
             self.curv = Some(timing);
             self.topo.as_mut().expect("made by the isosurface").est = Some(est);
@@ -578,7 +595,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let (gpu, opts) = (self.gpu.clone(), self.curv_opts);
         let t = self.topology(frame)?;
         let est = CurvatureEstimator::new(gpu, t.mesh.n_vertices(), &t.mesh.faces, opts)?;
-        let ms = est.topology_ms();
+        let (ms, how) = (est.topology_ms(), how(&est));
         t.est = Some(est);
         self.rec
             .wall(Pass::OneRings, ms, &format!("upload faces, {how}"));
