@@ -274,6 +274,26 @@ fn ply_header_problems() {
     let msg = load_err(&write(&dir, "word.ply", bad_value));
     assert!(msg.contains("vertex 1") && msg.contains("line 9"), "{msg}");
     assert!(load_err(&write(&dir, "garbage.ply", "not a ply file\n")).contains("header"));
+    // An unknown property type is named with its line, in both formats.
+    for format in ["ascii", "binary_little_endian"] {
+        let bad_type = format!(
+            "ply\nformat {format} 1.0\nelement vertex 3\nproperty float x\n\
+             property float y\nproperty real z\nend_header\n"
+        );
+        let msg = load_err(&write(&dir, "real.ply", &bad_type));
+        assert!(
+            msg.contains("header line 6") && msg.contains("unknown type 'real'"),
+            "{msg}"
+        );
+        assert!(!msg.contains("Couldn't parse"), "{msg}");
+    }
+    let bad_list = "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar vertex_indices\n\
+                    end_header\n3 0 1 2\n";
+    let msg = load_err(&write(&dir, "list.ply", bad_list));
+    assert!(
+        msg.contains("header line 4") && msg.contains("list"),
+        "{msg}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -156,3 +156,17 @@ fn welding_a_gltf_skin_joins_its_seams() {
     // Seams split one skinned vertex: the merged copies carry its weights.
     assert_eq!(differ, 0);
 }
+
+#[test]
+fn a_gltf_file_too_short_for_either_form_is_named() {
+    let dir = std::env::temp_dir().join(format!("shapecue-gltf-short-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes) in [("empty.gltf", &b"{}"[..]), ("nothing.glb", &b""[..])] {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        let e = load_gltf(&p).unwrap_err().to_string();
+        assert!(e.contains(name) && e.contains("too short for glTF"), "{e}");
+        assert!(!e.contains("fill whole buffer"), "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -431,3 +431,23 @@ fn a_script_with_every_cue_off_fails_instead_of_hanging() {
     );
     assert!(dir.join("a.png").is_file() && dir.join("a.svg").is_file());
 }
+
+#[test]
+fn an_unreachable_display_is_named_without_library_internals() {
+    let dir = scratch("view-baddisplay");
+    let out = cli()
+        .args(["view", data("spot.obj").to_str().unwrap()])
+        .env("DISPLAY", ":55")
+        .env_remove("WAYLAND_DISPLAY")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() != Some(4) {
+        // Some machine does serve :55; then there is nothing to check.
+        eprintln!("skipping: display :55 answered ({err})");
+        return;
+    }
+    assert!(err.contains(":55") && err.contains("X11 display"), "{err}");
+    assert!(!err.contains(".rs") && !err.contains("panicked"), "{err}");
+}

@@ -235,9 +235,9 @@ fn nrrd_multi_file_forms() {
         nrrd_header("type: short\nendian: little\nencoding: raw\ndata file: s%02d.raw 12 18 2\n"),
     );
     let (e, msg) = err(&p, None);
-    assert!(matches!(e, Error::Io { .. }), "{e:?}");
+    assert!(matches!(e, Error::InvalidInput { .. }), "{e:?}");
     assert!(
-        msg.contains(&dir.join("s18.raw").display().to_string()),
+        msg.contains(&dir.join("s18.raw").display().to_string()) && msg.contains("gone2.nhdr"),
         "{msg}"
     );
     // A slice of the wrong size is named.
@@ -277,15 +277,31 @@ ElementDataFile = LOCAL\n"
          ElementDataFile = b.raw\n",
     ));
     assert_eq!(v.value(1, 2, 3), vals[23] + 7.0);
-    // Missing data file: an Io error naming it.
+    // Missing data file: named with the header that names it.
     let p = write(
         &dir,
         "c.mhd",
         "NDims = 3\nDimSize = 2 3 4\nElementType = MET_UCHAR\nElementDataFile = nothere.raw\n",
     );
     let (e, msg) = err(&p, None);
-    assert!(matches!(e, Error::Io { .. }), "{e:?}");
-    assert!(msg.contains("nothere.raw"), "{msg}");
+    assert!(matches!(e, Error::InvalidInput { .. }), "{e:?}");
+    assert!(
+        msg.contains("c.mhd") && msg.contains("nothere.raw") && msg.contains("cannot be read"),
+        "{msg}"
+    );
+    // A data file that is a folder: said so, not "found 4096 bytes".
+    std::fs::create_dir_all(dir.join("folder.raw")).unwrap();
+    let p = write(
+        &dir,
+        "f.mhd",
+        "NDims = 3\nDimSize = 2 3 4\nElementType = MET_UCHAR\nElementDataFile = folder.raw\n",
+    );
+    let (_, msg) = err(&p, None);
+    assert!(
+        msg.contains("f.mhd") && msg.contains("is a folder"),
+        "{msg}"
+    );
+    assert!(!msg.contains("4096"), "{msg}");
     // Unknown element type, 2-D, rotated.
     invalid(
         &write(

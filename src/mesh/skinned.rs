@@ -268,6 +268,18 @@ fn check_before_import(path: &Path) -> Result<()> {
     let Ok(bytes) = std::fs::read(path) else {
         return Ok(());
     };
+    // The glTF crate reads a 4-byte magic first, and a shorter file fails
+    // with an I/O message that names nothing.
+    if bytes.len() < 4 {
+        return Err(bad(
+            path,
+            "file",
+            format!(
+                "{} bytes: too short for glTF (a JSON document with an asset, or a GLB file)",
+                bytes.len()
+            ),
+        ));
+    }
     // The memory bound: the glTF crate allocates the length a GLB header
     // declares before reading, so a header claiming more than the file
     // holds is refused here; so is one claiming less than the header itself,

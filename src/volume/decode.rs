@@ -268,7 +268,21 @@ impl Payload<'_> {
             path: path.to_path_buf(),
             source,
         };
-        let (mut r, size) = open_file(path)?;
+        // The header names the file: errors name both.
+        let named = || format!("data file {}", path.display());
+        let (mut r, size) = match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => {
+                return Err(Error::input(
+                    src,
+                    named(),
+                    "is a folder, not a file of samples",
+                ));
+            }
+            Err(e) => {
+                return Err(Error::input(src, named(), format!("cannot be read: {e}")));
+            }
+            Ok(_) => open_file(path)?,
+        };
         let mut skipped = 0u64;
         for _ in 0..self.line_skip {
             skipped += skip_line(&mut r).map_err(io)?.ok_or_else(|| {

@@ -54,6 +54,18 @@ struct Handler {
     painted_for_capture: u32,
 }
 
+/// An error message of the window crates without the source file and line
+/// they put before it (`os error at …/x11/mod.rs:123: …`).
+fn without_source_location(msg: &str) -> String {
+    match msg.rfind(".rs:") {
+        Some(i) => msg[i + 4..]
+            .trim_start_matches(|c: char| c.is_ascii_digit() || c == ':')
+            .trim()
+            .to_string(),
+        None => msg.to_string(),
+    }
+}
+
 /// Opens the window and runs the app until it quits (the user closes the
 /// window, or the script ends).
 ///
@@ -77,9 +89,13 @@ pub fn run(
         })
         .into());
     }
-    let event_loop = EventLoop::<Wake>::with_user_event()
-        .build()
-        .map_err(|e| NoDisplay(format!("cannot connect to the display: {e}")))?;
+    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
+        let display = std::env::var("DISPLAY").unwrap_or_default();
+        NoDisplay(format!(
+            "cannot connect to the X11 display {display} ({}); is an X server running there?",
+            without_source_location(&e.to_string())
+        ))
+    })?;
     let proxy = event_loop.create_proxy();
     let app = app_of(proxy.clone())?;
     let mut h = Handler {
@@ -355,4 +371,14 @@ fn save_window(gl: &glow::Context, w: u32, h: u32, path: &std::path::Path) -> an
     };
     frame.save_png(path)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn window_errors_lose_their_source_location() {
+        let m = "os error at /root/.cargo/registry/src/x/winit-0.30.12/src/platform_impl/linux/x11/mod.rs:123: failed to open display";
+        assert_eq!(super::without_source_location(m), "failed to open display");
+        assert_eq!(super::without_source_location("no display"), "no display");
+    }
 }

@@ -203,11 +203,55 @@ pub(super) fn check_header_text(bytes: &[u8], source: &str) -> Result<()> {
                 ),
             ));
         }
-        if line.strip_suffix(b"\r").unwrap_or(line) == b"end_header" {
+        let text = std::str::from_utf8(line.strip_suffix(b"\r").unwrap_or(line)).unwrap_or("");
+        if text == "end_header" {
             break;
+        }
+        if let Some(problem) = property_problem(text) {
+            return Err(Error::input(
+                source,
+                format!("header line {}", i + 1),
+                problem,
+            ));
         }
     }
     Ok(())
+}
+
+/// The PLY scalar types, in both of the format's spellings.
+const PLY_TYPES: [&str; 16] = [
+    "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8", "int16",
+    "uint16", "int32", "uint32", "float32", "float64",
+];
+
+/// What is wrong with a `property` line's types (the parser only says it
+/// could not parse the line), `None` for any other line or a good one.
+fn property_problem(line: &str) -> Option<String> {
+    let w: Vec<&str> = line.split_whitespace().collect();
+    if w.first() != Some(&"property") {
+        return None;
+    }
+    let known = |t: &str| PLY_TYPES.contains(&t);
+    let types = PLY_TYPES.join(", ");
+    match w.get(1) {
+        Some(&"list") => {
+            if w.len() != 5 {
+                return Some(format!(
+                    "'{line}': a list property is 'property list COUNT_TYPE VALUE_TYPE NAME'"
+                ));
+            }
+            w[2..4]
+                .iter()
+                .find(|t| !known(t))
+                .map(|t| format!("'{line}': unknown type '{t}' (PLY's types are {types})"))
+        }
+        Some(t) if !known(t) => Some(format!(
+            "'{line}': unknown type '{t}' (PLY's types are {types})"
+        )),
+        Some(_) if w.len() != 3 => Some(format!("'{line}': a property is 'property TYPE NAME'")),
+        None => Some(format!("'{line}': a property is 'property TYPE NAME'")),
+        _ => None,
+    }
 }
 
 /// The length of the header at the start of `bytes` (through the newline
