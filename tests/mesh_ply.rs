@@ -384,8 +384,10 @@ fn writer_without_field_and_errors() {
 
 /// Values a float cannot hold (a sphere scaled by 1e30 has areas of ~1e60,
 /// one scaled by 1e-40 curvatures of ~1e40) make the writer use double for
-/// the vertex properties, and say why; a non-finite value is an error naming
-/// the property and the vertex, never a silent `inf` in the file.
+/// the vertex properties, and say why; values too small for a float's normal
+/// range are written as the nearest float (the file stays float, as the
+/// docs say); a non-finite value is an error naming the property and the
+/// vertex, never a silent `inf` in the file.
 #[test]
 fn ply_values_outside_float_range_are_written_as_double() {
     let dir = scratch("ply-double");
@@ -425,9 +427,19 @@ fn ply_values_outside_float_range_are_written_as_double() {
     );
 
     f.areas[3] = 1.0;
-    f.k1[5] = 1e-40;
-    let w = write_ply(&dir.join("tiny.ply"), &m, Some(&f)).unwrap();
+    f.k1[5] = 1e40;
+    let w = write_ply(&dir.join("large.ply"), &m, Some(&f)).unwrap();
     assert!(w.double.unwrap().contains("'k1'"));
+    // A subnormal (and a value below float's subnormals): still float.
+    f.k1[5] = 1e-40;
+    f.k2[6] = -1e-300;
+    let p = dir.join("tiny.ply");
+    assert_eq!(write_ply(&p, &m, Some(&f)).unwrap().double, None);
+    let (names, rows, _) = read_ply_properties(&p).unwrap();
+    let k1 = names.iter().position(|n| n == "k1").unwrap();
+    let k2 = names.iter().position(|n| n == "k2").unwrap();
+    assert_eq!(rows[5][k1], 1e-40f32);
+    assert_eq!(rows[6][k2], 0.0);
 
     f.k1[5] = f64::INFINITY;
     let e = write_ply(&dir.join("inf.ply"), &m, Some(&f))

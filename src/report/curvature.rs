@@ -35,7 +35,7 @@ impl Default for CurvatureReportOptions {
 pub const REFINEMENT: [usize; 4] = [2_500, 10_000, 40_000, 160_000];
 
 fn e3(v: f64) -> Cell {
-    Cell::num(v, format!("{v:.3e}"))
+    Cell::sci(v, 3)
 }
 
 fn ms(v: f64) -> Cell {
@@ -112,7 +112,7 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
             Cell::text(label(&v)),
             e3(e1),
             e3(e2),
-            Cell::num(eh, format!("{eh:.2e}")),
+            Cell::sci(eh, 2),
             ms(res.kernel_ms),
             ms(res.wall_ms),
         ]));

@@ -113,8 +113,8 @@ pub fn table(gpu: &Arc<Gpu>, r: &mut Report) -> Result<()> {
         let e = analytic_errors(gpu, compat)?;
         t.rows.push(Row::new(vec![
             Cell::text(name),
-            Cell::num(e.torus_k_zero, format!("{:.2e}", e.torus_k_zero)),
-            Cell::num(e.ellipsoid_ridges, format!("{:.2e}", e.ellipsoid_ridges)),
+            Cell::sci(e.torus_k_zero, 2),
+            Cell::sci(e.ellipsoid_ridges, 2),
             Cell::num(e.kernel_ms, format!("{:.2}", e.kernel_ms)),
         ]));
     }

@@ -119,7 +119,12 @@ pub fn label(o: &CurvatureOptions) -> String {
 
 /// The variants the report and the criterion bench compare, default first.
 pub fn variants() -> Vec<CurvatureOptions> {
-    let d = CurvatureOptions::default();
+    // The paper's compare-and-swap scheme first, then the others beside it
+    // (gather is the library's default).
+    let d = CurvatureOptions {
+        accumulate: Accumulate::Atomic,
+        ..CurvatureOptions::default()
+    };
     vec![
         d,
         // the compare-and-swap scheme one face per work-item (the paper's

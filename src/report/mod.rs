@@ -151,6 +151,17 @@ impl Cell {
         }
     }
 
+    /// A number in scientific notation with `digits` decimals (`1.23e-4`),
+    /// and an exact zero as `0`, the same in every report.
+    pub fn sci(v: f64, digits: usize) -> Cell {
+        let text = if v == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{v:.digits$e}")
+        };
+        Cell::num(v, text)
+    }
+
     /// A count, printed as it is.
     pub fn int<T: Into<Value> + ToString>(v: T) -> Cell {
         Cell {

@@ -176,7 +176,7 @@ fn model(
             Cell::text(name.clone()),
         ]));
     };
-    let e2 = |v: f64| Cell::num(v, format!("{v:.2e}"));
+    let e2 = |v: f64| Cell::sci(v, 2);
     row(
         "skin",
         med(&|x| x.family_ms(Family::Skinning)),

@@ -104,12 +104,25 @@ impl Orbit {
         self.moved = true;
     }
 
-    /// Moves the eye towards the target: the distance times `factor` (< 1 closer).
+    /// Moves the eye towards the target: the distance times `factor` (< 1
+    /// closer), kept within 1e-4 and 1e4 times the scene camera's distance
+    /// (beyond them the view holds nothing of the model, and the camera's
+    /// numbers leave single precision).
     pub fn zoom(&mut self, factor: f32) {
         if !(factor > 0.0 && factor.is_finite()) {
             return;
         }
-        self.eye = self.target + (self.eye - self.target) * factor;
+        let off = self.eye - self.target;
+        let home = self
+            .home
+            .eye
+            .distance(self.home.target)
+            .max(f32::MIN_POSITIVE);
+        let d = off.length();
+        if d > 0.0 {
+            let want = (d * factor).clamp(1e-4 * home, 1e4 * home);
+            self.eye = self.target + off * (want / d);
+        }
         self.moved = true;
     }
 }
@@ -117,6 +130,17 @@ impl Orbit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn zoom_stays_within_four_decades_of_the_scene_distance() {
+        let mut o = orbit();
+        let home = o.eye.distance(o.target);
+        o.zoom(1e30);
+        assert!((o.eye.distance(o.target) / home - 1e4).abs() < 1.0);
+        assert!(o.eye.is_finite());
+        o.zoom(1e-30);
+        assert!((o.eye.distance(o.target) / home - 1e-4).abs() < 1e-6);
+    }
 
     fn orbit() -> Orbit {
         let view = ViewSpec {
