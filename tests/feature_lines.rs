@@ -469,3 +469,45 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
         .is_err()
     );
 }
+
+#[test]
+fn a_face_with_more_pieces_than_the_first_buffer_holds_grows_it() {
+    // One face seen along z (orthographic), with made-up inputs: n·v =
+    // (1, -1, -3), κr sin²θ = 0.64 k1 = (-1, 3, 1), sinθ D_w κr = 0.8 C111 =
+    // (0, 4, -1). Its suggestive contour's test changes sign twice along it
+    // (den at 1/3, num at 2/3): two pieces, beside one contour piece, three
+    // segments for one face where the buffer starts with two.
+    let faces = vec![[0u32, 1, 2]];
+    let x = LineArrays {
+        pos: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        nrm: vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, -3.0]],
+        d1: vec![[0.6, 0.0, 0.8]; 3],
+        d2: vec![[0.0, 1.0, 0.0]; 3],
+        k: vec![[-1.0 / 0.64, 0.0], [3.0 / 0.64, 0.0], [1.0 / 0.64, 0.0]],
+        dk: vec![[0.0; 4], [5.0, 0.0, 0.0, 0.0], [-1.25, 0.0, 0.0, 0.0]],
+    };
+    let opts = LineOptions {
+        threshold: 0.0,
+        ..Default::default()
+    };
+    let view = View::from_eye([0.0, 0.0, 1.0], true);
+    let mut ex = LineExtractor::new(gpu(), 3, &faces).unwrap();
+    let (s, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
+    let sc: Vec<&Segment> = s.iter().filter(|s| s.2 == 1).collect();
+    assert_eq!((s.len(), sc.len()), (3, 2), "{s:?}");
+    let t = lines_vertex(&li(&x), view);
+    let cpu = lines_face(
+        &faces,
+        &x.pos,
+        &t,
+        [true, true],
+        true,
+        false,
+        0.0,
+        opts.scaled_fade(1.0),
+    );
+    same(s.clone(), cpu, "one face, three pieces");
+    // A second extraction reuses the grown buffer.
+    let (again, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
+    assert_eq!(again.len(), 3);
+}

@@ -37,12 +37,21 @@ pub struct LineInputs<'a> {
     pub dk: &'a [[f32; 4]],
 }
 
-/// Segments the face pass can emit for `faces` faces: two of each kind per
-/// face (a plane crosses a triangle in at most one segment, and rtsc's test
-/// cuts it into at most two pieces), the capacity of the device's segment
-/// buffer.
+/// Segments the face pass can emit for `faces` faces: three per face (a
+/// plane crosses a triangle in at most one segment; rtsc's contour test,
+/// linear along it, keeps one piece of a contour, and the suggestive test,
+/// a ratio of two linear terms, at most two pieces of a suggestive
+/// contour).
 pub fn segments_bound(faces: usize) -> usize {
-    4 * faces
+    3 * faces
+}
+
+/// The first capacity of the face pass's segment buffer: one segment of
+/// each kind per face, which a mesh seen from one view never comes near;
+/// where a pass counts more, the buffer grows to what it counted and the
+/// pass runs again.
+pub fn segments_estimate(faces: usize) -> usize {
+    (2 * faces).max(1)
 }
 
 crate::spec::kernels::kernel_entries! {

@@ -3,16 +3,20 @@
 //! each call uploads the per-vertex inputs ([`LineExtractor::extract`]) or
 //! reads them from a curvature estimator's device buffers
 //! ([`LineExtractor::extract_device`]) and runs `lines_vertex` and
-//! `lines_face`. The segment buffer holds four segments per face (two pieces
-//! of each kind), the most a face can emit ([`segments_bound`]), and the kernel still
-//! counts and refuses what does not fit. CPU twin:
+//! `lines_face`. The segment buffer starts with two segments per face
+//! ([`segments_estimate`]); a pass that counts more (rtsc's test cuts a
+//! suggestive contour into up to two pieces: three per face at most,
+//! [`segments_bound`]) writes none past it, and runs again into a buffer
+//! grown to its count. CPU twin:
 //! [`crate::cpu::feature_lines`]. Views are [`crate::spec::view::View`]s
 //! (made by the renderer's camera, or [`View::from_eye`] for lines alone).
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
-use crate::spec::feature_lines::{CurveOptions, LineInputs, Segment, segments_bound};
+use crate::spec::feature_lines::{
+    CurveOptions, LineInputs, Segment, segments_bound, segments_estimate,
+};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
@@ -114,6 +118,8 @@ pub struct LineExtractor {
     terms: [Buffer<f32>; 4],
     seg: Buffer<f32>,
     ends: Buffer<u32>,
+    /// Segments `seg` and `ends` hold.
+    cap: usize,
     counter: Buffer<u32>,
     /// The faces, kept to build the curve stage when first asked for.
     host_faces: Vec<[u32; 3]>,
@@ -147,8 +153,9 @@ impl LineExtractor {
                 gpu.buffer(nv.max(1))?,
                 gpu.buffer(3 * nv.max(1))?,
             ],
-            seg: gpu.buffer(8 * segments_bound(faces.len()))?,
-            ends: gpu.buffer(4 * segments_bound(faces.len()))?,
+            seg: gpu.buffer(8 * segments_estimate(faces.len()))?,
+            ends: gpu.buffer(4 * segments_estimate(faces.len()))?,
+            cap: segments_estimate(faces.len()),
             counter: gpu.buffer(1)?,
             host_faces: faces.to_vec(),
             curves: None,
@@ -311,14 +318,19 @@ impl LineExtractor {
             buf(&self.terms[3]),
         ]);
         let e1 = launch(&g, &self.vertex, n, &args)?;
-        let cap = segments_bound(self.nf);
         let curve_fams = opts.curves.families.curves();
         let contours = opts.contours || opts.suggestive || curve_fams == Default::default();
-        let e2 = if !contours {
+        // Twice at most: a pass that counts more segments than the buffer
+        // holds writes none past it, and the second has room for them.
+        let mut e2 = Vec::new();
+        let mut found = 0;
+        for _ in 0..2 {
             g.zero(&mut self.counter, 1)?;
-            None
-        } else {
-            launch(
+            if !contours {
+                break;
+            }
+            let cap = self.cap;
+            let e = launch(
                 &g,
                 &self.face,
                 self.nf,
@@ -341,15 +353,23 @@ impl LineExtractor {
                     buf(&self.ends),
                     buf(&self.counter),
                 ],
-            )?
-        };
-        let mut c = [0u32];
-        g.read(&self.counter, &mut c)?;
-        let found = c[0] as usize;
-        if found > cap {
-            return Err(Error::InvalidArgument(format!(
-                "internal: {found} segments for {cap} slots; nothing was written past the buffer"
-            )));
+            )?;
+            e2.extend(e);
+            let mut c = [0u32];
+            g.read(&self.counter, &mut c)?;
+            found = c[0] as usize;
+            if found <= cap {
+                break;
+            }
+            if found > segments_bound(self.nf) {
+                return Err(Error::InvalidArgument(format!(
+                    "internal: {found} segments counted for {} faces; nothing was written past the buffer",
+                    self.nf
+                )));
+            }
+            self.seg = g.buffer(8 * found)?;
+            self.ends = g.buffer(4 * found)?;
+            self.cap = found;
         }
         let mut raw = vec![0f32; 8 * found];
         g.read(&self.seg, &mut raw)?;
@@ -372,7 +392,7 @@ impl LineExtractor {
         if let Some(e) = &e1 {
             timing.add(Step::LinesVertex, event_ms(e));
         }
-        if let Some(e) = &e2 {
+        for e in &e2 {
             timing.add(Step::LinesFace, event_ms(e));
         }
         if curve_fams != Default::default() {
