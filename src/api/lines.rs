@@ -220,7 +220,7 @@ pub fn line_segments_on(
         setup.feature_size,
         &mesh.positions,
         &mesh.faces,
-        Some((&f.k1, &f.k2)),
+        Some(&|i| [f.k1[i], f.k2[i]]),
     ) as f32;
     let mut ex = LineExtractor::new(gpu.clone(), mesh.n_vertices(), &mesh.faces)?;
     let (segments, st) = ex.extract(&x, view, fs, *opts)?;

@@ -35,10 +35,17 @@ pub fn rtsc_sample_indices(n: usize) -> Vec<usize> {
 /// rtsc. `None` for a mesh without vertices or a size that is not a finite
 /// positive number (a zero radius and no curvature).
 pub fn rtsc_feature_size(k1: &[f64], k2: &[f64], radius: f64) -> Option<f64> {
-    let idx = rtsc_sample_indices(k1.len().min(k2.len()));
+    rtsc_feature_size_of(k1.len().min(k2.len()), &|i| [k1[i], k2[i]], radius)
+}
+
+/// [`rtsc_feature_size`] of a mesh of `n` vertices whose (k1, k2) `k`
+/// gives by vertex: only the sampled vertices are asked for (a field that
+/// stays on the device is read at 500 vertices, not all).
+pub fn rtsc_feature_size_of(n: usize, k: &dyn Fn(usize) -> [f64; 2], radius: f64) -> Option<f64> {
+    let idx = rtsc_sample_indices(n);
     let mut s: Vec<f32> = idx
         .iter()
-        .flat_map(|&i| [k1[i], k2[i]])
+        .flat_map(|&i| k(i))
         .map(|x| {
             // rtsc keeps its curvature in single precision.
             let a = (x as f32).abs();
@@ -114,9 +121,9 @@ pub fn bounding_sphere(points: &[[f64; 3]]) -> Option<([f64; 3], f64)> {
 }
 
 /// The feature size `choice` asks for, in the mesh's units: rtsc's from the
-/// principal curvatures `k` (k1, k2 per vertex) and the bounding sphere of
-/// every vertex; the median edge length ([`super::feature_size`]); or the
-/// value given. Where rtsc's has no curvature to read (a run that computes
+/// principal curvatures `k` gives (k1, k2 of a vertex, asked for the sampled
+/// vertices only) and the bounding sphere of every vertex; the median edge
+/// length ([`super::feature_size`]); or the value given. Where rtsc's has no curvature to read (a run that computes
 /// none: contours from normals alone, isophotes, boundaries, none of which
 /// reads a threshold) or gives no positive size, the median edge length;
 /// where that is 0 too (no edge), the RMS distance from the centroid, else 1.
@@ -124,7 +131,7 @@ pub fn resolve(
     choice: FeatureSize,
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
-    k: Option<(&[f64], &[f64])>,
+    k: Option<&dyn Fn(usize) -> [f64; 2]>,
 ) -> f64 {
     let edge = || {
         let s = super::feature_size(positions, faces);
@@ -144,9 +151,9 @@ pub fn resolve(
         FeatureSize::Value(v) => f64::from(v),
         FeatureSize::Edge => edge(),
         FeatureSize::Rtsc => k
-            .and_then(|(k1, k2)| {
+            .and_then(|k| {
                 let (_, r) = bounding_sphere(positions)?;
-                rtsc_feature_size(k1, k2, r)
+                rtsc_feature_size_of(positions.len(), k, r)
             })
             .unwrap_or_else(edge),
     }
@@ -372,8 +379,7 @@ mod tests {
     fn a_choice_resolves_to_its_size_or_falls_back() {
         let pos = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
         let faces = [[0, 1, 2]];
-        let (k1, k2) = (vec![1.0; 3], vec![0.5; 3]);
-        let k = Some((&k1[..], &k2[..]));
+        let k: Option<&dyn Fn(usize) -> [f64; 2]> = Some(&|_| [1.0, 0.5]);
         assert_eq!(resolve(FeatureSize::Value(0.25), &pos, &faces, k), 0.25);
         assert_eq!(resolve(FeatureSize::Edge, &pos, &faces, k), 2.0);
         // 6 magnitudes, index 0: 0.5; min(0.01 / 0.5, 0.05 · √2).

@@ -196,19 +196,24 @@ impl Executor<'_, '_> {
             Some(fs) => fs,
             None => {
                 // Once per topology: rtsc's size reads the curvature of the
-                // first pose (world units), else the median edge length.
+                // first pose (world units) at its 500 sampled vertices, in
+                // place on the device; else the median edge length.
                 let field = match est {
-                    Some(_) if !self.plan.contains(Pass::Curvature) => None,
-                    Some(e) => Some(e.read()?),
-                    None => None,
+                    Some(e) if self.plan.contains(Pass::Curvature) => Some(e.mapped(None)?),
+                    _ => None,
                 };
-                let k = field.as_ref().map(|f| (&f.k1[..], &f.k2[..]));
+                let at = |i: usize| {
+                    let v = field.as_ref().expect("read only with a field").vertex(i);
+                    [v.k1, v.k2]
+                };
+                let k: Option<&dyn Fn(usize) -> [f64; 2]> = field.as_ref().map(|_| &at as _);
                 let fs = crate::mesh::feature_size::resolve(
                     self.scene.effects.feature_size,
                     &mesh.positions,
                     &mesh.faces,
                     k,
                 ) as f32;
+                drop(field);
                 *feature_size = Some(fs);
                 fs
             }
