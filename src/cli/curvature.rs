@@ -181,7 +181,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 "accumulate": opts.accumulate.name(),
                 "accumulate_why": match a.accumulate {
                     Some(_) => "given with --accumulate",
-                    None => Accumulate::why_default(&r.gpu.info.kind),
+                    None => Accumulate::why_default(),
                 },
                 "face_lanes": r.estimator.est.face_lanes(),
                 "face_lanes_why": match opts.lanes {

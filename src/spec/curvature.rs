@@ -173,20 +173,11 @@ impl Accumulate {
     ];
 
     /// Why gather is the default scheme ([`Accumulate::default`], the one
-    /// place it is decided) on a device of this type (`CL_DEVICE_TYPE` as
-    /// [`crate::gpu::DeviceInfo::kind`] spells it), with the figures it
-    /// rests on (printed by `--stats`).
-    pub fn why_default(device_kind: &str) -> &'static str {
-        if device_kind.eq_ignore_ascii_case("CPU") {
-            "gather: on CPU devices it took less time than the compare-and-swap atomics \
-             in every measurement (1.1-2.4x on PoCL, 2.3-3.9x on Intel's CPU runtime; \
-             bunny, lucy and tori, every pass with the derivative), and it is bitwise \
-             reproducible"
-        } else {
-            "gather: on an NVIDIA H200 it took 0.091 ms against 0.175 ms for the \
-             compare-and-swap atomics on the bunny (1.9-2.1x on lucy and a 2M-vertex \
-             torus), and it is bitwise reproducible"
-        }
+    /// place it is decided), as `--stats` says it. The measurements behind
+    /// it live in docs/performance.md and docs/notes/, not in the library.
+    pub fn why_default() -> &'static str {
+        "gather: bitwise reproducible from run to run, and faster than the \
+         compare-and-swap atomics on every device measured (docs/performance.md)"
     }
 
     /// The name used on the command line (`--accumulate`), in scene files,
