@@ -630,3 +630,58 @@ fn the_isosurface_pass_counts_every_step_of_an_extraction() {
         }
     }
 }
+
+#[test]
+fn a_scene_with_lines_says_what_scaled_their_thresholds() {
+    // rtsc's feature size by default, the median edge length where asked;
+    // the same number `shapecue lines` uses on the same mesh.
+    for (table, want) in [
+        ("", "rtsc's"),
+        ("[lines]\nfeature_size = \"edge\"\n", "median edge"),
+    ] {
+        let dir = scratch("fs-note");
+        let s = scene(
+            &dir,
+            &format!(
+                "[input]\ngenerate = \"torus\"\nresolution = 3000\n[effects]\n\
+                 suggestive_contours = {{}}\n{table}[output]\nsize = [96, 72]\n"
+            ),
+        );
+        let Some(r) = run(&s, &dir, false) else {
+            return;
+        };
+        let r = r.unwrap();
+        let note = r
+            .notes
+            .iter()
+            .find(|n| n.contains("feature size"))
+            .unwrap_or_else(|| panic!("no feature-size note in {:?}", r.notes));
+        assert!(note.contains(want), "{note}");
+        let fs: f64 = note
+            .split("feature size ")
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .and_then(|t| t.parse().ok())
+            .unwrap();
+        let m = shapecue::mesh::generated_by_name("torus", 3000).unwrap().1;
+        if want == "median edge" {
+            let edge = shapecue::mesh::feature_size(&m.positions, &m.faces);
+            assert!((fs - edge).abs() < 1e-3 * edge, "{fs} vs {edge}");
+        } else {
+            let gpu = common::gpu();
+            let ls = shapecue::api::line_segments_on(
+                &gpu,
+                &m,
+                shapecue::spec::view::View::from_eye([3.0, 0.0, 2.0], false),
+                &Default::default(),
+                &Default::default(),
+            )
+            .unwrap();
+            let lines_fs = f64::from(ls.feature_size);
+            assert!(
+                (fs - lines_fs).abs() < 1e-3 * lines_fs,
+                "{fs} vs {lines_fs}"
+            );
+        }
+    }
+}

@@ -350,7 +350,10 @@ fn render_all(
         segments: ex.segments,
         lines: std::mem::take(&mut ex.line_segments),
         strokes: ex.stroke_count,
-        notes,
+        notes: notes
+            .into_iter()
+            .chain(ex.feature_size_note.take())
+            .collect(),
         outputs: std::mem::take(&mut ex.outputs),
         wall_ms: ms_since(t_all),
     };

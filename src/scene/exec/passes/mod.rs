@@ -107,6 +107,9 @@ pub(super) struct Executor<'s, 'g> {
     strokes: Vec<Stroke>,
     /// Strokes over all poses.
     pub(super) stroke_count: usize,
+    /// What the line families' thresholds were scaled by, for the run's
+    /// notes (the first topology's).
+    pub(super) feature_size_note: Option<String>,
     topo: Option<Topology>,
     framing: Option<Framing>,
     color_scale: Option<f32>,
@@ -225,6 +228,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             sdf_lines,
             strokes: Vec::new(),
             stroke_count: 0,
+            feature_size_note: None,
             topo: None,
             framing: None,
             color_scale: fx.curvature_scale,

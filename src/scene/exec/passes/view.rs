@@ -213,8 +213,23 @@ impl Executor<'_, '_> {
                     &mesh.faces,
                     k,
                 ) as f32;
+                let read_curvature = k.is_some();
                 drop(field);
                 *feature_size = Some(fs);
+                if self.feature_size_note.is_none() {
+                    use crate::spec::feature_lines::FeatureSize;
+                    let how = match self.scene.effects.feature_size {
+                        FeatureSize::Rtsc if read_curvature => {
+                            "rtsc's, from the first pose's curvature"
+                        }
+                        FeatureSize::Rtsc => "the median edge length: no curvature is planned",
+                        FeatureSize::Edge => "the median edge length",
+                        FeatureSize::Value(_) => "as given",
+                    };
+                    self.feature_size_note = Some(format!(
+                        "line thresholds scaled by the feature size {fs:.4e} ({how})"
+                    ));
+                }
                 fs
             }
         };
