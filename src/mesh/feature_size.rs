@@ -27,21 +27,16 @@ pub fn rtsc_sample_indices(n: usize) -> Vec<usize> {
         .collect()
 }
 
-/// rtsc's feature size from the principal curvatures of each vertex and the
+/// rtsc's feature size of a mesh of `n` vertices, from the principal
+/// curvatures `k` gives by vertex (asked for the sampled vertices only, so a
+/// field that stays on the device is read at 500 vertices, not all) and the
 /// radius of the bounding sphere: min(0.01 / p, 0.05 r), p the 10th
 /// percentile (index ⌊0.1 · 2m⌋ of the 2m sorted magnitudes) of |k1| and
 /// |k2| at the sampled vertices. A non-finite curvature counts as the
 /// largest; where p is 0 (a flat sample) the cap 0.05 r is the size, as in
 /// rtsc. `None` for a mesh without vertices or a size that is not a finite
 /// positive number (a zero radius and no curvature).
-pub fn rtsc_feature_size(k1: &[f64], k2: &[f64], radius: f64) -> Option<f64> {
-    rtsc_feature_size_of(k1.len().min(k2.len()), &|i| [k1[i], k2[i]], radius)
-}
-
-/// [`rtsc_feature_size`] of a mesh of `n` vertices whose (k1, k2) `k`
-/// gives by vertex: only the sampled vertices are asked for (a field that
-/// stays on the device is read at 500 vertices, not all).
-pub fn rtsc_feature_size_of(n: usize, k: &dyn Fn(usize) -> [f64; 2], radius: f64) -> Option<f64> {
+pub fn rtsc_feature_size(n: usize, k: &dyn Fn(usize) -> [f64; 2], radius: f64) -> Option<f64> {
     let idx = rtsc_sample_indices(n);
     let mut s: Vec<f32> = idx
         .iter()
@@ -153,7 +148,7 @@ pub fn resolve(
         FeatureSize::Rtsc => k
             .and_then(|k| {
                 let (_, r) = bounding_sphere(positions)?;
-                rtsc_feature_size_of(positions.len(), k, r)
+                rtsc_feature_size(positions.len(), k, r)
             })
             .unwrap_or_else(edge),
     }
@@ -275,8 +270,7 @@ mod tests {
     use super::*;
 
     fn rtsc_fs(k: &[[f64; 2]], radius: f64) -> Option<f64> {
-        let (k1, k2): (Vec<f64>, Vec<f64>) = k.iter().map(|k| (k[0], k[1])).unzip();
-        rtsc_feature_size(&k1, &k2, radius)
+        rtsc_feature_size(k.len(), &|i| k[i], radius)
     }
 
     #[test]
