@@ -137,14 +137,12 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let width = a.width.unwrap_or(2.0f32.min(w.max(h) as f32));
     super::width_arg(width, (w, h), "line")?;
-    let ext = a
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let svg = match ext.as_deref() {
-        Some("svg") => true,
-        Some("png") => false,
+    let svg = match (
+        super::has_extension(&a.output, "svg"),
+        super::has_extension(&a.output, "png"),
+    ) {
+        (true, _) => true,
+        (_, true) => false,
         _ => bail!(
             "--output {}: give a name ending in .png (a picture) or .svg (a group per family)",
             a.output.display()

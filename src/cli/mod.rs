@@ -203,13 +203,16 @@ pub fn raw_spec(
     })
 }
 
+/// Whether a file name ends in `.ext`, in any case (`x.PNG` is a PNG name).
+pub fn has_extension(path: &Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
 /// Refuses an image output whose name does not end in `.png` (shapecue
 /// writes PNG only; a `.jpg` name would hold PNG bytes).
 pub fn require_png(option: &str, path: &Path) -> anyhow::Result<()> {
-    let ok = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !ok {
+    if !has_extension(path, "png") {
         anyhow::bail!(
             "{option} {}: images are written as PNG; give a name ending in .png",
             path.display()

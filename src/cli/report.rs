@@ -281,7 +281,7 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
 /// neither may overwrite an input or (without `--force`) an existing file.
 fn check(inputs: &[&Path], out: &Outputs) -> Result<()> {
     if let Some(p) = &out.plot {
-        let svg = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+        let svg = super::has_extension(p, "svg");
         if !svg {
             bail!(
                 "--plot {}: plots are written as SVG; give a name ending in .svg",

@@ -80,8 +80,7 @@ fn finite(v: f32, what: &str) -> Result<f32> {
 /// A file name of a writing command, whose extension must say what is
 /// written (any case): PNG for `screenshot` and `capture`, SVG for `svg`.
 fn named(p: PathBuf, cmd: &str, ext: &str) -> Result<PathBuf> {
-    let ok = p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
-    if !ok {
+    if !crate::cli::has_extension(&p, ext) {
         bail!(
             "{cmd} {}: it writes {}; give a name ending in .{ext}",
             p.display(),
