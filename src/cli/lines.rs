@@ -186,6 +186,34 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     } else {
         shapecue::mesh::load(&path, &LoadOptions::default())?
     };
+    let opts = picture_options(&a, fams, (w, h), width, svg, feature_size)?;
+    let gpu = Arc::new(Gpu::new(device)?);
+    let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
+    match &pic.layers {
+        Some(layers) => shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?,
+        None => pic.frame.save_png(&a.output)?,
+    }
+    if let Some(p) = &a.segments {
+        write_segments(p, &pic)?;
+    }
+    let found = summary(&pic.segments);
+    super::print(format_args!(
+        "{}: {found}, kernels {:.2} ms",
+        a.output.display(),
+        pic.timing.kernel_ms
+    ))?;
+    Ok(())
+}
+
+/// The picture's options from the arguments (checked by [`run`]).
+fn picture_options(
+    a: &LinesArgs,
+    fams: FamilySet,
+    (w, h): (u32, u32),
+    width: f32,
+    svg: bool,
+    feature_size: FeatureSize,
+) -> Result<LinesPictureOptions> {
     let mut opts = LinesPictureOptions {
         eye: super::vec3_arg(&a.eye, "eye")?,
         target: super::vec3_arg(&a.target, "target")?,
@@ -227,46 +255,41 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     c.fade = !a.no_fade;
     c.hermite = a.hermite;
     c.hermite_kh = a.hermite_kh;
-    let gpu = Arc::new(Gpu::new(device)?);
-    let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
-    match &pic.layers {
-        Some(layers) => shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?,
-        None => pic.frame.save_png(&a.output)?,
-    }
-    if let Some(p) = &a.segments {
-        let segs: Vec<serde_json::Value> = pic
-            .segments
-            .iter()
-            .map(|s| {
-                let fam = LineFamily::from_kind(s.2).map_or("unknown", |f| f.name());
-                serde_json::json!({"family": fam, "strength": s.3, "a": s.0, "b": s.1})
-            })
-            .collect();
-        write_json(
-            p,
-            &serde_json::json!({
-                "feature_size": pic.feature_size,
-                "segments": segs,
-            }),
-        )?;
-    }
+    Ok(opts)
+}
+
+/// Writes every segment (family, strength, ends) and the feature size as
+/// JSON (`--segments`).
+fn write_segments(path: &std::path::Path, pic: &shapecue::LinesPicture) -> Result<()> {
+    let segs: Vec<serde_json::Value> = pic
+        .segments
+        .iter()
+        .map(|s| {
+            let fam = LineFamily::from_kind(s.2).map_or("unknown", |f| f.name());
+            serde_json::json!({"family": fam, "strength": s.3, "a": s.0, "b": s.1})
+        })
+        .collect();
+    write_json(
+        path,
+        &serde_json::json!({
+            "feature_size": pic.feature_size,
+            "segments": segs,
+        }),
+    )
+}
+
+/// What the run found, in words: the segments per family.
+fn summary(segments: &[shapecue::spec::feature_lines::Segment]) -> String {
     let mut counts = std::collections::BTreeMap::<&str, usize>::new();
-    for s in &pic.segments {
+    for s in segments {
         if let Some(f) = LineFamily::from_kind(s.2) {
             *counts.entry(f.name()).or_default() += 1;
         }
     }
     let list: Vec<String> = counts.iter().map(|(k, v)| format!("{k} {v}")).collect();
-    let n = pic.segments.len();
-    let found = match n {
+    match segments.len() {
         0 => "no segments: no line of the chosen families is in view".to_string(),
         1 => format!("1 segment ({})", list.join(", ")),
-        _ => format!("{n} segments ({})", list.join(", ")),
-    };
-    super::print(format_args!(
-        "{}: {found}, kernels {:.2} ms",
-        a.output.display(),
-        pic.timing.kernel_ms
-    ))?;
-    Ok(())
+        n => format!("{n} segments ({})", list.join(", ")),
+    }
 }
