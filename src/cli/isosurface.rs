@@ -106,37 +106,9 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
     let t_load = Instant::now();
-    let (name, vol, read) = match (&a.input, &a.sdf) {
-        (_, Some(kind)) => (
-            format!("{kind} SDF {}³", a.resolution),
-            volume::sdf::sdf_by_name(kind, a.resolution)?,
-            Vec::new(),
-        ),
-        (Some(path), None) => {
-            let raw = super::raw_spec(
-                a.dims.as_deref(),
-                a.scalar.as_deref(),
-                a.big_endian,
-                a.header_bytes,
-                a.spacing.as_deref(),
-            )?;
-            let (vol, read) = volume::load_with_files(path, raw.as_ref())?;
-            (path.display().to_string(), vol, read)
-        }
-        (None, None) => bail!("give an input volume or --sdf"),
-    };
+    let (name, vol, read) = load_input(&a)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-    let iso = match (a.iso, &a.sdf) {
-        (Some(v), _) => v,
-        (None, Some(_)) => 0.0,
-        (None, None) => match vol.range() {
-            Some((lo, hi)) => bail!("give --iso (the volume's values span {lo} to {hi})"),
-            None => bail!("give --iso (the volume has no finite values)"),
-        },
-    };
-    if !iso.is_finite() {
-        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
-    }
+    let iso = iso_value(&a, &vol)?;
     check_outputs(
         a.input
             .as_deref()
@@ -146,24 +118,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         a.force,
     )?;
     let gpu = Arc::new(Gpu::new(device)?);
-    let curvature = a.curvature.then_some(CurvatureOptions {
-        accumulate: a.accumulate.unwrap_or_default(),
-        precision: a.precision,
-        compat: a.compat,
-        dcurv: !a.no_dcurv,
-        lanes: 0,
-    });
-    let opts = IsoOptions {
-        fusion: a.fusion,
-        inside: a.inside.unwrap_or(if a.sdf.is_some() {
-            Inside::Below
-        } else {
-            Inside::Above
-        }),
-        curvature,
-        curvature_normals: a.curvature_normals,
-        gradient_normals: a.normals && a.output.is_some(),
-    };
+    let opts = iso_options(&a);
     let s = shapecue::isosurface_on(&gpu, &vol, iso, &opts)
         .with_context(|| format!("uploading {name}"))?;
     let runs = match a.runs {
@@ -173,12 +128,10 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     let st = &s.stats;
     if st.faces == 0 {
         // As in scenes: an empty surface is an error, not an empty file.
-        let span = vol
-            .range()
-            .map_or("no finite values".to_string(), |(lo, hi)| {
-                format!("the values span {lo} to {hi}")
-            });
-        bail!("{name}: the isosurface at iso {iso} is empty ({span})");
+        bail!(
+            "{name}: the isosurface at iso {iso} is empty ({})",
+            values_span(&vol)
+        );
     }
     out!(
         "{name}: iso {iso}, fusion {}: {} vertices, {} faces ({} soup vertices, {} degenerate \
@@ -191,14 +144,8 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
         st.timing.kernel_ms,
         st.timing.wall_ms
     );
-    if let Some(n) = a.runs {
-        let mut k: Vec<f64> = runs.iter().map(|t| t.kernel_ms).collect();
-        let mut w: Vec<f64> = runs.iter().map(|t| t.wall_ms).collect();
-        out!(
-            "{n} timed extractions: median {:.2} ms kernels, {:.2} ms wall",
-            shapecue::report::metrics::median(&mut k),
-            shapecue::report::metrics::median(&mut w)
-        );
+    if a.runs.is_some() {
+        print_runs(&runs)?;
     }
     let t_write = Instant::now();
     if let Some(out) = &a.output {
@@ -207,17 +154,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
     }
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
     if let Some(path) = &a.stats {
-        let curv = s.curvature.as_ref().map_or(serde_json::Value::Null, |c| {
-            serde_json::json!({
-                "options": curvature,
-                "normals": a.curvature_normals,
-                "passes": super::curvature::passes(&c.timing),
-                "kernel_ms": c.timing.kernel_ms,
-                "run_wall_ms": c.timing.wall_ms,
-                "counts": c.counts,
-                "device_bytes": c.device_bytes,
-            })
-        });
+        let curv = curvature_stats(&a, &opts, &s);
         let mut stats = serde_json::json!({
             "input": name,
             "device": gpu.info,
@@ -256,4 +193,102 @@ fn write_ply(out: &Path, s: &shapecue::Isosurface) -> Result<()> {
     };
     super::note_double(out, &written);
     Ok(())
+}
+
+/// The volume of the arguments (a file, with every file it was read from,
+/// or a generated SDF) and its name for messages.
+fn load_input(a: &IsoArgs) -> Result<(String, volume::Volume, Vec<PathBuf>)> {
+    Ok(match (&a.input, &a.sdf) {
+        (_, Some(kind)) => (
+            format!("{kind} SDF {}³", a.resolution),
+            volume::sdf::sdf_by_name(kind, a.resolution)?,
+            Vec::new(),
+        ),
+        (Some(path), None) => {
+            let raw = super::raw_spec(
+                a.dims.as_deref(),
+                a.scalar.as_deref(),
+                a.big_endian,
+                a.header_bytes,
+                a.spacing.as_deref(),
+            )?;
+            let (vol, read) = volume::load_with_files(path, raw.as_ref())?;
+            (path.display().to_string(), vol, read)
+        }
+        (None, None) => bail!("give an input volume or --sdf"),
+    })
+}
+
+/// `--iso`, or 0 for an SDF; a volume file needs it given, finite.
+fn iso_value(a: &IsoArgs, vol: &volume::Volume) -> Result<f32> {
+    let iso = match (a.iso, &a.sdf) {
+        (Some(v), _) => v,
+        (None, Some(_)) => 0.0,
+        (None, None) => match vol.range() {
+            Some((lo, hi)) => bail!("give --iso (the volume's values span {lo} to {hi})"),
+            None => bail!("give --iso (the volume has no finite values)"),
+        },
+    };
+    if !iso.is_finite() {
+        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
+    }
+    Ok(iso)
+}
+
+/// The extraction's options from the arguments.
+fn iso_options(a: &IsoArgs) -> IsoOptions {
+    let curvature = a.curvature.then_some(CurvatureOptions {
+        accumulate: a.accumulate.unwrap_or_default(),
+        precision: a.precision,
+        compat: a.compat,
+        dcurv: !a.no_dcurv,
+        lanes: 0,
+    });
+    IsoOptions {
+        fusion: a.fusion,
+        inside: a.inside.unwrap_or(if a.sdf.is_some() {
+            Inside::Below
+        } else {
+            Inside::Above
+        }),
+        curvature,
+        curvature_normals: a.curvature_normals,
+        gradient_normals: a.normals && a.output.is_some(),
+    }
+}
+
+/// The range of a volume's values, in words.
+fn values_span(vol: &volume::Volume) -> String {
+    vol.range()
+        .map_or("no finite values".to_string(), |(lo, hi)| {
+            format!("the values span {lo} to {hi}")
+        })
+}
+
+/// The medians of the timed extractions (`--runs`).
+fn print_runs(runs: &[shapecue::spec::timing::Timing]) -> Result<()> {
+    let mut k: Vec<f64> = runs.iter().map(|t| t.kernel_ms).collect();
+    let mut w: Vec<f64> = runs.iter().map(|t| t.wall_ms).collect();
+    out!(
+        "{} timed extractions: median {:.2} ms kernels, {:.2} ms wall",
+        runs.len(),
+        shapecue::report::metrics::median(&mut k),
+        shapecue::report::metrics::median(&mut w)
+    );
+    Ok(())
+}
+
+/// The curvature part of `--stats` (null without `--curvature`).
+fn curvature_stats(a: &IsoArgs, opts: &IsoOptions, s: &shapecue::Isosurface) -> serde_json::Value {
+    s.curvature.as_ref().map_or(serde_json::Value::Null, |c| {
+        serde_json::json!({
+            "options": opts.curvature,
+            "normals": a.curvature_normals,
+            "passes": super::curvature::passes(&c.timing),
+            "kernel_ms": c.timing.kernel_ms,
+            "run_wall_ms": c.timing.wall_ms,
+            "counts": c.counts,
+            "device_bytes": c.device_bytes,
+        })
+    })
 }
