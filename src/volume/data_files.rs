@@ -82,9 +82,49 @@ pub(super) fn detached<'a>(
     source: &str,
     el: &str,
 ) -> Result<DataFiles> {
-    let Syntax { field, .. } = *syntax;
+    let field = Field {
+        syntax,
+        dims,
+        source,
+        el,
+    };
     let toks: Vec<&str> = value.split_whitespace().collect();
-    let subdim = |tok: Option<&&str>| -> Result<usize> {
+    let is_list = toks.first().is_some_and(|t| {
+        if syntax.metaio {
+            t.eq_ignore_ascii_case("list")
+        } else {
+            *t == "LIST"
+        }
+    });
+    if is_list {
+        return field.list(&toks, rest, dir);
+    }
+    if toks.len() >= 4 && toks[0].contains('%') && (toks.len() <= 5 || !syntax.metaio) {
+        return field.pattern(&toks, value, dir);
+    }
+    if value.is_empty() {
+        return Err(Error::input(source, el, syntax.empty));
+    }
+    Ok(DataFiles::Detached {
+        files: vec![dir.join(value)],
+        subdim: 3,
+    })
+}
+
+/// The data-file field being parsed: its syntax, the grid size if known,
+/// and the header's name and element for messages.
+struct Field<'s> {
+    syntax: &'s Syntax,
+    dims: Option<[usize; 3]>,
+    source: &'s str,
+    el: &'s str,
+}
+
+impl Field<'_> {
+    /// The subdimension written as `tok` (2 when absent), checked to be 1 to 3.
+    fn subdim(&self, tok: Option<&&str>) -> Result<usize> {
+        let (syntax, source, el) = (self.syntax, self.source, self.el);
+        let field = syntax.field;
         let d = match tok {
             None => 2,
             Some(t) => {
@@ -106,21 +146,27 @@ pub(super) fn detached<'a>(
                 format!("{field} {} {d} must be 1, 2 or 3", syntax.subdim),
             ))
         }
-    };
-    let slabs = |sub: usize| -> Result<usize> {
-        let dims = dims.ok_or_else(|| Error::input(source, el, syntax.sizes_first))?;
+    }
+
+    /// How many slabs of `sub` fast axes the grid holds (the grid size must
+    /// be known).
+    fn slabs(&self, sub: usize) -> Result<usize> {
+        let dims = self
+            .dims
+            .ok_or_else(|| Error::input(self.source, self.el, self.syntax.sizes_first))?;
         Ok(dims[sub..].iter().fold(1usize, |n, &d| n.saturating_mul(d)))
-    };
-    let is_list = toks.first().is_some_and(|t| {
-        if syntax.metaio {
-            t.eq_ignore_ascii_case("list")
-        } else {
-            *t == "LIST"
-        }
-    });
-    if is_list {
-        let sub = subdim(toks.get(1))?;
-        let max = slabs(sub)?;
+    }
+
+    /// The `LIST [subdim]` form: one file name per following line, at most
+    /// one per slab.
+    fn list<'a>(
+        &self,
+        toks: &[&str],
+        rest: impl Iterator<Item = &'a [u8]>,
+        dir: &Path,
+    ) -> Result<DataFiles> {
+        let sub = self.subdim(toks.get(1))?;
+        let max = self.slabs(sub)?;
         let mut files = Vec::new();
         for line in rest {
             let name = String::from_utf8_lossy(line);
@@ -130,19 +176,22 @@ pub(super) fn detached<'a>(
             }
             if files.len() == max {
                 return Err(Error::input(
-                    source,
-                    el,
+                    self.source,
+                    self.el,
                     format!(
-                        "the {field} LIST names more than the {max} files {}",
-                        syntax.list_bound
+                        "the {} LIST names more than the {max} files {}",
+                        self.syntax.field, self.syntax.list_bound
                     ),
                 ));
             }
             files.push(dir.join(name));
         }
-        return Ok(DataFiles::Detached { files, subdim: sub });
+        Ok(DataFiles::Detached { files, subdim: sub })
     }
-    if toks.len() >= 4 && toks[0].contains('%') && (toks.len() <= 5 || !syntax.metaio) {
+
+    /// The `format min max step [subdim]` form: the files a pattern names.
+    fn pattern(&self, toks: &[&str], value: &str, dir: &Path) -> Result<DataFiles> {
+        let (source, el) = (self.source, self.el);
         if toks.len() > 5 {
             return Err(Error::input(
                 source,
@@ -150,7 +199,8 @@ pub(super) fn detached<'a>(
                 format!("expected 'format min max step [subdim]', found '{value}'"),
             ));
         }
-        let sub = subdim(toks.get(4))?;
+        let sub = self.subdim(toks.get(4))?;
+        let field = self.syntax.field;
         let int =
             |k: usize, what: &str| number::<i64>(toks[k], &format!("{field} {what}"), source, el);
         let files = pattern_files(
@@ -158,19 +208,12 @@ pub(super) fn detached<'a>(
             int(1, "min")?,
             int(2, "max")?,
             int(3, "step")?,
-            slabs(sub)?,
+            self.slabs(sub)?,
             dir,
         )
         .map_err(|p| Error::input(source, el, p))?;
-        return Ok(DataFiles::Detached { files, subdim: sub });
+        Ok(DataFiles::Detached { files, subdim: sub })
     }
-    if value.is_empty() {
-        return Err(Error::input(source, el, syntax.empty));
-    }
-    Ok(DataFiles::Detached {
-        files: vec![dir.join(value)],
-        subdim: 3,
-    })
 }
 
 impl DataFiles {

@@ -4,7 +4,8 @@
 //! files, raw, compressed or ASCII, with their line and byte skips).
 
 use std::borrow::Cow;
-use std::io::Read;
+use std::fs::File;
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use super::{
@@ -263,117 +264,148 @@ impl Payload<'_> {
             Encoding::Raw => None,
             Encoding::Compressed(kind) => Some(kind),
         };
-        let src = self.source;
-        let io = |source| Error::Io {
-            path: path.to_path_buf(),
-            source,
+        let (mut r, size) = self.open_data_file(path)?;
+        let skipped = self.skip_data_lines(&mut r, path, &el)?;
+        let file = DataFile {
+            path,
+            el,
+            size,
+            skipped,
         };
-        // The header names the file: errors name both.
-        let named = || format!("data file {}", path.display());
-        let (mut r, size) = match std::fs::metadata(path) {
-            Ok(m) if m.is_dir() => {
-                return Err(Error::input(
-                    src,
-                    named(),
-                    "is a folder, not a file of samples",
-                ));
-            }
-            Err(e) => {
-                return Err(Error::input(src, named(), format!("cannot be read: {e}")));
-            }
-            Ok(_) => open_file(path)?,
-        };
-        let mut skipped = 0u64;
-        for _ in 0..self.line_skip {
-            skipped += skip_line(&mut r).map_err(io)?.ok_or_else(|| {
-                Error::input(
-                    src,
-                    &el,
-                    format!(
-                        "file ends before the {} lines to skip ('line skip')",
-                        self.line_skip
-                    ),
-                )
-            })?;
-        }
-        let rest = size.saturating_sub(skipped);
-        let expected = byte_count(count, self.scalar, src, &el)?;
-        let wrong_size = |found: u64| {
-            let lines = if skipped > 0 {
-                format!(", {skipped} of them in skipped lines")
-            } else {
-                String::new()
-            };
-            Error::input(
-                src,
-                &el,
-                format!(
-                    "{} (the file has {size} bytes{lines})",
-                    size_problem(&self.chunk_shape, self.scalar, found as usize)
-                ),
-            )
-        };
+        let expected = byte_count(count, self.scalar, self.source, &file.el)?;
         let data = match compression {
-            None => {
-                let (offset, found) = match self.byte_skip {
-                    Skip::Bytes(n) => (n as u64, rest.saturating_sub(n as u64)),
-                    // The last bytes: a larger file is fine, a smaller one not.
-                    Skip::ToEnd => (
-                        rest.saturating_sub(expected as u64),
-                        rest.min(expected as u64),
-                    ),
-                };
-                if found != expected as u64 {
-                    return Err(wrong_size(found));
-                }
-                // `offset` is at most the file's size: it fits in an i64.
-                r.seek_relative(offset as i64).map_err(io)?;
-                let mut buf = vec![0u8; expected];
-                r.read_exact(&mut buf).map_err(io)?;
-                buf
-            }
-            Some(kind) => {
-                let skip = match self.byte_skip {
-                    Skip::Bytes(n) => n,
-                    Skip::ToEnd => {
-                        return Err(Error::input(
-                            src,
-                            &el,
-                            "a byte skip of -1 (data at the end of the file) cannot be used \
-                             with compressed data",
-                        ));
-                    }
-                };
-                let limit = skip.saturating_add(expected).saturating_add(1);
-                let have = usize::try_from(rest).unwrap_or(usize::MAX);
-                check_inflate(have, limit - 1, kind).map_err(|p| Error::input(src, &el, p))?;
-                let mut d = decompress(r, kind, limit).map_err(|p| Error::input(src, &el, p))?;
-                let want = skip.saturating_add(expected);
-                if d.len() > want {
-                    return Err(Error::input(
-                        src,
-                        &el,
-                        format!(
-                            "the {} data inflate to more than the {want} bytes the header calls \
-                             for (decompression stopped there)",
-                            kind.name()
-                        ),
-                    ));
-                }
-                if d.len() < want {
-                    let found = d.len().saturating_sub(skip);
-                    return Err(Error::input(
-                        src,
-                        &el,
-                        size_problem(&self.chunk_shape, self.scalar, found),
-                    ));
-                }
-                d.drain(..skip);
-                d
-            }
+            None => self.read_raw(&file, r, expected)?,
+            Some(kind) => self.read_compressed(&file, r, kind, expected)?,
         };
         convert_into(&data, self.scalar, self.big_endian, out);
         Ok(())
+    }
+
+    /// Opens a data file that exists and is no folder; with its size.
+    fn open_data_file(&self, path: &Path) -> Result<(BufReader<File>, u64)> {
+        let src = self.source;
+        // The header names the file: errors name both.
+        let named = || format!("data file {}", path.display());
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => Err(Error::input(
+                src,
+                named(),
+                "is a folder, not a file of samples",
+            )),
+            Err(e) => Err(Error::input(src, named(), format!("cannot be read: {e}"))),
+            Ok(_) => open_file(path),
+        }
+    }
+
+    /// Skips the `line_skip` text lines of a data file; the bytes skipped.
+    fn skip_data_lines(&self, r: &mut BufReader<File>, path: &Path, el: &str) -> Result<u64> {
+        let mut skipped = 0u64;
+        for _ in 0..self.line_skip {
+            skipped += skip_line(r)
+                .map_err(|e| io_error(path, e))?
+                .ok_or_else(|| {
+                    Error::input(
+                        self.source,
+                        el,
+                        format!(
+                            "file ends before the {} lines to skip ('line skip')",
+                            self.line_skip
+                        ),
+                    )
+                })?;
+        }
+        Ok(skipped)
+    }
+
+    /// Reads the `expected` bytes of samples of an uncompressed data file,
+    /// after its byte skip (or at its end), refusing a file of the wrong size.
+    fn read_raw(&self, f: &DataFile, mut r: BufReader<File>, expected: usize) -> Result<Vec<u8>> {
+        let rest = f.size.saturating_sub(f.skipped);
+        let (offset, found) = match self.byte_skip {
+            Skip::Bytes(n) => (n as u64, rest.saturating_sub(n as u64)),
+            // The last bytes: a larger file is fine, a smaller one not.
+            Skip::ToEnd => (
+                rest.saturating_sub(expected as u64),
+                rest.min(expected as u64),
+            ),
+        };
+        if found != expected as u64 {
+            return Err(self.wrong_size(f, found));
+        }
+        // `offset` is at most the file's size: it fits in an i64.
+        r.seek_relative(offset as i64)
+            .map_err(|e| io_error(f.path, e))?;
+        let mut buf = vec![0u8; expected];
+        r.read_exact(&mut buf).map_err(|e| io_error(f.path, e))?;
+        Ok(buf)
+    }
+
+    /// The error for a raw data file holding `found` bytes of samples.
+    fn wrong_size(&self, f: &DataFile, found: u64) -> Error {
+        let (size, skipped) = (f.size, f.skipped);
+        let lines = if skipped > 0 {
+            format!(", {skipped} of them in skipped lines")
+        } else {
+            String::new()
+        };
+        Error::input(
+            self.source,
+            &f.el,
+            format!(
+                "{} (the file has {size} bytes{lines})",
+                size_problem(&self.chunk_shape, self.scalar, found as usize)
+            ),
+        )
+    }
+
+    /// Inflates a compressed data file, within the memory bound, to its
+    /// byte skip and the `expected` bytes of samples, and returns the latter.
+    fn read_compressed(
+        &self,
+        f: &DataFile,
+        r: BufReader<File>,
+        kind: Compression,
+        expected: usize,
+    ) -> Result<Vec<u8>> {
+        let (src, el) = (self.source, f.el.as_str());
+        let skip = match self.byte_skip {
+            Skip::Bytes(n) => n,
+            Skip::ToEnd => {
+                return Err(Error::input(
+                    src,
+                    el,
+                    "a byte skip of -1 (data at the end of the file) cannot be used \
+                     with compressed data",
+                ));
+            }
+        };
+        let rest = f.size.saturating_sub(f.skipped);
+        let limit = skip.saturating_add(expected).saturating_add(1);
+        let have = usize::try_from(rest).unwrap_or(usize::MAX);
+        check_inflate(have, limit - 1, kind).map_err(|p| Error::input(src, el, p))?;
+        let mut d = decompress(r, kind, limit).map_err(|p| Error::input(src, el, p))?;
+        let want = skip.saturating_add(expected);
+        if d.len() > want {
+            return Err(Error::input(
+                src,
+                el,
+                format!(
+                    "the {} data inflate to more than the {want} bytes the header calls \
+                     for (decompression stopped there)",
+                    kind.name()
+                ),
+            ));
+        }
+        if d.len() < want {
+            let found = d.len().saturating_sub(skip);
+            return Err(Error::input(
+                src,
+                el,
+                size_problem(&self.chunk_shape, self.scalar, found),
+            ));
+        }
+        d.drain(..skip);
+        Ok(d)
     }
 
     /// Decodes one chunk of `count` samples, appending them to `out`.
@@ -434,6 +466,23 @@ impl Payload<'_> {
         }
         convert_into(data, self.scalar, self.big_endian, out);
         Ok(())
+    }
+}
+
+/// A detached data file being read: its path, its name for messages, its
+/// size and the bytes of the lines skipped at its start.
+struct DataFile<'p> {
+    path: &'p Path,
+    el: String,
+    size: u64,
+    skipped: u64,
+}
+
+/// The error for a failed read of `path`.
+fn io_error(path: &Path, source: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        source,
     }
 }
 
