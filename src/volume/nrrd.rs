@@ -109,19 +109,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
 fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
     let mut lines = lines_with_end(bytes).enumerate();
     let magic = lines.next().map(|(_, (l, _))| l).unwrap_or_default();
-    let is_nrrd = magic.len() == 8
-        && magic.starts_with(b"NRRD000")
-        && magic.last().is_some_and(u8::is_ascii_digit);
-    if !is_nrrd {
-        return Err(Error::input(
-            source,
-            "header line 1",
-            format!(
-                "not a NRRD file: expected 'NRRD000X', found '{}'",
-                String::from_utf8_lossy(&magic[..magic.len().min(40)])
-            ),
-        ));
-    }
+    check_magic(magic, source)?;
     let mut h = Header::default();
     while let Some((i, (line, end))) = lines.next() {
         let element = format!("header line {}", i + 1);
@@ -150,52 +138,78 @@ fn parse_header(bytes: &[u8], source: &str, dir: &Path) -> Result<Header> {
         })?;
         let value = value.trim();
         let field = key.trim().to_ascii_lowercase();
-        match field.as_str() {
-            "dimension" => {
-                // Before `sizes`, whose count depends on it.
-                h.dimension = Some(dimension(value, "dimension", Path::new(source), el)?);
-            }
-            "type" => h.scalar = Some(scalar_type(value, source, el)?),
-            "encoding" => h.encoding = Some(encoding(value, source, el)?),
-            "endian" => {
-                h.big_endian = Some(match value.to_ascii_lowercase().as_str() {
-                    "little" => false,
-                    "big" => true,
-                    _ => {
-                        return Err(Error::input(
-                            source,
-                            el,
-                            format!("endian '{value}' is neither 'little' nor 'big'"),
-                        ));
-                    }
-                })
-            }
-            "sizes" => h.sizes = Some(numbers(value, "sizes", source, el)?),
-            "spacings" => h.spacings = Some(numbers(value, "spacings", source, el)?),
-            "space directions" => h.directions = Some(directions(value, source, el)?),
-            "space origin" => h.origin = Some(vector(value, "space origin", source, el)?),
-            "space dimension" => {
-                let d: usize = number(value, "space dimension", source, el)?;
-                if d != 3 {
-                    return Err(Error::input(
-                        source,
-                        el,
-                        format!("space dimension {d}: shapecue reads 3-D volumes only"),
-                    ));
-                }
-            }
-            "line skip" | "lineskip" => h.line_skip = number(value, "line skip", source, el)?,
-            "byte skip" | "byteskip" => {
-                h.byte_skip = Some(Skip::parse(value, "byte skip", source, el)?)
-            }
-            "data file" | "datafile" => {
-                let rest = lines.by_ref().map(|(_, (l, _))| l);
-                h.data = Some(detached(&NRRD, value, rest, h.sizes, dir, source, el)?);
-            }
-            _ => {} // descriptive fields: content, kinds, labels, units, ...
+        if field == "data file" || field == "datafile" {
+            let rest = lines.by_ref().map(|(_, (l, _))| l);
+            h.data = Some(detached(&NRRD, value, rest, h.sizes, dir, source, el)?);
+        } else {
+            read_field(&mut h, &field, value, source, el)?;
         }
     }
     Ok(h)
+}
+
+/// Checks the first line is a NRRD magic, `NRRD000X`.
+fn check_magic(magic: &[u8], source: &str) -> Result<()> {
+    let is_nrrd = magic.len() == 8
+        && magic.starts_with(b"NRRD000")
+        && magic.last().is_some_and(u8::is_ascii_digit);
+    if is_nrrd {
+        return Ok(());
+    }
+    Err(Error::input(
+        source,
+        "header line 1",
+        format!(
+            "not a NRRD file: expected 'NRRD000X', found '{}'",
+            String::from_utf8_lossy(&magic[..magic.len().min(40)])
+        ),
+    ))
+}
+
+/// Reads one `field: value` line (other than `data file`) into `h`.
+fn read_field(h: &mut Header, field: &str, value: &str, source: &str, el: &str) -> Result<()> {
+    match field {
+        "dimension" => {
+            // Before `sizes`, whose count depends on it.
+            h.dimension = Some(dimension(value, "dimension", Path::new(source), el)?);
+        }
+        "type" => h.scalar = Some(scalar_type(value, source, el)?),
+        "encoding" => h.encoding = Some(encoding(value, source, el)?),
+        "endian" => h.big_endian = Some(endian(value, source, el)?),
+        "sizes" => h.sizes = Some(numbers(value, "sizes", source, el)?),
+        "spacings" => h.spacings = Some(numbers(value, "spacings", source, el)?),
+        "space directions" => h.directions = Some(directions(value, source, el)?),
+        "space origin" => h.origin = Some(vector(value, "space origin", source, el)?),
+        "space dimension" => {
+            let d: usize = number(value, "space dimension", source, el)?;
+            if d != 3 {
+                return Err(Error::input(
+                    source,
+                    el,
+                    format!("space dimension {d}: shapecue reads 3-D volumes only"),
+                ));
+            }
+        }
+        "line skip" | "lineskip" => h.line_skip = number(value, "line skip", source, el)?,
+        "byte skip" | "byteskip" => {
+            h.byte_skip = Some(Skip::parse(value, "byte skip", source, el)?)
+        }
+        _ => {} // descriptive fields: content, kinds, labels, units, ...
+    }
+    Ok(())
+}
+
+/// Parses an `endian` value: true for big-endian.
+fn endian(value: &str, source: &str, el: &str) -> Result<bool> {
+    match value.to_ascii_lowercase().as_str() {
+        "little" => Ok(false),
+        "big" => Ok(true),
+        _ => Err(Error::input(
+            source,
+            el,
+            format!("endian '{value}' is neither 'little' nor 'big'"),
+        )),
+    }
 }
 
 /// Parses an `encoding` value.

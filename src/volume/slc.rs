@@ -92,10 +92,28 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
         pos: 0,
         source: src,
     };
+    let h = read_header(&mut c, path)?;
+    let count = voxel_count(h.dims, src, "sizes")?;
+    skip_icon(&mut c)?;
+    let values = read_slices(&mut c, &h, count)?;
+    oriented(h.dims, values, h.spacing, [0.0; 3], src)
+}
+
+/// The header fields that are used.
+struct Header {
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    /// 0 (none) or 1 (run-length).
+    compression: u32,
+}
+
+/// Reads the header, up to the compression field, refusing other than
+/// 8 bits per voxel and unknown compressions.
+fn read_header(c: &mut Cursor<'_>, path: &Path) -> Result<Header> {
     let magic: u32 = c.number("magic number")?;
     if magic != 11111 {
         return Err(Error::input(
-            src,
+            c.source,
             "magic number",
             format!("{magic} is not 11111: not an SLC file"),
         ));
@@ -127,27 +145,40 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
             problem: format!("compression {compression} (0 and 1 = run-length are read)"),
         });
     }
-    let count = voxel_count(dims, src, "sizes")?;
+    Ok(Header {
+        dims,
+        spacing,
+        compression,
+    })
+}
+
+/// Skips the icon: its size, an `X`, and its RGB bytes.
+fn skip_icon(c: &mut Cursor<'_>) -> Result<()> {
     let icon_w: usize = c.number("icon width")?;
     let icon_h: usize = c.number("icon height")?;
     c.x("icon")?;
     let icon = icon_w
         .checked_mul(icon_h)
         .and_then(|n| n.checked_mul(3))
-        .ok_or_else(|| Error::input(src, "icon", "icon size overflows"))?;
+        .ok_or_else(|| Error::input(c.source, "icon", "icon size overflows"))?;
     c.take(icon, "icon")?;
+    Ok(())
+}
 
+/// Reads the slices, each its size, an `X` and its (run-length) bytes.
+fn read_slices(c: &mut Cursor<'_>, h: &Header, count: usize) -> Result<Vec<f32>> {
+    let (src, dims) = (c.source, h.dims);
     let plane = dims[0] * dims[1];
     // Never reserve more than the file could decode to (runs of 127).
-    let mut values: Vec<f32> = Vec::with_capacity(count.min(bytes.len().saturating_mul(64)));
-    let mut slice = Vec::with_capacity(plane.min(bytes.len().saturating_mul(64)));
+    let mut values: Vec<f32> = Vec::with_capacity(count.min(c.bytes.len().saturating_mul(64)));
+    let mut slice = Vec::with_capacity(plane.min(c.bytes.len().saturating_mul(64)));
     for z in 0..dims[2] {
         let el = format!("slice {z}");
         let size: usize = c.number(&el)?;
         c.x(&el)?;
         let data = c.take(size, &el)?;
         slice.clear();
-        if compression == 1 {
+        if h.compression == 1 {
             decode_rle(data, plane, &mut slice).map_err(|p| Error::input(src, el.as_str(), p))?;
         } else {
             slice.extend_from_slice(data);
@@ -166,7 +197,7 @@ pub(super) fn load(path: &Path) -> Result<Volume> {
         }
         values.extend(slice.iter().map(|&b| f32::from(b)));
     }
-    oriented(dims, values, spacing, [0.0; 3], src)
+    Ok(values)
 }
 
 /// Decodes one run-length encoded slice of at most `max` bytes.
