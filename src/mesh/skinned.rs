@@ -105,266 +105,14 @@ pub struct SkinnedMesh {
     pub clips: Vec<Clip>,
 }
 
+/// An input error naming the glTF file, the element and the problem.
 fn bad(path: &Path, element: impl Into<String>, problem: impl Into<String>) -> Error {
     Error::input(path.display().to_string(), element, problem)
 }
 
-/// When a glTF file reads but a buffer or image it refers to does not, the
-/// error names that file and the glTF file that refers to it (the glTF
-/// crate's I/O error names neither).
-fn missing_part(path: &Path) -> Option<Error> {
-    let doc = gltf::Gltf::open(path).ok()?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let buffers = doc.buffers().filter_map(|b| match b.source() {
-        gltf::buffer::Source::Uri(u) => Some((format!("buffer {}", b.index()), u.to_string())),
-        gltf::buffer::Source::Bin => None,
-    });
-    let images = doc.images().filter_map(|i| match i.source() {
-        gltf::image::Source::Uri { uri, .. } => {
-            Some((format!("image {}", i.index()), uri.to_string()))
-        }
-        gltf::image::Source::View { .. } => None,
-    });
-    for (element, uri) in buffers.chain(images) {
-        if uri.starts_with("data:") {
-            continue;
-        }
-        let file = dir.join(&uri);
-        if let Err(source) = std::fs::metadata(&file) {
-            return Some(bad(
-                path,
-                element,
-                format!(
-                    "cannot read {} (referred to by this file): {source}",
-                    file.display()
-                ),
-            ));
-        }
-    }
-    None
-}
+mod check;
 
-/// Checks an accessor before the glTF crate's reader casts its bytes: its
-/// element type must be one of `dims` with a component type in `types`,
-/// and a sparse accessor must have at least one entry (the crate's reader
-/// panics on a mismatch, or indexes before the buffer on an empty sparse
-/// set). `what` names the accessor's role in the error.
-fn check_accessor(
-    path: &Path,
-    what: &str,
-    acc: Option<gltf::Accessor>,
-    dims: gltf::accessor::Dimensions,
-    types: &[gltf::accessor::DataType],
-) -> Result<()> {
-    let Some(acc) = acc else {
-        return Ok(());
-    };
-    let element = format!("accessor {}", acc.index());
-    if acc.dimensions() != dims || !types.contains(&acc.data_type()) {
-        return Err(bad(
-            path,
-            element,
-            format!(
-                "used as {what}, it must hold {} of {}, not {} of {}",
-                dims_name(dims),
-                types
-                    .iter()
-                    .map(|t| type_name(*t))
-                    .collect::<Vec<_>>()
-                    .join(" or "),
-                dims_name(acc.dimensions()),
-                type_name(acc.data_type())
-            ),
-        ));
-    }
-    if acc.sparse().is_some_and(|sp| sp.count() == 0) {
-        return Err(bad(path, element, "a sparse accessor with no entries"));
-    }
-    Ok(())
-}
-
-/// The glTF name of an element type.
-fn dims_name(d: gltf::accessor::Dimensions) -> &'static str {
-    use gltf::accessor::Dimensions as D;
-    match d {
-        D::Scalar => "SCALAR",
-        D::Vec2 => "VEC2",
-        D::Vec3 => "VEC3",
-        D::Vec4 => "VEC4",
-        D::Mat2 => "MAT2",
-        D::Mat3 => "MAT3",
-        D::Mat4 => "MAT4",
-    }
-}
-
-/// A component type in words.
-fn type_name(t: gltf::accessor::DataType) -> &'static str {
-    use gltf::accessor::DataType as T;
-    match t {
-        T::I8 => "signed bytes",
-        T::U8 => "unsigned bytes",
-        T::I16 => "signed shorts",
-        T::U16 => "unsigned shorts",
-        T::U32 => "unsigned ints",
-        T::F32 => "floats",
-    }
-}
-
-/// Checks every accessor [`load_gltf`] reads (see [`check_accessor`]).
-fn check_accessors(path: &Path, doc: &gltf::Document) -> Result<()> {
-    use gltf::Semantic;
-    use gltf::accessor::{DataType as T, Dimensions as D};
-    for skin in doc.skins() {
-        let ibm = skin.inverse_bind_matrices();
-        check_accessor(path, "inverse bind matrices", ibm, D::Mat4, &[T::F32])?;
-    }
-    for mesh in doc.meshes() {
-        for prim in mesh.primitives() {
-            let pos = prim.get(&Semantic::Positions);
-            check_accessor(path, "POSITION", pos, D::Vec3, &[T::F32])?;
-            let joints = prim.get(&Semantic::Joints(0));
-            check_accessor(path, "JOINTS_0", joints, D::Vec4, &[T::U8, T::U16])?;
-            let weights = prim.get(&Semantic::Weights(0));
-            check_accessor(
-                path,
-                "WEIGHTS_0",
-                weights,
-                D::Vec4,
-                &[T::F32, T::U8, T::U16],
-            )?;
-            let ints = [T::U8, T::U16, T::U32];
-            check_accessor(path, "indices", prim.indices(), D::Scalar, &ints)?;
-        }
-    }
-    for anim in doc.animations() {
-        for ch in anim.channels() {
-            let s = ch.sampler();
-            check_accessor(
-                path,
-                "keyframe times",
-                Some(s.input()),
-                D::Scalar,
-                &[T::F32],
-            )?;
-            use gltf::animation::Property as P;
-            let (dims, types): (D, &[T]) = match ch.target().property() {
-                P::Translation | P::Scale => (D::Vec3, &[T::F32]),
-                P::Rotation => (D::Vec4, &[T::F32, T::I8, T::U8, T::I16, T::U16]),
-                P::MorphTargetWeights => (D::Scalar, &[T::F32, T::I8, T::U8, T::I16, T::U16]),
-            };
-            check_accessor(path, "keyframe values", Some(s.output()), dims, types)?;
-        }
-    }
-    Ok(())
-}
-
-/// Checks a GLB header's length against the file size, and the accessor
-/// indices of mesh primitives on the document read
-/// without the glTF crate's validation, whose hook for primitives indexes
-/// the accessor list with the POSITION index before checking it (a panic on
-/// a file naming a missing accessor). A file that does not parse passes:
-/// the import reports it.
-fn check_before_import(path: &Path) -> Result<()> {
-    let Ok(bytes) = std::fs::read(path) else {
-        return Ok(());
-    };
-    // The glTF crate reads a 4-byte magic first, and a shorter file fails
-    // with an I/O message that names nothing.
-    if bytes.len() < 4 {
-        return Err(bad(
-            path,
-            "file",
-            format!(
-                "{} bytes: too short for glTF (a JSON document with an asset, or a GLB file)",
-                bytes.len()
-            ),
-        ));
-    }
-    // The memory bound: the glTF crate allocates the length a GLB header
-    // declares before reading, so a header claiming more than the file
-    // holds is refused here; so is one claiming less than the header itself,
-    // which the crate subtracts the header's size from unchecked.
-    if let Some(h) = bytes.first_chunk::<12>()
-        && h.starts_with(b"glTF")
-    {
-        let declared = u32::from_le_bytes([h[8], h[9], h[10], h[11]]);
-        if declared < 12 {
-            return Err(bad(
-                path,
-                "GLB header",
-                format!("declares {declared} bytes, less than its own 12"),
-            ));
-        }
-        if declared as usize > bytes.len() {
-            return Err(bad(
-                path,
-                "GLB header",
-                format!(
-                    "declares {declared} bytes, but the file has {}",
-                    bytes.len()
-                ),
-            ));
-        }
-    }
-    let Ok(g) = gltf::Gltf::from_slice_without_validation(&bytes) else {
-        return Ok(());
-    };
-    let root = g.document.as_json();
-    let n = root.accessors.len();
-    for (i, mesh) in root.meshes.iter().enumerate() {
-        for (j, prim) in mesh.primitives.iter().enumerate() {
-            let refs = prim.attributes.values().map(|a| a.value());
-            let indices = prim.indices.iter().map(|a| a.value());
-            if let Some(a) = refs.chain(indices).find(|&a| a >= n) {
-                return Err(bad(
-                    path,
-                    format!("mesh {i} primitive {j}"),
-                    format!("refers to accessor {a}, but the file has {n} accessors"),
-                ));
-            }
-        }
-    }
-    // Animation channels: the glTF crate unwraps their target path and
-    // indexes their node and sampler unchecked.
-    let nodes = root.nodes.len();
-    for (i, anim) in root.animations.iter().enumerate() {
-        let samplers = anim.samplers.len();
-        for (j, ch) in anim.channels.iter().enumerate() {
-            let what = format!("animation {i} channel {j}");
-            let problem = if matches!(ch.target.path, gltf::json::validation::Checked::Invalid) {
-                Some("has no valid target path (translation, rotation, scale or weights)".into())
-            } else if ch.target.node.value() >= nodes {
-                Some(format!(
-                    "targets node {}, but the file has {nodes} nodes",
-                    ch.target.node.value()
-                ))
-            } else if ch.sampler.value() >= samplers {
-                Some(format!(
-                    "uses sampler {}, but the animation has {samplers} samplers",
-                    ch.sampler.value()
-                ))
-            } else {
-                None
-            };
-            if let Some(p) = problem {
-                return Err(bad(path, what, p));
-            }
-        }
-        for (j, s) in anim.samplers.iter().enumerate() {
-            if let Some(a) = [s.input.value(), s.output.value()]
-                .into_iter()
-                .find(|&a| a >= n)
-            {
-                return Err(bad(
-                    path,
-                    format!("animation {i} sampler {j}"),
-                    format!("refers to accessor {a}, but the file has {n} accessors"),
-                ));
-            }
-        }
-    }
-    Ok(())
-}
+use check::{check_accessors, check_before_import, missing_part};
 
 /// Loads every skinned primitive of a glTF file.
 pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
@@ -378,29 +126,12 @@ pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
     })?;
     check_accessors(path, &doc)?;
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
-    let mut parents = vec![None; nodes.len()];
-    for n in &nodes {
-        for c in n.children() {
-            parents[c.index()] = Some(n.index());
-        }
-    }
-    let rest_trs: Vec<Trs> = nodes
-        .iter()
-        .map(|n| {
-            let (t, r, s) = n.transform().decomposed();
-            Trs {
-                t: Vec3::from(t),
-                r: Quat::from_array(r).normalize(),
-                s: Vec3::from(s),
-            }
-        })
-        .collect();
     let mut m = SkinnedMesh {
         rest: Mesh::default(),
         joints: Vec::new(),
         weights: Vec::new(),
-        parents,
-        rest_trs,
+        parents: parents(&nodes),
+        rest_trs: nodes.iter().map(rest_trs).collect(),
         joint_nodes: Vec::new(),
         inverse_bind: Vec::new(),
         joint_mesh_node: Vec::new(),
@@ -410,172 +141,272 @@ pub fn load_gltf(path: &Path) -> Result<SkinnedMesh> {
         let (Some(mesh), Some(skin)) = (node.mesh(), node.skin()) else {
             continue;
         };
-        let joint_base = m.joint_nodes.len() as u32;
-        let reader = skin.reader(|b| Some(&buffers[b.index()]));
-        let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
-        let ibm: Vec<Mat4> = match reader.read_inverse_bind_matrices() {
-            Some(it) => it.map(|c| Mat4::from_cols_array_2d(&c)).collect(),
-            None => vec![Mat4::IDENTITY; joints.len()],
-        };
-        if ibm.len() != joints.len() {
-            return Err(bad(
-                path,
-                format!("skin {}", skin.index()),
-                format!(
-                    "{} inverse bind matrices for {} joints",
-                    ibm.len(),
-                    joints.len()
-                ),
-            ));
-        }
-        m.joint_nodes.extend(&joints);
-        m.inverse_bind.extend(ibm);
-        m.joint_mesh_node
-            .extend(std::iter::repeat_n(node.index(), joints.len()));
+        let joints = add_skin(&mut m, path, node, &skin, &buffers)?;
         for prim in mesh.primitives() {
-            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                continue;
-            }
-            let r = prim.reader(|b| Some(&buffers[b.index()]));
-            let pos: Vec<[f32; 3]> = r
-                .read_positions()
-                .ok_or_else(|| bad(path, &what, "no POSITION"))?
-                .collect();
-            let nv = pos.len();
-            let js: Vec<[u16; 4]> = match r.read_joints(0) {
-                Some(j) => j.into_u16().collect(),
-                None => continue,
-            };
-            let ws: Vec<[f32; 4]> = r
-                .read_weights(0)
-                .ok_or_else(|| bad(path, &what, "JOINTS_0 without WEIGHTS_0"))?
-                .into_f32()
-                .collect();
-            if js.len() != nv || ws.len() != nv {
-                return Err(bad(
-                    path,
-                    &what,
-                    "JOINTS_0/WEIGHTS_0 length differs from POSITION",
-                ));
-            }
-            let base = m.rest.positions.len() as u32;
-            let idx: Vec<u32> = match r.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..nv as u32).collect(),
-            };
-            for (k, tri) in idx.chunks_exact(3).enumerate() {
-                if let Some(&v) = tri.iter().find(|&&v| v as usize >= nv) {
-                    return Err(bad(
-                        path,
-                        format!("{what} triangle {k}"),
-                        format!("index {v} ≥ {nv} vertices"),
-                    ));
-                }
-                m.rest
-                    .faces
-                    .push([base + tri[0], base + tri[1], base + tri[2]]);
-            }
-            for ((p, j), w) in pos.iter().zip(&js).zip(&ws) {
-                if p.iter().any(|c| !c.is_finite()) {
-                    return Err(bad(path, &what, "non-finite position"));
-                }
-                if let Some(&bad_j) = j.iter().find(|&&j| j as usize >= joints.len()) {
-                    return Err(bad(
-                        path,
-                        &what,
-                        format!(
-                            "joint {bad_j} ≥ {} joints of skin {}",
-                            joints.len(),
-                            skin.index()
-                        ),
-                    ));
-                }
-                m.rest.positions.push(p.map(f64::from));
-                m.joints.push(j.map(|j| joint_base + j as u32));
-                let sum: f32 = w.iter().filter(|x| x.is_finite() && **x > 0.0).sum();
-                m.weights.push(if sum > 0.0 {
-                    w.map(|x| {
-                        if x.is_finite() && x > 0.0 {
-                            x / sum
-                        } else {
-                            0.0
-                        }
-                    })
-                } else {
-                    [0.0; 4]
-                });
-            }
+            add_primitive(&mut m, path, &mesh, &prim, &joints, &buffers)?;
         }
     }
     if m.rest.faces.is_empty() {
         return Err(bad(path, "meshes", "no skinned triangle primitive"));
     }
     for anim in doc.animations() {
-        let mut clip = Clip {
-            name: anim
-                .name()
-                .map_or(format!("clip {}", anim.index()), str::to_string),
-            duration: 0.0,
-            channels: Vec::new(),
-        };
-        for ch in anim.channels() {
-            let r = ch.reader(|b| Some(&buffers[b.index()]));
-            let times: Vec<f32> = match r.read_inputs() {
-                Some(t) => t.collect(),
-                None => continue,
-            };
-            use gltf::animation::util::ReadOutputs;
-            let (property, values): (Property, Vec<[f32; 4]>) = match r.read_outputs() {
-                Some(ReadOutputs::Translations(t)) => (
-                    Property::Translation,
-                    t.map(|v| [v[0], v[1], v[2], 0.0]).collect(),
-                ),
-                Some(ReadOutputs::Scales(s)) => (
-                    Property::Scale,
-                    s.map(|v| [v[0], v[1], v[2], 0.0]).collect(),
-                ),
-                Some(ReadOutputs::Rotations(q)) => (Property::Rotation, q.into_f32().collect()),
-                _ => continue, // morph target weights: not skinning
-            };
-            let interp = match ch.sampler().interpolation() {
-                gltf::animation::Interpolation::Step => Interp::Step,
-                gltf::animation::Interpolation::Linear => Interp::Linear,
-                gltf::animation::Interpolation::CubicSpline => Interp::CubicSpline,
-            };
-            let per = if interp == Interp::CubicSpline { 3 } else { 1 };
-            if times.is_empty() || values.len() != per * times.len() {
-                return Err(bad(
-                    path,
-                    format!("animation {} channel", anim.index()),
-                    "keyframe count mismatch",
-                ));
-            }
-            // glTF keyframe times increase strictly; sampling bisects them.
-            if let Some(k) = (0..times.len())
-                .find(|&k| !times[k].is_finite() || (k > 0 && times[k] <= times[k - 1]))
-            {
-                return Err(bad(
-                    path,
-                    format!("animation {} channel, keyframe {k}", anim.index()),
-                    format!(
-                        "time {} is not finite or not after the previous keyframe's",
-                        times[k]
-                    ),
-                ));
-            }
-            clip.duration = clip.duration.max(*times.last().unwrap_or(&0.0));
-            clip.channels.push(Channel {
-                node: ch.target().node().index(),
-                property,
-                interp,
-                times,
-                values,
-            });
-        }
+        let clip = read_clip(path, &anim, &buffers)?;
         m.clips.push(clip);
     }
     Ok(m)
+}
+
+/// The parent of each node (`None` for roots).
+fn parents(nodes: &[gltf::Node]) -> Vec<Option<usize>> {
+    let mut parents = vec![None; nodes.len()];
+    for n in nodes {
+        for c in n.children() {
+            parents[c.index()] = Some(n.index());
+        }
+    }
+    parents
+}
+
+/// A node's rest transform, its rotation normalized.
+fn rest_trs(n: &gltf::Node) -> Trs {
+    let (t, r, s) = n.transform().decomposed();
+    Trs {
+        t: Vec3::from(t),
+        r: Quat::from_array(r).normalize(),
+        s: Vec3::from(s),
+    }
+}
+
+/// The joints of one skin instance in the joint list of a [`SkinnedMesh`].
+struct Joints {
+    /// The index of its first joint.
+    base: u32,
+    /// How many joints it has.
+    count: usize,
+    /// The glTF index of the skin, for messages.
+    skin: usize,
+}
+
+/// Appends the joints of `node`'s skin (their nodes, inverse bind matrices
+/// and mesh node) to `m`.
+fn add_skin(
+    m: &mut SkinnedMesh,
+    path: &Path,
+    node: &gltf::Node,
+    skin: &gltf::Skin,
+    buffers: &[gltf::buffer::Data],
+) -> Result<Joints> {
+    let joint_base = m.joint_nodes.len() as u32;
+    let reader = skin.reader(|b| Some(&buffers[b.index()]));
+    let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+    let ibm: Vec<Mat4> = match reader.read_inverse_bind_matrices() {
+        Some(it) => it.map(|c| Mat4::from_cols_array_2d(&c)).collect(),
+        None => vec![Mat4::IDENTITY; joints.len()],
+    };
+    if ibm.len() != joints.len() {
+        return Err(bad(
+            path,
+            format!("skin {}", skin.index()),
+            format!(
+                "{} inverse bind matrices for {} joints",
+                ibm.len(),
+                joints.len()
+            ),
+        ));
+    }
+    m.joint_nodes.extend(&joints);
+    m.inverse_bind.extend(ibm);
+    m.joint_mesh_node
+        .extend(std::iter::repeat_n(node.index(), joints.len()));
+    Ok(Joints {
+        base: joint_base,
+        count: joints.len(),
+        skin: skin.index(),
+    })
+}
+
+/// Appends a skinned triangle primitive's faces and vertices to `m` (other
+/// primitives are skipped).
+fn add_primitive(
+    m: &mut SkinnedMesh,
+    path: &Path,
+    mesh: &gltf::Mesh,
+    prim: &gltf::Primitive,
+    joints: &Joints,
+    buffers: &[gltf::buffer::Data],
+) -> Result<()> {
+    let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+    if prim.mode() != gltf::mesh::Mode::Triangles {
+        return Ok(());
+    }
+    let r = prim.reader(|b| Some(&buffers[b.index()]));
+    let pos: Vec<[f32; 3]> = r
+        .read_positions()
+        .ok_or_else(|| bad(path, &what, "no POSITION"))?
+        .collect();
+    let nv = pos.len();
+    let js: Vec<[u16; 4]> = match r.read_joints(0) {
+        Some(j) => j.into_u16().collect(),
+        None => return Ok(()),
+    };
+    let ws: Vec<[f32; 4]> = r
+        .read_weights(0)
+        .ok_or_else(|| bad(path, &what, "JOINTS_0 without WEIGHTS_0"))?
+        .into_f32()
+        .collect();
+    if js.len() != nv || ws.len() != nv {
+        return Err(bad(
+            path,
+            &what,
+            "JOINTS_0/WEIGHTS_0 length differs from POSITION",
+        ));
+    }
+    let base = m.rest.positions.len() as u32;
+    let idx: Vec<u32> = match r.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..nv as u32).collect(),
+    };
+    for (k, tri) in idx.chunks_exact(3).enumerate() {
+        if let Some(&v) = tri.iter().find(|&&v| v as usize >= nv) {
+            return Err(bad(
+                path,
+                format!("{what} triangle {k}"),
+                format!("index {v} ≥ {nv} vertices"),
+            ));
+        }
+        m.rest
+            .faces
+            .push([base + tri[0], base + tri[1], base + tri[2]]);
+    }
+    for ((p, j), w) in pos.iter().zip(&js).zip(&ws) {
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(bad(path, &what, "non-finite position"));
+        }
+        if let Some(&bad_j) = j.iter().find(|&&j| j as usize >= joints.count) {
+            return Err(bad(
+                path,
+                &what,
+                format!(
+                    "joint {bad_j} ≥ {} joints of skin {}",
+                    joints.count, joints.skin
+                ),
+            ));
+        }
+        m.rest.positions.push(p.map(f64::from));
+        m.joints.push(j.map(|j| joints.base + j as u32));
+        m.weights.push(normalized(w));
+    }
+    Ok(())
+}
+
+/// The weights `w` scaled to sum 1, ignoring non-finite and negative ones
+/// (all 0 when none is positive).
+fn normalized(w: &[f32; 4]) -> [f32; 4] {
+    let sum: f32 = w.iter().filter(|x| x.is_finite() && **x > 0.0).sum();
+    if sum > 0.0 {
+        w.map(|x| {
+            if x.is_finite() && x > 0.0 {
+                x / sum
+            } else {
+                0.0
+            }
+        })
+    } else {
+        [0.0; 4]
+    }
+}
+
+/// Reads an animation's translation, rotation and scale channels.
+fn read_clip(path: &Path, anim: &gltf::Animation, buffers: &[gltf::buffer::Data]) -> Result<Clip> {
+    let mut clip = Clip {
+        name: anim
+            .name()
+            .map_or(format!("clip {}", anim.index()), str::to_string),
+        duration: 0.0,
+        channels: Vec::new(),
+    };
+    for ch in anim.channels() {
+        let Some(channel) = read_channel(path, anim.index(), &ch, buffers)? else {
+            continue;
+        };
+        clip.duration = clip.duration.max(*channel.times.last().unwrap_or(&0.0));
+        clip.channels.push(channel);
+    }
+    Ok(clip)
+}
+
+/// Reads one channel of animation `anim`, with checked keyframes; `None`
+/// for a channel without inputs or driving morph target weights.
+fn read_channel(
+    path: &Path,
+    anim: usize,
+    ch: &gltf::animation::Channel,
+    buffers: &[gltf::buffer::Data],
+) -> Result<Option<Channel>> {
+    let r = ch.reader(|b| Some(&buffers[b.index()]));
+    let times: Vec<f32> = match r.read_inputs() {
+        Some(t) => t.collect(),
+        None => return Ok(None),
+    };
+    use gltf::animation::util::ReadOutputs;
+    let (property, values): (Property, Vec<[f32; 4]>) = match r.read_outputs() {
+        Some(ReadOutputs::Translations(t)) => (
+            Property::Translation,
+            t.map(|v| [v[0], v[1], v[2], 0.0]).collect(),
+        ),
+        Some(ReadOutputs::Scales(s)) => (
+            Property::Scale,
+            s.map(|v| [v[0], v[1], v[2], 0.0]).collect(),
+        ),
+        Some(ReadOutputs::Rotations(q)) => (Property::Rotation, q.into_f32().collect()),
+        _ => return Ok(None), // morph target weights: not skinning
+    };
+    let interp = match ch.sampler().interpolation() {
+        gltf::animation::Interpolation::Step => Interp::Step,
+        gltf::animation::Interpolation::Linear => Interp::Linear,
+        gltf::animation::Interpolation::CubicSpline => Interp::CubicSpline,
+    };
+    check_keyframes(path, anim, &times, values.len(), interp)?;
+    Ok(Some(Channel {
+        node: ch.target().node().index(),
+        property,
+        interp,
+        times,
+        values,
+    }))
+}
+
+/// Checks a channel has a value (three for cubic splines) per keyframe and
+/// keyframe times that are finite and increase strictly (sampling bisects
+/// them).
+fn check_keyframes(
+    path: &Path,
+    anim: usize,
+    times: &[f32],
+    values: usize,
+    interp: Interp,
+) -> Result<()> {
+    let per = if interp == Interp::CubicSpline { 3 } else { 1 };
+    if times.is_empty() || values != per * times.len() {
+        return Err(bad(
+            path,
+            format!("animation {anim} channel"),
+            "keyframe count mismatch",
+        ));
+    }
+    if let Some(k) =
+        (0..times.len()).find(|&k| !times[k].is_finite() || (k > 0 && times[k] <= times[k - 1]))
+    {
+        return Err(bad(
+            path,
+            format!("animation {anim} channel, keyframe {k}"),
+            format!(
+                "time {} is not finite or not after the previous keyframe's",
+                times[k]
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn sample(ch: &Channel, t: f32) -> [f32; 4] {
