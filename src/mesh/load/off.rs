@@ -10,7 +10,34 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("")))
         .filter(|(_, l)| !l.trim().is_empty());
+    let (nv, nf) = read_counts(&mut lines, source)?;
 
+    // The memory bound: one line per element, so counts that the lines
+    // after the counts line cannot hold are refused before anything is
+    // reserved or parsed (counting lines allocates nothing). Every element
+    // line takes at least two bytes, a vertex line at least six (`0 0 0`)
+    // and a face line eight (`3 0 1 2`), so the reservations below are
+    // also bounded by the file size.
+    check_counts(nv, nf, lines.clone().count(), bytes.len(), source)?;
+    let mut positions = Vec::with_capacity(capped(nv, bytes.len(), 6));
+    for i in 0..nv {
+        positions.push(vertex(lines.next(), i, nv, source)?);
+    }
+    let mut faces = Vec::with_capacity(capped(nf, bytes.len(), 8));
+    let mut poly: Vec<u32> = Vec::new();
+    for j in 0..nf {
+        face(lines.next(), j, (nv, nf), source, &mut poly)?;
+        fan(&poly, &mut faces);
+    }
+    Ok(Mesh { positions, faces })
+}
+
+/// Reads the header: the optional `OFF` keyword and the vertex and face
+/// counts, on its line or the next.
+fn read_counts<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    source: &str,
+) -> Result<(usize, usize)> {
     let header_err = |problem: String| Error::input(source, "header", problem);
     let (ln, first) = lines
         .next()
@@ -51,95 +78,92 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
             ))
         })
     };
-    let nv = count(0, "vertex")?;
-    let nf = count(1, "face")?;
+    Ok((count(0, "vertex")?, count(1, "face")?))
+}
 
-    // The memory bound: one line per element, so counts that the lines
-    // after the counts line cannot hold are refused before anything is
-    // reserved or parsed (counting lines allocates nothing). Every element
-    // line takes at least two bytes, a vertex line at least six (`0 0 0`)
-    // and a face line eight (`3 0 1 2`), so the reservations below are
-    // also bounded by the file size.
-    check_counts(nv, nf, lines.clone().count(), bytes.len(), source)?;
-    let mut positions = Vec::with_capacity(capped(nv, bytes.len(), 6));
-    for i in 0..nv {
-        let element = || format!("vertex {i}");
-        let (ln, l) = lines.next().ok_or_else(|| {
+/// Reads vertex `i` from its line (`None` past the end of the file).
+fn vertex(line: Option<(usize, &str)>, i: usize, nv: usize, source: &str) -> Result<[f64; 3]> {
+    let element = || format!("vertex {i}");
+    let (ln, l) = line.ok_or_else(|| {
+        Error::input(
+            source,
+            element(),
+            format!("unexpected end of file: the header declares {nv} vertices"),
+        )
+    })?;
+    let mut toks = l.split_whitespace();
+    let mut p = [0.0f64; 3];
+    for (k, c) in p.iter_mut().enumerate() {
+        let tok = toks.next().ok_or_else(|| {
             Error::input(
                 source,
                 element(),
-                format!("unexpected end of file: the header declares {nv} vertices"),
+                format!("line {ln}: expected 3 coordinates, found {k}"),
             )
         })?;
-        let mut toks = l.split_whitespace();
-        let mut p = [0.0f64; 3];
-        for (k, c) in p.iter_mut().enumerate() {
-            let tok = toks.next().ok_or_else(|| {
-                Error::input(
-                    source,
-                    element(),
-                    format!("line {ln}: expected 3 coordinates, found {k}"),
-                )
-            })?;
-            *c = tok.parse().map_err(|_| {
-                Error::input(
-                    source,
-                    element(),
-                    format!("line {ln}: cannot parse coordinate '{tok}' as a number"),
-                )
-            })?;
-        }
-        positions.push(p);
+        *c = tok.parse().map_err(|_| {
+            Error::input(
+                source,
+                element(),
+                format!("line {ln}: cannot parse coordinate '{tok}' as a number"),
+            )
+        })?;
     }
+    Ok(p)
+}
 
-    let mut faces = Vec::with_capacity(capped(nf, bytes.len(), 8));
-    let mut poly: Vec<u32> = Vec::new();
-    for j in 0..nf {
-        let element = || format!("face {j}");
-        let (ln, l) = lines.next().ok_or_else(|| {
-            Error::input(
-                source,
-                element(),
-                format!("unexpected end of file: the header declares {nf} faces"),
-            )
-        })?;
-        let mut toks = l.split_whitespace();
-        let n_tok = toks.next().unwrap_or("");
-        let n: i64 = n_tok.parse().map_err(|_| {
-            Error::input(
-                source,
-                element(),
-                format!("line {ln}: cannot parse vertex count '{n_tok}' as an integer"),
-            )
-        })?;
-        if n < 3 {
-            return Err(Error::input(
-                source,
-                element(),
-                format!("line {ln}: {n} vertex indices; a face needs at least 3"),
-            ));
-        }
-        poly.clear();
-        for k in 0..n {
-            let tok = toks.next().ok_or_else(|| {
-                Error::input(
-                    source,
-                    element(),
-                    format!("line {ln}: the face declares {n} vertex indices but has {k}"),
-                )
-            })?;
-            let v: i64 = tok.parse().map_err(|_| {
-                Error::input(
-                    source,
-                    element(),
-                    format!("line {ln}: cannot parse vertex index '{tok}' as an integer"),
-                )
-            })?;
-            poly.push(vertex_index(v, nv, source, element)?);
-        }
-        fan(&poly, &mut faces);
+/// Reads face `j` from its line (`None` past the end of the file) into
+/// `poly`, its indices checked against the `nv` of the counts `(nv, nf)`.
+fn face(
+    line: Option<(usize, &str)>,
+    j: usize,
+    (nv, nf): (usize, usize),
+    source: &str,
+    poly: &mut Vec<u32>,
+) -> Result<()> {
+    let element = || format!("face {j}");
+    let (ln, l) = line.ok_or_else(|| {
+        Error::input(
+            source,
+            element(),
+            format!("unexpected end of file: the header declares {nf} faces"),
+        )
+    })?;
+    let mut toks = l.split_whitespace();
+    let n_tok = toks.next().unwrap_or("");
+    let n: i64 = n_tok.parse().map_err(|_| {
+        Error::input(
+            source,
+            element(),
+            format!("line {ln}: cannot parse vertex count '{n_tok}' as an integer"),
+        )
+    })?;
+    if n < 3 {
+        return Err(Error::input(
+            source,
+            element(),
+            format!("line {ln}: {n} vertex indices; a face needs at least 3"),
+        ));
     }
-    Ok(Mesh { positions, faces })
+    poly.clear();
+    for k in 0..n {
+        let tok = toks.next().ok_or_else(|| {
+            Error::input(
+                source,
+                element(),
+                format!("line {ln}: the face declares {n} vertex indices but has {k}"),
+            )
+        })?;
+        let v: i64 = tok.parse().map_err(|_| {
+            Error::input(
+                source,
+                element(),
+                format!("line {ln}: cannot parse vertex index '{tok}' as an integer"),
+            )
+        })?;
+        poly.push(vertex_index(v, nv, source, element)?);
+    }
+    Ok(())
 }
 
 /// The vertex and face counts of the OFF header at the start of `head`

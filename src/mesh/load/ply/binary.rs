@@ -1,7 +1,7 @@
 //! The binary body (little- and big-endian): read directly from its bytes,
 //! a few rows at a time, with the messages of the element reader.
 
-use ply_rs_bw::ply::{Header, PropertyType, ScalarType};
+use ply_rs_bw::ply::{ElementDef, Header, PropertyType, ScalarType};
 
 use super::body::{BODY_CHUNK, Body};
 use super::header::{capacity, scalar_size};
@@ -82,162 +82,231 @@ pub(super) fn parse_binary<B: Body>(
     nv: usize,
     source: &str,
 ) -> Result<Mesh> {
-    let mut positions: Vec<[f64; 3]> = Vec::new();
-    let mut faces: Vec<[u32; 3]> = Vec::new();
-    let mut poly: Vec<u32> = Vec::new();
-    let mut indices: Vec<i64> = Vec::new();
+    let mut out = Built::default();
     for (name, def) in &header.elements {
         if def.properties.is_empty() {
             continue;
         }
         let is_vertex = name == "vertex";
         let is_face = name == "face";
-        // The list the header check accepted: the first of the names.
-        let list = FACE_LISTS
-            .iter()
-            .find(|n| is_face && def.properties.contains_key(**n));
-        let layout: Vec<(&PropertyType, Role, &str)> = def
-            .properties
-            .iter()
-            .map(|(pname, p)| {
-                let role = match (pname.as_str(), &p.data_type) {
-                    ("x", PropertyType::Scalar(_)) if is_vertex => Role::Axis(0),
-                    ("y", PropertyType::Scalar(_)) if is_vertex => Role::Axis(1),
-                    ("z", PropertyType::Scalar(_)) if is_vertex => Role::Axis(2),
-                    (n, PropertyType::List(..)) if list == Some(&n) => Role::Indices,
-                    _ => Role::Skip,
-                };
-                (&p.data_type, role, pname.as_str())
-            })
-            .collect();
+        let el = Element {
+            name,
+            def,
+            layout: layout(def, is_vertex, is_face),
+            is_vertex,
+            is_face,
+            big,
+            nv,
+            source,
+        };
         if is_vertex {
-            positions.reserve(capacity(def, header.encoding, payload));
+            out.positions
+                .reserve(capacity(def, header.encoding, payload));
         } else if is_face {
-            faces.reserve(capacity(def, header.encoding, payload));
+            out.faces.reserve(capacity(def, header.encoding, payload));
         }
         // Fixed-size elements with their coordinates at fixed offsets (the
         // usual vertex element) are read many rows at a time without the walk.
-        if is_vertex && let Some((stride, axes)) = fixed_rows(&layout) {
-            let batch = (BODY_CHUNK / stride).max(1);
-            let mut done = 0;
-            while done < def.count {
-                let k = batch.min(def.count - done);
-                let rows = body.take(k * stride)?;
-                positions.extend(rows.chunks_exact(stride).map(|r| {
-                    std::array::from_fn(|k| binary_value(&r[axes[k].0..], &axes[k].1, big))
-                }));
-                if rows.len() < k * stride {
-                    let i = done + rows.len() / stride;
-                    return Err(Error::input(
-                        source,
-                        format!("{name} {i}"),
-                        eof_problem(def),
-                    ));
-                }
-                done += k;
-            }
+        if is_vertex && let Some((stride, axes)) = fixed_rows(&el.layout) {
+            read_fixed_vertices(body, &el, stride, &axes, &mut out.positions)?;
             continue;
         }
-        // One element read property by property: every element of a
-        // general layout, and in the triangle reader below the rows it
-        // leaves (a polygon, a bad index, the end of the payload).
-        let mut element_at = |body: &mut B,
-                              i: usize,
-                              positions: &mut Vec<[f64; 3]>,
-                              faces: &mut Vec<[u32; 3]>|
-         -> Result<()> {
-            let element = || format!("{name} {i}");
-            let eof = || Error::input(source, element(), eof_problem(def));
-            let mut p = [0.0; 3];
-            // The face's vertex indices, decoded as they are read.
-            indices.clear();
-            for &(ty, role, pname) in &layout {
-                match ty {
-                    PropertyType::Scalar(t) => {
-                        let size = scalar_size(t);
-                        let b = body.take(size)?;
-                        if b.len() < size {
-                            return Err(eof());
-                        }
-                        if let Role::Axis(k) = role {
-                            p[k] = binary_value(b, t, big);
-                        }
-                    }
-                    PropertyType::List(c, t) => {
-                        let cs = scalar_size(c);
-                        let b = body.take(cs)?;
-                        if b.len() < cs {
-                            return Err(eof());
-                        }
-                        let n = binary_value(b, c, big);
-                        if n < 0.0 {
-                            return Err(Error::input(
-                                source,
-                                element(),
-                                format!("list '{pname}' has a negative length {n}"),
-                            ));
-                        }
-                        let size = scalar_size(t);
-                        let len = n as usize * size;
-                        let items = body.take(len)?;
-                        if items.len() < len {
-                            return Err(eof());
-                        }
-                        if role == Role::Indices {
-                            indices.extend(
-                                items
-                                    .chunks_exact(size)
-                                    .map(|b| binary_value(b, t, big) as i64),
-                            );
-                        }
-                    }
-                }
-            }
-            if is_vertex {
-                positions.push(p);
-            } else if is_face {
-                add_polygon(indices.iter().copied(), i, nv, source, &mut poly, faces)?;
-            }
-            Ok(())
-        };
         // A face element of the index list alone (the usual one) is read
         // many rows at a time while its rows are triangles with indices in
         // range: what the element reader would make of them, without its
         // walk over the layout and its list per face.
-        if is_face && let [(PropertyType::List(c, t), Role::Indices, _)] = layout.as_slice() {
-            let (cs, size) = (scalar_size(c), scalar_size(t));
-            let rec = cs + 3 * size;
-            let batch = (BODY_CHUNK / rec).max(1);
-            let mut i = 0;
-            while i < def.count {
-                let want = batch.min(def.count - i);
-                let mut rows = 0;
-                for r in body.peek(want * rec)?.chunks_exact(rec) {
-                    if binary_value(r, c, big) != 3.0 {
-                        break;
-                    }
-                    let tri: [i64; 3] =
-                        std::array::from_fn(|k| binary_value(&r[cs + k * size..], t, big) as i64);
-                    if tri.iter().any(|&v| v < 0 || v as u64 >= nv as u64) {
-                        break;
-                    }
-                    faces.push(tri.map(|v| v as u32));
-                    rows += 1;
-                }
-                body.skip(rows * rec);
-                i += rows;
-                if rows < want {
-                    element_at(body, i, &mut positions, &mut faces)?;
-                    i += 1;
-                }
-            }
+        if is_face && let [(PropertyType::List(c, t), Role::Indices, _)] = el.layout.as_slice() {
+            read_triangles(body, &el, (c, t), &mut out)?;
             continue;
         }
         for i in 0..def.count {
-            element_at(body, i, &mut positions, &mut faces)?;
+            read_element(body, &el, i, &mut out)?;
         }
     }
-    Ok(Mesh { positions, faces })
+    Ok(Mesh {
+        positions: out.positions,
+        faces: out.faces,
+    })
+}
+
+/// An element being read, with what its rows need from the file.
+struct Element<'h> {
+    name: &'h str,
+    def: &'h ElementDef,
+    /// Each property's type, role and name, in order.
+    layout: Vec<(&'h PropertyType, Role, &'h str)>,
+    is_vertex: bool,
+    is_face: bool,
+    /// Big-endian values.
+    big: bool,
+    /// The vertex count, which bounds face indices.
+    nv: usize,
+    source: &'h str,
+}
+
+/// The mesh being read, and the buffers of the face being read.
+#[derive(Default)]
+struct Built {
+    positions: Vec<[f64; 3]>,
+    faces: Vec<[u32; 3]>,
+    /// The polygon [`add_polygon`] triangulates.
+    poly: Vec<u32>,
+    /// The face's vertex indices, decoded as they are read.
+    indices: Vec<i64>,
+}
+
+/// The role of each property of an element: the coordinates of `vertex`,
+/// the index list of `face` (the first of [`FACE_LISTS`] it has, as the
+/// header check accepted), the rest skipped.
+fn layout(def: &ElementDef, is_vertex: bool, is_face: bool) -> Vec<(&PropertyType, Role, &str)> {
+    let list = FACE_LISTS
+        .iter()
+        .find(|n| is_face && def.properties.contains_key(**n));
+    def.properties
+        .iter()
+        .map(|(pname, p)| {
+            let role = match (pname.as_str(), &p.data_type) {
+                ("x", PropertyType::Scalar(_)) if is_vertex => Role::Axis(0),
+                ("y", PropertyType::Scalar(_)) if is_vertex => Role::Axis(1),
+                ("z", PropertyType::Scalar(_)) if is_vertex => Role::Axis(2),
+                (n, PropertyType::List(..)) if list == Some(&n) => Role::Indices,
+                _ => Role::Skip,
+            };
+            (&p.data_type, role, pname.as_str())
+        })
+        .collect()
+}
+
+/// Reads a vertex element of fixed-size rows (`stride` bytes, coordinates
+/// at `axes`) many rows at a time.
+fn read_fixed_vertices<B: Body>(
+    body: &mut B,
+    el: &Element,
+    stride: usize,
+    axes: &[(usize, ScalarType); 3],
+    positions: &mut Vec<[f64; 3]>,
+) -> Result<()> {
+    let def = el.def;
+    let batch = (BODY_CHUNK / stride).max(1);
+    let mut done = 0;
+    while done < def.count {
+        let k = batch.min(def.count - done);
+        let rows = body.take(k * stride)?;
+        positions.extend(
+            rows.chunks_exact(stride).map(|r| {
+                std::array::from_fn(|k| binary_value(&r[axes[k].0..], &axes[k].1, el.big))
+            }),
+        );
+        if rows.len() < k * stride {
+            let i = done + rows.len() / stride;
+            return Err(Error::input(
+                el.source,
+                format!("{} {i}", el.name),
+                eof_problem(def),
+            ));
+        }
+        done += k;
+    }
+    Ok(())
+}
+
+/// Reads a face element of the index list alone (count type `c`, index
+/// type `t`): triangles in range many rows at a time, any other row by the
+/// element reader.
+fn read_triangles<B: Body>(
+    body: &mut B,
+    el: &Element,
+    (c, t): (&ScalarType, &ScalarType),
+    out: &mut Built,
+) -> Result<()> {
+    let (big, nv) = (el.big, el.nv);
+    let (cs, size) = (scalar_size(c), scalar_size(t));
+    let rec = cs + 3 * size;
+    let batch = (BODY_CHUNK / rec).max(1);
+    let mut i = 0;
+    while i < el.def.count {
+        let want = batch.min(el.def.count - i);
+        let mut rows = 0;
+        for r in body.peek(want * rec)?.chunks_exact(rec) {
+            if binary_value(r, c, big) != 3.0 {
+                break;
+            }
+            let tri: [i64; 3] =
+                std::array::from_fn(|k| binary_value(&r[cs + k * size..], t, big) as i64);
+            if tri.iter().any(|&v| v < 0 || v as u64 >= nv as u64) {
+                break;
+            }
+            out.faces.push(tri.map(|v| v as u32));
+            rows += 1;
+        }
+        body.skip(rows * rec);
+        i += rows;
+        if rows < want {
+            read_element(body, el, i, out)?;
+            i += 1;
+        }
+    }
+    Ok(())
+}
+
+/// Reads element `i` property by property: every element of a general
+/// layout, and the rows the triangle reader leaves (a polygon, a bad index,
+/// the end of the payload).
+fn read_element<B: Body>(body: &mut B, el: &Element, i: usize, out: &mut Built) -> Result<()> {
+    let (big, source) = (el.big, el.source);
+    let element = || format!("{} {i}", el.name);
+    let eof = || Error::input(source, element(), eof_problem(el.def));
+    let mut p = [0.0; 3];
+    out.indices.clear();
+    for &(ty, role, pname) in &el.layout {
+        match ty {
+            PropertyType::Scalar(t) => {
+                let size = scalar_size(t);
+                let b = body.take(size)?;
+                if b.len() < size {
+                    return Err(eof());
+                }
+                if let Role::Axis(k) = role {
+                    p[k] = binary_value(b, t, big);
+                }
+            }
+            PropertyType::List(c, t) => {
+                let cs = scalar_size(c);
+                let b = body.take(cs)?;
+                if b.len() < cs {
+                    return Err(eof());
+                }
+                let n = binary_value(b, c, big);
+                if n < 0.0 {
+                    return Err(Error::input(
+                        source,
+                        element(),
+                        format!("list '{pname}' has a negative length {n}"),
+                    ));
+                }
+                let size = scalar_size(t);
+                let len = n as usize * size;
+                let items = body.take(len)?;
+                if items.len() < len {
+                    return Err(eof());
+                }
+                if role == Role::Indices {
+                    out.indices.extend(
+                        items
+                            .chunks_exact(size)
+                            .map(|b| binary_value(b, t, big) as i64),
+                    );
+                }
+            }
+        }
+    }
+    if el.is_vertex {
+        out.positions.push(p);
+    } else if el.is_face {
+        let indices = out.indices.iter().copied();
+        add_polygon(indices, i, el.nv, source, &mut out.poly, &mut out.faces)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
