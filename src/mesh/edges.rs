@@ -75,6 +75,8 @@ impl EdgeTopology {
         Ok(())
     }
 
+    /// Builds the edge buffer (with marked edges) and, `with_caps`, the cap
+    /// buffer.
     fn build(
         mesh: &Mesh,
         marked: &[[u32; 2]],
@@ -82,78 +84,14 @@ impl EdgeTopology {
         with_caps: bool,
     ) -> Result<EdgeTopology> {
         let nv = mesh.n_vertices();
-        let faces = &mesh.faces;
-        let (next, head) = sides_by_edge(nv, faces, source)?;
-        // Edges in order of their first face side (the order a hash map
-        // filled in face order would give), each with its faces in file order.
-        let mut edges = Vec::with_capacity(faces.len() * 3 / 2 + 1);
-        let mut entry_of: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-        let (mut boundary, mut non_manifold) = (0, 0);
-        let mut list: Vec<[u32; 3]> = Vec::new();
-        for (h0, _) in head.iter().enumerate().filter(|(_, is)| **is) {
-            list.clear();
-            let mut h = h0 as u32;
-            while h != NONE {
-                let (f, k) = (&faces[h as usize / 3], h as usize % 3);
-                list.push([f[k], f[(k + 1) % 3], f[(k + 2) % 3]]);
-                h = next[h as usize];
-            }
-            let key = (list[0][0].min(list[0][1]), list[0][0].max(list[0][1]));
-            if list.len() == 1 {
-                boundary += 1;
-            }
-            if list.len() > 2 {
-                non_manifold += 1;
-            }
-            for pair in list.chunks(2) {
-                let [a, b, c] = pair[0];
-                let d = if pair.len() == 2 { pair[1][2] } else { a };
-                if list.len() > 2 {
-                    entry_of.entry(key).or_default().push(edges.len() as u32);
-                }
-                edges.push([a, b, c, d]);
-            }
-        }
-        drop((next, head));
-        // Marked edges: i3 = i0 on every entry of the edge.
-        let mut n_marked = 0;
-        if !marked.is_empty() {
-            let key = |a: u32, b: u32| (a.min(b), a.max(b));
-            // Only the marked pairs are looked up: one scan of the edges finds
-            // the first entry of each.
-            let mut index: HashMap<(u32, u32), u32> =
-                marked.iter().map(|&[a, b]| (key(a, b), NONE)).collect();
-            for (i, e) in edges.iter().enumerate() {
-                if let Some(first) = index.get_mut(&key(e[0], e[1]))
-                    && *first == NONE
-                {
-                    *first = i as u32;
-                }
-            }
-            for (line, &[a, b]) in marked.iter().enumerate() {
-                let el = format!("marked edge {} ({a}, {b})", line + 1);
-                if a as usize >= nv || b as usize >= nv {
-                    return Err(Error::input(
-                        source,
-                        el,
-                        format!("vertex index past the mesh's {nv} vertices"),
-                    ));
-                }
-                let k = key(a, b);
-                let first = index[&k];
-                if first == NONE {
-                    return Err(Error::input(source, el, "not an edge of the mesh"));
-                }
-                let entries = entry_of.get(&k).cloned().unwrap_or_else(|| vec![first]);
-                for e in entries {
-                    let e = &mut edges[e as usize];
-                    if e[3] != e[0] {
-                        e[3] = e[0];
-                        n_marked += 1;
-                    }
-                }
-            }
-        }
+        let sides = sides_by_edge(nv, &mesh.faces, source)?;
+        let Entries {
+            mut edges,
+            entry_of,
+            boundary,
+            non_manifold,
+        } = edge_entries(&mesh.faces, sides);
+        let n_marked = mark_edges(&mut edges, &entry_of, marked, nv, source)?;
         let mut t = EdgeTopology {
             edges,
             caps: Vec::new(),
@@ -166,6 +104,107 @@ impl EdgeTopology {
         }
         Ok(t)
     }
+}
+
+/// The edge buffer with what the marked edges and the counts need.
+struct Entries {
+    edges: Vec<[u32; 4]>,
+    /// The entries of each non-manifold edge (by its sorted ends).
+    entry_of: HashMap<(u32, u32), Vec<u32>>,
+    boundary: usize,
+    non_manifold: usize,
+}
+
+/// Builds the edge entries from the face sides grouped by
+/// [`sides_by_edge`] (`next`, `head`), which are freed on return.
+fn edge_entries(faces: &[[u32; 3]], (next, head): (Vec<u32>, Vec<bool>)) -> Entries {
+    // Edges in order of their first face side (the order a hash map
+    // filled in face order would give), each with its faces in file order.
+    let mut edges = Vec::with_capacity(faces.len() * 3 / 2 + 1);
+    let mut entry_of: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    let (mut boundary, mut non_manifold) = (0, 0);
+    let mut list: Vec<[u32; 3]> = Vec::new();
+    for (h0, _) in head.iter().enumerate().filter(|(_, is)| **is) {
+        list.clear();
+        let mut h = h0 as u32;
+        while h != NONE {
+            let (f, k) = (&faces[h as usize / 3], h as usize % 3);
+            list.push([f[k], f[(k + 1) % 3], f[(k + 2) % 3]]);
+            h = next[h as usize];
+        }
+        let key = (list[0][0].min(list[0][1]), list[0][0].max(list[0][1]));
+        if list.len() == 1 {
+            boundary += 1;
+        }
+        if list.len() > 2 {
+            non_manifold += 1;
+        }
+        for pair in list.chunks(2) {
+            let [a, b, c] = pair[0];
+            let d = if pair.len() == 2 { pair[1][2] } else { a };
+            if list.len() > 2 {
+                entry_of.entry(key).or_default().push(edges.len() as u32);
+            }
+            edges.push([a, b, c, d]);
+        }
+    }
+    Entries {
+        edges,
+        entry_of,
+        boundary,
+        non_manifold,
+    }
+}
+
+/// Marks the `marked` edges, i3 = i0 on every entry of each; the number of
+/// entries that were not marked already.
+fn mark_edges(
+    edges: &mut [[u32; 4]],
+    entry_of: &HashMap<(u32, u32), Vec<u32>>,
+    marked: &[[u32; 2]],
+    nv: usize,
+    source: &str,
+) -> Result<usize> {
+    let mut n_marked = 0;
+    if marked.is_empty() {
+        return Ok(n_marked);
+    }
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // Only the marked pairs are looked up: one scan of the edges finds
+    // the first entry of each.
+    let mut index: HashMap<(u32, u32), u32> =
+        marked.iter().map(|&[a, b]| (key(a, b), NONE)).collect();
+    for (i, e) in edges.iter().enumerate() {
+        if let Some(first) = index.get_mut(&key(e[0], e[1]))
+            && *first == NONE
+        {
+            *first = i as u32;
+        }
+    }
+    for (line, &[a, b]) in marked.iter().enumerate() {
+        let el = format!("marked edge {} ({a}, {b})", line + 1);
+        if a as usize >= nv || b as usize >= nv {
+            return Err(Error::input(
+                source,
+                el,
+                format!("vertex index past the mesh's {nv} vertices"),
+            ));
+        }
+        let k = key(a, b);
+        let first = index[&k];
+        if first == NONE {
+            return Err(Error::input(source, el, "not an edge of the mesh"));
+        }
+        let entries = entry_of.get(&k).cloned().unwrap_or_else(|| vec![first]);
+        for e in entries {
+            let e = &mut edges[e as usize];
+            if e[3] != e[0] {
+                e[3] = e[0];
+                n_marked += 1;
+            }
+        }
+    }
+    Ok(n_marked)
 }
 
 /// End of a list in [`sides_by_edge`].

@@ -284,6 +284,8 @@ pub fn read_tgf(path: &Path) -> Result<Skeleton> {
     )
 }
 
+/// Parses TGF text: joint lines, then after a `#` line the bone lines
+/// (after a second `#` line everything is ignored).
 fn parse_tgf(text: &str, source: &str) -> Result<Skeleton> {
     let mut joints = Vec::new();
     let mut bones = Vec::new();
@@ -299,59 +301,9 @@ fn parse_tgf(text: &str, source: &str) -> Result<Skeleton> {
             continue;
         }
         if section == 0 {
-            let element = format!("joint {}", joints.len());
-            if toks.len() < 4 {
-                return Err(Error::input(
-                    source,
-                    element,
-                    format!(
-                        "line {ln}: expected 'index x y z', found {} fields",
-                        toks.len()
-                    ),
-                ));
-            }
-            let mut p = [0.0; 3];
-            for (c, tok) in p.iter_mut().zip(&toks[1..4]) {
-                *c = tok
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| {
-                        Error::input(
-                            source,
-                            &element,
-                            format!("line {ln}: '{tok}' is not a finite number"),
-                        )
-                    })?;
-            }
-            joints.push(p);
+            joints.push(tgf_joint(&toks, ln, joints.len(), source)?);
         } else {
-            let element = format!("bone {}", bones.len());
-            if toks.len() < 2 {
-                return Err(Error::input(
-                    source,
-                    element,
-                    format!("line {ln}: expected 'from to', found {} fields", toks.len()),
-                ));
-            }
-            let mut b = [0u32; 2];
-            for (v, tok) in b.iter_mut().zip(&toks[..2]) {
-                *v = match tok.parse::<u64>() {
-                    Ok(k) if k >= 1 && k <= joints.len() as u64 => (k - 1) as u32,
-                    _ => {
-                        return Err(Error::input(
-                            source,
-                            &element,
-                            format!(
-                                "line {ln}: joint '{tok}' is not in 1..={} (TGF indices are \
-                                 1-based)",
-                                joints.len()
-                            ),
-                        ));
-                    }
-                };
-            }
-            bones.push(b);
+            bones.push(tgf_bone(&toks, ln, (bones.len(), joints.len()), source)?);
         }
     }
     if joints.is_empty() {
@@ -365,6 +317,71 @@ fn parse_tgf(text: &str, source: &str) -> Result<Skeleton> {
         ));
     }
     Ok(Skeleton { joints, bones })
+}
+
+/// Reads joint `index` from the fields `toks` of line `ln`: `index x y z`.
+fn tgf_joint(toks: &[&str], ln: usize, index: usize, source: &str) -> Result<[f64; 3]> {
+    let element = format!("joint {index}");
+    if toks.len() < 4 {
+        return Err(Error::input(
+            source,
+            element,
+            format!(
+                "line {ln}: expected 'index x y z', found {} fields",
+                toks.len()
+            ),
+        ));
+    }
+    let mut p = [0.0; 3];
+    for (c, tok) in p.iter_mut().zip(&toks[1..4]) {
+        *c = tok
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                Error::input(
+                    source,
+                    &element,
+                    format!("line {ln}: '{tok}' is not a finite number"),
+                )
+            })?;
+    }
+    Ok(p)
+}
+
+/// Reads bone `index` from the fields `toks` of line `ln`: `from to`, two
+/// 1-based indices among the `joints` joints, made 0-based.
+fn tgf_bone(
+    toks: &[&str],
+    ln: usize,
+    (index, joints): (usize, usize),
+    source: &str,
+) -> Result<[u32; 2]> {
+    let element = format!("bone {index}");
+    if toks.len() < 2 {
+        return Err(Error::input(
+            source,
+            element,
+            format!("line {ln}: expected 'from to', found {} fields", toks.len()),
+        ));
+    }
+    let mut b = [0u32; 2];
+    for (v, tok) in b.iter_mut().zip(&toks[..2]) {
+        *v = match tok.parse::<u64>() {
+            Ok(k) if k >= 1 && k <= joints as u64 => (k - 1) as u32,
+            _ => {
+                return Err(Error::input(
+                    source,
+                    &element,
+                    format!(
+                        "line {ln}: joint '{tok}' is not in 1..={joints} (TGF indices are \
+                         1-based)"
+                    ),
+                ));
+            }
+        };
+    }
+    Ok(b)
 }
 
 /// The weight above which [`TruncationStats::significant_over_4`] counts an influence.

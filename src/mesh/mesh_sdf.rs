@@ -31,8 +31,35 @@ pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<Prepa
         )));
     }
     mesh.validate(source)?;
-    // The box of the vertices that faces use (unreferenced vertices, like
-    // the Stanford bunny's 1,113, do not widen it).
+    let (lo, hi) = used_box(mesh);
+    let grid = choose_grid(lo, hi, n).ok_or_else(|| all_degenerate(mesh, source))?;
+    let fixed = snap(mesh, &grid);
+    let inv = 1.0 / FIX_ONE as f32;
+    let grid_pos = fixed.iter().map(|q| q.map(|c| c as f32 * inv)).collect();
+    let triangles: Vec<[u32; 3]> = mesh
+        .faces
+        .iter()
+        .copied()
+        .filter(|f| !collinear(&fixed, f))
+        .collect();
+    let degenerate = mesh.faces.len() - triangles.len();
+    if triangles.is_empty() {
+        return Err(all_degenerate(mesh, source));
+    }
+    let adjacent = adjacency(&triangles);
+    Ok(PreparedMesh {
+        grid,
+        fixed,
+        grid_pos,
+        triangles,
+        degenerate,
+        adjacent,
+    })
+}
+
+/// The box of the vertices that faces use (unreferenced vertices, like
+/// the Stanford bunny's 1,113, do not widen it): its low and high corners.
+fn used_box(mesh: &Mesh) -> ([f64; 3], [f64; 3]) {
     let used = mesh.referenced();
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -42,21 +69,29 @@ pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<Prepa
             hi[k] = hi[k].max(p[k]);
         }
     }
+    (lo, hi)
+}
+
+/// The error for a mesh whose faces are all degenerate.
+fn all_degenerate(mesh: &Mesh, source: &str) -> Error {
+    Error::input(
+        source,
+        "faces",
+        format!(
+            "all {} faces are degenerate (zero area): there is no surface to measure \
+             a distance to",
+            mesh.faces.len()
+        ),
+    )
+}
+
+/// The grid of `n` samples along the longest axis of the box `lo..hi`,
+/// padded and centred on it; `None` for a flat or non-finite box.
+fn choose_grid(lo: [f64; 3], hi: [f64; 3], n: usize) -> Option<SdfGrid> {
     let ext: [f64; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
     let longest = ext.iter().copied().fold(0.0, f64::max);
-    let all_degenerate = || {
-        Error::input(
-            source,
-            "faces",
-            format!(
-                "all {} faces are degenerate (zero area): there is no surface to measure \
-                 a distance to",
-                mesh.faces.len()
-            ),
-        )
-    };
     if longest <= 0.0 || !longest.is_finite() {
-        return Err(all_degenerate());
+        return None;
     }
     let pad = padding_voxels(n);
     let h = longest / (n as f64 - 1.0 - 2.0 * pad);
@@ -72,14 +107,18 @@ pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<Prepa
     });
     let origin: [f64; 3] =
         std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]) - 0.5 * (dims[k] as f64 - 1.0) * h);
-    let grid = SdfGrid {
+    Some(SdfGrid {
         dims,
         spacing: h,
         origin,
-    };
-    let scale = FIX_ONE as f64 / h;
-    let fixed: Vec<[i32; 3]> = mesh
-        .positions
+    })
+}
+
+/// The vertices snapped to the grid's fixed-point lattice, clamped to it.
+fn snap(mesh: &Mesh, grid: &SdfGrid) -> Vec<[i32; 3]> {
+    let (dims, origin) = (grid.dims, grid.origin);
+    let scale = FIX_ONE as f64 / grid.spacing;
+    mesh.positions
         .iter()
         .map(|p| {
             std::array::from_fn(|k| {
@@ -87,28 +126,7 @@ pub fn prepare(mesh: &Mesh, opts: &MeshSdfOptions, source: &str) -> Result<Prepa
                 ((p[k] - origin[k]) * scale).round().clamp(0.0, max) as i32
             })
         })
-        .collect();
-    let inv = 1.0 / FIX_ONE as f32;
-    let grid_pos = fixed.iter().map(|q| q.map(|c| c as f32 * inv)).collect();
-    let triangles: Vec<[u32; 3]> = mesh
-        .faces
-        .iter()
-        .copied()
-        .filter(|f| !collinear(&fixed, f))
-        .collect();
-    let degenerate = mesh.faces.len() - triangles.len();
-    if triangles.is_empty() {
-        return Err(all_degenerate());
-    }
-    let adjacent = adjacency(&triangles);
-    Ok(PreparedMesh {
-        grid,
-        fixed,
-        grid_pos,
-        triangles,
-        degenerate,
-        adjacent,
-    })
+        .collect()
 }
 
 /// Edge neighbours of each triangle (see [`PreparedMesh::adjacent`]).
