@@ -219,18 +219,8 @@ fn write_body(
         path: path.to_path_buf(),
         source,
     };
-    let n = mesh.n_vertices();
-    let ty = if double { "double" } else { "float" };
-    let mut header = String::new();
-    header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
-    header.push_str(&format!("element vertex {n}\n"));
-    for name in names {
-        header.push_str(&format!("property {ty} {name}\n"));
-    }
-    header.push_str(&format!("element face {}\n", mesh.n_faces()));
-    header.push_str("property list uchar int vertex_indices\nend_header\n");
-    w.write_all(header.as_bytes()).map_err(write_err)?;
-
+    w.write_all(header(mesh, names, double).as_bytes())
+        .map_err(write_err)?;
     let cols = names.len();
     let width = if double { 8 } else { 4 };
     let mut vals = vec![0.0f64; BLOCK_VERTICES * cols];
@@ -242,46 +232,90 @@ fn write_body(
             row[..3].copy_from_slice(p);
             extra(first + k, &mut row[3..]);
         }
-        // The common case, all finite and (for float) all in range, is one
-        // branch-free pass over the values' bits; the first value that is
-        // not is then found.
-        let fine = if double {
-            vals.iter().fold(true, |ok, &x| ok & fits_f64(x))
-        } else {
-            vals.iter().fold(true, |ok, &x| ok & fits_f32(x))
-        };
-        if !fine {
-            let at = vals
-                .iter()
-                .position(|&x| if double { !fits_f64(x) } else { !fits_f32(x) })
-                .expect("a value that is not fine");
-            let (i, k, x) = (first + at / cols, at % cols, vals[at]);
-            if !x.is_finite() {
-                return Err(Error::InvalidArgument(format!(
-                    "{}: property '{}' of vertex {i} is {x}: not written",
-                    path.display(),
-                    names[k]
-                )));
-            }
-            return Ok(Some(format!(
-                "property '{}' of vertex {i} is {x:e}, outside the range of float \
-                 (about 1.2e-38 to 3.4e38)",
-                names[k]
-            )));
+        if let Some(why) = check_block(vals, first, names, path, double)? {
+            return Ok(Some(why));
         }
         let bytes = &mut bytes[..vals.len() * width];
-        if double {
-            for (o, x) in bytes.chunks_exact_mut(8).zip(vals.iter()) {
-                o.copy_from_slice(&x.to_le_bytes());
-            }
-        } else {
-            for (o, &x) in bytes.chunks_exact_mut(4).zip(vals.iter()) {
-                o.copy_from_slice(&(x as f32).to_le_bytes());
-            }
-        }
+        encode(vals, bytes, double);
         w.write_all(bytes).map_err(write_err)?;
     }
+    write_faces(w, path, mesh)?;
+    Ok(None)
+}
 
+/// The PLY header: the vertex properties, all `float` or all `double`, and
+/// the face index lists.
+fn header(mesh: &Mesh, names: &[&str], double: bool) -> String {
+    let n = mesh.n_vertices();
+    let ty = if double { "double" } else { "float" };
+    let mut header = String::new();
+    header.push_str("ply\nformat binary_little_endian 1.0\ncomment written by shapecue\n");
+    header.push_str(&format!("element vertex {n}\n"));
+    for name in names {
+        header.push_str(&format!("property {ty} {name}\n"));
+    }
+    header.push_str(&format!("element face {}\n", mesh.n_faces()));
+    header.push_str("property list uchar int vertex_indices\nend_header\n");
+    header
+}
+
+/// Checks a block of values (rows of `names.len()`, the first of vertex
+/// `first`): an error for a value that is not finite, `Some(why)` for one
+/// outside the range of `float` when `float` is written, else `None`.
+fn check_block(
+    vals: &[f64],
+    first: usize,
+    names: &[&str],
+    path: &Path,
+    double: bool,
+) -> Result<Option<String>> {
+    // The common case, all finite and (for float) all in range, is one
+    // branch-free pass over the values' bits; the first value that is
+    // not is then found.
+    let fine = if double {
+        vals.iter().fold(true, |ok, &x| ok & fits_f64(x))
+    } else {
+        vals.iter().fold(true, |ok, &x| ok & fits_f32(x))
+    };
+    if fine {
+        return Ok(None);
+    }
+    let cols = names.len();
+    let at = vals
+        .iter()
+        .position(|&x| if double { !fits_f64(x) } else { !fits_f32(x) })
+        .expect("a value that is not fine");
+    let (i, k, x) = (first + at / cols, at % cols, vals[at]);
+    if !x.is_finite() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: property '{}' of vertex {i} is {x}: not written",
+            path.display(),
+            names[k]
+        )));
+    }
+    Ok(Some(format!(
+        "property '{}' of vertex {i} is {x:e}, outside the range of float \
+         (about 1.2e-38 to 3.4e38)",
+        names[k]
+    )))
+}
+
+/// Converts checked values to little-endian `double` or `float` bytes.
+fn encode(vals: &[f64], bytes: &mut [u8], double: bool) {
+    if double {
+        for (o, x) in bytes.chunks_exact_mut(8).zip(vals.iter()) {
+            o.copy_from_slice(&x.to_le_bytes());
+        }
+    } else {
+        for (o, &x) in bytes.chunks_exact_mut(4).zip(vals.iter()) {
+            o.copy_from_slice(&(x as f32).to_le_bytes());
+        }
+    }
+}
+
+/// Writes the faces, in blocks of 13-byte records (a count of 3 and three
+/// `int` indices).
+fn write_faces(w: &mut BufWriter<OutputFile>, path: &Path, mesh: &Mesh) -> Result<()> {
     const REC: usize = 13;
     let mut recs = vec![0u8; BLOCK_VERTICES * REC];
     for block in mesh.faces.chunks(BLOCK_VERTICES) {
@@ -293,9 +327,12 @@ fn write_body(
                 rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&v.to_le_bytes());
             }
         }
-        w.write_all(recs).map_err(write_err)?;
+        w.write_all(recs).map_err(|source| Error::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
     }
-    Ok(None)
+    Ok(())
 }
 
 /// The contents of a PLY file as [`read_ply_properties`] returns them: the
