@@ -32,58 +32,13 @@ impl Renderer {
             let (ms, resolve, samples) = targets(&gl, &opts)?;
 
             let mesh_prog = program(&gl, "mesh", MESH_VS, MESH_FS)?;
-            let u = |name: &str| gl.get_uniform_location(mesh_prog, name);
-            let mesh_u = MeshUniforms {
-                view_proj: u("u_view_proj"),
-                eye: u("u_eye"),
-                view_dir: u("u_view_dir"),
-                ortho: u("u_ortho"),
-                headlight: u("u_headlight"),
-                light_dir: u("u_light_dir"),
-                ambient: u("u_ambient"),
-                vertex_color: u("u_vertex_color"),
-                color: u("u_color"),
-            };
+            let mesh_u = mesh_uniforms(&gl, mesh_prog);
             let clip_prog = program(&gl, "clip", CLIP_VS, CLIP_FS)?;
             let clip_color = gl.get_uniform_location(clip_prog, "u_color");
-
-            let buf = || {
-                gl.create_buffer()
-                    .map_err(|e| Error::render("glGenBuffers", e))
-            };
-            let vao = || {
-                gl.create_vertex_array()
-                    .map_err(|e| Error::render("glGenVertexArrays", e))
-            };
-            let mesh_vao = vao()?;
-            let mesh_bufs = [buf()?, buf()?, buf()?, buf()?];
-            gl.bind_vertex_array(Some(mesh_vao));
-            for (loc, b) in mesh_bufs[..3].iter().enumerate() {
-                gl.bind_buffer(glow::ARRAY_BUFFER, Some(*b));
-                gl.vertex_attrib_pointer_f32(loc as u32, 3, glow::FLOAT, false, 0, 0);
-            }
-            gl.enable_vertex_attrib_array(0);
-            gl.enable_vertex_attrib_array(1);
-            gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(mesh_bufs[3]));
-            let clip_vao = vao()?;
-            let clip_bufs = [buf()?, buf()?];
-            gl.bind_vertex_array(Some(clip_vao));
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(clip_bufs[0]));
-            gl.vertex_attrib_pointer_f32(0, 4, glow::FLOAT, false, 0, 0);
-            gl.enable_vertex_attrib_array(0);
-            gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(clip_bufs[1]));
+            let (mesh_vao, mesh_bufs) = mesh_arrays(&gl)?;
+            let (clip_vao, clip_bufs) = clip_arrays(&gl)?;
             gl.bind_vertex_array(None);
-
-            gl.enable(glow::DEPTH_TEST);
-            gl.disable(glow::CULL_FACE); // edge quads have either winding
-            gl.polygon_offset(1.0, 1.0);
-            gl.blend_func_separate(
-                glow::SRC_ALPHA,
-                glow::ONE_MINUS_SRC_ALPHA,
-                glow::ONE,
-                glow::ONE_MINUS_SRC_ALPHA,
-            );
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            fixed_state(&gl);
             check(&gl, "setting up the renderer")?;
 
             let info = format!("{driver}; OpenGL {version}; {}", ctx.describe());
@@ -210,5 +165,120 @@ impl Renderer {
         })?;
         self.ctx.make_current()?;
         Ok(f)
+    }
+}
+
+/// The uniform locations of the mesh program `prog`.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn mesh_uniforms(gl: &glow::Context, prog: glow::NativeProgram) -> MeshUniforms {
+    // SAFETY: the caller's contract.
+    let u = |name: &str| unsafe { gl.get_uniform_location(prog, name) };
+    MeshUniforms {
+        view_proj: u("u_view_proj"),
+        eye: u("u_eye"),
+        view_dir: u("u_view_dir"),
+        ortho: u("u_ortho"),
+        headlight: u("u_headlight"),
+        light_dir: u("u_light_dir"),
+        ambient: u("u_ambient"),
+        vertex_color: u("u_vertex_color"),
+        color: u("u_color"),
+    }
+}
+
+/// A new buffer.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn new_buffer(gl: &glow::Context) -> Result<glow::NativeBuffer> {
+    // SAFETY: the caller's contract.
+    unsafe {
+        gl.create_buffer()
+            .map_err(|e| Error::render("glGenBuffers", e))
+    }
+}
+
+/// A new vertex array.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn new_vertex_array(gl: &glow::Context) -> Result<glow::NativeVertexArray> {
+    // SAFETY: the caller's contract.
+    unsafe {
+        gl.create_vertex_array()
+            .map_err(|e| Error::render("glGenVertexArrays", e))
+    }
+}
+
+/// The mesh vertex array and its buffers: positions, normals and colours
+/// (attributes 0 to 2, 0 and 1 enabled), then the element buffer; left bound.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn mesh_arrays(
+    gl: &glow::Context,
+) -> Result<(glow::NativeVertexArray, [glow::NativeBuffer; 4])> {
+    // SAFETY: the caller's contract.
+    unsafe {
+        let vao = new_vertex_array(gl)?;
+        let bufs = [
+            new_buffer(gl)?,
+            new_buffer(gl)?,
+            new_buffer(gl)?,
+            new_buffer(gl)?,
+        ];
+        gl.bind_vertex_array(Some(vao));
+        for (loc, b) in bufs[..3].iter().enumerate() {
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(*b));
+            gl.vertex_attrib_pointer_f32(loc as u32, 3, glow::FLOAT, false, 0, 0);
+        }
+        gl.enable_vertex_attrib_array(0);
+        gl.enable_vertex_attrib_array(1);
+        gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(bufs[3]));
+        Ok((vao, bufs))
+    }
+}
+
+/// The clip-space vertex array and its buffers: `vec4` positions
+/// (attribute 0), then the element buffer; left bound.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn clip_arrays(
+    gl: &glow::Context,
+) -> Result<(glow::NativeVertexArray, [glow::NativeBuffer; 2])> {
+    // SAFETY: the caller's contract.
+    unsafe {
+        let vao = new_vertex_array(gl)?;
+        let bufs = [new_buffer(gl)?, new_buffer(gl)?];
+        gl.bind_vertex_array(Some(vao));
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(bufs[0]));
+        gl.vertex_attrib_pointer_f32(0, 4, glow::FLOAT, false, 0, 0);
+        gl.enable_vertex_attrib_array(0);
+        gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(bufs[1]));
+        Ok((vao, bufs))
+    }
+}
+
+/// Sets the state every frame shares: depth test, no culling, polygon
+/// offset, blending and tight pixel packing.
+///
+/// # Safety
+/// The context of `gl` must be current.
+unsafe fn fixed_state(gl: &glow::Context) {
+    // SAFETY: the caller's contract.
+    unsafe {
+        gl.enable(glow::DEPTH_TEST);
+        gl.disable(glow::CULL_FACE); // edge quads have either winding
+        gl.polygon_offset(1.0, 1.0);
+        gl.blend_func_separate(
+            glow::SRC_ALPHA,
+            glow::ONE_MINUS_SRC_ALPHA,
+            glow::ONE,
+            glow::ONE_MINUS_SRC_ALPHA,
+        );
+        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
     }
 }

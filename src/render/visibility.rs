@@ -134,17 +134,9 @@ pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec
 /// polylines (exactly by mesh edge where both ends know theirs, else by pixel
 /// position within 1/64 pixel), in a canonical order.
 pub fn visible_joined(lines: &[ClipLine], frame: &Frame, bias: f32) -> Vec<SvgPolyline> {
-    let (w, h) = (frame.width as f32, frame.height as f32);
-    let to_px = |c: [f32; 4]| {
-        [
-            (c[0] / c[3] * 0.5 + 0.5) * w,
-            (0.5 - c[1] / c[3] * 0.5) * h,
-            c[2] / c[3] * 0.5 + 0.5,
-        ]
-    };
     let mut pieces: Vec<Piece> = Vec::new();
     for l in lines {
-        let (s0, s1) = (to_px(l.ends[0]), to_px(l.ends[1]));
+        let (s0, s1) = (to_px(l.ends[0], frame), to_px(l.ends[1], frame));
         if !s0.iter().chain(&s1).all(|c| c.is_finite()) {
             continue;
         }
@@ -153,57 +145,15 @@ pub fn visible_joined(lines: &[ClipLine], frame: &Frame, bias: f32) -> Vec<SvgPo
         // The depth buffer holds one (multi)sample per pixel, up to a pixel away
         // from the sample point: allow the line's depth change over 1.5 pixels.
         let bias = bias + 1.5 * (s1[2] - s0[2]).abs() / len.max(1.0);
-        let at = |i: usize| {
-            let t = i as f32 / n as f32;
-            [
-                s0[0] + t * (s1[0] - s0[0]),
-                s0[1] + t * (s1[1] - s0[1]),
-                s0[2] + t * (s1[2] - s0[2]),
-            ]
-        };
-        let visible = |p: [f32; 3]| {
-            let (x, y) = (p[0].floor(), p[1].floor());
-            if !(x >= 0.0 && y >= 0.0 && x < w && y < h) {
-                return false;
-            }
-            // The faces beside a crease can be nearer than the edge a fraction of
-            // a pixel away (the mesh's polygon offset is only a slope's worth):
-            // the farthest depth of the 3×3 neighbourhood decides.
-            let (x, y) = (x as i64, y as i64);
-            let mut far = 0f32;
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if let Some(d) = frame.depth_at((x + dx).max(0) as u32, (y + dy).max(0) as u32)
-                    {
-                        far = far.max(d);
-                    }
-                }
-            }
-            p[2] <= far + bias
-        };
-        // A piece end keeps the line's mesh edge only where it is the line's
-        // own end; ends cut by occlusion are matched by position.
-        let mut push = |s: usize, e: usize| {
-            let (a, b) = (at(s), at(e));
-            let (a, b) = ([a[0], a[1]], [b[0], b[1]]);
-            let key = |i: usize, p: [f32; 2], own: Option<u64>| match own {
-                Some(k) if i == 0 || i == n => EndKey::Edge(k),
-                _ => pixel_key(p),
-            };
-            pieces.push(Piece {
-                ends: [a, b],
-                keys: [key(s, a, l.edges[0]), key(e, b, l.edges[1])],
-                opacity: l.opacity,
-            });
-        };
+        let samples = Samples { s0, s1, n };
         let mut start: Option<usize> = None;
         for i in 0..=n {
-            let v = visible(at(i));
+            let v = visible(samples.at(i), frame, bias);
             match (v, start) {
                 (true, None) => start = Some(i),
                 (false, Some(s)) => {
                     if i - 1 > s {
-                        push(s, i - 1);
+                        pieces.push(samples.piece(l, s, i - 1));
                     }
                     start = None;
                 }
@@ -211,10 +161,80 @@ pub fn visible_joined(lines: &[ClipLine], frame: &Frame, bias: f32) -> Vec<SvgPo
             }
         }
         if let Some(s) = start.filter(|&s| s < n) {
-            push(s, n);
+            pieces.push(samples.piece(l, s, n));
         }
     }
     join(pieces)
+}
+
+/// A clip-space point in image pixels (origin top left), with its window depth.
+fn to_px(c: [f32; 4], frame: &Frame) -> [f32; 3] {
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    [
+        (c[0] / c[3] * 0.5 + 0.5) * w,
+        (0.5 - c[1] / c[3] * 0.5) * h,
+        c[2] / c[3] * 0.5 + 0.5,
+    ]
+}
+
+/// Whether the pixel point `p` (with its depth) lies in the image and is not
+/// behind the depth of `frame` by more than `bias`.
+fn visible(p: [f32; 3], frame: &Frame, bias: f32) -> bool {
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    let (x, y) = (p[0].floor(), p[1].floor());
+    if !(x >= 0.0 && y >= 0.0 && x < w && y < h) {
+        return false;
+    }
+    // The faces beside a crease can be nearer than the edge a fraction of
+    // a pixel away (the mesh's polygon offset is only a slope's worth):
+    // the farthest depth of the 3×3 neighbourhood decides.
+    let (x, y) = (x as i64, y as i64);
+    let mut far = 0f32;
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            if let Some(d) = frame.depth_at((x + dx).max(0) as u32, (y + dy).max(0) as u32) {
+                far = far.max(d);
+            }
+        }
+    }
+    p[2] <= far + bias
+}
+
+/// A line in pixels, from `s0` to `s1`, sampled at `n + 1` points.
+struct Samples {
+    s0: [f32; 3],
+    s1: [f32; 3],
+    n: usize,
+}
+
+impl Samples {
+    /// Sample `i` of the line.
+    fn at(&self, i: usize) -> [f32; 3] {
+        let (s0, s1) = (self.s0, self.s1);
+        let t = i as f32 / self.n as f32;
+        [
+            s0[0] + t * (s1[0] - s0[0]),
+            s0[1] + t * (s1[1] - s0[1]),
+            s0[2] + t * (s1[2] - s0[2]),
+        ]
+    }
+
+    /// The visible piece of line `l` from sample `s` to sample `e`. A piece
+    /// end keeps the line's mesh edge only where it is the line's own end;
+    /// ends cut by occlusion are matched by position.
+    fn piece(&self, l: &ClipLine, s: usize, e: usize) -> Piece {
+        let (a, b) = (self.at(s), self.at(e));
+        let (a, b) = ([a[0], a[1]], [b[0], b[1]]);
+        let key = |i: usize, p: [f32; 2], own: Option<u64>| match own {
+            Some(k) if i == 0 || i == self.n => EndKey::Edge(k),
+            _ => pixel_key(p),
+        };
+        Piece {
+            ends: [a, b],
+            keys: [key(s, a, l.edges[0]), key(e, b, l.edges[1])],
+            opacity: l.opacity,
+        }
+    }
 }
 
 /// Joins pieces sharing end keys into polylines: chains start at ends that
