@@ -453,7 +453,7 @@ fn svg_contours_are_joined_by_mesh_edge_into_few_polylines_one_group_per_cue() {
     }
     assert_eq!(texts[0], texts[1], "the SVG is the same on every run");
     let t = &texts[0];
-    for id in ["contours", "suggestive-contours", "feature-edges"] {
+    for id in ["contours", "suggestive", "feature-edges"] {
         assert!(
             t.contains(&format!("<g id=\"{id}\" class=\"{id}\"")),
             "group {id} missing:\n{t}"

@@ -47,9 +47,10 @@ pub use edges::{
     feature_edges_picture_on,
 };
 
+pub use crate::scene::file::Shot;
 pub use lines::{
     Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
-    line_segments_on, lines_picture, lines_picture_on, wanted,
+    line_segments_on, lines_picture, lines_picture_on, lines_scene, wanted,
 };
 
 pub use strokes::{

@@ -215,13 +215,15 @@ fn picture_options(
     feature_size: FeatureSize,
 ) -> Result<LinesPictureOptions> {
     let mut opts = LinesPictureOptions {
-        eye: super::vec3_arg(&a.eye, "eye")?,
-        target: super::vec3_arg(&a.target, "target")?,
-        up: super::vec3_arg(&a.up, "up")?,
-        fov_deg: a.fov,
-        ortho: a.ortho,
-        width: w,
-        height: h,
+        shot: shapecue::Shot {
+            eye: super::vec3_arg(&a.eye, "eye")?,
+            target: super::vec3_arg(&a.target, "target")?,
+            up: super::vec3_arg(&a.up, "up")?,
+            fov_deg: a.fov,
+            ortho: a.ortho,
+            size: [w, h],
+            ..Default::default()
+        },
         line_width: width,
         hidden: a.hidden,
         svg,

@@ -53,12 +53,14 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 mod effects;
+mod held;
 pub mod lines;
 mod raw;
 mod settings;
 mod toml_words;
 
 pub use effects::{Effects, StrokeEffect};
+pub use held::{HeldMesh, HeldVolume, Shot};
 pub use lines::{LineEffects, LineStyle};
 pub use raw::{
     AoSpec, CameraSpec, ClipRef, CurvatureColorSpec, EdgeSpec, EffectsSpec, FramesSpec, InputSpec,
@@ -85,16 +87,20 @@ pub enum Source {
     Volume(PathBuf, f32, bool),
     /// An SDF (kind, resolution, isovalue, object above the isovalue).
     Sdf(String, usize, f32, bool),
+    /// A mesh the caller holds (the front door's pictures).
+    Held(HeldMesh),
+    /// A volume the caller holds, its isovalue, object above the isovalue.
+    HeldVolume(HeldVolume, f32, bool),
 }
 
 impl Source {
     /// The planner's input kind.
     pub fn input(&self) -> Input {
         match self {
-            Source::Mesh(_) | Source::Generate(..) => Input::Static,
+            Source::Mesh(_) | Source::Generate(..) | Source::Held(_) => Input::Static,
             Source::Gltf(..) | Source::Lbs(_) => Input::Skinned,
             Source::Flipbook(_) => Input::Flipbook,
-            Source::Volume(..) | Source::Sdf(..) => Input::Volume,
+            Source::Volume(..) | Source::Sdf(..) | Source::HeldVolume(..) => Input::Volume,
         }
     }
 }

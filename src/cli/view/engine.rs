@@ -150,7 +150,7 @@ fn serve(rx: Receiver<Request>, tx: Sender<Reply>, opts: ExecOptions, wake: Box<
         let reply = match result {
             Ok(f) => Reply::Frame(Box::new(Done {
                 id,
-                image: f.image.to_image(),
+                image: f.view.image.to_image(),
                 passes: f.passes,
                 wall_ms: t0.elapsed().as_secs_f64() * 1e3,
                 svg: f.svg,

@@ -96,6 +96,11 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
             values = v.range();
             (1, volume_bounds(&v))
         }
+        Source::Held(m) => (1, mesh_bounds(&m.0.positions, &m.0.faces)),
+        Source::HeldVolume(v, ..) => {
+            values = v.0.range();
+            (1, volume_bounds(&v.0))
+        }
     };
     let frames = shapecue::scene::exec::frame_indices(scene, available)?;
     Ok(Probe {

@@ -3,13 +3,16 @@
 //! the PNG and SVG files of one view.
 
 use crate::error::Result;
+use crate::export::svg::{
+    DEFAULT_BIAS, SvgLayer, SvgPolyline, pixel, segment_lines, visible_joined,
+};
 use crate::render::colormap::{curvature_color, with_ao};
 use crate::render::edges::draw_edges;
 use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
-use crate::scene::file::{CameraKind, Scene, ViewSpec};
+use crate::scene::file::{CameraKind, Effects, LineStyle, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
 use crate::spec::edges::EdgeOutput;
-use crate::spec::feature_lines::Segment;
+use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
 use std::path::PathBuf;
 
@@ -94,13 +97,54 @@ pub(super) fn mesh_colors(
         .collect()
 }
 
-/// The opacity bin (0..4) of a suggestive-contour segment's strength in [0, 1].
+/// The opacity bin (0..4) of a faded segment's strength in (0, 1].
 fn strength_bin(strength: f32) -> usize {
-    if strength.is_finite() {
-        ((strength.clamp(0.0, 1.0) * 4.0).ceil() as usize).clamp(1, 4) - 1
-    } else {
-        3
+    ((strength.clamp(0.0, 1.0) * 4.0).ceil() as usize).clamp(1, 4) - 1
+}
+
+/// Whether a segment is drawn at all: one of no strength (faded out, or a
+/// non-finite test) is not, in the image nor in the SVG.
+fn shown(s: &Segment) -> bool {
+    s.3 > 0.0
+}
+
+/// Every line family a scene draws, in drawing order (contours, suggestive
+/// contours, then the curvature line cues in family order), each with its
+/// stroke and whether its strength fades it: suggestive contours always
+/// (DeCarlo et al. fade them out as they approach the contour generator,
+/// where they are unstable), the curvature line families when `[lines]`
+/// fades them, contours never.
+pub(super) fn line_styles(fx: &Effects) -> Vec<(LineStyle, bool)> {
+    let hidden = |f: LineFamily| {
+        fx.lines
+            .styles
+            .iter()
+            .find(|s| s.family == f)
+            .map_or(Hidden::Remove, |s| s.hidden)
+    };
+    let mut out = Vec::new();
+    for (cue, family, (width, color), faded) in [
+        (Cue::Contours, LineFamily::Contours, fx.contour, false),
+        (
+            Cue::SuggestiveContours,
+            LineFamily::Suggestive,
+            fx.suggestive,
+            true,
+        ),
+    ] {
+        if fx.cues.contains(&cue) {
+            let style = LineStyle {
+                family,
+                width,
+                color,
+                hidden: hidden(family),
+            };
+            out.push((style, faded));
+        }
     }
+    let fade = fx.lines.curves.fade;
+    out.extend(fx.lines.styles_for(&fx.cues).into_iter().map(|s| (s, fade)));
+    out
 }
 
 /// What one view draws on top of the mesh.
@@ -116,9 +160,8 @@ pub(super) struct ViewLines<'a> {
 }
 
 /// Draws one view (the mesh the renderer holds, line quads, edge quads),
-/// reads it back and writes its images to `paths`. Returns the contour and
-/// suggestive-contour segments drawn, and the image read back (with depth
-/// when an SVG was asked for).
+/// reads it back and writes its images to `paths`; finds the SVG groups
+/// when a path is an SVG or `want_layers` asks for them.
 pub(super) fn draw_view(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -126,7 +169,8 @@ pub(super) fn draw_view(
     cam: &Camera,
     lines: ViewLines<'_>,
     paths: &[&PathBuf],
-) -> Result<([usize; 2], Frame)> {
+    want_layers: bool,
+) -> Result<DrawnView> {
     let fx = &scene.effects;
     let [w, h] = scene.size;
     renderer.begin(cam)?;
@@ -150,46 +194,28 @@ pub(super) fn draw_view(
     };
     renderer.draw_uploaded(style)?;
     let mut drawn = [0usize; 2];
-    // Contours opaque; suggestive contours in four opacity bins of
-    // their n·v fade (DeCarlo et al. fade them out as they approach
-    // the contour generator, where they are unstable).
+    // Faded families in four opacity bins of their strength.
     const BINS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
-    for (kind, (width, color)) in [(0u32, fx.contour), (1u32, fx.suggestive)] {
-        let mut n = 0;
-        for (bi, &alpha) in BINS.iter().enumerate() {
-            let pts: Vec<[f32; 3]> = lines
-                .segments
-                .iter()
-                .filter(|s| s.2 == kind && (kind == 0 || strength_bin(s.3) == bi))
-                .flat_map(|s| [s.0, s.1])
-                .collect();
-            if pts.is_empty() || (kind == 0 && bi > 0) {
-                continue;
-            }
-            n += pts.len() / 2;
-            let [r, g, b] = color;
-            let a = if kind == 0 { 1.0 } else { alpha };
-            renderer.draw_lines(&pts, [r, g, b, a], width)?;
-        }
-        drawn[kind as usize] += n;
-    }
-    // The curvature line families, each in its cue's style; with fading,
-    // in the same four opacity bins of their strength.
-    let fade = fx.lines.curves.fade;
-    for st in &fx.lines.styles_for(&fx.cues) {
+    for (st, faded) in line_styles(fx) {
         let kind = st.family as u32;
         for (bi, &alpha) in BINS.iter().enumerate() {
+            if !faded && bi > 0 {
+                break;
+            }
             let pts: Vec<[f32; 3]> = lines
                 .segments
                 .iter()
-                .filter(|s| s.2 == kind && (!fade || strength_bin(s.3) == bi))
+                .filter(|s| s.2 == kind && shown(s) && (!faded || strength_bin(s.3) == bi))
                 .flat_map(|s| [s.0, s.1])
                 .collect();
-            if pts.is_empty() || (!fade && bi > 0) {
+            if pts.is_empty() {
                 continue;
             }
+            if let Some(n) = drawn.get_mut(kind as usize) {
+                *n += pts.len() / 2;
+            }
             let [r, g, b] = st.color;
-            let a = if fade { alpha } else { 1.0 };
+            let a = if faded { alpha } else { 1.0 };
             renderer.draw_lines(&pts, [r, g, b, a], st.width)?;
         }
     }
@@ -208,106 +234,57 @@ pub(super) fn draw_view(
         crate::render::strokes::draw(renderer, cam, lines.strokes, &style)?;
     }
     // Depth only for an SVG's visibility test.
-    let svg = paths
-        .iter()
-        .any(|p| p.extension().is_none_or(|e| e != "png"));
+    let svg = want_layers
+        || paths
+            .iter()
+            .any(|p| p.extension().is_none_or(|e| e != "png"));
     let image: Frame = if svg {
         renderer.finish()?
     } else {
         renderer.finish_color()?
     };
+    let layers = svg.then(|| svg_layers(scene, plan, cam, &lines, &image));
     for path in paths {
-        if path.extension().is_some_and(|e| e == "png") {
-            image.save_png(path)?;
-        } else {
-            let layers = svg_layers(scene, plan, cam, &lines, &image);
-            crate::export::svg::write_svg_layers(path, &layers, w, h)?;
+        match &layers {
+            Some(l) if path.extension().is_none_or(|e| e != "png") => {
+                crate::export::svg::write_svg_layers(path, l, w, h)?;
+            }
+            _ => image.save_png(path)?,
         }
     }
-    Ok((drawn, image))
+    Ok(DrawnView {
+        segments: drawn,
+        image,
+        layers,
+    })
 }
 
-/// The SVG groups of one view: one per line cue the scene asks for (contours,
-/// suggestive contours, each curvature line family, feature edges), each with the cue's colour and width,
-/// visible parts only (against `image`'s depth), joined into polylines.
-fn svg_layers(
+/// What [`draw_view`] drew.
+pub(super) struct DrawnView {
+    /// Contour and suggestive-contour segments drawn.
+    pub(super) segments: [usize; 2],
+    /// The image read back (with depth when SVG groups were found).
+    pub(super) image: Frame,
+    /// The SVG groups, when an SVG was written or asked for.
+    pub(super) layers: Option<Vec<SvgLayer>>,
+}
+
+/// The SVG groups of one view: for each line family the scene draws
+/// ([`line_styles`]) its visible parts (against `image`'s depth), and under
+/// them, as the family's `hidden` asks, its hidden parts; then the feature
+/// edges. The one SVG layer writer of every picture.
+pub(super) fn svg_layers(
     scene: &Scene,
     plan: &Plan,
     cam: &Camera,
     lines: &ViewLines<'_>,
     image: &Frame,
-) -> Vec<crate::export::svg::SvgLayer> {
-    use crate::export::svg::{DEFAULT_BIAS, SvgLayer, SvgPolyline, segment_lines, visible_joined};
-    use crate::spec::feature_lines::{Hidden, hidden_id};
+) -> Vec<SvgLayer> {
     let fx = &scene.effects;
-    let [w, h] = scene.size;
-    let vp = cam.view_proj(w as f32 / h as f32);
+    let vp = cam.view_proj(scene.size[0] as f32 / scene.size[1] as f32);
     let mut layers = Vec::new();
-    // Suggestive contours fade as in the image (four opacity bins).
-    let alpha = |s: f32| [0.25, 0.5, 0.75, 1.0][strength_bin(s)];
-    for (kind, id, (width, color)) in [
-        (0u32, "contours", fx.contour),
-        (1u32, "suggestive-contours", fx.suggestive),
-    ] {
-        let wanted = if kind == 0 {
-            fx.cues.contains(&Cue::Contours)
-        } else {
-            fx.cues.contains(&Cue::SuggestiveContours)
-        };
-        if !wanted {
-            continue;
-        }
-        let clip = segment_lines(vp, lines.segments, kind, |s| {
-            if kind == 0 { 1.0 } else { alpha(s) }
-        });
-        layers.push(SvgLayer {
-            id,
-            stroke_width: width,
-            color,
-            lines: visible_joined(&clip, image, DEFAULT_BIAS),
-            dashed: false,
-        });
-    }
-    // The curvature line families as `shapecue lines` writes them: a group
-    // per family, under it (as its `hidden` asks) the hidden parts.
-    let fade = fx.lines.curves.fade;
-    for st in &fx.lines.styles_for(&fx.cues) {
-        let kind = st.family as u32;
-        let clip = segment_lines(
-            vp,
-            lines.segments,
-            kind,
-            |s| {
-                if fade { alpha(s) } else { 1.0 }
-            },
-        );
-        if st.hidden != Hidden::Remove {
-            let hidden: Vec<SvgPolyline> = lines
-                .segments
-                .iter()
-                .filter(|s| s.2 == kind)
-                .filter_map(|s| {
-                    Some(SvgPolyline {
-                        points: vec![pixel(vp, s.0, w, h)?, pixel(vp, s.1, w, h)?],
-                        opacity: if st.hidden == Hidden::Faded { 0.3 } else { 1.0 },
-                    })
-                })
-                .collect();
-            layers.push(SvgLayer {
-                id: hidden_id(st.family),
-                stroke_width: 0.5 * st.width,
-                color: st.color,
-                lines: hidden,
-                dashed: st.hidden == Hidden::Dashed,
-            });
-        }
-        layers.push(SvgLayer {
-            id: st.family.name(),
-            stroke_width: st.width,
-            color: st.color,
-            lines: visible_joined(&clip, image, DEFAULT_BIAS),
-            dashed: false,
-        });
+    for (st, faded) in line_styles(fx) {
+        family_layers(&mut layers, &st, faded, lines.segments, vp, image);
     }
     if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
         let clip = crate::export::svg::edge_out_lines(&eo.edge_out);
@@ -322,12 +299,56 @@ fn svg_layers(
     layers
 }
 
-/// `p` in image pixels (origin top left), or `None` behind the eye.
-fn pixel(vp: glam::Mat4, p: [f32; 3], w: u32, h: u32) -> Option<[f32; 2]> {
-    let c = vp * glam::Vec4::new(p[0], p[1], p[2], 1.0);
-    if c.w.is_nan() || c.w <= 0.0 {
-        return None;
+/// One line family's SVG groups: the hidden parts (as its style asks) under
+/// the visible ones, joined into polylines; a faded family's opacity is its
+/// strength.
+fn family_layers(
+    layers: &mut Vec<SvgLayer>,
+    st: &LineStyle,
+    faded: bool,
+    segments: &[Segment],
+    vp: glam::Mat4,
+    image: &Frame,
+) {
+    let kind = st.family as u32;
+    let (w, h) = (image.width, image.height);
+    let ours: Vec<Segment> = (segments.iter())
+        .filter(|s| s.2 == kind && shown(s))
+        .copied()
+        .collect();
+    if st.hidden != Hidden::Remove {
+        // Every segment projected, under the visible group: where the
+        // visible group does not cover it, the line is hidden.
+        let opacity = if st.hidden == Hidden::Faded { 0.3 } else { 1.0 };
+        let hidden = (ours.iter())
+            .filter_map(|s| {
+                Some(SvgPolyline {
+                    points: vec![pixel(vp, s.0, w, h)?, pixel(vp, s.1, w, h)?],
+                    opacity,
+                })
+            })
+            .collect();
+        layers.push(SvgLayer {
+            id: hidden_id(st.family),
+            stroke_width: 0.5 * st.width,
+            color: st.color,
+            lines: hidden,
+            dashed: st.hidden == Hidden::Dashed,
+        });
     }
-    let (x, y) = (c.x / c.w, c.y / c.w);
-    Some([0.5 * (x + 1.0) * w as f32, 0.5 * (1.0 - y) * h as f32])
+    let clip = segment_lines(
+        vp,
+        &ours,
+        kind,
+        |s| {
+            if faded { s.clamp(0.0, 1.0) } else { 1.0 }
+        },
+    );
+    layers.push(SvgLayer {
+        id: st.family.name(),
+        stroke_width: st.width,
+        color: st.color,
+        lines: visible_joined(&clip, image, DEFAULT_BIAS),
+        dashed: false,
+    });
 }

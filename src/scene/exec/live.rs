@@ -17,13 +17,20 @@ use super::passes::Executor;
 use super::report::{PassRecord, Recorder};
 use super::{ExecOptions, Session, frame_indices};
 use crate::error::{Error, Result};
-use crate::render::{Frame, RenderOptions};
+use crate::export::svg::SvgLayer;
+use crate::render::{Camera, Frame, RenderOptions};
 use crate::scene::file::Scene;
 use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
+use crate::spec::edges::EdgeOutput;
+use crate::spec::feature_lines::Segment;
+use crate::spec::sdf_lines::Stroke;
+use crate::spec::timing::Timing;
 use std::path::PathBuf;
 
 /// One frame to draw: the scene with the camera (its first view) and the
-/// frame (the first of its `frames`) of the moment.
+/// frame (the first of its `frames`) of the moment. The scene's `svg`
+/// switch asks for the SVG groups in the frame ([`ViewOutputs::layers`]);
+/// its `png` is ignored (the image always comes back).
 #[derive(Clone, Debug)]
 pub struct LiveRequest {
     /// The scene of this frame.
@@ -43,10 +50,32 @@ pub enum Change {
     View,
 }
 
+/// What a view drawn into memory hands its caller.
+pub struct ViewOutputs {
+    /// The image (RGBA, row 0 at the top; with depth when `layers` were found).
+    pub image: Frame,
+    /// The SVG groups (the scene's `svg` output asked for them).
+    pub layers: Option<Vec<SvgLayer>>,
+    /// The line segments found for this view (world coordinates).
+    pub segments: Vec<Segment>,
+    /// The edge stage's outputs as drawn, when feature edges are planned.
+    pub edges: Option<EdgeOutput>,
+    /// The curvature-directed strokes of the pose (world coordinates).
+    pub strokes: Vec<Stroke>,
+    /// The camera (world coordinates).
+    pub camera: Camera,
+    /// The feature size the line families' thresholds were scaled by, when
+    /// lines were found.
+    pub feature_size: Option<f32>,
+    /// Kernel time of this pose's curvature run and this view's lines and
+    /// edges.
+    pub timing: Timing,
+}
+
 /// A drawn frame.
 pub struct LiveFrame {
-    /// The image (RGBA, row 0 at the top).
-    pub image: Frame,
+    /// The view's image and what was found for it.
+    pub view: ViewOutputs,
     /// The passes that ran for this frame, in plan order, with their ms.
     pub passes: Vec<PassRecord>,
     /// What the request changed.
@@ -74,6 +103,23 @@ fn same_input(a: &Scene, b: &Scene) -> bool {
 }
 
 impl Session {
+    /// Draws the first view of the first frame of `scene` into memory (a
+    /// picture of the front door): every pass of the plan, nothing written
+    /// but what the scene's outputs name (the SVG groups come back when the
+    /// scene's `svg` is on).
+    pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<LiveFrame> {
+        let mut out = None;
+        let first = LiveRequest {
+            scene: scene.clone(),
+            svg: None,
+        };
+        self.live(opts, first, &mut |f| {
+            out = Some(f);
+            None
+        });
+        out.expect("the first request is always answered")
+    }
+
     /// Draws `first`, hands the frame to `next`, and draws what `next`
     /// returns, until it returns `None`. A failed request is handed to
     /// `next` as its error; the scene is set up anew for the request after
@@ -209,13 +255,14 @@ impl Live<'_> {
         }
         let cam = ex.camera_of(view)?;
         let paths: Vec<&PathBuf> = req.svg.iter().collect();
+        ex.keep_layers = req.scene.svg;
         ex.begin_view();
         for p in self.passes(|l| l == Lifetime::View) {
             ex.view_pass(p, &cam, &paths)?;
         }
-        let image = ex.image.take().expect("the render pass is in every plan");
+        let view = ex.kept.take().expect("the render pass is in every plan");
         Ok(LiveFrame {
-            image,
+            view,
             passes: ex.rec.in_plan_order(self.plan),
             change,
             svg: req.svg.clone(),

@@ -165,6 +165,8 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         Source::Sdf(kind, res, iso, above) => {
             inside_below(crate::volume::sdf::sdf_by_name(kind, *res)?, *iso, *above)
         }
+        Source::Held(m) => Loaded::Static(m.0.as_ref().clone()),
+        Source::HeldVolume(v, iso, above) => inside_below(v.0.as_ref().clone(), *iso, *above),
     })
 }
 

@@ -134,11 +134,13 @@ pub(super) struct Executor<'s, 'g> {
     pub(super) line_segments: std::collections::BTreeMap<&'static str, usize>,
     /// Files written.
     pub(super) outputs: Vec<PathBuf>,
-    /// Keep each view's image in [`Executor::image`] (a live scene hands
-    /// it to its caller instead of writing a PNG).
+    /// Keep each view's outputs in [`Executor::kept`] (a live scene or a
+    /// picture hands them to its caller instead of writing a PNG).
     pub(super) keep_image: bool,
-    /// The last view's image, when kept.
-    pub(super) image: Option<crate::render::Frame>,
+    /// Also find each kept view's SVG groups.
+    pub(super) keep_layers: bool,
+    /// The last view's outputs, when kept.
+    pub(super) kept: Option<super::live::ViewOutputs>,
 }
 
 impl<'s, 'g> Executor<'s, 'g> {
@@ -245,7 +247,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             line_segments: Default::default(),
             outputs: Vec::new(),
             keep_image: false,
-            image: None,
+            keep_layers: false,
+            kept: None,
         })
     }
 

@@ -136,10 +136,19 @@ impl Executor<'_, '_> {
                     // interpolated surface, which marching cubes cuts as chords.
                     stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
                 };
-                let (drawn, image) =
-                    draw::draw_view(&mut self.renderer, self.scene, self.plan, cam, lines, paths)?;
+                let want_layers = self.keep_image && self.keep_layers;
+                let d = draw::draw_view(
+                    &mut self.renderer,
+                    self.scene,
+                    self.plan,
+                    cam,
+                    lines,
+                    paths,
+                    want_layers,
+                )?;
+                let drawn = d.segments;
                 if self.keep_image {
-                    self.image = Some(image);
+                    self.kept = Some(self.kept_view(cam, d));
                 }
                 self.rec.wall(
                     pass,
@@ -159,6 +168,43 @@ impl Executor<'_, '_> {
             _ => unreachable!("{pass:?} is not a view pass"),
         }
         Ok(())
+    }
+
+    /// What a view drawn into memory hands its caller: the image, the SVG
+    /// groups, the segments (world coordinates), the edge stage's outputs,
+    /// the strokes, the camera (world coordinates) and the kernel time of
+    /// the pose and the view.
+    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> super::super::live::ViewOutputs {
+        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let world =
+            |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
+        let shift = glam::DVec3::from(o).as_vec3();
+        let mut timing = self.curv.clone().unwrap_or_default();
+        for t in [
+            &self.lines_ran,
+            &self.edges_ran.as_ref().map(|e| e.0.clone()),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            timing.extend(t);
+        }
+        super::super::live::ViewOutputs {
+            image: d.image,
+            layers: d.layers,
+            segments: (self.segs.iter())
+                .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
+                .collect(),
+            edges: self.edges_ran.as_ref().map(|e| e.1.clone()),
+            strokes: self.strokes.clone(),
+            camera: Camera {
+                eye: cam.eye + shift,
+                target: cam.target + shift,
+                ..*cam
+            },
+            feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
+            timing,
+        }
     }
 
     /// Contours, suggestive contours and the curvature line families of
