@@ -204,51 +204,13 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
         Topic::Strokes {
             max_resolution,
             out,
-        } => {
-            if !(32..=1024).contains(&max_resolution) {
-                bail!(
-                    "--max-resolution {max_resolution}: the sweep's grids are 32³, 64³, 128³ and \
-                     256³; give 32 or more (at most 1024)"
-                );
-            }
-            check(&[], &out)?;
-            let o = report::strokes::StrokesReportOptions { max_resolution };
-            (report::strokes::report(&gpu()?, o)?, out)
-        }
+        } => (strokes(&gpu, max_resolution, &out)?, out),
         Topic::Pipeline {
             models,
             frames,
             runs: n,
             out,
-        } => {
-            let models = if models.is_empty() {
-                vec![report::pipeline::default_model()]
-            } else {
-                models
-            };
-            if models.len() > report::pipeline::MAX_MODELS {
-                bail!(
-                    "give at most {} glTF models per report",
-                    report::pipeline::MAX_MODELS
-                );
-            }
-            for m in &models {
-                if !m.exists() {
-                    bail!(
-                        "{}: not found (give the glTF files to time: \
-                         `shapecue report pipeline MODEL.glb`)",
-                        m.display()
-                    );
-                }
-            }
-            let paths: Vec<&Path> = models.iter().map(PathBuf::as_path).collect();
-            check(&paths, &out)?;
-            let o = report::pipeline::PipelineReportOptions {
-                frames: frames.max(1),
-                runs: runs(n.max(1))?,
-            };
-            (report::pipeline::report(&gpu()?, &paths, o)?, out)
-        }
+        } => (pipeline(&gpu, models, frames, n, &out)?, out),
         Topic::Caps {
             size,
             width,
@@ -275,6 +237,62 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
         }
     };
     write(report.with_command(command_line()), &out)
+}
+
+/// `shapecue report strokes`: checks the sweep's largest grid and the
+/// outputs, then measures.
+fn strokes(
+    gpu: &dyn Fn() -> Result<Arc<Gpu>>,
+    max_resolution: usize,
+    out: &Outputs,
+) -> Result<Report> {
+    if !(32..=1024).contains(&max_resolution) {
+        bail!(
+            "--max-resolution {max_resolution}: the sweep's grids are 32³, 64³, 128³ and \
+             256³; give 32 or more (at most 1024)"
+        );
+    }
+    check(&[], out)?;
+    let o = report::strokes::StrokesReportOptions { max_resolution };
+    Ok(report::strokes::report(&gpu()?, o)?)
+}
+
+/// `shapecue report pipeline`: checks the models (the default one if none)
+/// and the outputs, then measures.
+fn pipeline(
+    gpu: &dyn Fn() -> Result<Arc<Gpu>>,
+    models: Vec<PathBuf>,
+    frames: usize,
+    n: usize,
+    out: &Outputs,
+) -> Result<Report> {
+    let models = if models.is_empty() {
+        vec![report::pipeline::default_model()]
+    } else {
+        models
+    };
+    if models.len() > report::pipeline::MAX_MODELS {
+        bail!(
+            "give at most {} glTF models per report",
+            report::pipeline::MAX_MODELS
+        );
+    }
+    for m in &models {
+        if !m.exists() {
+            bail!(
+                "{}: not found (give the glTF files to time: \
+                 `shapecue report pipeline MODEL.glb`)",
+                m.display()
+            );
+        }
+    }
+    let paths: Vec<&Path> = models.iter().map(PathBuf::as_path).collect();
+    check(&paths, out)?;
+    let o = report::pipeline::PipelineReportOptions {
+        frames: frames.max(1),
+        runs: runs(n.max(1))?,
+    };
+    Ok(report::pipeline::report(&gpu()?, &paths, o)?)
 }
 
 /// Checks the outputs before any measuring: `--plot` must be `.svg`, and

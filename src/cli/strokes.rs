@@ -116,40 +116,7 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     .map(PathBuf::as_path)
     .collect();
     let (name, input) = load_input(&a, &outputs)?;
-    let procedural = !matches!(input, Input::File(_));
-    let iso = match (a.iso, &input) {
-        (Some(v), _) => v,
-        (None, Input::File(vol)) => bail!("give --iso ({})", span(vol)),
-        (None, _) => 0.0,
-    };
-    if !iso.is_finite() {
-        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
-    }
-    let inside: Inside = match &a.inside {
-        Some(s) => s.parse()?,
-        None if procedural => Inside::Below,
-        None => Inside::Above,
-    };
-    let sampling = match a.sampling.as_str() {
-        "auto" => Sampling::Auto(Vec::new()),
-        s => match s.parse::<f64>() {
-            Ok(d) if d.is_finite() && d > 0.0 => Sampling::Fixed(d),
-            _ => bail!("--sampling {s:?}: expected auto or a positive distance in world units"),
-        },
-    };
-    let eye = super::vec3_arg(&a.eye, "eye")?;
-    let opts = StrokesOptions {
-        iso,
-        inside,
-        sampling,
-        spacing: a.seed_spacing,
-        picture: Some(PictureOptions {
-            width: w,
-            height: h,
-            eye,
-            surface: !a.no_surface,
-        }),
-    };
+    let opts = strokes_options(&a, &input, (w, h))?;
     let gpu = Arc::new(Gpu::new(device)?);
     let front = match &input {
         Input::File(v) | Input::Sdf(v) => StrokesInput::Volume(v),
@@ -170,7 +137,68 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     }
     let picture = out.picture.as_ref().expect("a picture was asked for");
     picture.frame.save_png(&output)?;
+    print_summary(&name, &out, &output)?;
+    if let Some(p) = &a.svg {
+        let facing = picture.facing_strokes();
+        shapecue::export::strokes::write_svg(p, &facing, &picture.camera, [w, h])?;
+        super::out!(
+            "wrote {} ({} strokes facing the eye)",
+            p.display(),
+            facing.len()
+        );
+    }
+    if let Some(p) = &a.geometry {
+        shapecue::export::strokes::write_ply(p, &out.strokes)?;
+        super::out!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.stats {
+        write_stats(p, &name, &gpu, &out)?;
+    }
+    Ok(())
+}
 
+/// The front door's options from the arguments: iso value (required for a
+/// volume file), inside, sampling, seed spacing and the `w`×`h` picture.
+fn strokes_options(a: &StrokesArgs, input: &Input, (w, h): (u32, u32)) -> Result<StrokesOptions> {
+    let procedural = !matches!(input, Input::File(_));
+    let iso = match (a.iso, input) {
+        (Some(v), _) => v,
+        (None, Input::File(vol)) => bail!("give --iso ({})", span(vol)),
+        (None, _) => 0.0,
+    };
+    if !iso.is_finite() {
+        bail!("--iso must be a finite number within single precision (±3.4e38), got {iso}");
+    }
+    let inside: Inside = match &a.inside {
+        Some(s) => s.parse()?,
+        None if procedural => Inside::Below,
+        None => Inside::Above,
+    };
+    let sampling = match a.sampling.as_str() {
+        "auto" => Sampling::Auto(Vec::new()),
+        s => match s.parse::<f64>() {
+            Ok(d) if d.is_finite() && d > 0.0 => Sampling::Fixed(d),
+            _ => bail!("--sampling {s:?}: expected auto or a positive distance in world units"),
+        },
+    };
+    let eye = super::vec3_arg(&a.eye, "eye")?;
+    Ok(StrokesOptions {
+        iso,
+        inside,
+        sampling,
+        spacing: a.seed_spacing,
+        picture: Some(PictureOptions {
+            width: w,
+            height: h,
+            eye,
+            surface: !a.no_surface,
+        }),
+    })
+}
+
+/// Prints the one summary line: samples, seeds, strokes, sampling distance
+/// and kernel time, and the PNG written.
+fn print_summary(name: &str, out: &Strokes, output: &Path) -> Result<()> {
     let st = &out.stats;
     let ms = st.ms.total;
     super::out!(
@@ -189,22 +217,6 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         },
         output.display()
     );
-    if let Some(p) = &a.svg {
-        let facing = picture.facing_strokes();
-        shapecue::export::strokes::write_svg(p, &facing, &picture.camera, [w, h])?;
-        super::out!(
-            "wrote {} ({} strokes facing the eye)",
-            p.display(),
-            facing.len()
-        );
-    }
-    if let Some(p) = &a.geometry {
-        shapecue::export::strokes::write_ply(p, &out.strokes)?;
-        super::out!("wrote {}", p.display());
-    }
-    if let Some(p) = &a.stats {
-        write_stats(p, &name, &gpu, &out)?;
-    }
     Ok(())
 }
 

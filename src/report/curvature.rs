@@ -42,6 +42,12 @@ fn ms(v: f64) -> Cell {
     Cell::num(v, format!("{v:.2}"))
 }
 
+/// A scatter chart's (label, x, y) points.
+type Points = Vec<(String, f64, f64)>;
+
+/// A convergence chart's series: (name, (h, error) points).
+type Series = Vec<(String, Vec<(f64, f64)>)>;
+
 /// Measures the report on `gpu`.
 ///
 /// # Errors
@@ -52,7 +58,6 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
     let mut r = Report::new("curvature", gpu.info.name.clone());
     let (nu, nv) = mesh::torus_resolution_for(o.resolution);
     let m = mesh::torus(1.0, 0.4, nu, nv);
-    let truth = torus_truth(&m);
     r.text(format!(
         "Curvature variants on a torus R=1 r=0.4, {} vertices, {} faces; device: {} ({} CUs)\n\
          errors: RMS of k1, k2 against the analytic torus; NRMSE of H = (k1+k2)/2 against the f64 \
@@ -63,6 +68,39 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
         gpu.info.name,
         gpu.info.compute_units
     ));
+    let (t, points) = variants_table(gpu, &m, runs)?;
+    r.blocks.push(Block::Table(t));
+    r.charts.push(Chart::Scatter {
+        title: format!(
+            "Curvature variants, torus of {} vertices: k1 error against kernel time",
+            m.n_vertices()
+        ),
+        x_label: "median kernel ms".into(),
+        y_label: "k1 RMS error vs analytic".into(),
+        points,
+    });
+
+    r.text(
+        "\nRefinement: RMS error of k1 against the analytic torus (exact solve converges ~h², \
+         trimesh2's pivot quirk does not)",
+    );
+    let (t, series) = refinement_table(gpu, runs)?;
+    r.blocks.push(Block::Table(t));
+    r.charts.push(Chart::Convergence {
+        title: "Refinement: k1 error against edge length h (torus)".into(),
+        x_label: "h (tube circumference / segments)".into(),
+        y_label: "k1 RMS error vs analytic".into(),
+        series,
+    });
+    super::lines::table(gpu, &mut r)?;
+    Ok(r)
+}
+
+/// Every variant on the torus `m` (a row saying why for one the device
+/// cannot run), then the CPU reference; with the (label, kernel ms, k1
+/// error) points of the scatter chart.
+fn variants_table(gpu: &Arc<Gpu>, m: &mesh::Mesh, runs: usize) -> Result<(Table, Points)> {
+    let truth = torus_truth(m);
     let mut t = Table::new(
         "variants",
         vec![
@@ -79,13 +117,13 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
             compat,
             ..Default::default()
         };
-        crate::cpu::curvature::estimate(&m, &o).0
+        crate::cpu::curvature::estimate(m, &o).0
     };
     let ref_exact = refs(Compat::Exact);
     let ref_compat = refs(Compat::Trimesh2);
     let mut points = Vec::new();
     for v in variants() {
-        let res = match measure(gpu, &m, v, runs) {
+        let res = match measure(gpu, m, v, runs) {
             Ok(res) => res,
             // a variant the device lacks a feature for (native float
             // atomics, fp64) is a row saying so, not the end of the table
@@ -117,33 +155,29 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
             ms(res.wall_ms),
         ]));
     }
+    t.rows.push(cpu_row(m, &truth));
+    Ok((t, points))
+}
+
+/// The f64 CPU reference (exact solve, one thread): its errors and time.
+fn cpu_row(m: &mesh::Mesh, truth: &[(f64, f64)]) -> Row {
     let clock = Instant::now();
-    let (cf, _) = crate::cpu::curvature::estimate(&m, &CurvatureOptions::default());
+    let (cf, _) = crate::cpu::curvature::estimate(m, &CurvatureOptions::default());
     let cpu_ms = clock.elapsed().as_secs_f64() * 1e3;
-    let (e1, e2) = analytic_rms(&cf, &truth);
-    t.rows.push(Row::new(vec![
+    let (e1, e2) = analytic_rms(&cf, truth);
+    Row::new(vec![
         Cell::text("cpu reference f64 exact (1 thread)"),
         e3(e1),
         e3(e2),
         Cell::num(0.0, "0".into()),
         Cell::shown("-", serde_json::Value::Null),
         ms(cpu_ms),
-    ]));
-    r.blocks.push(Block::Table(t));
-    r.charts.push(Chart::Scatter {
-        title: format!(
-            "Curvature variants, torus of {} vertices: k1 error against kernel time",
-            m.n_vertices()
-        ),
-        x_label: "median kernel ms".into(),
-        y_label: "k1 RMS error vs analytic".into(),
-        points,
-    });
+    ])
+}
 
-    r.text(
-        "\nRefinement: RMS error of k1 against the analytic torus (exact solve converges ~h², \
-         trimesh2's pivot quirk does not)",
-    );
+/// The refinement sweep over [`REFINEMENT`]: k1 errors of exact f32, exact
+/// f64 and trimesh2 f32 with their (h, error) series.
+fn refinement_table(gpu: &Arc<Gpu>, runs: usize) -> Result<(Table, Series)> {
     let mut t = Table::new(
         "refinement",
         vec![
@@ -156,60 +190,60 @@ pub fn report(gpu: &Arc<Gpu>, o: CurvatureReportOptions) -> Result<Report> {
             Column::new("exact f64 kernel ms", "exact_f64_kernel_ms"),
         ],
     );
-    let mut series: Vec<(String, Vec<(f64, f64)>)> = ["exact f32", "exact f64", "trimesh2 f32"]
+    let mut series: Series = ["exact f32", "exact f64", "trimesh2 f32"]
         .iter()
         .map(|s| (s.to_string(), Vec::new()))
         .collect();
     for nn in REFINEMENT {
-        let (nu, nv) = mesh::torus_resolution_for(nn);
-        let m = mesh::torus(1.0, 0.4, nu, nv);
-        let truth = torus_truth(&m);
-        let h = 2.0 * std::f64::consts::PI * 0.4 / nv as f64;
-        let d = CurvatureOptions::default();
-        let a = measure(gpu, &m, d, runs.min(3))?;
-        let b = measure(
-            gpu,
-            &m,
-            CurvatureOptions {
-                precision: Precision::F64,
-                ..d
-            },
-            runs.min(3),
-        )?;
-        let c = measure(
-            gpu,
-            &m,
-            CurvatureOptions {
-                compat: Compat::Trimesh2,
-                ..d
-            },
-            1,
-        )?;
-        let errs = [
-            analytic_rms(&a.field, &truth).0,
-            analytic_rms(&b.field, &truth).0,
-            analytic_rms(&c.field, &truth).0,
-        ];
+        let (row, h, errs) = refinement_row(gpu, nn, runs)?;
         for (s, e) in series.iter_mut().zip(errs) {
             s.1.push((h, e));
         }
-        t.rows.push(Row::new(vec![
-            Cell::int(m.n_vertices()),
-            Cell::num(h, format!("{h:.4}")),
-            e3(errs[0]),
-            e3(errs[1]),
-            e3(errs[2]),
-            ms(a.kernel_ms),
-            ms(b.kernel_ms),
-        ]));
+        t.rows.push(row);
     }
-    r.blocks.push(Block::Table(t));
-    r.charts.push(Chart::Convergence {
-        title: "Refinement: k1 error against edge length h (torus)".into(),
-        x_label: "h (tube circumference / segments)".into(),
-        y_label: "k1 RMS error vs analytic".into(),
-        series,
-    });
-    super::lines::table(gpu, &mut r)?;
-    Ok(r)
+    Ok((t, series))
+}
+
+/// One refinement step, a torus of about `nn` vertices: its row, edge
+/// length h and the three k1 errors.
+fn refinement_row(gpu: &Arc<Gpu>, nn: usize, runs: usize) -> Result<(Row, f64, [f64; 3])> {
+    let (nu, nv) = mesh::torus_resolution_for(nn);
+    let m = mesh::torus(1.0, 0.4, nu, nv);
+    let truth = torus_truth(&m);
+    let h = 2.0 * std::f64::consts::PI * 0.4 / nv as f64;
+    let d = CurvatureOptions::default();
+    let a = measure(gpu, &m, d, runs.min(3))?;
+    let b = measure(
+        gpu,
+        &m,
+        CurvatureOptions {
+            precision: Precision::F64,
+            ..d
+        },
+        runs.min(3),
+    )?;
+    let c = measure(
+        gpu,
+        &m,
+        CurvatureOptions {
+            compat: Compat::Trimesh2,
+            ..d
+        },
+        1,
+    )?;
+    let errs = [
+        analytic_rms(&a.field, &truth).0,
+        analytic_rms(&b.field, &truth).0,
+        analytic_rms(&c.field, &truth).0,
+    ];
+    let row = Row::new(vec![
+        Cell::int(m.n_vertices()),
+        Cell::num(h, format!("{h:.4}")),
+        e3(errs[0]),
+        e3(errs[1]),
+        e3(errs[2]),
+        ms(a.kernel_ms),
+        ms(b.kernel_ms),
+    ]);
+    Ok((row, h, errs))
 }

@@ -52,7 +52,6 @@ fn ms(v: f64) -> Cell {
 /// # Errors
 /// Device failures.
 pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
-    let (max_res, runs) = (o.max_resolution, o.runs);
     let mut r = Report::new("isosurface", gpu.info.name.clone());
     r.text(format!(
         "device: {} ({})\n\n\
@@ -62,26 +61,36 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
          (docs/notes/peer-comparisons.md); this report times shapecue alone.",
         gpu.info.name, gpu.info.platform,
     ));
-    let col = Column::new;
-    let mut t = Table::new(
-        "extraction",
-        vec![
-            col("volume", "volume"),
-            col("fuse", "fusion"),
-            col("kernel", "kernel_ms"),
-            col("wall", "wall_ms"),
-            col("soup v", "soup_vertices"),
-            col("vertices", "vertices"),
-            col("faces", "faces"),
-            col("hits", "exact_hits"),
-            col("dup pos", "duplicate_positions"),
-            col("collapse", "collapsed_faces"),
-            col("boundary", "boundary_edges"),
-            col("nonmanif", "nonmanifold_edges"),
-            col("euler", "euler"),
-        ],
+    let (t, chart) = extraction(gpu, o)?;
+    r.blocks.push(Block::Table(t));
+    r.charts.push(chart);
+
+    r.text("\n## Resolution sweep: curvature of the fused isosurface vs analytic");
+    let sweep = resolution_sweep(gpu, o)?;
+    r.blocks.push(Block::Table(sweep.table));
+    r.text(
+        "\n(k errors: RMS of k − k_analytic over the vertices, × r (sphere r = 0.8, torus tube \
+         r = 0.25); extraction uses --fusion direct; curvature kernel ms include dcurv and, for \
+         gradient normals, the override pass)",
     );
-    let mut inputs: Vec<(String, crate::volume::Volume, f32)> = Vec::new();
+    r.charts.push(Chart::Scatter {
+        title: "Isosurface curvature: k1 error (× r) against curvature kernel time".into(),
+        x_label: "median curvature kernel ms".into(),
+        y_label: "k1 RMS error × r".into(),
+        points: sweep.points,
+    });
+    r.charts.push(Chart::Convergence {
+        title: "Resolution sweep: k1 error (× r) against grid spacing h".into(),
+        x_label: "h (grid spacing)".into(),
+        y_label: "k1 RMS error × r".into(),
+        series: sweep.series,
+    });
+    Ok(r)
+}
+
+/// The extraction table's volumes: name, volume and isovalue.
+fn extraction_inputs(max_res: usize) -> Vec<(String, crate::volume::Volume, f32)> {
+    let mut inputs = Vec::new();
     for (kind, res) in [
         (Sdf::Sphere, 128),
         (Sdf::Sphere, 256),
@@ -101,16 +110,41 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
     ) {
         inputs.push(("bucky 32³ @51".into(), b, 51.0));
     }
+    inputs
+}
+
+/// Extraction + fusion of every fusion variant on each input: the table and
+/// its bar chart of kernel ms.
+fn extraction(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<(Table, Chart)> {
+    let col = Column::new;
+    let mut t = Table::new(
+        "extraction",
+        vec![
+            col("volume", "volume"),
+            col("fuse", "fusion"),
+            col("kernel", "kernel_ms"),
+            col("wall", "wall_ms"),
+            col("soup v", "soup_vertices"),
+            col("vertices", "vertices"),
+            col("faces", "faces"),
+            col("hits", "exact_hits"),
+            col("dup pos", "duplicate_positions"),
+            col("collapse", "collapsed_faces"),
+            col("boundary", "boundary_edges"),
+            col("nonmanif", "nonmanifold_edges"),
+            col("euler", "euler"),
+        ],
+    );
     let mut bars: Vec<(String, Vec<f64>)> = Fusion::ALL
         .iter()
         .map(|f| (f.name().to_string(), Vec::new()))
         .collect();
     let mut groups = Vec::new();
-    for (name, vol, iso) in inputs {
+    for (name, vol, iso) in extraction_inputs(o.max_resolution) {
         let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
         groups.push(name.clone());
         for (i, fusion) in Fusion::ALL.into_iter().enumerate() {
-            let (k, wall, st) = measure_isosurface(&mut ex, iso, fusion, runs)?;
+            let (k, wall, st) = measure_isosurface(&mut ex, iso, fusion, o.runs)?;
             let (p, f) = ex.read_index_space()?;
             let q = crate::mesh::quality(&p, &f);
             bars[i].1.push(k);
@@ -131,16 +165,29 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
             ]));
         }
     }
-    r.blocks.push(Block::Table(t));
-    r.charts.push(Chart::Bars {
+    let chart = Chart::Bars {
         title: "Extraction + fusion: median kernel ms per fusion variant".into(),
         y_label: "kernel ms".into(),
         log_y: true,
         groups,
         series: bars,
-    });
+    };
+    Ok((t, chart))
+}
 
-    r.text("\n## Resolution sweep: curvature of the fused isosurface vs analytic");
+/// The resolution sweep's table and the points of its two charts.
+struct Sweep {
+    /// One row per surface and resolution.
+    table: Table,
+    /// (label, curvature ms, k1 error) per surface, resolution and variant.
+    points: Vec<(String, f64, f64)>,
+    /// (h, k1 error) per surface and variant.
+    series: Vec<(String, Vec<(f64, f64)>)>,
+}
+
+/// The resolution sweep's columns: per [`SWEEP`] variant, ms and k errors.
+fn sweep_columns() -> Vec<Column> {
+    let col = Column::new;
     let mut cols = vec![
         col("surface", "surface"),
         col("res", "res"),
@@ -160,87 +207,96 @@ pub fn report(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Report> {
         ));
     }
     cols.push(Column::hidden("h"));
-    let mut t = Table::new("resolution_sweep", cols);
-    let mut points = Vec::new();
-    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    cols
+}
+
+/// The sphere and torus SDFs from 64³ to `max_resolution`³: extraction and
+/// each curvature variant's time and error against the analytic values.
+fn resolution_sweep(gpu: &Arc<Gpu>, o: IsosurfaceReportOptions) -> Result<Sweep> {
+    let mut sweep = Sweep {
+        table: Table::new("resolution_sweep", sweep_columns()),
+        points: Vec::new(),
+        series: Vec::new(),
+    };
     for kind in [Sdf::Sphere, Sdf::Torus] {
         let surface = format!("{kind:?}").to_lowercase();
-        let first = series.len();
-        series.extend(
+        let first = sweep.series.len();
+        sweep.series.extend(
             SWEEP
                 .iter()
                 .map(|(name, _, _)| (format!("{surface} {name}"), Vec::new())),
         );
         let mut res = 64;
-        while res <= max_res {
-            let vol = sdf::sdf(kind, res);
-            let h = vol.spacing[0];
-            let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
-            let (k, _, st) = measure_isosurface(&mut ex, 0.0, Fusion::Direct, runs)?;
-            let mesh = ex.read()?;
-            let (rad, truth): (f64, Vec<(f64, f64)>) = match kind {
-                Sdf::Torus => (
-                    sdf::TORUS_TUBE,
-                    mesh.positions
-                        .iter()
-                        .map(|&p| sdf::torus_curvature(p))
-                        .collect(),
-                ),
-                _ => (
-                    sdf::SPHERE_RADIUS,
-                    mesh.positions
-                        .iter()
-                        .map(|&p| sdf::sphere_curvature(p))
-                        .collect(),
-                ),
-            };
-            let mut cells = vec![
-                Cell::text(surface.clone()),
-                Cell::int(res),
-                Cell::int(st.faces),
-                ms(k),
-            ];
-            for (i, (name, precision, normals)) in SWEEP.into_iter().enumerate() {
-                let opts = CurvatureOptions {
-                    precision,
-                    ..Default::default()
-                };
-                let mut times = Vec::new();
-                let (mut est, _) = mcs::curvature(&ex, opts, normals)?;
-                for _ in 0..runs.max(1) {
-                    times.push(est.run()?.kernel_ms);
-                }
-                let f = est.read()?;
-                let (e1, e2) = analytic_rms(&f, &truth);
-                let (e1, e2, cm) = (e1 * rad, e2 * rad, median(&mut times));
-                points.push((format!("{surface} {res}³ {name}"), cm, e1));
-                series[first + i].1.push((h, e1));
-                cells.push(ms(cm));
-                cells.push(Cell::num(e1, format!("{e1:.3e}")));
-                cells.push(Cell::num(e2, format!("{e2:.3e}")));
-            }
-            cells.push(Cell::num(h, String::new()));
-            t.rows.push(Row::new(cells));
+        while res <= o.max_resolution {
+            sweep_row(gpu, &mut sweep, kind, res, first, o.runs)?;
             res *= 2;
         }
     }
-    r.blocks.push(Block::Table(t));
-    r.text(
-        "\n(k errors: RMS of k − k_analytic over the vertices, × r (sphere r = 0.8, torus tube \
-         r = 0.25); extraction uses --fusion direct; curvature kernel ms include dcurv and, for \
-         gradient normals, the override pass)",
-    );
-    r.charts.push(Chart::Scatter {
-        title: "Isosurface curvature: k1 error (× r) against curvature kernel time".into(),
-        x_label: "median curvature kernel ms".into(),
-        y_label: "k1 RMS error × r".into(),
-        points,
-    });
-    r.charts.push(Chart::Convergence {
-        title: "Resolution sweep: k1 error (× r) against grid spacing h".into(),
-        x_label: "h (grid spacing)".into(),
-        y_label: "k1 RMS error × r".into(),
-        series,
-    });
-    Ok(r)
+    Ok(sweep)
+}
+
+/// One row of the sweep: the `kind` SDF at `res`³, its variants' series
+/// starting at `first`.
+fn sweep_row(
+    gpu: &Arc<Gpu>,
+    sweep: &mut Sweep,
+    kind: Sdf,
+    res: usize,
+    first: usize,
+    runs: usize,
+) -> Result<()> {
+    let surface = format!("{kind:?}").to_lowercase();
+    let vol = sdf::sdf(kind, res);
+    let h = vol.spacing[0];
+    let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
+    let (k, _, st) = measure_isosurface(&mut ex, 0.0, Fusion::Direct, runs)?;
+    let mesh = ex.read()?;
+    let (rad, truth) = analytic(kind, &mesh.positions);
+    let mut cells = vec![
+        Cell::text(surface.clone()),
+        Cell::int(res),
+        Cell::int(st.faces),
+        ms(k),
+    ];
+    for (i, (name, precision, normals)) in SWEEP.into_iter().enumerate() {
+        let opts = CurvatureOptions {
+            precision,
+            ..Default::default()
+        };
+        let mut times = Vec::new();
+        let (mut est, _) = mcs::curvature(&ex, opts, normals)?;
+        for _ in 0..runs.max(1) {
+            times.push(est.run()?.kernel_ms);
+        }
+        let f = est.read()?;
+        let (e1, e2) = analytic_rms(&f, &truth);
+        let (e1, e2, cm) = (e1 * rad, e2 * rad, median(&mut times));
+        sweep
+            .points
+            .push((format!("{surface} {res}³ {name}"), cm, e1));
+        sweep.series[first + i].1.push((h, e1));
+        cells.push(ms(cm));
+        cells.push(Cell::num(e1, format!("{e1:.3e}")));
+        cells.push(Cell::num(e2, format!("{e2:.3e}")));
+    }
+    cells.push(Cell::num(h, String::new()));
+    sweep.table.rows.push(Row::new(cells));
+    Ok(())
+}
+
+/// The radius errors are scaled by and the analytic (k1, k2) at each position.
+fn analytic(kind: Sdf, positions: &[[f64; 3]]) -> (f64, Vec<(f64, f64)>) {
+    match kind {
+        Sdf::Torus => (
+            sdf::TORUS_TUBE,
+            positions.iter().map(|&p| sdf::torus_curvature(p)).collect(),
+        ),
+        _ => (
+            sdf::SPHERE_RADIUS,
+            positions
+                .iter()
+                .map(|&p| sdf::sphere_curvature(p))
+                .collect(),
+        ),
+    }
 }

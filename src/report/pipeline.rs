@@ -16,6 +16,7 @@ use crate::gpu::Gpu;
 use crate::spec::ao::AoMode;
 use crate::spec::feature_lines::{CurveOptions, FamilySet, LineFamily};
 use crate::spec::timing::Family;
+use crate::spec::view::View;
 use crate::stages::feature_lines::LineOptions;
 use crate::stages::pipeline::{PassTimes, PipelineOptions, PosePipeline, clip_poses};
 use std::path::Path;
@@ -70,6 +71,8 @@ const LINE_KEYS: [&str; 8] = [
 /// The most models one report times.
 pub const MAX_MODELS: usize = KEYS.len();
 
+/// Times the pipeline on one model and appends its text, tables and chart
+/// to `r` (`index`: the model's place, which keys its tables).
 fn model(
     r: &mut Report,
     gpu: &Arc<Gpu>,
@@ -79,36 +82,124 @@ fn model(
 ) -> Result<()> {
     let (frames, runs) = (o.frames.max(1), o.runs.max(1));
     let m = crate::mesh::skinned::load_gltf(gltf)?;
-    let mut p = PosePipeline::new(gpu.clone(), &m, PipelineOptions::default())?;
+    let p = PosePipeline::new(gpu.clone(), &m, PipelineOptions::default())?;
     let poses = clip_poses(&m, frames)?;
-    let (view, size, lines) = (p.front_view(), p.feature_size(), LineOptions::default());
-    p.frame(&poses[0], view, size, lines)?;
+    let (view, size) = (p.front_view(), p.feature_size());
+    let mut b = Bench {
+        p,
+        poses,
+        view,
+        size,
+    };
+    let mut fr = frame_runs(&mut b, runs)?;
+    let fam_ms = family_runs(&mut b)?;
+    let name = gltf.file_name().map_or_else(
+        || gltf.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    r.text(format!(
+        "{}Per-frame device pipeline on {name}: {} vertices, {} faces, {} poses × {runs} runs; \
+         device: {} ({} CUs); AO radius {:.4} (0.1 × RMS radius), feature size {size:.4}, \
+         {} segments in the last frame\n",
+        if index > 0 { "\n" } else { "" },
+        m.rest.positions.len(),
+        m.rest.faces.len(),
+        b.poses.len(),
+        gpu.info.name,
+        gpu.info.compute_units,
+        b.p.ao_radius(),
+        fr.t.last().map_or(0, |x| x.segments),
+    ));
+    let passes = pass_table(index, &name, &mut fr);
+    r.blocks.push(Block::Table(passes.table));
+    r.text("\nFeature-line kernels per view (pose terms once per pose), by family:\n".to_string());
+    r.blocks
+        .push(Block::Table(lines_table(index, &name, &fam_ms)));
+    let (kernel, wall) = (passes.kernel, passes.wall);
+    let verdict = |ms: f64| if ms <= 16.0 { "met" } else { "NOT met" };
+    r.text(format!(
+        "\nwall ms per frame (median, matrices up, segments back): {wall:.3}\n\
+         16 ms frame budget: {} by the kernel total ({kernel:.2} ms), {} by the wall time ({wall:.2} ms)",
+        verdict(kernel),
+        verdict(wall)
+    ));
+    r.charts.push(Chart::Bars {
+        title: format!(
+            "Per-frame device pipeline on {name}: median kernel ms per pass (total {kernel:.2} ms)"
+        ),
+        y_label: "kernel ms".into(),
+        log_y: false,
+        groups: passes.bars.0,
+        series: vec![("median kernel ms".into(), passes.bars.1)],
+    });
+    Ok(())
+}
+
+/// A model's pipeline, its poses, and the view and feature size its lines
+/// are found with.
+struct Bench {
+    p: PosePipeline,
+    poses: Vec<Vec<f32>>,
+    view: View,
+    size: f32,
+}
+
+/// The timed frames of the default pipeline, with the other AO levels run
+/// on the same curvatures beside them.
+struct FrameRuns {
+    /// Each frame's pass times.
+    t: Vec<PassTimes>,
+    /// Kernel ms of the `poly` AO level, per frame.
+    poly: Vec<f64>,
+    /// Kernel ms of the `exact` AO level, per frame.
+    exact: Vec<f64>,
+    /// Squared differences of `poly` from `exact`, over vertices and frames.
+    se_poly: f64,
+    /// Squared differences of `lut` from `exact`, over vertices and frames.
+    se_lut: f64,
+    /// Vertices × frames the squared differences sum over.
+    n: usize,
+}
+
+/// One warm-up frame (and AO level), then `runs` times every pose: the
+/// default pipeline's times and the AO levels' times and differences.
+fn frame_runs(b: &mut Bench, runs: usize) -> Result<FrameRuns> {
+    let (p, view, size, lines) = (&mut b.p, b.view, b.size, LineOptions::default());
+    p.frame(&b.poses[0], view, size, lines)?;
     for mode in AoMode::ALL {
         p.ao(mode)?;
     }
-    let mut t = Vec::new();
-    let (mut poly, mut exact) = (Vec::new(), Vec::new());
-    // Squared differences from the exact level, summed over vertices and frames.
-    let (mut se_poly, mut se_lut, mut n) = (0.0f64, 0.0f64, 0usize);
+    let mut fr = FrameRuns {
+        t: Vec::new(),
+        poly: Vec::new(),
+        exact: Vec::new(),
+        se_poly: 0.0,
+        se_lut: 0.0,
+        n: 0,
+    };
     for _ in 0..runs {
-        for mats in &poses {
+        for mats in &b.poses {
             let (_, times) = p.frame(mats, view, size, lines)?;
-            t.push(times);
+            fr.t.push(times);
             let lut = p.read_ao()?;
-            poly.push(p.ao(AoMode::Poly)?);
+            fr.poly.push(p.ao(AoMode::Poly)?);
             let pv = p.read_ao()?;
-            exact.push(p.ao(AoMode::Exact)?);
+            fr.exact.push(p.ao(AoMode::Exact)?);
             let ev = p.read_ao()?;
             for ((l, q), e) in lut.iter().zip(&pv).zip(&ev) {
-                se_lut += f64::from(l - e).powi(2);
-                se_poly += f64::from(q - e).powi(2);
+                fr.se_lut += f64::from(l - e).powi(2);
+                fr.se_poly += f64::from(q - e).powi(2);
             }
-            n += ev.len();
+            fr.n += ev.len();
         }
     }
-    // Each curvature line family alone, then every family at once: the
-    // feature-lines kernels of one view per pose (the pose terms once per
-    // pose), over the same poses.
+    Ok(fr)
+}
+
+/// Each curvature line family alone, then every family at once: the
+/// median feature-lines kernel ms of one view per pose (the pose terms once
+/// per pose), over the same poses.
+fn family_runs(b: &mut Bench) -> Result<Vec<(String, f64)>> {
     let mut fam_ms: Vec<(String, f64)> = Vec::new();
     let every = FamilySet(LineFamily::ALL.iter().fold(0, |m, f| m | f.bit()));
     let sets: Vec<(String, FamilySet)> = LineFamily::ALL[2..]
@@ -127,33 +218,34 @@ fn model(
             ..Default::default()
         };
         let mut ms = Vec::new();
-        for mats in &poses {
-            p.skin(mats)?;
-            p.curvature()?;
-            let (_, st) = p.lines(view, size, opts)?;
+        for mats in &b.poses {
+            b.p.skin(mats)?;
+            b.p.curvature()?;
+            let (_, st) = b.p.lines(b.view, b.size, opts)?;
             ms.push(st.timing.family_ms(Family::FeatureLines));
         }
         fam_ms.push((label, median(&mut ms)));
     }
-    let rms = |se: f64| (se / n.max(1) as f64).sqrt();
+    Ok(fam_ms)
+}
+
+/// The pass table of one model, its bars and the median totals.
+struct Passes {
+    table: Table,
+    /// (pass, median kernel ms), the total left out.
+    bars: (Vec<String>, Vec<f64>),
+    /// Median kernel total per frame.
+    kernel: f64,
+    /// Median host wall per frame.
+    wall: f64,
+}
+
+/// One row per pass of the model called `name`: median kernel ms and,
+/// for the AO levels, the RMS difference from `exact`; then the total.
+fn pass_table(index: usize, name: &str, fr: &mut FrameRuns) -> Passes {
+    let t = &fr.t;
+    let rms = |se: f64| (se / fr.n.max(1) as f64).sqrt();
     let med = |f: &dyn Fn(&PassTimes) -> f64| median(&mut t.iter().map(f).collect::<Vec<_>>());
-    let name = gltf.file_name().map_or_else(
-        || gltf.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
-    r.text(format!(
-        "{}Per-frame device pipeline on {name}: {} vertices, {} faces, {} poses × {runs} runs; \
-         device: {} ({} CUs); AO radius {:.4} (0.1 × RMS radius), feature size {size:.4}, \
-         {} segments in the last frame\n",
-        if index > 0 { "\n" } else { "" },
-        m.rest.positions.len(),
-        m.rest.faces.len(),
-        poses.len(),
-        gpu.info.name,
-        gpu.info.compute_units,
-        p.ao_radius(),
-        t.last().map_or(0, |x| x.segments),
-    ));
     let mut table = Table::new(
         KEYS[index.min(KEYS.len() - 1)],
         vec![
@@ -173,7 +265,7 @@ fn model(
             Cell::text(pass.trim_matches('*')),
             Cell::num(ms, format!("{ms:.3}")),
             err,
-            Cell::text(name.clone()),
+            Cell::text(name.to_string()),
         ]));
     };
     let e2 = |v: f64| Cell::sci(v, 2);
@@ -187,11 +279,15 @@ fn model(
         med(&|x| x.family_ms(Family::Curvature)),
         Cell::empty(),
     );
-    row("ao lut", med(&|x| x.family_ms(Family::Ao)), e2(rms(se_lut)));
-    row("ao poly", median(&mut poly), e2(rms(se_poly)));
+    row(
+        "ao lut",
+        med(&|x| x.family_ms(Family::Ao)),
+        e2(rms(fr.se_lut)),
+    );
+    row("ao poly", median(&mut fr.poly), e2(rms(fr.se_poly)));
     row(
         "ao exact",
-        median(&mut exact),
+        median(&mut fr.exact),
         Cell::shown("0 (reference)", serde_json::json!(0.0)),
     );
     row(
@@ -209,10 +305,18 @@ fn model(
     if let Some(last) = table.rows.last_mut() {
         last.cells[0].text = "**total (skin+curv+dcurv+ao lut+lines)**".into();
     }
-    r.blocks.push(Block::Table(table));
-    // The line families, beside the frame (not in its total): the
-    // feature-lines kernels of one view per pose, each family alone, then
-    // every family at once.
+    Passes {
+        table,
+        bars,
+        kernel,
+        wall,
+    }
+}
+
+/// The line families, beside the frame (not in its total): the
+/// feature-lines kernels of one view per pose, each family alone, then
+/// every family at once.
+fn lines_table(index: usize, name: &str, fam_ms: &[(String, f64)]) -> Table {
     let mut lines_table = Table::new(
         LINE_KEYS[index.min(LINE_KEYS.len() - 1)],
         vec![
@@ -221,30 +325,12 @@ fn model(
             Column::hidden("model"),
         ],
     );
-    for (label, ms) in &fam_ms {
+    for (label, ms) in fam_ms {
         lines_table.rows.push(Row::new(vec![
             Cell::text(label.trim_start_matches("lines: ")),
             Cell::num(*ms, format!("{ms:.3}")),
-            Cell::text(name.clone()),
+            Cell::text(name.to_string()),
         ]));
     }
-    r.text("\nFeature-line kernels per view (pose terms once per pose), by family:\n".to_string());
-    r.blocks.push(Block::Table(lines_table));
-    let verdict = |ms: f64| if ms <= 16.0 { "met" } else { "NOT met" };
-    r.text(format!(
-        "\nwall ms per frame (median, matrices up, segments back): {wall:.3}\n\
-         16 ms frame budget: {} by the kernel total ({kernel:.2} ms), {} by the wall time ({wall:.2} ms)",
-        verdict(kernel),
-        verdict(wall)
-    ));
-    r.charts.push(Chart::Bars {
-        title: format!(
-            "Per-frame device pipeline on {name}: median kernel ms per pass (total {kernel:.2} ms)"
-        ),
-        y_label: "kernel ms".into(),
-        log_y: false,
-        groups: bars.0,
-        series: vec![("median kernel ms".into(), bars.1)],
-    });
-    Ok(())
+    lines_table
 }

@@ -8,6 +8,8 @@ use super::{Chart, Report};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::coord::combinators::{BindKeyPoints, WithKeyPoints};
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Width of the SVG in pixels.
@@ -81,7 +83,14 @@ pub fn svg(report: &Report) -> Result<String> {
                     log_y,
                     groups,
                     series,
-                } => bars(area, &root, title, y_label, *log_y, groups, series)?,
+                } => {
+                    let data = BarChart {
+                        y_label,
+                        groups,
+                        series,
+                    };
+                    bars(area, &root, title, *log_y, &data)?
+                }
             }
         }
         root.present().map_err(err)?;
@@ -301,17 +310,21 @@ fn convergence(
     Ok(())
 }
 
-fn bars(
-    area: &Area,
-    root: &Area,
-    title: &str,
-    y_label: &str,
-    log_y: bool,
-    groups: &[String],
-    series: &[(String, Vec<f64>)],
-) -> Result<()> {
-    let values = || series.iter().flat_map(|s| s.1.iter().copied());
-    let n = groups.len();
+/// A bar chart's data: one bar per series in each group.
+struct BarChart<'s> {
+    /// The y axis' label.
+    y_label: &'s str,
+    /// The group names along x.
+    groups: &'s [String],
+    /// (name, one value per group) per series.
+    series: &'s [(String, Vec<f64>)],
+}
+
+/// Grouped bars on a linear or log y axis, the group names drawn on `root`
+/// under the axis.
+fn bars(area: &Area, root: &Area, title: &str, log_y: bool, data: &BarChart) -> Result<()> {
+    let values = || data.series.iter().flat_map(|s| s.1.iter().copied());
+    let n = data.groups.len();
     if n == 0 || values().all(|v| !v.is_finite()) {
         return no_data(area, title);
     }
@@ -323,10 +336,41 @@ fn bars(
         .margin(16)
         .x_label_area_size(36)
         .y_label_area_size(80);
-    let k = series.len().max(1) as f64;
-    let width = 0.8 / k;
+    if log_y {
+        let lo = values()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let (lo, hi) = (lo / 2.0, hi * 2.0);
+        let chart = builder
+            .build_cartesian_2d(
+                x,
+                (lo..hi).log_scale().with_key_points(log_ticks(&(lo..hi))),
+            )
+            .map_err(err)?;
+        draw_bars(chart, root, lo, data)
+    } else {
+        let chart = builder
+            .build_cartesian_2d(x, 0.0..(hi * 1.1).max(1e-9))
+            .map_err(err)?;
+        draw_bars(chart, root, 0.0, data)
+    }
+}
+
+/// The mesh, the bars from `base` up, their legend (more than one series)
+/// and the group names centred under their bars, on a linear or log y axis.
+fn draw_bars<'a, 'b: 'a, Y>(
+    mut chart: ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, Y>>,
+    root: &Area,
+    base: f64,
+    data: &BarChart,
+) -> Result<()>
+where
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let series = data.series;
+    let width = 0.8 / series.len().max(1) as f64;
     // One bar: series j of group i, from `base` to `v`.
-    let rect = |i: usize, j: usize, base: f64, v: f64| {
+    let rect = |i: usize, j: usize, v: f64| {
         let x0 = i as f64 - 0.4 + j as f64 * width;
         Rectangle::new(
             [(x0, base), (x0 + width * 0.92, v)],
@@ -337,76 +381,46 @@ fn bars(
         let c = Palette99::pick(j).to_rgba();
         move |(x, y): (i32, i32)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], c.filled())
     };
-    macro_rules! draw {
-        ($chart:expr, $base:expr) => {{
-            let mut chart = $chart;
-            chart
-                .configure_mesh()
-                .disable_x_mesh()
-                .x_labels(0)
-                .y_labels(12)
-                .y_label_formatter(&tick)
-                .y_desc(y_label)
-                .draw()
-                .map_err(err)?;
-            for (j, (name, vals)) in series.iter().enumerate() {
-                let base = $base;
-                chart
-                    .draw_series(
-                        vals.iter()
-                            .enumerate()
-                            .filter(|(_, v)| v.is_finite() && **v > base)
-                            .map(|(i, &v)| rect(i, j, base, v)),
-                    )
-                    .map_err(err)?
-                    .label(name.clone())
-                    .legend(legend(j));
-            }
-            if series.len() > 1 {
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font((FONT, 12))
-                    .draw()
-                    .map_err(err)?;
-            }
-            // The group names under the axis, centred on their bars.
-            let base = $base;
-            for (i, g) in groups.iter().enumerate() {
-                let (px, py) = chart.backend_coord(&(i as f64, base));
-                let style = TextStyle::from((FONT, 12).into_font()).pos(
-                    plotters::style::text_anchor::Pos::new(
-                        plotters::style::text_anchor::HPos::Center,
-                        plotters::style::text_anchor::VPos::Top,
-                    ),
-                );
-                root.draw_text(g, &style, (px, py + 8)).map_err(err)?;
-            }
-        }};
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_labels(12)
+        .y_label_formatter(&tick)
+        .y_desc(data.y_label)
+        .draw()
+        .map_err(err)?;
+    for (j, (name, vals)) in series.iter().enumerate() {
+        chart
+            .draw_series(
+                vals.iter()
+                    .enumerate()
+                    .filter(|(_, v)| v.is_finite() && **v > base)
+                    .map(|(i, &v)| rect(i, j, v)),
+            )
+            .map_err(err)?
+            .label(name.clone())
+            .legend(legend(j));
     }
-    if log_y {
-        let lo = values()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .fold(f64::INFINITY, f64::min);
-        let (lo, hi) = (lo / 2.0, hi * 2.0);
-        draw!(
-            builder
-                .build_cartesian_2d(
-                    x,
-                    (lo..hi).log_scale().with_key_points(log_ticks(&(lo..hi)))
-                )
-                .map_err(err)?,
-            lo
-        );
-    } else {
-        draw!(
-            builder
-                .build_cartesian_2d(x, 0.0..(hi * 1.1).max(1e-9))
-                .map_err(err)?,
-            0.0
-        );
+    if series.len() > 1 {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 12))
+            .draw()
+            .map_err(err)?;
+    }
+    // The group names under the axis, centred on their bars.
+    for (i, g) in data.groups.iter().enumerate() {
+        let (px, py) = chart.backend_coord(&(i as f64, base));
+        let style =
+            TextStyle::from((FONT, 12).into_font()).pos(plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Center,
+                plotters::style::text_anchor::VPos::Top,
+            ));
+        root.draw_text(g, &style, (px, py + 8)).map_err(err)?;
     }
     Ok(())
 }

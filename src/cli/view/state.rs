@@ -43,6 +43,13 @@ fn set_iso(s: &mut Scene, v: f64) {
 
 /// Every slider (the iso value's range is the volume's, set at start).
 pub fn sliders() -> Vec<Slider> {
+    let mut all = surface_sliders();
+    all.extend(line_sliders());
+    all
+}
+
+/// The surface's sliders: iso value, ambient term and AO radius.
+fn surface_sliders() -> Vec<Slider> {
     vec![
         Slider {
             key: "iso",
@@ -71,6 +78,13 @@ pub fn sliders() -> Vec<Slider> {
             get: |s| Some(f64::from(s.effects.ao_radius)),
             set: |s, v| s.effects.ao_radius = v as f32,
         },
+    ]
+}
+
+/// The lines' sliders: contour, suggestive contour and feature edge widths,
+/// the suggestive threshold and fade, and the crease angle.
+fn line_sliders() -> Vec<Slider> {
+    vec![
         Slider {
             key: "contour_width",
             label: "contour width (px)",

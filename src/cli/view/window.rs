@@ -125,6 +125,39 @@ fn open_window(
     let attrs = Window::default_attributes()
         .with_title(title)
         .with_inner_size(winit::dpi::PhysicalSize::new(inner[0], inner[1]));
+    let (window, config) = gl_config(el, &attrs)?;
+    let display = config.display();
+    let context = gl_context(&display, &config, window.as_ref())?;
+    let window = match window {
+        Some(w) => w,
+        None => glutin_winit::finalize_window(el, attrs, &config)
+            .map_err(|e| NoDisplay(format!("cannot open a window: {e}")))?,
+    };
+    let surface = gl_surface(&display, &config, &window)?;
+    let context = context
+        .make_current(&surface)
+        .map_err(|e| NoDisplay(format!("cannot make the window's GL context current: {e}")))?;
+    // No vsync: a script runs as fast as frames come; the UI repaints on events.
+    let _ = surface.set_swap_interval(&context, SwapInterval::DontWait);
+    // SAFETY: the context is current on this thread; the loader returns its
+    // entry points.
+    let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
+    Ok((
+        GlWindow {
+            window,
+            context,
+            surface,
+        },
+        gl,
+    ))
+}
+
+/// The display's first GL configuration for a window with `attrs`, and the
+/// window if the display made it already.
+fn gl_config(
+    el: &ActiveEventLoop,
+    attrs: &winit::window::WindowAttributes,
+) -> Result<(Option<Window>, glutin::config::Config), NoDisplay> {
     let template = glutin::config::ConfigTemplateBuilder::new()
         .with_depth_size(0)
         .with_stencil_size(0)
@@ -147,11 +180,16 @@ fn open_window(
         std::panic::set_hook(hook);
         r.unwrap_or_else(|_| Err("the display offers no matching configuration".into()))
     };
-    let (window, config) =
-        built.map_err(|e| NoDisplay(format!("no OpenGL configuration for a window: {e}")))?;
-    let display = config.display();
+    built.map_err(|e| NoDisplay(format!("no OpenGL configuration for a window: {e}")))
+}
+
+/// A desktop GL context for `config` (GLES if that fails), not yet current.
+fn gl_context(
+    display: &glutin::display::Display,
+    config: &glutin::config::Config,
+    window: Option<&Window>,
+) -> Result<glutin::context::NotCurrentContext, NoDisplay> {
     let handle = window
-        .as_ref()
         .and_then(|w| w.window_handle().ok())
         .map(|h| h.as_raw());
     let desktop = ContextAttributesBuilder::new().build(handle);
@@ -160,14 +198,17 @@ fn open_window(
         .build(handle);
     // SAFETY: the config and the raw window handle come from this display
     // and this event loop, and outlive the call.
-    let context = unsafe { display.create_context(&config, &desktop) }
-        .or_else(|_| unsafe { display.create_context(&config, &gles) })
-        .map_err(|e| NoDisplay(format!("cannot create an OpenGL context for a window: {e}")))?;
-    let window = match window {
-        Some(w) => w,
-        None => glutin_winit::finalize_window(el, attrs, &config)
-            .map_err(|e| NoDisplay(format!("cannot open a window: {e}")))?,
-    };
+    unsafe { display.create_context(config, &desktop) }
+        .or_else(|_| unsafe { display.create_context(config, &gles) })
+        .map_err(|e| NoDisplay(format!("cannot create an OpenGL context for a window: {e}")))
+}
+
+/// The GL surface of `window`, at its inner size.
+fn gl_surface(
+    display: &glutin::display::Display,
+    config: &glutin::config::Config,
+    window: &Window,
+) -> Result<Surface<WindowSurface>, NoDisplay> {
     let size = window.inner_size();
     let nz = |v: u32| NonZeroU32::new(v).unwrap_or(NonZeroU32::MIN);
     let raw = window
@@ -181,24 +222,8 @@ fn open_window(
     );
     // SAFETY: the surface is made for this window, which the GlWindow keeps
     // alive (and drops after the surface).
-    let surface = unsafe { display.create_window_surface(&config, &sattrs) }
-        .map_err(|e| NoDisplay(format!("cannot make a GL surface for the window: {e}")))?;
-    let context = context
-        .make_current(&surface)
-        .map_err(|e| NoDisplay(format!("cannot make the window's GL context current: {e}")))?;
-    // No vsync: a script runs as fast as frames come; the UI repaints on events.
-    let _ = surface.set_swap_interval(&context, SwapInterval::DontWait);
-    // SAFETY: the context is current on this thread; the loader returns its
-    // entry points.
-    let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
-    Ok((
-        GlWindow {
-            window,
-            context,
-            surface,
-        },
-        gl,
-    ))
+    unsafe { display.create_window_surface(config, &sattrs) }
+        .map_err(|e| NoDisplay(format!("cannot make a GL surface for the window: {e}")))
 }
 
 impl Handler {

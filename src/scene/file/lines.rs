@@ -21,7 +21,7 @@
 //! finds every family, so `fade` and `cull` are shared: tables that give
 //! them must agree, and so must the thresholds of ridges and valleys.
 
-use super::raw::{PlainLineSpec, ThresholdLineSpec};
+use super::raw::{IsophoteSpec, PlainLineSpec, ThresholdLineSpec};
 use crate::scene::planner::Cue;
 use crate::spec::feature_lines::{CurveOptions, FamilySet, Hidden, LineFamily, family_style};
 
@@ -125,9 +125,59 @@ fn shared(
 pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<LineEffects, String> {
     let mut curves = CurveOptions::default();
     let mut styles = Vec::new();
-    let (mut fade, mut cull) = (None, None);
-    let mut ridge_threshold: Option<(f32, &'static str)> = None;
-    fn t(s: &Option<ThresholdLineSpec>) -> Option<(Common<'_>, Option<f32>)> {
+    let mut shared_by = Shared::default();
+    let mut families = Vec::new();
+    for (cue, table) in tables(fx) {
+        let Some((c, threshold)) = table else {
+            continue;
+        };
+        let key = cue.key();
+        let family = cue.family().expect("a line family cue");
+        cues.push(cue);
+        families.push(family);
+        let d = LineStyle::default_for(family);
+        let width = super::positive(c.width, d.width, &format!("{key}.width"))?;
+        let color = super::color(c.color, d.color, &format!("{key}.color"))?;
+        let hidden = hidden(c.hidden, key)?;
+        shared(&mut shared_by.fade, c.fade, key, "fade")?;
+        shared(&mut shared_by.cull, c.cull, key, "cull")?;
+        if let Some(x) = threshold {
+            set_threshold(&mut curves, &mut shared_by.ridge_threshold, cue, x)?;
+        }
+        styles.push(LineStyle {
+            family,
+            width,
+            color,
+            hidden,
+        });
+    }
+    if let Some(s) = &fx.isophotes {
+        isophotes(s, &mut curves)?;
+    }
+    curves.families = FamilySet::of(&families);
+    curves.fade = shared_by.fade.is_none_or(|f| f.0);
+    curves.cull = shared_by.cull.is_none_or(|c| c.0);
+    Ok(LineEffects { styles, curves })
+}
+
+/// The settings every family shares, each with the first table that set it.
+#[derive(Default)]
+struct Shared {
+    /// `fade`.
+    fade: Option<(bool, &'static str)>,
+    /// `cull`.
+    cull: Option<(bool, &'static str)>,
+    /// The threshold of ridges and valleys.
+    ridge_threshold: Option<(f32, &'static str)>,
+}
+
+/// A line family table: what every table has, and its threshold if it takes one.
+type LineTable<'a> = Option<(Common<'a>, Option<f32>)>;
+
+/// Each line family cue with its table in `fx` (`None`: not asked), in
+/// family order.
+fn tables(fx: &super::EffectsSpec) -> [(Cue, LineTable<'_>); 10] {
+    fn t(s: &Option<ThresholdLineSpec>) -> LineTable<'_> {
         s.as_ref().map(|s| {
             (
                 Common {
@@ -141,7 +191,7 @@ pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<Li
             )
         })
     }
-    fn p(s: &Option<PlainLineSpec>) -> Option<(Common<'_>, Option<f32>)> {
+    fn p(s: &Option<PlainLineSpec>) -> LineTable<'_> {
         s.as_ref().map(|s| {
             (
                 Common {
@@ -167,7 +217,7 @@ pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<Li
             None,
         )
     });
-    let tables = [
+    [
         (Cue::Ridges, t(&fx.ridges)),
         (Cue::Valleys, t(&fx.valleys)),
         (Cue::ApparentRidges, t(&fx.apparent_ridges)),
@@ -178,76 +228,67 @@ pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<Li
         (Cue::HZero, p(&fx.h_zero)),
         (Cue::DwkrZero, p(&fx.dwkr_zero)),
         (Cue::Boundaries, p(&fx.boundaries)),
-    ];
-    let mut families = Vec::new();
-    for (cue, table) in tables {
-        let Some((c, threshold)) = table else {
-            continue;
-        };
-        let key = cue.key();
-        let family = cue.family().expect("a line family cue");
-        cues.push(cue);
-        families.push(family);
-        let d = LineStyle::default_for(family);
-        let width = super::positive(c.width, d.width, &format!("{key}.width"))?;
-        let color = super::color(c.color, d.color, &format!("{key}.color"))?;
-        let hidden = match c.hidden {
-            None => Hidden::Remove,
-            Some(h) => h
-                .parse::<Hidden>()
-                .map_err(|_| format!("{key}.hidden {h:?}: expected remove, faded or dashed"))?,
-        };
-        shared(&mut fade, c.fade, key, "fade")?;
-        shared(&mut cull, c.cull, key, "cull")?;
-        if let Some(x) = threshold {
-            if !(x.is_finite() && x >= 0.0) {
-                return Err(format!("{key}.threshold {x} must be a finite number ≥ 0"));
-            }
-            match cue {
-                Cue::Ridges | Cue::Valleys => match ridge_threshold {
-                    Some((y, by)) if y != x => {
-                        return Err(format!(
-                            "{key}.threshold = {x} but {by}.threshold = {y}: ridges and valleys \
-                             share one threshold"
-                        ));
-                    }
-                    _ => {
-                        ridge_threshold = Some((x, key));
-                        curves.ridge_threshold = x;
-                    }
-                },
-                Cue::ApparentRidges => curves.apparent_threshold = x,
-                Cue::SuggestiveHighlights => curves.highlight_threshold = x,
-                _ => curves.principal_threshold = x,
-            }
-        }
-        styles.push(LineStyle {
-            family,
-            width,
-            color,
-            hidden,
-        });
+    ]
+}
+
+/// `{key}.hidden`: the hidden parts in the SVG (default: removed).
+fn hidden(h: &Option<String>, key: &str) -> Result<Hidden, String> {
+    match h {
+        None => Ok(Hidden::Remove),
+        Some(h) => h
+            .parse::<Hidden>()
+            .map_err(|_| format!("{key}.hidden {h:?}: expected remove, faded or dashed")),
     }
-    if let Some(s) = &fx.isophotes {
-        if let Some(n) = s.count {
-            if !(1..=1000).contains(&n) {
-                return Err(format!("isophotes.count {n} must be 1 to 1000"));
-            }
-            curves.isophotes = n;
-        }
-        if let Some(l) = s.light {
-            let n = l.iter().map(|c| c * c).sum::<f32>().sqrt();
-            if !(n.is_finite() && n > 0.0) {
+}
+
+/// `{key}.threshold` = `x` into `curves`; ridges and valleys must agree.
+fn set_threshold(
+    curves: &mut CurveOptions,
+    ridge_threshold: &mut Option<(f32, &'static str)>,
+    cue: Cue,
+    x: f32,
+) -> Result<(), String> {
+    let key = cue.key();
+    if !(x.is_finite() && x >= 0.0) {
+        return Err(format!("{key}.threshold {x} must be a finite number ≥ 0"));
+    }
+    match cue {
+        Cue::Ridges | Cue::Valleys => match *ridge_threshold {
+            Some((y, by)) if y != x => {
                 return Err(format!(
-                    "isophotes.light [{}, {}, {}] must be a finite, non-zero direction",
-                    l[0], l[1], l[2]
+                    "{key}.threshold = {x} but {by}.threshold = {y}: ridges and valleys \
+                     share one threshold"
                 ));
             }
-            curves.light = l;
-        }
+            _ => {
+                *ridge_threshold = Some((x, key));
+                curves.ridge_threshold = x;
+            }
+        },
+        Cue::ApparentRidges => curves.apparent_threshold = x,
+        Cue::SuggestiveHighlights => curves.highlight_threshold = x,
+        _ => curves.principal_threshold = x,
     }
-    curves.families = FamilySet::of(&families);
-    curves.fade = fade.is_none_or(|f| f.0);
-    curves.cull = cull.is_none_or(|c| c.0);
-    Ok(LineEffects { styles, curves })
+    Ok(())
+}
+
+/// `isophotes.count` and `isophotes.light` into `curves`.
+fn isophotes(s: &IsophoteSpec, curves: &mut CurveOptions) -> Result<(), String> {
+    if let Some(n) = s.count {
+        if !(1..=1000).contains(&n) {
+            return Err(format!("isophotes.count {n} must be 1 to 1000"));
+        }
+        curves.isophotes = n;
+    }
+    if let Some(l) = s.light {
+        let n = l.iter().map(|c| c * c).sum::<f32>().sqrt();
+        if !(n.is_finite() && n > 0.0) {
+            return Err(format!(
+                "isophotes.light [{}, {}, {}] must be a finite, non-zero direction",
+                l[0], l[1], l[2]
+            ));
+        }
+        curves.light = l;
+    }
+    Ok(())
 }

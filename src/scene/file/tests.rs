@@ -1,6 +1,10 @@
 //! Scene-file parsing and checks.
 
 use super::*;
+use crate::scene::planner::Cue;
+use crate::spec::ao::AoMode;
+use crate::spec::edges::CapMode;
+use crate::spec::feature_lines::FeatureSize;
 
 fn parse(text: &str) -> Result<Scene> {
     Scene::from_str(Path::new("/nonexistent/dir/test.toml"), text)
