@@ -48,7 +48,8 @@ mod load;
 mod passes;
 mod report;
 
-pub use live::{Change, LiveFrame, LiveRequest, ViewOutputs};
+pub use draw::ViewOutputs;
+pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
 

@@ -14,6 +14,7 @@ use crate::scene::planner::{Cue, Pass, Plan};
 use crate::spec::edges::EdgeOutput;
 use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
+use crate::spec::timing::Timing;
 use std::path::PathBuf;
 
 /// Host copies of the pose that the renderer and the host-side passes use,
@@ -351,4 +352,26 @@ fn family_layers(
         lines: visible_joined(&clip, image, DEFAULT_BIAS),
         dashed: false,
     });
+}
+
+/// What a view drawn into memory hands its caller.
+pub struct ViewOutputs {
+    /// The image (RGBA, row 0 at the top; with depth when `layers` were found).
+    pub image: Frame,
+    /// The SVG groups (the scene's `svg` output asked for them).
+    pub layers: Option<Vec<SvgLayer>>,
+    /// The line segments found for this view (world coordinates).
+    pub segments: Vec<Segment>,
+    /// The edge stage's outputs as drawn, when feature edges are planned.
+    pub edges: Option<EdgeOutput>,
+    /// The curvature-directed strokes of the pose (world coordinates).
+    pub strokes: Vec<Stroke>,
+    /// The camera (world coordinates).
+    pub camera: Camera,
+    /// The feature size the line families' thresholds were scaled by, when
+    /// lines were found.
+    pub feature_size: Option<f32>,
+    /// Kernel time of this pose's curvature run and this view's lines and
+    /// edges.
+    pub timing: Timing,
 }

@@ -12,19 +12,15 @@
 //! (the image comes back in the [`LiveFrame`]). Each frame reports the
 //! passes that ran for it, as the run report does for a whole run.
 
+use super::draw::ViewOutputs;
 use super::load::{Loaded, load};
 use super::passes::Executor;
 use super::report::{PassRecord, Recorder};
 use super::{ExecOptions, Session, frame_indices};
 use crate::error::{Error, Result};
-use crate::export::svg::SvgLayer;
-use crate::render::{Camera, Frame, RenderOptions};
+use crate::render::RenderOptions;
 use crate::scene::file::Scene;
 use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
-use crate::spec::edges::EdgeOutput;
-use crate::spec::feature_lines::Segment;
-use crate::spec::sdf_lines::Stroke;
-use crate::spec::timing::Timing;
 use std::path::PathBuf;
 
 /// One frame to draw: the scene with the camera (its first view) and the
@@ -48,28 +44,6 @@ pub enum Change {
     Pose,
     /// Only the camera (or nothing): the view passes.
     View,
-}
-
-/// What a view drawn into memory hands its caller.
-pub struct ViewOutputs {
-    /// The image (RGBA, row 0 at the top; with depth when `layers` were found).
-    pub image: Frame,
-    /// The SVG groups (the scene's `svg` output asked for them).
-    pub layers: Option<Vec<SvgLayer>>,
-    /// The line segments found for this view (world coordinates).
-    pub segments: Vec<Segment>,
-    /// The edge stage's outputs as drawn, when feature edges are planned.
-    pub edges: Option<EdgeOutput>,
-    /// The curvature-directed strokes of the pose (world coordinates).
-    pub strokes: Vec<Stroke>,
-    /// The camera (world coordinates).
-    pub camera: Camera,
-    /// The feature size the line families' thresholds were scaled by, when
-    /// lines were found.
-    pub feature_size: Option<f32>,
-    /// Kernel time of this pose's curvature run and this view's lines and
-    /// edges.
-    pub timing: Timing,
 }
 
 /// A drawn frame.

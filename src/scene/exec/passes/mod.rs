@@ -140,7 +140,7 @@ pub(super) struct Executor<'s, 'g> {
     /// Also find each kept view's SVG groups.
     pub(super) keep_layers: bool,
     /// The last view's outputs, when kept.
-    pub(super) kept: Option<super::live::ViewOutputs>,
+    pub(super) kept: Option<super::draw::ViewOutputs>,
 }
 
 impl<'s, 'g> Executor<'s, 'g> {

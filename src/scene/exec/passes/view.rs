@@ -174,7 +174,7 @@ impl Executor<'_, '_> {
     /// groups, the segments (world coordinates), the edge stage's outputs,
     /// the strokes, the camera (world coordinates) and the kernel time of
     /// the pose and the view.
-    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> super::super::live::ViewOutputs {
+    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> super::super::draw::ViewOutputs {
         let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let world =
             |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
@@ -189,7 +189,7 @@ impl Executor<'_, '_> {
         {
             timing.extend(t);
         }
-        super::super::live::ViewOutputs {
+        super::super::draw::ViewOutputs {
             image: d.image,
             layers: d.layers,
             segments: (self.segs.iter())
