@@ -13,18 +13,12 @@
 // on it; its vertices are numbered x-edges first, then y, then z, each in x
 // order, from off[r] on. Cell row (y, z) reads grid rows 00 = (y, z),
 // 10 = (y+1, z), 01 = (y, z+1), 11 = (y+1, z+1).
-//   mc_direct_rows       per grid row  where its x-edges cross, its ends' sides (info)
-//   mc_direct_count      per grid row  in the x range where its rows differ:
-//                                      vertices, triangles, hits (vertices on a
-//                                      grid point), twins; y/z splits; trim range
+//   mc_direct_rows       per grid row  where its x-edges cross (info)
+//   mc_direct_count      per grid row  vertices, triangles, hits, twins; splits; trim
 //   (scan.cl)                          one exclusive scan of rowc[0..4G)
-//   mc_direct_hits       per grid row  only with hits: the hit points' grid indices
-//                                      (sorted and made unique on the host)
-//   mc_direct_recount    per cell row  only then: kept triangles (collapsing dropped;
-//                                      only the cells with a corner on a hit point)
-//   mc_direct_triangles  per cell row  owned vertices' positions, triangles with
-//                                      final indices; those with a hit corner
-//                                      lying in a grid plane also listed in `side`
+//   mc_direct_hits       per grid row  only with hits: the hit points
+//   mc_direct_recount    per cell row  only then: kept triangles
+//   mc_direct_triangles  per cell row  positions, triangles with final indices
 //   mc_direct_points     per hit       positions of the hit slots
 // One work-item walks one row, 16 cells at a time (float16 loads), reading
 // nothing outside the row's trim range but the 16-cell chunk that ends at the
@@ -35,11 +29,6 @@
 // place into off); split uint[2G]; trim uint[3G]; tcount uint[G]; hit_keys
 // uint[H] (sorted, unique: U); pos float[3(V+U)]; faces uint[3T]; side
 // uint[3·20H]; V, T, H the scan's first three partial totals.
-//
-// With no hit and a finite volume no triangle can collapse and the only twins
-// (a flat triangle and its mirror across the face) are found by has_twin;
-// otherwise the host checks the listed triangles and runs vertex fusion's
-// clean-up only when it would change the mesh (docs/notes/isosurface-kernels.md).
 
 // Per grid row, read once (Flying Edges' first pass): info[4r..] = the first
 // cell whose x-edge crosses iso or touches a non-finite value (nx if none),
@@ -293,6 +282,13 @@ __kernel void mc_direct_count(uint grid_rows, uint nx, uint ny, uint nz,
     trim[3 * gid + 2] = mask;
 }
 
+// Only with hits (vertices rounding onto a grid point), per grid row: the
+// grid indices of its hit points, listed in keys (sorted and made unique on
+// the host). With no hit and a finite volume no triangle can collapse and the
+// only twins (a flat triangle and its mirror across the face) are found by
+// has_twin; otherwise the host checks the triangles listed in `side` and runs
+// vertex fusion's clean-up only when it would change the mesh
+// (docs/notes/isosurface-kernels.md).
 __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
                              __global const float *vol, float iso, __global const uint *off,
                              __global const uint *trim, uint hit_base, uint hit_end,
@@ -339,8 +335,9 @@ __kernel void mc_direct_hits(uint grid_rows, uint nx, uint ny, uint nz,
 }
 
 // Only where there are hits: the triangles of each cell row that are kept
-// (twins across faces and collapsing triangles dropped) into tcount[r]; rows
-// whose four grid rows have no hit keep their count from the first scan.
+// (twins across faces and collapsing triangles dropped) into tcount[r]; only
+// the cells with a corner on a hit point are looked at again, and rows whose
+// four grid rows have no hit keep their count from the first scan.
 __kernel void mc_direct_recount(uint grid_rows, uint nx, uint ny, uint nz,
                                 __global const float *vol, float iso, __constant uchar *counts,
                                 __constant uchar *tris, __constant uchar *flat,
@@ -677,6 +674,8 @@ __kernel void mc_direct_triangles(uint grid_rows, uint nx, uint ny, uint nz,
                       nh, hit_keys, pos, faces, side_cap, side, side_n, gid, trim[3 * gid + 2], false);
 }
 
+// Per hit point: the position of its vertex (slot V + its rank among the
+// sorted, unique hit points).
 __kernel void mc_direct_points(uint nh, __global const uint *hit_keys, uint nx, uint ny,
                                uint edge_vertices, __global float *pos)
 {

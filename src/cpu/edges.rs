@@ -77,43 +77,8 @@ pub fn edges_detect(
     let mut out = Vec::with_capacity(4 * edges.len());
     let mut kinds = Vec::with_capacity(edges.len());
     for &[i0, i1, i2, i3] in edges {
-        let (v0, v1, v2, v3) = (at(pos, i0), at(pos, i1), at(pos, i2), at(pos, i3));
-        let u = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
-        let v = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
-        let na = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let w = [v3[0] - v1[0], v3[1] - v1[1], v3[2] - v1[2]];
-        let nb = [
-            w[1] * u[2] - w[2] * u[1],
-            w[2] * u[0] - w[0] * u[2],
-            w[0] * u[1] - w[1] * u[0],
-        ];
-        let mut k = 0;
-        if i3 == i0 {
-            if p.boundaries != 0.0 {
-                k |= KIND_BOUNDARY;
-            }
-        } else {
-            let e = if p.ortho != 0.0 {
-                p.view_dir.map(|c| -c)
-            } else {
-                [p.eye[0] - v0[0], p.eye[1] - v0[1], p.eye[2] - v0[2]]
-            };
-            let da = na[0] * e[0] + na[1] * e[1] + na[2] * e[2];
-            let db = nb[0] * e[0] + nb[1] * e[1] + nb[2] * e[2];
-            if p.contours != 0.0 && ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
-                k |= KIND_CONTOUR;
-            }
-            let dn = na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2];
-            let la = na[0] * na[0] + na[1] * na[1] + na[2] * na[2];
-            let lb = nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2];
-            if dn < p.cos_crease * (la * lb).sqrt() {
-                k |= KIND_CREASE;
-            }
-        }
+        let (v0, v1) = (at(pos, i0), at(pos, i1));
+        let k = edge_kind(p, pos, [i0, i1, i2, i3]);
         let pr = project(p, v0, v1);
         let drawn = k != 0 && pr.c0[3] > p.w_min && pr.c1[3] > p.w_min;
         if !drawn {
@@ -122,37 +87,89 @@ pub fn edges_detect(
             continue;
         }
         kinds.push(k | KIND_DRAWN);
-        let (s0, s1, q, f0, f1) = (pr.s0, pr.s1, pr.perp, pr.f0, pr.f1);
-        let (c0, c1) = (pr.c0, pr.c1);
-        // Half quads for contour-only edges: outward by the full width.
-        let half = p.half_contours != 0.0 && k == KIND_CONTOUR;
-        let n = if half { at(nrm, i0) } else { at(nrm, 0) };
-        let d = clip(p, n, 0.0);
-        let m = [
-            (d[0] * c0[3] - c0[0] * d[3]) * p.half_vw,
-            (d[1] * c0[3] - c0[1] * d[3]) * p.half_vh,
-        ];
-        let g = if m[0] * q[0] + m[1] * q[1] >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
-        let (lo, hi) = if half { (0.0, 2.0 * g) } else { (1.0, 1.0) };
-        let mut put = |s: [f32; 2], c: [f32; 4], f: f32, t: f32| {
-            out.push(screen(
-                p,
-                s[0] + q[0] * f * t,
-                s[1] + q[1] * f * t,
-                c[2],
-                c[3],
-            ));
-        };
-        put(s0, c0, f0, -lo);
-        put(s1, c1, f1, -lo);
-        put(s1, c1, f1, hi);
-        put(s0, c0, f0, hi);
+        edge_quad(p, &pr, nrm, i0, k, &mut out);
     }
     (out, kinds)
+}
+
+/// The kind bits of edge entry `[i0, i1, i2, i3]` (faces i0 i1 i2 and
+/// i1 i0 i3, or a boundary where i3 == i0): boundary, contour, crease.
+fn edge_kind(p: &P, pos: &[[f32; 3]], [i0, i1, i2, i3]: [u32; 4]) -> u32 {
+    let (v0, v1, v2, v3) = (at(pos, i0), at(pos, i1), at(pos, i2), at(pos, i3));
+    let u = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
+    let v = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
+    let na = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let w = [v3[0] - v1[0], v3[1] - v1[1], v3[2] - v1[2]];
+    let nb = [
+        w[1] * u[2] - w[2] * u[1],
+        w[2] * u[0] - w[0] * u[2],
+        w[0] * u[1] - w[1] * u[0],
+    ];
+    let mut k = 0;
+    if i3 == i0 {
+        if p.boundaries != 0.0 {
+            k |= KIND_BOUNDARY;
+        }
+    } else {
+        let e = if p.ortho != 0.0 {
+            p.view_dir.map(|c| -c)
+        } else {
+            [p.eye[0] - v0[0], p.eye[1] - v0[1], p.eye[2] - v0[2]]
+        };
+        let da = na[0] * e[0] + na[1] * e[1] + na[2] * e[2];
+        let db = nb[0] * e[0] + nb[1] * e[1] + nb[2] * e[2];
+        if p.contours != 0.0 && ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+            k |= KIND_CONTOUR;
+        }
+        let dn = na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2];
+        let la = na[0] * na[0] + na[1] * na[1] + na[2] * na[2];
+        let lb = nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2];
+        if dn < p.cos_crease * (la * lb).sqrt() {
+            k |= KIND_CREASE;
+        }
+    }
+    k
+}
+
+/// The quad of a drawn edge from vertex `i0`, of kind `k`, projected as
+/// `pr`, pushed onto `out` (4 vertices); a contour-only edge with half
+/// quads extends outward by the full width, on the side the projected
+/// normal of i0 points to (vertex 0's normal is read otherwise, as in the
+/// kernel, and leaves the quad centred).
+fn edge_quad(p: &P, pr: &Projected, nrm: &[[f32; 3]], i0: u32, k: u32, out: &mut Vec<[f32; 4]>) {
+    let (s0, s1, q, f0, f1) = (pr.s0, pr.s1, pr.perp, pr.f0, pr.f1);
+    let (c0, c1) = (pr.c0, pr.c1);
+    // Half quads for contour-only edges: outward by the full width.
+    let half = p.half_contours != 0.0 && k == KIND_CONTOUR;
+    let n = if half { at(nrm, i0) } else { at(nrm, 0) };
+    let d = clip(p, n, 0.0);
+    let m = [
+        (d[0] * c0[3] - c0[0] * d[3]) * p.half_vw,
+        (d[1] * c0[3] - c0[1] * d[3]) * p.half_vh,
+    ];
+    let g = if m[0] * q[0] + m[1] * q[1] >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    };
+    let (lo, hi) = if half { (0.0, 2.0 * g) } else { (1.0, 1.0) };
+    let mut put = |s: [f32; 2], c: [f32; 4], f: f32, t: f32| {
+        out.push(screen(
+            p,
+            s[0] + q[0] * f * t,
+            s[1] + q[1] * f * t,
+            c[2],
+            c[3],
+        ));
+    };
+    put(s0, c0, f0, -lo);
+    put(s1, c1, f1, -lo);
+    put(s1, c1, f1, hi);
+    put(s0, c0, f0, hi);
 }
 
 /// `caps_mh`: McGuire-Hughes half-caps at the i0 and i1 ends of every drawn

@@ -108,6 +108,7 @@ pub fn zero_hermite(fa: f32, fb: f32, da: f32, db: f32) -> f32 {
 /// `gradkr`), for the Hermite placement of suggestive contours and
 /// highlights; `uu`, `ww` the view vector's components along e1, e2, `c`
 /// n·v, `rlen` 1 / distance to the eye (0 orthographic).
+// Mirrors grad_kr of kernels/common/isoline.h argument for argument.
 #[allow(clippy::too_many_arguments)]
 pub fn grad_kr(
     e1: [f32; 3],
@@ -193,6 +194,8 @@ pub fn test_alpha(num: f32, den: f32, fade: f32) -> f32 {
 /// `emit_tested` of kernels/common/isoline.h: the segment `pa → pb` of face
 /// `f` (its ends on the mesh edges `ea`, `eb`) whole (without the test), or
 /// its tested pieces, each with the mean of its ends' fades as strength.
+// Mirrors emit_tested of kernels/common/isoline.h argument for argument
+// (pairs grouped; its outputs as `out`).
 #[allow(clippy::too_many_arguments)]
 pub fn emit_tested(
     out: &mut Vec<Segment>,
@@ -225,6 +228,9 @@ pub fn emit_tested(
 /// `test` (contours: κr ≥ 0; suggestive contours: sinθ D_w κr / (n·v) ≥
 /// `sc_thresh`, faded by `fade`), suggestive contours placed by rtsc's
 /// Hermite fit when `hermite`.
+// Mirrors the kernel lines_face of kernels/feature_lines.cl argument for
+// argument (ndv, kr, sc, gkr as `t`, the two wants as `want`; its outputs
+// returned).
 #[allow(clippy::too_many_arguments)]
 pub fn lines_face(
     faces: &[[u32; 3]],

@@ -297,6 +297,8 @@ fn ridge_w(ea: f32, eb: f32) -> f32 {
 
 /// One ridge-like segment; with `judd` (the directions of increasing q1 at
 /// the three corners), Judd et al.'s test of apparent ridges.
+// Mirrors ridge_segment of kernels/feature_lines_curves.cl argument for
+// argument (its outputs as `out`; judd with t0, t1, t2 as one Option).
 #[allow(clippy::too_many_arguments)]
 fn ridge_segment(
     out: &mut Out,
@@ -351,6 +353,10 @@ fn rot2<T: Copy>(a: [T; 3]) -> [T; 3] {
     [a[2], a[0], a[1]]
 }
 
+/// The ridge-like segments of face `f` (corners `v`) where the directions
+/// `t` at its corners flip.
+// Mirrors ridge_face of kernels/feature_lines_curves.cl argument for
+// argument (its outputs as `out`; t0, t1, t2 as `t`).
 #[allow(clippy::too_many_arguments)]
 fn ridge_face(
     out: &mut Out,
@@ -471,165 +477,245 @@ pub fn lines_curves(
     let mut segs = Vec::new();
     let mut out = Out { segs: &mut segs };
     let want = o.families;
-    let (test, fade) = (o.test, o.fade);
-    let (vt, pt, wt) = (x.vertex, x.pose, x.view);
     for (fi, face) in faces.iter().enumerate() {
-        let v = *face;
-        let g = |a: &[f32]| v.map(|i| a[i as usize]);
-        let nd = g(&vt.ndv);
+        let f = CurveFace {
+            fi,
+            v: *face,
+            pos,
+            x,
+            o,
+            thr,
+        };
         if want.has(LineFamily::Boundaries) {
-            for j in 0..3 {
-                if x.bnd[fi] & (1 << j) != 0 {
-                    let (ia, ib) = (v[j], v[(j + 1) % 3]);
-                    out.emit(
-                        pos[ia as usize],
-                        pos[ib as usize],
-                        LineFamily::Boundaries,
-                        1.0,
-                        [[ia, ia], [ib, ib]],
-                    );
-                }
-            }
+            f.boundaries(&mut out);
         }
         if want.has(LineFamily::ApparentRidges) {
-            // Not culled, as in rtsc.
-            let q = g(&wt.q1);
-            let e = g(x.dt);
-            if q.iter().any(|&qq| qq > thr.ar) {
-                let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
-                let fam = LineFamily::ApparentRidges;
-                ridge_face(
-                    &mut out, fi as u32, v, e, t, q, pos, test, thr.ar, fade, fam, true,
-                );
-            }
+            f.apparent_ridges(&mut out);
         }
-        if o.cull && nd.iter().all(|&n| n <= 0.0) {
+        if o.cull && f.g(&x.vertex.ndv).iter().all(|&n| n <= 0.0) {
             continue;
         }
-        let km = g(&pt.kmax);
-        let dm = v.map(|i| pt.dmax[i as usize]);
-        for (fam, sg) in [(LineFamily::Ridges, 1.0f32), (LineFamily::Valleys, -1.0)] {
-            if !want.has(fam) || !km.iter().all(|&k| sg * k > 0.0) {
-                continue;
-            }
-            let em = g(&pt.emax);
-            let t = [0, 1, 2].map(|i| mul(sg * em[i], dm[i]));
-            ridge_face(
-                &mut out, fi as u32, v, em, t, km, pos, test, thr.rv, fade, fam, false,
-            );
-        }
+        f.ridges_valleys(&mut out);
         if want.has(LineFamily::PrincipalHighlights) {
-            let mut r = 0;
-            for i in 1..3 {
-                if km[i].abs() > km[r].abs() {
-                    r = i;
-                }
-            }
-            let mut ok = true;
-            let mut dots = g(&wt.phdot);
-            for i in 0..3 {
-                let c = dot(dm[i], dm[r]);
-                if c < 0.0 {
-                    dots[i] *= -1.0;
-                }
-                ok = ok && c.abs() >= std::f32::consts::FRAC_1_SQRT_2;
-            }
-            let tst = g(&wt.phtest);
-            let kmin = km[0].min(km[1]).min(km[2]);
-            let kmax = km[0].max(km[1]).max(km[2]);
-            let flavour = !test || kmin >= 0.0 || kmax <= 0.0;
-            let z01 = dots[0] * dots[1] <= 0.0;
-            let z12 = dots[1] * dots[2] <= 0.0;
-            let z20 = dots[2] * dots[0] <= 0.0;
-            if ok && flavour && (z01 as u32 + z12 as u32 + z20 as u32) >= 2 {
-                let fam = LineFamily::PrincipalHighlights;
-                let f = fi as u32;
-                let (rv, rd, rt) = if !z01 {
-                    (rot1(v), rot1(dots), rot1(tst))
-                } else if !z12 {
-                    (rot2(v), rot2(dots), rot2(tst))
-                } else {
-                    (v, dots, tst)
-                };
-                if !(z01 && z12 && z20) {
-                    ridge_segment(&mut out, f, rv, rd, rt, pos, thr.ph, fade, false, fam, None);
-                }
-            }
+            f.principal_highlights(&mut out);
         }
         if want.has(LineFamily::SuggestiveHighlights) {
-            let f = g(&vt.kr);
-            if let Some(c) = odd_corner(f) {
-                let tt = if o.hermite {
-                    // rtsc's Hermite placement from the gradient of κr sin²θ.
-                    let (a, b) = ((c + 1) % 3, (c + 2) % 3);
-                    let (ic, ia, ib) = (v[c] as usize, v[a] as usize, v[b] as usize);
-                    let (ea, eb) = (sub(pos[ia], pos[ic]), sub(pos[ib], pos[ic]));
-                    let gk = &vt.gkr;
-                    (
-                        zero_hermite(f[c], f[a], dot(ea, gk[ic]), dot(ea, gk[ia])),
-                        zero_hermite(f[c], f[b], dot(eb, gk[ic]), dot(eb, gk[ib])),
-                    )
-                } else {
-                    iso_params(v, f, c, pos, None)
-                };
-                let (a, b) = ((c + 1) % 3, (c + 2) % 3);
-                let s3 = g(&vt.sc);
-                let num: [f32; 3] = std::array::from_fn(|i| -s3[i] - thr.sh * nd[i]);
-                let ends = [
-                    num[c] + tt.0 * (num[a] - num[c]),
-                    num[c] + tt.1 * (num[b] - num[c]),
-                    nd[c] + tt.0 * (nd[a] - nd[c]),
-                    nd[c] + tt.1 * (nd[b] - nd[c]),
-                ];
-                let pc = pos[v[c] as usize];
-                emit_tested(
-                    out.segs,
-                    (
-                        lerp(pc, pos[v[a] as usize], tt.0),
-                        lerp(pc, pos[v[b] as usize], tt.1),
-                    ),
-                    (edge_of(v[c], v[a]), edge_of(v[c], v[b])),
-                    fi as u32,
-                    ends,
-                    test,
-                    thr.sh_fade,
-                    LineFamily::SuggestiveHighlights as u32,
+            f.suggestive_highlights(&mut out);
+        }
+        f.zero_sets(&mut out);
+        if want.has(LineFamily::Isophotes) && o.isophotes > 0 {
+            f.isophotes(&mut out);
+        }
+    }
+    segs
+}
+
+/// One face of [`lines_curves`] and what its families read; its methods
+/// are the families, in the kernel's order.
+struct CurveFace<'a> {
+    /// Face index and corners.
+    fi: usize,
+    v: [u32; 3],
+    pos: &'a [V3],
+    x: &'a CurveTerms<'a>,
+    o: &'a CurveOptions,
+    thr: ScaledThresholds,
+}
+
+impl CurveFace<'_> {
+    /// The corners' values of a per-vertex array.
+    fn g(&self, a: &[f32]) -> [f32; 3] {
+        self.v.map(|i| a[i as usize])
+    }
+
+    /// The face's edges marked as boundary edges.
+    fn boundaries(&self, out: &mut Out) {
+        let (v, pos) = (self.v, self.pos);
+        for j in 0..3 {
+            if self.x.bnd[self.fi] & (1 << j) != 0 {
+                let (ia, ib) = (v[j], v[(j + 1) % 3]);
+                out.emit(
+                    pos[ia as usize],
+                    pos[ib as usize],
+                    LineFamily::Boundaries,
+                    1.0,
+                    [[ia, ia], [ib, ib]],
                 );
             }
         }
+    }
+
+    /// Apparent ridges (not culled, as in rtsc).
+    fn apparent_ridges(&self, out: &mut Out) {
+        let (v, wt, thr) = (self.v, self.x.view, self.thr);
+        let q = self.g(&wt.q1);
+        let e = self.g(self.x.dt);
+        if q.iter().any(|&qq| qq > thr.ar) {
+            let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
+            let fam = LineFamily::ApparentRidges;
+            let (f, pos, test, fade) = (self.fi as u32, self.pos, self.o.test, self.o.fade);
+            ridge_face(out, f, v, e, t, q, pos, test, thr.ar, fade, fam, true);
+        }
+    }
+
+    /// Ridges and valleys, where the face's κmax all have their sign.
+    fn ridges_valleys(&self, out: &mut Out) {
+        let (v, pt) = (self.v, self.x.pose);
+        let km = self.g(&pt.kmax);
+        let dm = v.map(|i| pt.dmax[i as usize]);
+        let (f, pos, test, fade) = (self.fi as u32, self.pos, self.o.test, self.o.fade);
+        for (fam, sg) in [(LineFamily::Ridges, 1.0f32), (LineFamily::Valleys, -1.0)] {
+            if !self.o.families.has(fam) || !km.iter().all(|&k| sg * k > 0.0) {
+                continue;
+            }
+            let em = self.g(&pt.emax);
+            let t = [0, 1, 2].map(|i| mul(sg * em[i], dm[i]));
+            ridge_face(
+                out,
+                f,
+                v,
+                em,
+                t,
+                km,
+                pos,
+                test,
+                self.thr.rv,
+                fade,
+                fam,
+                false,
+            );
+        }
+    }
+
+    /// Principal highlights: where the view terms' dots flip across the
+    /// face, its κmax directions agreeing.
+    fn principal_highlights(&self, out: &mut Out) {
+        let (v, pt, wt) = (self.v, self.x.pose, self.x.view);
+        let km = self.g(&pt.kmax);
+        let dm = v.map(|i| pt.dmax[i as usize]);
+        let mut r = 0;
+        for i in 1..3 {
+            if km[i].abs() > km[r].abs() {
+                r = i;
+            }
+        }
+        let mut ok = true;
+        let mut dots = self.g(&wt.phdot);
+        for i in 0..3 {
+            let c = dot(dm[i], dm[r]);
+            if c < 0.0 {
+                dots[i] *= -1.0;
+            }
+            ok = ok && c.abs() >= std::f32::consts::FRAC_1_SQRT_2;
+        }
+        let tst = self.g(&wt.phtest);
+        let kmin = km[0].min(km[1]).min(km[2]);
+        let kmax = km[0].max(km[1]).max(km[2]);
+        let flavour = !self.o.test || kmin >= 0.0 || kmax <= 0.0;
+        let z01 = dots[0] * dots[1] <= 0.0;
+        let z12 = dots[1] * dots[2] <= 0.0;
+        let z20 = dots[2] * dots[0] <= 0.0;
+        if ok && flavour && (z01 as u32 + z12 as u32 + z20 as u32) >= 2 {
+            let fam = LineFamily::PrincipalHighlights;
+            let f = self.fi as u32;
+            let (rv, rd, rt) = if !z01 {
+                (rot1(v), rot1(dots), rot1(tst))
+            } else if !z12 {
+                (rot2(v), rot2(dots), rot2(tst))
+            } else {
+                (v, dots, tst)
+            };
+            if !(z01 && z12 && z20) {
+                let (pos, ph, fade) = (self.pos, self.thr.ph, self.o.fade);
+                ridge_segment(out, f, rv, rd, rt, pos, ph, fade, false, fam, None);
+            }
+        }
+    }
+
+    /// Suggestive highlights: the zero set of κr, tested (and faded) by
+    /// sinθ D_w κr against the threshold.
+    fn suggestive_highlights(&self, out: &mut Out) {
+        let (v, pos, vt, thr) = (self.v, self.pos, self.x.vertex, self.thr);
+        let f = self.g(&vt.kr);
+        let Some(c) = odd_corner(f) else { return };
+        let tt = if self.o.hermite {
+            // rtsc's Hermite placement from the gradient of κr sin²θ.
+            let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+            let (ic, ia, ib) = (v[c] as usize, v[a] as usize, v[b] as usize);
+            let (ea, eb) = (sub(pos[ia], pos[ic]), sub(pos[ib], pos[ic]));
+            let gk = &vt.gkr;
+            (
+                zero_hermite(f[c], f[a], dot(ea, gk[ic]), dot(ea, gk[ia])),
+                zero_hermite(f[c], f[b], dot(eb, gk[ic]), dot(eb, gk[ib])),
+            )
+        } else {
+            iso_params(v, f, c, pos, None)
+        };
+        let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+        let nd = self.g(&vt.ndv);
+        let s3 = self.g(&vt.sc);
+        let num: [f32; 3] = std::array::from_fn(|i| -s3[i] - thr.sh * nd[i]);
+        let ends = [
+            num[c] + tt.0 * (num[a] - num[c]),
+            num[c] + tt.1 * (num[b] - num[c]),
+            nd[c] + tt.0 * (nd[a] - nd[c]),
+            nd[c] + tt.1 * (nd[b] - nd[c]),
+        ];
+        let pc = pos[v[c] as usize];
+        emit_tested(
+            out.segs,
+            (
+                lerp(pc, pos[v[a] as usize], tt.0),
+                lerp(pc, pos[v[b] as usize], tt.1),
+            ),
+            (edge_of(v[c], v[a]), edge_of(v[c], v[b])),
+            self.fi as u32,
+            ends,
+            self.o.test,
+            thr.sh_fade,
+            LineFamily::SuggestiveHighlights as u32,
+        );
+    }
+
+    /// The zero sets of K, H and D_w κr (against the suggestive-contour
+    /// threshold), K and H placed by Hermite fits where asked.
+    fn zero_sets(&self, out: &mut Out) {
+        let (v, pt, o) = (self.v, self.x.pose, self.o);
         for fam in [LineFamily::KZero, LineFamily::HZero, LineFamily::DwkrZero] {
-            if !want.has(fam) {
+            if !o.families.has(fam) {
                 continue;
             }
             let f = match fam {
-                LineFamily::KZero => g(&pt.gauss),
-                LineFamily::HZero => g(&pt.mean),
+                LineFamily::KZero => self.g(&pt.gauss),
+                LineFamily::HZero => self.g(&pt.mean),
                 _ => {
-                    let s3 = g(&vt.sc);
-                    std::array::from_fn(|i| s3[i] - thr.sc * nd[i])
+                    let (s3, nd) = (self.g(&self.x.vertex.sc), self.g(&self.x.vertex.ndv));
+                    std::array::from_fn(|i| s3[i] - self.thr.sc * nd[i])
                 }
             };
             let Some(c) = odd_corner(f) else { continue };
             let grad = (o.hermite_kh && fam != LineFamily::DwkrZero)
                 .then(|| (&pt.grad[..], if fam == LineFamily::KZero { 0 } else { 1 }));
-            let tt = iso_params(v, f, c, pos, grad);
-            iso_emit(&mut out, v, c, tt, pos, fam, 1.0);
+            let tt = iso_params(v, f, c, self.pos, grad);
+            iso_emit(out, v, c, tt, self.pos, fam, 1.0);
         }
-        if want.has(LineFamily::Isophotes) && o.isophotes > 0 {
-            let nl = g(&wt.ndl);
-            let n = o.isophotes as f32;
-            let lo = nl[0].min(nl[1]).min(nl[2]);
-            let hi = nl[0].max(nl[1]).max(nl[2]);
-            let j0 = ((lo * n).floor() as i32).max(1 - o.isophotes as i32);
-            let j1 = ((hi * n).ceil() as i32).min(o.isophotes as i32 - 1);
-            for j in j0..=j1 {
-                let f = nl.map(|c| c - j as f32 / n);
-                if let Some(c) = odd_corner(f) {
-                    let tt = iso_params(v, f, c, pos, None);
-                    iso_emit(&mut out, v, c, tt, pos, LineFamily::Isophotes, 1.0);
-                }
+    }
+
+    /// Isophotes: the levels j / n of n·l crossing the face.
+    fn isophotes(&self, out: &mut Out) {
+        let (v, isophotes) = (self.v, self.o.isophotes);
+        let nl = self.g(&self.x.view.ndl);
+        let n = isophotes as f32;
+        let lo = nl[0].min(nl[1]).min(nl[2]);
+        let hi = nl[0].max(nl[1]).max(nl[2]);
+        let j0 = ((lo * n).floor() as i32).max(1 - isophotes as i32);
+        let j1 = ((hi * n).ceil() as i32).min(isophotes as i32 - 1);
+        for j in j0..=j1 {
+            let f = nl.map(|c| c - j as f32 / n);
+            if let Some(c) = odd_corner(f) {
+                let tt = iso_params(v, f, c, self.pos, None);
+                iso_emit(out, v, c, tt, self.pos, LineFamily::Isophotes, 1.0);
             }
         }
     }
-    segs
 }

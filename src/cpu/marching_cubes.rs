@@ -365,12 +365,49 @@ pub struct Direct {
 /// `mc_direct_hits` (the hit points, sorted), `mc_direct_triangles` and
 /// `mc_direct_points`: the positions and triangles, indices final.
 pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
-    let [nx, ny, nz] = vol.dims;
     let counts = mc_direct_count(vol, iso);
-    let n = nx * ny * nz;
+    let (id, mut positions, mut hit_points) = edge_vertex_ids(vol, iso);
+    let edge_vertices = positions.len();
+    debug_assert_eq!(
+        edge_vertices as u64,
+        counts.rows.iter().map(|r| r[0] as u64).sum::<u64>()
+    );
+    let hits = hit_points.len();
+    hit_points.sort_unstable();
+    hit_points.dedup();
+    let [nx, ny, _] = vol.dims;
+    for &g in &hit_points {
+        let g = g as usize;
+        positions.push([
+            (g % nx) as f32,
+            (g / nx % ny) as f32,
+            (g / (nx * ny)) as f32,
+        ]);
+    }
+    let numbering = Numbering {
+        id: &id,
+        edge_vertices,
+        hit_points: &hit_points,
+    };
+    let (faces, row_faces) = direct_triangles(vol, iso, &numbering);
+    Direct {
+        positions,
+        faces,
+        edge_vertices,
+        hits,
+        twins: counts.rows.iter().map(|r| r[3] as usize).sum(),
+        row_faces,
+    }
+}
+
+/// The vertices of direct numbering's edges, rows in order (x, y, z edges
+/// each): the id of every interior edge vertex (per grid point and axis,
+/// `u32::MAX` for none), their positions, and the grid points that
+/// vertices round onto (unsorted, repeated).
+fn edge_vertex_ids(vol: &Volume, iso: f32) -> (Vec<u32>, Vec<[f32; 3]>, Vec<u32>) {
+    let [nx, ny, nz] = vol.dims;
     let lin = |g: [usize; 3]| g[0] + nx * (g[1] + ny * g[2]);
-    // Vertex id of every interior edge vertex: rows in order; x, y, z edges.
-    let mut id = vec![u32::MAX; 3 * n];
+    let mut id = vec![u32::MAX; 3 * nx * ny * nz];
     let mut positions = Vec::new();
     let mut hit_points = Vec::new();
     for r in 0..ny * nz {
@@ -396,22 +433,22 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
             }
         }
     }
-    let edge_vertices = positions.len();
-    debug_assert_eq!(
-        edge_vertices as u64,
-        counts.rows.iter().map(|r| r[0] as u64).sum::<u64>()
-    );
-    let hits = hit_points.len();
-    hit_points.sort_unstable();
-    hit_points.dedup();
-    for &g in &hit_points {
-        let g = g as usize;
-        positions.push([
-            (g % nx) as f32,
-            (g / nx % ny) as f32,
-            (g / (nx * ny)) as f32,
-        ]);
-    }
+    (id, positions, hit_points)
+}
+
+/// How direct numbering names a vertex: the edge vertices' ids, then the
+/// sorted, unique hit points after them.
+struct Numbering<'a> {
+    id: &'a [u32],
+    edge_vertices: usize,
+    hit_points: &'a [u32],
+}
+
+/// The kept triangles of every cell with their final indices, cell rows in
+/// order, and the triangles of each cell row (per grid row `y + ny z`).
+fn direct_triangles(vol: &Volume, iso: f32, n: &Numbering) -> (Vec<[u32; 3]>, Vec<u32>) {
+    let [nx, ny, nz] = vol.dims;
+    let lin = |g: [usize; 3]| g[0] + nx * (g[1] + ny * g[2]);
     let t = table();
     let mut faces = Vec::new();
     let mut row_faces = vec![0u32; ny * nz];
@@ -427,14 +464,14 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
                     let g = [x + (c0 & 1), y + (c0 >> 1 & 1), z + (c0 >> 2)];
                     let axis = e / 4;
                     match grid_edge(vol, iso, g, axis) {
-                        EdgeVertex::Inside(_) => id[3 * lin(g) + axis],
+                        EdgeVertex::Inside(_) => n.id[3 * lin(g) + axis],
                         hit => {
                             let mut p = g;
                             if hit == EdgeVertex::Upper {
                                 p[axis] += 1;
                             }
                             let k = lin(p) as u32;
-                            (edge_vertices + hit_points.partition_point(|&h| h < k)) as u32
+                            (n.edge_vertices + n.hit_points.partition_point(|&h| h < k)) as u32
                         }
                     }
                 };
@@ -450,14 +487,7 @@ pub fn mc_direct(vol: &Volume, iso: f32) -> Direct {
             row_faces[y + ny * z] = (faces.len() - first) as u32;
         }
     }
-    Direct {
-        positions,
-        faces,
-        edge_vertices,
-        hits,
-        twins: counts.rows.iter().map(|r| r[3] as usize).sum(),
-        row_faces,
-    }
+    (faces, row_faces)
 }
 
 /// `mc_direct_unused_rows`, `_clear`, `_mark` and `_count`: how many

@@ -34,7 +34,9 @@ pub fn histogram(keys: &[u32], block: usize, shift: u32, mask: u32) -> (Vec<u32>
 
 /// Moves each pair of block `b`, in order, to `next[d × blocks + b]` (then
 /// increments it), where `next` is the exclusive scan of [`histogram`].
-#[allow(clippy::too_many_arguments)] // mirrors the kernel's argument list
+// Mirrors radix_scatter of kernels/radix_sort.cl argument for argument (n
+// and blocks from the slices).
+#[allow(clippy::too_many_arguments)]
 pub fn scatter(
     keys: &[u32],
     values: &[u32],

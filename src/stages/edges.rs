@@ -23,28 +23,8 @@
 //! remembers what the last run drew), which removes most of the output traffic.
 //! The stage takes a [`crate::spec::view::View`] (inside [`EdgeParams`]) and
 //! knows no screen: framing and drawing live in `render::{camera, edges}`,
-//! and the cap-quality evaluation in `report::caps`.
-//!
-//! Conventions:
-//! - **Contour**: the two face normals face opposite ways seen from the eye
-//!   (per-edge eye vector `eye − p0` in perspective, the view direction in
-//!   orthographic views). Faces must be consistently oriented.
-//! - **Crease**: the angle between the two face normals is larger than the
-//!   user angle θ (degrees, in (0, 180]): `na·nb < cos θ |na||nb|`. A flat
-//!   region has 0°, a cube's edges 90°: θ = 30 finds the cube's 12 edges and
-//!   none of its face diagonals. (House & Li write `na·nb < −cos θ'`, i.e.
-//!   θ' = 180° − θ is the dihedral angle between the faces.)
-//! - **Boundary and marked**: `i3 == i0`.
-//! - **Half quads** (`half_contours`): contour-only edges extend from the edge
-//!   outward by the full width; their quad-end midpoints lie on the stroke's
-//!   centre line, so adjacency caps join them (McGuire-Hughes caps stay
-//!   centred on the edge).
-//! - **Width**: `line_width` pixels across, times max(1, k/w) with depth scale
-//!   k (House & Li's appendix; k = 0 or `None`: constant screen width).
-//! - **Near plane**: an edge with an end at clip w ≤ near (perspective) is not
-//!   drawn, so an eye inside the mesh gives no screen-spanning quads.
-//! - **Degenerate output** is House & Li's marker `(NaN, 0, −1, 1)` on every
-//!   vertex of the quad, triangle or cap.
+//! and the cap-quality evaluation in `report::caps`. Detection's conventions
+//! (contour, crease, width, near plane, the marker) are on [`EdgeStage`].
 
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
@@ -56,6 +36,7 @@ use crate::spec::edges::{MARKER, PARAMS_LEN, cap_adjacency_bound, cap_mh_bound, 
 use crate::spec::timing::{Step, Timing};
 use crate::stages::kernel_files;
 use crate::stages::scan::Scan;
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -64,6 +45,27 @@ use std::time::Instant;
 use crate::spec::edges::{CapMode, EdgeOutput, EdgeParams};
 
 /// Device buffers and kernels of the edges stage for one mesh topology.
+///
+/// Conventions:
+/// - **Contour**: the two face normals face opposite ways seen from the eye
+///   (per-edge eye vector `eye − p0` in perspective, the view direction in
+///   orthographic views). Faces must be consistently oriented.
+/// - **Crease**: the angle between the two face normals is larger than the
+///   user angle θ (degrees, in (0, 180]): `na·nb < cos θ |na||nb|`. A flat
+///   region has 0°, a cube's edges 90°: θ = 30 finds the cube's 12 edges and
+///   none of its face diagonals. (House & Li write `na·nb < −cos θ'`, i.e.
+///   θ' = 180° − θ is the dihedral angle between the faces.)
+/// - **Boundary and marked**: `i3 == i0`.
+/// - **Half quads** (`half_contours`): contour-only edges extend from the edge
+///   outward by the full width; their quad-end midpoints lie on the stroke's
+///   centre line, so adjacency caps join them (McGuire-Hughes caps stay
+///   centred on the edge).
+/// - **Width**: `line_width` pixels across, times max(1, k/w) with depth scale
+///   k (House & Li's appendix; k = 0 or `None`: constant screen width).
+/// - **Near plane**: an edge with an end at clip w ≤ near (perspective) is not
+///   drawn, so an eye inside the mesh gives no screen-spanning quads.
+/// - **Degenerate output** is House & Li's marker `(NaN, 0, −1, 1)` on every
+///   vertex of the quad, triangle or cap.
 pub struct EdgeStage {
     gpu: Arc<Gpu>,
     n_vertices: usize,
@@ -124,6 +126,8 @@ struct Compactor {
     k_edges: Kernel,
     /// Flags, then slots after the scan, per edge entry.
     slots: Buffer<u32>,
+    /// Edge entries.
+    ne: usize,
     /// The compacted vertices: edge-out, then the half-caps; grown as needed.
     dst: Buffer<f32>,
     /// float4 vertices `dst` holds.
@@ -279,76 +283,12 @@ impl EdgeStage {
         self.ensure_caps(mode)?;
         let g = self.gpu.clone();
         g.write(&mut self.params, packed.as_floats())?;
-        let ne = self.n_edges as u32;
-        let ev_d = launch(
-            &g,
-            &self.k_detect,
-            self.n_edges,
-            &[
-                Arg::U32(ne),
-                buf(&self.params),
-                buf(&self.pos),
-                buf(&self.nrm),
-                buf(&self.edges),
-                buf(&self.edge_out),
-                buf(&self.kind),
-            ],
-        )?;
+        let ev_d = self.edges_detect()?;
         // The cap kernels' events, and the scan's kernel time (adjacency).
         let (cap_events, scan_ms) = match mode {
             CapMode::None => (Vec::new(), 0.0),
-            CapMode::Mh => {
-                let [mh0, mh1] = self.cap_mh.as_ref().expect("allocated above");
-                let ev = launch(
-                    &g,
-                    &self.k_mh,
-                    self.n_edges,
-                    &[
-                        Arg::U32(ne),
-                        buf(&self.params),
-                        buf(&self.pos),
-                        buf(&self.nrm),
-                        buf(&self.edges),
-                        buf(&self.kind),
-                        buf(mh0),
-                        buf(mh1),
-                    ],
-                )?;
-                (ev.into_iter().collect(), 0.0)
-            }
-            CapMode::Adjacency => {
-                let nc = self.n_caps;
-                let caps = self.cap_adj.as_mut().expect("allocated above");
-                let scan = self.scan.as_mut().expect("made with the caps");
-                let common = [
-                    Arg::U32(nc as u32),
-                    buf(&self.params),
-                    buf(&self.edges),
-                    buf(&self.caps),
-                    buf(&self.kind),
-                    buf(&self.edge_out),
-                ];
-                let mut args = common.to_vec();
-                args.push(buf(&caps.slots));
-                let mut events: Vec<_> = launch(&g, &self.k_adj_flags, nc, &args)?
-                    .into_iter()
-                    .collect();
-                // The scan's total read is the one wait before the caps.
-                let (total, _) = scan.exclusive_at(&caps.slots, &caps.slots, nc, &[])?;
-                let total = total as usize;
-                if total > caps.room {
-                    let room = grown(total, caps.room);
-                    caps.out = g.buffer(16 * room)?;
-                    caps.room = room;
-                }
-                caps.drawn = total;
-                if total > 0 {
-                    let mut args = common.to_vec();
-                    args.extend([buf(&caps.slots), Arg::U32(total as u32), buf(&caps.out)]);
-                    events.extend(launch(&g, &self.k_adj, nc, &args)?);
-                }
-                (events, scan.last_ms())
-            }
+            CapMode::Mh => (self.caps_mh()?.into_iter().collect(), 0.0),
+            CapMode::Adjacency => self.caps_adjacency()?,
         };
         g.finish()?;
         // The flags, their scan and the drawn caps for adjacency caps.
@@ -365,6 +305,82 @@ impl EdgeStage {
         }
         t.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(t)
+    }
+
+    /// `edges_detect`: each edge's kind and quad (or the marker).
+    fn edges_detect(&self) -> Result<Option<Event>> {
+        launch(
+            &self.gpu,
+            &self.k_detect,
+            self.n_edges,
+            &[
+                Arg::U32(self.n_edges as u32),
+                buf(&self.params),
+                buf(&self.pos),
+                buf(&self.nrm),
+                buf(&self.edges),
+                buf(&self.edge_out),
+                buf(&self.kind),
+            ],
+        )
+    }
+
+    /// `caps_mh`: McGuire-Hughes half-caps at both ends of each drawn edge.
+    fn caps_mh(&self) -> Result<Option<Event>> {
+        let [mh0, mh1] = self.cap_mh.as_ref().expect("allocated above");
+        launch(
+            &self.gpu,
+            &self.k_mh,
+            self.n_edges,
+            &[
+                Arg::U32(self.n_edges as u32),
+                buf(&self.params),
+                buf(&self.pos),
+                buf(&self.nrm),
+                buf(&self.edges),
+                buf(&self.kind),
+                buf(mh0),
+                buf(mh1),
+            ],
+        )
+    }
+
+    /// `caps_adjacency_flags`, their scan (the one wait) and
+    /// `caps_adjacency`: the drawn caps written at their slots, the output
+    /// grown first where they do not fit; returns the kernels' events and
+    /// the scan's ms.
+    fn caps_adjacency(&mut self) -> Result<(Vec<Event>, f64)> {
+        let (g, nc) = (&*self.gpu, self.n_caps);
+        let caps = self.cap_adj.as_mut().expect("allocated above");
+        let scan = self.scan.as_mut().expect("made with the caps");
+        let common = [
+            Arg::U32(nc as u32),
+            buf(&self.params),
+            buf(&self.edges),
+            buf(&self.caps),
+            buf(&self.kind),
+            buf(&self.edge_out),
+        ];
+        let mut args = common.to_vec();
+        args.push(buf(&caps.slots));
+        let mut events: Vec<_> = launch(g, &self.k_adj_flags, nc, &args)?
+            .into_iter()
+            .collect();
+        // The scan's total read is the one wait before the caps.
+        let (total, _) = scan.exclusive_at(&caps.slots, &caps.slots, nc, &[])?;
+        let total = total as usize;
+        if total > caps.room {
+            let room = grown(total, caps.room);
+            caps.out = g.buffer(16 * room)?;
+            caps.room = room;
+        }
+        caps.drawn = total;
+        if total > 0 {
+            let mut args = common.to_vec();
+            args.extend([buf(&caps.slots), Arg::U32(total as u32), buf(&caps.out)]);
+            events.extend(launch(g, &self.k_adj, nc, &args)?);
+        }
+        Ok((events, scan.last_ms()))
     }
 
     /// Reads back the outputs of the last run (caps of the last run's mode only).
@@ -419,45 +435,18 @@ impl EdgeStage {
     /// compacted by their kernel already; CPU twin
     /// [`crate::cpu::edges::compact_drawn`]). Drawing the result draws
     /// exactly what drawing [`read`](Self::read)'s would (the renderer skips
-    /// markers and keeps order), from a few percent of the bytes: on a
-    /// 2M-vertex torus seen whole, 5,202 of 6M edges. Two waits: the scan's
-    /// total, then the reads.
+    /// markers and keeps order), from a few percent of the bytes. Two
+    /// waits: the scan's total, then the reads.
     pub fn read_drawn(&mut self) -> Result<EdgeOutput> {
         let g = self.gpu.clone();
         let ne = self.n_edges;
-        if self.compact.is_none() {
-            let file = kernel_files::EDGES;
-            let prog = g.program(&file, "")?;
-            self.compact = Some(Compactor {
-                k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
-                k_edges: g.entry(&prog, EdgesKernel::CompactEdges)?,
-                slots: g.buffer(ne.max(1))?,
-                dst: g.buffer(4)?,
-                dst_len: 1,
-                last_ms: 0.0,
-            });
-        }
-        self.ensure_scan()?;
+        self.ensure_compactor()?;
         let c = self.compact.as_mut().expect("made above");
         let scan = self.scan.as_mut().expect("made above");
         let mut kind = vec![0u32; ne];
         let mut events = Vec::new();
-        let mut ms = 0.0;
-        let mut drawn_edges = 0;
-        if ne > 0 {
-            events.extend(launch(
-                &g,
-                &c.k_flags,
-                ne,
-                &[Arg::U32(ne as u32), buf(&self.kind), buf(&c.slots)],
-            )?);
-            drawn_edges = scan.exclusive_at(&c.slots, &c.slots, ne, &[])?.0 as usize;
-            ms += scan.last_ms();
-        }
-        let mh = match (self.last_mode, &self.cap_mh) {
-            (CapMode::Mh, Some([m0, m1])) => Some((m0, m1)),
-            _ => None,
-        };
+        let (drawn_edges, mut ms) = c.drawn_flags(&g, scan, &self.kind, &mut events)?;
+        let mh = half_caps(self.last_mode, &self.cap_mh);
         let adj = match (self.last_mode, &self.cap_adj) {
             (CapMode::Adjacency, Some(a)) => Some(a),
             _ => None,
@@ -470,54 +459,10 @@ impl EdgeStage {
             c.dst = g.buffer(4 * len)?;
             c.dst_len = len;
         }
-        let mut parts: Vec<(usize, usize)> = Vec::new();
-        if drawn_edges > 0 {
-            let mut srcs: Vec<(&Buffer<f32>, u32)> = vec![(&self.edge_out, 4)];
-            if let Some((m0, m1)) = mh {
-                srcs.push((m0, 3));
-                srcs.push((m1, 3));
-            }
-            let mut at_v = 0usize;
-            for (src, per) in srcs {
-                events.extend(launch(
-                    &g,
-                    &c.k_edges,
-                    ne,
-                    &[
-                        Arg::U32(ne as u32),
-                        Arg::U32(per),
-                        buf(src),
-                        buf(&self.kind),
-                        buf(&c.slots),
-                        Arg::U32(at_v as u32),
-                        buf(&c.dst),
-                    ],
-                )?);
-                parts.push((at_v, per as usize * drawn_edges));
-                at_v += per as usize * drawn_edges;
-            }
-        }
-        let mut vecs: Vec<Vec<[f32; 4]>> = parts.iter().map(|p| vec![[0f32; 4]; p.1]).collect();
-        let mut caps = vec![[0f32; 4]; adj.map_or(0, |a| 4 * a.drawn)];
-        // SAFETY: `kind`, `vecs` and `caps` are neither moved nor read until
-        // `finish` below, which also runs on the error path; the ranges lie
-        // inside the buffers (parts are within `need` ≤ dst_len vertices, the
-        // caps within the drawn caps' room).
-        let failed = unsafe {
-            let mut reads = vec![g.read_at_async(&self.kind, 0, &mut kind)];
-            for (v, p) in vecs.iter_mut().zip(&parts) {
-                reads.push(g.read_at_async(&c.dst, 4 * p.0, bytemuck::cast_slice_mut(v)));
-            }
-            if let Some(a) = adj {
-                reads.push(g.read_at_async(&a.out, 0, bytemuck::cast_slice_mut(&mut caps)));
-            }
-            reads.into_iter().find_map(|r| r.err())
-        };
-        let done = g.finish();
-        if let Some(e) = failed {
-            return Err(e);
-        }
-        done?;
+        let srcs = drawn_sources(&self.edge_out, mh);
+        let dst = buf(&c.dst);
+        let parts = c.compact_edges(&g, &self.kind, &srcs, drawn_edges, dst, &mut events)?;
+        let (vecs, caps) = read_compacted(&g, (&self.kind, &mut kind), &c.dst, &parts, adj)?;
         ms += events.iter().map(event_ms).sum::<f64>();
         c.last_ms = ms;
         let mut vecs = vecs.into_iter();
@@ -534,6 +479,15 @@ impl EdgeStage {
             }
         }
         Ok(out)
+    }
+
+    /// Makes the read-back compaction's kernels and flags, and the scan,
+    /// on first use.
+    fn ensure_compactor(&mut self) -> Result<()> {
+        if self.compact.is_none() {
+            self.compact = Some(Compactor::new(&self.gpu, self.n_edges)?);
+        }
+        self.ensure_scan()
     }
 
     /// Vertices [`compact_into`](Self::compact_into) may write for `mode`:
@@ -570,63 +524,20 @@ impl EdgeStage {
             )));
         }
         // The read-back compaction's kernels and flags, made once.
-        if self.compact.is_none() {
-            let g = self.gpu.clone();
-            let prog = g.program(&kernel_files::EDGES, "")?;
-            self.compact = Some(Compactor {
-                k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
-                k_edges: g.entry(&prog, EdgesKernel::CompactEdges)?,
-                slots: g.buffer(self.n_edges.max(1))?,
-                dst: g.buffer(4)?,
-                dst_len: 1,
-                last_ms: 0.0,
-            });
-        }
-        self.ensure_scan()?;
+        self.ensure_compactor()?;
         let g = self.gpu.clone();
         let ne = self.n_edges;
         let c = self.compact.as_mut().expect("made above");
         let scan = self.scan.as_mut().expect("made above");
         let mut out = SharedDrawn::default();
         let mut events = Vec::new();
-        let mut ms = 0.0;
-        if ne > 0 {
-            events.extend(launch(
-                &g,
-                &c.k_flags,
-                ne,
-                &[Arg::U32(ne as u32), buf(&self.kind), buf(&c.slots)],
-            )?);
-            out.edges = scan.exclusive_at(&c.slots, &c.slots, ne, &[])?.0 as usize;
-            ms += scan.last_ms();
-        }
-        let mut srcs: Vec<(&Buffer<f32>, u32)> = vec![(&self.edge_out, 4)];
-        if let (CapMode::Mh, Some([m0, m1])) = (self.last_mode, &self.cap_mh) {
-            srcs.push((m0, 3));
-            srcs.push((m1, 3));
-            out.mh = true;
-        }
-        let mut at_v = 0usize;
-        for (src, per) in srcs {
-            if out.edges > 0 {
-                events.extend(launch(
-                    &g,
-                    &c.k_edges,
-                    ne,
-                    &[
-                        Arg::U32(ne as u32),
-                        Arg::U32(per),
-                        buf(src),
-                        buf(&self.kind),
-                        buf(&c.slots),
-                        Arg::U32(at_v as u32),
-                        buf(&*dst),
-                    ],
-                )?);
-            }
-            at_v += per as usize * out.edges;
-        }
-        out.caps_at = at_v;
+        let ms;
+        (out.edges, ms) = c.drawn_flags(&g, scan, &self.kind, &mut events)?;
+        let mh = half_caps(self.last_mode, &self.cap_mh);
+        out.mh = mh.is_some();
+        let srcs = drawn_sources(&self.edge_out, mh);
+        let parts = c.compact_edges(&g, &self.kind, &srcs, out.edges, buf(&*dst), &mut events)?;
+        out.caps_at = parts.last().map_or(0, |&(at, n)| at + n);
         if let (CapMode::Adjacency, Some(a)) = (self.last_mode, &self.cap_adj)
             && a.drawn > 0
         {
@@ -635,14 +546,13 @@ impl EdgeStage {
             // and `dst` holds `need` ≥ 4E + 4C vertices).
             unsafe {
                 g.queue()
-                    .enqueue_copy_buffer(&a.out, dst, 0, 16 * at_v, 16 * 4 * a.drawn, &[])
+                    .enqueue_copy_buffer(&a.out, dst, 0, 16 * out.caps_at, 16 * 4 * a.drawn, &[])
                     .map_err(|e| Error::cl("clEnqueueCopyBuffer (adjacency caps)", e))?;
             }
         }
         out.kind = vec![0u32; ne];
         g.read(&self.kind, &mut out.kind)?;
-        ms += events.iter().map(event_ms).sum::<f64>();
-        c.last_ms = ms;
+        c.last_ms = ms + events.iter().map(event_ms).sum::<f64>();
         Ok(out)
     }
 
@@ -655,6 +565,143 @@ impl EdgeStage {
         }
         t
     }
+}
+
+impl Compactor {
+    /// The compaction's kernels (of `kernels/edges.cl`), the flags of `ne`
+    /// edge entries and room for one vertex.
+    fn new(g: &Gpu, ne: usize) -> Result<Self> {
+        let prog = g.program(&kernel_files::EDGES, "")?;
+        Ok(Compactor {
+            k_flags: g.entry(&prog, EdgesKernel::DrawnFlags)?,
+            k_edges: g.entry(&prog, EdgesKernel::CompactEdges)?,
+            slots: g.buffer(ne.max(1))?,
+            ne,
+            dst: g.buffer(4)?,
+            dst_len: 1,
+            last_ms: 0.0,
+        })
+    }
+
+    /// `drawn_flags` and their scan into slots (where there are edges):
+    /// returns the drawn edges and the scan's ms.
+    fn drawn_flags(
+        &self,
+        g: &Gpu,
+        scan: &mut Scan,
+        kind: &Buffer<u32>,
+        events: &mut Vec<Event>,
+    ) -> Result<(usize, f64)> {
+        let ne = self.ne;
+        if ne == 0 {
+            return Ok((0, 0.0));
+        }
+        let a = [Arg::U32(ne as u32), buf(kind), buf(&self.slots)];
+        events.extend(launch(g, &self.k_flags, ne, &a)?);
+        let drawn = scan.exclusive_at(&self.slots, &self.slots, ne, &[])?.0 as usize;
+        Ok((drawn, scan.last_ms()))
+    }
+
+    /// `compact_edges` per source (`per` vertices per edge), each after the
+    /// last in `dst`, when `drawn` edges were drawn: returns each source's
+    /// first vertex and vertex count (none when nothing was drawn).
+    fn compact_edges(
+        &self,
+        g: &Gpu,
+        kind: &Buffer<u32>,
+        srcs: &[(&Buffer<f32>, u32)],
+        drawn: usize,
+        dst: Arg,
+        events: &mut Vec<Event>,
+    ) -> Result<Vec<(usize, usize)>> {
+        let ne = self.ne;
+        let mut parts = Vec::new();
+        if drawn == 0 {
+            return Ok(parts);
+        }
+        let mut at_v = 0usize;
+        for &(src, per) in srcs {
+            events.extend(launch(
+                g,
+                &self.k_edges,
+                ne,
+                &[
+                    Arg::U32(ne as u32),
+                    Arg::U32(per),
+                    buf(src),
+                    buf(kind),
+                    buf(&self.slots),
+                    Arg::U32(at_v as u32),
+                    dst,
+                ],
+            )?);
+            parts.push((at_v, per as usize * drawn));
+            at_v += per as usize * drawn;
+        }
+        Ok(parts)
+    }
+}
+
+/// The half-cap buffers when the last run (`mode`) drew McGuire-Hughes caps.
+fn half_caps(
+    mode: CapMode,
+    cap_mh: &Option<[Buffer<f32>; 2]>,
+) -> Option<(&Buffer<f32>, &Buffer<f32>)> {
+    match (mode, cap_mh) {
+        (CapMode::Mh, Some([m0, m1])) => Some((m0, m1)),
+        _ => None,
+    }
+}
+
+/// What the compaction copies, with its vertices per edge: edge-out, then
+/// the half-caps `mh` where there are some.
+fn drawn_sources<'a>(
+    edge_out: &'a Buffer<f32>,
+    mh: Option<(&'a Buffer<f32>, &'a Buffer<f32>)>,
+) -> Vec<(&'a Buffer<f32>, u32)> {
+    let mut srcs = vec![(edge_out, 4)];
+    if let Some((m0, m1)) = mh {
+        srcs.push((m0, 3));
+        srcs.push((m1, 3));
+    }
+    srcs
+}
+
+/// Vertices read back, 4 floats each.
+type Float4s = Vec<[f32; 4]>;
+
+/// Reads `kind` (device buffer, host slice) and the compacted `parts` of
+/// `dst` (first vertex, vertices) back, with the drawn adjacency caps of
+/// `adj`; all reads are enqueued, then one wait.
+fn read_compacted(
+    g: &Gpu,
+    kind: (&Buffer<u32>, &mut [u32]),
+    dst: &Buffer<f32>,
+    parts: &[(usize, usize)],
+    adj: Option<&AdjacencyCaps>,
+) -> Result<(Vec<Float4s>, Float4s)> {
+    let mut vecs: Vec<Vec<[f32; 4]>> = parts.iter().map(|p| vec![[0f32; 4]; p.1]).collect();
+    let mut caps = vec![[0f32; 4]; adj.map_or(0, |a| 4 * a.drawn)];
+    // SAFETY: `kind`, `vecs` and `caps` are neither moved nor read until
+    // `finish` below, which also runs on the error path; the ranges lie
+    // inside the buffers (parts are within the vertices `dst` holds, the
+    // caps within the drawn caps' room).
+    let failed = unsafe {
+        let mut reads = vec![g.read_at_async(kind.0, 0, kind.1)];
+        for (v, p) in vecs.iter_mut().zip(parts) {
+            reads.push(g.read_at_async(dst, 4 * p.0, bytemuck::cast_slice_mut(v)));
+        }
+        if let Some(a) = adj {
+            reads.push(g.read_at_async(&a.out, 0, bytemuck::cast_slice_mut(&mut caps)));
+        }
+        reads.into_iter().find_map(|r| r.err())
+    };
+    let done = g.finish();
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    done?;
+    Ok((vecs, caps))
 }
 
 #[cfg(test)]

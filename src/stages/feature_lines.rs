@@ -22,6 +22,7 @@ use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines_curves::{CurveArgs, CurveStage};
 use crate::stages::kernel_files;
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -300,9 +301,40 @@ impl LineExtractor {
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
         opts.check()?;
+        self.gpu.zero(&mut self.counter, 1)?;
+        let e1 = self.lines_vertex(inputs, view, &opts)?;
+        let curve_fams = opts.curves.families.curves();
+        let contours = opts.contours || opts.suggestive || curve_fams == Default::default();
+        let (e2, found) = self.lines_face(inputs[0], feature_size, &opts, contours)?;
+        let mut segs = self.read_segments(found)?;
+        let mut timing = Timing::default();
+        if let Some(e) = &e1 {
+            timing.add(Step::LinesVertex, event_ms(e));
+        }
+        for e in &e2 {
+            timing.add(Step::LinesFace, event_ms(e));
+        }
+        if curve_fams != Default::default() {
+            let (more, t) = self.curve_lines(inputs, view, feature_size, &opts)?;
+            timing.extend(&t);
+            segs.extend(more);
+        }
+        let stats = LineStats {
+            segments: segs.len(),
+            timing,
+        };
+        Ok((segs, stats))
+    }
+
+    /// `lines_vertex`: the per-vertex terms (ndv, kr, sc, the gradient of
+    /// κr sin²θ) of `inputs` for `view`.
+    fn lines_vertex(
+        &mut self,
+        inputs: [Arg; 6],
+        view: ([f32; 3], bool),
+        opts: &LineOptions,
+    ) -> Result<Option<Event>> {
         let n = self.nv;
-        let g = self.gpu.clone();
-        g.zero(&mut self.counter, 1)?;
         let ([ex, ey, ez], ortho) = view;
         let mut args: Vec<Arg> = vec![Arg::U32(n as u32)];
         args.extend(inputs);
@@ -317,9 +349,20 @@ impl LineExtractor {
             Arg::U32(u32::from(opts.curves.hermite)),
             buf(&self.terms[3]),
         ]);
-        let e1 = launch(&g, &self.vertex, n, &args)?;
-        let curve_fams = opts.curves.families.curves();
-        let contours = opts.contours || opts.suggestive || curve_fams == Default::default();
+        launch(&self.gpu, &self.vertex, n, &args)
+    }
+
+    /// `lines_face` (when `contours`): the contour and suggestive-contour
+    /// segments at positions `pos`, appended with the counter; returns the
+    /// launches and the segments found.
+    fn lines_face(
+        &mut self,
+        pos: Arg,
+        feature_size: f32,
+        opts: &LineOptions,
+        contours: bool,
+    ) -> Result<(Vec<Event>, usize)> {
+        let g = self.gpu.clone();
         // Twice at most: a pass that counts more segments than the buffer
         // holds writes none past it, and the second has room for them.
         let mut e2 = Vec::new();
@@ -337,7 +380,7 @@ impl LineExtractor {
                 &[
                     Arg::U32(self.nf as u32),
                     buf(&self.faces),
-                    inputs[0],
+                    pos,
                     buf(&self.terms[0]),
                     buf(&self.terms[1]),
                     buf(&self.terms[2]),
@@ -371,11 +414,17 @@ impl LineExtractor {
             self.ends = g.buffer(4 * found)?;
             self.cap = found;
         }
+        Ok((e2, found))
+    }
+
+    /// Reads the first `found` segments of `lines_face` back.
+    fn read_segments(&self, found: usize) -> Result<Vec<Segment>> {
+        let g = &self.gpu;
         let mut raw = vec![0f32; 8 * found];
         g.read(&self.seg, &mut raw)?;
         let mut ends = vec![0u32; 4 * found];
         g.read(&self.ends, &mut ends)?;
-        let mut segs: Vec<Segment> = raw
+        Ok(raw
             .chunks_exact(8)
             .zip(ends.chunks_exact(4))
             .map(|(s, e)| {
@@ -387,37 +436,33 @@ impl LineExtractor {
                     [[e[0], e[1]], [e[2], e[3]]],
                 )
             })
-            .collect();
-        let mut timing = Timing::default();
-        if let Some(e) = &e1 {
-            timing.add(Step::LinesVertex, event_ms(e));
+            .collect())
+    }
+
+    /// The curvature line families' segments, by the curve stage (built the
+    /// first time one is asked for) on the same inputs and terms.
+    fn curve_lines(
+        &mut self,
+        inputs: [Arg; 6],
+        view: ([f32; 3], bool),
+        feature_size: f32,
+        opts: &LineOptions,
+    ) -> Result<(Vec<Segment>, Timing)> {
+        if self.curves.is_none() {
+            let stage = CurveStage::new(self.gpu.clone(), self.nv, &self.host_faces)?;
+            self.curves = Some(stage);
         }
-        for e in &e2 {
-            timing.add(Step::LinesFace, event_ms(e));
-        }
-        if curve_fams != Default::default() {
-            if self.curves.is_none() {
-                self.curves = Some(CurveStage::new(g.clone(), n, &self.host_faces)?);
-            }
-            let args = CurveArgs {
-                inputs,
-                terms: self.terms.each_ref().map(buf),
-                faces: buf(&self.faces),
-            };
-            let stage = self.curves.as_mut().expect("built above");
-            let sc = (
-                opts.scaled_threshold(feature_size),
-                opts.scaled_fade(feature_size),
-            );
-            let (more, t) = stage.run(&args, view, feature_size, sc, &opts.curves)?;
-            timing.extend(&t);
-            segs.extend(more);
-        }
-        let stats = LineStats {
-            segments: segs.len(),
-            timing,
+        let args = CurveArgs {
+            inputs,
+            terms: self.terms.each_ref().map(buf),
+            faces: buf(&self.faces),
         };
-        Ok((segs, stats))
+        let stage = self.curves.as_mut().expect("built above");
+        let sc = (
+            opts.scaled_threshold(feature_size),
+            opts.scaled_fade(feature_size),
+        );
+        stage.run(&args, view, feature_size, sc, &opts.curves)
     }
 }
 

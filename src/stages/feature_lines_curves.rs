@@ -13,7 +13,7 @@ use crate::cpu::feature_lines_curves::{ScaledThresholds, boundary_mask};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::{
-    CurveOptions, LineFamily, LinesCurvesKernel, Segment, curve_segments_estimate,
+    CurveOptions, FamilySet, LineFamily, LinesCurvesKernel, Segment, curve_segments_estimate,
 };
 use crate::spec::timing::{Step, Timing};
 use crate::stages::kernel_files;
@@ -128,37 +128,9 @@ impl CurveStage {
     ) -> Result<(Vec<Segment>, Timing)> {
         opts.check()?;
         let fams = opts.families.curves();
-        let g = self.gpu.clone();
         // Profiling times are read once the blocking read of the counter
         // has finished every launch before it.
-        let mut events: Vec<(Step, opencl3::event::Event)> = Vec::new();
-        let mut time = |step: Step, e: Option<opencl3::event::Event>| {
-            if let Some(e) = e {
-                events.push((step, e));
-            }
-        };
-        let nv = self.nv as u32;
-        let [pos, nrm, d1, d2, k, dk] = a.inputs;
-        let [ndv, kr, sc, gkr] = a.terms;
-        let needs_pose = fams.iter().any(|f| {
-            matches!(
-                f,
-                LineFamily::Ridges
-                    | LineFamily::Valleys
-                    | LineFamily::PrincipalHighlights
-                    | LineFamily::KZero
-                    | LineFamily::HZero
-            )
-        });
-        let needs_view = fams.iter().any(|f| {
-            matches!(
-                f,
-                LineFamily::ApparentRidges
-                    | LineFamily::PrincipalHighlights
-                    | LineFamily::Isophotes
-            )
-        });
-        let needs_dt = fams.has(LineFamily::ApparentRidges);
+        let mut events = Vec::new();
         let grads = opts.hermite_kh;
         // The view pass reads dmax from the pose terms, used only by the
         // principal highlights, which need the pose pass anyway.
@@ -166,114 +138,21 @@ impl CurveStage {
             Some(g) => g || !grads,
             None => false,
         };
-        if needs_pose && !pose_ok {
-            let e = launch(
-                &g,
-                &self.kernels[0],
-                self.nv,
-                &[
-                    Arg::U32(nv),
-                    d1,
-                    d2,
-                    k,
-                    dk,
-                    Arg::U32(u32::from(grads)),
-                    buf(&self.pose),
-                    buf(&self.grad),
-                ],
-            )?;
-            time(Step::LinesPose, e);
-            self.pose_done = Some(grads);
+        if needs_pose(fams) && !pose_ok {
+            self.lines_pose(a, grads, &mut events)?;
         }
-        let ([ex, ey, ez], ortho) = view;
-        if needs_view {
-            let [lx, ly, lz] = opts.unit_light();
-            let e = launch(
-                &g,
-                &self.kernels[1],
-                self.nv,
-                &[
-                    Arg::U32(nv),
-                    pos,
-                    nrm,
-                    d1,
-                    d2,
-                    k,
-                    buf(&self.pose),
-                    ndv,
-                    Arg::F32(ex),
-                    Arg::F32(ey),
-                    Arg::F32(ez),
-                    Arg::U32(u32::from(ortho)),
-                    Arg::F32(lx),
-                    Arg::F32(ly),
-                    Arg::F32(lz),
-                    buf(&self.view),
-                ],
-            )?;
-            time(Step::LinesView, e);
+        if needs_view(fams) {
+            self.lines_view(a, view, opts, &mut events)?;
         }
-        if needs_dt {
-            let e = launch(
-                &g,
-                &self.kernels[2],
-                self.nv,
-                &[
-                    Arg::U32(nv),
-                    a.faces,
-                    pos,
-                    nrm,
-                    buf(&self.off),
-                    buf(&self.ring),
-                    buf(&self.view),
-                    ndv,
-                    buf(&self.dt),
-                ],
-            )?;
-            time(Step::LinesDt1q1, e);
+        if fams.has(LineFamily::ApparentRidges) {
+            self.lines_dt1q1(a, &mut events)?;
         }
         let thr = ScaledThresholds::of(opts, feature_size, sc_scaled);
         self.grow(curve_segments_estimate(self.nf, fams))?;
         // Twice at most: a first pass that overflows reports the count it
         // needs, and the second has room for it.
         for _ in 0..2 {
-            g.zero(&mut self.counter, 1)?;
-            let e = launch(
-                &g,
-                &self.kernels[3],
-                self.nf,
-                &[
-                    Arg::U32(self.nf as u32),
-                    a.faces,
-                    pos,
-                    ndv,
-                    kr,
-                    sc,
-                    gkr,
-                    buf(&self.pose),
-                    buf(&self.grad),
-                    buf(&self.view),
-                    buf(&self.dt),
-                    buf(&self.bnd),
-                    Arg::U32(fams.0),
-                    Arg::U32(opts.flags()),
-                    Arg::F32(thr.rv),
-                    Arg::F32(thr.ar),
-                    Arg::F32(thr.ph),
-                    Arg::F32(thr.sh),
-                    Arg::F32(thr.sc),
-                    Arg::F32(thr.sh_fade),
-                    Arg::U32(opts.isophotes),
-                    Arg::U32(self.cap as u32),
-                    buf(&self.seg),
-                    buf(&self.ends),
-                    buf(&self.counter),
-                ],
-            )?;
-            time(Step::LinesCurves, e);
-            let mut c = [0u32];
-            g.read(&self.counter, &mut c)?;
-            let found = c[0] as usize;
+            let found = self.lines_curves(a, opts, &thr, &mut events)?;
             if found <= self.cap {
                 let segs = self.read(found)?;
                 let mut timing = Timing::default();
@@ -288,6 +167,144 @@ impl CurveStage {
             "internal: the curve line pass overflowed twice; nothing was written past the buffer"
                 .into(),
         ))
+    }
+
+    /// `lines_pose`: the per-pose terms (with their gradients if `grads`).
+    fn lines_pose(&mut self, a: &CurveArgs, grads: bool, events: &mut Events) -> Result<()> {
+        let [_, _, d1, d2, k, dk] = a.inputs;
+        let e = launch(
+            &self.gpu,
+            &self.kernels[0],
+            self.nv,
+            &[
+                Arg::U32(self.nv as u32),
+                d1,
+                d2,
+                k,
+                dk,
+                Arg::U32(u32::from(grads)),
+                buf(&self.pose),
+                buf(&self.grad),
+            ],
+        )?;
+        time(events, Step::LinesPose, e);
+        self.pose_done = Some(grads);
+        Ok(())
+    }
+
+    /// `lines_view`: the per-view terms for the eye (or direction) `view`
+    /// and the options' light.
+    fn lines_view(
+        &mut self,
+        a: &CurveArgs,
+        view: ([f32; 3], bool),
+        opts: &CurveOptions,
+        events: &mut Events,
+    ) -> Result<()> {
+        let [pos, nrm, d1, d2, k, _] = a.inputs;
+        let ndv = a.terms[0];
+        let ([ex, ey, ez], ortho) = view;
+        let [lx, ly, lz] = opts.unit_light();
+        let e = launch(
+            &self.gpu,
+            &self.kernels[1],
+            self.nv,
+            &[
+                Arg::U32(self.nv as u32),
+                pos,
+                nrm,
+                d1,
+                d2,
+                k,
+                buf(&self.pose),
+                ndv,
+                Arg::F32(ex),
+                Arg::F32(ey),
+                Arg::F32(ez),
+                Arg::U32(u32::from(ortho)),
+                Arg::F32(lx),
+                Arg::F32(ly),
+                Arg::F32(lz),
+                buf(&self.view),
+            ],
+        )?;
+        time(events, Step::LinesView, e);
+        Ok(())
+    }
+
+    /// `lines_dt1q1`: D_t1 q1 per vertex (the apparent ridges).
+    fn lines_dt1q1(&mut self, a: &CurveArgs, events: &mut Events) -> Result<()> {
+        let [pos, nrm, ..] = a.inputs;
+        let e = launch(
+            &self.gpu,
+            &self.kernels[2],
+            self.nv,
+            &[
+                Arg::U32(self.nv as u32),
+                a.faces,
+                pos,
+                nrm,
+                buf(&self.off),
+                buf(&self.ring),
+                buf(&self.view),
+                a.terms[0],
+                buf(&self.dt),
+            ],
+        )?;
+        time(events, Step::LinesDt1q1, e);
+        Ok(())
+    }
+
+    /// `lines_curves`: the segments of the options' families, with the
+    /// scaled thresholds `thr`, appended with the counter; returns the count
+    /// found (past `cap` when they did not fit).
+    fn lines_curves(
+        &mut self,
+        a: &CurveArgs,
+        opts: &CurveOptions,
+        thr: &ScaledThresholds,
+        events: &mut Events,
+    ) -> Result<usize> {
+        let g = self.gpu.clone();
+        let pos = a.inputs[0];
+        let [ndv, kr, sc, gkr] = a.terms;
+        g.zero(&mut self.counter, 1)?;
+        let e = launch(
+            &g,
+            &self.kernels[3],
+            self.nf,
+            &[
+                Arg::U32(self.nf as u32),
+                a.faces,
+                pos,
+                ndv,
+                kr,
+                sc,
+                gkr,
+                buf(&self.pose),
+                buf(&self.grad),
+                buf(&self.view),
+                buf(&self.dt),
+                buf(&self.bnd),
+                Arg::U32(opts.families.curves().0),
+                Arg::U32(opts.flags()),
+                Arg::F32(thr.rv),
+                Arg::F32(thr.ar),
+                Arg::F32(thr.ph),
+                Arg::F32(thr.sh),
+                Arg::F32(thr.sc),
+                Arg::F32(thr.sh_fade),
+                Arg::U32(opts.isophotes),
+                Arg::U32(self.cap as u32),
+                buf(&self.seg),
+                buf(&self.ends),
+                buf(&self.counter),
+            ],
+        )?;
+        time(events, Step::LinesCurves, e);
+        let mut c = [0u32];
+        g.read(&self.counter, &mut c)?;
+        Ok(c[0] as usize)
     }
 
     /// The device's per-vertex terms of the last run, for step-by-step
@@ -331,4 +348,39 @@ impl CurveStage {
             })
             .collect())
     }
+}
+
+/// The launches of one run with their steps, timed once the run has read
+/// its count back.
+type Events = Vec<(Step, opencl3::event::Event)>;
+
+/// Keeps the event of a launch of `step` (none when nothing launched).
+fn time(events: &mut Events, step: Step, e: Option<opencl3::event::Event>) {
+    if let Some(e) = e {
+        events.push((step, e));
+    }
+}
+
+/// Whether one of `fams` reads the per-pose terms.
+fn needs_pose(fams: FamilySet) -> bool {
+    fams.iter().any(|f| {
+        matches!(
+            f,
+            LineFamily::Ridges
+                | LineFamily::Valleys
+                | LineFamily::PrincipalHighlights
+                | LineFamily::KZero
+                | LineFamily::HZero
+        )
+    })
+}
+
+/// Whether one of `fams` reads the per-view terms.
+fn needs_view(fams: FamilySet) -> bool {
+    fams.iter().any(|f| {
+        matches!(
+            f,
+            LineFamily::ApparentRidges | LineFamily::PrincipalHighlights | LineFamily::Isophotes
+        )
+    })
 }

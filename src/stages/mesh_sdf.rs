@@ -146,6 +146,7 @@ impl MeshSdf {
         self.run_inner(prep, true)
     }
 
+    /// Converts `prep`, reading the intermediate buffers back when `traced`.
     fn run_inner(
         &mut self,
         prep: &PreparedMesh,
@@ -153,29 +154,103 @@ impl MeshSdf {
     ) -> Result<(Vec<f32>, MeshSdfStats, MeshSdfTrace)> {
         let t0 = Instant::now();
         let g = &*self.gpu.clone();
-        let grid = prep.grid;
-        let n = grid.voxels();
-        let ntri = prep.triangles.len();
-        let work = prep.band_work()?;
-        if n > u32::MAX as usize {
-            return Err(Error::InvalidArgument(format!(
-                "mesh signed distance: {n} voxels exceed the u32 index range"
-            )));
+        let mut st = stats_of(prep)?;
+        let mut c = Conversion::new(self, g, prep)?;
+        let n = c.n;
+        let mut trace = MeshSdfTrace::default();
+        st.timing.add(Step::MsdfBand, c.band()?);
+        if traced {
+            trace.band = (read_vec(g, &c.d2, n)?, read_vec(g, &c.id[0], n)?);
         }
-        let mut st = MeshSdfStats {
-            dims: grid.dims,
-            spacing: grid.spacing,
-            origin: grid.origin,
-            voxels: n,
-            triangles: ntri,
-            degenerate_faces: prep.degenerate,
-            band_work: work,
-            ..Default::default()
-        };
-        st.device_bytes = 48 * n as u64 + 24 * prep.grid_pos.len() as u64 + 24 * ntri as u64;
+        st.jfa_passes = prep.grid.steps().len();
+        let (ms, cur) = c.flood()?;
+        st.timing.add(Step::MsdfJfa, ms);
+        if traced {
+            let flat: Vec<f32> = read_vec(g, &c.q[cur], 3 * n)?;
+            let pts = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            trace.flooded = (pts, read_vec(g, &c.id[cur], n)?);
+        }
+        st.timing.add(Step::MsdfRefine, c.refine(cur)?);
+        if traced {
+            trace.refined = (read_vec(g, &c.d2, n)?, read_vec(g, &c.id[1 - cur], n)?);
+        }
+        let (ms, winding) = c.sign()?;
+        st.timing.add(Step::MsdfSign, ms);
+        if traced {
+            trace.winding = read_vec(g, &winding, n)?;
+        }
+        let (ms, out) = c.finish(&winding)?;
+        st.timing.add(Step::MsdfFinish, ms);
+        let values = read_vec(g, &out, n)?;
+        st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::input(
+                "mesh",
+                format!("voxel {i}"),
+                "no triangle reached this sample (non-finite distance)",
+            ));
+        }
+        Ok((values, st, trace))
+    }
+}
 
-        // Inputs.
-        let nv = prep.grid_pos.len();
+/// The stats of converting `prep` known before it runs; refuses a grid past
+/// the u32 index range.
+fn stats_of(prep: &PreparedMesh) -> Result<MeshSdfStats> {
+    let grid = prep.grid;
+    let n = grid.voxels();
+    let ntri = prep.triangles.len();
+    let work = prep.band_work()?;
+    if n > u32::MAX as usize {
+        return Err(Error::InvalidArgument(format!(
+            "mesh signed distance: {n} voxels exceed the u32 index range"
+        )));
+    }
+    let mut st = MeshSdfStats {
+        dims: grid.dims,
+        spacing: grid.spacing,
+        origin: grid.origin,
+        voxels: n,
+        triangles: ntri,
+        degenerate_faces: prep.degenerate,
+        band_work: work,
+        ..Default::default()
+    };
+    st.device_bytes = 48 * n as u64 + 24 * prep.grid_pos.len() as u64 + 24 * ntri as u64;
+    Ok(st)
+}
+
+/// One conversion: the kernels, the device, the prepared mesh's buffers,
+/// the nearest-triangle buffers and the launches not yet waited for; its
+/// methods are the passes, in the order they run.
+struct Conversion<'a> {
+    k: &'a MeshSdf,
+    g: &'a Gpu,
+    prep: &'a PreparedMesh,
+    /// Voxels and triangles.
+    n: usize,
+    ntri: usize,
+    /// Grid positions, fixed-point positions, triangles, edge neighbours.
+    pos: Buffer<f32>,
+    fix: Buffer<i32>,
+    tris: Buffer<u32>,
+    adj: Buffer<u32>,
+    /// Squared distance, nearest triangle and nearest point per voxel (the
+    /// last two twice, for the flooding's ping-pong).
+    d2: Buffer<f32>,
+    id: [Buffer<u32>; 2],
+    q: [Buffer<f32>; 2],
+    ev: Vec<Event>,
+}
+
+impl<'a> Conversion<'a> {
+    /// Uploads `prep` and allocates the nearest-triangle buffers.
+    fn new(k: &'a MeshSdf, g: &'a Gpu, prep: &'a PreparedMesh) -> Result<Self> {
+        let (n, ntri, nv) = (
+            prep.grid.voxels(),
+            prep.triangles.len(),
+            prep.grid_pos.len(),
+        );
         let mut pos = g.buffer_flags::<f32>(3 * nv, CL_MEM_READ_ONLY)?;
         g.write(&mut pos, prep.grid_pos.as_flattened())?;
         let mut fix = g.buffer_flags::<i32>(3 * nv, CL_MEM_READ_ONLY)?;
@@ -184,47 +259,63 @@ impl MeshSdf {
         g.write(&mut tris, prep.triangles.as_flattened())?;
         let mut adj = g.buffer_flags::<u32>(3 * ntri, CL_MEM_READ_ONLY)?;
         g.write(&mut adj, prep.adjacent.as_flattened())?;
-
-        // Band: exact nearest triangle within BAND_VOXELS.
-        let [nx, ny, nz] = grid.dims.map(|d| d as i32);
-        let (nu, ntu) = (Arg::U32(n as u32), Arg::U32(ntri as u32));
-        let dims = [Arg::I32(nx), Arg::I32(ny), Arg::I32(nz)];
-        let d2 = g.buffer::<f32>(n)?;
-        let id = [g.buffer::<u32>(n)?, g.buffer::<u32>(n)?];
-        let q = [g.buffer::<f32>(3 * n)?, g.buffer::<f32>(3 * n)?];
-        let mut ev: Vec<Event> = Vec::new();
-        ev.extend(launch(g, &self.clear, n, &[nu, buf(&d2), buf(&id[0])])?);
-        let mut a = vec![ntu];
-        a.extend_from_slice(&dims);
-        a.extend([Arg::F32(BAND_VOXELS), buf(&tris), buf(&pos), buf(&d2)]);
-        ev.extend(launch(g, &self.band_min, ntri, &a)?);
-        a.push(buf(&id[0]));
-        ev.extend(launch(g, &self.band_id, ntri, &a)?);
-        st.timing.add(Step::MsdfBand, wait_all(&mut ev)?);
-        let mut trace = MeshSdfTrace::default();
-        if traced {
-            trace.band = (read_vec(g, &d2, n)?, read_vec(g, &id[0], n)?);
-        }
-
-        // Flooding of nearest points (ping-pong), then the exact pass.
-        ev.extend(launch(
+        Ok(Conversion {
+            k,
             g,
-            &self.seed,
+            prep,
             n,
-            &[
-                nu,
-                dims[0],
-                dims[1],
-                buf(&id[0]),
-                buf(&tris),
-                buf(&pos),
-                buf(&q[0]),
-            ],
-        )?);
-        let steps = grid.steps();
-        st.jfa_passes = steps.len();
+            ntri,
+            pos,
+            fix,
+            tris,
+            adj,
+            d2: g.buffer::<f32>(n)?,
+            id: [g.buffer::<u32>(n)?, g.buffer::<u32>(n)?],
+            q: [g.buffer::<f32>(3 * n)?, g.buffer::<f32>(3 * n)?],
+            ev: Vec::new(),
+        })
+    }
+
+    /// nx, ny, nz as kernel arguments.
+    fn dims(&self) -> [Arg; 3] {
+        self.prep.grid.dims.map(|d| Arg::I32(d as i32))
+    }
+
+    /// `msdf_clear`, `msdf_band_min`, `msdf_band_id`: the exact nearest
+    /// triangle within BAND_VOXELS; returns the kernel ms.
+    fn band(&mut self) -> Result<f64> {
+        let (g, k, n, ntri) = (self.g, self.k, self.n, self.ntri);
+        let (d2, id0) = (buf(&self.d2), buf(&self.id[0]));
+        let nu = Arg::U32(n as u32);
+        self.ev.extend(launch(g, &k.clear, n, &[nu, d2, id0])?);
+        let mut a = vec![Arg::U32(ntri as u32)];
+        a.extend_from_slice(&self.dims());
+        a.extend([Arg::F32(BAND_VOXELS), buf(&self.tris), buf(&self.pos), d2]);
+        self.ev.extend(launch(g, &k.band_min, ntri, &a)?);
+        a.push(id0);
+        self.ev.extend(launch(g, &k.band_id, ntri, &a)?);
+        wait_all(&mut self.ev)
+    }
+
+    /// `msdf_seed` and `msdf_jfa` per step: nearest points flooded beyond
+    /// the band (ping-pong); returns the kernel ms and the buffers' side
+    /// that holds the result.
+    fn flood(&mut self) -> Result<(f64, usize)> {
+        let (g, k, n, dims) = (self.g, self.k, self.n, self.dims());
+        let nu = Arg::U32(n as u32);
+        let (id, q) = (&self.id, &self.q);
+        let a = [
+            nu,
+            dims[0],
+            dims[1],
+            buf(&id[0]),
+            buf(&self.tris),
+            buf(&self.pos),
+            buf(&q[0]),
+        ];
+        self.ev.extend(launch(g, &k.seed, n, &a)?);
         let mut cur = 0;
-        for step in steps {
+        for step in self.prep.grid.steps() {
             let mut a = vec![nu];
             a.extend_from_slice(&dims);
             a.extend([
@@ -234,33 +325,37 @@ impl MeshSdf {
                 buf(&q[1 - cur]),
                 buf(&id[1 - cur]),
             ]);
-            ev.extend(launch(g, &self.jfa, n, &a)?);
+            self.ev.extend(launch(g, &k.jfa, n, &a)?);
             cur = 1 - cur;
         }
-        st.timing.add(Step::MsdfJfa, wait_all(&mut ev)?);
-        if traced {
-            let flat: Vec<f32> = read_vec(g, &q[cur], 3 * n)?;
-            let pts = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-            trace.flooded = (pts, read_vec(g, &id[cur], n)?);
-        }
-        let mut a = vec![nu];
-        a.extend_from_slice(&dims);
-        a.extend([
-            buf(&id[cur]),
-            buf(&tris),
-            buf(&pos),
-            buf(&adj),
-            Arg::U32(MAX_DESCENT),
-            buf(&d2),
-            buf(&id[1 - cur]),
-        ]);
-        ev.extend(launch(g, &self.refine, n, &a)?);
-        st.timing.add(Step::MsdfRefine, wait_all(&mut ev)?);
-        if traced {
-            trace.refined = (read_vec(g, &d2, n)?, read_vec(g, &id[1 - cur], n)?);
-        }
+        Ok((wait_all(&mut self.ev)?, cur))
+    }
 
-        // Sign: six-ray winding sum, one axis at a time into one crossings buffer.
+    /// `msdf_refine`: the exact distance to each voxel's candidate triangle
+    /// (side `cur`), with a descent across edge-adjacent triangles, into
+    /// the other side; returns the kernel ms.
+    fn refine(&mut self, cur: usize) -> Result<f64> {
+        let mut a = vec![Arg::U32(self.n as u32)];
+        a.extend_from_slice(&self.dims());
+        a.extend([
+            buf(&self.id[cur]),
+            buf(&self.tris),
+            buf(&self.pos),
+            buf(&self.adj),
+            Arg::U32(MAX_DESCENT),
+            buf(&self.d2),
+            buf(&self.id[1 - cur]),
+        ]);
+        self.ev.extend(launch(self.g, &self.k.refine, self.n, &a)?);
+        wait_all(&mut self.ev)
+    }
+
+    /// `msdf_cross` and `msdf_wind` per axis: the six-ray winding sum, one
+    /// axis at a time into one crossings buffer; returns the kernel ms and
+    /// the sums.
+    fn sign(&mut self) -> Result<(f64, Buffer<i32>)> {
+        let (g, n, ntri, grid) = (self.g, self.n, self.ntri, self.prep.grid);
+        let [nx, ny, nz] = grid.dims.map(|d| d as i32);
         let mut diff = g.buffer::<i32>(n)?;
         let mut winding = g.buffer::<i32>(n)?;
         g.zero(&mut winding, n)?;
@@ -276,42 +371,30 @@ impl MeshSdf {
             ];
             let mut a = vec![Arg::U32(ntri as u32)];
             a.extend_from_slice(&dims);
-            a.extend([buf(&tris), buf(&fix), buf(&diff)]);
-            ev.extend(launch(g, &self.cross, ntri, &a)?);
+            a.extend([buf(&self.tris), buf(&self.fix), buf(&diff)]);
+            self.ev.extend(launch(g, &self.k.cross, ntri, &a)?);
             let mut a = vec![Arg::U32(lines as u32)];
             a.extend_from_slice(&dims);
             a.extend([buf(&diff), buf(&winding)]);
-            ev.extend(launch(g, &self.wind, lines, &a)?);
+            self.ev.extend(launch(g, &self.k.wind, lines, &a)?);
         }
-        st.timing.add(Step::MsdfSign, wait_all(&mut ev)?);
-        if traced {
-            trace.winding = read_vec(g, &winding, n)?;
-        }
+        Ok((wait_all(&mut self.ev)?, winding))
+    }
 
+    /// `msdf_finish`: the signed distance in world units from the squared
+    /// distance and the winding sums; returns the kernel ms and the field.
+    fn finish(&mut self, winding: &Buffer<i32>) -> Result<(f64, Buffer<f32>)> {
+        let (g, n) = (self.g, self.n);
         let out = g.buffer::<f32>(n)?;
-        ev.extend(launch(
-            g,
-            &self.finish,
-            n,
-            &[
-                Arg::U32(n as u32),
-                Arg::F32(grid.spacing as f32),
-                buf(&d2),
-                buf(&winding),
-                buf(&out),
-            ],
-        )?);
-        st.timing.add(Step::MsdfFinish, wait_all(&mut ev)?);
-        let values = read_vec(g, &out, n)?;
-        st.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::input(
-                "mesh",
-                format!("voxel {i}"),
-                "no triangle reached this sample (non-finite distance)",
-            ));
-        }
-        Ok((values, st, trace))
+        let a = [
+            Arg::U32(n as u32),
+            Arg::F32(self.prep.grid.spacing as f32),
+            buf(&self.d2),
+            buf(winding),
+            buf(&out),
+        ];
+        self.ev.extend(launch(g, &self.k.finish, n, &a)?);
+        Ok((wait_all(&mut self.ev)?, out))
     }
 }
 

@@ -52,6 +52,64 @@ struct SeedBufs {
     pos: Buffer<f32>,
 }
 
+/// The Poisson grid of one thinning: `d` dense samples, `nc` cells
+/// (`grid` per axis); each sample's cell, the cells' counts (later the kept
+/// flags), offsets, fill cursors and sample lists, and each cell's kept
+/// sample.
+struct Cells {
+    d: usize,
+    nc: usize,
+    grid: [u32; 4],
+    cell: Buffer<u32>,
+    count: Buffer<u32>,
+    off: Buffer<u32>,
+    fill: Buffer<u32>,
+    items: Buffer<u32>,
+    kept: Buffer<u32>,
+}
+
+impl Cells {
+    /// The buffers, counts and fill cursors zeroed, no sample kept.
+    fn new(g: &Gpu, d: usize, nc: usize, grid: [u32; 4]) -> Result<Self> {
+        let (cell, mut count, off) = (g.buffer(d)?, g.buffer(nc)?, g.buffer(nc)?);
+        let (mut fill, items, mut kept) = (g.buffer(nc)?, g.buffer(d)?, g.buffer(nc)?);
+        g.zero(&mut count, nc)?;
+        g.zero(&mut fill, nc)?;
+        fill_u32(g, &mut kept, nc, NONE)?;
+        Ok(Cells {
+            d,
+            nc,
+            grid,
+            cell,
+            count,
+            off,
+            fill,
+            items,
+            kept,
+        })
+    }
+}
+
+/// The traced strokes on the device: points and normals (4 floats per
+/// slot, `slots` of them), per stroke its first point, count and centre
+/// (`meta`, 4 each), width, strip vertices and their offsets.
+struct Traced {
+    slots: usize,
+    pts: Buffer<f32>,
+    nrm: Buffer<f32>,
+    meta: Buffer<u32>,
+    wid: Buffer<f32>,
+    nverts: Buffer<u32>,
+    voff: Buffer<u32>,
+}
+
+/// The strokes' strips on the device (4 floats per vertex) and their
+/// vertex count.
+struct Strips {
+    strip: Buffer<f32>,
+    nv: usize,
+}
+
 /// Curvature-directed strokes of one volume on the device.
 pub struct SdfLines {
     gpu: Arc<Gpu>,
@@ -218,6 +276,21 @@ impl SdfLines {
     /// Poisson-disk thinning with spacing `r`: seed positions on the device.
     fn thin_device(&mut self, r: f64) -> Result<SeedBufs> {
         let d = self.ensure_dense()?;
+        let (p, nc) = self.thin_params(r)?;
+        let c = Cells::new(&self.gpu, d, nc, p.cells)?;
+        let mut events = Vec::new();
+        let mut scan_ms = self.cell_bins(&c, &mut events)?;
+        self.thin_phases(&c, &mut events)?;
+        let (seeds, ms2) = self.thin_compact(&c, &mut events)?;
+        scan_ms += ms2;
+        self.gpu.finish()?;
+        self.ms.thin += ms(&events) + scan_ms;
+        Ok(seeds)
+    }
+
+    /// The parameters of a thinning with spacing `r` (written to the
+    /// device) and its count of Poisson grid cells.
+    fn thin_params(&mut self, r: f64) -> Result<(SdflParams, usize)> {
         let res = resolve(
             &SdfLineOptions {
                 spacing: Some(r),
@@ -229,50 +302,38 @@ impl SdfLines {
         let p = self.base_params(&res);
         let nc = cell_count(&p, self.opts.max_cells, r)?;
         self.set_params(&p)?;
-        let g = self.gpu.clone();
-        let mut events = Vec::new();
-        let cell = g.buffer::<u32>(d)?;
-        let mut count = g.buffer::<u32>(nc)?;
-        let off = g.buffer::<u32>(nc)?;
-        let mut fill = g.buffer::<u32>(nc)?;
-        let items = g.buffer::<u32>(d)?;
-        let mut kept = g.buffer::<u32>(nc)?;
-        g.zero(&mut count, nc)?;
-        g.zero(&mut fill, nc)?;
-        fill_u32(&g, &mut kept, nc, NONE)?;
-        events.extend(launch(
-            &g,
-            &self.k.cell_count,
+        Ok((p, nc))
+    }
+
+    /// `sdfl_cell_count`, the scan of the counts and `sdfl_cell_fill`: the
+    /// dense samples binned into the cells; returns the scan's ms.
+    fn cell_bins(&mut self, c: &Cells, events: &mut Vec<Event>) -> Result<f64> {
+        let (g, d) = (&self.gpu, Arg::U32(c.d as u32));
+        let a = [
             d,
-            &[
-                Arg::U32(d as u32),
-                buf(&self.params),
-                buf(&self.dense_pos),
-                buf(&cell),
-                buf(&count),
-            ],
-        )?);
-        self.scan.exclusive(&count, &off, nc)?;
-        let mut scan_ms = self.scan.last_ms();
-        events.extend(launch(
-            &g,
-            &self.k.cell_fill,
-            d,
-            &[
-                Arg::U32(d as u32),
-                buf(&cell),
-                buf(&off),
-                buf(&fill),
-                buf(&items),
-            ],
-        )?);
-        let cells = p.cells;
+            buf(&self.params),
+            buf(&self.dense_pos),
+            buf(&c.cell),
+            buf(&c.count),
+        ];
+        events.extend(launch(g, &self.k.cell_count, c.d, &a)?);
+        self.scan.exclusive(&c.count, &c.off, c.nc)?;
+        let scan_ms = self.scan.last_ms();
+        let a = [d, buf(&c.cell), buf(&c.off), buf(&c.fill), buf(&c.items)];
+        events.extend(launch(g, &self.k.cell_fill, c.d, &a)?);
+        Ok(scan_ms)
+    }
+
+    /// `sdfl_thin_phase`, 27 times: the cells of one phase of the 3 × 3 × 3
+    /// pattern at a time keep their samples.
+    fn thin_phases(&mut self, c: &Cells, events: &mut Vec<Event>) -> Result<()> {
+        let cells = c.grid;
         for phase in 0..27u32 {
             let (px, py, pz) = (phase % 3, phase / 3 % 3, phase / 9);
             let per = |g: u32, o: u32| (g.saturating_sub(o)).div_ceil(3) as usize;
             let n = per(cells[0], px) * per(cells[1], py) * per(cells[2], pz);
             events.extend(launch(
-                &g,
+                &self.gpu,
                 &self.k.thin_phase,
                 n,
                 &[
@@ -283,22 +344,25 @@ impl SdfLines {
                     Arg::U32(pz),
                     buf(&self.dense_pos),
                     buf(&self.dense_key),
-                    buf(&off),
-                    buf(&count),
-                    buf(&items),
-                    buf(&kept),
+                    buf(&c.off),
+                    buf(&c.count),
+                    buf(&c.items),
+                    buf(&c.kept),
                 ],
             )?);
         }
+        Ok(())
+    }
+
+    /// `sdfl_thin_flags`, their scan and `sdfl_thin_compact`: the kept
+    /// samples listed as seeds; returns them and the scan's ms.
+    fn thin_compact(&mut self, c: &Cells, events: &mut Vec<Event>) -> Result<(SeedBufs, f64)> {
+        let (g, nc) = (self.gpu.clone(), c.nc);
         // Flags into `count` (no longer needed), offsets into `off`.
-        events.extend(launch(
-            &g,
-            &self.k.thin_flags,
-            nc,
-            &[Arg::U32(nc as u32), buf(&kept), buf(&count)],
-        )?);
-        let s = self.scan.exclusive(&count, &off, nc)? as usize;
-        scan_ms += self.scan.last_ms();
+        let a = [Arg::U32(nc as u32), buf(&c.kept), buf(&c.count)];
+        events.extend(launch(&g, &self.k.thin_flags, nc, &a)?);
+        let s = self.scan.exclusive(&c.count, &c.off, nc)? as usize;
+        let scan_ms = self.scan.last_ms();
         let seeds = g.buffer::<u32>(s)?;
         let pos = g.buffer::<f32>(3 * s)?;
         events.extend(launch(
@@ -307,16 +371,14 @@ impl SdfLines {
             nc,
             &[
                 Arg::U32(nc as u32),
-                buf(&kept),
-                buf(&off),
+                buf(&c.kept),
+                buf(&c.off),
                 buf(&self.dense_pos),
                 buf(&seeds),
                 buf(&pos),
             ],
         )?);
-        g.finish()?;
-        self.ms.thin += ms(&events) + scan_ms;
-        Ok(SeedBufs { count: s, pos })
+        Ok((SeedBufs { count: s, pos }, scan_ms))
     }
 
     /// Kept sample positions (local world) for spacing `r`, in cell order.
@@ -419,35 +481,7 @@ impl SdfLines {
         self.ms = StepMs::default();
         let dense = self.ensure_dense()?;
         self.ensure_gradient()?;
-        let candidates = sampling_candidates(&self.opts.sampling, self.spacing);
-        let mut sweep = Vec::new();
-        let h = if let Sampling::Fixed(h) = self.opts.sampling {
-            h
-        } else {
-            let before = (self.ms.thin, self.ms.curvature);
-            let r0 = self
-                .opts
-                .spacing
-                .unwrap_or(PROVISIONAL_SPACING_VOXELS * voxel_size(self.spacing));
-            let s = self.thin_device(r0)?;
-            for &hc in &candidates {
-                let res = resolve(&self.opts, self.spacing, hc)?;
-                let p = self.base_params(&res);
-                self.set_params(&p)?;
-                let out = self.curvature_device(&s.pos, s.count, hc)?;
-                let c = read_principal(&self.gpu, &out, s.count)?;
-                let (cv, n) = coefficient_of_variation(c.iter().filter(|c| c.valid).map(|c| c.k1));
-                sweep.push(CvPoint {
-                    distance: hc,
-                    cv,
-                    seeds: n,
-                });
-            }
-            self.ms.sweep = (self.ms.thin - before.0) + (self.ms.curvature - before.1);
-            self.ms.thin = before.0;
-            self.ms.curvature = before.1;
-            pick_sampling(&sweep).unwrap_or(candidates[0])
-        };
+        let (h, sweep) = self.sampling_distance()?;
         let res = resolve(&self.opts, self.spacing, h)?;
         let seeds = self.thin_device(res.spacing)?;
         let s = seeds.count;
@@ -455,27 +489,95 @@ impl SdfLines {
         let p = self.base_params(&res);
         self.set_params(&p)?;
         let curv = self.curvature_device(&seeds.pos, s, h)?;
-        let g = self.gpu.clone();
+        let range = self.range(&curv, s)?;
+        let kk = res.points_per_stroke();
+        let traced = self.trace(&seeds, &curv, &range, kk)?;
+        let strips = self.strips(&traced, s, kk)?;
+        // Read back.
+        let (lo, hi) = read_range(&self.gpu, &range)?;
+        let mut out = self.read_strokes(&seeds, &curv, &traced, &strips, kk)?;
+        out.stats = twin::stats(dense, &out, res, sweep, lo, hi);
+        let mut t = self.ms;
+        t.total =
+            t.dense + t.thin + t.gradient + t.curvature + t.range + t.trace + t.strips + t.sweep;
+        out.stats.ms = t;
+        out.stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(out)
+    }
+
+    /// The Hessian sampling distance: the fixed one, or the candidate whose
+    /// κ1 varies least over the seeds of a provisional thinning (the sweep,
+    /// returned too, its time counted apart from the run's own steps).
+    fn sampling_distance(&mut self) -> Result<(f64, Vec<CvPoint>)> {
+        let candidates = sampling_candidates(&self.opts.sampling, self.spacing);
+        let mut sweep = Vec::new();
+        if let Sampling::Fixed(h) = self.opts.sampling {
+            return Ok((h, sweep));
+        }
+        let before = (self.ms.thin, self.ms.curvature);
+        let r0 = self
+            .opts
+            .spacing
+            .unwrap_or(PROVISIONAL_SPACING_VOXELS * voxel_size(self.spacing));
+        let s = self.thin_device(r0)?;
+        for &hc in &candidates {
+            let res = resolve(&self.opts, self.spacing, hc)?;
+            let p = self.base_params(&res);
+            self.set_params(&p)?;
+            let out = self.curvature_device(&s.pos, s.count, hc)?;
+            let c = read_principal(&self.gpu, &out, s.count)?;
+            let (cv, n) = coefficient_of_variation(c.iter().filter(|c| c.valid).map(|c| c.k1));
+            sweep.push(CvPoint {
+                distance: hc,
+                cv,
+                seeds: n,
+            });
+        }
+        self.ms.sweep = (self.ms.thin - before.0) + (self.ms.curvature - before.1);
+        self.ms.thin = before.0;
+        self.ms.curvature = before.1;
+        let h = pick_sampling(&sweep).unwrap_or(candidates[0]);
+        Ok((h, sweep))
+    }
+
+    /// `sdfl_range`: the κ1 range over the `s` seeds' curvatures `curv`, as
+    /// two order-preserving keys.
+    fn range(&mut self, curv: &Buffer<f32>, s: usize) -> Result<Buffer<u32>> {
+        let g = &self.gpu;
         let mut range = g.buffer::<u32>(2)?;
         g.write(&mut range, &[u32::MAX, 0])?;
         let ev = launch(
-            &g,
+            g,
             &self.k.range,
             s,
-            &[Arg::U32(s as u32), buf(&curv), buf(&range)],
+            &[Arg::U32(s as u32), buf(curv), buf(&range)],
         )?;
         g.finish()?;
         self.ms.range = ev.as_ref().map(event_ms).unwrap_or(0.0);
-        let kk = res.points_per_stroke();
+        Ok(range)
+    }
+
+    /// `sdfl_trace`: a stroke of up to `kk` points from each seed.
+    fn trace(
+        &mut self,
+        seeds: &SeedBufs,
+        curv: &Buffer<f32>,
+        range: &Buffer<u32>,
+        kk: usize,
+    ) -> Result<Traced> {
+        let (g, s) = (&self.gpu, seeds.count);
         let slots = stroke_points_bound(s, kk);
-        let pts = g.buffer::<f32>(4 * slots)?;
-        let nrm = g.buffer::<f32>(4 * slots)?;
-        let meta = g.buffer::<u32>(4 * s)?;
-        let wid = g.buffer::<f32>(s)?;
-        let nverts = g.buffer::<u32>(s)?;
-        let voff = g.buffer::<u32>(s)?;
+        let t = Traced {
+            slots,
+            pts: g.buffer::<f32>(4 * slots)?,
+            nrm: g.buffer::<f32>(4 * slots)?,
+            meta: g.buffer::<u32>(4 * s)?,
+            wid: g.buffer::<f32>(s)?,
+            nverts: g.buffer::<u32>(s)?,
+            voff: g.buffer::<u32>(s)?,
+        };
         let ev = launch(
-            &g,
+            g,
             &self.k.trace,
             s,
             &[
@@ -484,18 +586,26 @@ impl SdfLines {
                 buf(&self.vol),
                 buf(self.grad.as_ref().expect("gradient")),
                 buf(&seeds.pos),
-                buf(&curv),
-                buf(&range),
-                buf(&pts),
-                buf(&nrm),
-                buf(&meta),
-                buf(&wid),
-                buf(&nverts),
+                buf(curv),
+                buf(range),
+                buf(&t.pts),
+                buf(&t.nrm),
+                buf(&t.meta),
+                buf(&t.wid),
+                buf(&t.nverts),
             ],
         )?;
         g.finish()?;
         self.ms.trace = ev.as_ref().map(event_ms).unwrap_or(0.0);
-        let nv = self.scan.exclusive(&nverts, &voff, s)? as usize;
+        Ok(t)
+    }
+
+    /// The scan of the strokes' strip vertices and `sdfl_strips`: a strip
+    /// of two vertices per point of each of the `s` strokes (`kk` points at
+    /// most); refuses strips past their bound.
+    fn strips(&mut self, t: &Traced, s: usize, kk: usize) -> Result<Strips> {
+        let g = self.gpu.clone();
+        let nv = self.scan.exclusive(&t.nverts, &t.voff, s)? as usize;
         self.ms.strips = self.scan.last_ms();
         let cap = strip_vertices_bound(s, kk);
         let strip = g.buffer::<f32>(4 * cap.max(1))?;
@@ -508,12 +618,12 @@ impl SdfLines {
             &[
                 Arg::U32(s as u32),
                 buf(&self.params),
-                buf(&pts),
-                buf(&nrm),
-                buf(&meta),
-                buf(&wid),
-                buf(&nverts),
-                buf(&voff),
+                buf(&t.pts),
+                buf(&t.nrm),
+                buf(&t.meta),
+                buf(&t.wid),
+                buf(&t.nverts),
+                buf(&t.voff),
                 Arg::U32(cap as u32),
                 buf(&strip),
                 buf(&overflow),
@@ -528,27 +638,33 @@ impl SdfLines {
                 "curvature-directed strokes: {nv} strip vertices exceed the bound of {cap}"
             )));
         }
-        // Read back.
-        let mut rg = [0u32; 2];
-        g.read(&range, &mut rg)?;
-        let (lo, hi) = if rg[0] <= rg[1] {
-            (unordered(rg[0]) as f64, unordered(rg[1]) as f64)
-        } else {
-            (0.0, 0.0)
-        };
-        let c = read_principal(&g, &curv, s)?;
+        Ok(Strips { strip, nv })
+    }
+
+    /// Reads the seeds (with their curvatures `curv`) and the strokes of at
+    /// most `kk` points back, in world units.
+    fn read_strokes(
+        &self,
+        seeds: &SeedBufs,
+        curv: &Buffer<f32>,
+        t: &Traced,
+        strips: &Strips,
+        kk: usize,
+    ) -> Result<SdfLinesOutput> {
+        let (g, s, nv) = (&self.gpu, seeds.count, strips.nv);
+        let c = read_principal(g, curv, s)?;
         let mut sp = vec![0f32; 3 * s];
         g.read(&seeds.pos, &mut sp)?;
         let mut m = vec![0u32; 4 * s];
-        g.read(&meta, &mut m)?;
-        let mut pv = vec![0f32; 4 * slots];
-        let mut nvv = vec![0f32; 4 * slots];
-        g.read(&pts, &mut pv)?;
-        g.read(&nrm, &mut nvv)?;
+        g.read(&t.meta, &mut m)?;
+        let mut pv = vec![0f32; 4 * t.slots];
+        let mut nvv = vec![0f32; 4 * t.slots];
+        g.read(&t.pts, &mut pv)?;
+        g.read(&t.nrm, &mut nvv)?;
         let mut sv = vec![0f32; 4 * nv];
-        g.read(&strip, &mut sv)?;
+        g.read(&strips.strip, &mut sv)?;
         let mut vo = vec![0u32; s];
-        g.read(&voff, &mut vo)?;
+        g.read(&t.voff, &mut vo)?;
         let o = self.origin;
         let world = |q: &[f32]| -> [f64; 3] { std::array::from_fn(|a| q[a] as f64 + o[a]) };
         let v3 = |q: &[f32]| -> [f64; 3] { std::array::from_fn(|a| q[a] as f64) };
@@ -586,14 +702,20 @@ impl SdfLines {
                 .collect();
             out.strokes.push(st);
         }
-        out.stats = twin::stats(dense, &out, res, sweep, lo, hi);
-        let mut t = self.ms;
-        t.total =
-            t.dense + t.thin + t.gradient + t.curvature + t.range + t.trace + t.strips + t.sweep;
-        out.stats.ms = t;
-        out.stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(out)
     }
+}
+
+/// The κ1 range the seeds span, from `sdfl_range`'s two keys ((0, 0) when
+/// no seed had a valid curvature).
+fn read_range(g: &Gpu, range: &Buffer<u32>) -> Result<(f64, f64)> {
+    let mut rg = [0u32; 2];
+    g.read(range, &mut rg)?;
+    Ok(if rg[0] <= rg[1] {
+        (unordered(rg[0]) as f64, unordered(rg[1]) as f64)
+    } else {
+        (0.0, 0.0)
+    })
 }
 
 /// Inverse of the kernel's order-preserving float → uint map.

@@ -15,6 +15,7 @@ use crate::spec::vertex_fusion::{Fusion, soup_triangles};
 use crate::stages::kernel_files;
 use crate::stages::radix_sort::RadixSort;
 use crate::stages::scan::Scan;
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use std::sync::Arc;
@@ -289,19 +290,59 @@ impl Fuser {
         self.finish_inner(Some(rep), pos, nv, nt, None)
     }
 
+    /// [`Fuser::finish`] on `rep` (the fuser's own buffer where `None`),
+    /// after `fuse_index`'s launch `e_index` where it ran.
     fn finish_inner(
         &mut self,
         rep: Option<&Buffer<u32>>,
         pos: &Buffer<f32>,
         n: usize,
         nt: usize,
-        e_index: Option<opencl3::event::Event>,
+        e_index: Option<Event>,
     ) -> Result<(FusionCounts, Timing)> {
         let g = self.gpu.clone();
         let mut t = Timing::default();
         if nt == 0 {
             return Ok((FusionCounts::default(), t));
         }
+        self.reserve_finish(n, nt)?;
+        let r = buf(rep.unwrap_or(&self.rep.buf));
+        let mut times = FinishTimes {
+            e_index,
+            ..Default::default()
+        };
+        (times.e_clear, times.e_tri) = self.fuse_triangles(r, pos, n, nt)?;
+        let n_cand = self
+            .scan
+            .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
+        debug_assert!(n_cand <= nt);
+        // Steps in execution order; the kernel events are read once done.
+        times.cand_scan = self.scan.last_ms();
+        if n_cand > 0 {
+            times.cancel = self.cancel_twins(r, nt, n_cand)?;
+        }
+        let (faces, vertices) = self.fuse_mark(r, n, nt, &mut times)?;
+        times.add_to(&mut t);
+        // Sized from the scans, within the bounds the memory check assumed.
+        debug_assert!(vertices <= n && faces <= nt);
+        self.out_pos.reserve(&g, 3 * vertices)?;
+        self.out_faces.reserve(&g, 3 * faces)?;
+        let rep = rep.unwrap_or(&self.rep.buf);
+        self.compact(rep, pos, n, nt, Vec::new(), &mut t)?;
+        Ok((
+            FusionCounts {
+                vertices,
+                faces,
+                dropped: nt - faces,
+            },
+            t,
+        ))
+    }
+
+    /// The scratch of [`Fuser::finish`] for `n` vertex slots and `nt`
+    /// triangles.
+    fn reserve_finish(&mut self, n: usize, nt: usize) -> Result<()> {
+        let g = self.gpu.clone();
         for b in [&mut self.referenced, &mut self.vert_id] {
             b.reserve(&g, n)?;
         }
@@ -313,82 +354,107 @@ impl Fuser {
         ] {
             b.reserve(&g, nt)?;
         }
-        let rep = rep.unwrap_or(&self.rep.buf);
+        Ok(())
+    }
+
+    /// `fuse_clear` and `fuse_triangles`: the marks of the `n` slots
+    /// cleared; of the `nt` triangles of `rep` (positions `pos`), those
+    /// whose corners repeat dropped and the twin candidates flagged.
+    fn fuse_triangles(
+        &mut self,
+        rep: Arg,
+        pos: &Buffer<f32>,
+        n: usize,
+        nt: usize,
+    ) -> Result<(Option<Event>, Option<Event>)> {
+        let g = &*self.gpu;
         let n32 = n as u32;
         let e_clear = launch(
-            &g,
+            g,
             &self.clear,
             n,
             &[Arg::U32(n32), buf(&self.referenced.buf)],
         )?;
         let e_tri = launch(
-            &g,
+            g,
             &self.triangles,
             nt,
             &[
                 Arg::U32(nt as u32),
                 Arg::U32(n as u32),
-                buf(rep),
+                rep,
                 buf(pos),
                 buf(&self.keep.buf),
                 buf(&self.cand.buf),
             ],
         )?;
-        let n_cand = self
-            .scan
-            .exclusive(&self.cand.buf, &self.cand_off.buf, nt)? as usize;
-        debug_assert!(n_cand <= nt);
-        // Steps in execution order; the kernel events are read once done.
-        let cand_scan = self.scan.last_ms();
+        Ok((e_clear, e_tri))
+    }
+
+    /// `fuse_candidates`, their sort and `fuse_cancel`: the `n_cand`
+    /// candidates among the `nt` triangles of `rep` listed by key, and
+    /// opposite twins cancelled; waits, and returns the steps' times.
+    fn cancel_twins(&mut self, rep: Arg, nt: usize, n_cand: usize) -> Result<Timing> {
+        let g = self.gpu.clone();
         let mut cancel = Timing::default();
-        if n_cand > 0 {
-            self.ckeys.reserve(&g, n_cand)?;
-            self.cvals.reserve(&g, n_cand)?;
-            let e = launch(
-                &g,
-                &self.candidates,
-                nt,
-                &[
-                    Arg::U32(nt as u32),
-                    buf(rep),
-                    buf(&self.cand.buf),
-                    buf(&self.cand_off.buf),
-                    buf(&self.ckeys.buf),
-                    buf(&self.cvals.buf),
-                ],
-            )?;
-            self.sort
-                .sort_pairs(&mut self.ckeys.buf, &mut self.cvals.buf, n_cand, 32)?;
-            let sort_ms = self.sort.last_ms();
-            let e2 = launch(
-                &g,
-                &self.cancel,
-                n_cand,
-                &[
-                    Arg::U32(n_cand as u32),
-                    buf(&self.ckeys.buf),
-                    buf(&self.cvals.buf),
-                    buf(rep),
-                    buf(&self.keep.buf),
-                ],
-            )?;
-            g.finish()?;
-            if let Some(e) = &e {
-                cancel.add(Step::FuseCandidates, event_ms(e));
-            }
-            cancel.add(Step::RadixSortPairs, sort_ms);
-            if let Some(e) = &e2 {
-                cancel.add(Step::FuseCancel, event_ms(e));
-            }
-        }
-        let e_mark = launch(
+        self.ckeys.reserve(&g, n_cand)?;
+        self.cvals.reserve(&g, n_cand)?;
+        let e = launch(
             &g,
+            &self.candidates,
+            nt,
+            &[
+                Arg::U32(nt as u32),
+                rep,
+                buf(&self.cand.buf),
+                buf(&self.cand_off.buf),
+                buf(&self.ckeys.buf),
+                buf(&self.cvals.buf),
+            ],
+        )?;
+        self.sort
+            .sort_pairs(&mut self.ckeys.buf, &mut self.cvals.buf, n_cand, 32)?;
+        let sort_ms = self.sort.last_ms();
+        let e2 = launch(
+            &g,
+            &self.cancel,
+            n_cand,
+            &[
+                Arg::U32(n_cand as u32),
+                buf(&self.ckeys.buf),
+                buf(&self.cvals.buf),
+                rep,
+                buf(&self.keep.buf),
+            ],
+        )?;
+        g.finish()?;
+        if let Some(e) = &e {
+            cancel.add(Step::FuseCandidates, event_ms(e));
+        }
+        cancel.add(Step::RadixSortPairs, sort_ms);
+        if let Some(e) = &e2 {
+            cancel.add(Step::FuseCancel, event_ms(e));
+        }
+        Ok(cancel)
+    }
+
+    /// `fuse_mark` and the scans of the keep flags and the marks: the slots
+    /// the kept triangles of `rep` use; returns (faces, vertices) kept.
+    fn fuse_mark(
+        &mut self,
+        rep: Arg,
+        n: usize,
+        nt: usize,
+        times: &mut FinishTimes,
+    ) -> Result<(usize, usize)> {
+        times.e_mark = launch(
+            &self.gpu,
             &self.mark,
             nt,
             &[
                 Arg::U32(nt as u32),
                 Arg::U32(n as u32),
-                buf(rep),
+                rep,
                 buf(&self.keep.buf),
                 buf(&self.referenced.buf),
             ],
@@ -396,38 +462,12 @@ impl Fuser {
         let faces = self
             .scan
             .exclusive(&self.keep.buf, &self.face_off.buf, nt)? as usize;
-        let face_scan = self.scan.last_ms();
+        times.face_scan = self.scan.last_ms();
         let vertices = self
             .scan
             .exclusive(&self.referenced.buf, &self.vert_id.buf, n)? as usize;
-        let vertex_scan = self.scan.last_ms();
-        if let Some(e) = &e_index {
-            t.add(Step::FuseIndex, event_ms(e));
-        }
-        // `fuse_clear` is counted in the triangles step it prepares.
-        for e in [&e_clear, &e_tri].into_iter().flatten() {
-            t.add(Step::FuseTriangles, event_ms(e));
-        }
-        t.add(Step::ScanExclusive, cand_scan);
-        t.extend(&cancel);
-        if let Some(e) = &e_mark {
-            t.add(Step::FuseMark, event_ms(e));
-        }
-        t.add(Step::ScanExclusive, face_scan);
-        t.add(Step::ScanExclusive, vertex_scan);
-        // Sized from the scans, within the bounds the memory check assumed.
-        debug_assert!(vertices <= n && faces <= nt);
-        self.out_pos.reserve(&g, 3 * vertices)?;
-        self.out_faces.reserve(&g, 3 * faces)?;
-        self.compact(rep, pos, n, nt, Vec::new(), &mut t)?;
-        Ok((
-            FusionCounts {
-                vertices,
-                faces,
-                dropped: nt - faces,
-            },
-            t,
-        ))
+        times.vertex_scan = self.scan.last_ms();
+        Ok((faces, vertices))
     }
 
     /// The last two steps of [`Fuser::finish`] and
@@ -485,6 +525,40 @@ impl Fuser {
             t.add(Step::FuseCompactFaces, event_ms(e));
         }
         Ok(())
+    }
+}
+
+/// The launches and scan times of [`Fuser::finish`], added to its timing
+/// in execution order once the queue is done.
+#[derive(Default)]
+struct FinishTimes {
+    e_index: Option<Event>,
+    e_clear: Option<Event>,
+    e_tri: Option<Event>,
+    cand_scan: f64,
+    cancel: Timing,
+    e_mark: Option<Event>,
+    face_scan: f64,
+    vertex_scan: f64,
+}
+
+impl FinishTimes {
+    /// Adds the steps to `t`, in the order they ran.
+    fn add_to(&self, t: &mut Timing) {
+        if let Some(e) = &self.e_index {
+            t.add(Step::FuseIndex, event_ms(e));
+        }
+        // `fuse_clear` is counted in the triangles step it prepares.
+        for e in [&self.e_clear, &self.e_tri].into_iter().flatten() {
+            t.add(Step::FuseTriangles, event_ms(e));
+        }
+        t.add(Step::ScanExclusive, self.cand_scan);
+        t.extend(&self.cancel);
+        if let Some(e) = &self.e_mark {
+            t.add(Step::FuseMark, event_ms(e));
+        }
+        t.add(Step::ScanExclusive, self.face_scan);
+        t.add(Step::ScanExclusive, self.vertex_scan);
     }
 }
 

@@ -1,15 +1,18 @@
 //! Building the curvature program for a variant: the device checks, the
 //! build options, the kernels of the common passes and of the accumulation
-//! scheme; [`build_kernels`] builds and saves variants ahead of use.
+//! scheme; [`build_kernels`] builds and saves variants ahead of use; with
+//! the program built, a mesh's per-vertex buffers and its scheme's
+//! topology-only data ([`topology`]).
 
-use super::{CurvatureEstimator, atomic, gather};
+use super::{CurvatureEstimator, Faces, Scheme, atomic, gather, rings_on_device};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::spec::curvature::CurvKernel;
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision, padded_vertices};
 use crate::spec::timing::Timing;
 use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;
+use opencl3::memory::Buffer;
 use opencl3::program::Program;
 use std::sync::Arc;
 use std::time::Instant;
@@ -136,14 +139,14 @@ impl CurvatureEstimator {
             if !gpu.info.fp64 {
                 return Err(Error::DeviceUnsupported {
                     device: gpu.info.name.clone(),
-                    what: "--precision f64 needs cl_khr_fp64".into(),
+                    what: "precision = f64 needs cl_khr_fp64".into(),
                 });
             }
             if opts.accumulate == Accumulate::Atomic && !gpu.info.int64_atomics {
                 return Err(Error::DeviceUnsupported {
                     device: gpu.info.name.clone(),
                     what: "f64 atomic accumulation needs cl_khr_int64_base_atomics; \
-                           use --accumulate gather"
+                           use accumulate = gather"
                         .into(),
                 });
             }
@@ -161,9 +164,9 @@ impl CurvatureEstimator {
             return Err(Error::DeviceUnsupported {
                 device: gpu.info.name.clone(),
                 what: format!(
-                    "--accumulate atomic-native needs native {} float atomic adds \
+                    "accumulate = atomic-native needs native {} float atomic adds \
                      (cl_ext_float_atomics, or NVIDIA's CUDA platform for inline PTX); \
-                     use --accumulate atomic or gather",
+                     use accumulate = atomic or gather",
                     opts.precision.name()
                 ),
             });
@@ -291,4 +294,75 @@ pub fn build_kernels(
         }
     }
     Ok(out)
+}
+
+/// Reals per vertex of pos, nrm, area, pd1, pd2, tens, kk, dk.
+const REALS: [usize; 8] = [3, 3, 1, 3, 3, 3, 2, 4];
+
+/// Reals of per-vertex buffer `i` of `REALS` (`n` per vertex) for `nvp`
+/// padded vertices. The positions have one real more: the normal pass
+/// with lanes loads each vertex's x y z as 4 reals (ld_pos in
+/// kernels/common/curvature_lanes.h).
+fn vertex_reals(i: usize, n: usize, nvp: usize) -> usize {
+    n * nvp + usize::from(i == 0)
+}
+
+/// The per-vertex buffers of `REALS` for `nvp` padded vertices of `real`
+/// bytes per real.
+pub(super) fn vertex_buffers(gpu: &Gpu, nvp: usize, real: usize) -> Result<Vec<Buffer<u8>>> {
+    REALS
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| gpu.buffer::<u8>(vertex_reals(i, n, nvp) * real))
+        .collect()
+}
+
+/// Zeroes the per-vertex buffers (enqueued, then flushed). Zeroed once: a
+/// partial run (normals only, for contours) leaves the curvature buffers
+/// unwritten, and later stages reading them through
+/// [`CurvatureEstimator::device_outputs`] must see finite values.
+fn zero_vertex_buffers(gpu: &Gpu, bufs: &mut [Buffer<u8>], nvp: usize, real: usize) -> Result<()> {
+    for (i, (b, n)) in bufs.iter_mut().zip(REALS).enumerate() {
+        gpu.zero(b, vertex_reals(i, n, nvp) * real)?;
+    }
+    gpu.flush()
+}
+
+/// The topology-only data of the scheme's kernels for `faces` (one-rings
+/// for gather, the owning faces into `owner` either way), with the
+/// per-vertex buffers `bufs` zeroed beside it.
+pub(super) fn topology(
+    gpu: &Arc<Gpu>,
+    scheme: SchemeKernels,
+    program: &Program,
+    faces: &Faces<'_>,
+    owner: &mut Buffer<i32>,
+    bufs: &mut [Buffer<u8>],
+    real: usize,
+) -> Result<Scheme> {
+    let (nv, nf) = (faces.nv, faces.nf);
+    let nvp = padded_vertices(nv);
+    // The fills are enqueued (no host zeros) and run on the device
+    // beside the host's work below; the one `finish` after it waits
+    // for them. On a CPU device they are also the first touch of the
+    // buffers' pages, which then costs the host nothing.
+    Ok(match scheme {
+        SchemeKernels::Gather(gk) => {
+            let fills = || zero_vertex_buffers(gpu, bufs, nvp, real);
+            if rings_on_device(gpu) {
+                let fb = &faces.buffer;
+                Scheme::Gather(gather::Gather::new_on_device(
+                    gpu, gk, program, fb, nf, nv, owner, real, fills,
+                )?)
+            } else {
+                let host = faces.host.unwrap_or(&[]);
+                Scheme::Gather(gather::Gather::new(gpu, gk, host, nv, owner, real, fills)?)
+            }
+        }
+        SchemeKernels::Atomic(ak) => {
+            zero_vertex_buffers(gpu, bufs, nvp, real)?;
+            atomic::owners(gpu, program, &faces.buffer, nf, owner, nvp)?;
+            Scheme::Atomic(ak)
+        }
+    })
 }

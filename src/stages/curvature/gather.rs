@@ -62,7 +62,7 @@ pub(super) fn check_faces(nf: usize) -> Result<()> {
     if corner_reals_bound(nf) > u32::MAX as usize {
         return Err(Error::InvalidArgument(format!(
             "{nf} faces are more than the gather scheme's 32-bit corner slots address \
-             ({} at most); use --accumulate atomic",
+             ({} at most); use accumulate = atomic",
             u32::MAX as usize / 12 - MAX_FACE_LANES as usize
         )));
     }

@@ -211,6 +211,23 @@ struct OneRing<'a> {
     lanes: u32,
 }
 
+/// The estimator's buffers as the passes take them, and the vertex records
+/// of either scheme with lanes (see `Kernels`).
+#[derive(Clone, Copy)]
+struct PassArgs {
+    pos: Arg,
+    faces: Arg,
+    cnt: Arg,
+    nrm: Arg,
+    area: Arg,
+    pd1: Arg,
+    pd2: Arg,
+    tens: Arg,
+    kk: Arg,
+    dk: Arg,
+    rec: Option<Arg>,
+}
+
 impl OneRing<'_> {
     /// The pass's place in each scheme's kernel triples.
     fn index(&self) -> usize {
@@ -322,12 +339,6 @@ impl CurvatureEstimator {
         opts: CurvatureOptions,
         built: Built,
     ) -> Result<Self> {
-        let Faces {
-            nv,
-            nf,
-            buffer: faces_b,
-            host: faces,
-        } = faces;
         let Built {
             k,
             scheme,
@@ -335,6 +346,7 @@ impl CurvatureEstimator {
             t0,
             build_ms,
         } = built;
+        let (nv, nf) = (faces.nv, faces.nf);
         let real = opts.precision.bytes();
         if let SchemeKernels::Gather(_) = scheme {
             gather::check_faces(nf)?;
@@ -343,49 +355,8 @@ impl CurvatureEstimator {
         // per-vertex kernels with lanes read and write whole blocks.
         let nvp = padded_vertices(nv);
         let mut owner = gpu.buffer::<i32>(nvp)?;
-        // Zeroed once: a partial run (normals only, for contours) leaves the
-        // curvature buffers unwritten, and later stages reading them through
-        // [`CurvatureEstimator::device_outputs`] must see finite values.
-        // Reals per vertex of pos, nrm, area, pd1, pd2, tens, kk, dk.
-        const REALS: [usize; 8] = [3, 3, 1, 3, 3, 3, 2, 4];
-        // The positions have one real more: the normal pass with lanes loads
-        // each vertex's x y z as 4 reals (ld_pos in kernels/common/curvature_lanes.h).
-        let reals = |i: usize, n: usize| n * nvp + usize::from(i == 0);
-        let mut bufs = REALS
-            .iter()
-            .enumerate()
-            .map(|(i, &n)| gpu.buffer::<u8>(reals(i, n) * real))
-            .collect::<Result<Vec<_>>>()?;
-        // The fills are enqueued (no host zeros) and run on the device
-        // beside the host's work below; the one `finish` at the end waits
-        // for them. On a CPU device they are also the first touch of the
-        // buffers' pages, which then costs the host nothing.
-        let zero_all = |bufs: &mut [Buffer<u8>]| -> Result<()> {
-            for (i, (b, n)) in bufs.iter_mut().zip(REALS).enumerate() {
-                gpu.zero(b, reals(i, n) * real)?;
-            }
-            gpu.flush()
-        };
-        let scheme = match scheme {
-            SchemeKernels::Gather(gk) => {
-                let fills = || zero_all(&mut bufs);
-                if rings_on_device(&gpu) {
-                    Scheme::Gather(gather::Gather::new_on_device(
-                        &gpu, gk, &program, &faces_b, nf, nv, &mut owner, real, fills,
-                    )?)
-                } else {
-                    let faces = faces.unwrap_or(&[]);
-                    Scheme::Gather(gather::Gather::new(
-                        &gpu, gk, faces, nv, &mut owner, real, fills,
-                    )?)
-                }
-            }
-            SchemeKernels::Atomic(ak) => {
-                zero_all(&mut bufs)?;
-                atomic::owners(&gpu, &program, &faces_b, nf, &mut owner, nvp)?;
-                Scheme::Atomic(ak)
-            }
-        };
+        let mut bufs = build::vertex_buffers(&gpu, nvp, real)?;
+        let scheme = build::topology(&gpu, scheme, &program, &faces, &mut owner, &mut bufs, real)?;
         gpu.finish()?;
         let [pos, nrm, area, pd1, pd2, tens, kk, dk]: [Buffer<u8>; 8] = bufs
             .try_into()
@@ -419,13 +390,13 @@ impl CurvatureEstimator {
                 center: [0.0; 3],
                 scale: 1.0,
             },
-            referenced: match faces {
+            referenced: match faces.host {
                 Some(f) => crate::mesh::referenced(nv, f),
                 None => vec![true; nv],
             },
             staging: Vec::with_capacity(3 * nv * real),
             k,
-            faces: faces_b,
+            faces: faces.buffer,
             owner,
             scheme,
             topology_ms: t0.elapsed().as_secs_f64() * 1e3,
@@ -590,89 +561,40 @@ impl CurvatureEstimator {
     /// Runs the position-dependent passes up to and including `last`
     /// (the dcurv pass only if the options ask for it).
     pub fn run_until(&mut self, last: Pass) -> Result<Timing> {
-        let g = &*self.gpu;
-        let (nv, nf) = (self.nv, self.nf);
-        let nv32 = nv as u32;
         let t0 = Instant::now();
         // Not a blocking write: the skinning or position load queued before
         // this run keeps going while the passes are enqueued.
-        g.zero(&mut self.counters, 4)?;
+        self.gpu.zero(&mut self.counters, 4)?;
+        let g = &*self.gpu;
         let mut events: Vec<(Pass, Event)> = Vec::new();
-        let (pos, faces, cnt) = (buf(&self.pos), buf(&self.faces), buf(&self.counters));
-        let (nrm, area, pd1, pd2) = (
-            buf(&self.nrm),
-            buf(&self.area),
-            buf(&self.pd1),
-            buf(&self.pd2),
-        );
-        let (tens, kk, dk) = (buf(&self.tens), buf(&self.kk), buf(&self.dk));
+        let a = self.pass_args();
         let dcurv = self.opts.dcurv && Pass::Dcurv <= last;
-        // Work-items of curv_frames and curv_principal: one per block of
-        // `lanes` vertices.
-        let vblocks = nv.div_ceil(self.k.lanes as usize);
-
-        // A one-ring pass as the scheme runs it (atomic: adds from each face;
-        // gather: corners per face, then ring sums per vertex).
-        let one_ring = |pass: Pass, face_args: &[Arg], outputs: &[Arg]| {
-            let r = OneRing {
-                pass,
-                face_args,
-                outputs,
-                counters: cnt,
-                nv,
-                nf,
-                lanes: self.k.lanes,
-            };
-            self.scheme.one_ring(g, &r)
-        };
-
-        if let Scheme::Atomic(a) = &self.scheme {
-            events.extend(
-                a.clear(g, nv, [nrm, area, tens, dk])?
-                    .map(|e| (Pass::Clear, e)),
-            );
+        if let Scheme::Atomic(s) = &self.scheme {
+            let sums = [a.nrm, a.area, a.tens, a.dk];
+            events.extend(s.clear(g, self.nv, sums)?.map(|e| (Pass::Clear, e)));
         }
         if Pass::NormalsAreas <= last {
-            events.extend(one_ring(Pass::NormalsAreas, &[pos, faces], &[nrm, area])?);
-            if let Some(src) = &self.normal_override {
-                let args = [Arg::U32(nv32), buf(src), nrm];
-                let ev = launch(g, &self.k.override_normals, nv, &args)?;
-                events.extend(ev.map(|e| (Pass::NormalsAreas, e)));
-            }
+            self.normals_areas(&a, &mut events)?;
         }
-        // The vertex records of either scheme with lanes (see `Kernels`).
-        let rec = self.rec.as_ref().map(buf);
         if Pass::Frames <= last {
-            let mut args = vec![Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
-            args.extend(rec.map(|r| [area, r, cnt]).into_iter().flatten());
-            let ev = launch(g, &self.k.frames, vblocks, &args)?;
-            events.extend(ev.map(|e| (Pass::Frames, e)));
-            if rec.is_none() {
-                // (curv_frames with lanes counts these itself)
-                let args = [Arg::U32(nv32), area, cnt];
-                let ev = launch(g, &self.k.count_empty, nv, &args)?;
-                events.extend(ev.map(|e| (Pass::Frames, e)));
-            }
+            self.frames(&a, &mut events)?;
         }
         if Pass::Tensor <= last {
-            let args: &[Arg] = match &rec {
-                Some(r) => &[*r, faces],
-                None => &[pos, faces, nrm, area, pd1, pd2],
+            let args: &[Arg] = match &a.rec {
+                Some(r) => &[*r, a.faces],
+                None => &[a.pos, a.faces, a.nrm, a.area, a.pd1, a.pd2],
             };
-            events.extend(one_ring(Pass::Tensor, args, &[tens])?);
+            events.extend(self.one_ring(Pass::Tensor, args, &[a.tens], a.cnt)?);
         }
         if Pass::Principal <= last {
-            let mut args = vec![Arg::U32(nv32), nrm, tens, pd1, pd2, kk];
-            args.extend(rec.map(|r| [pos, area, r]).into_iter().flatten());
-            let ev = launch(g, &self.k.principal, vblocks, &args)?;
-            events.extend(ev.map(|e| (Pass::Principal, e)));
+            self.principal(&a, &mut events)?;
         }
         if dcurv {
-            let args: &[Arg] = match &rec {
-                Some(r) => &[*r, faces],
-                None => &[pos, faces, area, pd1, pd2, kk],
+            let args: &[Arg] = match &a.rec {
+                Some(r) => &[*r, a.faces],
+                None => &[a.pos, a.faces, a.area, a.pd1, a.pd2, a.kk],
             };
-            events.extend(one_ring(Pass::Dcurv, args, &[dk])?);
+            events.extend(self.one_ring(Pass::Dcurv, args, &[a.dk], a.cnt)?);
         }
         g.finish()?;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -685,6 +607,86 @@ impl CurvatureEstimator {
         Ok(timing)
     }
 
+    /// The buffers the passes read and write, as kernel arguments.
+    fn pass_args(&self) -> PassArgs {
+        PassArgs {
+            pos: buf(&self.pos),
+            faces: buf(&self.faces),
+            cnt: buf(&self.counters),
+            nrm: buf(&self.nrm),
+            area: buf(&self.area),
+            pd1: buf(&self.pd1),
+            pd2: buf(&self.pd2),
+            tens: buf(&self.tens),
+            kk: buf(&self.kk),
+            dk: buf(&self.dk),
+            rec: self.rec.as_ref().map(buf),
+        }
+    }
+
+    /// A one-ring pass as the scheme runs it (atomic: adds from each face;
+    /// gather: corners per face, then ring sums per vertex).
+    fn one_ring(
+        &self,
+        pass: Pass,
+        face_args: &[Arg],
+        outputs: &[Arg],
+        counters: Arg,
+    ) -> Result<Vec<(Pass, Event)>> {
+        let r = OneRing {
+            pass,
+            face_args,
+            outputs,
+            counters,
+            nv: self.nv,
+            nf: self.nf,
+            lanes: self.k.lanes,
+        };
+        self.scheme.one_ring(&self.gpu, &r)
+    }
+
+    /// The normals and areas pass, then the normals given in their place
+    /// where there are some.
+    fn normals_areas(&self, a: &PassArgs, events: &mut Vec<(Pass, Event)>) -> Result<()> {
+        let (pos, faces, nrm, area) = (a.pos, a.faces, a.nrm, a.area);
+        events.extend(self.one_ring(Pass::NormalsAreas, &[pos, faces], &[nrm, area], a.cnt)?);
+        if let Some(src) = &self.normal_override {
+            let args = [Arg::U32(self.nv as u32), buf(src), nrm];
+            let ev = launch(&self.gpu, &self.k.override_normals, self.nv, &args)?;
+            events.extend(ev.map(|e| (Pass::NormalsAreas, e)));
+        }
+        Ok(())
+    }
+
+    /// `curv_frames` (one work-item per block of `lanes` vertices), and
+    /// without lanes the count of vertices without faces.
+    fn frames(&self, a: &PassArgs, events: &mut Vec<(Pass, Event)>) -> Result<()> {
+        let (g, nv32) = (&*self.gpu, self.nv as u32);
+        let vblocks = self.nv.div_ceil(self.k.lanes as usize);
+        let (pos, faces, nrm, pd1, pd2) = (a.pos, a.faces, a.nrm, a.pd1, a.pd2);
+        let mut args = vec![Arg::U32(nv32), pos, faces, buf(&self.owner), nrm, pd1, pd2];
+        args.extend(a.rec.map(|r| [a.area, r, a.cnt]).into_iter().flatten());
+        let ev = launch(g, &self.k.frames, vblocks, &args)?;
+        events.extend(ev.map(|e| (Pass::Frames, e)));
+        if a.rec.is_none() {
+            // (curv_frames with lanes counts these itself)
+            let args = [Arg::U32(nv32), a.area, a.cnt];
+            let ev = launch(g, &self.k.count_empty, self.nv, &args)?;
+            events.extend(ev.map(|e| (Pass::Frames, e)));
+        }
+        Ok(())
+    }
+
+    /// `curv_principal` (one work-item per block of `lanes` vertices).
+    fn principal(&self, a: &PassArgs, events: &mut Vec<(Pass, Event)>) -> Result<()> {
+        let vblocks = self.nv.div_ceil(self.k.lanes as usize);
+        let mut args = vec![Arg::U32(self.nv as u32), a.nrm, a.tens, a.pd1, a.pd2, a.kk];
+        args.extend(a.rec.map(|r| [a.pos, a.area, r]).into_iter().flatten());
+        let ev = launch(&self.gpu, &self.k.principal, vblocks, &args)?;
+        events.extend(ev.map(|e| (Pass::Principal, e)));
+        Ok(())
+    }
+
     /// The device buffers of the last run, for chaining later stages on the
     /// device without a host round trip. Only f32 buffers can be chained (the
     /// line and AO kernels are f32): an f64 estimator is refused.
@@ -692,7 +694,7 @@ impl CurvatureEstimator {
         if self.opts.precision != Precision::F32 {
             return Err(Error::InvalidArgument(
                 "device chaining needs f32 precision (this curvature estimator runs f64; \
-                 use --precision f32, or read the field back)"
+                 use precision = f32, or read the field back)"
                     .into(),
             ));
         }
@@ -723,9 +725,8 @@ impl CurvatureEstimator {
 
 /// Where the gather scheme's one-ring lists are built: on the device for
 /// devices with their own memory (GPUs: the host build writes scattered
-/// entries through a mapping, 132 ms for a 2M-vertex torus on an H200's
-/// host), on the host for CPU devices (the lists land in the buffers
-/// themselves). `SHAPECUE_RING_BUILD=device` or `host` overrides it.
+/// entries through a mapping), on the host for CPU devices (the lists land
+/// in the buffers themselves). `SHAPECUE_RING_BUILD=device` or `host` overrides it.
 fn rings_on_device(gpu: &Gpu) -> bool {
     match std::env::var("SHAPECUE_RING_BUILD").as_deref() {
         Ok("device") => true,

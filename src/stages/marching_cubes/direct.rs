@@ -8,12 +8,14 @@
 //! compaction of the used ones only if one is not. CPU twin:
 //! [`crate::cpu::marching_cubes::mc_direct`].
 
-use super::{Holder, IsoStats, Isosurfacer};
+use super::{Holder, IsoStats, Isosurfacer, add_event};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::marching_cubes::{McKernel, cell_rows, unused_check_near};
 use crate::spec::timing::{Step, Timing};
-use crate::stages::vertex_fusion::Grow;
+use crate::stages::scan::Scan;
+use crate::stages::vertex_fusion::{Fuser, Grow};
+use opencl3::event::Event;
 use opencl3::kernel::Kernel;
 use opencl3::memory::Buffer;
 use opencl3::program::Program;
@@ -100,39 +102,135 @@ impl Direct {
     }
 }
 
+/// What the count pass's scan found: the scanned totals at the vertex,
+/// triangle and hit boundaries, and the counts they give.
+struct Counts {
+    /// The exclusive scan at `gr`, `2 gr` and `3 gr`.
+    at: Vec<u32>,
+    /// Edge vertices.
+    v: usize,
+    /// Triangles the cells make.
+    t: usize,
+    /// Vertices that land on a grid point (exact hits).
+    h: usize,
+    /// Triangles dropped as twins across a cell face.
+    twins: usize,
+}
+
+/// One direct extraction's device, buffers and the arguments its kernels
+/// share; its methods are the family's steps, in the order they run.
+struct DirectPass<'a> {
+    g: &'a Gpu,
+    d: &'a mut Direct,
+    scan: &'a mut Scan,
+    fuser: &'a mut Fuser,
+    dims: [usize; 3],
+    iso: f32,
+    /// Grid rows.
+    gr: usize,
+    /// Grid rows, nx, ny, nz, the volume and the iso value.
+    common: [Arg; 6],
+    /// The case table as the direct kernels take it: counts, tris, flat.
+    tables: [Arg; 3],
+}
+
 impl Isosurfacer {
     /// Direct numbering of `value = iso` (see the module's description).
     pub(super) fn extract_direct(&mut self, iso: f32, st: &mut IsoStats) -> Result<()> {
         let g = self.gpu.clone();
-        let [nx, ny, nz] = self.dims;
-        let voxels = nx * ny * nz;
+        let mut p = DirectPass::new(self, &g, iso);
+        let e_rows = p.rows()?;
+        let e_count = p.count()?;
+        let c = p.scan()?;
+        add_event(st, Step::McDirectRows, &e_rows);
+        add_event(st, Step::McDirectCount, &e_count);
+        st.timing.add(Step::ScanExclusive, p.scan.last_ms());
+        let side_cap = p.check_room(&c)?;
+        st.soup_triangles = c.t + c.twins;
+        st.exact_hits = c.h;
+        // Hits: their grid points sorted and made unique (the vertices after
+        // the edge vertices), and the triangles that collapse onto them
+        // recounted where rows have hits.
+        let (mut u, mut tk, mut collapsed) = (0, c.t, 0);
+        if c.h > 0 {
+            u = p.hits(&c, st)?;
+            (tk, collapsed) = p.recount(&c, u, st)?;
+        }
+        let nv = c.v + u;
+        let e_tri = p.triangles(&c, u, tk, side_cap)?;
+        let e_pts = p.points(c.v, u)?;
+        let full = p.needs_cleanup(c.h, side_cap)?;
+        let dropped = c.twins + collapsed;
+        let drops = Drops {
+            vertices: nv,
+            hit_points: u,
+            recounted: c.h > 0,
+            dropped,
+        };
+        p.d.last_drops = (dropped > 0).then_some(drops);
+        let used = if !full && dropped > 0 {
+            p.unused(&drops, tk, (&e_tri, &e_pts), st)?
+        } else {
+            g.finish()?;
+            add_events(st, &e_tri, &e_pts);
+            None
+        };
+        let result = p.keep(full, used, &drops, tk, st)?;
+        self.result = Some(result);
+        Ok(())
+    }
+}
+
+impl<'a> DirectPass<'a> {
+    /// Borrows the direct kernels, the scan and the fuser of `iz` for one
+    /// extraction of `value = iso` on `g`.
+    fn new(iz: &'a mut Isosurfacer, g: &'a Gpu, iso: f32) -> Self {
+        let [nx, ny, nz] = iz.dims;
         let gr = ny * nz;
-        let d = &mut self.direct;
-        let common = [
-            Arg::U32(gr as u32),
-            Arg::U32(nx as u32),
-            Arg::U32(ny as u32),
-            Arg::U32(nz as u32),
-            buf(&self.vol),
-            Arg::F32(iso),
-        ];
-        // The case table as the direct kernels take it: counts, tris, flat.
-        let tables = [buf(&self.counts), buf(&self.tris), buf(&self.flat)];
-        let e_rows = launch(
-            &g,
-            &d.rows,
-            gr,
-            &[
+        DirectPass {
+            g,
+            common: [
                 Arg::U32(gr as u32),
                 Arg::U32(nx as u32),
-                buf(&self.vol),
+                Arg::U32(ny as u32),
+                Arg::U32(nz as u32),
+                buf(&iz.vol),
                 Arg::F32(iso),
-                buf(&d.info),
             ],
-        )?;
-        let mut a = [&common[..], &tables[..]].concat();
-        a.extend([buf(&d.info), buf(&d.rowc), buf(&d.split), buf(&d.trim)]);
-        let e_count = launch(&g, &d.count, gr, &a)?;
+            tables: [buf(&iz.counts), buf(&iz.tris), buf(&iz.flat)],
+            d: &mut iz.direct,
+            scan: &mut iz.scan,
+            fuser: &mut iz.fuser,
+            dims: iz.dims,
+            iso,
+            gr,
+        }
+    }
+
+    /// The shared arguments, the case table, then `rest`.
+    fn with_tables(&self, rest: &[Arg]) -> Vec<Arg> {
+        [&self.common[..], &self.tables[..], rest].concat()
+    }
+
+    /// `mc_direct_rows`: each grid row trimmed to where the surface is.
+    fn rows(&mut self) -> Result<Option<Event>> {
+        // Grid rows, nx, the volume and the iso value.
+        let c = &self.common;
+        let a = [c[0], c[1], c[4], c[5], buf(&self.d.info)];
+        launch(self.g, &self.d.rows, self.gr, &a)
+    }
+
+    /// `mc_direct_count`: per grid row, its vertices, triangles, hits and twins.
+    fn count(&mut self) -> Result<Option<Event>> {
+        let d = &self.d;
+        let a = self.with_tables(&[buf(&d.info), buf(&d.rowc), buf(&d.split), buf(&d.trim)]);
+        launch(self.g, &d.count, self.gr, &a)
+    }
+
+    /// The one scan of the four per-row counts (in place), whose totals at
+    /// the boundaries size the outputs: the extraction's host round trip.
+    fn scan(&mut self) -> Result<Counts> {
+        let (gr, iso, d) = (self.gr, self.iso, &self.d);
         let (total, at) = self
             .scan
             .exclusive_at(&d.rowc, &d.rowc, 4 * gr, &[gr, 2 * gr, 3 * gr])
@@ -143,20 +241,20 @@ impl Isosurfacer {
                 )),
                 e => e,
             })?;
-        if let Some(e) = &e_rows {
-            st.timing.add(Step::McDirectRows, event_ms(e));
-        }
-        if let Some(e) = &e_count {
-            st.timing.add(Step::McDirectCount, event_ms(e));
-        }
-        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-        let (v, t, h, twins) = (
-            at[0] as usize,
-            (at[1] - at[0]) as usize,
-            (at[2] - at[1]) as usize,
-            (total - at[2] as u64) as usize,
-        );
-        let slots = v + h;
+        Ok(Counts {
+            v: at[0] as usize,
+            t: (at[1] - at[0]) as usize,
+            h: (at[2] - at[1]) as usize,
+            twins: (total - at[2] as u64) as usize,
+            at,
+        })
+    }
+
+    /// Refuses counts past the device's 32-bit indices or its memory;
+    /// returns the room for the triangles the host checks for twins.
+    fn check_room(&self, c: &Counts) -> Result<usize> {
+        let (g, iso, t) = (self.g, self.iso, c.t);
+        let slots = c.v + c.h;
         if 3 * slots as u64 > u32::MAX as u64 || 3 * t as u64 > u32::MAX as u64 {
             return Err(Error::InvalidArgument(format!(
                 "iso {iso}: {slots} vertices and {t} triangles exceed the 32-bit indices of \
@@ -164,18 +262,19 @@ impl Isosurfacer {
                 u32::MAX / 3
             )));
         }
-        let cleanup = h > 0 || d.nonfinite;
-        let side_cap = side_records(h, t);
+        let cleanup = c.h > 0 || self.d.nonfinite;
+        let side_cap = side_records(c.h, t);
         // Twins alone (no hit, a finite volume) can still drop triangles and
         // leave a vertex unused, which takes the compaction's buffers too.
+        let voxels = self.dims.iter().product::<usize>();
         let need = 4 * voxels as u64
             + crate::spec::vertex_fusion::direct_device_bytes_bound(
-                gr,
-                v,
-                h,
+                self.gr,
+                c.v,
+                c.h,
                 t,
                 side_cap,
-                cleanup || twins > 0,
+                cleanup || c.twins > 0,
             );
         if need > g.info.global_mem {
             return Err(Error::DeviceUnsupported {
@@ -187,69 +286,82 @@ impl Isosurfacer {
                 ),
             });
         }
-        st.soup_triangles = t + twins;
-        st.exact_hits = h;
-        // Hits: their grid points sorted and made unique (the vertices after
-        // the edge vertices), and the triangles that collapse onto them
-        // recounted where rows have hits.
-        let (mut u, mut tk, mut collapsed) = (0, t, 0);
-        if h > 0 {
-            d.hit_keys.reserve(&g, h)?;
-            let mut a = common.to_vec();
-            a.extend([
-                buf(&d.rowc),
-                buf(&d.trim),
-                Arg::U32(at[1]),
-                Arg::U32(at[2]),
-                buf(&d.hit_keys.buf),
-            ]);
-            let e = launch(&g, &d.hits, gr, &a)?;
-            // Sorted and made unique on the host: the keys come back anyway
-            // to size the vertices, and a device sort is a dozen launches.
-            let mut keys = vec![0u32; h];
-            g.read(&d.hit_keys.buf, &mut keys)?;
-            keys.sort_unstable();
-            keys.dedup();
-            u = keys.len();
-            g.write(&mut d.hit_keys.buf, &keys)?;
-            if let Some(e) = &e {
-                st.timing.add(Step::McDirectHits, event_ms(e));
-            }
-            let mut a = [&common[..], &tables[..]].concat();
-            a.extend([
-                buf(&d.rowc),
-                buf(&d.trim),
-                buf(&d.tcount),
-                Arg::U32(u as u32),
-                buf(&d.hit_keys.buf),
-            ]);
-            let e = launch(&g, &d.recount, gr, &a)?;
-            tk = self.scan.exclusive(&d.tcount, &d.tcount, gr)? as usize;
-            if let Some(e) = &e {
-                st.timing.add(Step::McDirectRecount, event_ms(e));
-            }
-            st.timing.add(Step::ScanExclusive, self.scan.last_ms());
-            collapsed = t.checked_sub(tk).ok_or_else(|| Error::DeviceResult {
-                what: "triangle recount".into(),
-                detail: format!("{tk} kept triangles of {t}"),
-            })?;
-        }
-        let nv = v + u;
-        d.pos.reserve(&g, 3 * nv)?;
-        d.faces.reserve(&g, 3 * tk)?;
+        Ok(side_cap)
+    }
+
+    /// `mc_direct_hits`: the grid points that vertices land on, listed, then
+    /// sorted and made unique; returns how many.
+    fn hits(&mut self, c: &Counts, st: &mut IsoStats) -> Result<usize> {
+        let (g, d) = (self.g, &mut *self.d);
+        d.hit_keys.reserve(g, c.h)?;
+        let mut a = self.common.to_vec();
+        a.extend([
+            buf(&d.rowc),
+            buf(&d.trim),
+            Arg::U32(c.at[1]),
+            Arg::U32(c.at[2]),
+            buf(&d.hit_keys.buf),
+        ]);
+        let e = launch(g, &d.hits, self.gr, &a)?;
+        // Sorted and made unique on the host: the keys come back anyway
+        // to size the vertices, and a device sort is a dozen launches.
+        let mut keys = vec![0u32; c.h];
+        g.read(&d.hit_keys.buf, &mut keys)?;
+        keys.sort_unstable();
+        keys.dedup();
+        g.write(&mut d.hit_keys.buf, &keys)?;
+        add_event(st, Step::McDirectHits, &e);
+        Ok(keys.len())
+    }
+
+    /// `mc_direct_recount` and its scan: the triangles kept where `u` hit
+    /// points collapse some; returns (kept, collapsed).
+    fn recount(&mut self, c: &Counts, u: usize, st: &mut IsoStats) -> Result<(usize, usize)> {
+        let d = &self.d;
+        let a = self.with_tables(&[
+            buf(&d.rowc),
+            buf(&d.trim),
+            buf(&d.tcount),
+            Arg::U32(u as u32),
+            buf(&d.hit_keys.buf),
+        ]);
+        let e = launch(self.g, &d.recount, self.gr, &a)?;
+        let tk = self.scan.exclusive(&d.tcount, &d.tcount, self.gr)? as usize;
+        add_event(st, Step::McDirectRecount, &e);
+        st.timing.add(Step::ScanExclusive, self.scan.last_ms());
+        let t = c.t;
+        let collapsed = t.checked_sub(tk).ok_or_else(|| Error::DeviceResult {
+            what: "triangle recount".into(),
+            detail: format!("{tk} kept triangles of {t}"),
+        })?;
+        Ok((tk, collapsed))
+    }
+
+    /// `mc_direct_triangles`: the `tk` kept triangles with their final
+    /// indices and the edge vertices' positions (outputs sized first).
+    fn triangles(
+        &mut self,
+        c: &Counts,
+        u: usize,
+        tk: usize,
+        side_cap: usize,
+    ) -> Result<Option<Event>> {
+        let (g, gr, v, h) = (self.g, self.gr, c.v, c.h);
+        self.d.pos.reserve(g, 3 * (v + u))?;
+        self.d.faces.reserve(g, 3 * tk)?;
         if h > 0 {
             // Only written where there are hits (a blocking write otherwise
             // would be a second wait of the extraction).
-            d.side.reserve(&g, 3 * side_cap)?;
-            g.write(&mut d.side_n, &[0])?;
+            self.d.side.reserve(g, 3 * side_cap)?;
+            g.write(&mut self.d.side_n, &[0])?;
         }
+        let d = &*self.d;
         let (toff, tshift, tbase) = if h > 0 {
             (&d.tcount, 0, 0)
         } else {
             (&d.rowc, gr as u32, v as u32)
         };
-        let mut a = [&common[..], &tables[..]].concat();
-        a.extend([
+        let a = self.with_tables(&[
             buf(&d.rowc),
             buf(&d.split),
             buf(&d.trim),
@@ -265,9 +377,16 @@ impl Isosurfacer {
             buf(&d.side.buf),
             buf(&d.side_n),
         ]);
-        let e_tri = launch(&g, &d.triangles, gr, &a)?;
-        let e_pts = launch(
-            &g,
+        launch(g, &d.triangles, gr, &a)
+    }
+
+    /// `mc_direct_points`: the positions of the `u` hit-point vertices,
+    /// after the `v` edge vertices.
+    fn points(&mut self, v: usize, u: usize) -> Result<Option<Event>> {
+        let [nx, ny, _] = self.dims;
+        let d = &self.d;
+        launch(
+            self.g,
             &d.points,
             u,
             &[
@@ -278,8 +397,14 @@ impl Isosurfacer {
                 Arg::U32(v as u32),
                 buf(&d.pos.buf),
             ],
-        )?;
-        // Does anything remain for vertex fusion's clean-up to do?
+        )
+    }
+
+    /// Whether anything remains for vertex fusion's clean-up to do: a
+    /// non-finite volume, an overflowing list of triangles on grid points
+    /// (`h` hits, room for `side_cap`), or twins among them.
+    fn needs_cleanup(&self, h: usize, side_cap: usize) -> Result<bool> {
+        let (g, d) = (self.g, &self.d);
         let mut full = d.nonfinite;
         if h > 0 && !full {
             let mut n = [0u32];
@@ -291,52 +416,67 @@ impl Isosurfacer {
                 hit_twins(&rec)
             };
         }
-        let dropped = twins + collapsed;
-        let drops = Drops {
-            vertices: nv,
-            hit_points: u,
-            recounted: h > 0,
-            dropped,
-        };
-        d.last_drops = (dropped > 0).then_some(drops);
-        // Dropped triangles may have been a vertex's only ones: then the
-        // vertices still used are compacted (no triangle to drop or cancel).
-        let mut used = None;
-        if !full && dropped > 0 {
-            let mut n = nv;
-            let mut all = true;
-            if unused_check_near(dropped, cell_rows(self.dims)) {
-                let (unused, t) = d.count_unused_near(&g, self.dims, &drops)?;
-                Self::add_events(st, &e_tri, &e_pts);
-                st.timing.extend(&t);
-                all = unused > 0;
-                n = nv.checked_sub(unused).ok_or_else(|| Error::DeviceResult {
-                    what: "count of unused vertices".into(),
-                    detail: format!("{unused} unused of {nv}"),
-                })?;
-            }
-            if all {
-                // The marks of every vertex, which the compaction numbers.
-                let (m, t) = self.fuser.count_referenced(&d.faces.buf, nv, tk)?;
-                if n == nv {
-                    Self::add_events(st, &e_tri, &e_pts);
-                }
-                st.timing.extend(&t);
-                debug_assert!(n == nv || n == m, "unused near {} all {}", nv - n, nv - m);
-                n = m;
-            }
-            used = (n < nv).then_some(n);
-        } else {
-            g.finish()?;
-            Self::add_events(st, &e_tri, &e_pts);
+        Ok(full)
+    }
+
+    /// `mc_direct_unused_*` (near few dropped triangles) or the fuser's
+    /// count over every vertex: dropped triangles may have been a vertex's
+    /// only ones; returns the vertices still used when some are not (then
+    /// compacted: no triangle to drop or cancel). `events` are the triangle
+    /// and point passes', added once they have run.
+    fn unused(
+        &mut self,
+        drops: &Drops,
+        tk: usize,
+        events: (&Option<Event>, &Option<Event>),
+        st: &mut IsoStats,
+    ) -> Result<Option<usize>> {
+        let (e_tri, e_pts) = events;
+        let nv = drops.vertices;
+        let mut n = nv;
+        let mut all = true;
+        if unused_check_near(drops.dropped, cell_rows(self.dims)) {
+            let (unused, t) = self.d.count_unused_near(self.g, self.dims, drops)?;
+            add_events(st, e_tri, e_pts);
+            st.timing.extend(&t);
+            all = unused > 0;
+            n = nv.checked_sub(unused).ok_or_else(|| Error::DeviceResult {
+                what: "count of unused vertices".into(),
+                detail: format!("{unused} unused of {nv}"),
+            })?;
         }
+        if all {
+            // The marks of every vertex, which the compaction numbers.
+            let (m, t) = self.fuser.count_referenced(&self.d.faces.buf, nv, tk)?;
+            if n == nv {
+                add_events(st, e_tri, e_pts);
+            }
+            st.timing.extend(&t);
+            debug_assert!(n == nv || n == m, "unused near {} all {}", nv - n, nv - m);
+            n = m;
+        }
+        Ok((n < nv).then_some(n))
+    }
+
+    /// The result: fused by the clean-up when `full`, compacted to `used`
+    /// vertices, or the direct mesh as it is (`tk` triangles); the stats
+    /// say which.
+    fn keep(
+        &mut self,
+        full: bool,
+        used: Option<usize>,
+        drops: &Drops,
+        tk: usize,
+        st: &mut IsoStats,
+    ) -> Result<(Holder, usize, usize)> {
+        let (d, nv, dropped) = (&self.d, drops.vertices, drops.dropped);
         if full {
             let (c, ft) = self.fuser.finish(&d.faces.buf, &d.pos.buf, nv, tk)?;
             st.vertices = c.vertices;
             st.faces = c.faces;
             st.degenerate_dropped = dropped + c.dropped;
-            self.result = Some((Holder::Fused, c.vertices, c.faces));
             st.timing.extend(&ft);
+            Ok((Holder::Fused, c.vertices, c.faces))
         } else if let Some(n) = used {
             let (c, ft) = self
                 .fuser
@@ -344,31 +484,22 @@ impl Isosurfacer {
             st.vertices = c.vertices;
             st.faces = c.faces;
             st.degenerate_dropped = dropped;
-            self.result = Some((Holder::Fused, c.vertices, c.faces));
             st.timing.extend(&ft);
+            Ok((Holder::Fused, c.vertices, c.faces))
         } else {
             st.vertices = nv;
             st.faces = tk;
             st.degenerate_dropped = dropped;
-            self.result = Some((Holder::Direct, nv, tk));
+            Ok((Holder::Direct, nv, tk))
         }
-        Ok(())
     }
+}
 
-    /// Adds the kernel times of `mc_direct_triangles` and `mc_direct_points`
-    /// (once they have run).
-    fn add_events(
-        st: &mut IsoStats,
-        tri: &Option<opencl3::event::Event>,
-        pts: &Option<opencl3::event::Event>,
-    ) {
-        if let Some(e) = tri {
-            st.timing.add(Step::McDirectTriangles, event_ms(e));
-        }
-        if let Some(e) = pts {
-            st.timing.add(Step::McDirectPoints, event_ms(e));
-        }
-    }
+/// Adds the kernel times of `mc_direct_triangles` and `mc_direct_points`
+/// (once they have run).
+fn add_events(st: &mut IsoStats, tri: &Option<Event>, pts: &Option<Event>) {
+    add_event(st, Step::McDirectTriangles, tri);
+    add_event(st, Step::McDirectPoints, pts);
 }
 
 /// What the last extraction's triangle pass left, for the check that the
@@ -387,6 +518,34 @@ pub(super) struct Drops {
     pub(super) dropped: usize,
 }
 
+/// The arguments the four kernels of the check for unused vertices share.
+struct UnusedArgs {
+    /// Grid rows, nx, ny, nz.
+    gr: Arg,
+    nx: Arg,
+    ny: Arg,
+    nz: Arg,
+    /// The per-row offsets (the count pass's scan).
+    off: Arg,
+    /// The kept triangles' offsets, their shift and base (the recount's or
+    /// the count pass's).
+    toff: Arg,
+    tshift: Arg,
+    tbase: Arg,
+    /// Hit points and their sorted keys.
+    nh: Arg,
+    keys: Arg,
+    /// Vertices, and the faces that use them.
+    nv: Arg,
+    faces: Arg,
+    /// Room for cell rows in the list (`cap` as an argument), the list
+    /// (its two counts, then the rows) and the vertices' marks.
+    cap: usize,
+    cap32: Arg,
+    list: Arg,
+    marks: Arg,
+}
+
 impl Direct {
     /// `mc_direct_unused_rows`, `_clear`, `_mark`, `_count`: how many of the
     /// `nv` vertices the kept triangles no longer use, looked for only in the
@@ -399,75 +558,22 @@ impl Direct {
         dims: [usize; 3],
         drops: &Drops,
     ) -> Result<(usize, Timing)> {
-        let [nx, ny, nz] = dims;
-        let (nv, u) = (drops.vertices, drops.hit_points);
-        let gr = ny * nz;
-        let v = nv - u;
-        let (toff, tshift, tbase) = if drops.recounted {
-            (&self.tcount, 0, 0)
-        } else {
-            (&self.rowc, gr as u32, v as u32)
-        };
-        let cap = drops.dropped.min(gr);
-        self.unused.reserve(g, nv)?;
-        self.unused_list.reserve(g, 2 + cap)?;
-        g.zero(&mut self.unused_list.buf, 2)?;
-        let (gr32, nx32, ny32, nz32, cap32) = (
-            Arg::U32(gr as u32),
-            Arg::U32(nx as u32),
-            Arg::U32(ny as u32),
-            Arg::U32(nz as u32),
-            Arg::U32(cap as u32),
-        );
-        let (off, toff, list, marks) = (
-            buf(&self.rowc),
-            buf(toff),
-            buf(&self.unused_list.buf),
-            buf(&self.unused.buf),
-        );
-        let (tshift, nh, keys) = (
-            Arg::U32(tshift),
-            Arg::U32(u as u32),
-            buf(&self.hit_keys.buf),
-        );
-        let e_rows = launch(
-            g,
-            &self.unused_rows,
-            gr,
-            &[gr32, ny32, nz32, off, toff, tshift, cap32, list],
-        )?;
-        let e_clear = launch(
-            g,
-            &self.unused_clear,
-            4 * cap,
-            &[gr32, nx32, ny32, nz32, off, nh, keys, cap32, list, marks],
-        )?;
-        let e_mark = launch(
-            g,
-            &self.unused_mark,
-            9 * cap,
-            &[
-                gr32,
-                ny32,
-                nz32,
-                toff,
-                tshift,
-                Arg::U32(tbase),
-                Arg::U32(nv as u32),
-                buf(&self.faces.buf),
-                cap32,
-                list,
-                marks,
-            ],
-        )?;
-        let e_count = launch(
-            g,
-            &self.unused_count,
-            4 * cap,
-            &[
-                gr32, nx32, ny32, nz32, off, toff, tshift, nh, keys, marks, cap32, list,
-            ],
-        )?;
+        let a = self.unused_args(g, dims, drops)?;
+        let (gr, cap) = (dims[1] * dims[2], a.cap);
+        let rows = [a.gr, a.ny, a.nz, a.off, a.toff, a.tshift, a.cap32, a.list];
+        let e_rows = launch(g, &self.unused_rows, gr, &rows)?;
+        let clear = [
+            a.gr, a.nx, a.ny, a.nz, a.off, a.nh, a.keys, a.cap32, a.list, a.marks,
+        ];
+        let e_clear = launch(g, &self.unused_clear, 4 * cap, &clear)?;
+        let mark = [
+            a.gr, a.ny, a.nz, a.toff, a.tshift, a.tbase, a.nv, a.faces, a.cap32, a.list, a.marks,
+        ];
+        let e_mark = launch(g, &self.unused_mark, 9 * cap, &mark)?;
+        let count = [
+            a.gr, a.nx, a.ny, a.nz, a.off, a.toff, a.tshift, a.nh, a.keys, a.marks, a.cap32, a.list,
+        ];
+        let e_count = launch(g, &self.unused_count, 4 * cap, &count)?;
         let mut n = [0u32; 2];
         g.read(&self.unused_list.buf, &mut n)?;
         let mut t = Timing::default();
@@ -475,6 +581,43 @@ impl Direct {
             t.add(Step::McDirectUnused, event_ms(e));
         }
         Ok((n[1] as usize, t))
+    }
+
+    /// Sizes the marks and the list of cell rows (its counts zeroed) for
+    /// the check after the triangle pass that left `drops`, and returns the
+    /// arguments its kernels share.
+    fn unused_args(&mut self, g: &Gpu, dims: [usize; 3], drops: &Drops) -> Result<UnusedArgs> {
+        let [nx, ny, nz] = dims;
+        let (nv, u) = (drops.vertices, drops.hit_points);
+        let gr = ny * nz;
+        let v = nv - u;
+        let cap = drops.dropped.min(gr);
+        self.unused.reserve(g, nv)?;
+        self.unused_list.reserve(g, 2 + cap)?;
+        g.zero(&mut self.unused_list.buf, 2)?;
+        let (toff, tshift, tbase) = if drops.recounted {
+            (&self.tcount, 0, 0)
+        } else {
+            (&self.rowc, gr as u32, v as u32)
+        };
+        Ok(UnusedArgs {
+            gr: Arg::U32(gr as u32),
+            nx: Arg::U32(nx as u32),
+            ny: Arg::U32(ny as u32),
+            nz: Arg::U32(nz as u32),
+            off: buf(&self.rowc),
+            toff: buf(toff),
+            tshift: Arg::U32(tshift),
+            tbase: Arg::U32(tbase),
+            nh: Arg::U32(u as u32),
+            keys: buf(&self.hit_keys.buf),
+            nv: Arg::U32(nv as u32),
+            faces: buf(&self.faces.buf),
+            cap,
+            cap32: Arg::U32(cap as u32),
+            list: buf(&self.unused_list.buf),
+            marks: buf(&self.unused.buf),
+        })
     }
 }
 

@@ -21,7 +21,7 @@ use crate::spec::marching_cubes::McKernel;
 use crate::spec::marching_cubes::{
     cell_rows, check_dims, edge_key_bits, halves_differences, table,
 };
-use crate::spec::timing::Timing;
+use crate::spec::timing::{Step, Timing};
 use crate::spec::vertex_fusion::Fusion;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::kernel_files;
@@ -34,8 +34,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Values ahead of each row's loads that CPU devices prefetch (2 KiB, 32
-/// cache lines; measured on PoCL: 512³ sphere row pass 71–77 → 42–47 ms,
-/// count 50–56 → 34–38, triangles 72–78 → 58–62; 256 and 1024 no better).
+/// cache lines; 256 and 1024 were no better).
 const CPU_PREFETCH_VALUES: usize = 512;
 
 /// What one extraction did and how long each pass took.
@@ -219,8 +218,8 @@ impl Isosurfacer {
         }
         if fusion == Fusion::Edge && edge_key_bits(voxels).is_none() {
             return Err(Error::InvalidArgument(format!(
-                "--fusion edge keys vertices by 4 × voxel index in 32 bits: at most 2^30 voxels, \
-                 this volume has {voxels}; use --fusion direct or hash"
+                "fusion = edge keys vertices by 4 × voxel index in 32 bits: at most 2^30 voxels, \
+                 this volume has {voxels}; use fusion = direct or hash"
             )));
         }
         if fusion == Fusion::Direct {
@@ -306,6 +305,13 @@ impl Isosurfacer {
                 .collect(),
             faces,
         }
+    }
+}
+
+/// Adds the kernel time of `step` from its launch's event, if it launched.
+fn add_event(st: &mut IsoStats, step: Step, e: &Option<opencl3::event::Event>) {
+    if let Some(e) = e {
+        st.timing.add(step, crate::gpu::event_ms(e));
     }
 }
 
