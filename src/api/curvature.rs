@@ -13,7 +13,7 @@ use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::mesh::order::MeshOrder;
 use crate::mesh::{Generated, LoadOptions, Mesh};
-use crate::spec::curvature::{Accumulate, CurvatureCounts, CurvatureOptions};
+use crate::spec::curvature::{Accumulate, AccumulateChoice, CurvatureCounts, CurvatureOptions};
 use crate::spec::timing::Timing;
 use crate::stages::curvature::{CurvatureEstimator, MappedField, OrderPlan, OrderedEstimator};
 
@@ -53,10 +53,10 @@ pub struct CurvatureJob {
     /// The device (`SHAPECUE_DEVICE` or the first GPU, else CPU, when `None`).
     pub device: Option<String>,
     /// The options; `accumulate` is replaced by [`CurvatureJob::accumulate`]
-    /// or the default.
+    /// resolved.
     pub opts: CurvatureOptions,
-    /// The accumulation variant; `None`: the default ([`Accumulate::default`]).
-    pub accumulate: Option<Accumulate>,
+    /// The accumulation scheme asked for ([`AccumulateChoice::resolve`]).
+    pub accumulate: AccumulateChoice,
     /// The memory order the device computes in.
     pub order: MeshOrder,
     /// Timed runs of the device passes after the first (0: none).
@@ -149,12 +149,12 @@ struct Prepared {
 fn prepare_device(
     device: Option<&str>,
     mut opts: CurvatureOptions,
-    accumulate: Option<Accumulate>,
+    accumulate: AccumulateChoice,
 ) -> Result<Prepared> {
     let t = Instant::now();
     let gpu = Arc::new(Gpu::new(device)?);
     let device_ms = ms_since(t);
-    opts.accumulate = accumulate.unwrap_or_default();
+    opts.accumulate = accumulate.resolve();
     let t = Instant::now();
     let _ = CurvatureEstimator::prepare(&gpu, &opts);
     Ok(Prepared {
@@ -179,7 +179,7 @@ fn prepare_device(
 ///     source: shapecue::MeshSource::Generated(Generated::Torus, 2000),
 ///     device: None,
 ///     opts: Default::default(),
-///     accumulate: None,
+///     accumulate: Default::default(),
 ///     order: Default::default(),
 ///     runs: 0,
 /// };

@@ -19,7 +19,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions};
-use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions, Precision};
 use shapecue::stages::curvature::OrderedEstimator;
 use shapecue::{CurvatureJob, MeshSource};
 use std::path::PathBuf;
@@ -48,8 +48,8 @@ pub struct CurvatureArgs {
     /// atomic add, cl_ext_float_atomics or NVIDIA's PTX red.global.add), or
     /// per-vertex gather (bitwise reproducible). Default: gather, the faster
     /// exact scheme on CPU devices and GPUs measured (--stats says why).
-    #[arg(long, value_parser = super::choice::<Accumulate>())]
-    accumulate: Option<Accumulate>,
+    #[arg(long, value_parser = super::choice::<AccumulateChoice>(), default_value = "auto")]
+    accumulate: AccumulateChoice,
     /// Faces per work-item of the per-face kernels (and vertices per
     /// work-item of the frame and principal passes), computed as SIMD
     /// lanes: 1, 2, 4, 8 or 16. Default: the device's native vector width on
@@ -93,7 +93,7 @@ pub struct CurvatureArgs {
 /// Runs `shapecue curvature`.
 pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     let mut opts = CurvatureOptions {
-        accumulate: a.accumulate.unwrap_or_default(),
+        accumulate: a.accumulate.resolve(),
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,
@@ -179,10 +179,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             let mut stats = serde_json::json!({
                 "device": r.gpu.info,
                 "accumulate": opts.accumulate.name(),
-                "accumulate_why": match a.accumulate {
-                    Some(_) => "given with --accumulate",
-                    None => Accumulate::why_default(),
-                },
+                "accumulate_why": a.accumulate.why(),
                 "face_lanes": r.estimator.est.face_lanes(),
                 "face_lanes_why": match opts.lanes {
                     0 => shapecue::spec::curvature::why_face_lanes(&r.gpu.info.kind),

@@ -7,7 +7,7 @@ use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use shapecue::gpu::Gpu;
-use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions, Precision};
 use shapecue::spec::marching_cubes::IsoNormals;
 use shapecue::spec::vertex_fusion::Fusion;
 use shapecue::volume;
@@ -71,8 +71,8 @@ pub struct IsoArgs {
     precision: Precision,
     /// Curvature's one-ring accumulation, as for `shapecue curvature`
     /// (default: gather, bitwise reproducible).
-    #[arg(long, value_parser = super::choice::<Accumulate>())]
-    accumulate: Option<Accumulate>,
+    #[arg(long, value_parser = super::choice::<AccumulateChoice>(), default_value = "auto")]
+    accumulate: AccumulateChoice,
     /// Curvature's least squares: exact, or trimesh2 2.16's.
     #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
     compat: Compat,
@@ -238,7 +238,7 @@ fn iso_value(a: &IsoArgs, vol: &volume::Volume) -> Result<f32> {
 /// The extraction's options from the arguments.
 fn iso_options(a: &IsoArgs) -> IsoOptions {
     let curvature = a.curvature.then_some(CurvatureOptions {
-        accumulate: a.accumulate.unwrap_or_default(),
+        accumulate: a.accumulate.resolve(),
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,

@@ -10,7 +10,9 @@ use super::out;
 use anyhow::{Context, Result};
 use clap::Args;
 use shapecue::gpu::Gpu;
-use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{
+    Accumulate, AccumulateChoice, Compat, CurvatureOptions, Precision,
+};
 use shapecue::stages::curvature::build_kernels;
 use std::sync::Arc;
 
@@ -20,8 +22,8 @@ pub struct KernelsArgs {
     /// One-ring accumulation variants to build (comma-separated), as in
     /// `shapecue curvature --accumulate`. Default: the device type's default
     /// (gather, the faster exact scheme on CPU devices and GPUs).
-    #[arg(long, value_parser = super::choice::<Accumulate>(), value_delimiter = ',')]
-    accumulate: Vec<Accumulate>,
+    #[arg(long, value_parser = super::choice::<AccumulateChoice>(), value_delimiter = ',', default_value = "auto")]
+    accumulate: Vec<AccumulateChoice>,
     /// SIMD lanes of the gather variant, as in `shapecue curvature
     /// --lanes`. Default: the device's native vector width on CPU devices.
     #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
@@ -38,11 +40,7 @@ pub struct KernelsArgs {
 pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
     let gpu = Arc::new(Gpu::new(device)?);
     let lanes = a.lanes.as_deref().map_or(Ok(0), str::parse)?;
-    let accumulate = if a.accumulate.is_empty() {
-        vec![Accumulate::default()]
-    } else {
-        a.accumulate.clone()
-    };
+    let accumulate: Vec<Accumulate> = a.accumulate.iter().map(|c| c.resolve()).collect();
     let variants = CurvatureOptions::combinations(&accumulate, &a.precision, &a.compat, lanes);
     if let Some(dir) = gpu.cache_folder() {
         out!(

@@ -11,7 +11,7 @@ use shapecue::LinesPictureOptions;
 use shapecue::api::{Hidden, LineSetup};
 use shapecue::gpu::Gpu;
 use shapecue::mesh::LoadOptions;
-use shapecue::spec::curvature::{Accumulate, Compat, CurvatureOptions};
+use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions};
 use shapecue::spec::feature_lines::FeatureSize;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily};
 use std::path::PathBuf;
@@ -93,8 +93,8 @@ pub struct LinesArgs {
     compat: Compat,
     /// Curvature's one-ring accumulation (default: gather, bitwise
     /// reproducible).
-    #[arg(long, value_parser = super::choice::<Accumulate>())]
-    accumulate: Option<Accumulate>,
+    #[arg(long, value_parser = super::choice::<AccumulateChoice>(), default_value = "auto")]
+    accumulate: AccumulateChoice,
     /// Keep lines on back faces.
     #[arg(long)]
     no_cull: bool,
@@ -229,7 +229,7 @@ fn picture_options(
         svg,
         setup: LineSetup {
             curvature: CurvatureOptions {
-                accumulate: a.accumulate.unwrap_or_default(),
+                accumulate: a.accumulate.resolve(),
                 compat: a.compat,
                 ..Default::default()
             },

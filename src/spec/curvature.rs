@@ -256,6 +256,62 @@ impl Compat {
     }
 }
 
+/// The accumulation scheme as a caller asks for it: `Auto` (the library's
+/// default, decided in one place, [`AccumulateChoice::resolve`]) or a scheme.
+/// The command line (`--accumulate auto`), scene files, Python
+/// (`accumulate="auto"`) and `shapecue build-kernels` pass this on; only
+/// the library resolves it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AccumulateChoice {
+    /// The library's default scheme ([`Accumulate::default`]; see
+    /// [`Accumulate::why_default`]).
+    #[default]
+    Auto,
+    /// This scheme.
+    Use(Accumulate),
+}
+
+impl AccumulateChoice {
+    /// Every choice, in the order `--help` lists them.
+    pub const ALL: [AccumulateChoice; 4] = [
+        AccumulateChoice::Auto,
+        AccumulateChoice::Use(Accumulate::Atomic),
+        AccumulateChoice::Use(Accumulate::AtomicNative),
+        AccumulateChoice::Use(Accumulate::Gather),
+    ];
+
+    /// `auto`, or the scheme's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            AccumulateChoice::Auto => "auto",
+            AccumulateChoice::Use(a) => a.name(),
+        }
+    }
+
+    /// The scheme to run: the one place where `Auto` is decided.
+    pub fn resolve(self) -> Accumulate {
+        match self {
+            AccumulateChoice::Auto => Accumulate::default(),
+            AccumulateChoice::Use(a) => a,
+        }
+    }
+
+    /// Why [`resolve`](Self::resolve) gives its scheme, as `--stats` says it.
+    pub fn why(self) -> &'static str {
+        match self {
+            AccumulateChoice::Auto => Accumulate::why_default(),
+            AccumulateChoice::Use(_) => "as asked for",
+        }
+    }
+}
+
+impl From<Accumulate> for AccumulateChoice {
+    fn from(a: Accumulate) -> Self {
+        AccumulateChoice::Use(a)
+    }
+}
+
+super::named_choice!(AccumulateChoice, "accumulation");
 super::named_choice!(Accumulate, "accumulation");
 super::named_choice!(Precision, "precision");
 super::named_choice!(Compat, "compat mode");
