@@ -235,8 +235,21 @@ pub struct StepTime {
     pub launches: u32,
 }
 
+/// Host wall time of one phase of a call: a part that is not one kernel
+/// (loading, building a topology, uploading, drawing, reading back).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PhaseTime {
+    /// The phase's name (`load`, `topology`, `upload`, ...), as reports
+    /// and `--stats` print it.
+    pub phase: &'static str,
+    /// Wall time in milliseconds.
+    pub ms: f64,
+}
+
 /// Timing of one stage call (or of a chain of them): kernel ms per step in
-/// execution order, their sum, and the host wall time.
+/// execution order, their sum, the host wall time, and the wall time of the
+/// call's phases. The one type of time a library result carries: repeats,
+/// medians and tables live in `shapecue report` and the command line.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Timing {
     /// Kernel time per step, in execution order; a step launched again
@@ -247,6 +260,9 @@ pub struct Timing {
     /// Host wall time of the call, uploads and waits included (0 where the
     /// caller measures it).
     pub wall_ms: f64,
+    /// Wall time of the call's phases, in the order they first ran.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<PhaseTime>,
 }
 
 impl Timing {
@@ -274,7 +290,24 @@ impl Timing {
         }
     }
 
-    /// Appends another call's steps (its wall time added too).
+    /// Adds `ms` to the phase `phase` (a new phase at the end, or the one of
+    /// that name).
+    pub fn phase(&mut self, phase: &'static str, ms: f64) {
+        match self.phases.iter_mut().find(|p| p.phase == phase) {
+            Some(p) => p.ms += ms,
+            None => self.phases.push(PhaseTime { phase, ms }),
+        }
+    }
+
+    /// The wall ms of a phase (0 when it did not run).
+    pub fn phase_ms(&self, phase: &str) -> f64 {
+        self.phases
+            .iter()
+            .find(|p| p.phase == phase)
+            .map_or(0.0, |p| p.ms)
+    }
+
+    /// Appends another call's steps (its wall time and phases added too).
     pub fn extend(&mut self, other: &Timing) {
         for s in &other.steps {
             self.kernel_ms += s.kernel_ms;
@@ -287,6 +320,9 @@ impl Timing {
             }
         }
         self.wall_ms += other.wall_ms;
+        for p in &other.phases {
+            self.phase(p.phase, p.ms);
+        }
     }
 
     /// Summed kernel ms of the entries whose step is in `steps`.
