@@ -100,13 +100,14 @@ pub fn lines_picture_on(
     let scene = lines_scene(Arc::new(mesh.clone()), opts);
     let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
     let v = f.view;
+    let camera = v.world_camera();
     Ok(LinesPicture {
         frame: v.image,
         segments: v.segments,
         layers: v.layers,
         timing: v.timing,
         passes: f.passes,
-        camera: v.camera,
+        camera,
         feature_size: v.feature_size.unwrap_or(0.0),
     })
 }

@@ -1,20 +1,22 @@
 //! The strokes front door: curvature-directed strokes on a signed distance
-//! field ([`crate::stages::sdf_lines`]) and, when a picture is asked for,
-//! the isosurface under them ([`crate::stages::marching_cubes`]) drawn with
-//! the strokes over it by the renderer. The compute runs here; the renderer
-//! only draws what it is given.
+//! field ([`crate::stages::sdf_lines`]); when a picture is asked for, a
+//! one-view scene of the field (its isosurface shaded, the strokes over it)
+//! that the scene executor runs, strokes included.
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
-use crate::render::strokes::{StrokeStyle, draw};
-use crate::render::{Camera, Frame, MeshStyle, Placement, RenderOptions, Renderer, framed};
+use crate::render::strokes::StrokeStyle;
+use crate::render::{Camera, Frame, MeshStyle, RenderOptions};
+use crate::scene::exec::{ExecOptions, Session};
+use crate::scene::file::{HeldVolume, Scene, Shot, Source, StrokeEffect};
+use crate::scene::planner::Cue;
 use crate::spec::marching_cubes::Inside;
 use crate::spec::mesh_sdf::MeshSdfOptions;
-use crate::spec::sdf_lines::{Sampling, SdfLineOptions, SdfLineStats, Seed, Stroke, voxel_size};
+use crate::spec::sdf_lines::{
+    Sampling, SdfLineOptions, SdfLineStats, SdfLinesOutput, Seed, Stroke,
+};
 use crate::spec::timing::Timing;
-use crate::spec::vertex_fusion::Fusion;
-use crate::stages::marching_cubes::Isosurfacer;
 use crate::stages::mesh_sdf::MeshSdfStats;
 use crate::stages::sdf_lines::SdfLines;
 use crate::volume::Volume;
@@ -38,13 +40,9 @@ pub enum StrokesInput<'a> {
 /// over it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PictureOptions {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Eye position in world units; `None`: a view fitted to the surface
-    /// from [`FIT_DIRECTION`].
-    pub eye: Option<glam::Vec3>,
+    /// The camera and the image size (default: 800 × 800, 35°, fitted to
+    /// the surface from [`FIT_DIRECTION`]).
+    pub shot: Shot,
     /// Shade the surface; `false` draws it in the background colour, so it
     /// still hides the strokes behind it.
     pub surface: bool,
@@ -53,9 +51,12 @@ pub struct PictureOptions {
 impl Default for PictureOptions {
     fn default() -> Self {
         PictureOptions {
-            width: 800,
-            height: 800,
-            eye: None,
+            shot: Shot {
+                size: [800, 800],
+                fov_deg: 35.0,
+                fit_direction: glam::Vec3::from(FIT_DIRECTION),
+                ..Shot::default()
+            },
             surface: true,
         }
     }
@@ -196,36 +197,86 @@ pub fn strokes_on(
     };
     // Both the surface and the strokes see the object below the iso value.
     let (vol, iso_below) = volume.oriented(opts.iso, opts.inside);
-    let line_opts = SdfLineOptions {
-        iso: iso_below,
-        inside: Inside::Below,
-        sampling: opts.sampling.clone(),
-        spacing: opts.spacing,
-        ..SdfLineOptions::default()
-    };
-    let out = SdfLines::new(gpu.clone(), &vol, &line_opts)?.run()?;
-    let (surface, picture) = match &opts.picture {
-        None => (None, None),
+    let (out, surface, picture) = match &opts.picture {
+        None => {
+            let line_opts = SdfLineOptions {
+                iso: iso_below,
+                inside: Inside::Below,
+                sampling: opts.sampling.clone(),
+                spacing: opts.spacing,
+                ..SdfLineOptions::default()
+            };
+            let out = SdfLines::new(gpu.clone(), &vol, &line_opts)?.run()?;
+            (out, None, None)
+        }
         Some(p) => {
             let what = match input {
                 StrokesInput::Mesh(..) => Surface::OfMesh,
                 _ => Surface::Iso(volume, opts.iso),
             };
-            let (mesh, picture) = draw_picture(gpu, &vol, iso_below, what, &out.strokes, p)?;
-            (Some(mesh), Some(picture))
+            check_surface(&vol, iso_below, what)?;
+            let scene = strokes_scene(Arc::new(vol.into_owned()), iso_below, opts, p);
+            let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
+            let v = f.view;
+            let o = v.origin;
+            let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
+            let strokes = (v.strokes.strokes.iter())
+                .map(|s| Stroke {
+                    points: s.points.iter().map(local).collect(),
+                    strip: s.strip.iter().map(local).collect(),
+                    ..s.clone()
+                })
+                .collect();
+            let picture = Picture {
+                frame: v.image,
+                camera: v.camera,
+                centre: o,
+                strokes,
+            };
+            (v.strokes, v.mesh, Some(picture))
         }
     };
     let timing = out.stats.ms.timing(out.stats.wall_ms);
+    let SdfLinesOutput {
+        seeds,
+        strokes,
+        stats,
+    } = out;
     Ok(Strokes {
-        seeds: out.seeds,
-        strokes: out.strokes,
-        stats: out.stats,
+        seeds,
+        strokes,
+        stats,
         timing,
-        grid: (vol.dims, vol.spacing, vol.origin),
+        grid: (volume.dims, volume.spacing, volume.origin),
         field,
         surface,
         picture,
     })
+}
+
+/// The one-view scene of a strokes picture: the field's isosurface shaded
+/// (or flat in white) as the renderer's defaults draw a mesh, the strokes in
+/// their default colour over it.
+fn strokes_scene(vol: Arc<Volume>, iso: f32, opts: &StrokesOptions, p: &PictureOptions) -> Scene {
+    let mut s = Scene::held(Source::HeldVolume(HeldVolume(vol), iso, false), &p.shot);
+    let [r, g, b, _] = RenderOptions::default().background;
+    s.background = [r, g, b];
+    s.msaa = RenderOptions::default().msaa;
+    let fx = &mut s.effects;
+    fx.cues = match p.surface {
+        true => vec![Cue::Shading, Cue::CurvatureStrokes],
+        false => vec![Cue::CurvatureStrokes],
+    };
+    let style = MeshStyle::default();
+    (fx.ambient, fx.base_color) = (style.ambient, style.color);
+    let [r, g, b, _] = StrokeStyle::default().color;
+    fx.strokes = StrokeEffect {
+        spacing: opts.spacing,
+        sampling: opts.sampling.clone(),
+        color: [r, g, b],
+        width: None,
+    };
+    s
 }
 
 /// What the surface under the strokes is, for the message when it is empty:
@@ -236,97 +287,26 @@ enum Surface<'a> {
     Iso(&'a Volume, f32),
 }
 
-/// The isosurface under the strokes and the picture of both.
-fn draw_picture(
-    gpu: &Arc<Gpu>,
-    vol: &Volume,
-    iso_below: f32,
-    what: Surface<'_>,
-    world_strokes: &[Stroke],
-    p: &PictureOptions,
-) -> Result<(Mesh, Picture)> {
-    let mut ex = Isosurfacer::new(gpu.clone(), vol)?;
-    ex.extract(iso_below, Fusion::Direct)?;
-    let (ipos, faces) = ex.read_index_space()?;
-    let mesh = ex.world_mesh(&ipos, faces);
-    if mesh.n_faces() == 0 {
-        return Err(Error::InvalidArgument(match what {
-            Surface::OfMesh => "the mesh's distance field has no inside, so there is no \
-                                surface to draw strokes on: is the mesh closed?"
-                .to_string(),
-            Surface::Iso(volume, iso) => {
-                let span = volume
-                    .range()
-                    .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
-                        format!("the values span {lo} to {hi}")
-                    });
-                format!("the isosurface at iso {iso} is empty ({span})")
-            }
-        }));
+/// Refuses a field with no surface at the iso value (every finite value on
+/// one side of it), before anything is drawn.
+fn check_surface(vol: &Volume, iso_below: f32, what: Surface<'_>) -> Result<()> {
+    let crosses = (vol.range()).is_some_and(|(lo, hi)| lo < iso_below && hi >= iso_below);
+    if crosses {
+        return Ok(());
     }
-    let normals = crate::cpu::marching_cubes::gradient_normals(vol, &ipos);
-
-    // Draw in a frame centred on the surface (f32 precision far from 0).
-    let bounds = mesh.bounds();
-    let c: [f64; 3] = std::array::from_fn(|i| 0.5 * (bounds.0[i] + bounds.1[i]));
-    let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - c[i]) };
-    let lb = (local(&bounds.0), local(&bounds.1));
-    let placement = match p.eye {
-        Some(e) => Placement::At(e - glam::DVec3::from(c).as_vec3()),
-        None => Placement::Fit(glam::Vec3::from(FIT_DIRECTION)),
-    };
-    let (w, h) = (p.width, p.height);
-    let camera = framed(placement, None, None, 35.0, false, lb, w as f32 / h as f32)?;
-    let strokes: Vec<Stroke> = world_strokes
-        .iter()
-        .map(|s| Stroke {
-            points: s.points.iter().map(local).collect(),
-            strip: s.strip.iter().map(local).collect(),
-            ..s.clone()
-        })
-        .collect();
-    let pos: Vec<[f32; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| local(p).map(|x| x as f32))
-        .collect();
-    let nrm: Vec<[f32; 3]> = normals.iter().map(|n| n.map(|x| x as f32)).collect();
-    let mut r = Renderer::new(RenderOptions {
-        width: w,
-        height: h,
-        ..RenderOptions::default()
-    })?;
-    let style = if p.surface {
-        MeshStyle::default()
-    } else {
-        MeshStyle {
-            ambient: 1.0,
-            color: [1.0; 3],
-            ..MeshStyle::default()
+    Err(Error::InvalidArgument(match what {
+        Surface::OfMesh => "the mesh's distance field has no inside, so there is no \
+                            surface to draw strokes on: is the mesh closed?"
+            .to_string(),
+        Surface::Iso(volume, iso) => {
+            let span = volume
+                .range()
+                .map_or("the volume has no finite values".to_string(), |(lo, hi)| {
+                    format!("the values span {lo} to {hi}")
+                });
+            format!("the isosurface at iso {iso} is empty ({span})")
         }
-    };
-    let voxel = voxel_size(vol.spacing);
-    r.begin(&camera)?;
-    r.draw_mesh(&pos, &nrm, &[], &mesh.faces, style)?;
-    draw(
-        &mut r,
-        &camera,
-        &strokes,
-        &StrokeStyle {
-            lift: (0.5 * voxel) as f32,
-            ..StrokeStyle::default()
-        },
-    )?;
-    let frame = r.finish()?;
-    Ok((
-        mesh,
-        Picture {
-            frame,
-            camera,
-            centre: c,
-            strokes,
-        },
-    ))
+    }))
 }
 
 /// Whether a stroke's outward normal at its seed faces the eye (local frame).

@@ -188,9 +188,11 @@ fn strokes_options(a: &StrokesArgs, input: &Input, (w, h): (u32, u32)) -> Result
         sampling,
         spacing: a.seed_spacing,
         picture: Some(PictureOptions {
-            width: w,
-            height: h,
-            eye,
+            shot: shapecue::Shot {
+                size: [w, h],
+                eye,
+                ..PictureOptions::default().shot
+            },
             surface: !a.no_surface,
         }),
     })

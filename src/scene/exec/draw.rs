@@ -13,7 +13,7 @@ use crate::scene::file::{CameraKind, Effects, LineStyle, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
 use crate::spec::edges::EdgeOutput;
 use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
-use crate::spec::sdf_lines::Stroke;
+use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
 use crate::spec::timing::Timing;
 use std::path::PathBuf;
 
@@ -364,14 +364,33 @@ pub struct ViewOutputs {
     pub segments: Vec<Segment>,
     /// The edge stage's outputs as drawn, when feature edges are planned.
     pub edges: Option<EdgeOutput>,
-    /// The curvature-directed strokes of the pose (world coordinates).
-    pub strokes: Vec<Stroke>,
-    /// The camera (world coordinates).
+    /// The curvature-directed strokes run of the pose: seeds, strokes
+    /// (world coordinates), counts and parameters.
+    pub strokes: SdfLinesOutput,
+    /// The camera, in the scene frame (world minus `origin`, so that f32
+    /// keeps its precision far from the world origin).
     pub camera: Camera,
+    /// World position of the scene frame's origin (the centre of the first
+    /// pose's bounds).
+    pub origin: [f64; 3],
+    /// The surface drawn (world coordinates), for a picture.
+    pub mesh: Option<crate::mesh::Mesh>,
     /// The feature size the line families' thresholds were scaled by, when
     /// lines were found.
     pub feature_size: Option<f32>,
     /// Kernel time of this pose's curvature run and this view's lines and
     /// edges.
     pub timing: Timing,
+}
+
+impl ViewOutputs {
+    /// The camera in world coordinates.
+    pub fn world_camera(&self) -> Camera {
+        let shift = glam::DVec3::from(self.origin).as_vec3();
+        Camera {
+            eye: self.camera.eye + shift,
+            target: self.camera.target + shift,
+            ..self.camera
+        }
+    }
 }

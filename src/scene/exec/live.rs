@@ -78,20 +78,39 @@ fn same_input(a: &Scene, b: &Scene) -> bool {
 
 impl Session {
     /// Draws the first view of the first frame of `scene` into memory (a
-    /// picture of the front door): every pass of the plan, nothing written
-    /// but what the scene's outputs name (the SVG groups come back when the
-    /// scene's `svg` is on).
+    /// picture of the front door): every pass of the plan, nothing written;
+    /// the SVG groups come back when the scene's `svg` is on, and the
+    /// surface drawn ([`ViewOutputs::mesh`]).
     pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<LiveFrame> {
-        let mut out = None;
-        let first = LiveRequest {
+        let loaded = load(scene, &mut Vec::new())?;
+        let fx = &scene.effects;
+        let input = scene.source.input();
+        let plan = plan_with(&fx.cues, input, fx.caps);
+        let gpu = self.gpu(opts)?;
+        let [br, bg, bb] = scene.background;
+        let renderer = self.renderer(RenderOptions {
+            width: scene.size[0],
+            height: scene.size[1],
+            msaa: scene.msaa,
+            background: [br, bg, bb, 1.0],
+        })?;
+        let n_frames = loaded.frames();
+        let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
+        ex.keep_image = true;
+        ex.keep_mesh = true;
+        let mut live = Live {
+            plan: &plan,
+            input,
+            n_frames,
+            pose: None,
+        };
+        let req = LiveRequest {
             scene: scene.clone(),
             svg: None,
         };
-        self.live(opts, first, &mut |f| {
-            out = Some(f);
-            None
-        });
-        out.expect("the first request is always answered")
+        let frame = live.frame(&mut ex, &req);
+        self.renderer = Some(ex.into_renderer());
+        frame
     }
 
     /// Draws `first`, hands the frame to `next`, and draws what `next`

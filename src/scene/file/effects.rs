@@ -57,8 +57,9 @@ pub struct Effects {
 pub struct StrokeEffect {
     /// Poisson-disk seed spacing.
     pub spacing: Option<f64>,
-    /// Hessian sampling distance (`None`: automatic).
-    pub sampling: Option<f64>,
+    /// Hessian sampling distance: fixed, or chosen among candidates
+    /// (`"auto"`: the default candidates).
+    pub sampling: crate::spec::sdf_lines::Sampling,
     /// RGB.
     pub color: [f32; 3],
     /// Stroke width at the largest κ1.

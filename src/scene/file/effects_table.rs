@@ -9,6 +9,7 @@ use crate::scene::planner::{Cue, Input};
 use crate::spec::ao::AoMode;
 use crate::spec::edges::CapMode;
 use crate::spec::feature_lines::FeatureSize;
+use crate::spec::sdf_lines::Sampling;
 use std::ops::Range;
 use toml::Spanned;
 
@@ -240,14 +241,15 @@ impl Table<'_> {
         })
     }
 
-    /// `curvature_strokes.sampling`: `"auto"` (`None`) or a positive distance.
-    fn sampling(&self, st: &StrokeSpec) -> Result<Option<f64>> {
+    /// `curvature_strokes.sampling`: `"auto"` (the default candidates) or a
+    /// positive distance.
+    fn sampling(&self, st: &StrokeSpec) -> Result<Sampling> {
         let Some(s) = &st.sampling else {
-            return Ok(None);
+            return Ok(Sampling::Auto(Vec::new()));
         };
         match s.get_ref() {
-            SamplingSpec::Word(w) if w == "auto" => Ok(None),
-            SamplingSpec::Distance(h) if h.is_finite() && *h > 0.0 => Ok(Some(*h)),
+            SamplingSpec::Word(w) if w == "auto" => Ok(Sampling::Auto(Vec::new())),
+            SamplingSpec::Distance(h) if h.is_finite() && *h > 0.0 => Ok(Sampling::Fixed(*h)),
             other => Err(self.ck.err(
                 s.span(),
                 format!(

@@ -157,13 +157,21 @@ fn curvature_strokes_resolve_and_need_a_volume() {
     assert_eq!(s.effects.cues, vec![Cue::Shading, Cue::CurvatureStrokes]);
     let st = &s.effects.strokes;
     assert_eq!(
-        (st.spacing, st.sampling, st.color, st.width),
-        (Some(0.05), Some(0.03), [1.0, 0.0, 0.0], Some(0.01))
+        (st.spacing, st.sampling.clone(), st.color, st.width),
+        (
+            Some(0.05),
+            crate::spec::sdf_lines::Sampling::Fixed(0.03),
+            [1.0, 0.0, 0.0],
+            Some(0.01)
+        )
     );
     let s =
         parse("[input]\nsdf = \"torus\"\n[effects]\ncurvature_strokes = { sampling = \"auto\" }\n")
             .unwrap();
-    assert_eq!(s.effects.strokes.sampling, None);
+    assert_eq!(
+        s.effects.strokes.sampling,
+        crate::spec::sdf_lines::Sampling::Auto(Vec::new())
+    );
     let e =
         err("[input]\nsdf = \"torus\"\n[effects]\ncurvature_strokes = { sampling = \"often\" }\n");
     assert!(

@@ -30,7 +30,7 @@ use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::{EdgeOutput, EdgeParams};
 use crate::spec::feature_lines::{LineInputs, Segment};
 use crate::spec::marching_cubes::IsoNormals;
-use crate::spec::sdf_lines::{Inside, Sampling, SdfLineOptions, Stroke};
+use crate::spec::sdf_lines::{Inside, SdfLineOptions, SdfLinesOutput, Stroke};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
@@ -103,8 +103,11 @@ pub(super) struct Executor<'s, 'g> {
     ao: Option<AoStage>,
     /// Curvature-directed strokes of a volume input, and its voxel size.
     sdf_lines: Option<(SdfLines, f64)>,
-    /// This pose: the strokes (world units).
-    strokes: Vec<Stroke>,
+    /// This pose: the strokes run (seeds, strokes in world units, stats).
+    strokes: SdfLinesOutput,
+    /// This pose: an isosurface's unit normals from the volume gradient
+    /// (when normals are planned without curvature).
+    iso_normals: Option<Vec<[f32; 3]>>,
     /// Strokes over all poses.
     pub(super) stroke_count: usize,
     /// What the line families' thresholds were scaled by, for the run's
@@ -137,6 +140,8 @@ pub(super) struct Executor<'s, 'g> {
     /// Keep each view's outputs in [`Executor::kept`] (a live scene or a
     /// picture hands them to its caller instead of writing a PNG).
     pub(super) keep_image: bool,
+    /// Also hand each kept view's surface (world coordinates).
+    pub(super) keep_mesh: bool,
     /// Also find each kept view's SVG groups.
     pub(super) keep_layers: bool,
     /// The last view's outputs, when kept.
@@ -199,9 +204,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 let opts = SdfLineOptions {
                     iso: *iso,
                     inside: Inside::Below,
-                    sampling: st
-                        .sampling
-                        .map_or(Sampling::Auto(Vec::new()), Sampling::Fixed),
+                    sampling: st.sampling.clone(),
                     spacing: st.spacing,
                     width: st.width,
                     ..SdfLineOptions::default()
@@ -228,7 +231,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             iso,
             ao,
             sdf_lines,
-            strokes: Vec::new(),
+            strokes: SdfLinesOutput::default(),
+            iso_normals: None,
             stroke_count: 0,
             feature_size_note: None,
             topo: None,
@@ -248,6 +252,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             outputs: Vec::new(),
             keep_image: false,
             keep_layers: false,
+            keep_mesh: false,
             kept: None,
         })
     }
@@ -535,7 +540,18 @@ impl<'s, 'g> Executor<'s, 'g> {
             &s.timing,
             "marching cubes with direct vertex numbering",
         );
-        let m = ex.read()?;
+        let (ipos, faces) = ex.read_index_space()?;
+        let m = ex.world_mesh(&ipos, faces);
+        // Shading without curvature: the volume's gradient gives the
+        // normals (smoother than the faces' on marching cubes' chords).
+        let gradient =
+            self.plan.contains(Pass::VertexNormals) && !self.plan.contains(Pass::Curvature);
+        self.iso_normals = gradient.then(|| {
+            crate::cpu::marching_cubes::gradient_normals(v, &ipos)
+                .iter()
+                .map(|n| n.map(|c| c as f32))
+                .collect()
+        });
         if m.n_faces() == 0 {
             return Err(Error::input(
                 self.scene.path.display().to_string(),
@@ -629,6 +645,13 @@ impl<'s, 'g> Executor<'s, 'g> {
             };
             let how = format!("clear + normals_areas + frames ({normals})");
             self.rec.kernels(Pass::VertexNormals, &t, &how);
+        } else if let Some(n) = &self.iso_normals {
+            self.pose.nrm = n.clone();
+            self.rec.wall(
+                Pass::VertexNormals,
+                0.0,
+                "from the volume's gradient at the isosurface's vertices (with the isosurface)",
+            );
         } else {
             let t0 = Instant::now();
             let faces = self.topo.as_ref().expect("made above").mesh.faces.clone();
@@ -699,7 +722,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         );
         self.rec.kernels(Pass::SdfLines, &t, &how);
         self.stroke_count += out.strokes.len();
-        self.strokes = out.strokes;
+        self.strokes = out;
         Ok(())
     }
 
@@ -707,8 +730,7 @@ impl<'s, 'g> Executor<'s, 'g> {
     fn scene_strokes(&self) -> Vec<Stroke> {
         let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
-        self.strokes
-            .iter()
+        (self.strokes.strokes.iter())
             .map(|s| Stroke {
                 points: s.points.iter().map(local).collect(),
                 strip: s.strip.iter().map(local).collect(),

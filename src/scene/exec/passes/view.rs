@@ -174,11 +174,10 @@ impl Executor<'_, '_> {
     /// groups, the segments (world coordinates), the edge stage's outputs,
     /// the strokes, the camera (world coordinates) and the kernel time of
     /// the pose and the view.
-    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> super::super::draw::ViewOutputs {
+    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> draw::ViewOutputs {
         let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let world =
             |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
-        let shift = glam::DVec3::from(o).as_vec3();
         let mut timing = self.curv.clone().unwrap_or_default();
         for t in [
             &self.lines_ran,
@@ -189,7 +188,8 @@ impl Executor<'_, '_> {
         {
             timing.extend(t);
         }
-        super::super::draw::ViewOutputs {
+        let topo = self.topo.as_ref();
+        draw::ViewOutputs {
             image: d.image,
             layers: d.layers,
             segments: (self.segs.iter())
@@ -197,12 +197,10 @@ impl Executor<'_, '_> {
                 .collect(),
             edges: self.edges_ran.as_ref().map(|e| e.1.clone()),
             strokes: self.strokes.clone(),
-            camera: Camera {
-                eye: cam.eye + shift,
-                target: cam.target + shift,
-                ..*cam
-            },
-            feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
+            camera: *cam,
+            origin: o,
+            mesh: topo.filter(|_| self.keep_mesh).map(|t| t.mesh.clone()),
+            feature_size: topo.and_then(|t| t.feature_size),
             timing,
         }
     }
