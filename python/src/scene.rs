@@ -106,8 +106,10 @@ impl EdgeArgs<'_, '_> {
         Ok(cam.view(w, h))
     }
 
-    /// The library's options, `caps` checked by the library's parser.
+    /// The library's options, `caps` checked by the library's parser
+    /// (after `marked`, as before the options were collected).
     fn options(&self) -> PyResult<shapecue::EdgeOptions> {
+        let marked = self.marked.map_or(Ok(Vec::new()), read_marked)?;
         Ok(shapecue::EdgeOptions {
             caps: parse(self.caps)?,
             line_width: self.line_width,
@@ -116,7 +118,7 @@ impl EdgeArgs<'_, '_> {
             boundaries: self.boundaries,
             depth_scale: self.depth_scale,
             half_contours: self.half_contours,
-            marked: self.marked.map_or(Ok(Vec::new()), read_marked)?,
+            marked,
         })
     }
 }
