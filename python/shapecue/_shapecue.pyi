@@ -59,6 +59,19 @@ def feature_edges(
     marked: Optional[list[list[int]]],
     device: Optional[str],
 ) -> dict[str, Any]: ...
+def lines(
+    vertices: npt.NDArray[np.floating],
+    faces: npt.NDArray[np.integer],
+    families: str,
+    eye: Tuple[float, float, float],
+    ortho: bool,
+    thresholds: Tuple[float, float, float, float, float, float],
+    isophotes: int,
+    light: Tuple[float, float, float],
+    switches: Tuple[bool, bool, bool, bool, bool],
+    setup: Tuple[str, str, str],
+    device: Optional[str],
+) -> dict[str, Any]: ...
 def render_file(path: str, out_dir: Optional[str], force: bool, device: Optional[str]) -> str: ...
 def render_text(
     json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]

@@ -21,7 +21,9 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueEr
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use shapecue::gpu::Gpu;
-use shapecue::spec::curvature::{Accumulate, Compat, Curvature, CurvatureOptions, Precision};
+use shapecue::spec::curvature::{
+    Accumulate, AccumulateChoice, Compat, Curvature, CurvatureOptions, Precision,
+};
 use shapecue::stages::curvature::CurvatureEstimator as RustEstimator;
 use shapecue::{Error, Mesh};
 use std::cell::RefCell;
@@ -195,38 +197,29 @@ fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> PyResult<T> {
     s.parse::<T>().map_err(to_py)
 }
 
-/// The options of a call; `accumulate = "auto"` is resolved for the device
-/// by [`device_options`] (the command line's rule).
-fn options(
-    accumulate: &str,
-    precision: &str,
-    compat: &str,
+/// The curvature keyword options of `curvature` and `CurvatureEstimator`,
+/// as the Python layer passes them (its names and defaults).
+struct CurvatureArgs<'a> {
+    accumulate: &'a str,
+    precision: &'a str,
+    compat: &'a str,
     dcurv: bool,
-) -> PyResult<CurvatureOptions> {
-    Ok(CurvatureOptions {
-        accumulate: if accumulate == "auto" {
-            shapecue::spec::curvature::Accumulate::default()
-        } else {
-            parse(accumulate)?
-        },
-        precision: parse(precision)?,
-        compat: parse(compat)?,
-        dcurv,
-        // by device type, as on the command line
-        lanes: 0,
-    })
+    device: Option<String>,
 }
 
-/// `opts` with an `accumulate = "auto"` resolved: the library's default
-/// scheme (`Accumulate::default`, gather on every device).
-fn device_options(opts: CurvatureOptions, accumulate: &str, _gpu: &Gpu) -> CurvatureOptions {
-    if accumulate == "auto" {
-        CurvatureOptions {
-            accumulate: shapecue::spec::curvature::Accumulate::default(),
-            ..opts
-        }
-    } else {
-        opts
+impl CurvatureArgs<'_> {
+    /// The library's options, every name checked by the library's parser
+    /// before a device opens; `accumulate = "auto"` is decided by
+    /// [`AccumulateChoice::resolve`], the library's one place for it.
+    fn options(&self) -> PyResult<CurvatureOptions> {
+        Ok(CurvatureOptions {
+            accumulate: parse::<AccumulateChoice>(self.accumulate)?.resolve(),
+            precision: parse(self.precision)?,
+            compat: parse(self.compat)?,
+            dcurv: self.dcurv,
+            // by device type, as on the command line
+            lanes: 0,
+        })
     }
 }
 
@@ -325,10 +318,11 @@ fn build_kernels<'py>(
     compat: Vec<String>,
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyList>> {
-    // Names are checked before the device opens; "auto" is the device's default.
-    let accumulate: Vec<Option<Accumulate>> = accumulate
+    // Names are checked by the library's parsers before the device opens;
+    // "auto" is decided by the library (AccumulateChoice::resolve).
+    let accumulate: Vec<Accumulate> = accumulate
         .iter()
-        .map(|a| (a != "auto").then(|| parse(a)).transpose())
+        .map(|a| parse::<AccumulateChoice>(a).map(AccumulateChoice::resolve))
         .collect::<PyResult<_>>()?;
     let precision: Vec<Precision> = precision
         .iter()
@@ -338,10 +332,6 @@ fn build_kernels<'py>(
     let built = py
         .detach(|| {
             let gpu = Arc::new(Gpu::new(device.as_deref())?);
-            let accumulate: Vec<Accumulate> = accumulate
-                .iter()
-                .map(|a| a.unwrap_or_default())
-                .collect();
             // lanes 0: by device type, as on the command line
             let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, 0);
             shapecue::stages::curvature::build_kernels(&gpu, &variants, |_| {})
@@ -364,6 +354,8 @@ fn build_kernels<'py>(
 /// curvature(vertices, faces, accumulate, precision, compat, dcurv, device, reference) -> dict
 #[pyfunction]
 #[pyo3(signature = (vertices, faces, accumulate, precision, compat, dcurv, device, reference))]
+// PyO3 takes the arguments one by one (the positional signature of
+// `_shapecue.pyi`); the body only collects them into `CurvatureArgs`.
 #[allow(clippy::too_many_arguments)]
 fn curvature<'py>(
     py: Python<'py>,
@@ -376,8 +368,27 @@ fn curvature<'py>(
     device: Option<String>,
     reference: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let args = CurvatureArgs {
+        accumulate,
+        precision,
+        compat,
+        dcurv,
+        device,
+    };
+    curvature_with(py, (vertices, faces), args, reference)
+}
+
+/// [`curvature`] with its options collected: on the device, or with the
+/// single-threaded f64 CPU reference when `reference`.
+fn curvature_with<'py>(
+    py: Python<'py>,
+    (vertices, faces): (&Bound<'py, PyAny>, &Bound<'py, PyAny>),
+    args: CurvatureArgs<'_>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyDict>> {
     let mesh = read_mesh(vertices, faces)?;
-    let opts = options(accumulate, precision, compat, dcurv)?;
+    let opts = args.options()?;
+    let device = args.device;
     let mut library_ms = 0.0;
     let (c, name) = py
         .detach(|| {
@@ -385,7 +396,7 @@ fn curvature<'py>(
                 // The reference computes in f64, so it judges faces by f64
                 // rounding (as the command line's --cpu does).
                 let opts = CurvatureOptions {
-                    precision: shapecue::spec::curvature::Precision::F64,
+                    precision: Precision::F64,
                     ..opts
                 };
                 let t = Instant::now();
@@ -394,7 +405,6 @@ fn curvature<'py>(
                 Ok::<_, Error>((c, "cpu reference (f64, single thread)".to_string()))
             } else {
                 let gpu = open_gpu(device.as_deref())?;
-                let opts = device_options(opts, accumulate, &gpu);
                 let t = Instant::now();
                 let c = shapecue::curvature_on(&gpu, &mesh, opts)?;
                 library_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -421,10 +431,45 @@ struct PyEstimator {
     device: String,
 }
 
+impl PyEstimator {
+    /// [`PyEstimator::new`] with its options collected: the topology checked
+    /// and built on this thread's device.
+    fn open(
+        py: Python<'_>,
+        faces: &Bound<'_, PyAny>,
+        n_vertices: usize,
+        args: CurvatureArgs<'_>,
+    ) -> PyResult<Self> {
+        let faces = read_faces(faces, "faces")?;
+        if n_vertices == 0 {
+            return Err(value_err("n_vertices: the mesh has no vertices"));
+        }
+        shapecue::mesh::check_faces(n_vertices, &faces, "faces").map_err(to_py)?;
+        let opts = args.options()?;
+        let device = args.device;
+        let n_faces = faces.len();
+        let (est, device) = py
+            .detach(|| {
+                let gpu = open_gpu(device.as_deref())?;
+                let name = gpu.info.name.clone();
+                Ok::<_, Error>((RustEstimator::new(gpu, n_vertices, &faces, opts)?, name))
+            })
+            .map_err(to_py)?;
+        Ok(PyEstimator {
+            inner: Mutex::new(est),
+            n_vertices,
+            n_faces,
+            device,
+        })
+    }
+}
+
 #[pymethods]
 impl PyEstimator {
     #[new]
     #[pyo3(signature = (faces, n_vertices, accumulate, precision, compat, dcurv, device))]
+    // PyO3 takes the arguments one by one (the positional signature of
+    // `_shapecue.pyi`); the body only collects them into `CurvatureArgs`.
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -436,27 +481,14 @@ impl PyEstimator {
         dcurv: bool,
         device: Option<String>,
     ) -> PyResult<Self> {
-        let faces = read_faces(faces, "faces")?;
-        if n_vertices == 0 {
-            return Err(value_err("n_vertices: the mesh has no vertices"));
-        }
-        shapecue::mesh::check_faces(n_vertices, &faces, "faces").map_err(to_py)?;
-        let opts = options(accumulate, precision, compat, dcurv)?;
-        let n_faces = faces.len();
-        let (est, device) = py
-            .detach(|| {
-                let gpu = open_gpu(device.as_deref())?;
-                let opts = device_options(opts, accumulate, &gpu);
-                let name = gpu.info.name.clone();
-                Ok::<_, Error>((RustEstimator::new(gpu, n_vertices, &faces, opts)?, name))
-            })
-            .map_err(to_py)?;
-        Ok(PyEstimator {
-            inner: Mutex::new(est),
-            n_vertices,
-            n_faces,
+        let args = CurvatureArgs {
+            accumulate,
+            precision,
+            compat,
+            dcurv,
             device,
-        })
+        };
+        Self::open(py, faces, n_vertices, args)
     }
 
     /// run(positions) -> dict: the curvature of one pose.
@@ -564,6 +596,8 @@ impl ToF32 for f64 {
 /// isosurface(volume, iso, spacing, origin, fusion, inside, curvature, normals, device) -> dict
 #[pyfunction]
 #[pyo3(signature = (volume, iso, spacing, origin, fusion, inside, curvature, normals, device))]
+// PyO3 takes the arguments one by one (the positional signature of
+// `_shapecue.pyi`); the body only collects them into `IsoArgs`.
 #[allow(clippy::too_many_arguments)]
 fn isosurface<'py>(
     py: Python<'py>,
@@ -577,19 +611,65 @@ fn isosurface<'py>(
     normals: bool,
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let args = IsoArgs {
+        iso,
+        spacing,
+        origin,
+        fusion,
+        inside,
+        curvature,
+        normals,
+        device,
+    };
+    isosurface_with(py, volume, args)
+}
+
+/// The keyword options of `isosurface`, as the Python layer passes them.
+struct IsoArgs<'a> {
+    iso: f32,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    fusion: &'a str,
+    inside: &'a str,
+    curvature: bool,
+    normals: bool,
+    device: Option<String>,
+}
+
+impl IsoArgs<'_> {
+    /// The library's options, names checked by the library's parsers. The
+    /// curvature of the result uses the library's defaults ("auto"
+    /// accumulation, decided by [`AccumulateChoice::resolve`]).
+    fn options(&self) -> PyResult<shapecue::IsoOptions> {
+        let curvature = CurvatureOptions {
+            accumulate: AccumulateChoice::Auto.resolve(),
+            ..CurvatureOptions::default()
+        };
+        Ok(shapecue::IsoOptions {
+            fusion: parse(self.fusion)?,
+            inside: parse(self.inside)?,
+            curvature: self.curvature.then_some(curvature),
+            gradient_normals: self.normals,
+            ..Default::default()
+        })
+    }
+}
+
+/// [`isosurface`] with its options collected.
+fn isosurface_with<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyAny>,
+    args: IsoArgs<'_>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let iso = args.iso;
     if !iso.is_finite() {
         return Err(value_err(format!("iso: {iso} is not a finite number")));
     }
     let vol = read_volume(volume)?
-        .with_geometry(spacing, origin)
+        .with_geometry(args.spacing, args.origin)
         .map_err(to_py)?;
-    let opts = shapecue::IsoOptions {
-        fusion: parse(fusion)?,
-        inside: parse(inside)?,
-        curvature: curvature.then(CurvatureOptions::default),
-        gradient_normals: normals,
-        ..Default::default()
-    };
+    let opts = args.options()?;
+    let device = args.device;
     let (s, name) = py
         .detach(|| {
             let gpu = open_gpu(device.as_deref())?;
@@ -597,6 +677,15 @@ fn isosurface<'py>(
             Ok::<_, Error>((s, gpu.info.name.clone()))
         })
         .map_err(to_py)?;
+    isosurface_dict(py, s, &name)
+}
+
+/// The isosurface as a dict of numpy arrays, counts and timings.
+fn isosurface_dict<'py>(
+    py: Python<'py>,
+    s: shapecue::Isosurface,
+    name: &str,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let (nv, nf) = (s.mesh.n_vertices(), s.mesh.n_faces());
     d.set_item(
@@ -609,7 +698,7 @@ fn isosurface<'py>(
         None => d.set_item("normals", py.None())?,
     }
     match s.curvature {
-        Some(c) => d.set_item("curvature", curvature_dict(py, c, &name)?)?,
+        Some(c) => d.set_item("curvature", curvature_dict(py, c, name)?)?,
         None => d.set_item("curvature", py.None())?,
     }
     d.set_item("soup_triangles", s.stats.soup_triangles)?;

@@ -18,6 +18,8 @@ use shapecue::stages::feature_lines::LineOptions;
 /// "auto" | a scheme).
 #[pyfunction]
 #[pyo3(signature = (vertices, faces, families, eye, ortho, thresholds, isophotes, light, switches, setup, device))]
+// PyO3 takes the arguments one by one (the positional signature of
+// `_shapecue.pyi`); the body only collects them into `LinesArgs`.
 #[allow(clippy::too_many_arguments)]
 pub fn lines<'py>(
     py: Python<'py>,
@@ -33,44 +35,89 @@ pub fn lines<'py>(
     setup: (String, String, String),
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mesh = read_mesh(vertices, faces)?;
-    let fams = FamilySet::parse(families).map_err(to_py)?;
-    let [sc, rv, ar, ph, sh, sc_fade] = thresholds;
-    let [cull, test, fade, hermite, hermite_kh] = switches;
-    let opts = LineOptions {
-        contours: fams.has(LineFamily::Contours),
-        suggestive: fams.has(LineFamily::Suggestive),
-        threshold: sc,
-        fade: sc_fade,
-        curves: CurveOptions {
-            families: fams.curves(),
-            ridge_threshold: rv,
-            apparent_threshold: ar,
-            principal_threshold: ph,
-            highlight_threshold: sh,
-            isophotes,
-            light,
-            cull,
-            test,
-            fade,
-            hermite,
-            hermite_kh,
-        },
+    let args = LinesArgs {
+        families,
+        eye,
+        ortho,
+        thresholds,
+        isophotes,
+        light,
+        switches,
+        setup,
+        device,
     };
-    let (feature_size, compat, accumulate) = setup;
-    let setup = LineSetup {
-        curvature: CurvatureOptions {
-            accumulate: if accumulate == "auto" {
-                Default::default()
-            } else {
-                parse(&accumulate)?
+    lines_with(py, (vertices, faces), args)
+}
+
+/// The keyword options of `lines`, as the Python layer passes them (see
+/// [`lines`] for the order within the tuples).
+struct LinesArgs<'a> {
+    families: &'a str,
+    eye: [f32; 3],
+    ortho: bool,
+    thresholds: [f32; 6],
+    isophotes: u32,
+    light: [f32; 3],
+    switches: [bool; 5],
+    setup: (String, String, String),
+    device: Option<String>,
+}
+
+impl LinesArgs<'_> {
+    /// The line families and their thresholds and switches.
+    fn line_options(&self) -> PyResult<LineOptions> {
+        let fams = FamilySet::parse(self.families).map_err(to_py)?;
+        let [sc, rv, ar, ph, sh, sc_fade] = self.thresholds;
+        let [cull, test, fade, hermite, hermite_kh] = self.switches;
+        Ok(LineOptions {
+            contours: fams.has(LineFamily::Contours),
+            suggestive: fams.has(LineFamily::Suggestive),
+            threshold: sc,
+            fade: sc_fade,
+            curves: CurveOptions {
+                families: fams.curves(),
+                ridge_threshold: rv,
+                apparent_threshold: ar,
+                principal_threshold: ph,
+                highlight_threshold: sh,
+                isophotes: self.isophotes,
+                light: self.light,
+                cull,
+                test,
+                fade,
+                hermite,
+                hermite_kh,
             },
-            compat: parse(&compat)?,
-            ..Default::default()
-        },
-        feature_size: feature_size.parse::<FeatureSize>().map_err(to_py)?,
-    };
-    let view = View::from_eye(eye, ortho);
+        })
+    }
+
+    /// The curvature and feature size the lines are computed with, names
+    /// checked by the library's parsers; `accumulate = "auto"` is decided
+    /// by [`AccumulateChoice::resolve`].
+    fn setup(&self) -> PyResult<LineSetup> {
+        let (feature_size, compat, accumulate) = &self.setup;
+        Ok(LineSetup {
+            curvature: CurvatureOptions {
+                accumulate: parse::<AccumulateChoice>(accumulate)?.resolve(),
+                compat: parse(compat)?,
+                ..Default::default()
+            },
+            feature_size: feature_size.parse::<FeatureSize>().map_err(to_py)?,
+        })
+    }
+}
+
+/// [`lines`] with its options collected.
+fn lines_with<'py>(
+    py: Python<'py>,
+    (vertices, faces): (&Bound<'py, PyAny>, &Bound<'py, PyAny>),
+    args: LinesArgs<'_>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mesh = read_mesh(vertices, faces)?;
+    let opts = args.line_options()?;
+    let setup = args.setup()?;
+    let view = View::from_eye(args.eye, args.ortho);
+    let device = args.device;
     let (ls, name) = py
         .detach(|| {
             let gpu = open_gpu(device.as_deref())?;

@@ -125,6 +125,37 @@ def test_auto_accumulation_is_gather_on_cpu_devices_and_atomic_elsewhere(device)
                                    rtol=1e-4, atol=1e-5)
 
 
+def close(a, b):
+    # Equal up to the last bits that atomic sums may vary in between runs,
+    # should the library's default ever be a scatter scheme on the device.
+    for k in FIELDS:
+        np.testing.assert_allclose(getattr(a, k), getattr(b, k), rtol=1e-4, atol=1e-5, err_msg=k)
+
+
+def test_auto_accumulation_is_the_default(device):
+    v, f = torus(24, 12)
+    default = shapecue.curvature(v, f)
+    close(shapecue.curvature(v, f, accumulate="auto"), default)
+    close(shapecue.CurvatureEstimator(f, len(v), accumulate="auto").run(v), default)
+    close(shapecue.CurvatureEstimator(f, len(v)).run(v), default)
+
+
+# The library's parser's message, naming every valid choice.
+UNKNOWN_ACCUMULATION = r'unknown accumulation "sometimes": expected auto, atomic, atomic-native, gather'
+
+
+def test_unknown_accumulation_names_the_choices(device):
+    v, f = torus(12, 8)
+    with pytest.raises(ValueError, match=UNKNOWN_ACCUMULATION):
+        shapecue.curvature(v, f, accumulate="sometimes")
+    with pytest.raises(ValueError, match=UNKNOWN_ACCUMULATION):
+        shapecue.curvature(v, f, accumulate="sometimes", reference=True)
+    with pytest.raises(ValueError, match=UNKNOWN_ACCUMULATION):
+        shapecue.CurvatureEstimator(f, len(v), accumulate="sometimes")
+    with pytest.raises(ValueError, match=UNKNOWN_ACCUMULATION):
+        shapecue.build_kernels(accumulate=["gather", "sometimes"])
+
+
 def test_isolated_vertices_and_degenerate_faces_are_counted(device):
     v, f = torus(24, 12)
     v = np.vstack([v, [[5.0, 5.0, 5.0]]])  # an unreferenced vertex

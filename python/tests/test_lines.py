@@ -32,3 +32,15 @@ def test_unknown_family_is_a_clear_error():
     v, f = torus(nu=8, nv=4)
     with pytest.raises(ValueError, match="creases"):
         shapecue.lines(v, f, lines=["ridges", "creases"])
+
+
+def test_auto_accumulation_is_the_default_and_unknown_names_the_choices():
+    v, f = torus(nu=24, nv=12)
+    default = shapecue.lines(v, f, lines="k-zero,contours", cull=False)
+    auto = shapecue.lines(v, f, lines="k-zero,contours", cull=False, accumulate="auto")
+    assert auto.segments.shape == default.segments.shape
+    np.testing.assert_allclose(auto.segments, default.segments, rtol=1e-4, atol=1e-5)
+    np.testing.assert_array_equal(auto.kind, default.kind)
+    msg = r'unknown accumulation "sometimes": expected auto, atomic, atomic-native, gather'
+    with pytest.raises(ValueError, match=msg):
+        shapecue.lines(v, f, accumulate="sometimes")

@@ -115,6 +115,9 @@ def test_build_kernels_fills_the_kernel_cache(tmp_path, monkeypatch, device):
     assert len(list(cache.glob("*.clbin"))) == 1
     again = shapecue.build_kernels(accumulate=["gather"])
     assert again[0]["cache"] == "hit" and again[0]["saved"] is False
+    # "auto" builds the default's variant (loaded from the cache now).
+    auto = shapecue.build_kernels(accumulate="auto")
+    assert [b["variant"] for b in auto] == [b["variant"] for b in shapecue.build_kernels()]
     with pytest.raises(ValueError, match="accumulation"):
         shapecue.build_kernels(accumulate=["sideways"])
     with pytest.raises(TypeError, match="precision"):
@@ -122,3 +125,27 @@ def test_build_kernels_fills_the_kernel_cache(tmp_path, monkeypatch, device):
     monkeypatch.setenv("SHAPECUE_NO_CACHE", "1")
     with pytest.raises(ValueError, match="kernel cache is off"):
         shapecue.build_kernels()
+
+
+def test_extension_signatures_match_the_stub():
+    # The extension's functions keep the positional signatures of
+    # _shapecue.pyi (their options are collected into one struct per entry
+    # point inside the Rust functions, not in their Python signatures).
+    import ast
+    import inspect
+
+    stub = REPO / "python" / "shapecue" / "_shapecue.pyi"
+    tree = ast.parse(stub.read_text())
+    funcs = {n.name: [a.arg for a in n.args.args] for n in tree.body if isinstance(n, ast.FunctionDef)}
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "_CurvatureEstimator")
+    init = next(n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
+    exported = {k for k, v in vars(shapecue._shapecue).items() if callable(v) and not isinstance(v, type)}
+    assert exported == set(funcs)
+    for name, params in funcs.items():
+        sig = inspect.signature(getattr(shapecue._shapecue, name))
+        assert list(sig.parameters) == params, name
+    try:
+        sig = inspect.signature(shapecue._shapecue._CurvatureEstimator)
+    except ValueError:  # no class text signature under this build (abi3)
+        return
+    assert list(sig.parameters) == [a.arg for a in init.args.args][1:]
