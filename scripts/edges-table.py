@@ -84,16 +84,16 @@ def main():
         print(f"{name}: done", file=sys.stderr)
 
     print("| mesh | vertices | Line Art | edges kernels | warm frame | × Line Art | "
-          "read-back | GL mesh | GL edges | image read-back | first frame | topology | process |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "edges pass | caps pass | render pass | first frame | topology | process |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, d, proc in rows:
         la = LINE_ART_MS.get(name)
         pm = d["phases_median_ms"]
         f = d["frame_median_ms"]
         ratio = f"{f / la:.2f}" if la else "–"
         print(f"| {name} | {d['vertices']:,} | {la if la else '–'} | {d['kernel_median_ms']:.2f} | "
-              f"{f:.1f} | {ratio} | {pm['readback']:.1f} | {pm['draw_mesh']:.1f} | "
-              f"{pm['draw_edges']:.1f} | {pm['image_readback']:.1f} | {d['frame_ms']:.0f} | "
+              f"{f:.1f} | {ratio} | {pm['edges']:.1f} | {pm.get('caps', 0.0):.1f} | "
+              f"{pm['render']:.1f} | {d['frame_ms']:.0f} | "
               f"{d['topology_ms']:.1f} | {proc:.0f} |")
 
     if a.scene:

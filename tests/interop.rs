@@ -251,20 +251,22 @@ fn edges_on_external_memory_draws_the_host_image() {
     };
     let gpu = std::sync::Arc::new(gpu);
     let (_, mesh) = shapecue::mesh::Generated::Torus.mesh(4000);
+    assert_eq!(d.route, InteropRoute::ExternalMemory);
     let mut opts = shapecue::EdgePictureOptions {
-        eye: None,
         msaa: 0,
         ..Default::default()
     };
+    opts.shot.eye = None;
     for caps in shapecue::spec::edges::CapMode::ALL {
         opts.caps = caps;
-        opts.interop = InteropRoute::Host;
+        opts.interop = InteropMode::Off;
         let host = shapecue::feature_edges_picture_on(&gpu, &mesh, "torus", &opts).unwrap();
-        opts.interop = d.route;
+        assert_eq!(host.interop.route, InteropRoute::Host);
+        opts.interop = InteropMode::On;
         let shared = shapecue::feature_edges_picture_on(&gpu, &mesh, "torus", &opts).unwrap();
         assert_eq!(host.output.kind, shared.output.kind, "{}", caps.name());
         assert_eq!(host.drawn_caps, shared.drawn_caps, "{}", caps.name());
-        assert_eq!(shared.interop, InteropRoute::ExternalMemory);
+        assert_eq!(shared.interop.route, InteropRoute::ExternalMemory);
         assert!(
             host.frame.rgba == shared.frame.rgba,
             "{}: images differ",

@@ -43,8 +43,7 @@ mod strokes;
 pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
 
 pub use edges::{
-    EdgePhases, EdgePicture, EdgePictureOptions, EdgeRuns, feature_edges_picture,
-    feature_edges_picture_on,
+    EdgePicture, EdgePictureOptions, edges_scene, feature_edges_picture, feature_edges_picture_on,
 };
 
 pub use crate::scene::file::Shot;

@@ -1,8 +1,9 @@
 //! `shapecue edges`: object-space feature edges with caps (House & Li),
 //! drawn over the shaded mesh by one front-door call
-//! ([`shapecue::feature_edges_picture_on`]) to PNG,
-//! with the visible edges as SVG and JSON stats (`shapecue report caps` and
-//! `shapecue report memory` print the cap-quality and memory tables).
+//! ([`shapecue::feature_edges_picture_on`]) to PNG, with the visible edges
+//! as SVG and JSON stats; `--runs` times more frames of the same view
+//! ([`shapecue::report::frames`]). `shapecue report caps` and `shapecue
+//! report memory` print the cap-quality and memory tables.
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
@@ -10,9 +11,7 @@ use clap::Args;
 use shapecue::EdgePictureOptions;
 use shapecue::gpu::Gpu;
 use shapecue::mesh::LoadOptions;
-use shapecue::spec::edges::{
-    CapMode, KIND_BOUNDARY, KIND_CONTOUR, KIND_CREASE, KIND_DRAWN, decide_interop,
-};
+use shapecue::spec::edges::CapMode;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -104,18 +103,11 @@ fn ms_since(t: std::time::Instant) -> f64 {
 
 /// Runs `shapecue edges`.
 pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
-    // Parsed here rather than by clap's ValueEnum so that a bad name keeps
-    // the library's message ("unknown cap mode ...") and exit code 1.
-    let mode: CapMode = a.caps.parse()?;
-    let (w, h) = super::size_arg(&a.size)?;
-    // Checked before any table or drawing: the message names the flag.
-    super::width_arg(a.width, (w, h), "edge")?;
+    let opts = picture_options(&a)?;
+    let [w, h] = opts.shot.size;
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
-    let gpu = Arc::new(Gpu::new(device)?);
-    let offer = shapecue::api::interop::interop_offer(&gpu, a.interop);
-    let interop = decide_interop(a.interop, &offer)?;
     let path = a.mesh.as_path();
     if let Some(o) = &a.output {
         super::require_png("-o", o)?;
@@ -131,75 +123,40 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
             .map(PathBuf::as_path),
         a.force,
     )?;
+    let gpu = Arc::new(Gpu::new(device)?);
     let t_load = std::time::Instant::now();
-    let mesh = shapecue::mesh::load(path, &LoadOptions::default())?;
+    let mesh = Arc::new(shapecue::mesh::load(path, &LoadOptions::default())?);
     let load_ms = ms_since(t_load);
-    let eye = super::vec3_arg(&a.eye, "eye")?;
-    if eye.is_none() && a.target.is_some() {
-        bail!("--target needs --eye (without both, the view is fitted around the mesh)");
-    }
-    let opts = EdgePictureOptions {
-        eye,
-        target: super::vec3_arg(&a.target, "target")?,
-        up: super::vec3_arg(&a.up, "up")?,
-        fov_deg: a.fov,
-        ortho: a.ortho,
-        width: w,
-        height: h,
-        msaa: a.msaa,
-        caps: mode,
-        line_width: a.width,
-        crease_deg: a.crease,
-        depth_scale: a.depth_scale,
-        half_contours: a.half_contours,
-        marked: a.marked.clone(),
-        polylines: a.svg.is_some(),
-        timed_runs: a.runs.unwrap_or(0),
-        interop: interop.route,
-    };
-    let d = shapecue::feature_edges_picture_on(&gpu, &mesh, &path.display().to_string(), &opts)?;
+    let name = path.display().to_string();
+    let d = shapecue::feature_edges_picture_on(&gpu, &mesh, &name, &opts)?;
     let t_png = std::time::Instant::now();
     d.frame.save_png(output)?;
     let png_ms = ms_since(t_png);
-    let t = &d.topology;
-    out!(
-        "{}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {} \
-         (in front of the near plane) of those detected as contour {}, crease {}, \
-         boundary/marked {}; kernels {:.3} ms; wrote {}",
-        path.display(),
-        t.edges.len(),
-        t.boundary,
-        t.non_manifold,
-        t.marked,
-        t.caps.len(),
-        d.count(KIND_DRAWN),
-        d.count(KIND_CONTOUR),
-        d.count(KIND_CREASE),
-        d.count(KIND_BOUNDARY),
-        d.timing.kernel_ms,
-        output.display()
-    );
-    if let Some(r) = &d.runs {
-        out!(
-            "{} timed frames: median {:.2} ms per frame, {:.3} ms kernels",
-            r.runs,
-            r.frame_median_ms,
-            r.kernel_median_ms
-        );
-    }
+    print_summary(&name, &d, output)?;
+    let runs = match a.runs {
+        Some(n) => {
+            let scene = shapecue::api::edges_scene(mesh, &name, &opts)?;
+            let r = shapecue::report::frames::timed_frames(&gpu, &scene, n)?;
+            out!(
+                "{} timed frames: median {:.2} ms per frame, {:.3} ms kernels",
+                r.runs,
+                r.frame_median_ms,
+                r.kernel_median_ms
+            );
+            Some(r)
+        }
+        None => None,
+    };
     let mut svg_ms = 0.0;
-    if let (Some(svg), Some(lines)) = (&a.svg, &d.polylines) {
+    if let (Some(svg), Some(layers)) = (&a.svg, &d.layers) {
         let t_svg = std::time::Instant::now();
-        shapecue::export::svg::write_svg(svg, lines, w, h, a.width)?;
+        shapecue::export::svg::write_svg_layers(svg, layers, w, h)?;
         svg_ms = ms_since(t_svg);
-        out!("wrote {} ({} polylines)", svg.display(), lines.len());
+        let n: usize = layers.iter().map(|l| l.lines.len()).sum();
+        out!("wrote {} ({n} polylines)", svg.display());
     }
     if let Some(sp) = &a.stats {
-        let mut doc = d.stats(&path.display().to_string(), &interop);
-        // What each route needs, as the device, GL and Vulkan reported it.
-        if let Some(o) = doc.as_object_mut() {
-            o.insert("interop_offer".into(), serde_json::to_value(&offer)?);
-        }
+        let mut doc = stats(&name, &d, runs.as_ref());
         // The phases outside the library call: loading, PNG, SVG file.
         if let Some(ph) = doc.get_mut("phases_ms").and_then(|v| v.as_object_mut()) {
             ph.insert("load".into(), load_ms.into());
@@ -209,4 +166,103 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         write_json(sp, &doc)?;
     }
     Ok(())
+}
+
+/// The picture's options from the arguments (checked here: the messages
+/// name the flags).
+fn picture_options(a: &EdgesArgs) -> Result<EdgePictureOptions> {
+    // Parsed here rather than by clap's ValueEnum so that a bad name keeps
+    // the library's message ("unknown cap mode ...") and exit code 1.
+    let mode: CapMode = a.caps.parse()?;
+    let (w, h) = super::size_arg(&a.size)?;
+    // Checked before any table or drawing: the message names the flag.
+    super::width_arg(a.width, (w, h), "edge")?;
+    let eye = super::vec3_arg(&a.eye, "eye")?;
+    if eye.is_none() && a.target.is_some() {
+        bail!("--target needs --eye (without both, the view is fitted around the mesh)");
+    }
+    Ok(EdgePictureOptions {
+        shot: shapecue::Shot {
+            eye,
+            target: super::vec3_arg(&a.target, "target")?,
+            up: super::vec3_arg(&a.up, "up")?,
+            fov_deg: a.fov,
+            ortho: a.ortho,
+            size: [w, h],
+            ..Default::default()
+        },
+        msaa: a.msaa,
+        caps: mode,
+        line_width: a.width,
+        crease_deg: a.crease,
+        depth_scale: a.depth_scale,
+        half_contours: a.half_contours,
+        marked: a.marked.clone(),
+        svg: a.svg.is_some(),
+        interop: a.interop,
+    })
+}
+
+/// The one line of counts and kernel time.
+fn print_summary(name: &str, d: &shapecue::EdgePicture, output: &std::path::Path) -> Result<()> {
+    let t = &d.counts;
+    let [drawn, contour, crease, boundary] = d.kinds();
+    out!(
+        "{name}: {} edges ({} boundary, {} non-manifold, {} marked), {} cap pairs; drawn {drawn} \
+         (in front of the near plane) of those detected as contour {contour}, crease {crease}, \
+         boundary/marked {boundary}; kernels {:.3} ms; wrote {}",
+        t.edges,
+        t.boundary,
+        t.non_manifold,
+        t.marked,
+        t.cap_pairs,
+        d.timing.kernel_ms,
+        output.display()
+    );
+    Ok(())
+}
+
+/// The statistics document of `--stats`: counts, timings, memory, the
+/// interop route and what was offered; `input` names the mesh.
+fn stats(
+    input: &str,
+    d: &shapecue::EdgePicture,
+    runs: Option<&shapecue::report::frames::FrameRuns>,
+) -> serde_json::Value {
+    let t = &d.counts;
+    let [drawn, contour, crease, boundary] = d.kinds();
+    let phases: serde_json::Map<String, serde_json::Value> = (d.timing.phases.iter())
+        .map(|p| (p.phase.to_string(), p.ms.into()))
+        .collect();
+    serde_json::json!({
+        "input": input,
+        "device": d.device,
+        "vertices": d.vertices,
+        "faces": d.faces,
+        "edges": t.edges,
+        "cap_pairs": t.cap_pairs,
+        "boundary": t.boundary,
+        "non_manifold": t.non_manifold,
+        "marked": t.marked,
+        "drawn": drawn,
+        "contour": contour,
+        "crease": crease,
+        "boundary_or_marked": boundary,
+        "caps": d.caps,
+        // Adjacency caps drawn (the device holds only these).
+        "drawn_caps": d.drawn_caps,
+        "interop": d.interop,
+        "interop_offer": d.offer,
+        "timing": d.timing,
+        "topology_ms": d.timing.phase_ms("edge_buffer") + d.timing.phase_ms("cap_buffer"),
+        "frame_ms": d.passes.iter().map(|p| p.ms).sum::<f64>(),
+        "phases_ms": phases,
+        "memory_bits": d.memory,
+        "svg_polylines": d.layers.as_ref().map_or(0, |l| l.iter().map(|l| l.lines.len()).sum()),
+        "runs": runs.map(|r| r.runs),
+        "frame_median_ms": runs.map(|r| r.frame_median_ms),
+        "kernel_median_ms": runs.map(|r| r.kernel_median_ms),
+        "phases_median_ms": runs.map(|r| &r.passes_median_ms),
+        "gl_uploads": d.uploads,
+    })
 }

@@ -10,6 +10,7 @@
 
 pub mod caps;
 pub mod curvature;
+pub mod frames;
 pub mod isosurface;
 pub mod lines;
 pub mod memory;

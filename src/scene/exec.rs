@@ -43,12 +43,13 @@
 //! (`report`).
 
 mod draw;
+pub mod interop;
 mod live;
 mod load;
 mod passes;
 mod report;
 
-pub use draw::ViewOutputs;
+pub use draw::{EdgeCounts, EdgeInfo, ViewOutputs};
 pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};

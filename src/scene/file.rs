@@ -170,6 +170,10 @@ pub struct Scene {
     /// The curvature estimator's scheme, precision and least squares
     /// (`[curvature]`; the derivative is on where a pass needs it).
     pub curvature: CurvatureOptions,
+    /// How the edges frame's buffers reach GL (default `off`: read back
+    /// and uploaded; `auto`: shared memory where the device, GL and Vulkan
+    /// offer it). The executor decides.
+    pub interop: crate::spec::interop::InteropMode,
 }
 
 /// 1-based line and column of a byte offset.
@@ -292,6 +296,7 @@ impl Scene {
             svg: out.svg,
             msaa: out.msaa,
             background: out.background,
+            interop: crate::spec::interop::InteropMode::Off,
         })
     }
 }

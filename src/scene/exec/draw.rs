@@ -2,6 +2,7 @@
 //! pose's bounds, the mesh colours and style, the line and edge quads, and
 //! the PNG and SVG files of one view.
 
+use super::interop::SharedEdges;
 use crate::error::Result;
 use crate::export::svg::{
     DEFAULT_BIAS, SvgLayer, SvgPolyline, pixel, segment_lines, visible_joined,
@@ -13,8 +14,10 @@ use crate::scene::file::{CameraKind, Effects, LineStyle, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
 use crate::spec::edges::EdgeOutput;
 use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
+use crate::spec::interop::{InteropDecision, InteropOffer};
 use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
 use crate::spec::timing::Timing;
+use crate::stages::edges::SharedDrawn;
 use std::path::PathBuf;
 
 /// Host copies of the pose that the renderer and the host-side passes use,
@@ -154,6 +157,9 @@ pub(super) struct ViewLines<'a> {
     pub(super) segments: &'a [Segment],
     /// The edge stage's outputs, when feature edges are planned.
     pub(super) edges: Option<&'a EdgeOutput>,
+    /// On the external-memory route, the shared buffer and what the stage
+    /// compacted into it (drawn from there instead of `edges`).
+    pub(super) shared: Option<(&'a SharedEdges, &'a SharedDrawn)>,
     /// Curvature-directed strokes (scene frame).
     pub(super) strokes: &'a [Stroke],
     /// Lift of the strokes towards the eye (world units).
@@ -222,7 +228,10 @@ pub(super) fn draw_view(
     }
     if let Some(eo) = lines.edges {
         let [r, g, b] = fx.edge.1;
-        draw_edges(renderer, eo, [r, g, b, 1.0])?;
+        match lines.shared {
+            Some((sh, d)) => sh.draw(renderer, d, [r, g, b, 1.0])?,
+            None => draw_edges(renderer, eo, [r, g, b, 1.0])?,
+        }
     }
     if plan.contains(Pass::SdfLines) {
         // Strips over the surface (drawn first, so it hides the far side).
@@ -375,6 +384,10 @@ pub struct ViewOutputs {
     pub origin: [f64; 3],
     /// The surface drawn (world coordinates), for a picture.
     pub mesh: Option<crate::mesh::Mesh>,
+    /// The feature edges' buffer counts and route, when they are planned.
+    pub edge_info: Option<EdgeInfo>,
+    /// Mesh data uploads to GL so far.
+    pub uploads: crate::render::Uploads,
     /// The feature size the line families' thresholds were scaled by, when
     /// lines were found.
     pub feature_size: Option<f32>,
@@ -393,4 +406,33 @@ impl ViewOutputs {
             ..self.camera
         }
     }
+}
+
+/// The edge buffer's counts (House & Li's edge buffer and the adjacency
+/// caps' pairs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct EdgeCounts {
+    /// Unique edges.
+    pub edges: usize,
+    /// Adjacency cap pairs (0 without adjacency caps).
+    pub cap_pairs: usize,
+    /// Boundary edges (one face).
+    pub boundary: usize,
+    /// Non-manifold edges (three faces or more).
+    pub non_manifold: usize,
+    /// Marked edges.
+    pub marked: usize,
+}
+
+/// What a view with feature edges hands its caller besides their outputs.
+#[derive(Clone, Debug)]
+pub struct EdgeInfo {
+    /// The edge buffer's counts.
+    pub counts: EdgeCounts,
+    /// The route the buffers took to GL, and why.
+    pub decision: InteropDecision,
+    /// What the device, GL and Vulkan offered.
+    pub offer: InteropOffer,
+    /// Adjacency caps drawn.
+    pub drawn_caps: usize,
 }

@@ -41,6 +41,13 @@ pub struct Effects {
     pub edge_contours: bool,
     /// Edge boundaries.
     pub edge_boundaries: bool,
+    /// Depth scale k of the edge width factor max(1, k/w) (`None`: none).
+    pub edge_depth_scale: Option<f32>,
+    /// Contour-only edges as half quads, outward from the silhouette.
+    pub edge_half_contours: bool,
+    /// Marked edges: a text file of vertex-index pairs
+    /// ([`crate::mesh::edges::read_marked`]).
+    pub edge_marked: Option<std::path::PathBuf>,
     /// Curvature-directed strokes.
     pub strokes: StrokeEffect,
     /// The curvature line cues (ridges, valleys, ..., boundaries), with the

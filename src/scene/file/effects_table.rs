@@ -49,6 +49,9 @@ pub(super) fn resolve(
         caps: fe.caps,
         edge_contours: fe.contours,
         edge_boundaries: fe.boundaries,
+        edge_depth_scale: fe.depth_scale,
+        edge_half_contours: fe.half_contours,
+        edge_marked: fe.marked,
         strokes,
         lines,
         feature_size: FeatureSize::default(),
@@ -80,6 +83,12 @@ struct FeatureEdges {
     contours: bool,
     /// Edge boundaries.
     boundaries: bool,
+    /// Depth scale of the width.
+    depth_scale: Option<f32>,
+    /// Half-quad contours.
+    half_contours: bool,
+    /// The marked edges' file.
+    marked: Option<std::path::PathBuf>,
 }
 
 /// The `[effects]` table's span, for errors that name the table.
@@ -214,6 +223,20 @@ impl Table<'_> {
             caps,
             contours: fe.contours.unwrap_or(true),
             boundaries: fe.boundaries.unwrap_or(true),
+            depth_scale: match fe.depth_scale {
+                Some(k) if !(k.is_finite() && k > 0.0) => {
+                    return Err(self.err(format!(
+                        "feature_edges.depth_scale {k} must be a positive number"
+                    )));
+                }
+                k => k,
+            },
+            half_contours: fe.half_contours.unwrap_or(false),
+            marked: fe
+                .marked
+                .as_ref()
+                .map(|m| self.ck.existing(m))
+                .transpose()?,
         })
     }
 

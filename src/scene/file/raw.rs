@@ -310,6 +310,13 @@ pub struct EdgeSpec {
     pub contours: Option<bool>,
     /// Draw boundary edges (default true).
     pub boundaries: Option<bool>,
+    /// Depth scale k of the width factor max(1, k/w) (default: none).
+    pub depth_scale: Option<f32>,
+    /// Contour-only edges as half quads, outward from the silhouette.
+    pub half_contours: Option<bool>,
+    /// A text file of marked edges (vertex-index pairs), relative to the
+    /// scene file.
+    pub marked: Option<Spanned<String>>,
 }
 
 /// `[effects.curvature_strokes]`: Interrante-style strokes along the first

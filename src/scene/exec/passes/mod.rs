@@ -15,12 +15,13 @@
 mod view;
 
 use super::draw::{self, PoseData, ViewLines};
+use super::interop::{SharedEdges, interop_offer};
 use super::load::Loaded;
 use super::report::{Recorder, ms_since};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
-use crate::mesh::edges::EdgeTopology;
+use crate::mesh::edges::{EdgeTopology, read_marked};
 use crate::mesh::topology::vertex_normals;
 use crate::render::colormap::curvature_scale;
 use crate::render::{Camera, Renderer};
@@ -29,12 +30,13 @@ use crate::scene::planner::{Pass, Plan};
 use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::{EdgeOutput, EdgeParams};
 use crate::spec::feature_lines::{LineInputs, Segment};
+use crate::spec::interop::{InteropDecision, InteropOffer, InteropRoute, decide_interop};
 use crate::spec::marching_cubes::IsoNormals;
 use crate::spec::sdf_lines::{Inside, SdfLineOptions, SdfLinesOutput, Stroke};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::curvature::CurvatureEstimator;
-use crate::stages::edges::EdgeStage;
+use crate::stages::edges::{EdgeStage, SharedDrawn};
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use crate::stages::marching_cubes::Isosurfacer;
 use crate::stages::pipeline::{PipelineOptions, PipelineStages, PosePipeline};
@@ -56,6 +58,11 @@ struct Topology {
     est: Option<CurvatureEstimator>,
     lines: Option<LineExtractor>,
     edges: Option<EdgeStage>,
+    /// The edge buffer's counts.
+    edge_counts: Option<draw::EdgeCounts>,
+    /// The edges frame's shared buffer (external-memory route), made by the
+    /// first view.
+    shared: Option<SharedEdges>,
 }
 
 impl Topology {
@@ -68,6 +75,8 @@ impl Topology {
             est: None,
             lines: None,
             edges: None,
+            edge_counts: None,
+            shared: None,
         }
     }
 }
@@ -127,6 +136,11 @@ pub(super) struct Executor<'s, 'g> {
     /// positions, normals and colours (uploaded by the first view).
     gl_topology: bool,
     gl_pose: bool,
+    /// How the edges frame's buffers reach GL, and what was offered
+    /// (decided once, when feature edges are planned).
+    interop: Option<(InteropDecision, InteropOffer)>,
+    /// This view: what the edge stage compacted into the shared buffer.
+    shared_drawn: Option<SharedDrawn>,
     /// This view: the lines and the edge stage's run and outputs.
     segs: Vec<Segment>,
     lines_ran: Option<Timing>,
@@ -214,6 +228,10 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             _ => None,
         };
+        let interop = match has(Pass::Edges) {
+            true => Some(decide(gpu, scene)?),
+            false => None,
+        };
         let ao = match (&pipe, has(Pass::Ao)) {
             (None, true) => Some(AoStage::new(gpu.clone())?),
             _ => None,
@@ -244,6 +262,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             pose_ready: false,
             gl_topology: false,
             gl_pose: false,
+            interop,
+            shared_drawn: None,
             segs: Vec::new(),
             lines_ran: None,
             edges_ran: None,
@@ -267,14 +287,18 @@ impl<'s, 'g> Executor<'s, 'g> {
         self.renderer.uploads()
     }
 
-    /// The renderer, for the next scene of the session.
+    /// The renderer, for the next scene of the session (the shared edge
+    /// buffer freed first).
     pub(super) fn into_renderer(self) -> Renderer {
-        self.renderer
+        self.into_parts().1
     }
 
     /// The loaded input and the renderer, for the next executor of a live
     /// scene whose input stays.
-    pub(super) fn into_parts(self) -> (Loaded, Renderer) {
+    pub(super) fn into_parts(mut self) -> (Loaded, Renderer) {
+        if let Some(sh) = self.topo.as_mut().and_then(|t| t.shared.take()) {
+            sh.free(&mut self.renderer);
+        }
         (self.loaded, self.renderer)
     }
 
@@ -460,13 +484,16 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             Pass::EdgeBuffer => {
                 let t0 = Instant::now();
-                let name = self.scene.path.display().to_string();
                 let caps = has(Pass::CapBuffer);
+                let (marked, name) = match &self.scene.effects.edge_marked {
+                    Some(f) => (read_marked(f)?, f.display().to_string()),
+                    None => (Vec::new(), self.scene.path.display().to_string()),
+                };
                 let t = self.topology(frame)?;
                 let et = if caps {
-                    EdgeTopology::new(&t.mesh, &[], &name)?
+                    EdgeTopology::new(&t.mesh, &marked, &name)?
                 } else {
-                    EdgeTopology::without_caps(&t.mesh, &[], &name)?
+                    EdgeTopology::without_caps(&t.mesh, &marked, &name)?
                 };
                 self.rec.wall(
                     pass,
@@ -475,6 +502,13 @@ impl<'s, 'g> Executor<'s, 'g> {
                 );
                 let t = self.topo.as_mut().expect("made above");
                 t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
+                t.edge_counts = Some(draw::EdgeCounts {
+                    edges: et.edges.len(),
+                    cap_pairs: et.caps.len(),
+                    boundary: et.boundary,
+                    non_manifold: et.non_manifold,
+                    marked: et.marked,
+                });
             }
             Pass::OneRings => self.one_rings(frame)?,
             Pass::CapBuffer => self.rec.wall(
@@ -738,4 +772,24 @@ impl<'s, 'g> Executor<'s, 'g> {
             })
             .collect()
     }
+}
+
+/// The route of the edges frame's buffers to GL, decided once per run from
+/// the scene's mode and what the device, GL and Vulkan offer. An
+/// isosurface's topology changes every pose, so it always reads back.
+fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, InteropOffer)> {
+    let offer = interop_offer(gpu, scene.interop);
+    let mut d = decide_interop(scene.interop, &offer)?;
+    if d.route == InteropRoute::ExternalMemory
+        && scene.source.input() == crate::scene::planner::Input::Volume
+    {
+        d.passed_over.push(format!("external memory: {}", d.reason));
+        d = InteropDecision {
+            route: InteropRoute::Host,
+            shared: false,
+            reason: "host path: an isosurface's topology changes every pose".into(),
+            passed_over: d.passed_over,
+        };
+    }
+    Ok((d, offer))
 }

@@ -10,6 +10,7 @@ impl Executor<'_, '_> {
         self.segs.clear();
         self.lines_ran = None;
         self.edges_ran = None;
+        self.shared_drawn = None;
     }
 
     /// Runs one view pass from `cam`; the render pass writes `paths`.
@@ -90,11 +91,43 @@ impl Executor<'_, '_> {
                 p.crease_deg = fx.crease;
                 p.contours = fx.edge_contours;
                 p.boundaries = fx.edge_boundaries;
+                p.depth_scale = fx.edge_depth_scale;
+                p.half_contours = fx.edge_half_contours;
+                p.pack()?;
+                let shared = (self.interop.as_ref()).is_some_and(|(d, _)| d.shared);
+                let svg = self.keep_layers
+                    || paths
+                        .iter()
+                        .any(|p| p.extension().is_none_or(|e| e != "png"));
                 let t = self.topo.as_mut().expect("a pose ran");
                 let es = t.edges.as_mut().expect("planned with the edge buffer");
                 let timing = es.run(&p, fx.caps)?;
-                // Only what was drawn comes back, compacted on the device.
-                let out = es.read_drawn()?;
+                let out = if shared {
+                    // Compacted into memory GL draws from; only the kinds
+                    // (and the quads for an SVG) come back.
+                    let sh = match &mut t.shared {
+                        Some(sh) => sh,
+                        None => t.shared.insert(SharedEdges::new(
+                            self.gpu,
+                            &mut self.renderer,
+                            es,
+                            fx.caps,
+                        )?),
+                    };
+                    let d = sh.compact(self.gpu, es)?;
+                    let mut out = EdgeOutput {
+                        kind: d.kind.clone(),
+                        ..EdgeOutput::default()
+                    };
+                    if svg {
+                        out.edge_out = sh.read_edges(self.gpu, &d)?;
+                    }
+                    self.shared_drawn = Some(d);
+                    out
+                } else {
+                    // Only what was drawn comes back, compacted on the device.
+                    es.read_drawn()?
+                };
                 self.rec.kernels(
                     pass,
                     &timing,
@@ -128,9 +161,11 @@ impl Executor<'_, '_> {
                     self.gl_pose = true;
                 }
                 let strokes = self.scene_strokes();
+                let shared = (t.shared.as_ref()).zip(self.shared_drawn.as_ref());
                 let lines = ViewLines {
                     segments: &self.segs,
                     edges: self.edges_ran.as_ref().map(|e| &e.1),
+                    shared,
                     strokes: &strokes,
                     // Half a voxel towards the eye: the strokes lie on the
                     // interpolated surface, which marching cubes cuts as chords.
@@ -200,6 +235,20 @@ impl Executor<'_, '_> {
             camera: *cam,
             origin: o,
             mesh: topo.filter(|_| self.keep_mesh).map(|t| t.mesh.clone()),
+            edge_info: self
+                .interop
+                .as_ref()
+                .map(|(decision, offer)| draw::EdgeInfo {
+                    counts: topo.and_then(|t| t.edge_counts).unwrap_or_default(),
+                    decision: decision.clone(),
+                    offer: offer.clone(),
+                    drawn_caps: match (&self.shared_drawn, &self.edges_ran) {
+                        (Some(d), _) => d.adjacency_caps,
+                        (None, Some((_, out))) => out.cap_adj.len() / 4,
+                        (None, None) => 0,
+                    },
+                }),
+            uploads: self.renderer.uploads(),
             feature_size: topo.and_then(|t| t.feature_size),
             timing,
         }
