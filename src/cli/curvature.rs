@@ -4,15 +4,15 @@
 //! (`shapecue report curvature` prints the accuracy/time table).
 //!
 //! The stats time every phase of the command (`phases_ms`): the library
-//! call's phases ([`shapecue::CurvaturePhases`]: load = parse and
-//! validation, device, reorder (the memory order of `--order`), program
+//! call's phases (the phases of [`shapecue::CurvatureRun::timing`]: load =
+//! parse and validation, device, reorder (the memory order of `--order`), program
 //! build, topology, normalisation, upload, the first run with the driver's
 //! compilation at first launch, program-cache write), then read-back (the
 //! device buffers mapped, not copied: CPU runtimes hand over their own
 //! memory) and PLY write (with each value's conversion, scaling back and
 //! mapping back to the input's order, done as it is written); `--runs N`
-//! adds N timed runs of the device passes after the one whose results are
-//! written, with medians.
+//! adds N timed runs of the device passes after the library's (the command
+//! runs the returned estimator again), with medians.
 
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
@@ -165,15 +165,22 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
             // One library call: the load beside the device's opening and the
             // program build, then the ordered estimator, run and left on the
             // device; the phases come back with it.
-            let r = shapecue::curvature_of(&CurvatureJob {
+            let mut r = shapecue::curvature_of(&CurvatureJob {
                 source,
                 device: device.map(str::to_string),
                 opts,
                 accumulate: a.accumulate,
                 order: a.order,
-                runs: a.runs.unwrap_or(0),
             })?;
-            let ph = &r.phases;
+            // The timed runs after the one the library made: each writes
+            // the same values (the passes are deterministic for gather;
+            // atomic sums may differ in the last bits), so the field read
+            // afterwards is the last run's.
+            let t_runs = Instant::now();
+            let runs = (0..a.runs.unwrap_or(0))
+                .map(|_| r.estimator.est.run())
+                .collect::<shapecue::Result<Vec<_>>>()?;
+            let runs_ms = ms_since(t_runs);
             opts.accumulate = r.opts.accumulate;
             let device_bytes = r.estimator.est.device_bytes();
             let mut stats = serde_json::json!({
@@ -194,11 +201,11 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 "device_bytes_per_vertex": device_bytes as f64 / r.mesh.n_vertices() as f64,
             });
             if a.runs.is_some() {
-                shapecue::report::metrics::runs_stats(&mut stats, &r.runs, r.timing.wall_ms);
+                shapecue::report::metrics::runs_stats(&mut stats, &runs, r.timing.wall_ms);
             }
             // PoCL compiles at the first build and launch when its own cache is
             // empty (seconds), and shapecue saves nothing there on its own.
-            let compile_ms = ph.program_prepare + r.timing.wall_ms;
+            let compile_ms = r.timing.phase_ms("program_prepare") + r.timing.wall_ms;
             if compile_ms > 1000.0
                 && r.gpu
                     .program_builds()
@@ -212,11 +219,17 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
                 );
             }
             stats["programs"] = serde_json::to_value(r.gpu.program_builds())?;
-            let phases = match serde_json::to_value(ph)? {
-                serde_json::Value::Object(m) => m,
-                _ => unreachable!("the phases are a struct"),
-            };
-            let (load_ms, compute_ms) = (ph.load, r.compute_ms);
+            // The library call's phases; `compute` (its share after the
+            // load) counts in the total instead.
+            let phases: serde_json::Map<_, _> = r
+                .timing
+                .phases
+                .iter()
+                .filter(|p| p.phase != "compute")
+                .map(|p| (p.phase.to_string(), serde_json::json!(p.ms)))
+                .collect();
+            let load_ms = r.timing.phase_ms("load");
+            let compute_ms = r.timing.phase_ms("compute") + runs_ms;
             let shapecue::CurvatureRun {
                 name,
                 mesh,
