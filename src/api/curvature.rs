@@ -238,10 +238,9 @@ pub fn curvature_of(job: &CurvatureJob) -> Result<CurvatureRun> {
     timing.phase("topology", est.topology_ms() - est.build_ms());
     timing.phase("normalise", est.upload_ms().normalise);
     timing.phase("upload", est.upload_ms().write);
+    // The run's steps, kernel and wall time (the phases' timing has none).
     let run = estimator.est.run()?;
-    timing.steps = run.steps;
-    timing.kernel_ms = run.kernel_ms;
-    timing.wall_ms = run.wall_ms;
+    timing.extend(&run);
     timing.phase("first_run", run.wall_ms);
     let counts = estimator.est.counts()?;
     // After the run, so that code the driver compiled at the first launch
