@@ -48,11 +48,11 @@ pub mod volume;
 pub struct ReadmeDoctests;
 
 pub use api::{
-    CurvatureJob, CurvaturePhases, CurvatureRun, EdgePicture, EdgePictureOptions, IsoOptions,
-    Isosurface, LinesPicture, LinesPictureOptions, MeshSource, PictureOptions, Shot, Strokes,
-    StrokesInput, StrokesOptions, curvature, curvature_of, curvature_on, feature_edges,
-    feature_edges_on, feature_edges_picture, feature_edges_picture_on, isosurface, isosurface_on,
-    lines_picture, lines_picture_on, render_scene, render_scene_on, strokes, strokes_on,
+    CurvatureJob, CurvatureRun, EdgePicture, EdgePictureOptions, IsoOptions, Isosurface,
+    LinesPicture, LinesPictureOptions, MeshSource, PictureOptions, Shot, Strokes, StrokesInput,
+    StrokesOptions, curvature, curvature_of, curvature_on, feature_edges, feature_edges_on,
+    feature_edges_picture, feature_edges_picture_on, isosurface, isosurface_on, lines_picture,
+    lines_picture_on, render_scene, render_scene_on, strokes, strokes_on,
 };
 pub use error::{Error, Result};
 pub use mesh::Mesh;

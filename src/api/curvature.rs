@@ -3,7 +3,9 @@
 //! the curvature program is built (or loaded from the kernel cache) on
 //! another, then the ordered estimator ([`OrderedEstimator`]) built, run
 //! once and read in place ([`CurvatureRun::mapped`]: the device buffers
-//! mapped, no copy of the field), with every phase timed.
+//! mapped, no copy of the field), with every phase timed (the phases of the
+//! run's [`Timing`]). Timed repeats are the caller's: `shapecue curvature
+//! --runs` runs the returned estimator again.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -59,40 +61,10 @@ pub struct CurvatureJob {
     pub accumulate: AccumulateChoice,
     /// The memory order the device computes in.
     pub order: MeshOrder,
-    /// Timed runs of the device passes after the first (0: none).
-    pub runs: usize,
-}
-
-/// Host wall time of each phase of [`curvature_of`], ms.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct CurvaturePhases {
-    /// Parsing and validating (or generating) the mesh.
-    pub load: f64,
-    /// Opening the device (beside the load).
-    pub device: f64,
-    /// Building the curvature program or loading it from the cache (beside
-    /// the load).
-    pub program_prepare: f64,
-    /// Waiting for the device thread after the load.
-    pub device_wait: f64,
-    /// Choosing and applying the memory order (in the load's thread).
-    pub reorder: f64,
-    /// Getting the programs for the estimator.
-    pub program_build: f64,
-    /// The index-only structures on the device.
-    pub topology: f64,
-    /// Normalising the positions.
-    pub normalise: f64,
-    /// Writing them to the device.
-    pub upload: f64,
-    /// The first run (with the driver's compilation at first launch).
-    pub first_run: f64,
-    /// Saving newly built programs to the kernel cache.
-    pub cache_write: f64,
 }
 
 /// What [`curvature_of`] made: the mesh, the estimator holding the results
-/// on the device, and the phases.
+/// on the device, and the call's timing.
 pub struct CurvatureRun {
     /// The mesh's name (its path, or the generated mesh's description).
     pub name: String,
@@ -100,23 +72,31 @@ pub struct CurvatureRun {
     pub mesh: Mesh,
     /// The device.
     pub gpu: Arc<Gpu>,
-    /// The estimator after its runs; its results are read with
-    /// [`CurvatureRun::mapped`].
+    /// The estimator after its run; its results are read with
+    /// [`CurvatureRun::mapped`]. A caller timing repeats runs it again
+    /// (`estimator.est.run()`: the same values, so the field read
+    /// afterwards is the last run's).
     pub estimator: OrderedEstimator,
     /// The options run (the accumulation variant chosen).
     pub opts: CurvatureOptions,
-    /// The first run's kernel time per pass and wall time.
+    /// The run's kernel time per pass and wall time (`wall_ms`), and the
+    /// wall time of each phase of the call ([`Timing::phase_ms`]): `load`
+    /// (parsing and validating, or generating, the mesh), `device` (opening
+    /// it, beside the load), `program_prepare` (building the curvature
+    /// program or loading it from the kernel cache, beside the load),
+    /// `device_wait` (waiting for the device thread after the load),
+    /// `reorder` (choosing and applying the memory order, in the load's
+    /// thread), `program_build` (getting the programs for the estimator),
+    /// `topology` (the index-only structures on the device), `normalise`
+    /// (the positions), `upload` (writing them to the device), `first_run`
+    /// (the run, with the driver's compilation at first launch),
+    /// `cache_write` (saving newly built programs to the kernel cache), and
+    /// `compute`: from the end of the load and the device's preparation to
+    /// the end of the call (building the estimator, the run, the cache
+    /// write).
     pub timing: Timing,
-    /// The timed runs after it ([`CurvatureJob::runs`]).
-    pub runs: Vec<Timing>,
     /// Skip counts of the run.
     pub counts: CurvatureCounts,
-    /// Wall time of each phase.
-    pub phases: CurvaturePhases,
-    /// Wall ms from the end of the load and the device's preparation to
-    /// the end of the call: building the estimator, the runs, the cache
-    /// write.
-    pub compute_ms: f64,
 }
 
 impl CurvatureRun {
@@ -135,12 +115,12 @@ impl CurvatureRun {
     }
 }
 
-/// The device opened and the program built for the options.
+/// The device opened and the program built for the options, with the
+/// `device` and `program_prepare` phases.
 struct Prepared {
     gpu: Arc<Gpu>,
     accumulate: Accumulate,
-    device_ms: f64,
-    prepare_ms: f64,
+    timing: Timing,
 }
 
 /// Opens the device and gets the curvature program for `opts` built (or
@@ -151,18 +131,64 @@ fn prepare_device(
     mut opts: CurvatureOptions,
     accumulate: AccumulateChoice,
 ) -> Result<Prepared> {
+    let mut timing = Timing::default();
     let t = Instant::now();
     let gpu = Arc::new(Gpu::new(device)?);
-    let device_ms = ms_since(t);
+    timing.phase("device", ms_since(t));
     opts.accumulate = accumulate.resolve();
     let t = Instant::now();
     let _ = CurvatureEstimator::prepare(&gpu, &opts);
+    timing.phase("program_prepare", ms_since(t));
     Ok(Prepared {
         gpu,
         accumulate: opts.accumulate,
-        device_ms,
-        prepare_ms: ms_since(t),
+        timing,
     })
+}
+
+/// The mesh loaded and its memory order planned, with the `load` phase.
+struct Loaded {
+    name: String,
+    mesh: Mesh,
+    plan: OrderPlan,
+    timing: Timing,
+}
+
+/// Loads the job's mesh and plans its memory order (this thread's half of
+/// [`curvature_of`]).
+fn load_and_plan(job: &CurvatureJob) -> Result<Loaded> {
+    let mut timing = Timing::default();
+    let t = Instant::now();
+    let (name, mesh) = job.source.load()?;
+    timing.phase("load", ms_since(t));
+    let plan = OrderPlan::new(&mesh, job.order);
+    Ok(Loaded {
+        name,
+        mesh,
+        plan,
+        timing,
+    })
+}
+
+/// The load and the memory order on this thread while the device opens and
+/// the program builds on another; the phases of both, and `device_wait`,
+/// in the load's timing.
+fn load_beside_device(job: &CurvatureJob) -> Result<(Loaded, Prepared)> {
+    let (loaded, prepared) = std::thread::scope(|s| {
+        let prepare = s.spawn(|| prepare_device(job.device.as_deref(), job.opts, job.accumulate));
+        let loaded = load_and_plan(job);
+        let t_wait = Instant::now();
+        let prepared = match prepare.join() {
+            Ok(p) => p.map(|p| (p, ms_since(t_wait))),
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        (loaded, prepared)
+    });
+    let mut loaded = loaded?;
+    let (prepared, wait_ms) = prepared?;
+    loaded.timing.extend(&prepared.timing);
+    loaded.timing.phase("device_wait", wait_ms);
+    Ok((loaded, prepared))
 }
 
 /// Curvature of a mesh still to be loaded, as fast as one process can get
@@ -181,7 +207,6 @@ fn prepare_device(
 ///     opts: Default::default(),
 ///     accumulate: Default::default(),
 ///     order: Default::default(),
-///     runs: 0,
 /// };
 /// let run = shapecue::curvature_of(&job)?;
 /// let k = run.mapped()?;
@@ -193,55 +218,37 @@ fn prepare_device(
 /// The mesh's errors, no device, a device without what the variant needs,
 /// OpenCL failures.
 pub fn curvature_of(job: &CurvatureJob) -> Result<CurvatureRun> {
-    let mut opts = job.opts;
-    let (loaded, prepared) = std::thread::scope(|s| {
-        let prepare = s.spawn(|| prepare_device(job.device.as_deref(), opts, job.accumulate));
-        let loaded = (|| {
-            let t = Instant::now();
-            let (name, mesh) = job.source.load()?;
-            let load_ms = ms_since(t);
-            let plan = OrderPlan::new(&mesh, job.order);
-            Ok::<_, crate::error::Error>((name, mesh, load_ms, plan))
-        })();
-        let t_wait = Instant::now();
-        let prepared = match prepare.join() {
-            Ok(p) => p.map(|p| (p, ms_since(t_wait))),
-            Err(panic) => std::panic::resume_unwind(panic),
-        };
-        (loaded, prepared)
-    });
-    let (name, mesh, load_ms, plan) = loaded?;
-    let (p, wait_ms) = prepared?;
+    let (loaded, prepared) = load_beside_device(job)?;
+    let Loaded {
+        name,
+        mesh,
+        plan,
+        mut timing,
+    } = loaded;
     let t_compute = Instant::now();
-    opts.accumulate = p.accumulate;
-    let gpu = p.gpu;
-    let mut estimator = OrderedEstimator::with_plan(gpu.clone(), &mesh, opts, plan)?;
-    let mut phases = CurvaturePhases {
-        load: load_ms,
-        device: p.device_ms,
-        program_prepare: p.prepare_ms,
-        device_wait: wait_ms,
-        reorder: estimator.reorder_ms,
-        program_build: estimator.est.build_ms(),
-        topology: estimator.est.topology_ms() - estimator.est.build_ms(),
-        normalise: estimator.est.upload_ms().normalise,
-        upload: estimator.est.upload_ms().write,
-        ..CurvaturePhases::default()
+    let opts = CurvatureOptions {
+        accumulate: prepared.accumulate,
+        ..job.opts
     };
-    let timing = estimator.est.run()?;
-    phases.first_run = timing.wall_ms;
+    let gpu = prepared.gpu;
+    let mut estimator = OrderedEstimator::with_plan(gpu.clone(), &mesh, opts, plan)?;
+    let est = &estimator.est;
+    timing.phase("reorder", estimator.reorder_ms());
+    timing.phase("program_build", est.build_ms());
+    timing.phase("topology", est.topology_ms() - est.build_ms());
+    timing.phase("normalise", est.upload_ms().normalise);
+    timing.phase("upload", est.upload_ms().write);
+    // The run's steps, kernel and wall time (the phases' timing has none).
+    let run = estimator.est.run()?;
+    timing.extend(&run);
+    timing.phase("first_run", run.wall_ms);
     let counts = estimator.est.counts()?;
-    // Each run writes the same values (the passes are deterministic for
-    // gather; atomic sums may differ in the last bits), so the field read
-    // afterwards is the last run's.
-    let runs = (0..job.runs)
-        .map(|_| estimator.est.run())
-        .collect::<Result<Vec<_>>>()?;
-    // After the runs, so that code the driver compiled at the first launch
+    // After the run, so that code the driver compiled at the first launch
     // is in the saved binaries; a no-op when the cache hit.
     let t = Instant::now();
     gpu.persist_programs();
-    phases.cache_write = ms_since(t);
+    timing.phase("cache_write", ms_since(t));
+    timing.phase("compute", ms_since(t_compute));
     Ok(CurvatureRun {
         name,
         mesh,
@@ -249,10 +256,7 @@ pub fn curvature_of(job: &CurvatureJob) -> Result<CurvatureRun> {
         estimator,
         opts,
         timing,
-        runs,
         counts,
-        phases,
-        compute_ms: ms_since(t_compute),
     })
 }
 

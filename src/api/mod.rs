@@ -40,7 +40,7 @@ pub mod interop;
 mod lines;
 mod strokes;
 
-pub use curvature::{CurvatureJob, CurvaturePhases, CurvatureRun, MeshSource, curvature_of};
+pub use curvature::{CurvatureJob, CurvatureRun, MeshSource, curvature_of};
 
 pub use edges::{
     EdgePicture, EdgePictureOptions, edges_scene, feature_edges_picture, feature_edges_picture_on,

@@ -19,8 +19,9 @@ pub struct OrderedEstimator {
     pub est: CurvatureEstimator,
     /// The renumbering it computes in, or `None` for the input's order.
     pub order: Option<LocalityOrder>,
-    /// Host ms of choosing and applying the order.
-    pub reorder_ms: f64,
+    /// Host ms of choosing and applying the order
+    /// ([`OrderedEstimator::reorder_ms`]).
+    reorder_ms: f64,
 }
 
 /// The host half of an [`OrderedEstimator`], which needs no device: the
@@ -32,7 +33,7 @@ pub struct OrderPlan {
     reordered: Option<crate::Mesh>,
     frame_faces: Option<Vec<i32>>,
     /// Host ms of choosing and applying the order.
-    pub reorder_ms: f64,
+    reorder_ms: f64,
 }
 
 impl OrderPlan {
@@ -94,6 +95,12 @@ impl OrderedEstimator {
         })
     }
 
+    /// Host wall ms of choosing and applying the memory order (in
+    /// [`OrderPlan::new`]); a caller's `reorder` phase.
+    pub fn reorder_ms(&self) -> f64 {
+        self.reorder_ms
+    }
+
     /// The results of the last full run, in the input's vertex order.
     pub fn read(&self) -> Result<CurvatureField> {
         self.est
@@ -125,7 +132,7 @@ pub fn estimate(
         field: o.read()?,
         counts: o.est.counts()?,
         timing,
-        topology_ms: o.reorder_ms + o.est.topology_ms(),
+        topology_ms: o.reorder_ms() + o.est.topology_ms(),
         device_bytes: o.est.device_bytes(),
     })
 }
