@@ -24,7 +24,7 @@ fn bench(c: &mut Criterion) {
         };
         let mut s = SdfLines::new(gpu.clone(), &vol, &opts).expect("upload");
         let out = s.run().expect("run");
-        eprintln!("{name}: {:?}", out.stats.ms);
+        eprintln!("{name}: {:?}", out.stats.timing);
         let mut g = c.benchmark_group("sdf_lines");
         g.sample_size(10).measurement_time(Duration::from_secs(5));
         g.bench_function(format!("all/{name}"), |b| b.iter(|| s.run().expect("run")));

@@ -107,10 +107,12 @@ def main():
         with open(reports[0]) as f:
             r = json.load(f)
         views = r["views"] * len(r["frames"])
-        per_view = r["view_ms_median"] + r["render_ms_median"]
+        laps = lambda name: [p["ms"] for p in r["timing"].get("phases", []) if p["phase"] == name]
+        view_ms, render_ms = statistics.median(laps("view")), statistics.median(laps("render"))
+        per_view = view_ms + render_ms
         print()
         print(f"scene {os.path.basename(scene)}: {views} views at {r['renderer'].split(';')[-1].strip()}; "
-              f"per view {r['view_ms_median']:.1f} ms passes + {r['render_ms_median']:.1f} ms "
+              f"per view {view_ms:.1f} ms passes + {render_ms:.1f} ms "
               f"drawing and files = {per_view:.1f} ms ({1e3 / per_view:.1f} views/s; Blender "
               f"Line Art + Workbench: 755 ms per view, 1.3 views/s); process {total:.0f} ms; "
               f"mesh uploads to GL: {r['gl_uploads']['topology']} of the faces, "

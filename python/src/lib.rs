@@ -274,7 +274,7 @@ fn curvature_dict<'py>(
     d.set_item("dcurv_solves_skipped", c.counts.dcurv_solves_skipped)?;
     d.set_item("kernel_ms", c.timing.kernel_ms)?;
     d.set_item("wall_ms", c.timing.wall_ms)?;
-    d.set_item("topology_ms", c.topology_ms)?;
+    d.set_item("topology_ms", c.timing.phase_ms("topology"))?;
     d.set_item("device_bytes", c.device_bytes)?;
     d.set_item("device", device)?;
     Ok(d)
@@ -507,11 +507,11 @@ impl PyEstimator {
                 let mut timing = est.run()?;
                 let field = est.read()?;
                 timing.wall_ms = t.elapsed().as_secs_f64() * 1e3;
+                timing.phase("topology", est.topology_ms());
                 Ok::<_, Error>(Curvature {
                     field,
                     counts: est.counts()?,
                     timing,
-                    topology_ms: est.topology_ms(),
                     device_bytes: est.device_bytes(),
                 })
             })
@@ -705,7 +705,7 @@ fn isosurface_dict<'py>(
     d.set_item("degenerate_dropped", s.stats.degenerate_dropped)?;
     d.set_item("kernel_ms", s.stats.timing.kernel_ms)?;
     d.set_item("wall_ms", s.stats.timing.wall_ms)?;
-    d.set_item("upload_ms", s.upload_ms)?;
+    d.set_item("upload_ms", s.stats.timing.phase_ms("upload"))?;
     d.set_item("device", name)?;
     Ok(d)
 }

@@ -128,10 +128,9 @@ pub struct Isosurface {
     pub normals: Option<Vec<[f64; 3]>>,
     /// The curvature of the mesh, when asked for.
     pub curvature: Option<Curvature>,
-    /// Counts and timing of the extraction.
+    /// Counts and timing of the extraction; its timing has the phase
+    /// `upload` (uploading the volume and building the programs).
     pub stats: IsoStats,
-    /// Uploading the volume and building the programs, ms.
-    pub upload_ms: f64,
 }
 
 /// The isosurface of `volume` at `iso` on the default device: marching
@@ -171,7 +170,8 @@ pub fn isosurface_on(
     let t_up = Instant::now();
     let mut ex = Isosurfacer::new(gpu.clone(), &vol)?;
     let upload_ms = t_up.elapsed().as_secs_f64() * 1e3;
-    let stats = ex.extract(iso, opts.fusion)?;
+    let mut stats = ex.extract(iso, opts.fusion)?;
+    stats.timing.phase("upload", upload_ms);
     let curvature = match opts.curvature {
         Some(o) => {
             let (est, timing) = mcs::curvature(&ex, o, opts.curvature_normals)?;
@@ -184,8 +184,11 @@ pub fn isosurface_on(
             Some(Curvature {
                 field,
                 counts: est.counts()?,
-                timing,
-                topology_ms: est.topology_ms(),
+                timing: {
+                    let mut t = timing;
+                    t.phase("topology", est.topology_ms());
+                    t
+                },
                 device_bytes: est.device_bytes(),
             })
         }
@@ -200,7 +203,6 @@ pub fn isosurface_on(
         normals,
         curvature,
         stats,
-        upload_ms,
     })
 }
 

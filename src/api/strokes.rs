@@ -236,7 +236,7 @@ pub fn strokes_on(
             (v.strokes, v.mesh, Some(picture))
         }
     };
-    let timing = out.stats.ms.timing(out.stats.wall_ms);
+    let timing = out.stats.timing.clone();
     let SdfLinesOutput {
         seeds,
         strokes,

@@ -162,7 +162,7 @@ pub fn run(device: Option<&str>, a: IsoArgs) -> Result<()> {
             "spacing": vol.spacing,
             "origin": vol.origin,
             "load_ms": load_ms,
-            "upload_ms": s.upload_ms,
+            "upload_ms": s.stats.timing.phase_ms("upload"),
             "extraction": st,
             "quality": shapecue::mesh::quality(&s.mesh.positions, &s.mesh.faces),
             "curvature": curv,

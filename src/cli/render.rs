@@ -6,6 +6,7 @@
 use super::out;
 use anyhow::Result;
 use clap::Args;
+use shapecue::report::metrics::median;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
 use std::path::PathBuf;
@@ -116,12 +117,12 @@ fn print_report(r: &RunReport) -> Result<()> {
     out!(
         "  per frame: pose passes {:.2} ms (median); per view: lines/edges {:.2} ms, render {:.1} ms; \
          segments: {} contour, {} suggestive; wall {:.0} ms",
-        r.pose_ms_median,
-        r.view_ms_median,
-        r.render_ms_median,
+        median(&mut r.timing.laps("pose")),
+        median(&mut r.timing.laps("view")),
+        median(&mut r.timing.laps("render")),
         r.segments[0],
         r.segments[1],
-        r.wall_ms
+        r.timing.wall_ms
     );
     for n in &r.notes {
         out!("  note: {n}");

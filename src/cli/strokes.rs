@@ -202,7 +202,7 @@ fn strokes_options(a: &StrokesArgs, input: &Input, (w, h): (u32, u32)) -> Result
 /// and kernel time, and the PNG written.
 fn print_summary(name: &str, out: &Strokes, output: &Path) -> Result<()> {
     let st = &out.stats;
-    let ms = st.ms.total;
+    let ms = st.timing.kernel_ms;
     super::out!(
         "{name}: {} surface samples → {} seeds after Poisson-disk thinning (r = {:.4}); {} strokes, \
          {} segments; sampling distance {:.4} ({}); kernels {ms:.1} ms; wrote {}",
@@ -241,9 +241,9 @@ fn write_stats(p: &Path, name: &str, gpu: &Gpu, out: &Strokes) -> Result<()> {
         "sweep": st.sweep,
         "k1_min": st.k1_min,
         "k1_max": st.k1_max,
-        "kernel_ms": st.ms,
+        "kernel_ms": step_ms(&st.timing),
         "passes": out.timing,
-        "wall_ms": st.wall_ms,
+        "wall_ms": st.timing.wall_ms,
     });
     write_bytes_atomic(p, (serde_json::to_string_pretty(&s)? + "\n").as_bytes())?;
     super::out!("wrote {}", p.display());
@@ -299,4 +299,26 @@ fn load_input(a: &StrokesArgs, outputs: &[&Path]) -> Result<(String, Input)> {
         .collect();
     check_outputs(&inputs, outputs, a.force)?;
     Ok((path.display().to_string(), Input::File(v)))
+}
+
+/// Kernel ms per step under the names `--stats` has always used (`dense`,
+/// `thin`, `gradient`, ..., `sweep`), and their `total`.
+fn step_ms(t: &shapecue::spec::timing::Timing) -> serde_json::Value {
+    use shapecue::spec::timing::Step;
+    let names = [
+        (Step::SdflDense, "dense"),
+        (Step::SdflThin, "thin"),
+        (Step::SdflGradient, "gradient"),
+        (Step::SdflCurvature, "curvature"),
+        (Step::SdflRange, "range"),
+        (Step::SdflTrace, "trace"),
+        (Step::SdflStrips, "strips"),
+        (Step::SdflSweep, "sweep"),
+    ];
+    let mut m = serde_json::Map::new();
+    for (step, name) in names {
+        m.insert(name.into(), t.ms(&[step]).into());
+    }
+    m.insert("total".into(), t.kernel_ms.into());
+    serde_json::Value::Object(m)
 }

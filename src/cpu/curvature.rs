@@ -549,7 +549,6 @@ pub fn curvature(
         field,
         counts,
         timing,
-        topology_ms: 0.0,
         device_bytes: 0,
     })
 }

@@ -741,7 +741,7 @@ pub fn run(vol: &Volume, opts: &SdfLineOptions) -> Result<SdfLinesOutput> {
         });
     }
     out.stats = stats(samples.len(), &out, res, sweep, lo, hi);
-    out.stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+    out.stats.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(out)
 }
 

@@ -4,11 +4,11 @@
 //! --runs`). Medians live here, above the library: a library call runs
 //! once and reports its one timing.
 
+use super::metrics::median;
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::scene::exec::{ExecOptions, LiveRequest, Session};
 use crate::scene::file::Scene;
-use crate::spec::timing::median;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 

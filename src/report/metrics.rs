@@ -50,7 +50,21 @@ pub fn torus_truth(m: &Mesh) -> Vec<(f64, f64)> {
         .collect()
 }
 
-pub use crate::spec::timing::median;
+/// Median of a list of times (the mean of the middle two for an even
+/// count; 0 for an empty list): the medians a stage's repeated runs
+/// report (`shapecue report`, `shapecue render`'s per-view medians, the edges command's frames).
+pub fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
 
 /// One measured variant: the field of its last run and median times.
 pub struct Measured {

@@ -117,7 +117,7 @@ fn sweep_row(
     let seeds = ke.len();
     let (k50, k95) = (quantile(&mut ke, 0.5), quantile(&mut ke, 0.95));
     let (d50, d95) = (quantile(&mut de, 0.5), quantile(&mut de, 0.95));
-    let kms = out.stats.ms.total;
+    let kms = out.stats.timing.kernel_ms;
     let voxels = if hv == 1.0 { "voxel" } else { "voxels" };
     let point = (format!("{res}³, h = {hv} {voxels}"), kms, k50);
     let row = Row::new(vec![

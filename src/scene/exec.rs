@@ -295,7 +295,7 @@ fn render_all(
     let later_poses = of(&|l| l == Lifetime::Pose);
     let view_passes = of(&|l| l == Lifetime::View);
 
-    let (mut pose_ms, mut view_ms, mut render_ms) = (Vec::new(), Vec::new(), Vec::new());
+    let mut timing = crate::spec::timing::Timing::default();
     let total_views = frames.len() * scene.views.len();
     let mut done = 0;
     for (fi, &frame) in frames.iter().enumerate() {
@@ -307,7 +307,7 @@ fn render_all(
                 ex.pose_pass(p, frame)?;
             }
             ex.end_pose(frame)?;
-            pose_ms.push(ex.rec.lap());
+            timing.lap("pose", ex.rec.lap());
         }
         for (vi, cam) in ex.cameras().iter().enumerate() {
             let paths: Vec<&PathBuf> = images
@@ -318,11 +318,11 @@ fn render_all(
             ex.begin_view();
             for &p in &view_passes {
                 if p == Pass::Render {
-                    view_ms.push(ex.rec.lap());
+                    timing.lap("view", ex.rec.lap());
                 }
                 ex.view_pass(p, cam, &paths)?;
             }
-            render_ms.push(ex.rec.lap());
+            timing.lap("render", ex.rec.lap());
             done += 1;
             progress(done, total_views);
         }
@@ -339,9 +339,6 @@ fn render_all(
         vertices,
         faces,
         passes: ex.rec.in_plan_order(&plan),
-        pose_ms_median: crate::spec::timing::median(&mut pose_ms),
-        view_ms_median: crate::spec::timing::median(&mut view_ms),
-        render_ms_median: crate::spec::timing::median(&mut render_ms),
         gl_uploads: {
             let now = ex.uploads();
             crate::render::Uploads {
@@ -357,7 +354,10 @@ fn render_all(
             .chain(ex.feature_size_note.take())
             .collect(),
         outputs: std::mem::take(&mut ex.outputs),
-        wall_ms: ms_since(t_all),
+        timing: crate::spec::timing::Timing {
+            wall_ms: ms_since(t_all),
+            ..timing
+        },
     };
     // The next scene of the session draws with the same GL context.
     session.renderer = Some(ex.into_renderer());

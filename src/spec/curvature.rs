@@ -476,10 +476,10 @@ pub struct Curvature {
     /// Skip counters.
     pub counts: CurvatureCounts,
     /// Kernel ms per step and the run's wall ms (mesh already on the
-    /// device); for the CPU twin, the wall ms of the whole reference run.
+    /// device), and the phase `topology` (building the one-rings or owning
+    /// faces, and any memory reorder; absent for the twin); for the CPU
+    /// twin, the wall ms of the whole reference run.
     pub timing: crate::spec::timing::Timing,
-    /// Building the topology (one-rings, owning faces), ms; 0 for the twin.
-    pub topology_ms: f64,
     /// Device bytes allocated; 0 for the twin.
     pub device_bytes: u64,
 }

@@ -409,10 +409,9 @@ pub struct SdfLineStats {
     pub k1_min: f64,
     /// Largest κ1 over the seeds.
     pub k1_max: f64,
-    /// Kernel ms per step.
-    pub ms: StepMs,
-    /// Wall ms of the run (volume already on the device).
-    pub wall_ms: f64,
+    /// Kernel ms per step and the wall time of the run (volume already on
+    /// the device).
+    pub timing: crate::spec::timing::Timing,
 }
 
 /// The result of one run: seeds, strokes and stats.

@@ -299,12 +299,23 @@ impl Timing {
         }
     }
 
-    /// The wall ms of a phase (0 when it did not run).
+    /// Appends one more run of `phase` (a phase that runs once per pose or
+    /// per view keeps one entry per run: [`laps`](Self::laps)).
+    pub fn lap(&mut self, phase: &'static str, ms: f64) {
+        self.phases.push(PhaseTime { phase, ms });
+    }
+
+    /// The wall ms of a phase, over all its entries (0 when it did not run).
     pub fn phase_ms(&self, phase: &str) -> f64 {
-        self.phases
-            .iter()
-            .find(|p| p.phase == phase)
-            .map_or(0.0, |p| p.ms)
+        self.laps(phase).iter().sum()
+    }
+
+    /// The wall ms of each entry of a phase, in order.
+    pub fn laps(&self, phase: &str) -> Vec<f64> {
+        (self.phases.iter())
+            .filter(|p| p.phase == phase)
+            .map(|p| p.ms)
+            .collect()
     }
 
     /// Appends another call's steps (its wall time and phases added too).
@@ -346,22 +357,6 @@ impl Timing {
     /// Whether any entry's step is in `steps`.
     pub fn ran(&self, steps: &[Step]) -> bool {
         self.steps.iter().any(|s| steps.contains(&s.step))
-    }
-}
-
-/// Median of a list of times (the mean of the middle two for an even
-/// count; 0 for an empty list): the medians a stage's repeated runs
-/// report (the executor's per-frame medians, the edges command's frames).
-pub fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
     }
 }
 

@@ -500,8 +500,7 @@ impl SdfLines {
         let mut t = self.ms;
         t.total =
             t.dense + t.thin + t.gradient + t.curvature + t.range + t.trace + t.strips + t.sweep;
-        out.stats.ms = t;
-        out.stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        out.stats.timing = t.timing(t0.elapsed().as_secs_f64() * 1e3);
         Ok(out)
     }
 

@@ -297,7 +297,7 @@ impl App {
     pub fn finish(&mut self) -> Result<()> {
         let mut t = self.times.clone();
         if !t.is_empty() {
-            let med = shapecue::spec::timing::median(&mut t);
+            let med = shapecue::report::metrics::median(&mut t);
             println!(
                 "view: {} frame(s) drawn; median frame time {med:.1} ms ({:.1} frames/s)",
                 self.times.len(),

@@ -48,12 +48,6 @@ pub struct RunReport {
     pub faces: usize,
     /// The passes that ran, in plan order, with counts and times.
     pub passes: Vec<PassRecord>,
-    /// Median per-frame time of the pose passes (ms, their own clocks).
-    pub pose_ms_median: f64,
-    /// Median per-view time of the view passes other than rendering (ms).
-    pub view_ms_median: f64,
-    /// Median per-view render time (draw + read back), ms.
-    pub render_ms_median: f64,
     /// Mesh uploads to GL in this run: one per topology (faces) and one per
     /// pose (positions, normals, colours), however many views.
     pub gl_uploads: crate::render::Uploads,
@@ -68,8 +62,11 @@ pub struct RunReport {
     pub notes: Vec<String>,
     /// Files written (images; the report itself is written last).
     pub outputs: Vec<PathBuf>,
-    /// Wall time of the whole run, ms.
-    pub wall_ms: f64,
+    /// The wall time of the whole run, and one phase entry per pose
+    /// (`pose`: its passes, their own clocks), per view (`view`: the view
+    /// passes other than rendering) and per render (`render`: draw + read
+    /// back), in order; medians are the reader's ([`Timing::laps`]).
+    pub timing: Timing,
 }
 
 /// Accumulates what each pass did, and the time of the current pose or

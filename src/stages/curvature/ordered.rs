@@ -127,12 +127,12 @@ pub fn estimate(
     opts: CurvatureOptions,
 ) -> Result<crate::spec::curvature::Curvature> {
     let mut o = OrderedEstimator::new(gpu, mesh, opts, MeshOrder::Auto)?;
-    let timing = o.est.run()?;
+    let mut timing = o.est.run()?;
+    timing.phase("topology", o.reorder_ms() + o.est.topology_ms());
     Ok(crate::spec::curvature::Curvature {
         field: o.read()?,
         counts: o.est.counts()?,
         timing,
-        topology_ms: o.reorder_ms() + o.est.topology_ms(),
         device_bytes: o.est.device_bytes(),
     })
 }

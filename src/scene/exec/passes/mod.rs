@@ -738,7 +738,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let (stage, _) = self.sdf_lines.as_mut().expect("built for the strokes pass");
         let out = stage.run()?;
         let st = &out.stats;
-        let t = st.ms.timing(st.wall_ms);
+        let t = st.timing.clone();
         let h = st.params.map_or(0.0, |p| p.sampling);
         let r = st.params.map_or(0.0, |p| p.spacing);
         let how = format!(
