@@ -31,6 +31,10 @@
 #   window crates        winit, glutin, glutin-winit, egui, egui-winit and
 #                        egui_glow only in src/cli/view/ (the viewer), which
 #                        uses no shapecue::stages, shapecue::gpu, shapecue::cpu
+#   src/cli/ (not view/) the front door only: no shapecue::stages, gpu, cpu,
+#                        render or scene (shapecue::api names what it needs)
+#   time in results      no `pub *_ms` field in src/ outside spec/timing.rs
+#                        (Timing), src/report/ and src/cli/
 #
 # Then an import graph over the same `crate::<module>` paths (python3):
 #   - no cycle between the top-level modules of src/, nor between the files
@@ -319,6 +323,21 @@ while IFS= read -r hit; do
     echo "$hit: src/cli/view must not use shapecue::stages, shapecue::gpu or shapecue::cpu (the viewer draws through the scene executor)"
     status=1
 done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu)\b' src/cli/view 2>/dev/null | grep -v -E ':[0-9]+:\s*//' || true)
+
+# The command line reaches the library through the front door (shapecue's
+# root and shapecue::api, with report, export, spec and the loaders), never
+# the layers below it; the viewer is the one exception (the scene executor).
+while IFS= read -r hit; do
+    echo "$hit: src/cli (but the viewer) must not use shapecue::stages, gpu, cpu, render or scene (the command line goes through the front door, shapecue::api)"
+    status=1
+done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu|render|scene)\b' src/cli src/main.rs 2>/dev/null | grep -v -E '^src/cli/view/' | grep -v -E ':[0-9]+:\s*//' || true)
+
+# Time in a library result is one Timing (spec/timing.rs): no other public
+# field ending in _ms below the measurement and the command line.
+while IFS= read -r hit; do
+    echo "$hit: a public *_ms field outside spec::timing::Timing (a library result carries one Timing; repeats and medians live in src/report and src/cli)"
+    status=1
+done < <(grep -rn --include='*.rs' -E '^\s*pub [a-z0-9_]*_ms\s*:' src | grep -v -E '^src/(spec/timing\.rs|report/|cli/)' || true)
 
 # No source file over 800 lines (ARCHITECTURE.md, "Files over 700 lines").
 while IFS= read -r f; do

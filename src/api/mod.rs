@@ -18,10 +18,8 @@
 //! them from above.
 
 use crate::error::{Error, Result};
-use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::mesh::edges::EdgeTopology;
-use crate::scene::exec::{ExecOptions, RunReport};
 use crate::spec::curvature::{Curvature, CurvatureOptions};
 use crate::spec::edges::{CapMode, EdgeOptions, EdgeOutput};
 use crate::spec::marching_cubes::{Inside, IsoNormals};
@@ -47,6 +45,19 @@ pub use edges::{
 };
 
 pub use crate::scene::file::Shot;
+
+// The stateful types, the device and the scene runner the command line and
+// Python use beside the one-call tasks: the front door names them, so that
+// nothing above it reaches into the layers below.
+pub use crate::cpu::curvature::curvature as curvature_reference;
+pub use crate::gpu::{DeviceInfo, Gpu, list_devices};
+pub use crate::scene::exec::{
+    Checked, ExecOptions, RunReport, Session, check_scenes, explain, run as run_scene,
+};
+pub use crate::scene::file::Scene;
+pub use crate::stages::curvature::{
+    CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
+};
 pub use lines::{
     Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
     line_segments_on, lines_picture, lines_picture_on, lines_scene, wanted,

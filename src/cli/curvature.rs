@@ -17,6 +17,7 @@
 use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
+use shapecue::api::OrderedEstimator;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions, Mesh};
 use shapecue::spec::curvature::{
@@ -24,7 +25,6 @@ use shapecue::spec::curvature::{
     VertexCurvature,
 };
 use shapecue::spec::timing::Timing;
-use shapecue::stages::curvature::OrderedEstimator;
 use shapecue::{CurvatureJob, MeshSource};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -259,7 +259,7 @@ fn on_cpu(
         precision: Precision::F64,
         ..opts
     };
-    let c = shapecue::cpu::curvature::curvature(&mesh, f64_opts)?;
+    let c = shapecue::api::curvature_reference(&mesh, f64_opts)?;
     let mut stats = serde_json::json!({
         "device": "cpu reference (f64, single thread)",
         "wall_ms": c.timing.wall_ms,
@@ -268,7 +268,7 @@ fn on_cpu(
         let mut walls = Vec::with_capacity(n);
         for _ in 0..n {
             walls.push(
-                shapecue::cpu::curvature::curvature(&mesh, f64_opts)?
+                shapecue::api::curvature_reference(&mesh, f64_opts)?
                     .timing
                     .wall_ms,
             );

@@ -2,7 +2,7 @@
 
 use super::out;
 use anyhow::Result;
-use shapecue::gpu::{Gpu, list_devices};
+use shapecue::api::{Gpu, list_devices};
 
 /// Lists the devices; `*` marks the one a command would use: `device` (which
 /// must exist) or the default.

@@ -9,7 +9,7 @@ use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::EdgePictureOptions;
-use shapecue::gpu::Gpu;
+use shapecue::api::Gpu;
 use shapecue::mesh::LoadOptions;
 use shapecue::spec::edges::CapMode;
 use std::path::PathBuf;

@@ -6,7 +6,7 @@
 use super::{check_outputs, out, write_json};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use shapecue::gpu::Gpu;
+use shapecue::api::Gpu;
 use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions, Precision};
 use shapecue::spec::marching_cubes::IsoNormals;
 use shapecue::spec::vertex_fusion::Fusion;

@@ -9,11 +9,11 @@
 use super::out;
 use anyhow::{Context, Result};
 use clap::Args;
-use shapecue::gpu::Gpu;
+use shapecue::api::Gpu;
+use shapecue::api::build_kernels;
 use shapecue::spec::curvature::{
     Accumulate, AccumulateChoice, Compat, CurvatureOptions, Precision,
 };
-use shapecue::stages::curvature::build_kernels;
 use std::sync::Arc;
 
 /// The arguments of `shapecue build-kernels`.
@@ -50,7 +50,7 @@ pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
             dir.display()
         );
     }
-    let report = |b: &shapecue::stages::curvature::KernelBuild| -> std::io::Result<()> {
+    let report = |b: &shapecue::api::KernelBuild| -> std::io::Result<()> {
         let how = match (b.program.cache.as_str(), b.program.saved) {
             ("hit", _) => "already built (loaded from the cache)".to_string(),
             (_, true) => format!("built in {:.1} s, saved in {:.1} s", b.build_s, b.save_s),

@@ -6,9 +6,8 @@
 use super::out;
 use anyhow::Result;
 use clap::Args;
+use shapecue::api::{self as exec, ExecOptions, RunReport, Scene};
 use shapecue::report::metrics::median;
-use shapecue::scene::exec::{self, ExecOptions, RunReport};
-use shapecue::scene::file::Scene;
 use std::path::PathBuf;
 
 /// The arguments of `shapecue render`.

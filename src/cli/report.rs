@@ -7,7 +7,7 @@
 use super::check_outputs;
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
-use shapecue::gpu::Gpu;
+use shapecue::api::Gpu;
 use shapecue::report::{self, Report};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

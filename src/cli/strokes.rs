@@ -10,8 +10,8 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use shapecue::api::Gpu;
 use shapecue::export::output::{check_outputs, write_bytes_atomic};
-use shapecue::gpu::Gpu;
 use shapecue::spec::sdf_lines::{Inside, Sampling};
 use shapecue::volume::{self, Volume};
 use shapecue::{PictureOptions, Strokes, StrokesInput, StrokesOptions};

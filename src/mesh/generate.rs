@@ -349,3 +349,23 @@ pub const GENERATED_NAMES: [&str; 5] = [
 pub fn generated_by_name(kind: &str, n: usize) -> Option<(String, Mesh)> {
     kind.parse::<Generated>().ok().map(|g| g.mesh(n))
 }
+
+#[cfg(test)]
+mod names {
+    use super::Generated;
+    use crate::spec::Choice;
+
+    /// `name()`, `Display`, `FromStr` and the command line's names agree
+    /// (the spec's option enums are checked in the spec; the generated
+    /// meshes are data).
+    #[test]
+    fn generated_names_agree() {
+        assert_eq!(Generated::ALL.len(), Generated::all().len());
+        for (v, cli) in Generated::ALL.iter().zip(Generated::all()) {
+            assert_eq!(cli.label(), v.name());
+            assert_eq!(v.to_string(), v.name());
+            assert_eq!(v.name().parse::<Generated>().ok(), Some(*v));
+        }
+        assert!("no such mesh".parse::<Generated>().is_err());
+    }
+}

@@ -158,7 +158,7 @@ mod tests {
         names_agree(&curvature::Precision::ALL, |v| v.name());
         names_agree(&curvature::Compat::ALL, |v| v.name());
         names_agree(&marching_cubes::IsoNormals::ALL, |v| v.name());
-        names_agree(&crate::mesh::Generated::ALL, |v| v.name());
+        names_agree(&curvature::AccumulateChoice::ALL, |v| v.name());
     }
 
     #[test]
