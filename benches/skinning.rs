@@ -37,7 +37,7 @@ fn bench(c: &mut Criterion) {
             precision: Precision::F32,
             compat: Compat::Exact,
             dcurv: true,
-            lanes: 0,
+            lanes: shapecue::spec::curvature::Lanes::Auto,
         };
         let mut est =
             CurvatureEstimator::new(gpu.clone(), m.rest.positions.len(), &m.rest.faces, opts)

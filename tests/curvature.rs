@@ -410,7 +410,7 @@ fn memory_stays_within_budget() {
         (Accumulate::Atomic, 16),
     ] {
         let o = CurvatureOptions {
-            lanes,
+            lanes: shapecue::spec::curvature::Lanes::Fixed(lanes),
             ..with(CurvatureOptions::default(), acc, Precision::F32)
         };
         let e = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o).unwrap();

@@ -62,7 +62,7 @@ fn device_built_one_rings_give_the_host_built_bits() {
                 let o = CurvatureOptions {
                     accumulate: Accumulate::Gather,
                     precision,
-                    lanes,
+                    lanes: shapecue::spec::curvature::Lanes::Fixed(lanes),
                     ..CurvatureOptions::default()
                 };
                 let host = run(m, o, "host");

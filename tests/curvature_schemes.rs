@@ -248,7 +248,7 @@ fn face_lanes_give_bitwise_identical_results() {
     for (what, m) in &meshes {
         for prec in [Precision::F32, Precision::F64] {
             let o = |lanes| CurvatureOptions {
-                lanes,
+                lanes: shapecue::spec::curvature::Lanes::Fixed(lanes),
                 ..with(CurvatureOptions::default(), Accumulate::Gather, prec)
             };
             let mut est = CurvatureEstimator::new(gpu(), m.n_vertices(), &m.faces, o(1)).unwrap();
@@ -276,7 +276,7 @@ fn face_lanes_give_bitwise_identical_results() {
         }
     }
     let bad = CurvatureOptions {
-        lanes: 3,
+        lanes: shapecue::spec::curvature::Lanes::Fixed(3),
         ..with(
             CurvatureOptions::default(),
             Accumulate::Gather,
@@ -301,7 +301,7 @@ fn atomic_scheme_with_lanes_matches_one_lane() {
     for (what, m) in &lane_test_meshes() {
         for (prec, tol) in [(Precision::F32, 1e-5), (Precision::F64, 1e-12)] {
             let o = |lanes| CurvatureOptions {
-                lanes,
+                lanes: shapecue::spec::curvature::Lanes::Fixed(lanes),
                 ..with(CurvatureOptions::default(), Accumulate::Atomic, prec)
             };
             let run = |lanes| {
@@ -354,7 +354,7 @@ fn pair_adds_match_single_adds() {
     let m = mesh::jittered_sphere(1.0, 4, 0.3, 3);
     for lanes in [1, 16] {
         let o = CurvatureOptions {
-            lanes,
+            lanes: shapecue::spec::curvature::Lanes::Fixed(lanes),
             ..with(
                 CurvatureOptions::default(),
                 Accumulate::Atomic,

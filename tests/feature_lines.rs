@@ -21,7 +21,7 @@ fn inputs(m: &Mesh) -> LineArrays {
         precision: Precision::F64,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let f: CurvatureField = estimate(gpu(), m, opts).unwrap().field;
     LineArrays::new(to_f32(&m.positions), &f)

@@ -27,7 +27,7 @@ fn inputs(m: &Mesh) -> LineArrays {
         precision: Precision::F64,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let f: CurvatureField = estimate(gpu(), m, opts).unwrap().field;
     LineArrays::new(to_f32(&m.positions), &f)
@@ -528,7 +528,7 @@ fn each_family_runs_only_its_passes_and_reports_its_kernel_time() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let mut est = shapecue::stages::curvature::CurvatureEstimator::new(
         gpu(),
@@ -632,7 +632,7 @@ fn a_skinned_frame_gives_the_lines_of_the_static_mesh_in_the_same_pose() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let f = estimate(gpu(), &mesh, copts).unwrap().field;
     let x = LineArrays::new(posed, &f);

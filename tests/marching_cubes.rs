@@ -622,7 +622,7 @@ fn curvature_on_the_device_resident_isosurface() {
         precision: Precision::F64,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let mut errs = Vec::new();
     for (res, fusion) in [(48, Fusion::Edge), (96, Fusion::Direct)] {
@@ -685,7 +685,7 @@ fn gradient_normals_match_the_cpu_twin_and_make_curvature_converge() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let mut errs = Vec::new();
     for res in [32, 64, 128] {

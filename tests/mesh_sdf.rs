@@ -539,7 +539,7 @@ fn ellipsoid_curvature_matches_the_isosurface_estimate() {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: false,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     };
     let mut errs = Vec::new();
     for res in [64, 128] {

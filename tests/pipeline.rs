@@ -29,7 +29,7 @@ fn f32_opts() -> CurvatureOptions {
         precision: Precision::F32,
         compat: Compat::Exact,
         dcurv: true,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     }
 }
 

@@ -218,7 +218,7 @@ impl CurvatureArgs<'_> {
             compat: parse(self.compat)?,
             dcurv: self.dcurv,
             // by device type, as on the command line
-            lanes: 0,
+            lanes: shapecue::spec::curvature::Lanes::Auto,
         })
     }
 }
@@ -332,8 +332,9 @@ fn build_kernels<'py>(
     let built = py
         .detach(|| {
             let gpu = Arc::new(Gpu::new(device.as_deref())?);
-            // lanes 0: by device type, as on the command line
-            let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, 0);
+            // lanes by device type, as on the command line
+            let lanes = shapecue::spec::curvature::Lanes::Auto;
+            let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, lanes);
             shapecue::stages::curvature::build_kernels(&gpu, &variants, |_| {})
         })
         .map_err(to_py)?;

@@ -21,7 +21,7 @@ use shapecue::api::OrderedEstimator;
 use shapecue::mesh::order::MeshOrder;
 use shapecue::mesh::{Generated, LoadOptions, Mesh};
 use shapecue::spec::curvature::{
-    AccumulateChoice, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Precision,
+    AccumulateChoice, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Lanes, Precision,
     VertexCurvature,
 };
 use shapecue::spec::timing::Timing;
@@ -61,8 +61,8 @@ pub struct CurvatureArgs {
     /// every count, the atomic schemes the same values up to the rounding
     /// of their sums; more than one lane adds 64 bytes of device memory per
     /// vertex (f32).
-    #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
-    lanes: Option<String>,
+    #[arg(long, value_parser = super::choice::<Lanes>(), default_value = "auto")]
+    lanes: Lanes,
     /// Order of the vertices and faces in device memory: auto renumbers
     /// them along a Morton curve when the input's order is scattered (as in
     /// scanned meshes), for cache locality; spatial always does, input never.
@@ -159,7 +159,7 @@ fn options(a: &CurvatureArgs) -> Result<CurvatureOptions> {
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,
-        lanes: a.lanes.as_deref().map_or(Ok(0), str::parse)?,
+        lanes: a.lanes,
     })
 }
 
@@ -365,8 +365,8 @@ fn device_stats(
         "accumulate_why": a.accumulate.why(),
         "face_lanes": est.face_lanes(),
         "face_lanes_why": match opts.lanes {
-            0 => shapecue::spec::curvature::why_face_lanes(&r.gpu.info.kind),
-            _ => "given with --lanes",
+            Lanes::Auto => shapecue::spec::curvature::why_face_lanes(&r.gpu.info.kind),
+            Lanes::Fixed(_) => "given with --lanes",
         },
         "order": if r.reordered() { "spatial" } else { "input" },
         "topology_ms": est.topology_ms(),

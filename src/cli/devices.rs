@@ -49,7 +49,11 @@ pub fn run(device: Option<&str>, json: bool) -> Result<()> {
                 (false, true) => "f64",
                 (false, false) => "no",
             },
-            shapecue::spec::curvature::face_lanes_for(0, &d.kind, d.native_float_width),
+            shapecue::spec::curvature::face_lanes_for(
+                shapecue::spec::curvature::Lanes::Auto,
+                &d.kind,
+                d.native_float_width
+            ),
             d.platform,
             d.name,
             d.version

@@ -242,7 +242,7 @@ fn iso_options(a: &IsoArgs) -> IsoOptions {
         precision: a.precision,
         compat: a.compat,
         dcurv: !a.no_dcurv,
-        lanes: 0,
+        lanes: shapecue::spec::curvature::Lanes::Auto,
     });
     IsoOptions {
         fusion: a.fusion,

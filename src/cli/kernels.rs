@@ -12,7 +12,7 @@ use clap::Args;
 use shapecue::api::Gpu;
 use shapecue::api::build_kernels;
 use shapecue::spec::curvature::{
-    Accumulate, AccumulateChoice, Compat, CurvatureOptions, Precision,
+    Accumulate, AccumulateChoice, Compat, CurvatureOptions, Lanes, Precision,
 };
 use std::sync::Arc;
 
@@ -26,8 +26,8 @@ pub struct KernelsArgs {
     accumulate: Vec<AccumulateChoice>,
     /// SIMD lanes of the gather variant, as in `shapecue curvature
     /// --lanes`. Default: the device's native vector width on CPU devices.
-    #[arg(long, value_parser = ["1", "2", "4", "8", "16"])]
-    lanes: Option<String>,
+    #[arg(long, value_parser = super::choice::<Lanes>(), default_value = "auto")]
+    lanes: Lanes,
     /// Device precisions to build (comma-separated).
     #[arg(long, value_parser = super::choice::<Precision>(), value_delimiter = ',', default_value = "f32")]
     precision: Vec<Precision>,
@@ -39,7 +39,7 @@ pub struct KernelsArgs {
 /// Runs `shapecue build-kernels`.
 pub fn run(device: Option<&str>, a: KernelsArgs) -> Result<()> {
     let gpu = Arc::new(Gpu::new(device)?);
-    let lanes = a.lanes.as_deref().map_or(Ok(0), str::parse)?;
+    let lanes = a.lanes;
     let accumulate: Vec<Accumulate> = a.accumulate.iter().map(|c| c.resolve()).collect();
     let variants = CurvatureOptions::combinations(&accumulate, &a.precision, &a.compat, lanes);
     if let Some(dir) = gpu.cache_folder() {

@@ -5,7 +5,9 @@
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::mesh::{self, Mesh};
-use crate::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
+use crate::spec::curvature::{
+    Accumulate, Compat, CurvatureField, CurvatureOptions, Lanes, Precision,
+};
 use crate::spec::timing::Timing;
 use crate::stages::curvature::CurvatureEstimator;
 use std::sync::Arc;
@@ -124,10 +126,10 @@ pub fn label(o: &CurvatureOptions) -> String {
         },
         if o.dcurv { "" } else { " no-dcurv" }
     ) + &match o.lanes {
-        // explicit lane counts; 0 is the device's default
-        0 => String::new(),
-        1 => " 1-lane".to_string(),
-        n => format!(" {n}-lanes"),
+        // explicit lane counts; auto is the device's default
+        Lanes::Auto => String::new(),
+        Lanes::Fixed(1) => " 1-lane".to_string(),
+        Lanes::Fixed(n) => format!(" {n}-lanes"),
     }
 }
 
@@ -143,7 +145,10 @@ pub fn variants() -> Vec<CurvatureOptions> {
         d,
         // the compare-and-swap scheme one face per work-item (the paper's
         // form): what SIMD lanes gain it on a CPU device
-        CurvatureOptions { lanes: 1, ..d },
+        CurvatureOptions {
+            lanes: Lanes::Fixed(1),
+            ..d
+        },
         CurvatureOptions { dcurv: false, ..d },
         CurvatureOptions {
             accumulate: Accumulate::Gather,
@@ -152,7 +157,7 @@ pub fn variants() -> Vec<CurvatureOptions> {
         // the gather scheme one face per work-item: what explicit SIMD lanes gain
         CurvatureOptions {
             accumulate: Accumulate::Gather,
-            lanes: 1,
+            lanes: Lanes::Fixed(1),
             ..d
         },
         // the device's own float atomic add, where it has one

@@ -329,13 +329,60 @@ pub struct CurvatureOptions {
     pub dcurv: bool,
     /// Faces per work-item of the per-face kernels (and vertices per
     /// work-item of the frame and principal kernels), as explicit SIMD
-    /// lanes: 0 picks by device type ([`face_lanes_for`]), else 1, 2, 4, 8
-    /// or 16. The gather variant gives the same bits for every count, the
-    /// atomic variants the same values up to the rounding of their sums.
-    /// A mesh already on the device (`CurvatureEstimator::from_device`)
-    /// always runs with 1.
-    pub lanes: u32,
+    /// lanes: by device type ([`Lanes::Auto`], resolved by
+    /// [`face_lanes_for`]), or 1, 2, 4, 8 or 16. The gather variant gives
+    /// the same bits for every count, the atomic variants the same values
+    /// up to the rounding of their sums. A mesh already on the device
+    /// (`CurvatureEstimator::from_device`) always runs with 1.
+    pub lanes: Lanes,
 }
+
+/// The face lanes asked for: by device type, or a count.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Lanes {
+    /// The device type's count ([`face_lanes_for`], [`why_face_lanes`]).
+    #[default]
+    Auto,
+    /// This many (1, 2, 4, 8 or 16; the estimator refuses others).
+    Fixed(u32),
+}
+
+impl Lanes {
+    /// Every choice, in the order `--help` lists them.
+    pub const ALL: [Lanes; 6] = [
+        Lanes::Auto,
+        Lanes::Fixed(1),
+        Lanes::Fixed(2),
+        Lanes::Fixed(4),
+        Lanes::Fixed(8),
+        Lanes::Fixed(16),
+    ];
+
+    /// `auto`, or the count (`other` for a count the estimator refuses).
+    pub fn name(self) -> &'static str {
+        match self {
+            Lanes::Auto => "auto",
+            Lanes::Fixed(1) => "1",
+            Lanes::Fixed(2) => "2",
+            Lanes::Fixed(4) => "4",
+            Lanes::Fixed(8) => "8",
+            Lanes::Fixed(16) => "16",
+            Lanes::Fixed(_) => "other",
+        }
+    }
+}
+
+/// Stats and bench ids write the count as before: 0 for `auto`.
+impl serde::Serialize for Lanes {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_u32(match self {
+            Lanes::Auto => 0,
+            Lanes::Fixed(n) => *n,
+        })
+    }
+}
+
+super::named_choice!(Lanes, "face lane count");
 
 impl CurvatureOptions {
     /// Every combination of the given schemes, precisions and least-squares
@@ -345,7 +392,7 @@ impl CurvatureOptions {
         accumulate: &[Accumulate],
         precision: &[Precision],
         compat: &[Compat],
-        lanes: u32,
+        lanes: Lanes,
     ) -> Vec<CurvatureOptions> {
         let mut v = Vec::with_capacity(accumulate.len() * precision.len() * compat.len());
         for &accumulate in accumulate {
@@ -372,7 +419,7 @@ impl Default for CurvatureOptions {
             precision: Precision::F32,
             compat: Compat::Exact,
             dcurv: true,
-            lanes: 0,
+            lanes: Lanes::Auto,
         }
     }
 }
@@ -563,7 +610,7 @@ pub fn corner_weights_bound(nf: usize) -> usize {
 ///
 /// The count is rounded down to a power of two and clamped to
 /// 1..=[`MAX_FACE_LANES`]. The results are the same for every count.
-pub fn face_lanes_for(requested: u32, device_kind: &str, native_width: u32) -> u32 {
+pub fn face_lanes_for(requested: Lanes, device_kind: &str, native_width: u32) -> u32 {
     let n = face_lanes_unclamped(requested, device_kind, native_width);
     let n = n.clamp(1, MAX_FACE_LANES);
     1 << (31 - n.leading_zeros())
@@ -580,11 +627,11 @@ pub fn why_face_lanes(device_kind: &str) -> &'static str {
     }
 }
 
-fn face_lanes_unclamped(requested: u32, device_kind: &str, native_width: u32) -> u32 {
+fn face_lanes_unclamped(requested: Lanes, device_kind: &str, native_width: u32) -> u32 {
     match requested {
-        0 if device_kind.eq_ignore_ascii_case("CPU") => native_width,
-        0 => 1,
-        n => n,
+        Lanes::Auto if device_kind.eq_ignore_ascii_case("CPU") => native_width,
+        Lanes::Auto => 1,
+        Lanes::Fixed(n) => n,
     }
 }
 

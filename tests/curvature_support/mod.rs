@@ -17,7 +17,7 @@ pub const F64: CurvatureOptions = CurvatureOptions {
     precision: Precision::F64,
     compat: Compat::Exact,
     dcurv: true,
-    lanes: 0,
+    lanes: shapecue::spec::curvature::Lanes::Auto,
 };
 
 pub fn with(o: CurvatureOptions, acc: Accumulate, prec: Precision) -> CurvatureOptions {

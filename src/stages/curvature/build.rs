@@ -8,7 +8,9 @@ use super::{CurvatureEstimator, Faces, Scheme, atomic, gather, rings_on_device};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::spec::curvature::CurvKernel;
-use crate::spec::curvature::{Accumulate, Compat, CurvatureOptions, Precision, padded_vertices};
+use crate::spec::curvature::{
+    Accumulate, Compat, CurvatureOptions, Lanes, Precision, padded_vertices,
+};
 use crate::spec::timing::Timing;
 use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;
@@ -171,10 +173,11 @@ impl CurvatureEstimator {
                 ),
             });
         }
-        if !matches!(opts.lanes, 0 | 1 | 2 | 4 | 8 | 16) {
+        if let Lanes::Fixed(n) = opts.lanes
+            && !matches!(n, 1 | 2 | 4 | 8 | 16)
+        {
             return Err(Error::InvalidArgument(format!(
-                "face lanes must be 1, 2, 4, 8 or 16 (or 0: by device type), not {}",
-                opts.lanes
+                "face lanes must be 1, 2, 4, 8 or 16 (or auto: by device type), not {n}"
             )));
         }
         let native = match opts.precision {

@@ -319,7 +319,10 @@ impl CurvatureEstimator {
         }
         // One face per work-item: the face kernels with lanes read the faces
         // in whole blocks, which this buffer, copied as it is, does not hold.
-        let opts = CurvatureOptions { lanes: 1, ..opts };
+        let opts = CurvatureOptions {
+            lanes: crate::spec::curvature::Lanes::Fixed(1),
+            ..opts
+        };
         let built = Self::build(&gpu, &opts)?;
         let faces = Faces {
             nv: n_vertices,
