@@ -146,7 +146,7 @@ pub fn run(device: Option<&str>, a: CurvatureArgs) -> Result<()> {
     }
     // The process ends with this command, and everything is written: the
     // OS takes back the device buffers, the context and the mesh at once,
-    // about 5 ms sooner on the bunny than releasing them one by one.
+    // sooner than releasing them one by one.
     std::mem::forget(mapped);
     std::mem::forget(c);
     Ok(())

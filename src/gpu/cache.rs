@@ -9,17 +9,14 @@
 //! Later processes create the program from that binary.
 //!
 //! - **When:** at the first build from source of a key, on every runtime but
-//!   PoCL ([`saves`]). Intel's CPU runtime returns its binary in about 30 ms
-//!   and has no cache of its own (each process compiled the curvature
-//!   program for 6 to 7 s there), so the cache turns every later process's
-//!   build into a load. PoCL has its own kernel cache, and asking it for a
-//!   program's binary compiles every kernel of the program for any
-//!   work-group size (for `kernels/curvature.cl`, 16 kernels, 7 to 19 s on
-//!   this project's 2-core machine under load), so on PoCL shapecue saves
+//!   PoCL ([`saves`]). Intel's CPU runtime returns its binary quickly and
+//!   has no cache of its own (each process compiled the curvature program
+//!   anew), so the cache turns every later process's build into a load.
+//!   PoCL has its own kernel cache, and asking it for a program's binary
+//!   compiles every kernel of the program for any work-group size (seconds
+//!   for `kernels/curvature.cl`'s 16 kernels), so on PoCL shapecue saves
 //!   only in `shapecue build-kernels` ([`crate::gpu::Gpu::save_every_build`])
-//!   or with `SHAPECUE_CACHE_POCL=1` (then the build from PoCL's warm
-//!   cache drops from about 130 ms to 25–50 ms, and a process whose PoCL
-//!   cache is empty starts in about 1 s instead of 11 s).
+//!   or with `SHAPECUE_CACHE_POCL=1`. docs/performance.md has the figures.
 //! - **Where:** `$SHAPECUE_CACHE_DIR`, else `$XDG_CACHE_HOME/shapecue`, else
 //!   `~/.cache/shapecue`; `SHAPECUE_NO_CACHE=1` turns the cache off.
 //! - **Key:** a 128-bit FNV-1a hash of the assembled kernel text, the full
@@ -158,8 +155,8 @@ pub fn decode(key: u128, bytes: &[u8]) -> Result<&[u8], Reject> {
 /// PoCL unless `SHAPECUE_CACHE_POCL=1`: PoCL keeps a cache of its own
 /// (`POCL_CACHE_DIR`, by default `~/.cache/pocl`), so it does not recompile
 /// in every process anyway, and asking it for a program's binary compiles
-/// every kernel of the program for any work-group size (7 to 19 s for
-/// `kernels/curvature.cl` on a loaded 2-core machine), a cost a user would
+/// every kernel of the program for any work-group size (seconds for
+/// `kernels/curvature.cl`), a cost a user would
 /// meet on an ordinary run (`shapecue build-kernels` saves anyway, through
 /// [`crate::gpu::Gpu::save_every_build`]). Entries that exist are used on
 /// every platform.

@@ -418,8 +418,9 @@ impl Gpu {
     /// driver allocates in pinned host memory (`CL_MEM_ALLOC_HOST_PTR`),
     /// [`STAGING_BYTES`] at a time: map, copy, unmap, then a device copy
     /// into `buf`. A plain write from pageable memory makes the driver pin
-    /// or bounce every page itself, which on an NVIDIA H200 ran at 1.2 GB/s;
-    /// from pinned memory the copy runs at the bus's speed. Blocking.
+    /// or bounce every page itself, far below the bus's speed on an NVIDIA
+    /// GPU (docs/performance.md); from pinned memory the copy runs at the
+    /// bus's speed. Blocking.
     pub fn write_staged<T>(&self, buf: &mut Buffer<T>, data: &[T]) -> Result<()> {
         let bytes: &[u8] = unsafe {
             // SAFETY: a live slice of `T` viewed as its bytes (read only).
@@ -672,9 +673,8 @@ impl Gpu {
 /// Bytes in the zero pattern of [`Gpu::zero`]: the largest pattern OpenCL
 /// allows (a power of two up to 128 bytes) that divides `bytes`. Runtimes
 /// fill a pattern at a time (PoCL 3.1's CPU devices copy one pattern per
-/// step), so a pattern of one element fills hundreds of megabytes slowly:
-/// 120 against 70 ms for the 176 MB of a 2M-vertex curvature estimator,
-/// whose rest is the first touch of the pages.
+/// step), so a pattern of one element fills hundreds of megabytes slowly
+/// (docs/performance.md).
 fn zero_pattern_bytes(bytes: usize) -> usize {
     let mut p = 128;
     while p > 1 && !bytes.is_multiple_of(p) {

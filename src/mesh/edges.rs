@@ -217,7 +217,8 @@ const NONE: u32 = u32::MAX;
 /// within a bucket the sides with the same upper vertex are linked in side
 /// order. Returns `next` (the next side of the same edge, or [`NONE`]) and
 /// `head` (the side is its edge's first). A hash map from vertex pairs to
-/// face lists gave the same groups in 10–20× the time (one allocation per edge).
+/// face lists gives the same groups with one allocation per edge, and is
+/// much slower (docs/performance.md).
 fn sides_by_edge(nv: usize, faces: &[[u32; 3]], source: &str) -> Result<(Vec<u32>, Vec<bool>)> {
     let m = faces.len() * 3;
     if m >= NONE as usize {

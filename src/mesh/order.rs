@@ -5,8 +5,7 @@
 //! pass reads the faces around each vertex. When consecutive faces use
 //! vertices far apart in memory (scanned meshes such as the Stanford bunny,
 //! whose faces' vertex indices lie thousands apart), every face costs cache
-//! misses: on the bunny the curvature stage's ring sums run 1.3× and its
-//! per-face passes 1.2× slower than in a Morton order. [`LocalityOrder`]
+//! misses (docs/performance.md gives the bunny's figures). [`LocalityOrder`]
 //! renumbers the vertices along a Morton (Z-order) curve through the
 //! bounding box, so that vertices near in space are near in memory, then
 //! puts the faces in the order of their first vertex (a stable counting

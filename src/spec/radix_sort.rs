@@ -93,8 +93,8 @@ pub fn wg_tiles(n: usize) -> (usize, usize) {
 
 /// A sort whose largest top-digit bucket holds more than `n / SKEW_LIMIT`
 /// pairs runs [`Strategy::Lsd`]: one work-item sorting that bucket would
-/// leave the other cores idle (all keys below 2^24 with `key_bits = 32`: 8M
-/// pairs took 180–230 ms that way, against 100–140 ms for LSD).
+/// leave the other cores idle (all keys below 2^24 with `key_bits = 32`;
+/// docs/performance.md has the figures).
 pub const SKEW_LIMIT: usize = 8;
 
 crate::spec::kernels::kernel_entries! {

@@ -21,9 +21,8 @@
 //!   by the low bits with serial LSD passes, ending in the caller's buffers.
 //!
 //! Only the MSD pass streams the whole data set through DRAM; the buckets are
-//! sorted in cache. On PoCL (2 cores) that sorts 8M pairs by 32-bit keys in
-//! about half the time of four LSD passes (70 against 135 ms, interleaved
-//! runs). The price is load balance: when one bucket holds most of the pairs,
+//! sorted in cache: on a CPU device, about half the time of four LSD passes
+//! (docs/performance.md). The price is load balance: when one bucket holds most of the pairs,
 //! one work-item sorts them while the other cores idle. So the host reads the
 //! 256 bucket sizes back after the scan (one strided read, the only sync
 //! point) and, when the largest exceeds `n / SKEW_LIMIT`, runs plain LSD
@@ -31,8 +30,7 @@
 //! ([`Strategy::Lsd`]).
 //!
 //! That shape suits CPU devices, whose work-items are cores; on a GPU 256
-//! serial work-items leave the card idle (an H200 took 335 ms for 7.57M
-//! pairs). GPUs run [`Strategy::WorkGroups`] instead: LSD passes of
+//! serial work-items leave the card idle. GPUs run [`Strategy::WorkGroups`] instead: LSD passes of
 //! [`WG_BITS`]-bit digits, `radix_wg_histogram` and `radix_wg_scatter` per
 //! tile of [`WG_TILE`] pairs with their counts and stable ranks in local
 //! memory, and the device-wide [`Scan`] between (Satish, Harris & Garland
