@@ -34,13 +34,11 @@
 //   sorted vertex pair of each endpoint's mesh edge ((v, v) at a vertex,
 //   (0xffffffff, face) at a face centre, (LINE_FREE, face) where a test cut
 //   the segment); counter uint[1]: all counted
-// flags: bit 0 back-face culling, 1 the extremum / test checks, 2 fading by
-// test strength, 3 Hermite placement of the K = 0 and H = 0 crossings (from
-// grad), 4 of the suggestive highlights' κr = 0 crossings (rtsc's, from gkr:
-// lines_vertex's gradient of κr sin²θ, float[3V]).
-// Thresholds arrive already divided by the feature size (rv) or its square
-// (ar, ph, sh, sc), and so does the fade of suggestive highlights (sh_fade,
-// 0 for none).
+// flags: bit 0 back-face culling, 1 the extremum / test checks, 2 fading,
+// 3 Hermite placement of K = 0 and H = 0 (from grad), 4 of the suggestive
+// highlights' κr = 0 (from gkr, lines_vertex's ∇(κr sin²θ), float[3V]).
+// Thresholds (and sh_fade) arrive divided by the feature size (rv) or its
+// square (ar, ph, sh, sc).
 
 #define LF_RIDGES 2u
 #define LF_VALLEYS 3u

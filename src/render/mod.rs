@@ -2,11 +2,9 @@
 //! triangles that the edge stage writes (House & Li's edge-out and cap-out
 //! buffers), read back as an RGBA8 + depth [`Frame`] or saved as PNG.
 //!
-//! Why GL and not a CPU rasteriser: the edge-out buffers are meant to be drawn
-//! by the GPU as they are (the vertex shader applies no transform), with
-//! coverage, depth test and MSAA from the rasteriser; on a machine without a
-//! GPU, Mesa's llvmpipe does the same through EGL's surfaceless platform (see
-//! `context.rs`). Nothing here needs a window or a display server.
+//! GL, not a CPU rasteriser: the edge-out buffers are drawn as they are (the
+//! vertex shader applies no transform), with coverage, depth test and MSAA;
+//! without a GPU, Mesa's llvmpipe does it through EGL (`context.rs`).
 //!
 //! A frame is `begin(&camera)` → any number of `draw_*` → `finish()`:
 //! - [`Renderer::draw_mesh`]: Lambert shading × per-vertex colour, two-sided,
@@ -23,9 +21,8 @@
 //! the uploads. [`Renderer::reconfigure`] changes the image size and
 //! antialiasing while keeping the context, its programs and the mesh.
 //!
-//! Clip space is OpenGL's (z in [−w, w]), as produced by
-//! [`Camera::view_proj`]. All drawing goes to the renderer's own framebuffer
-//! objects (multisampled when `msaa > 0`, resolved in `finish`).
+//! Clip space is OpenGL's (z in [−w, w], [`Camera::view_proj`]); drawing goes
+//! to the renderer's own framebuffers (multisampled when `msaa > 0`).
 //!
 //! Threads: a `Renderer` is not `Send` (its GL context is current on the
 //! thread that made it); make one per thread. Any number may exist at once or

@@ -38,9 +38,8 @@
 //! formats = ["png", "svg"]
 //! ```
 //!
-//! Every table rejects unknown keys, and every error (syntax, unknown key,
-//! wrong type, a missing or second source, a missing file) names the scene
-//! file and the line. Relative paths are relative to the scene file.
+//! Unknown keys are refused; every error names the scene file and the line.
+//! Relative paths are relative to the scene file.
 
 use crate::error::{Error, Result};
 use crate::scene::planner::Input;
@@ -296,7 +295,7 @@ impl Scene {
             svg: out.svg,
             msaa: out.msaa,
             background: out.background,
-            interop: crate::spec::interop::InteropMode::Off,
+            interop: out.interop,
         })
     }
 }

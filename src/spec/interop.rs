@@ -64,7 +64,7 @@ impl InteropMode {
     }
 }
 
-crate::spec::choice!(InteropMode);
+crate::spec::named_choice!(InteropMode, "interop mode");
 
 /// A route from the kernels' buffers to GL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -1,9 +1,10 @@
-//! `[output]` checked: where the images go, their size, formats, MSAA and
-//! background. Errors without a key of their own name the `[output]` line.
+//! `[output]` checked: where the images go, their size, formats, MSAA,
+//! background and the feature edges' interop mode. Errors without a key of their own name the `[output]` line.
 
 use super::raw::OutputSpec;
 use super::{Checker, color};
 use crate::error::{Error, Result};
+use crate::spec::interop::InteropMode;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -24,6 +25,8 @@ pub(super) struct OutputPart {
     pub msaa: u32,
     /// Background.
     pub background: [f32; 3],
+    /// How the edges frame's buffers reach GL.
+    pub interop: InteropMode,
 }
 
 /// Checks `[output]` (absent: the defaults) of the scene called `name`.
@@ -48,6 +51,11 @@ pub(super) fn resolve(
     let (png, svg) = t.formats(&out)?;
     let background =
         color(out.background, [1.0, 1.0, 1.0], "output.background").map_err(|p| t.err(p))?;
+    let interop = match &out.interop {
+        None => InteropMode::Off,
+        Some(m) => (m.get_ref().parse())
+            .map_err(|e: Error| ck.err(m.span(), format!("output.interop: {e}")))?,
+    };
     let prefix = out.name.clone().unwrap_or_else(|| name.to_string());
     if prefix.is_empty() || prefix.contains(['/', '\\']) {
         return Err(t.err(format!(
@@ -65,6 +73,7 @@ pub(super) fn resolve(
         svg,
         msaa,
         background,
+        interop,
     })
 }
 

@@ -366,6 +366,8 @@ pub struct OutputSpec {
     /// Background RGB (default white).
     #[serde(default, deserialize_with = "exact")]
     pub background: Option<[f32; 3]>,
+    /// How feature edges reach GL: `off` (default), `auto` or `on`.
+    pub interop: Option<Spanned<String>>,
 }
 
 /// `[effects.ridges]`, `valleys`, `apparent_ridges`, `suggestive_highlights`

@@ -296,3 +296,19 @@ fn a_bad_clip_reads_as_toml_words() {
         Source::Gltf(fox.into(), Some(ClipRef::Name("Walk".into())))
     );
 }
+
+#[test]
+fn output_interop_is_a_mode() {
+    use crate::spec::interop::InteropMode;
+    let s = parse("[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n").unwrap();
+    assert_eq!(s.interop, InteropMode::Off);
+    let s = parse(
+        "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[output]\ninterop = \"auto\"\n",
+    )
+    .unwrap();
+    assert_eq!(s.interop, InteropMode::Auto);
+    let e = err(
+        "[input]\ngenerate = \"torus\"\n[effects]\nshading = {}\n[output]\ninterop = \"maybe\"\n",
+    );
+    assert!(e.contains("line 6") && e.contains("output.interop"), "{e}");
+}
