@@ -32,7 +32,7 @@
 #                        egui_glow only in src/cli/view/ (the viewer), which
 #                        uses no shapecue::stages, shapecue::gpu, shapecue::cpu
 #   src/cli/ (not view/) the front door only: no shapecue::stages, gpu, cpu,
-#                        render or scene (shapecue::api names what it needs)
+#   and python/src/      render or scene (shapecue::api names what they need)
 #   time in results      no `pub *_ms` field in src/ outside spec/timing.rs
 #                        (Timing), src/report/ and src/cli/
 #
@@ -328,9 +328,9 @@ done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu)\b' src/cli/v
 # root and shapecue::api, with report, export, spec and the loaders), never
 # the layers below it; the viewer is the one exception (the scene executor).
 while IFS= read -r hit; do
-    echo "$hit: src/cli (but the viewer) must not use shapecue::stages, gpu, cpu, render or scene (the command line goes through the front door, shapecue::api)"
+    echo "$hit: src/cli (but the viewer) and python/src must not use shapecue::stages, gpu, cpu, render or scene (they go through the front door, shapecue::api)"
     status=1
-done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu|render|scene)\b' src/cli src/main.rs 2>/dev/null | grep -v -E '^src/cli/view/' | grep -v -E ':[0-9]+:\s*//' || true)
+done < <(grep -rn --include='*.rs' -E '\bshapecue::(stages|gpu|cpu|render|scene)\b' src/cli src/main.rs python/src 2>/dev/null | grep -v -E '^src/cli/view/' | grep -v -E ':[0-9]+:\s*//' || true)
 
 # Time in a library result is one Timing (spec/timing.rs): no other public
 # field ending in _ms below the measurement and the command line.

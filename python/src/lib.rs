@@ -20,11 +20,11 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use shapecue::gpu::Gpu;
+use shapecue::api::CurvatureEstimator as RustEstimator;
+use shapecue::api::Gpu;
 use shapecue::spec::curvature::{
     Accumulate, AccumulateChoice, Compat, Curvature, CurvatureOptions, Precision,
 };
-use shapecue::stages::curvature::CurvatureEstimator as RustEstimator;
 use shapecue::{Error, Mesh};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -286,7 +286,7 @@ fn curvature_dict<'py>(
 fn devices(py: Python<'_>) -> PyResult<String> {
     let (all, default) = py
         .detach(|| {
-            let all = shapecue::gpu::list_devices()?;
+            let all = shapecue::api::list_devices()?;
             let default = Gpu::new(None).ok().map(|g| g.info.index);
             Ok::<_, Error>((all, default))
         })
@@ -307,7 +307,7 @@ fn devices(py: Python<'_>) -> PyResult<String> {
 ///
 /// Builds the curvature program of every combination of the given
 /// variants on the device, runs it once and saves it into shapecue's kernel
-/// cache (`shapecue::stages::curvature::build_kernels`), with a `Gpu` of its
+/// cache (`shapecue::api::build_kernels`), with a `Gpu` of its
 /// own so that later calls of this process keep the usual saving rule.
 #[pyfunction]
 #[pyo3(signature = (accumulate, precision, compat, device))]
@@ -335,7 +335,7 @@ fn build_kernels<'py>(
             // lanes by device type, as on the command line
             let lanes = shapecue::spec::curvature::Lanes::Auto;
             let variants = CurvatureOptions::combinations(&accumulate, &precision, &compat, lanes);
-            shapecue::stages::curvature::build_kernels(&gpu, &variants, |_| {})
+            shapecue::api::build_kernels(&gpu, &variants, |_| {})
         })
         .map_err(to_py)?;
     let out = PyList::empty(py);
@@ -401,7 +401,7 @@ fn curvature_with<'py>(
                     ..opts
                 };
                 let t = Instant::now();
-                let c = shapecue::cpu::curvature::curvature(&mesh, opts)?;
+                let c = shapecue::api::curvature_reference(&mesh, opts)?;
                 library_ms = t.elapsed().as_secs_f64() * 1e3;
                 Ok::<_, Error>((c, "cpu reference (f64, single thread)".to_string()))
             } else {

@@ -4,10 +4,10 @@
 //! strength, no picture.
 
 use super::*;
+use shapecue::api::LineOptions;
 use shapecue::api::LineSetup;
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
 use shapecue::spec::view::View;
-use shapecue::stages::feature_lines::LineOptions;
 
 /// lines(vertices, faces, families, eye, ortho, thresholds, isophotes,
 /// light, switches, setup, device) -> dict

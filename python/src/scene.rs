@@ -79,7 +79,7 @@ impl EdgeArgs<'_, '_> {
     /// The view of the camera: at `eye`, or fitted to the mesh's bounds
     /// from `direction`.
     fn view(&self, mesh: &Mesh) -> PyResult<shapecue::spec::view::View> {
-        use shapecue::render::{Placement, framed};
+        use shapecue::api::{Placement, framed};
         let (w, h) = self.size;
         if w == 0 || h == 0 {
             return Err(value_err(format!("size: ({w}, {h}) must be positive")));
@@ -202,7 +202,7 @@ pub(crate) fn render_file(
     force: bool,
     device: Option<String>,
 ) -> PyResult<String> {
-    let opts = shapecue::scene::exec::ExecOptions {
+    let opts = shapecue::api::ExecOptions {
         out_dir,
         force,
         device: None,
@@ -229,8 +229,8 @@ pub(crate) fn render_text(
     let value: serde_json::Value =
         serde_json::from_str(json).map_err(|e| value_err(format!("scene: {e}")))?;
     let text = toml::to_string(&value).map_err(|e| value_err(format!("scene: {e}")))?;
-    let scene = shapecue::scene::file::Scene::from_str(&anchor, &text).map_err(to_py)?;
-    let opts = shapecue::scene::exec::ExecOptions {
+    let scene = shapecue::api::Scene::from_str(&anchor, &text).map_err(to_py)?;
+    let opts = shapecue::api::ExecOptions {
         out_dir,
         force,
         device: None,
@@ -238,7 +238,7 @@ pub(crate) fn render_text(
     let report = py
         .detach(|| {
             let gpu = open_gpu(device.as_deref())?;
-            shapecue::scene::exec::run_on(&gpu, &scene, &opts, &mut |_, _| {})
+            shapecue::api::run_scene_on(&gpu, &scene, &opts, &mut |_, _| {})
         })
         .map_err(to_py)?;
     serde_json::to_string(&report).map_err(|e| PyRuntimeError::new_err(e.to_string()))

@@ -51,13 +51,16 @@ pub use crate::scene::file::Shot;
 // nothing above it reaches into the layers below.
 pub use crate::cpu::curvature::curvature as curvature_reference;
 pub use crate::gpu::{DeviceInfo, Gpu, list_devices};
+pub use crate::render::{Camera, Placement, framed};
 pub use crate::scene::exec::{
     Checked, ExecOptions, RunReport, Session, check_scenes, explain, run as run_scene,
+    run_on as run_scene_on,
 };
 pub use crate::scene::file::Scene;
 pub use crate::stages::curvature::{
     CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
 };
+pub use crate::stages::feature_lines::LineOptions;
 pub use lines::{
     Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
     line_segments_on, lines_picture, lines_picture_on, lines_scene, wanted,
