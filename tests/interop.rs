@@ -60,7 +60,7 @@ fn decision_for_every_combination_of_what_is_reported() {
         let off = decide_interop(InteropMode::Off, &o).unwrap();
         assert_eq!(off.route, InteropRoute::Host, "{case}");
         assert!(
-            !off.shared && off.reason.contains("--interop off"),
+            !off.shared && off.reason.contains("interop is off"),
             "{case}"
         );
 

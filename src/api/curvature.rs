@@ -37,7 +37,7 @@ impl MeshSource {
     pub fn load(&self) -> Result<(String, Mesh)> {
         Ok(match self {
             MeshSource::Generated(kind, n) => {
-                crate::spec::limits::check_mesh_vertices("--resolution", *n)?;
+                crate::spec::limits::check_mesh_vertices("the generated mesh's vertex count", *n)?;
                 kind.mesh(*n)
             }
             MeshSource::File(path, opts) => {

@@ -175,7 +175,11 @@ fn check_args(a: &CurvatureArgs) -> Result<MeshSource> {
         a.force,
     )?;
     Ok(match (&a.input, a.generate) {
-        (_, Some(kind)) => MeshSource::Generated(kind, a.resolution),
+        (_, Some(kind)) => {
+            // Checked here first: the message names the flag.
+            shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
+            MeshSource::Generated(kind, a.resolution)
+        }
         (Some(path), None) => MeshSource::File(path.clone(), LoadOptions { weld: a.weld }),
         (None, None) => bail!("give an input mesh or --generate"),
     })

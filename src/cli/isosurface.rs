@@ -201,7 +201,11 @@ fn load_input(a: &IsoArgs) -> Result<(String, volume::Volume, Vec<PathBuf>)> {
     Ok(match (&a.input, &a.sdf) {
         (_, Some(kind)) => (
             format!("{kind} SDF {}³", a.resolution),
-            volume::sdf::sdf_by_name(kind, a.resolution)?,
+            {
+                // Checked here first: the message names the flag.
+                shapecue::spec::limits::check_volume_resolution("--resolution", a.resolution)?;
+                volume::sdf::sdf_by_name(kind, a.resolution)?
+            },
             Vec::new(),
         ),
         (Some(path), None) => {

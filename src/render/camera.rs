@@ -177,7 +177,7 @@ impl Camera {
         }
         if dir.normalize().cross(up).length() < 1e-4 {
             return bad(format!(
-                "up ({}) is parallel to the view direction ({}); give another --up",
+                "up ({}) is parallel to the view direction ({}); give another up direction",
                 crate::error::values(self.up.to_array(), ", "),
                 crate::error::values(dir.to_array(), ", ")
             ));

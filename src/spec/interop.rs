@@ -199,7 +199,7 @@ pub fn decide_interop(mode: InteropMode, offer: &InteropOffer) -> Result<Interop
     if mode == InteropMode::Off {
         return decision(
             InteropRoute::Host,
-            "host path: --interop off".into(),
+            "host path: interop is off".into(),
             Vec::new(),
         );
     }

@@ -134,7 +134,7 @@ pub fn sdf_by_name(name: &str, res: usize) -> Result<Volume> {
     let kind: Sdf = name.parse()?;
     // Checked before allocating: the error names the option, the bytes and
     // the limit (a typo like 100000 must not abort on allocation).
-    crate::spec::limits::check_volume_resolution("--resolution", res)?;
+    crate::spec::limits::check_volume_resolution("the field's resolution", res)?;
     Ok(sdf(kind, res))
 }
 
