@@ -132,7 +132,8 @@ fn refuse_output(
             " (the same file under another name)".to_string()
         };
         return Err(refuse(format!(
-            "refusing to write {}: it is the input file {}{how}; --force never overwrites an input",
+            "refusing to write {}: it is the input file {}{how}; an input is never overwritten, \
+             not even with force = true (the command line's --force)",
             out.display(),
             inp.display()
         )));
@@ -156,7 +157,8 @@ fn refuse_output(
     }
     if id.is_some() && !force {
         return Err(refuse(format!(
-            "{} exists; pass --force to overwrite it",
+            "{} exists and overwrite is off; pass force = true (the command line's --force) \
+             to overwrite it",
             out.display()
         )));
     }

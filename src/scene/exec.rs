@@ -515,7 +515,8 @@ fn check_outputs_across(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
         }
         if !opts.force && a.exists() {
             return Err(Error::InvalidArgument(format!(
-                "{}: {} exists (from an earlier run); use --force to overwrite it",
+                "{}: {} exists (from an earlier run) and overwrite is off; pass force = true \
+                 (the command line's --force) to overwrite it",
                 sa.path.display(),
                 a.display()
             )));
