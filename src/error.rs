@@ -8,7 +8,8 @@ use std::path::PathBuf;
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// What [`Error::gl_sharing_required`] says is missing; the reasons follow it.
-pub const GL_SHARING_REQUIRED: &str = "--interop on needs a shared route, CL-GL sharing \
+pub const GL_SHARING_REQUIRED: &str = "interop mode on (the command line's --interop on) needs \
+     a shared route, CL-GL sharing \
      (cl_khr_gl_sharing) or external memory (cl_khr_external_memory_opaque_fd with \
      GL_EXT_memory_object_fd and Vulkan's VK_KHR_external_memory_fd), and neither can run";
 
@@ -64,7 +65,8 @@ pub enum Error {
     /// No device matched the user's selection.
     #[error("no OpenCL device matches '{selector}'; available: {available}")]
     NoDevice {
-        /// The `--device` / `SHAPECUE_DEVICE` value.
+        /// The device selector (the command line's `--device`, or
+        /// `SHAPECUE_DEVICE`).
         selector: String,
         /// A list of the devices found.
         available: String,
@@ -158,7 +160,7 @@ impl Error {
         }
     }
 
-    /// `--interop on` without a shared route: a [`Error::DeviceUnsupported`]
+    /// Interop mode on without a shared route: a [`Error::DeviceUnsupported`]
     /// whose `what` is [`GL_SHARING_REQUIRED`] followed by `why` (why each
     /// route cannot run), the one device refusal with its own exit code (see
     /// [`Error::exit_code`]).
@@ -170,7 +172,7 @@ impl Error {
     }
 
     /// The process exit code of a command that failed with this error: 3 for
-    /// `--interop on` without a shared route ([`Error::gl_sharing_required`]),
+    /// interop mode on without a shared route ([`Error::gl_sharing_required`]),
     /// 1 for everything else. The one place exit codes are decided.
     pub fn exit_code(&self) -> i32 {
         match self {

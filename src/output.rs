@@ -88,91 +88,115 @@ pub fn check_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Result
         .iter()
         .filter_map(|p| identity(p).map(|id| (*p, id)))
         .collect();
-    let mut seen: Vec<(&Path, PathBuf, Option<Identity>)> = Vec::new();
+    let mut seen: Vec<Seen> = Vec::new();
     for &out in outputs {
-        if out.as_os_str() == "-" {
-            return Err(refuse(
-                "an output of '-' is not supported: give a file name".to_string(),
-            ));
-        }
-        if out.as_os_str().is_empty() || out.file_name().is_none() {
-            return Err(refuse(format!(
-                "'{}' is not a file name for an output",
-                out.display()
-            )));
-        }
-        let id = identity(out);
-        if let Some(id) = &id
-            && let Some((inp, _)) = input_ids.iter().find(|(_, i)| i == id)
-        {
-            let how = if location(out) == location(inp) {
-                String::new()
-            } else {
-                " (the same file under another name)".to_string()
-            };
-            return Err(refuse(format!(
-                "refusing to write {}: it is the input file {}{how}; --force never overwrites an input",
-                out.display(),
-                inp.display()
-            )));
-        }
-        let loc = location(out);
-        if let Some((other, _, _)) = seen
-            .iter()
-            .find(|(_, l, i)| *l == loc || (id.is_some() && i.as_ref() == id.as_ref()))
-        {
-            return Err(refuse(format!(
-                "{} and {} name the same output file; give each output its own name",
-                other.display(),
-                out.display()
-            )));
-        }
-        if id.is_some() && !std::fs::metadata(out).map(|m| m.is_file()).unwrap_or(false) {
-            return Err(refuse(format!(
-                "refusing to write {}: it exists and is not a regular file",
-                out.display()
-            )));
-        }
-        if id.is_some() && !force {
-            return Err(refuse(format!(
-                "{} exists; pass --force to overwrite it",
-                out.display()
-            )));
-        }
+        let (loc, id) = refuse_output(out, &input_ids, &seen, force)?;
         seen.push((out, loc, id));
     }
     for &out in outputs {
-        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if let Some(file) = dir
-                .ancestors()
-                .find(|a| a.exists() && !a.is_dir() && !a.as_os_str().is_empty())
-            {
-                return Err(refuse(format!(
-                    "cannot write {}: {} is a file, not a folder",
-                    out.display(),
-                    file.display()
-                )));
-            }
-            std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-                path: dir.to_path_buf(),
-                source,
-            })?;
-        }
-        // Each folder must take a new file now, so that a run with several
-        // outputs does not write the first and then fail on a later one (a
-        // read-only folder, one of /proc or /sys): the probe is the hidden
-        // temporary file `write_atomic` would make, removed at once.
-        let probe = temp_path(out);
-        std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&probe)
-            .map_err(|source| Error::Write {
-                path: out.to_path_buf(),
-                source,
-            })?;
-        let _ = std::fs::remove_file(&probe);
+        prepare_folder(out)?;
     }
+    Ok(())
+}
+
+/// An output already checked: its path, its location and its identity
+/// (when it exists).
+type Seen<'a> = (&'a Path, PathBuf, Option<Identity>);
+
+/// The checks of [`check_outputs`] on one output against the inputs and
+/// the outputs before it; returns its location and identity.
+fn refuse_output(
+    out: &Path,
+    input_ids: &[(&Path, Identity)],
+    seen: &[Seen],
+    force: bool,
+) -> Result<(PathBuf, Option<Identity>)> {
+    if out.as_os_str() == "-" {
+        return Err(refuse(
+            "an output of '-' is not supported: give a file name".to_string(),
+        ));
+    }
+    if out.as_os_str().is_empty() || out.file_name().is_none() {
+        return Err(refuse(format!(
+            "'{}' is not a file name for an output",
+            out.display()
+        )));
+    }
+    let id = identity(out);
+    if let Some(id) = &id
+        && let Some((inp, _)) = input_ids.iter().find(|(_, i)| i == id)
+    {
+        let how = if location(out) == location(inp) {
+            String::new()
+        } else {
+            " (the same file under another name)".to_string()
+        };
+        return Err(refuse(format!(
+            "refusing to write {}: it is the input file {}{how}; an input is never overwritten, \
+             not even with force = true (the command line's --force)",
+            out.display(),
+            inp.display()
+        )));
+    }
+    let loc = location(out);
+    if let Some((other, _, _)) = seen
+        .iter()
+        .find(|(_, l, i)| *l == loc || (id.is_some() && i.as_ref() == id.as_ref()))
+    {
+        return Err(refuse(format!(
+            "{} and {} name the same output file; give each output its own name",
+            other.display(),
+            out.display()
+        )));
+    }
+    if id.is_some() && !std::fs::metadata(out).map(|m| m.is_file()).unwrap_or(false) {
+        return Err(refuse(format!(
+            "refusing to write {}: it exists and is not a regular file",
+            out.display()
+        )));
+    }
+    if id.is_some() && !force {
+        return Err(refuse(format!(
+            "{} exists and overwrite is off; pass force = true (the command line's --force) \
+             to overwrite it",
+            out.display()
+        )));
+    }
+    Ok((loc, id))
+}
+
+/// Creates the folder of `out` and checks that it can take a new file.
+fn prepare_folder(out: &Path) -> Result<()> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Some(file) = dir
+            .ancestors()
+            .find(|a| a.exists() && !a.is_dir() && !a.as_os_str().is_empty())
+        {
+            return Err(refuse(format!(
+                "cannot write {}: {} is a file, not a folder",
+                out.display(),
+                file.display()
+            )));
+        }
+        std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+    }
+    // Each folder must take a new file now, so that a run with several
+    // outputs does not write the first and then fail on a later one (a
+    // read-only folder, one of /proc or /sys): the probe is the hidden
+    // temporary file `write_atomic` would make, removed at once.
+    let probe = temp_path(out);
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|source| Error::Write {
+            path: out.to_path_buf(),
+            source,
+        })?;
+    let _ = std::fs::remove_file(&probe);
     Ok(())
 }
 

@@ -19,28 +19,23 @@
 //! flipbook frame, host normals, building topology, rendering) report wall
 //! time. The report says which, per pass.
 //!
-//! A run of several scenes checks them all first ([`check_scenes`]):
-//! output collisions, frame ranges against each animation, a flipbook's
-//! frames against its first frame's topology; the animated inputs it loads
-//! for that go to [`run_checked`], so nothing is loaded twice and a bad
-//! last scene fails the run before the first writes anything.
+//! A run of several scenes checks them all first ([`check_scenes`]: output
+//! collisions, frame ranges, a flipbook's topology), loading the animated
+//! inputs once for [`run_checked`]: a bad last scene fails the run before
+//! the first writes anything.
 //!
-//! One process, one device and one GL context: a [`Session`] holds the
-//! OpenCL device (its programs built once) and the renderer across the
-//! scenes it runs, resizing the renderer's framebuffers when a scene's image
-//! size differs. Within a scene the mesh goes to GL once per topology (its
-//! faces) and once per pose (positions, normals, colours), not once per view.
+//! One process, one device and one GL context: a [`Session`] holds both
+//! across the scenes it runs. Within a scene the mesh goes to GL once per
+//! topology and once per pose, not once per view.
 //!
 //! A front end that draws one camera and frame at a time holds a scene
 //! live ([`Session::live`], in `live`): a camera move reruns only the view
 //! passes, a new frame only the pose passes and the view passes.
 //!
 //! The plan is the program: [`run`] walks the plan's passes in order,
-//! filtered by lifetime (topology passes on a new topology, pose passes per
-//! pose, view passes per camera), one arm per pass
-//! ([`passes`](self) has them). Split by concern: loading inputs (`load`),
-//! per-pass execution (`passes`), drawing and outputs (`draw`), the report
-//! (`report`).
+//! filtered by lifetime, one arm per pass ([`passes`](self) has them).
+//! Split by concern: loading inputs (`load`), per-pass execution
+//! (`passes`), drawing and outputs (`draw`), the report (`report`).
 
 mod draw;
 pub mod interop;
@@ -58,7 +53,7 @@ use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
 use crate::scene::file::{Scene, Source};
-use crate::scene::planner::{Input, Lifetime, Pass, plan_with};
+use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
 use load::load;
 use passes::Executor;
 use report::ms_since;
@@ -77,9 +72,11 @@ pub struct ExecOptions {
     pub device: Option<String>,
 }
 
-/// What the scene runs of one process share: the OpenCL device and one
-/// renderer (one GL context with its programs), made by the first scene that
-/// needs them and reconfigured for each scene's image size and antialiasing.
+/// What the scene runs of one process share: the OpenCL device (its
+/// programs built once) and one renderer (one GL context with its
+/// programs), made by the first scene that needs them and reconfigured for
+/// each scene's image size and antialiasing (its framebuffers made anew
+/// when the size differs).
 /// A renderer is tied to its thread: so is a `Session`.
 #[derive(Default)]
 pub struct Session {
@@ -204,73 +201,107 @@ fn run_loaded(
         .out_dir
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
-    let (images, report_path) = output_paths(scene, &frames, &out_dir);
-    // What this run creates (folders, and files that did not exist), to
-    // remove again if it fails: a failed run leaves what it found.
-    let new_dirs: Vec<PathBuf> = out_dir
-        .ancestors()
-        .filter(|d| !d.as_os_str().is_empty() && !d.exists())
-        .map(PathBuf::from)
-        .collect();
-    let new_files: Vec<PathBuf> = images
-        .iter()
-        .map(|i| &i.2)
-        .chain([&report_path])
-        .filter(|p| !p.exists())
-        .cloned()
-        .collect();
-    let result = refuse_overwrite(scene, &images, &report_path, opts.force)
+    let outputs = RunOutputs::new(scene, &frames, &out_dir);
+    let input = RunInput {
+        loaded,
+        frames,
+        notes,
+        t_all,
+    };
+    let result = refuse_overwrite(scene, &outputs.images, &outputs.report, opts.force)
         .and_then(|()| {
             std::fs::create_dir_all(&out_dir).map_err(|source| Error::Write {
                 path: out_dir.clone(),
                 source,
             })
         })
-        .and_then(|()| {
-            render_all(
-                session,
-                scene,
-                opts,
-                progress,
-                loaded,
-                frames,
-                &images,
-                &report_path,
-                notes,
-                t_all,
-            )
-        });
+        .and_then(|()| render_all(session, scene, opts, progress, input, &outputs));
     if result.is_err() {
-        for f in &new_files {
-            let _ = std::fs::remove_file(f);
-        }
-        // Deepest first; only folders left empty go.
-        for d in &new_dirs {
-            let _ = std::fs::remove_dir(d);
-        }
+        outputs.remove_created();
     }
     result
 }
 
-/// The frame loop of [`run_loaded`] after the outputs are checked and the
-/// folder exists (`t_all`: when the run started; `notes`: what loading the
-/// input said); writes the report last.
-#[allow(clippy::too_many_arguments)]
+/// The files a run writes, and what of them it creates (folders, and
+/// files that did not exist), to remove again if it fails: a failed run
+/// leaves what it found.
+struct RunOutputs {
+    /// The images: frame, view and path, frame-major ([`output_paths`]).
+    images: Vec<(usize, usize, PathBuf)>,
+    /// The report's path.
+    report: PathBuf,
+    /// Folders of the output folder's path that do not exist yet, deepest
+    /// first.
+    new_dirs: Vec<PathBuf>,
+    /// Images and report that do not exist yet.
+    new_files: Vec<PathBuf>,
+}
+
+impl RunOutputs {
+    /// The outputs of `scene`'s `frames` in `out_dir`, before the run.
+    fn new(scene: &Scene, frames: &[usize], out_dir: &std::path::Path) -> RunOutputs {
+        let (images, report) = output_paths(scene, frames, out_dir);
+        let new_dirs: Vec<PathBuf> = out_dir
+            .ancestors()
+            .filter(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(PathBuf::from)
+            .collect();
+        let new_files: Vec<PathBuf> = images
+            .iter()
+            .map(|i| &i.2)
+            .chain([&report])
+            .filter(|p| !p.exists())
+            .cloned()
+            .collect();
+        RunOutputs {
+            images,
+            report,
+            new_dirs,
+            new_files,
+        }
+    }
+
+    /// Removes what the failed run created: its files, then its folders
+    /// where they are left empty.
+    fn remove_created(&self) {
+        for f in &self.new_files {
+            let _ = std::fs::remove_file(f);
+        }
+        // Deepest first; only folders left empty go.
+        for d in &self.new_dirs {
+            let _ = std::fs::remove_dir(d);
+        }
+    }
+}
+
+/// What a run renders from: the loaded input, the frames it renders, what
+/// loading the input said, and when the run started.
+struct RunInput {
+    loaded: load::Loaded,
+    frames: Vec<usize>,
+    notes: Vec<String>,
+    t_all: Instant,
+}
+
+/// The rendering of [`run_loaded`] after the outputs are checked and the
+/// folder exists: builds the executor, runs the frames ([`run_frames`]) and
+/// writes the report last.
 fn render_all(
     session: &mut Session,
     scene: &Scene,
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
-    loaded: load::Loaded,
-    frames: Vec<usize>,
-    images: &[(usize, usize, PathBuf)],
-    report_path: &std::path::Path,
-    notes: Vec<String>,
-    t_all: Instant,
+    input: RunInput,
+    outputs: &RunOutputs,
 ) -> Result<RunReport> {
+    let RunInput {
+        loaded,
+        frames,
+        notes,
+        t_all,
+    } = input;
     let fx = &scene.effects;
-    let input = scene.source.input();
-    let plan = plan_with(&fx.cues, input, fx.caps);
+    let plan = plan_with(&fx.cues, scene.source.input(), fx.caps);
     let gpu = session.gpu(opts)?;
     let [w, h] = scene.size;
     let [br, bg, bb] = scene.background;
@@ -282,7 +313,60 @@ fn render_all(
     })?;
     let uploads_before = renderer.uploads();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
+    let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, progress)?;
 
+    let (vertices, faces) = ex.counts();
+    let report = RunReport {
+        scene: scene.path.display().to_string(),
+        device: gpu.info.name.clone(),
+        renderer: ex.gl_info(),
+        plan: plan.clone(),
+        frames,
+        views: scene.views.len(),
+        vertices,
+        faces,
+        passes: ex.rec.in_plan_order(&plan),
+        gl_uploads: {
+            let now = ex.uploads();
+            crate::render::Uploads {
+                topology: now.topology - uploads_before.topology,
+                pose: now.pose - uploads_before.pose,
+            }
+        },
+        segments: ex.segments,
+        lines: std::mem::take(&mut ex.line_segments),
+        strokes: ex.stroke_count,
+        notes: notes
+            .into_iter()
+            .chain(ex.feature_size_note.take())
+            .collect(),
+        outputs: std::mem::take(&mut ex.outputs),
+        timing: crate::spec::timing::Timing {
+            wall_ms: ms_since(t_all),
+            ..timing
+        },
+    };
+    // The next scene of the session draws with the same GL context.
+    session.renderer = Some(ex.into_renderer());
+    let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
+    crate::export::output::write_bytes_atomic(&outputs.report, json.as_bytes())?;
+    Ok(report)
+}
+
+/// The frame loop: the plan's passes frame by frame and view by view, by
+/// lifetime (topology passes on a new topology, pose passes per pose, view
+/// passes per camera), each view writing its `images`; calls
+/// `progress(done, total)` after each view. Returns the pose, view and
+/// render laps.
+fn run_frames(
+    ex: &mut Executor<'_, '_>,
+    scene: &Scene,
+    plan: &Plan,
+    frames: &[usize],
+    images: &[(usize, usize, PathBuf)],
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<crate::spec::timing::Timing> {
+    let input = scene.source.input();
     // The plan's passes by lifetime, each list in plan order.
     let of = |keep: &dyn Fn(Lifetime) -> bool| -> Vec<Pass> {
         plan.passes
@@ -327,43 +411,7 @@ fn render_all(
             progress(done, total_views);
         }
     }
-
-    let (vertices, faces) = ex.counts();
-    let report = RunReport {
-        scene: scene.path.display().to_string(),
-        device: gpu.info.name.clone(),
-        renderer: ex.gl_info(),
-        plan: plan.clone(),
-        frames,
-        views: scene.views.len(),
-        vertices,
-        faces,
-        passes: ex.rec.in_plan_order(&plan),
-        gl_uploads: {
-            let now = ex.uploads();
-            crate::render::Uploads {
-                topology: now.topology - uploads_before.topology,
-                pose: now.pose - uploads_before.pose,
-            }
-        },
-        segments: ex.segments,
-        lines: std::mem::take(&mut ex.line_segments),
-        strokes: ex.stroke_count,
-        notes: notes
-            .into_iter()
-            .chain(ex.feature_size_note.take())
-            .collect(),
-        outputs: std::mem::take(&mut ex.outputs),
-        timing: crate::spec::timing::Timing {
-            wall_ms: ms_since(t_all),
-            ..timing
-        },
-    };
-    // The next scene of the session draws with the same GL context.
-    session.renderer = Some(ex.into_renderer());
-    let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
-    crate::export::output::write_bytes_atomic(report_path, json.as_bytes())?;
-    Ok(report)
+    Ok(timing)
 }
 
 /// What [`check_scenes`] learnt of one scene: the input it loaded to check
@@ -467,7 +515,8 @@ fn check_outputs_across(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
         }
         if !opts.force && a.exists() {
             return Err(Error::InvalidArgument(format!(
-                "{}: {} exists (from an earlier run); use --force to overwrite it",
+                "{}: {} exists (from an earlier run) and overwrite is off; pass force = true \
+                 (the command line's --force) to overwrite it",
                 sa.path.display(),
                 a.display()
             )));

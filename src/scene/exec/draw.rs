@@ -178,13 +178,37 @@ pub(super) fn draw_view(
     paths: &[&PathBuf],
     want_layers: bool,
 ) -> Result<DrawnView> {
-    let fx = &scene.effects;
-    let [w, h] = scene.size;
     renderer.begin(cam)?;
+    renderer.draw_uploaded(mesh_style(scene, plan))?;
+    let drawn = draw_line_families(renderer, &scene.effects, lines.segments)?;
+    draw_edges_and_strokes(renderer, scene, plan, cam, &lines)?;
+    // Depth only for an SVG's visibility test.
+    let svg = want_layers
+        || paths
+            .iter()
+            .any(|p| p.extension().is_none_or(|e| e != "png"));
+    let image: Frame = if svg {
+        renderer.finish()?
+    } else {
+        renderer.finish_color()?
+    };
+    let layers = svg.then(|| svg_layers(scene, plan, cam, &lines, &image));
+    write_view(scene, paths, &image, layers.as_deref())?;
+    Ok(DrawnView {
+        segments: drawn,
+        image,
+        layers,
+    })
+}
+
+/// The mesh's style: shaded, or flat in the background colour when only
+/// lines are drawn.
+fn mesh_style(scene: &Scene, plan: &Plan) -> MeshStyle {
+    let fx = &scene.effects;
     let lines_only = !(plan.contains(Pass::Ao)
         || fx.cues.contains(&Cue::Shading)
         || fx.cues.contains(&Cue::CurvatureColors));
-    let style = if lines_only {
+    if lines_only {
         // Lines only: the mesh is drawn flat in the background colour,
         // so that it hides the lines behind it.
         MeshStyle {
@@ -198,8 +222,16 @@ pub(super) fn draw_view(
             color: fx.base_color,
             ..MeshStyle::default()
         }
-    };
-    renderer.draw_uploaded(style)?;
+    }
+}
+
+/// Draws the line families' quads; returns the contour and
+/// suggestive-contour segments drawn.
+fn draw_line_families(
+    renderer: &mut Renderer,
+    fx: &Effects,
+    segments: &[Segment],
+) -> Result<[usize; 2]> {
     let mut drawn = [0usize; 2];
     // Faded families in four opacity bins of their strength.
     const BINS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
@@ -209,8 +241,7 @@ pub(super) fn draw_view(
             if !faded && bi > 0 {
                 break;
             }
-            let pts: Vec<[f32; 3]> = lines
-                .segments
+            let pts: Vec<[f32; 3]> = segments
                 .iter()
                 .filter(|s| s.2 == kind && shown(s) && (!faded || strength_bin(s.3) == bi))
                 .flat_map(|s| [s.0, s.1])
@@ -226,6 +257,19 @@ pub(super) fn draw_view(
             renderer.draw_lines(&pts, [r, g, b, a], st.width)?;
         }
     }
+    Ok(drawn)
+}
+
+/// Draws the feature edges (from the shared buffer or the read-back
+/// outputs) and the curvature-directed strokes, where planned.
+fn draw_edges_and_strokes(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    plan: &Plan,
+    cam: &Camera,
+    lines: &ViewLines<'_>,
+) -> Result<()> {
+    let fx = &scene.effects;
     if let Some(eo) = lines.edges {
         let [r, g, b] = fx.edge.1;
         match lines.shared {
@@ -243,30 +287,27 @@ pub(super) fn draw_view(
         };
         crate::render::strokes::draw(renderer, cam, lines.strokes, &style)?;
     }
-    // Depth only for an SVG's visibility test.
-    let svg = want_layers
-        || paths
-            .iter()
-            .any(|p| p.extension().is_none_or(|e| e != "png"));
-    let image: Frame = if svg {
-        renderer.finish()?
-    } else {
-        renderer.finish_color()?
-    };
-    let layers = svg.then(|| svg_layers(scene, plan, cam, &lines, &image));
+    Ok(())
+}
+
+/// Writes the view's files: an SVG from `layers` where a path is not a
+/// PNG and the groups were found, else the image as a PNG.
+fn write_view(
+    scene: &Scene,
+    paths: &[&PathBuf],
+    image: &Frame,
+    layers: Option<&[SvgLayer]>,
+) -> Result<()> {
+    let [w, h] = scene.size;
     for path in paths {
-        match &layers {
+        match layers {
             Some(l) if path.extension().is_none_or(|e| e != "png") => {
                 crate::export::svg::write_svg_layers(path, l, w, h)?;
             }
             _ => image.save_png(path)?,
         }
     }
-    Ok(DrawnView {
-        segments: drawn,
-        image,
-        layers,
-    })
+    Ok(())
 }
 
 /// What [`draw_view`] drew.

@@ -78,84 +78,8 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
                 )));
             }
         },
-        Source::Gltf(p, clip) => {
-            let m = weld_skinned(crate::mesh::skinned::load_gltf(p)?, scene.weld, p, notes);
-            if m.clips.is_empty() && clip.is_none() {
-                notes.push(format!(
-                    "{}: no animation; the rest pose is the one frame",
-                    p.display()
-                ));
-                let rest = SkinnedMesh::flatten(&m.joint_matrices(None, 0.0)?);
-                return Ok(Loaded::Skinned {
-                    mesh: Box::new(m),
-                    poses: Box::new(move |_| Ok(rest.clone())),
-                    frames: 1,
-                });
-            }
-            let idx = match clip.clone().unwrap_or(ClipRef::Index(0)) {
-                ClipRef::Index(i) => i,
-                ClipRef::Name(n) => m.clips.iter().position(|c| c.name == n).ok_or_else(|| {
-                    Error::input(
-                        p.display().to_string(),
-                        format!("clip {n:?}"),
-                        format!(
-                            "no such clip; the file has {}",
-                            m.clips
-                                .iter()
-                                .map(|c| format!("\"{}\"", c.name))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    )
-                })?,
-            };
-            if idx >= m.clips.len() {
-                return Err(Error::input(
-                    p.display().to_string(),
-                    format!("clip {idx}"),
-                    format!("the file has {} clips", m.clips.len()),
-                ));
-            }
-            let duration = m.clips[idx].duration;
-            let fps = scene.fps;
-            let frames = (duration * fps).floor() as usize + 1;
-            notes.push(format!(
-                "clip {idx} {:?}: {duration:.3} s at {fps} fps = {frames} frames",
-                m.clips[idx].name
-            ));
-            let mm = m.clone();
-            Loaded::Skinned {
-                mesh: Box::new(m),
-                poses: Box::new(move |f| {
-                    let t = (f as f32 / fps).min(duration);
-                    Ok(SkinnedMesh::flatten(&mm.joint_matrices(Some(idx), t)?))
-                }),
-                frames,
-            }
-        }
-        Source::Lbs(p) => {
-            let a = crate::mesh::libigl::load_elephant_set(p)?;
-            let (m, trunc) = a.to_skinned();
-            let m = weld_skinned(m, scene.weld, p, notes);
-            notes.push(format!(
-                "{}: {} bones, weights cut to the 4 largest per vertex ({} vertices had more \
-                 than four, {} more than four above {}; largest dropped weight sum {:.3}, \
-                 mean {:.4})",
-                p.display(),
-                m.joint_nodes.len(),
-                trunc.vertices_over_4,
-                trunc.significant_over_4,
-                crate::mesh::libigl::SIGNIFICANT_WEIGHT,
-                trunc.max_dropped,
-                trunc.mean_dropped
-            ));
-            let frames = a.frames;
-            Loaded::Skinned {
-                mesh: Box::new(m),
-                poses: Box::new(move |f| Ok(SkinnedMesh::flatten(&a.frame_matrices(f)?))),
-                frames,
-            }
-        }
+        Source::Gltf(p, clip) => gltf_input(scene, p, clip.as_ref(), notes)?,
+        Source::Lbs(p) => lbs_input(scene, p, notes)?,
         Source::Flipbook(pat) => Loaded::Flipbook(crate::mesh::flipbook::Flipbook::open(
             pat,
             Path::new(""),
@@ -167,6 +91,102 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         }
         Source::Held(m) => Loaded::Static(m.0.as_ref().clone()),
         Source::HeldVolume(v, iso, above) => inside_below(v.0.as_ref().clone(), *iso, *above),
+    })
+}
+
+/// A glTF model and its clip's poses (the rest pose as the one frame when
+/// the file has no animation and the scene names no clip).
+fn gltf_input(
+    scene: &Scene,
+    p: &Path,
+    clip: Option<&ClipRef>,
+    notes: &mut Vec<String>,
+) -> Result<Loaded> {
+    let m = weld_skinned(crate::mesh::skinned::load_gltf(p)?, scene.weld, p, notes);
+    if m.clips.is_empty() && clip.is_none() {
+        notes.push(format!(
+            "{}: no animation; the rest pose is the one frame",
+            p.display()
+        ));
+        let rest = SkinnedMesh::flatten(&m.joint_matrices(None, 0.0)?);
+        return Ok(Loaded::Skinned {
+            mesh: Box::new(m),
+            poses: Box::new(move |_| Ok(rest.clone())),
+            frames: 1,
+        });
+    }
+    let idx = clip_index(&m, p, clip)?;
+    let duration = m.clips[idx].duration;
+    let fps = scene.fps;
+    let frames = (duration * fps).floor() as usize + 1;
+    notes.push(format!(
+        "clip {idx} {:?}: {duration:.3} s at {fps} fps = {frames} frames",
+        m.clips[idx].name
+    ));
+    let mm = m.clone();
+    Ok(Loaded::Skinned {
+        mesh: Box::new(m),
+        poses: Box::new(move |f| {
+            let t = (f as f32 / fps).min(duration);
+            Ok(SkinnedMesh::flatten(&mm.joint_matrices(Some(idx), t)?))
+        }),
+        frames,
+    })
+}
+
+/// The index of the scene's clip (the first when it names none), checked
+/// against the clips of the model at `p`.
+fn clip_index(m: &SkinnedMesh, p: &Path, clip: Option<&ClipRef>) -> Result<usize> {
+    let idx = match clip.cloned().unwrap_or(ClipRef::Index(0)) {
+        ClipRef::Index(i) => i,
+        ClipRef::Name(n) => m.clips.iter().position(|c| c.name == n).ok_or_else(|| {
+            Error::input(
+                p.display().to_string(),
+                format!("clip {n:?}"),
+                format!(
+                    "no such clip; the file has {}",
+                    m.clips
+                        .iter()
+                        .map(|c| format!("\"{}\"", c.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })?,
+    };
+    if idx >= m.clips.len() {
+        return Err(Error::input(
+            p.display().to_string(),
+            format!("clip {idx}"),
+            format!("the file has {} clips", m.clips.len()),
+        ));
+    }
+    Ok(idx)
+}
+
+/// An LBS set (libigl's elephant format) with its weights cut to four per
+/// vertex, and a note of what the cut dropped.
+fn lbs_input(scene: &Scene, p: &Path, notes: &mut Vec<String>) -> Result<Loaded> {
+    let a = crate::mesh::libigl::load_elephant_set(p)?;
+    let (m, trunc) = a.to_skinned();
+    let m = weld_skinned(m, scene.weld, p, notes);
+    notes.push(format!(
+        "{}: {} bones, weights cut to the 4 largest per vertex ({} vertices had more \
+         than four, {} more than four above {}; largest dropped weight sum {:.3}, \
+         mean {:.4})",
+        p.display(),
+        m.joint_nodes.len(),
+        trunc.vertices_over_4,
+        trunc.significant_over_4,
+        crate::mesh::libigl::SIGNIFICANT_WEIGHT,
+        trunc.max_dropped,
+        trunc.mean_dropped
+    ));
+    let frames = a.frames;
+    Ok(Loaded::Skinned {
+        mesh: Box::new(m),
+        poses: Box::new(move |f| Ok(SkinnedMesh::flatten(&a.frame_matrices(f)?))),
+        frames,
     })
 }
 

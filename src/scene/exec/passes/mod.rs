@@ -178,58 +178,12 @@ impl<'s, 'g> Executor<'s, 'g> {
             dcurv: has(Pass::Dcurv),
             ..scene.curvature
         };
-        let line_opts = LineOptions {
-            contours: has(Pass::Contours),
-            suggestive: has(Pass::SuggestiveContours),
-            threshold: fx.suggestive_threshold,
-            fade: fx.suggestive_fade,
-            // The curvature line cues' families and controls.
-            curves: fx.lines.curves_for(&fx.cues),
-        };
-        let pipe = match &loaded {
-            Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(
-                gpu.clone(),
-                mesh,
-                PipelineOptions {
-                    curvature: curv_opts,
-                    ao_mode: fx.ao_mode,
-                    ..PipelineOptions::default()
-                },
-                PipelineStages {
-                    curvature: has(Pass::OneRings),
-                    ao: has(Pass::Ao),
-                    // The lines are per topology for every input (contours
-                    // alone are found from host normals, without curvature).
-                    lines: false,
-                },
-            )?),
-            _ => None,
-        };
-        let iso = match &loaded {
-            Loaded::Volume(v, ..) if has(Pass::Isosurface) => {
-                Some(Isosurfacer::new(gpu.clone(), v)?)
-            }
-            _ => None,
-        };
-        let sdf_lines = match &loaded {
-            Loaded::Volume(v, iso, _) if has(Pass::SdfLines) => {
-                let st = &fx.strokes;
-                // The loader negated an `above` volume: inside is below iso.
-                let opts = SdfLineOptions {
-                    iso: *iso,
-                    inside: Inside::Below,
-                    sampling: st.sampling.clone(),
-                    spacing: st.spacing,
-                    width: st.width,
-                    ..SdfLineOptions::default()
-                };
-                let voxel = crate::spec::sdf_lines::voxel_size(v.spacing);
-                Some((SdfLines::new(gpu.clone(), v, &opts)?, voxel))
-            }
-            _ => None,
-        };
+        let line_opts = line_options(scene, plan);
+        let pipe = skinning_pipeline(&loaded, plan, gpu, scene, curv_opts)?;
+        let iso = isosurfacer(&loaded, plan, gpu)?;
+        let sdf_lines = strokes_stage(&loaded, plan, gpu, scene)?;
         let interop = match has(Pass::Edges) {
-            true => Some(decide(gpu, scene)?),
+            true => Some(view::decide(gpu, scene)?),
             false => None,
         };
         let ao = match (&pipe, has(Pass::Ao)) {
@@ -302,27 +256,11 @@ impl<'s, 'g> Executor<'s, 'g> {
         (self.loaded, self.renderer)
     }
 
-    /// The camera of a view resolved as the first pose resolved the
-    /// scene's own (same origin, same bounds for a fitted view).
-    pub(super) fn camera_of(&self, v: &crate::scene::file::ViewSpec) -> Result<Camera> {
-        let f = self.framing.as_ref().expect("a pose ran");
-        let [w, h] = self.scene.size;
-        draw::camera(v, f.bounds, w as f32 / h as f32, f.origin)
-    }
-
     /// Vertices and faces of the current topology.
     pub(super) fn counts(&self) -> (usize, usize) {
         self.topo
             .as_ref()
             .map_or((0, 0), |t| (t.mesh.n_vertices(), t.mesh.n_faces()))
-    }
-
-    /// The cameras fixed by the first pose.
-    pub(super) fn cameras(&self) -> Vec<Camera> {
-        self.framing
-            .as_ref()
-            .map(|f| f.cameras.clone())
-            .unwrap_or_default()
     }
 
     /// The curvature estimator of the current pose, wherever it lives.
@@ -460,19 +398,9 @@ impl<'s, 'g> Executor<'s, 'g> {
 
     /// Runs one topology or pose pass.
     pub(super) fn pose_pass(&mut self, pass: Pass, frame: usize) -> Result<()> {
-        let has = |p: Pass| self.plan.contains(p);
         match pass {
             Pass::Isosurface => self.isosurface()?,
-            Pass::Skinning => {
-                let Loaded::Skinned { poses, .. } = &self.loaded else {
-                    unreachable!("planned for a skinned input")
-                };
-                let mats = poses(frame)?;
-                let pipe = self.pipe.as_mut().expect("built for the skinning pass");
-                let t = pipe.skin(&mats)?;
-                self.rec
-                    .kernels(pass, &t, "skin_lbs (linear blend, ≤ 4 joints)");
-            }
+            Pass::Skinning => self.skin(frame)?,
             Pass::LoadFrame => {
                 let Loaded::Flipbook(fb) = &self.loaded else {
                     unreachable!("planned for a flipbook input")
@@ -482,34 +410,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 self.rec.wall(pass, ms_since(t0), "read the frame file");
                 self.frame_pos = Some(p);
             }
-            Pass::EdgeBuffer => {
-                let t0 = Instant::now();
-                let caps = has(Pass::CapBuffer);
-                let (marked, name) = match &self.scene.effects.edge_marked {
-                    Some(f) => (read_marked(f)?, f.display().to_string()),
-                    None => (Vec::new(), self.scene.path.display().to_string()),
-                };
-                let t = self.topology(frame)?;
-                let et = if caps {
-                    EdgeTopology::new(&t.mesh, &marked, &name)?
-                } else {
-                    EdgeTopology::without_caps(&t.mesh, &marked, &name)?
-                };
-                self.rec.wall(
-                    pass,
-                    ms_since(t0),
-                    "unique edges with opposite vertices (host, once per topology)",
-                );
-                let t = self.topo.as_mut().expect("made above");
-                t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
-                t.edge_counts = Some(draw::EdgeCounts {
-                    edges: et.edges.len(),
-                    cap_pairs: et.caps.len(),
-                    boundary: et.boundary,
-                    non_manifold: et.non_manifold,
-                    marked: et.marked,
-                });
-            }
+            Pass::EdgeBuffer => self.edge_buffer(frame)?,
             Pass::OneRings => self.one_rings(frame)?,
             Pass::CapBuffer => self.rec.wall(
                 pass,
@@ -517,18 +418,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 "pairs of edges sharing a vertex (built with the edge buffer; time counted there)",
             ),
             Pass::VertexNormals => self.vertex_normals(frame)?,
-            Pass::FaceNormals => {
-                self.host_pose(frame)?;
-                let t0 = Instant::now();
-                let t = self.topo.as_mut().expect("made by the host copies");
-                let es = t.edges.as_mut().expect("planned with the edge buffer");
-                es.set_positions(&self.pose.pos, &self.pose.nrm)?;
-                self.rec.wall(
-                    pass,
-                    ms_since(t0),
-                    "upload the pose to the edge stage; face normals are computed inside edges_detect",
-                );
-            }
+            Pass::FaceNormals => self.face_normals(frame)?,
             Pass::Curvature => {
                 let t = self.curvature_run(frame)?;
                 self.rec
@@ -559,6 +449,68 @@ impl<'s, 'g> Executor<'s, 'g> {
                 unreachable!("{pass:?} is a view pass")
             }
         }
+        Ok(())
+    }
+
+    /// Linear blend skinning of this frame's joint matrices.
+    fn skin(&mut self, frame: usize) -> Result<()> {
+        let Loaded::Skinned { poses, .. } = &self.loaded else {
+            unreachable!("planned for a skinned input")
+        };
+        let mats = poses(frame)?;
+        let pipe = self.pipe.as_mut().expect("built for the skinning pass");
+        let t = pipe.skin(&mats)?;
+        self.rec
+            .kernels(Pass::Skinning, &t, "skin_lbs (linear blend, ≤ 4 joints)");
+        Ok(())
+    }
+
+    /// The edge buffer of this topology: unique edges with their opposite
+    /// vertices (and the cap pairs, when planned), found on the host, and
+    /// the edge stage built on them.
+    fn edge_buffer(&mut self, frame: usize) -> Result<()> {
+        let t0 = Instant::now();
+        let caps = self.plan.contains(Pass::CapBuffer);
+        let (marked, name) = match &self.scene.effects.edge_marked {
+            Some(f) => (read_marked(f)?, f.display().to_string()),
+            None => (Vec::new(), self.scene.path.display().to_string()),
+        };
+        let t = self.topology(frame)?;
+        let et = if caps {
+            EdgeTopology::new(&t.mesh, &marked, &name)?
+        } else {
+            EdgeTopology::without_caps(&t.mesh, &marked, &name)?
+        };
+        self.rec.wall(
+            Pass::EdgeBuffer,
+            ms_since(t0),
+            "unique edges with opposite vertices (host, once per topology)",
+        );
+        let t = self.topo.as_mut().expect("made above");
+        t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
+        t.edge_counts = Some(draw::EdgeCounts {
+            edges: et.edges.len(),
+            cap_pairs: et.caps.len(),
+            boundary: et.boundary,
+            non_manifold: et.non_manifold,
+            marked: et.marked,
+        });
+        Ok(())
+    }
+
+    /// The pose to the edge stage, which computes face normals inside
+    /// `edges_detect`.
+    fn face_normals(&mut self, frame: usize) -> Result<()> {
+        self.host_pose(frame)?;
+        let t0 = Instant::now();
+        let t = self.topo.as_mut().expect("made by the host copies");
+        let es = t.edges.as_mut().expect("planned with the edge buffer");
+        es.set_positions(&self.pose.pos, &self.pose.nrm)?;
+        self.rec.wall(
+            Pass::FaceNormals,
+            ms_since(t0),
+            "upload the pose to the edge stage; face normals are computed inside edges_detect",
+        );
         Ok(())
     }
 
@@ -759,37 +711,86 @@ impl<'s, 'g> Executor<'s, 'g> {
         self.strokes = out;
         Ok(())
     }
+}
 
-    /// The strokes in the scene frame (world minus the scene origin).
-    fn scene_strokes(&self) -> Vec<Stroke> {
-        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
-        let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
-        (self.strokes.strokes.iter())
-            .map(|s| Stroke {
-                points: s.points.iter().map(local).collect(),
-                strip: s.strip.iter().map(local).collect(),
-                ..s.clone()
-            })
-            .collect()
+/// The line extractor's options: the contour families and the curvature
+/// line cues' families and controls the plan holds.
+fn line_options(scene: &Scene, plan: &Plan) -> LineOptions {
+    let fx = &scene.effects;
+    LineOptions {
+        contours: plan.contains(Pass::Contours),
+        suggestive: plan.contains(Pass::SuggestiveContours),
+        threshold: fx.suggestive_threshold,
+        fade: fx.suggestive_fade,
+        // The curvature line cues' families and controls.
+        curves: fx.lines.curves_for(&fx.cues),
     }
 }
 
-/// The route of the edges frame's buffers to GL, decided once per run from
-/// the scene's mode and what the device, GL and Vulkan offer. An
-/// isosurface's topology changes every pose, so it always reads back.
-fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, InteropOffer)> {
-    let offer = interop_offer(gpu, scene.interop);
-    let mut d = decide_interop(scene.interop, &offer)?;
-    if d.route == InteropRoute::ExternalMemory
-        && scene.source.input() == crate::scene::planner::Input::Volume
-    {
-        d.passed_over.push(format!("external memory: {}", d.reason));
-        d = InteropDecision {
-            route: InteropRoute::Host,
-            shared: false,
-            reason: "host path: an isosurface's topology changes every pose".into(),
-            passed_over: d.passed_over,
-        };
-    }
-    Ok((d, offer))
+/// The skinning pipeline of a skinned input (skinning, and curvature and
+/// AO where planned); none for other inputs.
+fn skinning_pipeline(
+    loaded: &Loaded,
+    plan: &Plan,
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    curv_opts: CurvatureOptions,
+) -> Result<Option<PosePipeline>> {
+    let has = |p: Pass| plan.contains(p);
+    Ok(match loaded {
+        Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(
+            gpu.clone(),
+            mesh,
+            PipelineOptions {
+                curvature: curv_opts,
+                ao_mode: scene.effects.ao_mode,
+                ..PipelineOptions::default()
+            },
+            PipelineStages {
+                curvature: has(Pass::OneRings),
+                ao: has(Pass::Ao),
+                // The lines are per topology for every input (contours
+                // alone are found from host normals, without curvature).
+                lines: false,
+            },
+        )?),
+        _ => None,
+    })
+}
+
+/// The isosurfacer of a volume input, when the isosurface is planned.
+fn isosurfacer(loaded: &Loaded, plan: &Plan, gpu: &Arc<Gpu>) -> Result<Option<Isosurfacer>> {
+    Ok(match loaded {
+        Loaded::Volume(v, ..) if plan.contains(Pass::Isosurface) => {
+            Some(Isosurfacer::new(gpu.clone(), v)?)
+        }
+        _ => None,
+    })
+}
+
+/// The curvature-directed strokes stage of a volume input and its voxel
+/// size, when the strokes are planned.
+fn strokes_stage(
+    loaded: &Loaded,
+    plan: &Plan,
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+) -> Result<Option<(SdfLines, f64)>> {
+    Ok(match loaded {
+        Loaded::Volume(v, iso, _) if plan.contains(Pass::SdfLines) => {
+            let st = &scene.effects.strokes;
+            // The loader negated an `above` volume: inside is below iso.
+            let opts = SdfLineOptions {
+                iso: *iso,
+                inside: Inside::Below,
+                sampling: st.sampling.clone(),
+                spacing: st.spacing,
+                width: st.width,
+                ..SdfLineOptions::default()
+            };
+            let voxel = crate::spec::sdf_lines::voxel_size(v.spacing);
+            Some((SdfLines::new(gpu.clone(), v, &opts)?, voxel))
+        }
+        _ => None,
+    })
 }

@@ -1,10 +1,31 @@
 //! The view passes: contours and suggestive contours, feature edges with
 //! their caps, and the render pass, run once per frame and camera. Each arm
-//! runs because its pass is in the plan.
+//! runs because its pass is in the plan. Also what the views need of the
+//! run: their cameras, the edges frame's route to GL and the strokes in the
+//! scene frame.
 
 use super::*;
 
 impl Executor<'_, '_> {
+    /// The camera of a view resolved as the first pose resolved the
+    /// scene's own (same origin, same bounds for a fitted view).
+    pub(in crate::scene::exec) fn camera_of(
+        &self,
+        v: &crate::scene::file::ViewSpec,
+    ) -> Result<Camera> {
+        let f = self.framing.as_ref().expect("a pose ran");
+        let [w, h] = self.scene.size;
+        draw::camera(v, f.bounds, w as f32 / h as f32, f.origin)
+    }
+
+    /// The cameras fixed by the first pose.
+    pub(in crate::scene::exec) fn cameras(&self) -> Vec<Camera> {
+        self.framing
+            .as_ref()
+            .map(|f| f.cameras.clone())
+            .unwrap_or_default()
+    }
+
     /// Starts a view.
     pub(in crate::scene::exec) fn begin_view(&mut self) {
         self.segs.clear();
@@ -54,155 +75,213 @@ impl Executor<'_, '_> {
                 };
                 self.rec.kernels(pass, &t, how);
             }
-            Pass::LinesCurves => {
-                let t = self.lines(cam)?;
-                // The pose terms run in the first view's launch after a
-                // curvature run: recorded where they ran, once per pose.
-                if t.ran(Pass::LinesPose.kernels()) {
-                    self.rec.kernels(
-                        Pass::LinesPose,
-                        &t,
-                        "lines_pose (larger principal curvature, its derivative, K, H), \
-                         launched with the pose's first view",
-                    );
-                }
-                let fx = &self.scene.effects;
-                let families: Vec<&str> = (fx.lines.styles_for(&fx.cues).iter())
-                    .map(|s| s.family.name())
-                    .collect();
-                let contours = self.plan.contains(Pass::Contours)
-                    || self.plan.contains(Pass::SuggestiveContours);
-                if contours {
-                    let how = format!(
-                        "lines_curves ({}); lines_vertex counted with the contours",
-                        families.join(", ")
-                    );
-                    self.rec.kernels_of(pass, &t, &[Step::LinesCurves], &how);
-                } else {
-                    let how = format!("lines_vertex + lines_curves ({})", families.join(", "));
-                    self.rec.kernels(pass, &t, &how);
-                }
-            }
-            Pass::Edges => {
-                let fx = &self.scene.effects;
-                let [w, h] = self.scene.size;
-                let mut p = EdgeParams::new(cam.view(w, h));
-                p.line_width = fx.edge.0;
-                p.crease_deg = fx.crease;
-                p.contours = fx.edge_contours;
-                p.boundaries = fx.edge_boundaries;
-                p.depth_scale = fx.edge_depth_scale;
-                p.half_contours = fx.edge_half_contours;
-                p.pack()?;
-                let shared = (self.interop.as_ref()).is_some_and(|(d, _)| d.shared);
-                let svg = self.keep_layers
-                    || paths
-                        .iter()
-                        .any(|p| p.extension().is_none_or(|e| e != "png"));
-                let t = self.topo.as_mut().expect("a pose ran");
-                let es = t.edges.as_mut().expect("planned with the edge buffer");
-                let timing = es.run(&p, fx.caps)?;
-                let out = if shared {
-                    // Compacted into memory GL draws from; only the kinds
-                    // (and the quads for an SVG) come back.
-                    let sh = match &mut t.shared {
-                        Some(sh) => sh,
-                        None => t.shared.insert(SharedEdges::new(
-                            self.gpu,
-                            &mut self.renderer,
-                            es,
-                            fx.caps,
-                        )?),
-                    };
-                    let d = sh.compact(self.gpu, es)?;
-                    let mut out = EdgeOutput {
-                        kind: d.kind.clone(),
-                        ..EdgeOutput::default()
-                    };
-                    if svg {
-                        out.edge_out = sh.read_edges(self.gpu, &d)?;
-                    }
-                    self.shared_drawn = Some(d);
-                    out
-                } else {
-                    // Only what was drawn comes back, compacted on the device.
-                    es.read_drawn()?
-                };
-                self.rec.kernels(
-                    pass,
-                    &timing,
-                    "edges_detect (contour, crease, boundary) into edge-out",
-                );
-                self.edges_ran = Some((timing, out));
-            }
+            Pass::LinesCurves => self.line_curves_pass(pass, cam)?,
+            Pass::Edges => self.edges_pass(pass, cam, paths)?,
             Pass::Caps => {
                 let (timing, _) = self.edges_ran.as_ref().expect("planned after the edges");
                 let how = format!("caps_{}", self.scene.effects.caps.name());
                 self.rec.kernels(pass, timing, &how);
             }
-            Pass::Render => {
-                let t0 = Instant::now();
-                let t = self.topo.as_ref().expect("a pose ran");
-                // The mesh goes to GL once per topology (faces) and once per
-                // pose (positions, normals, colours), not once per view.
-                if !self.gl_topology {
-                    self.renderer.upload_topology(&t.mesh.faces)?;
-                    self.gl_topology = true;
-                }
-                if !self.gl_pose {
-                    let colors = draw::mesh_colors(
-                        self.scene,
-                        self.plan,
-                        &self.pose,
-                        self.color_scale.unwrap_or(1.0),
-                    );
-                    self.renderer
-                        .upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
-                    self.gl_pose = true;
-                }
-                let strokes = self.scene_strokes();
-                let shared = (t.shared.as_ref()).zip(self.shared_drawn.as_ref());
-                let lines = ViewLines {
-                    segments: &self.segs,
-                    edges: self.edges_ran.as_ref().map(|e| &e.1),
-                    shared,
-                    strokes: &strokes,
-                    // Half a voxel towards the eye: the strokes lie on the
-                    // interpolated surface, which marching cubes cuts as chords.
-                    stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
-                };
-                let want_layers = self.keep_image && self.keep_layers;
-                let d = draw::draw_view(
-                    &mut self.renderer,
-                    self.scene,
-                    self.plan,
-                    cam,
-                    lines,
-                    paths,
-                    want_layers,
-                )?;
-                let drawn = d.segments;
-                if self.keep_image {
-                    self.kept = Some(self.kept_view(cam, d));
-                }
-                self.rec.wall(
-                    pass,
-                    ms_since(t0),
-                    "draw mesh, line quads, edge quads and stroke strips; read back",
-                );
-                self.segments[0] += drawn[0];
-                self.segments[1] += drawn[1];
-                let fx = &self.scene.effects;
-                for st in &fx.lines.styles_for(&fx.cues) {
-                    let kind = st.family as u32;
-                    let n = self.segs.iter().filter(|s| s.2 == kind).count();
-                    *self.line_segments.entry(st.family.name()).or_default() += n;
-                }
-                self.outputs.extend(paths.iter().map(|p| (*p).clone()));
-            }
+            Pass::Render => self.render_pass(pass, cam, paths)?,
             _ => unreachable!("{pass:?} is not a view pass"),
         }
         Ok(())
+    }
+
+    /// The curvature line families of this view (and the pose terms, when
+    /// they ran in its launch).
+    fn line_curves_pass(&mut self, pass: Pass, cam: &Camera) -> Result<()> {
+        let t = self.lines(cam)?;
+        // The pose terms run in the first view's launch after a
+        // curvature run: recorded where they ran, once per pose.
+        if t.ran(Pass::LinesPose.kernels()) {
+            self.rec.kernels(
+                Pass::LinesPose,
+                &t,
+                "lines_pose (larger principal curvature, its derivative, K, H), \
+                 launched with the pose's first view",
+            );
+        }
+        let fx = &self.scene.effects;
+        let families: Vec<&str> = (fx.lines.styles_for(&fx.cues).iter())
+            .map(|s| s.family.name())
+            .collect();
+        let contours =
+            self.plan.contains(Pass::Contours) || self.plan.contains(Pass::SuggestiveContours);
+        if contours {
+            let how = format!(
+                "lines_curves ({}); lines_vertex counted with the contours",
+                families.join(", ")
+            );
+            self.rec.kernels_of(pass, &t, &[Step::LinesCurves], &how);
+        } else {
+            let how = format!("lines_vertex + lines_curves ({})", families.join(", "));
+            self.rec.kernels(pass, &t, &how);
+        }
+        Ok(())
+    }
+
+    /// The feature edges of this view: the edge stage runs, then what is
+    /// drawn reaches GL through the shared buffer or comes back compacted.
+    fn edges_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
+        let p = self.edge_params(cam)?;
+        let caps = self.scene.effects.caps;
+        let shared = (self.interop.as_ref()).is_some_and(|(d, _)| d.shared);
+        let svg = self.keep_layers
+            || paths
+                .iter()
+                .any(|p| p.extension().is_none_or(|e| e != "png"));
+        let t = self.topo.as_mut().expect("a pose ran");
+        let es = t.edges.as_mut().expect("planned with the edge buffer");
+        let timing = es.run(&p, caps)?;
+        let out = if shared {
+            self.compact_shared(svg)?
+        } else {
+            // Only what was drawn comes back, compacted on the device.
+            es.read_drawn()?
+        };
+        self.rec.kernels(
+            pass,
+            &timing,
+            "edges_detect (contour, crease, boundary) into edge-out",
+        );
+        self.edges_ran = Some((timing, out));
+        Ok(())
+    }
+
+    /// The edge stage's parameters for `cam`, from the scene's effects.
+    fn edge_params(&self, cam: &Camera) -> Result<EdgeParams> {
+        let fx = &self.scene.effects;
+        let [w, h] = self.scene.size;
+        let mut p = EdgeParams::new(cam.view(w, h));
+        p.line_width = fx.edge.0;
+        p.crease_deg = fx.crease;
+        p.contours = fx.edge_contours;
+        p.boundaries = fx.edge_boundaries;
+        p.depth_scale = fx.edge_depth_scale;
+        p.half_contours = fx.edge_half_contours;
+        p.pack()?;
+        Ok(p)
+    }
+
+    /// The edges compacted into memory GL draws from (the shared buffer,
+    /// made by the first view); only the kinds (and the quads for an SVG)
+    /// come back.
+    fn compact_shared(&mut self, svg: bool) -> Result<EdgeOutput> {
+        let caps = self.scene.effects.caps;
+        let t = self.topo.as_mut().expect("a pose ran");
+        let es = t.edges.as_mut().expect("planned with the edge buffer");
+        let sh = match &mut t.shared {
+            Some(sh) => sh,
+            None => t
+                .shared
+                .insert(SharedEdges::new(self.gpu, &mut self.renderer, es, caps)?),
+        };
+        let d = sh.compact(self.gpu, es)?;
+        let mut out = EdgeOutput {
+            kind: d.kind.clone(),
+            ..EdgeOutput::default()
+        };
+        if svg {
+            out.edge_out = sh.read_edges(self.gpu, &d)?;
+        }
+        self.shared_drawn = Some(d);
+        Ok(out)
+    }
+
+    /// The render pass: draws the view, writes `paths`, keeps the view's
+    /// outputs when asked and counts its segments.
+    fn render_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
+        let t0 = Instant::now();
+        self.upload_mesh()?;
+        let d = self.draw(cam, paths)?;
+        let drawn = d.segments;
+        if self.keep_image {
+            self.kept = Some(self.kept_view(cam, d));
+        }
+        self.rec.wall(
+            pass,
+            ms_since(t0),
+            "draw mesh, line quads, edge quads and stroke strips; read back",
+        );
+        self.count_segments(drawn);
+        self.outputs.extend(paths.iter().map(|p| (*p).clone()));
+        Ok(())
+    }
+
+    /// The mesh to GL once per topology (faces) and once per pose
+    /// (positions, normals, colours), not once per view.
+    fn upload_mesh(&mut self) -> Result<()> {
+        let t = self.topo.as_ref().expect("a pose ran");
+        if !self.gl_topology {
+            self.renderer.upload_topology(&t.mesh.faces)?;
+            self.gl_topology = true;
+        }
+        if !self.gl_pose {
+            let colors = draw::mesh_colors(
+                self.scene,
+                self.plan,
+                &self.pose,
+                self.color_scale.unwrap_or(1.0),
+            );
+            self.renderer
+                .upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
+            self.gl_pose = true;
+        }
+        Ok(())
+    }
+
+    /// Draws the view's mesh, lines, edges and strokes from `cam` and
+    /// writes `paths` ([`draw::draw_view`]).
+    fn draw(&mut self, cam: &Camera, paths: &[&PathBuf]) -> Result<draw::DrawnView> {
+        let t = self.topo.as_ref().expect("a pose ran");
+        let strokes = self.scene_strokes();
+        let shared = (t.shared.as_ref()).zip(self.shared_drawn.as_ref());
+        let lines = ViewLines {
+            segments: &self.segs,
+            edges: self.edges_ran.as_ref().map(|e| &e.1),
+            shared,
+            strokes: &strokes,
+            // Half a voxel towards the eye: the strokes lie on the
+            // interpolated surface, which marching cubes cuts as chords.
+            stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
+        };
+        let want_layers = self.keep_image && self.keep_layers;
+        draw::draw_view(
+            &mut self.renderer,
+            self.scene,
+            self.plan,
+            cam,
+            lines,
+            paths,
+            want_layers,
+        )
+    }
+
+    /// Adds the view's drawn contour and suggestive-contour segments, and
+    /// its segments of each curvature line family, to the run's counts.
+    fn count_segments(&mut self, drawn: [usize; 2]) {
+        self.segments[0] += drawn[0];
+        self.segments[1] += drawn[1];
+        let fx = &self.scene.effects;
+        for st in &fx.lines.styles_for(&fx.cues) {
+            let kind = st.family as u32;
+            let n = self.segs.iter().filter(|s| s.2 == kind).count();
+            *self.line_segments.entry(st.family.name()).or_default() += n;
+        }
+    }
+
+    /// The strokes in the scene frame (world minus the scene origin).
+    fn scene_strokes(&self) -> Vec<Stroke> {
+        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
+        (self.strokes.strokes.iter())
+            .map(|s| Stroke {
+                points: s.points.iter().map(local).collect(),
+                strip: s.strip.iter().map(local).collect(),
+                ..s.clone()
+            })
+            .collect()
     }
 
     /// What a view drawn into memory hands its caller: the image, the SVG
@@ -288,41 +367,14 @@ impl Executor<'_, '_> {
         let feature_size = match *feature_size {
             Some(fs) => fs,
             None => {
-                // Once per topology: rtsc's size reads the curvature of the
-                // first pose (world units) at its 500 sampled vertices, in
-                // place on the device; else the median edge length.
-                let field = match est {
-                    Some(e) if self.plan.contains(Pass::Curvature) => Some(e.mapped(None)?),
-                    _ => None,
-                };
-                let at = |i: usize| {
-                    let v = field.as_ref().expect("read only with a field").vertex(i);
-                    [v.k1, v.k2]
-                };
-                let k: Option<&dyn Fn(usize) -> [f64; 2]> = field.as_ref().map(|_| &at as _);
-                let fs = crate::mesh::feature_size::resolve(
-                    self.scene.effects.feature_size,
-                    &mesh.positions,
-                    &mesh.faces,
-                    k,
-                ) as f32;
-                let read_curvature = k.is_some();
-                drop(field);
+                let fs = resolve_feature_size(
+                    self.scene,
+                    self.plan,
+                    mesh,
+                    est,
+                    &mut self.feature_size_note,
+                )?;
                 *feature_size = Some(fs);
-                if self.feature_size_note.is_none() {
-                    use crate::spec::feature_lines::FeatureSize;
-                    let how = match self.scene.effects.feature_size {
-                        FeatureSize::Rtsc if read_curvature => {
-                            "rtsc's, from the first pose's curvature"
-                        }
-                        FeatureSize::Rtsc => "the median edge length: no curvature is planned",
-                        FeatureSize::Edge => "the median edge length",
-                        FeatureSize::Value(_) => "as given",
-                    };
-                    self.feature_size_note = Some(format!(
-                        "line thresholds scaled by the feature size {fs:.4e} ({how})"
-                    ));
-                }
                 fs
             }
         };
@@ -346,4 +398,67 @@ impl Executor<'_, '_> {
         self.lines_ran = Some(stats.timing.clone());
         Ok(stats.timing)
     }
+}
+
+/// The feature size of a topology, found once by its first view: rtsc's
+/// size reads the curvature of the first pose (world units) at its 500
+/// sampled vertices, in place on the device; else the median edge length.
+/// The first topology's also goes to `note`, for the run's notes.
+fn resolve_feature_size(
+    scene: &Scene,
+    plan: &Plan,
+    mesh: &Mesh,
+    est: Option<&CurvatureEstimator>,
+    note: &mut Option<String>,
+) -> Result<f32> {
+    let field = match est {
+        Some(e) if plan.contains(Pass::Curvature) => Some(e.mapped(None)?),
+        _ => None,
+    };
+    let at = |i: usize| {
+        let v = field.as_ref().expect("read only with a field").vertex(i);
+        [v.k1, v.k2]
+    };
+    let k: Option<&dyn Fn(usize) -> [f64; 2]> = field.as_ref().map(|_| &at as _);
+    let fs = crate::mesh::feature_size::resolve(
+        scene.effects.feature_size,
+        &mesh.positions,
+        &mesh.faces,
+        k,
+    ) as f32;
+    let read_curvature = k.is_some();
+    drop(field);
+    if note.is_none() {
+        use crate::spec::feature_lines::FeatureSize;
+        let how = match scene.effects.feature_size {
+            FeatureSize::Rtsc if read_curvature => "rtsc's, from the first pose's curvature",
+            FeatureSize::Rtsc => "the median edge length: no curvature is planned",
+            FeatureSize::Edge => "the median edge length",
+            FeatureSize::Value(_) => "as given",
+        };
+        *note = Some(format!(
+            "line thresholds scaled by the feature size {fs:.4e} ({how})"
+        ));
+    }
+    Ok(fs)
+}
+
+/// The route of the edges frame's buffers to GL, decided once per run from
+/// the scene's mode and what the device, GL and Vulkan offer. An
+/// isosurface's topology changes every pose, so it always reads back.
+pub(super) fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, InteropOffer)> {
+    let offer = interop_offer(gpu, scene.interop);
+    let mut d = decide_interop(scene.interop, &offer)?;
+    if d.route == InteropRoute::ExternalMemory
+        && scene.source.input() == crate::scene::planner::Input::Volume
+    {
+        d.passed_over.push(format!("external memory: {}", d.reason));
+        d = InteropDecision {
+            route: InteropRoute::Host,
+            shared: false,
+            reason: "host path: an isosurface's topology changes every pose".into(),
+            passed_over: d.passed_over,
+        };
+    }
+    Ok((d, offer))
 }
