@@ -8,8 +8,7 @@ use std::path::PathBuf;
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// What [`Error::gl_sharing_required`] says is missing; the reasons follow it.
-pub const GL_SHARING_REQUIRED: &str = "interop mode on (the command line's --interop on) needs \
-     a shared route, CL-GL sharing \
+pub const GL_SHARING_REQUIRED: &str = "interop = on needs a shared route, CL-GL sharing \
      (cl_khr_gl_sharing) or external memory (cl_khr_external_memory_opaque_fd with \
      GL_EXT_memory_object_fd and Vulkan's VK_KHR_external_memory_fd), and neither can run";
 

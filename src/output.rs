@@ -133,7 +133,7 @@ fn refuse_output(
         };
         return Err(refuse(format!(
             "refusing to write {}: it is the input file {}{how}; an input is never overwritten, \
-             not even with force = true (the command line's --force)",
+             not even with force = true",
             out.display(),
             inp.display()
         )));
@@ -157,8 +157,7 @@ fn refuse_output(
     }
     if id.is_some() && !force {
         return Err(refuse(format!(
-            "{} exists and overwrite is off; pass force = true (the command line's --force) \
-             to overwrite it",
+            "{} exists; pass force = true to overwrite it",
             out.display()
         )));
     }
@@ -445,7 +444,7 @@ mod tests {
         let a = d.join("o.json");
         std::fs::write(&a, "{}").unwrap();
         let e = check_outputs(&[], &[&a], false).unwrap_err().to_string();
-        assert!(e.contains("--force"), "{e}");
+        assert!(e.contains("force = true"), "{e}");
         check_outputs(&[], &[&a], true).unwrap();
         let e = check_outputs(&[], &[Path::new("-")], true)
             .unwrap_err()

@@ -102,7 +102,7 @@ fn decision_for_every_combination_of_what_is_reported() {
                 assert_eq!(e.exit_code(), 3, "{case}");
                 let m = e.to_string();
                 for name in [
-                    "--interop on",
+                    "interop = on",
                     "cl_khr_gl_sharing",
                     "external memory",
                     missing,

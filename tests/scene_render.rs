@@ -160,7 +160,7 @@ fn outputs_are_not_overwritten_without_force() {
     let png = r.unwrap().outputs[0].clone();
     std::fs::write(&png, b"mine").unwrap();
     let e = run(&s, &dir, false).unwrap().expect_err("refuses");
-    assert!(e.to_string().contains("--force"), "{e}");
+    assert!(e.to_string().contains("force = true"), "{e}");
     assert_eq!(std::fs::read(&png).unwrap(), b"mine", "untouched");
     run(&s, &dir, true).unwrap().unwrap();
     assert_ne!(

@@ -95,7 +95,7 @@ pub fn fail(e: &anyhow::Error) -> i32 {
         msg.push_str(&text);
         prev = text;
     }
-    eprintln!("error: {msg}");
+    eprintln!("error: {}", flag_words(&msg));
     if e.chain()
         .any(|c| c.downcast_ref::<view::NoDisplay>().is_some())
     {
@@ -104,6 +104,19 @@ pub fn fail(e: &anyhow::Error) -> i32 {
     e.chain()
         .find_map(|c| c.downcast_ref::<shapecue::Error>())
         .map_or(1, shapecue::Error::exit_code)
+}
+
+/// The library's option words in a message as this command line's flags
+/// (the library names options and values: `force = true`, `interop = on`).
+fn flag_words(msg: &str) -> String {
+    const FLAGS: [(&str, &str); 3] = [
+        ("pass force = true", "pass --force"),
+        ("not even with force = true", "not even with --force"),
+        ("interop = on needs", "--interop on needs"),
+    ];
+    FLAGS
+        .iter()
+        .fold(msg.to_string(), |m, (option, flag)| m.replace(option, flag))
 }
 
 /// Says on stderr when a PLY file's vertex properties had to be written as

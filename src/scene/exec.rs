@@ -515,8 +515,7 @@ fn check_outputs_across(scenes: &[Scene], opts: &ExecOptions) -> Result<()> {
         }
         if !opts.force && a.exists() {
             return Err(Error::InvalidArgument(format!(
-                "{}: {} exists (from an earlier run) and overwrite is off; pass force = true \
-                 (the command line's --force) to overwrite it",
+                "{}: {} exists (from an earlier run); pass force = true to overwrite it",
                 sa.path.display(),
                 a.display()
             )));
