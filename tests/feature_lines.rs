@@ -511,3 +511,36 @@ fn a_face_with_more_pieces_than_the_first_buffer_holds_grows_it() {
     let (again, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
     assert_eq!(again.len(), 3);
 }
+
+/// A lines picture of no family, and a held scene of no cue, are refused
+/// with a clear error (nothing to draw), never a panic.
+#[test]
+fn a_picture_of_nothing_is_an_error() {
+    let (_, mesh) = mesh::Generated::Torus.mesh(500);
+    let opts = shapecue::LinesPictureOptions {
+        lines: LineOptions {
+            contours: false,
+            suggestive: false,
+            curves: Default::default(),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let e = shapecue::lines_picture_on(&gpu(), &mesh, &opts)
+        .err()
+        .expect("refused");
+    assert!(e.to_string().contains("no line family"), "{e}");
+    let held = shapecue::api::Source::Held(shapecue::api::HeldMesh(std::sync::Arc::new(mesh)));
+    let scene = shapecue::api::Scene::held(held, &shapecue::Shot::default());
+    match shapecue::api::Session::on(gpu()).picture(&scene, &Default::default()) {
+        Err(e) => {
+            let m = e.to_string();
+            // Without GL the renderer's error comes first; with it, the plan's.
+            assert!(
+                m.contains("nothing to draw") || m.contains("OpenGL") || m.contains("EGL"),
+                "{m}"
+            );
+        }
+        Ok(_) => panic!("a scene of no cue drew something"),
+    }
+}

@@ -97,8 +97,10 @@ pub struct EdgePicture {
     pub vertices: usize,
     /// Mesh faces.
     pub faces: usize,
-    /// Kernel time of the edge stage, and the wall time of every pass that
-    /// ran as a phase named after it.
+    /// Kernel time of the edge stage, the wall time of the whole frame
+    /// (topology, stage, GL context, drawing and read-backs), and every pass
+    /// that ran as a phase named after it (on the pass's own clock: kernel
+    /// time for `edges` and `caps`, wall time for the others).
     pub timing: Timing,
     /// The passes that ran, in plan order.
     pub passes: Vec<PassRecord>,
@@ -167,11 +169,14 @@ pub fn feature_edges_picture_on(
     opts: &EdgePictureOptions,
 ) -> Result<EdgePicture> {
     let scene = edges_scene(Arc::new(mesh.clone()), name, opts)?;
+    let t0 = std::time::Instant::now();
     let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
+    let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
     let v = f.view;
     let camera = v.world_camera();
     let info = v.edge_info.expect("feature edges are planned");
     let mut timing = v.timing;
+    timing.wall_ms = wall_ms;
     for p in &f.passes {
         timing.phase(p.pass.name(), p.ms);
     }

@@ -97,6 +97,11 @@ pub fn lines_picture_on(
     mesh: &Mesh,
     opts: &LinesPictureOptions,
 ) -> Result<LinesPicture> {
+    if wanted(&opts.lines).is_empty() {
+        return Err(crate::error::Error::InvalidArgument(
+            "no line family is asked for, so there is nothing to draw".into(),
+        ));
+    }
     let scene = lines_scene(Arc::new(mesh.clone()), opts);
     let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
     let v = f.view;

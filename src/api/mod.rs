@@ -56,7 +56,7 @@ pub use crate::scene::exec::{
     Checked, ExecOptions, RunReport, Session, check_scenes, explain, run as run_scene,
     run_on as run_scene_on,
 };
-pub use crate::scene::file::Scene;
+pub use crate::scene::file::{HeldMesh, HeldVolume, Scene, Source};
 pub use crate::stages::curvature::{
     CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
 };

@@ -290,7 +290,12 @@ enum Surface<'a> {
 /// Refuses a field with no surface at the iso value (every finite value on
 /// one side of it), before anything is drawn.
 fn check_surface(vol: &Volume, iso_below: f32, what: Surface<'_>) -> Result<()> {
-    let crosses = (vol.range()).is_some_and(|(lo, hi)| lo < iso_below && hi >= iso_below);
+    // Finite values only: marching cubes takes an infinite one as missing.
+    let finite = vol.values.iter().filter(|v| v.is_finite());
+    let (below, above) = finite.fold((false, false), |(b, a), &v| {
+        (b || v < iso_below, a || v >= iso_below)
+    });
+    let crosses = below && above;
     if crosses {
         return Ok(());
     }

@@ -255,7 +255,7 @@ fn stats(
         "interop_offer": d.offer,
         "timing": d.timing,
         "topology_ms": d.timing.phase_ms("edge_buffer") + d.timing.phase_ms("cap_buffer"),
-        "frame_ms": d.passes.iter().map(|p| p.ms).sum::<f64>(),
+        "frame_ms": d.timing.wall_ms,
         "phases_ms": phases,
         "memory_bits": d.memory,
         "svg_polylines": d.layers.as_ref().map_or(0, |l| l.iter().map(|l| l.lines.len()).sum()),

@@ -107,12 +107,12 @@ pub fn fail(e: &anyhow::Error) -> i32 {
 }
 
 /// The library's option words in a message as this command line's flags
-/// (the library names options and values: `force = true`, `interop = on`).
+/// (the library names options and values: `force = true`; `interop = on`
+/// stays, since it may come from a scene file's `[output]` as well).
 fn flag_words(msg: &str) -> String {
-    const FLAGS: [(&str, &str); 3] = [
+    const FLAGS: [(&str, &str); 2] = [
         ("pass force = true", "pass --force"),
         ("not even with force = true", "not even with --force"),
-        ("interop = on needs", "--interop on needs"),
     ];
     FLAGS
         .iter()

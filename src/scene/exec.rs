@@ -316,6 +316,12 @@ fn render_all(
     let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, progress)?;
 
     let (vertices, faces) = ex.counts();
+    let passes = ex.rec.in_plan_order(&plan);
+    // The run's kernel time: its kernel passes' (the laps are wall time).
+    let kernel_ms = (passes.iter())
+        .filter(|p| p.clock == "kernel")
+        .map(|p| p.ms)
+        .sum();
     let report = RunReport {
         scene: scene.path.display().to_string(),
         device: gpu.info.name.clone(),
@@ -325,7 +331,7 @@ fn render_all(
         views: scene.views.len(),
         vertices,
         faces,
-        passes: ex.rec.in_plan_order(&plan),
+        passes,
         gl_uploads: {
             let now = ex.uploads();
             crate::render::Uploads {
@@ -343,6 +349,7 @@ fn render_all(
         outputs: std::mem::take(&mut ex.outputs),
         timing: crate::spec::timing::Timing {
             wall_ms: ms_since(t_all),
+            kernel_ms,
             ..timing
         },
     };

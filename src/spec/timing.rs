@@ -235,8 +235,9 @@ pub struct StepTime {
     pub launches: u32,
 }
 
-/// Host wall time of one phase of a call: a part that is not one kernel
-/// (loading, building a topology, uploading, drawing, reading back).
+/// The time of one phase of a call: a part that is not one kernel step
+/// (loading, building a topology, uploading, drawing, reading back; a scene
+/// pass on its own clock), in milliseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PhaseTime {
     /// The phase's name (`load`, `topology`, `upload`, ...), as reports
@@ -260,7 +261,9 @@ pub struct Timing {
     /// Host wall time of the call, uploads and waits included (0 where the
     /// caller measures it).
     pub wall_ms: f64,
-    /// Wall time of the call's phases, in the order they first ran.
+    /// The call's phases in order: one entry per phase ([`Timing::phase`]
+    /// adds to it), or one per run of a phase that repeats ([`Timing::lap`]);
+    /// [`Timing::extend`] adds another's entries by name.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<PhaseTime>,
 }

@@ -423,7 +423,9 @@ pub struct ViewOutputs {
     /// World position of the scene frame's origin (the centre of the first
     /// pose's bounds).
     pub origin: [f64; 3],
-    /// The surface drawn (world coordinates), for a picture.
+    /// The topology's mesh (world coordinates), for a picture: the surface
+    /// drawn for a static mesh or an isosurface; the rest pose (skinned) or
+    /// the first frame (flipbook) of an animation.
     pub mesh: Option<crate::mesh::Mesh>,
     /// The feature edges' buffer counts and route, when they are planned.
     pub edge_info: Option<EdgeInfo>,

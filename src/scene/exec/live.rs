@@ -253,7 +253,12 @@ impl Live<'_> {
         for p in self.passes(|l| l == Lifetime::View) {
             ex.view_pass(p, &cam, &paths)?;
         }
-        let view = ex.kept.take().expect("the render pass is in every plan");
+        let view = ex.kept.take().ok_or_else(|| {
+            Error::InvalidArgument(format!(
+                "{}: no cue is asked for, so there is nothing to draw",
+                req.scene.path.display()
+            ))
+        })?;
         Ok(LiveFrame {
             view,
             passes: ex.rec.in_plan_order(self.plan),

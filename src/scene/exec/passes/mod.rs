@@ -481,13 +481,14 @@ impl<'s, 'g> Executor<'s, 'g> {
         } else {
             EdgeTopology::without_caps(&t.mesh, &marked, &name)?
         };
+        let t = self.topo.as_mut().expect("made above");
+        t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
         self.rec.wall(
             Pass::EdgeBuffer,
             ms_since(t0),
-            "unique edges with opposite vertices (host, once per topology)",
+            "unique edges with opposite vertices (host), then the edge stage's buffers \
+             (once per topology)",
         );
-        let t = self.topo.as_mut().expect("made above");
-        t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
         t.edge_counts = Some(draw::EdgeCounts {
             edges: et.edges.len(),
             cap_pairs: et.caps.len(),

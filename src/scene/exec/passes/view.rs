@@ -126,7 +126,10 @@ impl Executor<'_, '_> {
     fn edges_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
         let p = self.edge_params(cam)?;
         let caps = self.scene.effects.caps;
-        let shared = (self.interop.as_ref()).is_some_and(|(d, _)| d.shared);
+        // The external-memory route draws from the shared buffer (CL-GL
+        // sharing is not built: `GL_SHARING_BUILT`).
+        let shared =
+            (self.interop.as_ref()).is_some_and(|(d, _)| d.route == InteropRoute::ExternalMemory);
         let svg = self.keep_layers
             || paths
                 .iter()
@@ -266,7 +269,10 @@ impl Executor<'_, '_> {
         let fx = &self.scene.effects;
         for st in &fx.lines.styles_for(&fx.cues) {
             let kind = st.family as u32;
-            let n = self.segs.iter().filter(|s| s.2 == kind).count();
+            // Drawn segments, as for the contours (none of no strength).
+            let n = (self.segs.iter())
+                .filter(|s| s.2 == kind && s.3 > 0.0)
+                .count();
             *self.line_segments.entry(st.family.name()).or_default() += n;
         }
     }
@@ -447,18 +453,28 @@ fn resolve_feature_size(
 /// the scene's mode and what the device, GL and Vulkan offer. An
 /// isosurface's topology changes every pose, so it always reads back.
 pub(super) fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, InteropOffer)> {
-    let offer = interop_offer(gpu, scene.interop);
-    let mut d = decide_interop(scene.interop, &offer)?;
-    if d.route == InteropRoute::ExternalMemory
-        && scene.source.input() == crate::scene::planner::Input::Volume
-    {
-        d.passed_over.push(format!("external memory: {}", d.reason));
-        d = InteropDecision {
+    const ISO: &str = "an isosurface's topology changes every pose, so its edges read back";
+    if scene.source.input() == crate::scene::planner::Input::Volume {
+        // Nothing a probe could answer changes the route: no GL context
+        // or Vulkan instance is made for it.
+        if scene.interop == crate::spec::interop::InteropMode::On {
+            return Err(crate::error::Error::gl_sharing_required(
+                &gpu.info.name,
+                ISO,
+            ));
+        }
+        let offer = InteropOffer {
+            device: gpu.info.name.clone(),
+            ..InteropOffer::default()
+        };
+        let d = InteropDecision {
             route: InteropRoute::Host,
             shared: false,
-            reason: "host path: an isosurface's topology changes every pose".into(),
-            passed_over: d.passed_over,
+            reason: format!("host path: {ISO}"),
+            passed_over: Vec::new(),
         };
+        return Ok((d, offer));
     }
-    Ok((d, offer))
+    let offer = interop_offer(gpu, scene.interop);
+    Ok((decide_interop(scene.interop, &offer)?, offer))
 }
