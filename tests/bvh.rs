@@ -14,7 +14,9 @@ mod common;
 use common::{gpu, to_f32};
 use shapecue::cpu::bvh::{self as twin, Tree, segment_measures};
 use shapecue::mesh::{Generated, Mesh, splitmix};
-use shapecue::spec::bvh::{BvhBox, BvhQuery, END_EPS, LEAF, NONE, OCCLUDED, STACK_DEPTH, VISIBLE};
+use shapecue::spec::bvh::{
+    BvhBox, BvhQuery, END_EPS, LEAF, NONE, OCCLUDED, OVERFLOW, STACK_DEPTH, VISIBLE,
+};
 use shapecue::stages::bvh::Bvh;
 
 /// Relative band around a decision boundary (barycentric, segment end, or
@@ -442,4 +444,47 @@ fn no_face_is_an_empty_tree_and_bad_input_is_an_error() {
     assert!(e.contains("vertex 0") && e.contains("finite"), "{e}");
     assert!(dev.build(&pos[..2]).is_err(), "too few positions");
     assert_eq!(LEAF, 1 << 31);
+}
+
+#[test]
+fn chords_of_a_convex_mesh_are_visible() {
+    // Segments between two vertices of the icosphere (convex) run inside
+    // it: the faces around each end are hit at t = 0 or 1 (trimmed) or
+    // contain the segment (det = 0): no exclusion is needed.
+    let m = sphere();
+    let pos = to_f32(&m.positions);
+    let (mut dev, cpu) = build_both("sphere", &pos, &m.faces);
+    let nv = m.positions.len() as u64;
+    let (a, b) = (common::random(2000, nv, 11), common::random(2000, nv, 12));
+    let qs: Vec<BvhQuery> = (a.iter().zip(&b))
+        .filter(|(a, b)| a != b)
+        .map(|(&a, &b)| BvhQuery::new(pos[a as usize], pos[b as usize], &[]))
+        .collect();
+    let (got, _) = dev.occluded(&qs).unwrap();
+    let blocked = got.iter().filter(|&&r| r != VISIBLE).count();
+    assert_eq!(blocked, 0, "{blocked} of {} chords blocked", qs.len());
+    check_queries("sphere chords", &mut dev, &cpu, &pos, &m.faces, &qs);
+}
+
+#[test]
+fn a_short_stack_overflows_into_the_counter_as_the_twin_does() {
+    let m = torus();
+    let pos = to_f32(&m.positions);
+    let mut dev = Bvh::with_stack(gpu(), pos.len(), &m.faces, 3).unwrap();
+    dev.build(&pos).unwrap();
+    let cpu = Tree::new("torus", &pos, &m.faces).unwrap();
+    let qs = random_queries(&pos, &m.faces, 2000, 1.6, 23);
+    let (got, overflows) = dev.occluded(&qs).unwrap();
+    let want: Vec<u32> = (qs.iter())
+        .map(|q| cpu.occluded_with_stack(&pos, &m.faces, q, 3))
+        .collect();
+    assert_eq!(got, want, "device vs twin with a 3-entry stack");
+    let counted = got.iter().filter(|&&r| r == OVERFLOW).count();
+    assert!(counted > 0, "a 3-entry stack overflows on a torus");
+    assert_eq!(
+        overflows as usize, counted,
+        "one count per overflowed query"
+    );
+    assert!(Bvh::with_stack(gpu(), pos.len(), &m.faces, 0).is_err());
+    assert!(Bvh::with_stack(gpu(), pos.len(), &m.faces, STACK_DEPTH + 1).is_err());
 }

@@ -285,6 +285,20 @@ impl Tree {
     /// Step `occluded` for one query: [`VISIBLE`], [`OCCLUDED`] or
     /// [`OVERFLOW`] (the stack of [`STACK_DEPTH`] entries was full).
     pub fn occluded(&self, positions: &[[f32; 3]], faces: &[[u32; 3]], q: &BvhQuery) -> u32 {
+        self.occluded_with_stack(positions, faces, q, STACK_DEPTH)
+    }
+
+    /// [`Tree::occluded`] with a stack of `depth` entries (at most
+    /// [`STACK_DEPTH`], at least 1), as the kernel built with
+    /// `-DBVH_STACK=depth`.
+    pub fn occluded_with_stack(
+        &self,
+        positions: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        q: &BvhQuery,
+        depth: usize,
+    ) -> u32 {
+        let depth = depth.clamp(1, STACK_DEPTH);
         let Some(root) = self.root() else {
             return VISIBLE;
         };
@@ -315,7 +329,7 @@ impl Tree {
             let n = self.nodes[r as usize];
             for c in [n.left, n.right] {
                 if box_hit(&self.child_box(c), o, d) {
-                    if sp == STACK_DEPTH {
+                    if sp == depth {
                         return OVERFLOW;
                     }
                     stack[sp] = c;

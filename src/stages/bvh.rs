@@ -36,8 +36,14 @@ use std::sync::Arc;
 
 /// The build options of `kernels/bvh.cl`: the spec's constants.
 pub fn build_options() -> String {
+    build_options_with(STACK_DEPTH)
+}
+
+/// [`build_options`] with a traversal stack of `stack` entries (tests
+/// exercise the overflow path with a short one).
+pub fn build_options_with(stack: usize) -> String {
     format!(
-        "-DBVH_STACK={STACK_DEPTH} -DBVH_EDGE_EPS={EDGE_EPS:e}f -DBVH_END_EPS={END_EPS:e}f \
+        "-DBVH_STACK={stack} -DBVH_EDGE_EPS={EDGE_EPS:e}f -DBVH_END_EPS={END_EPS:e}f \
          -DBVH_BOX_PAD={BOX_PAD:e}f"
     )
 }
@@ -67,8 +73,25 @@ impl Bvh {
     /// Checks and uploads the faces of a mesh of `n_vertices` vertices;
     /// allocates the tree. Nothing is built until [`Bvh::build`].
     pub fn new(gpu: Arc<Gpu>, n_vertices: usize, faces: &[[u32; 3]]) -> Result<Bvh> {
+        Bvh::with_stack(gpu, n_vertices, faces, STACK_DEPTH)
+    }
+
+    /// [`Bvh::new`] with a query stack of `stack` entries (1 to
+    /// [`STACK_DEPTH`]) instead of [`STACK_DEPTH`]: for tests of the overflow
+    /// path ([`Tree::occluded_with_stack`] is its twin).
+    pub fn with_stack(
+        gpu: Arc<Gpu>,
+        n_vertices: usize,
+        faces: &[[u32; 3]],
+        stack: usize,
+    ) -> Result<Bvh> {
+        if !(1..=STACK_DEPTH).contains(&stack) {
+            return Err(Error::InvalidArgument(format!(
+                "bvh: a query stack of {stack} entries, 1 to {STACK_DEPTH} expected"
+            )));
+        }
         check_faces("bvh mesh", n_vertices, faces)?;
-        let program = gpu.program(&kernel_files::BVH, &build_options())?;
+        let program = gpu.program(&kernel_files::BVH, &build_options_with(stack))?;
         let entry = |k| gpu.entry(&program, k);
         let kernels = [
             entry(BvhKernel::Morton)?,
