@@ -138,6 +138,11 @@ fn every_kernel_file_builds_and_holds_every_entry_its_enum_names() {
         .filter(|n| *n != "edges_probe_layout") // appended by the layout probe test
         .collect();
     let msdf_opts = shapecue::stages::mesh_sdf::build_options();
+    let bvh_opts = shapecue::stages::bvh::build_options();
+    let bvh: Vec<_> = names(shapecue::spec::bvh::BvhKernel::ALL)
+        .into_iter()
+        .filter(|n| *n != "bvh_probe_layout") // appended by the layout probe test
+        .collect();
     let cases: Vec<(KernelFile, &str, Vec<&str>)> = vec![
         (kernel_files::CURVATURE, "", atomic),
         (kernel_files::CURVATURE, "-DSC_GATHER", gather),
@@ -160,6 +165,7 @@ fn every_kernel_file_builds_and_holds_every_entry_its_enum_names() {
         (kernel_files::EDGES, "", edges),
         (kernel_files::SDF_LINES, "", names(SdflKernel::ALL)),
         (kernel_files::MESH_SDF, &msdf_opts, names(MsdfKernel::ALL)),
+        (kernel_files::BVH, &bvh_opts, bvh),
     ];
     assert_eq!(
         kernel_files::ALL.len(),

@@ -3,6 +3,7 @@
 //! oracles the tests compare the device with.
 
 pub mod ao;
+pub mod bvh;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

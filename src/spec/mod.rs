@@ -10,6 +10,7 @@
 //! the device.
 
 pub mod ao;
+pub mod bvh;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

@@ -5,6 +5,7 @@
 //! each other.
 
 use super::ao::AoKernel;
+use super::bvh::BvhKernel;
 use super::curvature::CurvKernel;
 use super::edges::EdgesKernel;
 use super::feature_lines::{LinesCurvesKernel, LinesKernel};
@@ -72,6 +73,10 @@ impl Step {
             Step::MsdfRefine => MsdfKernel::Refine.name(),
             Step::MsdfSign => MsdfKernel::Wind.name(),
             Step::MsdfFinish => MsdfKernel::Finish.name(),
+            Step::BvhMorton => BvhKernel::Morton.name(),
+            Step::BvhBuild => BvhKernel::Build.name(),
+            Step::BvhRefit => BvhKernel::Refit.name(),
+            Step::BvhOccluded => BvhKernel::Occluded.name(),
         }
     }
 }

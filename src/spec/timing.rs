@@ -37,6 +37,8 @@ pub enum Family {
     SdfLines,
     /// `kernels/mesh_sdf.cl` (a mesh's signed distance field).
     MeshSdf,
+    /// `kernels/bvh.cl` (a linear BVH over a mesh's faces, Karras 2012).
+    Bvh,
 }
 
 /// A step of a stage: a kernel entry point `<prefix>_<step>` of
@@ -165,6 +167,14 @@ pub enum Step {
     MsdfSign,
     /// `msdf_finish`: the signed field.
     MsdfFinish,
+    /// `bvh_morton`: Morton codes of the face centroids.
+    BvhMorton,
+    /// `bvh_build`: Karras's internal nodes from the sorted codes.
+    BvhBuild,
+    /// `bvh_refit`: leaf boxes, then internal boxes bottom-up.
+    BvhRefit,
+    /// `bvh_occluded`: segment occlusion queries.
+    BvhOccluded,
 }
 
 impl Step {
@@ -182,6 +192,7 @@ impl Step {
             Family::Ao => &k["ao_".len()..],
             Family::SdfLines => &k["sdfl_".len()..],
             Family::MeshSdf => &k["msdf_".len()..],
+            Family::Bvh => &k["bvh_".len()..],
             Family::Scan | Family::RadixSort | Family::Edges => k,
         }
     }
@@ -208,6 +219,7 @@ impl Step {
             SdflDense | SdflThin | SdflGradient | SdflCurvature | SdflRange | SdflTrace
             | SdflStrips | SdflSweep => Family::SdfLines,
             MsdfBand | MsdfJfa | MsdfRefine | MsdfSign | MsdfFinish => Family::MeshSdf,
+            BvhMorton | BvhBuild | BvhRefit | BvhOccluded => Family::Bvh,
         }
     }
 }

@@ -123,6 +123,9 @@ pub const MESH_SDF: KernelFile = plain(
     include_str!("../../kernels/mesh_sdf.cl"),
 );
 
+/// `kernels/bvh.cl`: a linear BVH over a mesh's faces and segment queries.
+pub const BVH: KernelFile = plain("kernels/bvh.cl", include_str!("../../kernels/bvh.cl"));
+
 /// Every family's kernel file.
 pub const ALL: &[KernelFile] = &[
     CURVATURE,
@@ -137,6 +140,7 @@ pub const ALL: &[KernelFile] = &[
     EDGES,
     SDF_LINES,
     MESH_SDF,
+    BVH,
 ];
 
 /// A kernel file with the common headers and no includes.

@@ -3,6 +3,7 @@
 //! pose on the device.
 
 pub mod ao;
+pub mod bvh;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
