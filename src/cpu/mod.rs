@@ -16,3 +16,4 @@ pub mod sdf_lines;
 pub mod skinning;
 mod vec3;
 pub mod vertex_fusion;
+pub mod visibility;

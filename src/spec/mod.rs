@@ -27,6 +27,7 @@ mod step_entries;
 pub mod timing;
 pub mod vertex_fusion;
 pub mod view;
+pub mod visibility;
 
 /// An option enum named by words (`atomic`, `gather`, ...): every choice and
 /// its name, the same on the command line, in scene files and in stats.

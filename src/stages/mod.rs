@@ -17,3 +17,4 @@ pub mod scan;
 pub mod sdf_lines;
 pub mod skinning;
 pub mod vertex_fusion;
+pub mod visibility;

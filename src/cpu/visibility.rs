@@ -1,0 +1,449 @@
+//! CPU twin and f64 reference of the `visibility` family (exact,
+//! object-space visibility of line segments; method, options and output in
+//! [`crate::spec::visibility`]).
+//!
+//! [`Plan::new`] reads the segments once: the faces each one lies on (left
+//! out of its queries, at most four), its number of sampling intervals, the
+//! local edge length that scales the contour offset, and the bounding sphere
+//! that orthographic queries cross. [`classify_by`] runs the rounds (the
+//! samples, then one round per bisection level over the brackets whose ends
+//! differ) through a caller's cast function, one call per round, and turns
+//! the answers into pieces; the device ([`crate::stages::visibility`]), the
+//! twin ([`classify_twin`], [`Tree::occluded`] in f32, equal to the device
+//! bit for bit: the queries are built here, in the same f32 operations) and
+//! the reference ([`classify_reference`], [`occluded_brute`] in f64 over
+//! every face) all use it.
+//!
+//! Which faces a segment lies on, from its ends' edges ([`Segment`]): an
+//! end on a mesh edge names the edge's faces, an end at a face centre or
+//! cut by a test (`[u32::MAX or LINE_FREE, face]`) its face, an end at a
+//! vertex (`[v, v]`) the faces around the vertex. The segment lies on the
+//! faces both ends name (normally one); where they share none (an edge
+//! unknown to the mesh), on the union. The first four are kept.
+
+use std::collections::HashMap;
+
+use crate::cpu::bvh::{Tree, occluded_brute};
+use crate::error::{Error, Result};
+use crate::spec::bvh::{BvhQuery, OCCLUDED};
+use crate::spec::feature_lines::{LINE_FREE, Segment};
+use crate::spec::view::View;
+use crate::spec::visibility::{MAX_INTERVALS, Pieces, Spacing, VisibilityOptions};
+
+/// One sample of one segment: `(segment index, t)`.
+pub type Cast = (u32, f32);
+
+/// What one segment needs for its queries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegPlan {
+    /// First end.
+    pub a: [f32; 3],
+    /// Second end.
+    pub b: [f32; 3],
+    /// Faces left out of its queries (at most four).
+    pub exclude: Vec<u32>,
+    /// Sampling intervals (1 to [`MAX_INTERVALS`]).
+    pub intervals: usize,
+    /// Start of each query along the ray (world units).
+    pub offset: f32,
+}
+
+/// The segments of one view, ready to classify.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// Per segment.
+    pub segs: Vec<SegPlan>,
+    /// The view's eye, unit view direction, near plane and projection kind.
+    pub view: View,
+    /// Centre and radius of the mesh's bounding sphere (orthographic casts).
+    pub sphere: ([f32; 3], f32),
+    /// Bisection levels.
+    pub bisect: u32,
+}
+
+/// Faces around each vertex and on each edge.
+struct Topology {
+    around: Vec<Vec<u32>>,
+    edges: HashMap<(u32, u32), Vec<u32>>,
+}
+
+impl Topology {
+    fn new(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
+        let mut around = vec![Vec::new(); n_vertices];
+        let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        for (f, t) in faces.iter().enumerate() {
+            for k in 0..3 {
+                let (u, v) = (t[k], t[(k + 1) % 3]);
+                around[u as usize].push(f as u32);
+                edges
+                    .entry((u.min(v), u.max(v)))
+                    .or_default()
+                    .push(f as u32);
+            }
+        }
+        Topology { around, edges }
+    }
+
+    /// The faces an end names (see the module note), or a plain-words error.
+    fn end_faces(&self, n_faces: usize, e: [u32; 2], what: &str) -> Result<Vec<u32>> {
+        if e[0] == u32::MAX || e[0] == LINE_FREE {
+            if e[1] as usize >= n_faces {
+                return Err(Error::InvalidArgument(format!(
+                    "{what}: names face {} of a mesh of {n_faces} faces",
+                    e[1]
+                )));
+            }
+            return Ok(vec![e[1]]);
+        }
+        if e.iter().any(|&v| v as usize >= self.around.len()) {
+            return Err(Error::InvalidArgument(format!(
+                "{what}: names vertex {} of a mesh of {} vertices",
+                e[0].max(e[1]),
+                self.around.len()
+            )));
+        }
+        if e[0] == e[1] {
+            return Ok(self.around[e[0] as usize].clone());
+        }
+        let key = (e[0].min(e[1]), e[0].max(e[1]));
+        Ok(self.edges.get(&key).cloned().unwrap_or_default())
+    }
+}
+
+/// The faces segment `s` lies on (at most four).
+fn lies_on(topo: &Topology, n_faces: usize, s: &Segment, i: usize) -> Result<Vec<u32>> {
+    let f0 = topo.end_faces(n_faces, s.4[0], &format!("segment {i}, first end"))?;
+    let f1 = topo.end_faces(n_faces, s.4[1], &format!("segment {i}, second end"))?;
+    let mut both: Vec<u32> = f0.iter().copied().filter(|f| f1.contains(f)).collect();
+    if both.is_empty() {
+        both = f0;
+        both.extend(f1.iter().filter(|f| !both.contains(f)).collect::<Vec<_>>());
+    }
+    both.truncate(4);
+    Ok(both)
+}
+
+fn sub(x: [f32; 3], y: [f32; 3]) -> [f32; 3] {
+    [x[0] - y[0], x[1] - y[1], x[2] - y[2]]
+}
+
+fn norm(x: [f32; 3]) -> f32 {
+    (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+}
+
+/// Box centre and half diagonal of `positions`.
+fn bounding_sphere(positions: &[[f32; 3]]) -> ([f32; 3], f32) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if positions.is_empty() {
+        return ([0.0; 3], 0.0);
+    }
+    let c = [
+        0.5 * (lo[0] + hi[0]),
+        0.5 * (lo[1] + hi[1]),
+        0.5 * (lo[2] + hi[2]),
+    ];
+    (c, 0.5 * norm(sub(hi, lo)))
+}
+
+/// Sampling intervals of the segment `a..b`.
+fn intervals(view: &View, spacing: Spacing, diag: f32, a: [f32; 3], b: [f32; 3]) -> usize {
+    let n = match spacing {
+        Spacing::Diagonal(f) => norm(sub(b, a)) / (f * diag),
+        Spacing::View(f) => {
+            let pa = view.view_proj * glam::Vec4::new(a[0], a[1], a[2], 1.0);
+            let pb = view.view_proj * glam::Vec4::new(b[0], b[1], b[2], 1.0);
+            if pa.w > 0.0 && pb.w > 0.0 {
+                let d = pa.truncate().truncate() / pa.w - pb.truncate().truncate() / pb.w;
+                0.5 * d.length() / f
+            } else {
+                MAX_INTERVALS as f32
+            }
+        }
+    };
+    if n.is_finite() {
+        (n.ceil() as usize).clamp(1, MAX_INTERVALS)
+    } else {
+        MAX_INTERVALS
+    }
+}
+
+impl Plan {
+    /// Reads `segments` over the mesh (`positions`, `faces`) seen in
+    /// `view`. Errors, in plain words: bad options or view, a non-finite
+    /// end, an end naming a vertex or face the mesh lacks.
+    pub fn new(
+        positions: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        segments: &[Segment],
+        view: &View,
+        opts: &VisibilityOptions,
+    ) -> Result<Plan> {
+        opts.check()?;
+        view.check("visibility")?;
+        crate::cpu::bvh::check_faces("visibility mesh", positions.len(), faces)?;
+        let topo = Topology::new(positions.len(), faces);
+        let sphere = bounding_sphere(positions);
+        let diag = (2.0 * sphere.1).max(f32::MIN_POSITIVE);
+        let mut segs = Vec::with_capacity(segments.len());
+        for (i, s) in segments.iter().enumerate() {
+            if !s.0.iter().chain(&s.1).all(|c| c.is_finite()) {
+                return Err(Error::InvalidArgument(format!(
+                    "visibility: segment {i} has a non-finite end"
+                )));
+            }
+            let exclude = lies_on(&topo, faces.len(), s, i)?;
+            let edge = match exclude.first() {
+                Some(&f) => {
+                    let p = faces[f as usize].map(|v| positions[v as usize]);
+                    (norm(sub(p[1], p[0])) + norm(sub(p[2], p[1])) + norm(sub(p[0], p[2]))) / 3.0
+                }
+                None => norm(sub(s.1, s.0)),
+            };
+            let edge = if edge > 0.0 { edge } else { 1e-3 * diag };
+            segs.push(SegPlan {
+                a: s.0,
+                b: s.1,
+                exclude,
+                intervals: intervals(view, opts.spacing, diag, s.0, s.1),
+                offset: opts.contour_offset * edge,
+            });
+        }
+        Ok(Plan {
+            segs,
+            view: *view,
+            sphere,
+            bisect: opts.bisect,
+        })
+    }
+
+    /// The f32 query of a cast, or `None` where the point is behind the
+    /// eye (hidden without a query). The device and the twin both take
+    /// their queries from here.
+    pub fn query(&self, (seg, t): Cast) -> Option<BvhQuery> {
+        let s = &self.segs[seg as usize];
+        let p: [f32; 3] = std::array::from_fn(|k| s.a[k] + t * (s.b[k] - s.a[k]));
+        let eye = self.view.eye.to_array();
+        let dir = self.view.unit_dir().to_array();
+        let (u, far) = if self.view.ortho {
+            let u = dir.map(|c| -c);
+            let (c, r) = self.sphere;
+            (u, (norm(sub(p, c)) + r) * 1.001 + 1e-6)
+        } else {
+            let d = sub(p, eye);
+            if d[0] * dir[0] + d[1] * dir[1] + d[2] * dir[2] < self.view.near {
+                return None;
+            }
+            let len = norm(d);
+            (d.map(|c| -c / len), len)
+        };
+        let off = s.offset.min(0.5 * far);
+        let origin = std::array::from_fn(|k| p[k] + off * u[k]);
+        let target = if self.view.ortho {
+            std::array::from_fn(|k| p[k] + far * u[k])
+        } else {
+            eye
+        };
+        Some(BvhQuery::new(origin, target, &s.exclude))
+    }
+
+    /// The f64 answer of a cast (the reference): the same construction as
+    /// [`Plan::query`] in f64, tested by [`occluded_brute`].
+    pub fn hidden_f64(&self, positions: &[[f64; 3]], faces: &[[u32; 3]], (seg, t): Cast) -> bool {
+        let s = &self.segs[seg as usize];
+        let t = f64::from(t);
+        let (a, b) = (s.a.map(f64::from), s.b.map(f64::from));
+        let p: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]));
+        let eye = self.view.eye.as_dvec3().to_array();
+        let dir = self.view.dir.as_dvec3().normalize().to_array();
+        let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        let (u, far) = if self.view.ortho {
+            let c = self.sphere.0.map(f64::from);
+            let d: [f64; 3] = std::array::from_fn(|k| p[k] - c[k]);
+            (
+                dir.map(|c| -c),
+                (n3(d) + f64::from(self.sphere.1)) * 1.001 + 1e-6,
+            )
+        } else {
+            let d: [f64; 3] = std::array::from_fn(|k| p[k] - eye[k]);
+            if d[0] * dir[0] + d[1] * dir[1] + d[2] * dir[2] < f64::from(self.view.near) {
+                return true;
+            }
+            let len = n3(d);
+            (d.map(|c| -c / len), len)
+        };
+        let off = f64::from(s.offset).min(0.5 * far);
+        let origin = std::array::from_fn(|k| p[k] + off * u[k]);
+        let target = if self.view.ortho {
+            std::array::from_fn(|k| p[k] + far * u[k])
+        } else {
+            eye
+        };
+        occluded_brute(positions, faces, origin, target, &s.exclude)
+    }
+}
+
+/// The queries of `casts` that need one, and for each cast the index of
+/// its query (`None`: behind the eye, hidden).
+pub fn queries_of(plan: &Plan, casts: &[Cast]) -> (Vec<BvhQuery>, Vec<Option<usize>>) {
+    let mut qs = Vec::with_capacity(casts.len());
+    let at = casts
+        .iter()
+        .map(|&c| {
+            plan.query(c).map(|q| {
+                qs.push(q);
+                qs.len() - 1
+            })
+        })
+        .collect();
+    (qs, at)
+}
+
+/// Hidden flags of `casts` from the answers to [`queries_of`]'s queries
+/// (only [`OCCLUDED`] hides: a stack overflow, never seen at the spec's
+/// depth, counts as visible).
+pub fn hidden_from(at: &[Option<usize>], answers: &[u32]) -> Vec<bool> {
+    at.iter()
+        .map(|a| a.is_none_or(|i| answers[i] == OCCLUDED))
+        .collect()
+}
+
+/// A bracket between two samples whose answers differ.
+struct Bracket {
+    seg: u32,
+    interval: usize,
+    lo: f32,
+    hi: f32,
+    hidden_lo: bool,
+}
+
+/// The rounds of a classification through `cast` (one call per round: the
+/// samples, then one per bisection level), turned into pieces.
+pub fn classify_by(
+    plan: &Plan,
+    mut cast: impl FnMut(&[Cast]) -> Result<Vec<bool>>,
+) -> Result<Vec<Pieces>> {
+    let mut casts = Vec::new();
+    let mut first = Vec::with_capacity(plan.segs.len());
+    for (i, s) in plan.segs.iter().enumerate() {
+        first.push(casts.len());
+        casts.extend((0..=s.intervals).map(|k| (i as u32, k as f32 / s.intervals as f32)));
+    }
+    let hidden = cast(&casts)?;
+    let mut brackets = Vec::new();
+    for (i, s) in plan.segs.iter().enumerate() {
+        for k in 0..s.intervals {
+            let (h0, h1) = (hidden[first[i] + k], hidden[first[i] + k + 1]);
+            if h0 != h1 {
+                let (lo, hi) = (casts[first[i] + k].1, casts[first[i] + k + 1].1);
+                let (seg, interval, hidden_lo) = (i as u32, k, h0);
+                brackets.push(Bracket {
+                    seg,
+                    interval,
+                    lo,
+                    hi,
+                    hidden_lo,
+                });
+            }
+        }
+    }
+    for _ in 0..plan.bisect {
+        if brackets.is_empty() {
+            break;
+        }
+        let mids: Vec<Cast> = brackets
+            .iter()
+            .map(|b| (b.seg, 0.5 * (b.lo + b.hi)))
+            .collect();
+        let h = cast(&mids)?;
+        for ((b, m), h) in brackets.iter_mut().zip(&mids).zip(h) {
+            if h == b.hidden_lo {
+                b.lo = m.1;
+            } else {
+                b.hi = m.1;
+            }
+        }
+    }
+    Ok(pieces(plan, &first, &hidden, &brackets))
+}
+
+/// Pieces from the sample answers and the final brackets.
+fn pieces(plan: &Plan, first: &[usize], hidden: &[bool], brackets: &[Bracket]) -> Vec<Pieces> {
+    let mut next = brackets.iter().peekable();
+    let mut out = Vec::with_capacity(plan.segs.len());
+    for (i, s) in plan.segs.iter().enumerate() {
+        let mut ps = Pieces::new();
+        let (mut start, mut cur) = (0.0f32, hidden[first[i]]);
+        for k in 0..s.intervals {
+            if hidden[first[i] + k + 1] == cur {
+                continue;
+            }
+            let b = next.next().filter(|b| b.seg == i as u32 && b.interval == k);
+            let split = b.map_or(start, |b| 0.5 * (b.lo + b.hi));
+            ps.push((start, split, !cur));
+            (start, cur) = (split, !cur);
+        }
+        ps.push((start, 1.0, !cur));
+        out.push(ps);
+    }
+    out
+}
+
+/// The twin: [`classify_by`] with [`Tree::occluded`] (f32, the device's
+/// arithmetic) over the tree of `positions`.
+pub fn classify_twin(
+    tree: &Tree,
+    positions: &[[f32; 3]],
+    faces: &[[u32; 3]],
+    plan: &Plan,
+) -> Result<Vec<Pieces>> {
+    classify_by(plan, |casts| {
+        let (qs, at) = queries_of(plan, casts);
+        let answers: Vec<u32> = qs
+            .iter()
+            .map(|q| tree.occluded(positions, faces, q))
+            .collect();
+        Ok(hidden_from(&at, &answers))
+    })
+}
+
+/// The reference: [`classify_by`] with [`occluded_brute`] in f64 over every
+/// face of the mesh (`positions` in f64, the plan built from their f32
+/// rounding).
+pub fn classify_reference(
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    plan: &Plan,
+) -> Result<Vec<Pieces>> {
+    classify_by(plan, |casts| {
+        Ok(casts
+            .iter()
+            .map(|&c| plan.hidden_f64(positions, faces, c))
+            .collect())
+    })
+}
+
+/// Length-weighted share of `[0, 1]` on which two piece lists agree, and
+/// the length they cover: `(agreeing length, total length)` in world units
+/// of the segment `len`.
+pub fn agreement(a: &Pieces, b: &Pieces, len: f64) -> (f64, f64) {
+    let at = |ps: &Pieces, t: f32| ps.iter().find(|p| t <= p.1).is_none_or(|p| p.2);
+    let mut cuts: Vec<f32> = a.iter().chain(b).flat_map(|p| [p.0, p.1]).collect();
+    cuts.push(0.0);
+    cuts.push(1.0);
+    cuts.sort_by(f32::total_cmp);
+    let mut same = 0.0;
+    for w in cuts.windows(2) {
+        let mid = 0.5 * (w[0] + w[1]);
+        if at(a, mid) == at(b, mid) {
+            same += f64::from(w[1] - w[0]);
+        }
+    }
+    (same * len, len)
+}

@@ -1,0 +1,136 @@
+//! Shared types of the `visibility` family: exact, object-space visibility
+//! of line segments (the issue "Exact visibility on the device"), by
+//! occlusion queries towards the eye over the `bvh` family's tree. The
+//! options ([`VisibilityOptions`], [`Spacing`]), the output ([`Piece`],
+//! [`Pieces`]) and its bound ([`visibility_bound`], [`MAX_INTERVALS`]).
+//!
+//! Method: each segment is sampled at `n + 1` evenly spaced points
+//! (`t = k / n`, `n` from [`Spacing`], at most [`MAX_INTERVALS`]); each
+//! sample casts one query towards the eye (perspective: to the eye point;
+//! orthographic: along the direction towards the viewer to beyond the
+//! mesh's bounding sphere), leaving out the faces the segment lies on.
+//! Between neighbouring samples whose answers differ, `bisect` halvings
+//! place the split (the midpoint of the last bracket). A point behind the
+//! eye (perspective, nearer than the near plane) is hidden without a query.
+//!
+//! Contours lie on the grazing set, where the ray towards the eye runs
+//! along the surface and the neighbouring faces of a polyhedral mesh may
+//! cross it within about an edge length. The chosen method: every query
+//! starts `contour_offset` × the local edge length (the mean edge of the
+//! segment's face) along the ray towards the eye. It needs no normals and
+//! no exclusion slots (a vertex end may already name more faces than the
+//! four slots hold), and is the same for every family; its price is that
+//! a real occluder nearer than that offset is missed.
+//!
+//! Mirrors: none in a kernel (the device work is `bvh_occluded`).
+
+/// How far apart the samples along a segment are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spacing {
+    /// A fraction of the view's size (of the NDC square's side, 2): a
+    /// segment spanning a fraction `s` of the view gets `ceil(s / f)`
+    /// intervals. A segment with an end behind the eye gets
+    /// [`MAX_INTERVALS`].
+    View(f32),
+    /// A fraction of the mesh's bounding-box diagonal, in world space.
+    Diagonal(f32),
+}
+
+/// Options of the classification.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisibilityOptions {
+    /// Sample spacing.
+    pub spacing: Spacing,
+    /// Halvings of a bracket between two samples whose answers differ
+    /// (0 to [`MAX_BISECT`]); the split lies within `2^-bisect` of the
+    /// interval from the true transition (when there is one).
+    pub bisect: u32,
+    /// Start of every query along the ray towards the eye, as a fraction of
+    /// the local edge length (0 to 10): see the module note on contours.
+    pub contour_offset: f32,
+}
+
+impl Default for VisibilityOptions {
+    fn default() -> Self {
+        VisibilityOptions {
+            spacing: Spacing::View(0.005),
+            bisect: 10,
+            contour_offset: 0.5,
+        }
+    }
+}
+
+/// Most halvings of a bracket.
+pub const MAX_BISECT: u32 = 20;
+/// Most intervals (samples − 1) of one segment.
+pub const MAX_INTERVALS: usize = 1024;
+
+impl VisibilityOptions {
+    /// Rejects options no classification can use, in plain words.
+    pub fn check(&self) -> crate::error::Result<()> {
+        let bad = |m: String| Err(crate::error::Error::InvalidArgument(m));
+        let (what, f) = match self.spacing {
+            Spacing::View(f) => ("of the view", f),
+            Spacing::Diagonal(f) => ("of the bounding diagonal", f),
+        };
+        if !(f.is_finite() && f > 0.0) {
+            return bad(format!(
+                "visibility: a sample spacing of {f} {what}, a positive fraction expected"
+            ));
+        }
+        if self.bisect > MAX_BISECT {
+            return bad(format!(
+                "visibility: {} bisection levels, at most {MAX_BISECT}",
+                self.bisect
+            ));
+        }
+        let o = self.contour_offset;
+        if !(o.is_finite() && (0.0..=10.0).contains(&o)) {
+            return bad(format!(
+                "visibility: a contour offset of {o} edge lengths, 0 to 10 expected"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A piece of a segment: `(t0, t1, visible)`, `t` the fraction of the way
+/// from its first end to its second (`0 ≤ t0 < t1 ≤ 1`, or `(0, 1)` for a
+/// zero-length segment).
+pub type Piece = (f32, f32, bool);
+
+/// The pieces of one segment, in order of `t`, covering `[0, 1]`,
+/// neighbours differing in visibility.
+pub type Pieces = Vec<Piece>;
+
+/// Most pieces of a segment sampled over `intervals` intervals: one split
+/// per interval whose ends differ, so `intervals + 1`.
+pub fn visibility_bound(intervals: usize) -> usize {
+    intervals + 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_are_checked_in_plain_words() {
+        assert!(VisibilityOptions::default().check().is_ok());
+        let o = VisibilityOptions {
+            spacing: Spacing::Diagonal(0.0),
+            ..Default::default()
+        };
+        assert!(format!("{:?}", o.check()).contains("spacing"));
+        let o = VisibilityOptions {
+            bisect: 99,
+            ..Default::default()
+        };
+        assert!(o.check().is_err());
+        let o = VisibilityOptions {
+            contour_offset: f32::NAN,
+            ..Default::default()
+        };
+        assert!(o.check().is_err());
+        assert_eq!(visibility_bound(1), 2);
+    }
+}
