@@ -20,7 +20,10 @@
 //! segment's face) along the ray towards the eye. It needs no normals and
 //! no exclusion slots (a vertex end may already name more faces than the
 //! four slots hold), and is the same for every family; its price is that
-//! a real occluder nearer than that offset is missed.
+//! a real occluder nearer than that offset is missed. Measured (f64
+//! reference, icosphere level 4, whose contours are all visible): 0.05
+//! edge hides 44–46 % of the contour length, 0.25 hides 17–22 %, 0.5 hides
+//! 0.4–0.9 %, 1.0 hides none; hence the default 1.0 (`tests/visibility.rs`).
 //!
 //! Mirrors: none in a kernel (the device work is `bvh_occluded`).
 
@@ -55,7 +58,7 @@ impl Default for VisibilityOptions {
         VisibilityOptions {
             spacing: Spacing::View(0.005),
             bisect: 10,
-            contour_offset: 0.5,
+            contour_offset: 1.0,
         }
     }
 }
