@@ -188,6 +188,7 @@ impl Plan {
         opts.check()?;
         view.check("visibility")?;
         crate::cpu::bvh::check_faces("visibility mesh", positions.len(), faces)?;
+        crate::cpu::bvh::check_positions("visibility mesh", positions.len(), positions)?;
         let topo = Topology::new(positions.len(), faces);
         let sphere = bounding_sphere(positions);
         let diag = (2.0 * sphere.1).max(f32::MIN_POSITIVE);
@@ -396,13 +397,21 @@ fn pieces(plan: &Plan, first: &[usize], hidden: &[bool], brackets: &[Bracket]) -
 }
 
 /// The twin: [`classify_by`] with [`Tree::occluded`] (f32, the device's
-/// arithmetic) over the tree of `positions`.
+/// arithmetic) over the tree of `positions` (an error where the tree holds
+/// another number of faces).
 pub fn classify_twin(
     tree: &Tree,
     positions: &[[f32; 3]],
     faces: &[[u32; 3]],
     plan: &Plan,
 ) -> Result<Vec<Pieces>> {
+    if tree.faces_sorted.len() != faces.len() {
+        return Err(Error::InvalidArgument(format!(
+            "visibility: a tree of {} faces for a mesh of {} faces",
+            tree.faces_sorted.len(),
+            faces.len()
+        )));
+    }
     classify_by(plan, |casts| {
         let (qs, at) = queries_of(plan, casts);
         let answers: Vec<u32> = qs
@@ -421,6 +430,7 @@ pub fn classify_reference(
     faces: &[[u32; 3]],
     plan: &Plan,
 ) -> Result<Vec<Pieces>> {
+    crate::cpu::bvh::check_faces("visibility reference mesh", positions.len(), faces)?;
     classify_by(plan, |casts| {
         Ok(casts
             .iter()
