@@ -310,38 +310,25 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::KernelFile;
 
     /// `BvhNode`, `BvhBox` and `BvhQuery` in the kernel have the spec's
     /// layout: a probe kernel reports `sizeof` and every `offsetof`.
     #[test]
     fn structs_match_the_kernel() {
-        let gpu = crate::gpu::test_gpu();
         let fields = crate::spec::bvh::field_offsets();
-        let mut probe = String::from("\n__kernel void bvh_probe_layout(__global uint* out) {\n");
-        for (i, (name, _)) in fields.iter().enumerate() {
-            let (st, field) = name.split_once('.').unwrap();
-            let expr = if field == "(size)" {
-                format!("sizeof({st})")
-            } else {
-                format!("__builtin_offsetof({st}, {field})")
-            };
-            probe += &format!("    out[{i}] = (uint)({expr});\n");
-        }
-        probe += "}\n";
-        let file = KernelFile {
-            name: "kernels/bvh.cl (layout probe)",
-            source: Box::leak((kernel_files::BVH.source.to_string() + &probe).into_boxed_str()),
-            ..kernel_files::BVH
-        };
-        let prog = gpu.program(&file, &build_options()).unwrap();
-        let k = gpu.entry(&prog, BvhKernel::ProbeLayout).unwrap();
-        let mut out: Buffer<u32> = gpu.buffer(fields.len()).unwrap();
-        gpu.write(&mut out, &vec![u32::MAX; fields.len()]).unwrap();
-        launch(&gpu, &k, 1, &[buf(&out)]).unwrap();
-        gpu.finish().unwrap();
-        let mut got = vec![0u32; fields.len()];
-        gpu.read(&out, &mut got).unwrap();
+        let exprs: Vec<String> = (fields.iter())
+            .map(|(name, _)| match name.split_once('.') {
+                Some((st, "(size)")) => format!("sizeof({st})"),
+                Some((st, field)) => format!("__builtin_offsetof({st}, {field})"),
+                None => panic!("{name}: expected struct.field"),
+            })
+            .collect();
+        let got = crate::gpu::probe_layout(
+            &kernel_files::BVH,
+            &build_options(),
+            BvhKernel::ProbeLayout,
+            &exprs,
+        );
         for ((name, want), got) in fields.iter().zip(got) {
             assert_eq!(got as usize, *want, "{name}: device vs Rust");
         }

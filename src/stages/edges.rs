@@ -707,7 +707,6 @@ fn read_compacted(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::KernelFile;
     use crate::spec::edges::EdgeParamBlock;
 
     /// The kernel's `EdgeParams` has the layout of [`EdgeParamBlock`]: a probe
@@ -715,31 +714,15 @@ mod tests {
     /// `offsetof` as the device compiler sees them.
     #[test]
     fn param_block_layout_matches_the_kernel() {
-        let gpu = crate::gpu::test_gpu();
         let fields = EdgeParamBlock::field_offsets();
-        let mut probe = String::from("\n__kernel void edges_probe_layout(__global uint* out) {\n");
-        for (i, (name, _)) in fields.iter().enumerate() {
-            let expr = if name.starts_with('(') {
-                "sizeof(EdgeParams)".to_string()
-            } else {
-                format!("__builtin_offsetof(EdgeParams, {name})")
-            };
-            probe += &format!("    out[{i}] = (uint)({expr});\n");
-        }
-        probe += "}\n";
-        let file = KernelFile {
-            name: "kernels/edges.cl (layout probe)",
-            source: Box::leak((kernel_files::EDGES.source.to_string() + &probe).into_boxed_str()),
-            ..kernel_files::EDGES
-        };
-        let prog = gpu.program(&file, "").unwrap();
-        let k = gpu.entry(&prog, EdgesKernel::ProbeLayout).unwrap();
-        let mut out: Buffer<u32> = gpu.buffer(fields.len()).unwrap();
-        gpu.write(&mut out, &vec![u32::MAX; fields.len()]).unwrap();
-        launch(&gpu, &k, 1, &[buf(&out)]).unwrap();
-        gpu.finish().unwrap();
-        let mut got = vec![0u32; fields.len()];
-        gpu.read(&out, &mut got).unwrap();
+        let exprs: Vec<String> = (fields.iter())
+            .map(|(name, _)| match name.starts_with('(') {
+                true => "sizeof(EdgeParams)".to_string(),
+                false => format!("__builtin_offsetof(EdgeParams, {name})"),
+            })
+            .collect();
+        let got =
+            crate::gpu::probe_layout(&kernel_files::EDGES, "", EdgesKernel::ProbeLayout, &exprs);
         for ((name, want), got) in fields.iter().zip(got) {
             assert_eq!(got as usize, *want, "{name}: device vs Rust");
         }
