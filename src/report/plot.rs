@@ -299,6 +299,13 @@ fn convergence(
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
     // Errors fall with h, so the data and the slope run from the lower left
     // to the upper right: the legend goes in the empty upper left.
+    legend_upper_left(&mut chart)
+}
+
+/// The series' legend in the chart's upper left, on a light box.
+fn legend_upper_left<'a, 'b: 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, CT>,
+) -> Result<()> {
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
@@ -306,8 +313,7 @@ fn convergence(
         .border_style(BLACK)
         .label_font((FONT, 12))
         .draw()
-        .map_err(err)?;
-    Ok(())
+        .map_err(err)
 }
 
 /// A bar chart's data: one bar per series in each group.
@@ -403,14 +409,7 @@ where
             .legend(legend(j));
     }
     if series.len() > 1 {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 12))
-            .draw()
-            .map_err(err)?;
+        legend_upper_left(&mut chart)?;
     }
     // The group names under the axis, centred on their bars.
     for (i, g) in data.groups.iter().enumerate() {
