@@ -358,6 +358,21 @@ impl Payload<'_> {
         )
     }
 
+    /// The byte skip of compressed data (`el` names the element in errors):
+    /// a count, since data "at the end of the file" has no place in a stream
+    /// that must be inflated from its start.
+    fn compressed_skip(&self, el: &str) -> Result<usize> {
+        match self.byte_skip {
+            Skip::Bytes(n) => Ok(n),
+            Skip::ToEnd => Err(Error::input(
+                self.source,
+                el,
+                "a byte skip of -1 (data at the end of the file) cannot be used \
+                 with compressed data",
+            )),
+        }
+    }
+
     /// Inflates a compressed data file, within the memory bound, to its
     /// byte skip and the `expected` bytes of samples, and returns the latter.
     fn read_compressed(
@@ -368,17 +383,7 @@ impl Payload<'_> {
         expected: usize,
     ) -> Result<Vec<u8>> {
         let (src, el) = (self.source, f.el.as_str());
-        let skip = match self.byte_skip {
-            Skip::Bytes(n) => n,
-            Skip::ToEnd => {
-                return Err(Error::input(
-                    src,
-                    el,
-                    "a byte skip of -1 (data at the end of the file) cannot be used \
-                     with compressed data",
-                ));
-            }
-        };
+        let skip = self.compressed_skip(el)?;
         let rest = f.size.saturating_sub(f.skipped);
         let limit = skip.saturating_add(expected).saturating_add(1);
         let have = usize::try_from(rest).unwrap_or(usize::MAX);
@@ -431,17 +436,7 @@ impl Payload<'_> {
                 return parse_ascii_into(data, count, out, src, el);
             }
             Encoding::Compressed(kind) => {
-                let skip = match self.byte_skip {
-                    Skip::Bytes(n) => n,
-                    Skip::ToEnd => {
-                        return Err(Error::input(
-                            src,
-                            el,
-                            "a byte skip of -1 (data at the end of the file) cannot be used \
-                             with compressed data",
-                        ));
-                    }
-                };
+                let skip = self.compressed_skip(el)?;
                 let limit = skip.saturating_add(expected).saturating_add(1);
                 check_inflate(data.len(), limit - 1, kind).map_err(|p| Error::input(src, el, p))?;
                 decompressed =
