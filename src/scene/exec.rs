@@ -131,9 +131,17 @@ impl Session {
         Ok(g)
     }
 
-    /// The session's renderer set to `opts`: made on first use, its
-    /// framebuffers made anew when the size or antialiasing changes.
-    fn renderer(&mut self, opts: RenderOptions) -> Result<Renderer> {
+    /// The session's renderer set to `scene`'s image size, antialiasing
+    /// and background: made on first use, its framebuffers made anew when
+    /// the size or antialiasing changes.
+    fn renderer(&mut self, scene: &Scene) -> Result<Renderer> {
+        let [br, bg, bb] = scene.background;
+        let opts = RenderOptions {
+            width: scene.size[0],
+            height: scene.size[1],
+            msaa: scene.msaa,
+            background: [br, bg, bb, 1.0],
+        };
         match self.renderer.take() {
             Some(mut r) => {
                 r.reconfigure(opts)?;
@@ -142,6 +150,12 @@ impl Session {
             None => Renderer::new(opts),
         }
     }
+}
+
+/// The plan of a scene's cues for its input.
+fn plan_of(scene: &Scene) -> crate::scene::planner::Plan {
+    let fx = &scene.effects;
+    plan_with(&fx.cues, scene.source.input(), fx.caps)
 }
 
 /// Runs a scene: loads the input, plans, refuses to overwrite outputs
@@ -300,17 +314,9 @@ fn render_all(
         notes,
         t_all,
     } = input;
-    let fx = &scene.effects;
-    let plan = plan_with(&fx.cues, scene.source.input(), fx.caps);
+    let plan = plan_of(scene);
     let gpu = session.gpu(opts)?;
-    let [w, h] = scene.size;
-    let [br, bg, bb] = scene.background;
-    let renderer = session.renderer(RenderOptions {
-        width: w,
-        height: h,
-        msaa: scene.msaa,
-        background: [br, bg, bb, 1.0],
-    })?;
+    let renderer = session.renderer(scene)?;
     let uploads_before = renderer.uploads();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
     let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, progress)?;
@@ -554,8 +560,7 @@ pub fn explain(scene: &Scene, opts: &ExecOptions) -> Result<String> {
     let mut notes = Vec::new();
     let loaded = load(scene, &mut notes)?;
     let frames = frame_indices(scene, loaded.frames())?;
-    let fx = &scene.effects;
-    let plan = plan_with(&fx.cues, scene.source.input(), fx.caps);
+    let plan = plan_of(scene);
     let out_dir = opts
         .out_dir
         .clone()

@@ -16,11 +16,10 @@ use super::draw::ViewOutputs;
 use super::load::{Loaded, load};
 use super::passes::Executor;
 use super::report::{PassRecord, Recorder};
-use super::{ExecOptions, Session, frame_indices};
+use super::{ExecOptions, Session, frame_indices, plan_of};
 use crate::error::{Error, Result};
-use crate::render::RenderOptions;
 use crate::scene::file::Scene;
-use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
+use crate::scene::planner::{Input, Lifetime, Pass, Plan};
 use std::path::PathBuf;
 
 /// One frame to draw: the scene with the camera (its first view) and the
@@ -83,17 +82,10 @@ impl Session {
     /// surface drawn ([`ViewOutputs::mesh`]).
     pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<LiveFrame> {
         let loaded = load(scene, &mut Vec::new())?;
-        let fx = &scene.effects;
         let input = scene.source.input();
-        let plan = plan_with(&fx.cues, input, fx.caps);
+        let plan = plan_of(scene);
         let gpu = self.gpu(opts)?;
-        let [br, bg, bb] = scene.background;
-        let renderer = self.renderer(RenderOptions {
-            width: scene.size[0],
-            height: scene.size[1],
-            msaa: scene.msaa,
-            background: [br, bg, bb, 1.0],
-        })?;
+        let renderer = self.renderer(scene)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
         ex.keep_image = true;
@@ -155,18 +147,10 @@ impl Session {
             Some((s, l)) if same_input(&s, scene) => l,
             _ => load(scene, &mut Vec::new())?,
         };
-        let fx = &scene.effects;
         let input = scene.source.input();
-        let plan = plan_with(&fx.cues, input, fx.caps);
+        let plan = plan_of(scene);
         let gpu = self.gpu(opts)?;
-        let [w, h] = scene.size;
-        let [br, bg, bb] = scene.background;
-        let renderer = self.renderer(RenderOptions {
-            width: w,
-            height: h,
-            msaa: scene.msaa,
-            background: [br, bg, bb, 1.0],
-        })?;
+        let renderer = self.renderer(scene)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
         ex.keep_image = true;
