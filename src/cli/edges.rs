@@ -177,20 +177,12 @@ fn picture_options(a: &EdgesArgs) -> Result<EdgePictureOptions> {
     let (w, h) = super::size_arg(&a.size)?;
     // Checked before any table or drawing: the message names the flag.
     super::width_arg(a.width, (w, h), "edge")?;
-    let eye = super::vec3_arg(&a.eye, "eye")?;
-    if eye.is_none() && a.target.is_some() {
+    let shot = super::shot_arg([&a.eye, &a.target, &a.up], a.fov, a.ortho, [w, h])?;
+    if shot.eye.is_none() && shot.target.is_some() {
         bail!("--target needs --eye (without both, the view is fitted around the mesh)");
     }
     Ok(EdgePictureOptions {
-        shot: shapecue::Shot {
-            eye,
-            target: super::vec3_arg(&a.target, "target")?,
-            up: super::vec3_arg(&a.up, "up")?,
-            fov_deg: a.fov,
-            ortho: a.ortho,
-            size: [w, h],
-            ..Default::default()
-        },
+        shot,
         msaa: a.msaa,
         caps: mode,
         line_width: a.width,

@@ -215,15 +215,7 @@ fn picture_options(
     feature_size: FeatureSize,
 ) -> Result<LinesPictureOptions> {
     let mut opts = LinesPictureOptions {
-        shot: shapecue::Shot {
-            eye: super::vec3_arg(&a.eye, "eye")?,
-            target: super::vec3_arg(&a.target, "target")?,
-            up: super::vec3_arg(&a.up, "up")?,
-            fov_deg: a.fov,
-            ortho: a.ortho,
-            size: [w, h],
-            ..Default::default()
-        },
+        shot: super::shot_arg([&a.eye, &a.target, &a.up], a.fov, a.ortho, [w, h])?,
         line_width: width,
         hidden: a.hidden,
         svg,

@@ -147,6 +147,29 @@ pub fn width_arg(width: f32, size: (u32, u32), what: &str) -> anyhow::Result<()>
     Ok(())
 }
 
+/// A point or direction as clap gives it (`--eye 1,2,3`).
+pub type Vec3Arg = Option<Vec<f32>>;
+
+/// The camera of `--eye`, `--target`, `--up`, `--fov` and `--ortho` for a
+/// `size` image (`lines` and `edges`); the fitted direction is the
+/// library's default.
+pub fn shot_arg(
+    [eye, target, up]: [&Vec3Arg; 3],
+    fov: f32,
+    ortho: bool,
+    size: [u32; 2],
+) -> anyhow::Result<shapecue::Shot> {
+    Ok(shapecue::Shot {
+        eye: vec3_arg(eye, "eye")?,
+        target: vec3_arg(target, "target")?,
+        up: vec3_arg(up, "up")?,
+        fov_deg: fov,
+        ortho,
+        size,
+        ..Default::default()
+    })
+}
+
 /// A point or direction given as `X,Y,Z` (`--eye`, `--target`, `--up`,
 /// `--light`): three finite numbers, or an error naming the option and what
 /// was given.
