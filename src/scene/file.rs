@@ -219,6 +219,20 @@ impl Checker<'_> {
     }
 }
 
+/// A table's span, for errors that name the table's line rather than a key
+/// (`[effects]`, `[output]`); each table's checks add their methods.
+struct Table<'a> {
+    ck: &'a Checker<'a>,
+    span: Range<usize>,
+}
+
+impl Table<'_> {
+    /// An error at the table's line.
+    fn err(&self, problem: String) -> Error {
+        self.ck.err(self.span.clone(), problem)
+    }
+}
+
 fn positive(x: Option<f32>, default: f32, what: &str) -> std::result::Result<f32, String> {
     let v = x.unwrap_or(default);
     if v.is_finite() && v > 0.0 {

@@ -3,14 +3,13 @@
 //! input. Errors without a key of their own name the `[effects]` line.
 
 use super::raw::{EdgeSpec, EffectsSpec, SamplingSpec, StrokeSpec};
-use super::{Checker, Effects, StrokeEffect, color, lines, positive};
+use super::{Checker, Effects, StrokeEffect, Table, color, lines, positive};
 use crate::error::{Error, Result};
 use crate::scene::planner::{Cue, Input};
 use crate::spec::ao::AoMode;
 use crate::spec::edges::CapMode;
 use crate::spec::feature_lines::FeatureSize;
 use crate::spec::sdf_lines::Sampling;
-use std::ops::Range;
 use toml::Spanned;
 
 /// Checks `[effects]` for an `input` source whose key is `kind`.
@@ -91,18 +90,7 @@ struct FeatureEdges {
     marked: Option<std::path::PathBuf>,
 }
 
-/// The `[effects]` table's span, for errors that name the table.
-struct Table<'a> {
-    ck: &'a Checker<'a>,
-    span: Range<usize>,
-}
-
 impl Table<'_> {
-    /// An error at the `[effects]` line.
-    fn err(&self, problem: String) -> Error {
-        self.ck.err(self.span.clone(), problem)
-    }
-
     /// `shading`: the base colour and ambient term.
     fn shading(&self, fx: &EffectsSpec, cues: &mut Vec<Cue>) -> Result<([f32; 3], f32)> {
         let shading = fx.shading.clone().unwrap_or_default();

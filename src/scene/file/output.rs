@@ -2,10 +2,9 @@
 //! background and the feature edges' interop mode. Errors without a key of their own name the `[output]` line.
 
 use super::raw::OutputSpec;
-use super::{Checker, color};
+use super::{Checker, Table, color};
 use crate::error::{Error, Result};
 use crate::spec::interop::InteropMode;
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -77,18 +76,7 @@ pub(super) fn resolve(
     })
 }
 
-/// The `[output]` table's span, for errors that name the table.
-struct Table<'a> {
-    ck: &'a Checker<'a>,
-    span: Range<usize>,
-}
-
 impl Table<'_> {
-    /// An error at the `[output]` line.
-    fn err(&self, problem: String) -> Error {
-        self.ck.err(self.span.clone(), problem)
-    }
-
     /// `size`, within the image size limits.
     fn size(&self, out: &OutputSpec) -> Result<[u32; 2]> {
         let size = out.size.unwrap_or([640, 480]);
