@@ -12,13 +12,12 @@ use std::path::Path;
 use crate::error::Result;
 pub use crate::render::visibility::{
     ClipLine, DEFAULT_BIAS, SvgPolyline, edge_out_lines, segment_lines, visible_joined,
-    visible_polylines,
 };
 
 /// One cue's group in the SVG file.
 #[derive(Clone, Debug)]
 pub struct SvgLayer {
-    /// Group id and class (`contours`, `suggestive-contours`, `feature-edges`).
+    /// Group id and class (`contours`, `suggestive`, `ridges`, ..., `feature-edges`).
     pub id: &'static str,
     /// Stroke width in pixels.
     pub stroke_width: f32,
@@ -65,22 +64,6 @@ fn svg_open(width: u32, height: u32) -> String {
     )
 }
 
-/// SVG text of `polylines` on a `width` × `height` canvas, black round-joined
-/// strokes of `stroke_width` pixels, in one group `feature-edges`.
-pub fn svg_text(polylines: &[Vec<[f32; 2]>], width: u32, height: u32, stroke_width: f32) -> String {
-    let mut s = svg_open(width, height);
-    let _ = writeln!(
-        s,
-        "<g id=\"feature-edges\" class=\"feature-edges\" fill=\"none\" stroke=\"black\" \
-         stroke-width=\"{stroke_width}\" stroke-linecap=\"round\" stroke-linejoin=\"round\">"
-    );
-    for l in polylines {
-        push_polyline(&mut s, l, None);
-    }
-    s.push_str("</g>\n</svg>\n");
-    s
-}
-
 /// SVG text of `layers` on a `width` × `height` canvas: one group per layer
 /// with its id, class, colour and stroke width; round caps and joins; a
 /// polyline's `stroke-opacity` where it is below 1. Empty layers are kept (as
@@ -112,20 +95,6 @@ pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
     }
     s.push_str("</svg>\n");
     s
-}
-
-/// Writes [`svg_text`] to `path` (whole or not at all).
-pub fn write_svg(
-    path: &Path,
-    polylines: &[Vec<[f32; 2]>],
-    width: u32,
-    height: u32,
-    stroke_width: f32,
-) -> Result<()> {
-    super::output::write_bytes_atomic(
-        path,
-        svg_text(polylines, width, height, stroke_width).as_bytes(),
-    )
 }
 
 /// `p` in image pixels of a `w` × `h` image (origin top left) through

@@ -31,7 +31,7 @@ use glam::Mat4;
 use super::{Frame, clip_segment};
 use crate::spec::feature_lines::{LINE_FREE, Segment, edge_key};
 
-/// Default depth bias (window depth units) of [`visible_polylines`].
+/// Default depth bias (window depth units) of [`visible_joined`].
 pub const DEFAULT_BIAS: f32 = 1e-3;
 
 /// A line to test for visibility: clip-space ends (OpenGL convention, w > 0),
@@ -118,16 +118,6 @@ pub fn segment_lines(
         });
     }
     out
-}
-
-/// Visible pieces of the drawn edges of `edge_out` (4 clip-space vertices per
-/// edge, House & Li layout), in image pixel coordinates (origin top left),
-/// joined into polylines where pieces share an end point (within 1/64 pixel).
-pub fn visible_polylines(edge_out: &[[f32; 4]], frame: &Frame, bias: f32) -> Vec<Vec<[f32; 2]>> {
-    visible_joined(&edge_out_lines(edge_out), frame, bias)
-        .into_iter()
-        .map(|l| l.points)
-        .collect()
 }
 
 /// Visible parts of `lines` against the depth of `frame`, joined into
