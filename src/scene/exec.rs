@@ -325,7 +325,7 @@ fn render_all(
     let passes = ex.rec.in_plan_order(&plan);
     // The run's kernel time: its kernel passes' (the laps are wall time).
     let kernel_ms = (passes.iter())
-        .filter(|p| p.clock == "kernel")
+        .filter(|p| p.is_kernel())
         .map(|p| p.ms)
         .sum();
     let report = RunReport {

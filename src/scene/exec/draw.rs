@@ -108,7 +108,7 @@ fn strength_bin(strength: f32) -> usize {
 
 /// Whether a segment is drawn at all: one of no strength (faded out, or a
 /// non-finite test) is not, in the image nor in the SVG.
-fn shown(s: &Segment) -> bool {
+pub(super) fn shown(s: &Segment) -> bool {
     s.3 > 0.0
 }
 

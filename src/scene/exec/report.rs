@@ -27,6 +27,13 @@ pub struct PassRecord {
     pub how: String,
 }
 
+impl PassRecord {
+    /// Whether its ms are OpenCL kernel time (else host wall time).
+    pub fn is_kernel(&self) -> bool {
+        self.clock == "kernel"
+    }
+}
+
 /// The report of one scene run.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {

@@ -271,7 +271,7 @@ impl Executor<'_, '_> {
             let kind = st.family as u32;
             // Drawn segments, as for the contours (none of no strength).
             let n = (self.segs.iter())
-                .filter(|s| s.2 == kind && s.3 > 0.0)
+                .filter(|s| s.2 == kind && draw::shown(s))
                 .count();
             *self.line_segments.entry(st.family.name()).or_default() += n;
         }
