@@ -189,19 +189,7 @@ pub fn line_segments_on(
     let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, copts)?;
     est.set_positions(&mesh.positions)?;
     let mut timing = est.run()?;
-    let fs = {
-        let field = est.mapped(None)?;
-        let at = |i: usize| {
-            let v = field.vertex(i);
-            [v.k1, v.k2]
-        };
-        crate::mesh::feature_size::resolve(
-            setup.feature_size,
-            &mesh.positions,
-            &mesh.faces,
-            Some(&at),
-        ) as f32
-    };
+    let fs = est.feature_size(setup.feature_size, &mesh.positions, &mesh.faces)? as f32;
     let mut ex = LineExtractor::new(gpu.clone(), mesh.n_vertices(), &mesh.faces)?;
     let (segments, st) = ex.extract_device(&est, view, fs, *opts)?;
     timing.extend(&st.timing);

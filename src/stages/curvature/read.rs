@@ -173,6 +173,32 @@ impl CurvatureEstimator {
         })
     }
 
+    /// The line thresholds' scale `size` of the mesh (`positions`, `faces`:
+    /// this estimator's topology, in world units) with this pose's
+    /// curvature, read in place at the vertices rtsc samples
+    /// ([`crate::mesh::feature_size::resolve`]).
+    ///
+    /// # Errors
+    /// OpenCL errors of the maps.
+    pub fn feature_size(
+        &self,
+        size: crate::spec::feature_lines::FeatureSize,
+        positions: &[[f64; 3]],
+        faces: &[[u32; 3]],
+    ) -> Result<f64> {
+        let field = self.mapped(None)?;
+        let at = |i: usize| {
+            let v = field.vertex(i);
+            [v.k1, v.k2]
+        };
+        Ok(crate::mesh::feature_size::resolve(
+            size,
+            positions,
+            faces,
+            Some(&at),
+        ))
+    }
+
     /// Maps the first `comps` reals per vertex of `b` for reading.
     fn map_reals<'a>(&'a self, b: &'a Buffer<u8>, comps: usize) -> Result<Mapped<'a, u8>> {
         self.gpu.map_read(b, comps * self.nv * self.real)

@@ -417,23 +417,17 @@ fn resolve_feature_size(
     est: Option<&CurvatureEstimator>,
     note: &mut Option<String>,
 ) -> Result<f32> {
-    let field = match est {
-        Some(e) if plan.contains(Pass::Curvature) => Some(e.mapped(None)?),
-        _ => None,
+    let size = scene.effects.feature_size;
+    let (fs, read_curvature) = match est {
+        Some(e) if plan.contains(Pass::Curvature) => {
+            (e.feature_size(size, &mesh.positions, &mesh.faces)?, true)
+        }
+        _ => {
+            let fs = crate::mesh::feature_size::resolve(size, &mesh.positions, &mesh.faces, None);
+            (fs, false)
+        }
     };
-    let at = |i: usize| {
-        let v = field.as_ref().expect("read only with a field").vertex(i);
-        [v.k1, v.k2]
-    };
-    let k: Option<&dyn Fn(usize) -> [f64; 2]> = field.as_ref().map(|_| &at as _);
-    let fs = crate::mesh::feature_size::resolve(
-        scene.effects.feature_size,
-        &mesh.positions,
-        &mesh.faces,
-        k,
-    ) as f32;
-    let read_curvature = k.is_some();
-    drop(field);
+    let fs = fs as f32;
     if note.is_none() {
         use crate::spec::feature_lines::FeatureSize;
         let how = match scene.effects.feature_size {
