@@ -14,7 +14,17 @@ use common::{scratch, unless_no_gl};
 use shapecue::Error;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
-use shapecue::scene::planner::{Cue, Input, Pass, plan_with};
+use shapecue::scene::planner::{Cue, Input, Outputs, Pass, plan_for};
+use shapecue::spec::visibility::VisibilityMethod;
+
+/// PNG and SVG, the SVG's hidden lines found exactly.
+fn both_exact() -> Outputs {
+    Outputs {
+        raster: true,
+        vector: true,
+        visibility: VisibilityMethod::Exact,
+    }
+}
 use std::path::Path;
 
 fn scene(dir: &Path, text: &str) -> Scene {
@@ -83,7 +93,7 @@ fn each_line_cue_runs_exactly_its_passes_and_draws_its_family() {
         let what = format!("{cues:?}");
         assert_eq!(
             r.plan,
-            plan_with(&cues, Input::Static, s.effects.caps),
+            plan_for(&cues, Input::Static, s.effects.caps, both_exact()),
             "{what}"
         );
         check_minimal(&r, &what);

@@ -13,7 +13,8 @@ use common::{SHARED_DATA, model_path, scratch, unless_no_gl};
 use shapecue::Error;
 use shapecue::scene::exec::{self, ExecOptions, RunReport};
 use shapecue::scene::file::Scene;
-use shapecue::scene::planner::{Cue, Input, Pass, plan_with};
+use shapecue::scene::planner::{Cue, Input, Outputs, Pass, plan_for};
+use shapecue::spec::visibility::VisibilityMethod;
 use std::path::Path;
 
 /// Writes a scene next to its outputs and parses it.
@@ -90,7 +91,16 @@ fn static_scenes_run_exactly_their_passes() {
         let cues: Vec<Cue> = set.iter().map(|&i| CUES[i].1).collect();
         assert_eq!(
             r.plan,
-            plan_with(&cues, s.source.input(), s.effects.caps),
+            plan_for(
+                &cues,
+                s.source.input(),
+                s.effects.caps,
+                Outputs {
+                    raster: true,
+                    vector: true,
+                    visibility: VisibilityMethod::Exact,
+                }
+            ),
             "{cues:?}"
         );
         check_minimal(&r, &format!("{cues:?}"));

@@ -23,6 +23,7 @@ use crate::spec::edges::{
 };
 use crate::spec::interop::{InteropMode, InteropOffer};
 use crate::spec::timing::Timing;
+use crate::spec::visibility::VisibilityMethod;
 
 /// What [`feature_edges_picture`] draws and how (the `shapecue edges`
 /// options).
@@ -47,8 +48,14 @@ pub struct EdgePictureOptions {
     /// Marked edges: a text file of vertex-index pairs
     /// ([`crate::mesh::edges::read_marked`]).
     pub marked: Option<PathBuf>,
+    /// Draw the picture (GL). Off, with `svg` on and exact visibility, no
+    /// GL context is opened.
+    pub image: bool,
     /// Also find the SVG group of the visible edges.
     pub svg: bool,
+    /// How the SVG's hidden edges are found: exactly, over the mesh's BVH
+    /// (default), or against the picture's depth (which draws it).
+    pub visibility: VisibilityMethod,
     /// How the stage's buffers reach GL: `auto` shares memory (Vulkan
     /// external memory) where the device, GL and Vulkan offer it, else
     /// reads back and uploads; `on` refuses to run without sharing; `off`
@@ -70,7 +77,9 @@ impl Default for EdgePictureOptions {
             depth_scale: None,
             half_contours: false,
             marked: None,
+            image: true,
             svg: false,
+            visibility: VisibilityMethod::Exact,
             interop: InteropMode::Off,
         }
     }
@@ -79,9 +88,9 @@ impl Default for EdgePictureOptions {
 /// What [`feature_edges_picture`] made.
 #[derive(Clone, Debug)]
 pub struct EdgePicture {
-    /// The picture: the shaded mesh with its edges and caps in black (with
-    /// depth when [`EdgePictureOptions::svg`] asked for the SVG group).
-    pub frame: Frame,
+    /// The picture: the shaded mesh with its edges and caps in black, where
+    /// one was drawn (with depth when the SVG's hidden edges came from it).
+    pub frame: Option<Frame>,
     /// The stage's outputs as drawn: `kind` per edge, and only the edge
     /// quads and caps that hold geometry, compacted in index order (on the
     /// external-memory route they stay on the device: `kind` only, and the
@@ -108,6 +117,9 @@ pub struct EdgePicture {
     pub memory: MemoryUse,
     /// The SVG groups (the visible edges), when asked for.
     pub layers: Option<Vec<SvgLayer>>,
+    /// The drawn edges split where their visibility changes and joined into
+    /// chains (world coordinates), with exact visibility.
+    pub visible: Option<crate::scene::exec::VisibleLines>,
     /// The device that ran the stage.
     pub device: DeviceInfo,
     /// Mesh data uploads to GL (one topology and one pose).
@@ -193,6 +205,7 @@ pub fn feature_edges_picture_on(
         timing,
         passes: f.passes,
         layers: v.layers,
+        visible: v.visible,
         device: gpu.info.clone(),
         uploads: v.uploads,
         drawn_caps: info.drawn_caps,
@@ -212,7 +225,9 @@ pub fn edges_scene(mesh: Arc<Mesh>, name: &str, opts: &EdgePictureOptions) -> Re
     let [r, g, b, _] = RenderOptions::default().background;
     s.background = [r, g, b];
     s.msaa = opts.msaa;
+    s.png = opts.image;
     s.svg = opts.svg;
+    s.visibility = opts.visibility;
     s.interop = opts.interop;
     let fx = &mut s.effects;
     fx.cues = vec![Cue::Shading, Cue::FeatureEdges];

@@ -11,7 +11,7 @@ use crate::export::svg::SvgLayer;
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame, RenderOptions};
-use crate::scene::exec::{ExecOptions, PassRecord, Session};
+use crate::scene::exec::{ExecOptions, PassRecord, Session, VisibleLines};
 use crate::scene::file::{HeldMesh, LineStyle, Scene, Shot, Source};
 use crate::scene::planner::Cue;
 use crate::spec::curvature::CurvatureOptions;
@@ -19,6 +19,7 @@ use crate::spec::feature_lines::{FeatureSize, LineFamily, Segment};
 pub use crate::spec::feature_lines::{Hidden, family_style, hidden_id};
 use crate::spec::timing::Timing;
 use crate::spec::view::View;
+pub use crate::spec::visibility::VisibilityMethod;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use std::sync::Arc;
@@ -35,8 +36,14 @@ pub struct LinesPictureOptions {
     pub line_width: f32,
     /// Hidden parts in the SVG.
     pub hidden: Hidden,
+    /// Draw the picture (GL). Off, with `svg` on and exact visibility, no
+    /// GL context is opened.
+    pub image: bool,
     /// Also find the SVG groups.
     pub svg: bool,
+    /// How the SVG's hidden lines are found: exactly, over the mesh's BVH
+    /// (default), or against the picture's depth (which draws it).
+    pub visibility: VisibilityMethod,
     /// The curvature and the feature size the lines are found with.
     pub setup: LineSetup,
 }
@@ -60,7 +67,9 @@ impl Default for LinesPictureOptions {
             lines: LineOptions::default(),
             line_width: 2.0,
             hidden: Hidden::Remove,
+            image: true,
             svg: false,
+            visibility: VisibilityMethod::Exact,
             setup: LineSetup::default(),
         }
     }
@@ -68,13 +77,16 @@ impl Default for LinesPictureOptions {
 
 /// The result of [`lines_picture`].
 pub struct LinesPicture {
-    /// The picture (lines over the mesh in white).
-    pub frame: Frame,
+    /// The picture (lines over the mesh in white), where one was drawn.
+    pub frame: Option<Frame>,
     /// Every segment found, world coordinates, with its family (`kind`) and
     /// strength (the picture leaves out those of no strength).
     pub segments: Vec<Segment>,
     /// The SVG groups, one per family (and one per family's hidden parts).
     pub layers: Option<Vec<SvgLayer>>,
+    /// The drawn segments split where their visibility changes and joined
+    /// into chains (world coordinates), with exact visibility.
+    pub visible: Option<VisibleLines>,
     /// Kernel ms of curvature and line steps.
     pub timing: Timing,
     /// The passes that ran, in plan order, with their ms.
@@ -110,6 +122,7 @@ pub fn lines_picture_on(
         frame: v.image,
         segments: v.segments,
         layers: v.layers,
+        visible: v.visible,
         timing: v.timing,
         passes: f.passes,
         camera,
@@ -125,7 +138,9 @@ pub fn lines_scene(mesh: Arc<Mesh>, opts: &LinesPictureOptions) -> Scene {
     let [r, g, b, _] = RenderOptions::default().background;
     s.background = [r, g, b];
     s.msaa = RenderOptions::default().msaa;
+    s.png = opts.image;
     s.svg = opts.svg;
+    s.visibility = opts.visibility;
     s.curvature = opts.setup.curvature;
     let fx = &mut s.effects;
     fx.feature_size = opts.setup.feature_size;

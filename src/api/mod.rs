@@ -53,10 +53,11 @@ pub use crate::cpu::curvature::curvature as curvature_reference;
 pub use crate::gpu::{DeviceInfo, Gpu, list_devices};
 pub use crate::render::{Camera, Placement, framed};
 pub use crate::scene::exec::{
-    Checked, ExecOptions, RunReport, Session, check_scenes, explain, run as run_scene,
-    run_on as run_scene_on,
+    Checked, ExecOptions, LAYER_FEATURE_EDGES, RunReport, Session, VisibleLines, check_scenes,
+    explain, run as run_scene, run_on as run_scene_on,
 };
 pub use crate::scene::file::{HeldMesh, HeldVolume, Scene, Source};
+pub use crate::spec::visibility::VisibilityMethod;
 pub use crate::stages::curvature::{
     CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
 };

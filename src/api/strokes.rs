@@ -227,8 +227,11 @@ pub fn strokes_on(
                     ..s.clone()
                 })
                 .collect();
+            let frame = v.image.ok_or_else(|| {
+                crate::error::Error::InvalidArgument("the strokes picture drew no image".into())
+            })?;
             let picture = Picture {
-                frame: v.image,
+                frame,
                 camera: v.camera,
                 centre: o,
                 strokes,
@@ -262,6 +265,7 @@ fn strokes_scene(vol: Arc<Volume>, iso: f32, opts: &StrokesOptions, p: &PictureO
     let [r, g, b, _] = RenderOptions::default().background;
     s.background = [r, g, b];
     s.msaa = RenderOptions::default().msaa;
+    s.png = true;
     let fx = &mut s.effects;
     fx.cues = match p.surface {
         true => vec![Cue::Shading, Cue::CurvatureStrokes],

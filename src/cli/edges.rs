@@ -9,7 +9,7 @@ use super::{check_outputs, out, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::EdgePictureOptions;
-use shapecue::api::Gpu;
+use shapecue::api::{Gpu, VisibilityMethod};
 use shapecue::mesh::LoadOptions;
 use shapecue::spec::edges::CapMode;
 use std::path::PathBuf;
@@ -69,12 +69,18 @@ pub struct EdgesArgs {
     /// time of none at 1024x1024.
     #[arg(long, default_value_t = 4)]
     msaa: u32,
-    /// Output PNG.
+    /// Output: .png (the shaded picture) or .svg (the visible edges as
+    /// polylines; with exact visibility no OpenGL is needed).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Also write the visible edges as SVG polylines.
+    /// Also write the visible edges as SVG polylines beside a PNG.
     #[arg(long)]
     svg: Option<PathBuf>,
+    /// How the SVG's hidden edges are found: exact (in object space, by
+    /// rays towards the eye over a BVH of the mesh) or depth (against the
+    /// drawn picture's depth buffer).
+    #[arg(long, value_parser = super::choice::<VisibilityMethod>(), default_value = "exact")]
+    visibility: VisibilityMethod,
     /// Write statistics (edge counts, timings, memory, interop path) as JSON.
     #[arg(long)]
     stats: Option<PathBuf>,
@@ -103,18 +109,29 @@ fn ms_since(t: std::time::Instant) -> f64 {
 
 /// Runs `shapecue edges`.
 pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
-    let opts = picture_options(&a)?;
+    let Some(output) = &a.output else {
+        bail!("give -o OUT.png (a picture) or -o OUT.svg (the visible edges)");
+    };
+    let out_svg = super::has_extension(output, "svg");
+    // The options first: their messages name the flag at fault.
+    let opts = picture_options(&a, out_svg)?;
+    if !out_svg && !super::has_extension(output, "png") {
+        bail!(
+            "-o {}: give a name ending in .png (a picture) or .svg (the visible edges)",
+            output.display()
+        );
+    }
+    if out_svg && a.svg.is_some() {
+        bail!(
+            "-o {} is an SVG already: --svg adds one beside a PNG",
+            output.display()
+        );
+    }
     let [w, h] = opts.shot.size;
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
     let path = a.mesh.as_path();
-    if let Some(o) = &a.output {
-        super::require_png("-o", o)?;
-    }
-    let Some(output) = &a.output else {
-        bail!("give -o OUT.png");
-    };
     check_outputs(
         [path].into_iter().chain(a.marked.as_deref()),
         [Some(output), a.svg.as_ref(), a.stats.as_ref()]
@@ -130,8 +147,18 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let name = path.display().to_string();
     let d = shapecue::feature_edges_picture_on(&gpu, &mesh, &name, &opts)?;
     let t_png = std::time::Instant::now();
-    d.frame.save_png(output)?;
-    let png_ms = ms_since(t_png);
+    match (&d.frame, &d.layers) {
+        (_, Some(layers)) if out_svg => {
+            shapecue::export::svg::write_svg_layers(output, layers, w, h)?
+        }
+        (Some(frame), _) => frame.save_png(output)?,
+        _ => bail!("the picture drew no image for {}", output.display()),
+    }
+    // The output's write time: the PNG's, or the SVG's for -o OUT.svg.
+    let (png_ms, mut svg_ms) = match out_svg {
+        true => (0.0, ms_since(t_png)),
+        false => (ms_since(t_png), 0.0),
+    };
     print_summary(&name, &d, output)?;
     let runs = match a.runs {
         Some(n) => {
@@ -147,7 +174,6 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
         }
         None => None,
     };
-    let mut svg_ms = 0.0;
     if let (Some(svg), Some(layers)) = (&a.svg, &d.layers) {
         let t_svg = std::time::Instant::now();
         shapecue::export::svg::write_svg_layers(svg, layers, w, h)?;
@@ -170,7 +196,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
 
 /// The picture's options from the arguments (checked here: the messages
 /// name the flags).
-fn picture_options(a: &EdgesArgs) -> Result<EdgePictureOptions> {
+fn picture_options(a: &EdgesArgs, out_svg: bool) -> Result<EdgePictureOptions> {
     // Parsed here rather than by clap's ValueEnum so that a bad name keeps
     // the library's message ("unknown cap mode ...") and exit code 1.
     let mode: CapMode = a.caps.parse()?;
@@ -190,7 +216,9 @@ fn picture_options(a: &EdgesArgs) -> Result<EdgePictureOptions> {
         depth_scale: a.depth_scale,
         half_contours: a.half_contours,
         marked: a.marked.clone(),
-        svg: a.svg.is_some(),
+        image: !out_svg,
+        svg: out_svg || a.svg.is_some(),
+        visibility: a.visibility,
         interop: a.interop,
     })
 }

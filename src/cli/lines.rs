@@ -9,7 +9,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::LinesPictureOptions;
 use shapecue::api::Gpu;
-use shapecue::api::{Hidden, LineSetup};
+use shapecue::api::{Hidden, LineSetup, VisibilityMethod};
 use shapecue::mesh::LoadOptions;
 use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions};
 use shapecue::spec::feature_lines::FeatureSize;
@@ -114,13 +114,22 @@ pub struct LinesArgs {
     /// curvature gradients (shapecue's addition to rtsc).
     #[arg(long)]
     hermite_kh: bool,
+    /// How the hidden parts of the SVG and --segments are found: exact (in
+    /// object space, by rays towards the eye over a BVH of the mesh; no
+    /// OpenGL is needed for SVG and segments) or depth (against the drawn
+    /// picture's depth buffer).
+    #[arg(long, value_parser = super::choice::<VisibilityMethod>(), default_value = "exact")]
+    visibility: VisibilityMethod,
     /// Hidden parts in the SVG: remove, faded or dashed.
     #[arg(long, value_parser = super::choice::<Hidden>(), default_value = "remove")]
     hidden: Hidden,
     /// Output: .png (picture) or .svg (a group per family).
     #[arg(short, long)]
     output: PathBuf,
-    /// Also write the 3-D segments (family, strength, ends) as JSON.
+    /// Also write the 3-D segments as JSON: with exact visibility, each
+    /// drawn segment split where its visibility changes (family, strength,
+    /// ends, visible, the faces it lies on, its chain) and the chains;
+    /// else every segment (family, strength, ends).
     #[arg(long)]
     segments: Option<PathBuf>,
     /// Overwrite existing output files.
@@ -189,9 +198,12 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let opts = picture_options(&a, fams, (w, h), width, svg, feature_size)?;
     let gpu = Arc::new(Gpu::new(device)?);
     let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
-    match &pic.layers {
-        Some(layers) => shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?,
-        None => pic.frame.save_png(&a.output)?,
+    match (&pic.layers, &pic.frame) {
+        (Some(layers), _) if svg => {
+            shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?
+        }
+        (_, Some(frame)) => frame.save_png(&a.output)?,
+        _ => bail!("the picture drew no image for {}", a.output.display()),
     }
     if let Some(p) = &a.segments {
         write_segments(p, &pic)?;
@@ -218,7 +230,10 @@ fn picture_options(
         shot: super::shot_arg([&a.eye, &a.target, &a.up], a.fov, a.ortho, [w, h])?,
         line_width: width,
         hidden: a.hidden,
-        svg,
+        // The segments' visibility comes with the SVG groups.
+        image: !svg,
+        svg: svg || a.segments.is_some(),
+        visibility: a.visibility,
         setup: LineSetup {
             curvature: CurvatureOptions {
                 accumulate: a.accumulate.resolve(),
@@ -252,24 +267,55 @@ fn picture_options(
     Ok(opts)
 }
 
-/// Writes every segment (family, strength, ends) and the feature size as
-/// JSON (`--segments`).
+/// Writes the segments and the feature size as JSON (`--segments`): with
+/// exact visibility the drawn segments split into their pieces and the
+/// chains, else every segment.
 fn write_segments(path: &std::path::Path, pic: &shapecue::LinesPicture) -> Result<()> {
-    let segs: Vec<serde_json::Value> = pic
-        .segments
-        .iter()
-        .map(|s| {
-            let fam = LineFamily::from_kind(s.2).map_or("unknown", |f| f.name());
-            serde_json::json!({"family": fam, "strength": s.3, "a": s.0, "b": s.1})
-        })
-        .collect();
-    write_json(
-        path,
-        &serde_json::json!({
-            "feature_size": pic.feature_size,
-            "segments": segs,
-        }),
-    )
+    let family = |k: u32| LineFamily::from_kind(k).map_or("unknown", |f| f.name());
+    let doc = match &pic.visible {
+        Some(v) => {
+            let mut chain_of = vec![0usize; v.chain_pieces.len()];
+            for (c, ch) in v.chains.iter().enumerate() {
+                for &(i, _) in &ch.pieces {
+                    chain_of[i as usize] = c;
+                }
+            }
+            let pieces: Vec<serde_json::Value> = (v.chain_pieces.iter().enumerate())
+                .map(|(i, p)| {
+                    let s = &v.segments[p.seg as usize];
+                    serde_json::json!({
+                        "family": family(s.2),
+                        "strength": s.3,
+                        "a": v.point(p.seg, p.t[0]),
+                        "b": v.point(p.seg, p.t[1]),
+                        "visible": p.visible,
+                        "faces": v.faces[p.seg as usize],
+                        "chain": chain_of[i],
+                    })
+                })
+                .collect();
+            let chains: Vec<serde_json::Value> = (v.chains.iter())
+                .map(|c| {
+                    let idx: Vec<u32> = c.pieces.iter().map(|p| p.0).collect();
+                    serde_json::json!({"family": family(c.layer), "visible": c.visible, "segments": idx})
+                })
+                .collect();
+            serde_json::json!({
+                "feature_size": pic.feature_size,
+                "visibility": "exact",
+                "segments": pieces,
+                "chains": chains,
+                "mean_visible_chain_segments": v.mean_chain_length(),
+            })
+        }
+        None => {
+            let segs: Vec<serde_json::Value> = (pic.segments.iter())
+                .map(|s| serde_json::json!({"family": family(s.2), "strength": s.3, "a": s.0, "b": s.1}))
+                .collect();
+            serde_json::json!({"feature_size": pic.feature_size, "segments": segs})
+        }
+    };
+    write_json(path, &doc)
 }
 
 /// What the run found, in words: the segments per family.

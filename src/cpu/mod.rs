@@ -1,9 +1,11 @@
 //! Plain Rust reference implementations of the device stages, in f64, with
 //! the same step names as the kernels. Deliberately simple: they are the
-//! oracles the tests compare the device with.
+//! oracles the tests compare the device with. `chains` is the one host-only
+//! step (the visibility family's joining of pieces into chains).
 
 pub mod ao;
 pub mod bvh;
+pub mod chains;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

@@ -43,17 +43,19 @@ mod live;
 mod load;
 mod passes;
 mod report;
+mod vector;
 
 pub use draw::{EdgeCounts, EdgeInfo, ViewOutputs};
 pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
+pub use vector::{LAYER_FEATURE_EDGES, VisibleLines};
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
 use crate::scene::file::{Scene, Source};
-use crate::scene::planner::{Input, Lifetime, Pass, Plan, plan_with};
+use crate::scene::planner::{Input, Lifetime, Outputs, Pass, Plan, plan_for};
 use load::load;
 use passes::Executor;
 use report::ms_since;
@@ -134,7 +136,11 @@ impl Session {
     /// The session's renderer set to `scene`'s image size, antialiasing
     /// and background: made on first use, its framebuffers made anew when
     /// the size or antialiasing changes.
-    fn renderer(&mut self, scene: &Scene) -> Result<Renderer> {
+    /// None where `plan` draws no frame (no GL context is opened).
+    fn renderer(&mut self, scene: &Scene, plan: &Plan) -> Result<Option<Renderer>> {
+        if !plan.contains(Pass::Render) {
+            return Ok(None);
+        }
         let [br, bg, bb] = scene.background;
         let opts = RenderOptions {
             width: scene.size[0],
@@ -145,17 +151,23 @@ impl Session {
         match self.renderer.take() {
             Some(mut r) => {
                 r.reconfigure(opts)?;
-                Ok(r)
+                Ok(Some(r))
             }
-            None => Renderer::new(opts),
+            None => Renderer::new(opts).map(Some),
         }
     }
 }
 
-/// The plan of a scene's cues for its input.
-fn plan_of(scene: &Scene) -> crate::scene::planner::Plan {
+/// The plan of a scene's cues for its input and outputs; `image`: a frame
+/// is wanted besides the scene's PNG (a live view).
+fn plan_of(scene: &Scene, image: bool) -> crate::scene::planner::Plan {
     let fx = &scene.effects;
-    plan_with(&fx.cues, scene.source.input(), fx.caps)
+    let outputs = Outputs {
+        raster: scene.png || image,
+        vector: scene.svg,
+        visibility: scene.visibility,
+    };
+    plan_for(&fx.cues, scene.source.input(), fx.caps, outputs)
 }
 
 /// Runs a scene: loads the input, plans, refuses to overwrite outputs
@@ -314,10 +326,10 @@ fn render_all(
         notes,
         t_all,
     } = input;
-    let plan = plan_of(scene);
+    let plan = plan_of(scene, false);
     let gpu = session.gpu(opts)?;
-    let renderer = session.renderer(scene)?;
-    let uploads_before = renderer.uploads();
+    let renderer = session.renderer(scene, &plan)?;
+    let uploads_before = renderer.as_ref().map(|r| r.uploads()).unwrap_or_default();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
     let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, progress)?;
 
@@ -346,6 +358,7 @@ fn render_all(
             }
         },
         segments: ex.segments,
+        chains: report::Chains::new(ex.chains),
         lines: std::mem::take(&mut ex.line_segments),
         strokes: ex.stroke_count,
         notes: notes
@@ -360,7 +373,9 @@ fn render_all(
         },
     };
     // The next scene of the session draws with the same GL context.
-    session.renderer = Some(ex.into_renderer());
+    if let Some(r) = ex.into_renderer() {
+        session.renderer = Some(r);
+    }
     let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
     crate::export::output::write_bytes_atomic(&outputs.report, json.as_bytes())?;
     Ok(report)
@@ -413,12 +428,15 @@ fn run_frames(
                 .map(|i| &i.2)
                 .collect();
             ex.begin_view();
+            let mut drawing = false;
             for &p in &view_passes {
-                if p == Pass::Render {
+                if matches!(p, Pass::Render | Pass::Svg) && !drawing {
                     timing.lap("view", ex.rec.lap());
+                    drawing = true;
                 }
                 ex.view_pass(p, cam, &paths)?;
             }
+            ex.end_view(cam);
             timing.lap("render", ex.rec.lap());
             done += 1;
             progress(done, total_views);
@@ -560,7 +578,7 @@ pub fn explain(scene: &Scene, opts: &ExecOptions) -> Result<String> {
     let mut notes = Vec::new();
     let loaded = load(scene, &mut notes)?;
     let frames = frame_indices(scene, loaded.frames())?;
-    let plan = plan_of(scene);
+    let plan = plan_of(scene, false);
     let out_dir = opts
         .out_dir
         .clone()

@@ -173,6 +173,10 @@ pub struct Scene {
     /// and uploaded; `auto`: shared memory where the device, GL and Vulkan
     /// offer it). The executor decides.
     pub interop: crate::spec::interop::InteropMode,
+    /// How the SVG's hidden lines are found (default `exact`: in object
+    /// space over the mesh's BVH, with no GL context when no PNG is
+    /// written; `depth`: against the rendered depth).
+    pub visibility: crate::spec::visibility::VisibilityMethod,
 }
 
 /// 1-based line and column of a byte offset.
@@ -310,6 +314,7 @@ impl Scene {
             msaa: out.msaa,
             background: out.background,
             interop: out.interop,
+            visibility: out.visibility,
         })
     }
 }

@@ -15,6 +15,7 @@
 use crate::spec::edges::CapMode;
 use crate::spec::feature_lines::LineFamily;
 use crate::spec::timing::Step;
+use crate::spec::visibility::VisibilityMethod;
 use serde::Serialize;
 
 /// A shape cue a scene can ask for.
@@ -157,7 +158,9 @@ impl Cue {
     /// terms (`lines_view`; isophotes need only normals there); suggestive
     /// highlights and D_w κr = 0 the radial curvature and its derivative
     /// (dcurv); boundaries only the boundary edges, listed once per
-    /// topology, and the normals the segment pass culls with.
+    /// topology, and the normals the segment pass culls with. `Render`
+    /// here stands for the view's drawing: the plan puts in its place the
+    /// passes the outputs need ([`Outputs`]).
     pub fn needs(self) -> &'static [Pass] {
         use Pass::{Curvature, Dcurv, LinesCurves, LinesDt1q1, LinesPose, LinesView, Render};
         match self {
@@ -236,6 +239,9 @@ pub enum Pass {
     /// larger principal curvature, its derivative along its direction, K,
     /// H), once per pose however many views.
     LinesPose,
+    /// The mesh's BVH for exact visibility (family `bvh`): built when a
+    /// topology first appears, refitted to every later pose.
+    Bvh,
     /// Curvature-directed strokes traced on the volume itself (family
     /// `sdf_lines`): dense samples, Poisson-disk seeds, curvature from the
     /// Hessian, RK4 tracing along d1, tapered strips. Reads no mesh pass.
@@ -258,8 +264,15 @@ pub enum Pass {
     Edges,
     /// Cap geometry into the cap-out buffers.
     Caps,
-    /// Draw the frame.
+    /// Exact visibility of the view's lines (family `visibility`): every
+    /// segment split where its visibility changes, by occlusion queries
+    /// towards the eye over the BVH, then joined into chains.
+    Visibility,
+    /// Draw the frame (GL).
     Render,
+    /// Write the view's vector drawing (SVG groups of chains), its hidden
+    /// lines from the visibility pass or from the frame's depth.
+    Svg,
 }
 
 impl std::fmt::Display for Cue {
@@ -326,6 +339,9 @@ impl Pass {
             Pass::Dcurv => "dcurv",
             Pass::Ao => "ao",
             Pass::LinesPose => "lines_pose",
+            Pass::Bvh => "bvh",
+            Pass::Visibility => "visibility",
+            Pass::Svg => "svg",
             Pass::LinesView => "lines_view",
             Pass::LinesDt1q1 => "lines_dt1q1",
             Pass::LinesCurves => "lines_curves",
@@ -393,11 +409,14 @@ impl Pass {
             Pass::LinesCurves => &[LinesVertex, LinesCurves],
             Pass::Edges => &[EdgesDetect],
             Pass::Caps => &[CapsMh, CapsAdjacency],
+            Pass::Bvh => &[BvhMorton, RadixSortPairs, BvhBuild, BvhRefit],
+            Pass::Visibility => &[BvhOccluded],
             Pass::LoadFrame
             | Pass::EdgeBuffer
             | Pass::CapBuffer
             | Pass::FaceNormals
-            | Pass::Render => &[],
+            | Pass::Render
+            | Pass::Svg => &[],
         }
     }
 
@@ -421,7 +440,7 @@ impl Pass {
                 vec![Pass::Isosurface]
             }
             Pass::EdgeBuffer | Pass::OneRings | Pass::CapBuffer => vec![],
-            Pass::VertexNormals | Pass::FaceNormals => src.into_iter().collect(),
+            Pass::VertexNormals | Pass::FaceNormals | Pass::Bvh => src.into_iter().collect(),
             Pass::Curvature => vec![Pass::OneRings, Pass::VertexNormals],
             Pass::Dcurv => vec![Pass::Curvature],
             Pass::Ao => vec![Pass::Curvature],
@@ -441,6 +460,9 @@ impl Pass {
             // background colour to hide the strokes and lines behind it).
             Pass::Render if input == Input::Volume => vec![Pass::Isosurface],
             Pass::Render => vec![],
+            // What else these read depends on the plan ([`Plan::reads`]).
+            Pass::Visibility => vec![Pass::Bvh],
+            Pass::Svg => vec![],
         };
         v.sort();
         v
@@ -459,9 +481,62 @@ impl Pass {
             | Pass::LinesCurves
             | Pass::Edges
             | Pass::Caps
-            | Pass::Render => Lifetime::View,
+            | Pass::Visibility
+            | Pass::Render
+            | Pass::Svg => Lifetime::View,
             _ => Lifetime::Pose,
         }
+    }
+}
+
+/// What a scene's views are written as, which decides the passes after
+/// the cues' own: a raster image (PNG, or an image held in memory) needs
+/// the GL render pass; a vector drawing (SVG, segments) needs the SVG
+/// pass, and its hidden lines either the exact visibility pass (over the
+/// BVH, no GL) or the rendered depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub struct Outputs {
+    /// A raster image is drawn.
+    pub raster: bool,
+    /// A vector drawing is written.
+    pub vector: bool,
+    /// How the vector drawing's hidden lines are found.
+    pub visibility: VisibilityMethod,
+}
+
+impl Outputs {
+    /// A raster image only (PNG, or an image held in memory).
+    pub const RASTER: Outputs = Outputs {
+        raster: true,
+        vector: false,
+        visibility: VisibilityMethod::Exact,
+    };
+
+    /// The passes that end a view drawn from `cues`.
+    fn terminals(self, cues: &[Cue]) -> Vec<Pass> {
+        let lines = cues.iter().any(|c| c.draws_lines());
+        let mut v = Vec::new();
+        if self.raster || (self.vector && self.visibility == VisibilityMethod::Depth) {
+            v.push(Pass::Render);
+        }
+        if self.vector {
+            v.push(Pass::Svg);
+            if self.visibility == VisibilityMethod::Exact && lines {
+                v.push(Pass::Visibility);
+            }
+        }
+        v
+    }
+}
+
+impl Cue {
+    /// Whether the cue draws lines (whose hidden parts a vector drawing
+    /// must find).
+    pub fn draws_lines(self) -> bool {
+        !matches!(
+            self,
+            Cue::Shading | Cue::CurvatureColors | Cue::AmbientOcclusion
+        )
     }
 }
 
@@ -472,6 +547,8 @@ pub struct Plan {
     pub input: Input,
     /// The cues asked for.
     pub cues: Vec<Cue>,
+    /// What the views are written as.
+    pub outputs: Outputs,
     /// The closure of what the cues need, in execution order.
     pub passes: Vec<Pass>,
 }
@@ -485,12 +562,33 @@ pub fn plan(cues: &[Cue], input: Input) -> Plan {
 /// [`plan`] for feature edges drawn with `caps`: adjacency caps need the cap
 /// buffer and the cap pass; McGuire-Hughes half-caps need the cap pass and
 /// the vertex normals (they are built per edge, along the projected normals)
-/// but no cap buffer; no caps need neither.
+/// but no cap buffer; no caps need neither. A raster image is drawn.
 pub fn plan_with(cues: &[Cue], input: Input, caps: CapMode) -> Plan {
+    plan_for(cues, input, caps, Outputs::RASTER)
+}
+
+/// [`plan_with`] for views written as `outputs`: the cues' drawing ends in
+/// the render pass only where a raster image is drawn or the depth decides
+/// the hidden lines, so a vector drawing with exact visibility opens no GL
+/// context (and draws no caps).
+pub fn plan_for(cues: &[Cue], input: Input, caps: CapMode, outputs: Outputs) -> Plan {
     let mut set = std::collections::BTreeSet::new();
+    let terminals = outputs.terminals(cues);
+    // Caps fill the gaps between thick edge quads in a drawn frame; an
+    // SVG's polylines join round and need none.
+    let caps = match terminals.contains(&Pass::Render) {
+        true => caps,
+        false => CapMode::None,
+    };
+    // Shading, curvature colours and AO colour a drawn frame only.
     let mut stack: Vec<Pass> = cues
         .iter()
+        .filter(|c| outputs.raster || c.draws_lines())
         .flat_map(|c| c.needs().iter().copied())
+        .flat_map(|p| match p {
+            Pass::Render => terminals.clone(),
+            p => vec![p],
+        })
         .collect();
     while let Some(p) = stack.pop() {
         let dropped = match caps {
@@ -512,6 +610,7 @@ pub fn plan_with(cues: &[Cue], input: Input, caps: CapMode) -> Plan {
     Plan {
         input,
         cues,
+        outputs,
         // BTreeSet order is declaration order, which respects every need.
         passes: set.into_iter().collect(),
     }
@@ -521,6 +620,31 @@ impl Plan {
     /// Whether the plan runs `pass`.
     pub fn contains(&self, pass: Pass) -> bool {
         self.passes.contains(&pass)
+    }
+
+    /// The passes `pass` reads in this plan: its needs
+    /// ([`Pass::needs`]), and for the visibility pass the planned passes
+    /// whose lines it classifies, for the SVG pass the pass its hidden
+    /// lines come from.
+    pub fn reads(&self, pass: Pass) -> Vec<Pass> {
+        let mut v = pass.needs(self.input);
+        let extra: &[Pass] = match pass {
+            Pass::Visibility => &[
+                Pass::SdfLines,
+                Pass::Contours,
+                Pass::SuggestiveContours,
+                Pass::LinesCurves,
+                Pass::Edges,
+            ],
+            Pass::Svg => &[Pass::Visibility, Pass::Render],
+            _ => &[],
+        };
+        v.extend(extra.iter().copied().filter(|p| self.contains(*p)));
+        if pass == Pass::Svg && self.outputs.visibility == VisibilityMethod::Exact {
+            v.retain(|p| *p != Pass::Render);
+        }
+        v.sort();
+        v
     }
 
     /// How many times `pass` runs over `frames` frames seen by `views`
@@ -567,7 +691,7 @@ impl Plan {
                 p.name(),
                 p.lifetime(self.input).name(),
                 self.runs(p, frames, views),
-                list(&mut p.needs(self.input).iter().map(|n| n.to_string()))
+                list(&mut self.reads(p).iter().map(|n| n.to_string()))
             ));
         }
         s

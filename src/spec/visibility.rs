@@ -27,6 +27,35 @@
 //!
 //! Mirrors: none in a kernel (the device work is `bvh_occluded`).
 
+/// How the hidden parts of an SVG's lines are found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VisibilityMethod {
+    /// In object space, by occlusion queries over the mesh's BVH on the
+    /// device (this family): exact up to the sampling and the contour
+    /// offset, and no GL context is needed.
+    #[default]
+    Exact,
+    /// Against the depth buffer the renderer draws (GL): approximate at
+    /// silhouettes and dependent on the image size.
+    Depth,
+}
+
+impl VisibilityMethod {
+    /// Every method, in `--help` order.
+    pub const ALL: [VisibilityMethod; 2] = [VisibilityMethod::Exact, VisibilityMethod::Depth];
+
+    /// The name on the command line, in scene files and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            VisibilityMethod::Exact => "exact",
+            VisibilityMethod::Depth => "depth",
+        }
+    }
+}
+
+crate::spec::named_choice!(VisibilityMethod, "visibility method");
+
 /// How far apart the samples along a segment are.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Spacing {

@@ -10,6 +10,7 @@
 use crate::cpu::visibility::{Plan, classify_by, hidden_from, queries_of};
 use crate::error::{Error, Result};
 use crate::spec::feature_lines::Segment;
+use crate::spec::timing::Timing;
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
@@ -35,12 +36,38 @@ pub fn classify(
         )));
     }
     let plan = Plan::new(positions, faces, segments, view, opts)?;
-    let mut overflows = 0;
-    let pieces = classify_by(&plan, |casts| {
-        let (qs, at) = queries_of(&plan, casts);
+    let c = classify_planned(bvh, &plan)?;
+    Ok((c.pieces, c.overflows))
+}
+
+/// What [`classify_planned`] found and what it cost.
+#[derive(Clone, Debug, Default)]
+pub struct Classified {
+    /// The pieces of each segment.
+    pub pieces: Vec<Pieces>,
+    /// Query stack overflows (answered visible; none at the spec's depth).
+    pub overflows: u32,
+    /// Rounds (one `bvh_occluded` launch each) and queries in all.
+    pub rounds: usize,
+    /// Queries in all.
+    pub queries: usize,
+    /// Kernel time of the rounds' launches.
+    pub timing: Timing,
+}
+
+/// [`classify`] of segments already read into a [`Plan`] (whose faces each
+/// segment lies on the caller may want too), over a tree of the plan's mesh.
+pub fn classify_planned(bvh: &mut Bvh, plan: &Plan) -> Result<Classified> {
+    let mut c = Classified::default();
+    let pieces = classify_by(plan, |casts| {
+        let (qs, at) = queries_of(plan, casts);
         let (answers, o) = bvh.occluded(&qs)?;
-        overflows += o;
+        c.overflows += o;
+        c.rounds += 1;
+        c.queries += qs.len();
+        c.timing.extend(bvh.timing());
         Ok(hidden_from(&at, &answers))
     })?;
-    Ok((pieces, overflows))
+    c.pieces = pieces;
+    Ok(c)
 }

@@ -148,14 +148,17 @@ fn serve(rx: Receiver<Request>, tx: Sender<Reply>, opts: ExecOptions, wake: Box<
     let mut session = Session::new();
     session.live(&opts, live_request(first, &dir), &mut |result| {
         let reply = match result {
-            Ok(f) => Reply::Frame(Box::new(Done {
-                id,
-                image: f.view.image.to_image(),
-                passes: f.passes,
-                wall_ms: t0.elapsed().as_secs_f64() * 1e3,
-                svg: f.svg,
-                dropped,
-            })),
+            Ok(f) => match f.view.image {
+                Some(image) => Reply::Frame(Box::new(Done {
+                    id,
+                    image: image.to_image(),
+                    passes: f.passes,
+                    wall_ms: t0.elapsed().as_secs_f64() * 1e3,
+                    svg: f.svg,
+                    dropped,
+                })),
+                None => Reply::Failed(id, "the scene drew no frame".into()),
+            },
             Err(e) => Reply::Failed(id, e.to_string()),
         };
         tx.send(reply).ok()?;

@@ -167,8 +167,8 @@ pub(super) struct ViewLines<'a> {
 }
 
 /// Draws one view (the mesh the renderer holds, line quads, edge quads),
-/// reads it back and writes its images to `paths`; finds the SVG groups
-/// when a path is an SVG or `want_layers` asks for them.
+/// reads it back (with its depth when `depth`, for an SVG's hidden lines)
+/// and writes it to the PNG `paths`.
 pub(super) fn draw_view(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -176,29 +176,26 @@ pub(super) fn draw_view(
     cam: &Camera,
     lines: ViewLines<'_>,
     paths: &[&PathBuf],
-    want_layers: bool,
-) -> Result<DrawnView> {
+    depth: bool,
+) -> Result<Frame> {
     renderer.begin(cam)?;
     renderer.draw_uploaded(mesh_style(scene, plan))?;
-    let drawn = draw_line_families(renderer, &scene.effects, lines.segments)?;
+    draw_line_families(renderer, &scene.effects, lines.segments)?;
     draw_edges_and_strokes(renderer, scene, plan, cam, &lines)?;
-    // Depth only for an SVG's visibility test.
-    let svg = want_layers
-        || paths
-            .iter()
-            .any(|p| p.extension().is_none_or(|e| e != "png"));
-    let image: Frame = if svg {
+    let image: Frame = if depth {
         renderer.finish()?
     } else {
         renderer.finish_color()?
     };
-    let layers = svg.then(|| svg_layers(scene, plan, cam, &lines, &image));
-    write_view(scene, paths, &image, layers.as_deref())?;
-    Ok(DrawnView {
-        segments: drawn,
-        image,
-        layers,
-    })
+    for path in paths {
+        image.save_png(path)?;
+    }
+    Ok(image)
+}
+
+/// Whether an output path is a PNG (else an SVG).
+pub(super) fn is_png(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e == "png")
 }
 
 /// The mesh's style: shaded, or flat in the background colour when only
@@ -225,14 +222,8 @@ fn mesh_style(scene: &Scene, plan: &Plan) -> MeshStyle {
     }
 }
 
-/// Draws the line families' quads; returns the contour and
-/// suggestive-contour segments drawn.
-fn draw_line_families(
-    renderer: &mut Renderer,
-    fx: &Effects,
-    segments: &[Segment],
-) -> Result<[usize; 2]> {
-    let mut drawn = [0usize; 2];
+/// Draws the line families' quads.
+fn draw_line_families(renderer: &mut Renderer, fx: &Effects, segments: &[Segment]) -> Result<()> {
     // Faded families in four opacity bins of their strength.
     const BINS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
     for (st, faded) in line_styles(fx) {
@@ -249,15 +240,12 @@ fn draw_line_families(
             if pts.is_empty() {
                 continue;
             }
-            if let Some(n) = drawn.get_mut(kind as usize) {
-                *n += pts.len() / 2;
-            }
             let [r, g, b] = st.color;
             let a = if faded { alpha } else { 1.0 };
             renderer.draw_lines(&pts, [r, g, b, a], st.width)?;
         }
     }
-    Ok(drawn)
+    Ok(())
 }
 
 /// Draws the feature edges (from the shared buffer or the read-back
@@ -288,36 +276,6 @@ fn draw_edges_and_strokes(
         crate::render::strokes::draw(renderer, cam, lines.strokes, &style)?;
     }
     Ok(())
-}
-
-/// Writes the view's files: an SVG from `layers` where a path is not a
-/// PNG and the groups were found, else the image as a PNG.
-fn write_view(
-    scene: &Scene,
-    paths: &[&PathBuf],
-    image: &Frame,
-    layers: Option<&[SvgLayer]>,
-) -> Result<()> {
-    let [w, h] = scene.size;
-    for path in paths {
-        match layers {
-            Some(l) if path.extension().is_none_or(|e| e != "png") => {
-                crate::export::svg::write_svg_layers(path, l, w, h)?;
-            }
-            _ => image.save_png(path)?,
-        }
-    }
-    Ok(())
-}
-
-/// What [`draw_view`] drew.
-pub(super) struct DrawnView {
-    /// Contour and suggestive-contour segments drawn.
-    pub(super) segments: [usize; 2],
-    /// The image read back (with depth when SVG groups were found).
-    pub(super) image: Frame,
-    /// The SVG groups, when an SVG was written or asked for.
-    pub(super) layers: Option<Vec<SvgLayer>>,
 }
 
 /// The SVG groups of one view: for each line family the scene draws
@@ -406,10 +364,14 @@ fn family_layers(
 
 /// What a view drawn into memory hands its caller.
 pub struct ViewOutputs {
-    /// The image (RGBA, row 0 at the top; with depth when `layers` were found).
-    pub image: Frame,
+    /// The image (RGBA, row 0 at the top), where the plan drew one (a PNG,
+    /// or the depth-buffer method's hidden lines).
+    pub image: Option<Frame>,
     /// The SVG groups (the scene's `svg` output asked for them).
     pub layers: Option<Vec<SvgLayer>>,
+    /// The lines classified and chained by exact visibility (world
+    /// coordinates), where the plan ran it.
+    pub visible: Option<super::vector::VisibleLines>,
     /// The line segments found for this view (world coordinates).
     pub segments: Vec<Segment>,
     /// The edge stage's outputs as drawn, when feature edges are planned.

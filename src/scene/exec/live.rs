@@ -9,7 +9,9 @@
 //!   when the input itself (file, isovalue, weld, glTF rate) stays.
 //!
 //! Nothing is written but the SVG a request asks for: no report, no PNG
-//! (the image comes back in the [`LiveFrame`]). Each frame reports the
+//! (the image comes back in the [`LiveFrame`]). A live view's SVG takes its
+//! hidden lines from the frame's depth, which it draws anyway; a picture
+//! ([`Session::picture`]) plans as its scene's outputs and visibility say. Each frame reports the
 //! passes that ran for it, as the run report does for a whole run.
 
 use super::draw::ViewOutputs;
@@ -24,8 +26,10 @@ use std::path::PathBuf;
 
 /// One frame to draw: the scene with the camera (its first view) and the
 /// frame (the first of its `frames`) of the moment. The scene's `svg`
-/// switch asks for the SVG groups in the frame ([`ViewOutputs::layers`]);
-/// its `png` is ignored (the image always comes back).
+/// switch asks for the SVG groups in the frame ([`ViewOutputs::layers`]),
+/// found as its `visibility` says, and then the image comes back where its
+/// `png` is on; without `svg` the image always comes back. Changing these
+/// sets the scene up anew.
 #[derive(Clone, Debug)]
 pub struct LiveRequest {
     /// The scene of this frame.
@@ -63,11 +67,23 @@ fn setup(s: &Scene) -> Scene {
     let mut k = s.clone();
     k.views.clear();
     k.frames = (0, None, 1);
-    k.png = false;
-    k.svg = false;
     k.prefix.clear();
     k.out_dir = PathBuf::new();
     k
+}
+
+/// The plan of a live setup: a scene that asks for its SVG groups plans as
+/// its outputs say (a frame where `png` is on; exact visibility needs
+/// none); any other draws its frame, and the SVG a request asks for takes
+/// its hidden lines from the frame's depth.
+fn live_plan(scene: &Scene) -> Plan {
+    if scene.svg {
+        return plan_of(scene, false);
+    }
+    let mut s = scene.clone();
+    s.svg = true;
+    s.visibility = crate::spec::visibility::VisibilityMethod::Depth;
+    plan_of(&s, true)
 }
 
 /// Whether two scenes load the same input.
@@ -83,9 +99,9 @@ impl Session {
     pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<LiveFrame> {
         let loaded = load(scene, &mut Vec::new())?;
         let input = scene.source.input();
-        let plan = plan_of(scene);
+        let plan = plan_of(scene, false);
         let gpu = self.gpu(opts)?;
-        let renderer = self.renderer(scene)?;
+        let renderer = self.renderer(scene, &plan)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
         ex.keep_image = true;
@@ -101,7 +117,9 @@ impl Session {
             svg: None,
         };
         let frame = live.frame(&mut ex, &req);
-        self.renderer = Some(ex.into_renderer());
+        if let Some(r) = ex.into_renderer() {
+            self.renderer = Some(r);
+        }
         frame
     }
 
@@ -148,9 +166,9 @@ impl Session {
             _ => load(scene, &mut Vec::new())?,
         };
         let input = scene.source.input();
-        let plan = plan_of(scene);
+        let plan = live_plan(scene);
         let gpu = self.gpu(opts)?;
-        let renderer = self.renderer(scene)?;
+        let renderer = self.renderer(scene, &plan)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
         ex.keep_image = true;
@@ -165,13 +183,17 @@ impl Session {
             let frame = live.frame(&mut ex, &req)?;
             match next(Ok(frame)) {
                 None => {
-                    self.renderer = Some(ex.into_renderer());
+                    if let Some(r) = ex.into_renderer() {
+                        self.renderer = Some(r);
+                    }
                     return Ok(None);
                 }
                 Some(r) if setup(&r.scene) == *scene => req = r,
                 Some(r) => {
                     let (loaded, renderer) = ex.into_parts();
-                    self.renderer = Some(renderer);
+                    if renderer.is_some() {
+                        self.renderer = renderer;
+                    }
                     *held = Some((scene.clone(), loaded));
                     return Ok(Some(r));
                 }
@@ -237,6 +259,7 @@ impl Live<'_> {
         for p in self.passes(|l| l == Lifetime::View) {
             ex.view_pass(p, &cam, &paths)?;
         }
+        ex.end_view(&cam);
         let view = ex.kept.take().ok_or_else(|| {
             Error::InvalidArgument(format!(
                 "{}: no cue is asked for, so there is nothing to draw",

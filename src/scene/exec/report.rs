@@ -60,6 +60,8 @@ pub struct RunReport {
     pub gl_uploads: crate::render::Uploads,
     /// Contour and suggestive-contour segments over all views.
     pub segments: [usize; 2],
+    /// The visible chains of exact visibility over all views.
+    pub chains: Chains,
     /// Segments of each curvature line cue's family over all views, by
     /// family name.
     pub lines: BTreeMap<&'static str, usize>,
@@ -74,6 +76,33 @@ pub struct RunReport {
     /// passes other than rendering) and per render (`render`: draw + read
     /// back), in order; medians are the reader's ([`Timing::laps`]).
     pub timing: Timing,
+}
+
+/// The visible chains of a run's views (exact visibility: each an SVG
+/// polyline across faces).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Chains {
+    /// Chains over all views.
+    pub chains: usize,
+    /// Their pieces (a segment's visible part each).
+    pub pieces: usize,
+    /// Mean pieces per chain (0 without chains).
+    pub mean_length: f64,
+}
+
+impl Chains {
+    /// From `[chains, pieces]`.
+    pub fn new([chains, pieces]: [usize; 2]) -> Chains {
+        Chains {
+            chains,
+            pieces,
+            mean_length: if chains == 0 {
+                0.0
+            } else {
+                pieces as f64 / chains as f64
+            },
+        }
+    }
 }
 
 /// Accumulates what each pass did, and the time of the current pose or

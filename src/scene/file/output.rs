@@ -5,6 +5,7 @@ use super::raw::OutputSpec;
 use super::{Checker, Table, color};
 use crate::error::{Error, Result};
 use crate::spec::interop::InteropMode;
+use crate::spec::visibility::VisibilityMethod;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -26,6 +27,8 @@ pub(super) struct OutputPart {
     pub background: [f32; 3],
     /// How the edges frame's buffers reach GL.
     pub interop: InteropMode,
+    /// How an SVG's hidden lines are found.
+    pub visibility: VisibilityMethod,
 }
 
 /// Checks `[output]` (absent: the defaults) of the scene called `name`.
@@ -55,6 +58,11 @@ pub(super) fn resolve(
         Some(m) => (m.get_ref().parse())
             .map_err(|e: Error| ck.err(m.span(), format!("output.interop: {e}")))?,
     };
+    let visibility = match &out.visibility {
+        None => VisibilityMethod::Exact,
+        Some(m) => (m.get_ref().parse())
+            .map_err(|e: Error| ck.err(m.span(), format!("output.visibility: {e}")))?,
+    };
     let prefix = out.name.clone().unwrap_or_else(|| name.to_string());
     if prefix.is_empty() || prefix.contains(['/', '\\']) {
         return Err(t.err(format!(
@@ -73,6 +81,7 @@ pub(super) fn resolve(
         msaa,
         background,
         interop,
+        visibility,
     })
 }
 

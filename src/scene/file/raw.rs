@@ -368,6 +368,8 @@ pub struct OutputSpec {
     pub background: Option<[f32; 3]>,
     /// How feature edges reach GL: `off` (default), `auto` or `on`.
     pub interop: Option<Spanned<String>>,
+    /// How an SVG's hidden lines are found: `exact` (default) or `depth`.
+    pub visibility: Option<Spanned<String>>,
 }
 
 /// `[effects.ridges]`, `valleys`, `apparent_ridges`, `suggestive_highlights`

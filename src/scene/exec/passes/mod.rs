@@ -12,12 +12,15 @@
 //! curvature-directed strokes ([`SdfLines`]) are traced on the volume
 //! itself, uploaded once for the run, and need no mesh pass.
 
+mod stages;
 mod view;
+mod visibility;
 
 use super::draw::{self, PoseData, ViewLines};
 use super::interop::{SharedEdges, interop_offer};
 use super::load::Loaded;
 use super::report::{Recorder, ms_since};
+use super::vector::VisibleLines;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
@@ -32,15 +35,17 @@ use crate::spec::edges::{EdgeOutput, EdgeParams};
 use crate::spec::feature_lines::{LineInputs, Segment};
 use crate::spec::interop::{InteropDecision, InteropOffer, InteropRoute, decide_interop};
 use crate::spec::marching_cubes::IsoNormals;
-use crate::spec::sdf_lines::{Inside, SdfLineOptions, SdfLinesOutput, Stroke};
+use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
+use crate::stages::bvh::Bvh;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::edges::{EdgeStage, SharedDrawn};
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
 use crate::stages::marching_cubes::Isosurfacer;
-use crate::stages::pipeline::{PipelineOptions, PipelineStages, PosePipeline};
+use crate::stages::pipeline::PosePipeline;
 use crate::stages::sdf_lines::SdfLines;
+use stages::{isosurfacer, line_options, skinning_pipeline, strokes_stage};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -63,6 +68,11 @@ struct Topology {
     /// The edges frame's shared buffer (external-memory route), made by the
     /// first view.
     shared: Option<SharedEdges>,
+    /// The two vertices of each edge entry (for the SVG's feature edges).
+    edge_pairs: Vec<[u32; 2]>,
+    /// The BVH of exact visibility (built on the first pose, refitted to
+    /// later ones).
+    bvh: Option<Bvh>,
 }
 
 impl Topology {
@@ -77,6 +87,8 @@ impl Topology {
             edges: None,
             edge_counts: None,
             shared: None,
+            edge_pairs: Vec::new(),
+            bvh: None,
         }
     }
 }
@@ -102,7 +114,9 @@ pub(super) struct Executor<'s, 'g> {
     loaded: Loaded,
     gpu: &'g Arc<Gpu>,
     pub(super) rec: Recorder,
-    renderer: Renderer,
+    /// The renderer, where the plan draws a frame (none for a vector
+    /// drawing with exact visibility: no GL context is opened).
+    renderer: Option<Renderer>,
     curv_opts: CurvatureOptions,
     line_opts: LineOptions,
     /// Skinning, curvature and AO of a skinned input.
@@ -141,6 +155,13 @@ pub(super) struct Executor<'s, 'g> {
     interop: Option<(InteropDecision, InteropOffer)>,
     /// This view: what the edge stage compacted into the shared buffer.
     shared_drawn: Option<SharedDrawn>,
+    /// This view: its lines classified and chained (exact visibility), the
+    /// frame drawn and the SVG groups found.
+    vis: Option<VisibleLines>,
+    frame: Option<crate::render::Frame>,
+    layers: Option<Vec<crate::export::svg::SvgLayer>>,
+    /// Visible chains and their pieces over all views.
+    pub(super) chains: [usize; 2],
     /// This view: the lines and the edge stage's run and outputs.
     segs: Vec<Segment>,
     lines_ran: Option<Timing>,
@@ -170,7 +191,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         plan: &'s Plan,
         loaded: Loaded,
         gpu: &'g Arc<Gpu>,
-        renderer: Renderer,
+        renderer: Option<Renderer>,
     ) -> Result<Self> {
         let fx = &scene.effects;
         let has = |p: Pass| plan.contains(p);
@@ -183,7 +204,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let iso = isosurfacer(&loaded, plan, gpu)?;
         let sdf_lines = strokes_stage(&loaded, plan, gpu, scene)?;
         let interop = match has(Pass::Edges) {
-            true => Some(view::decide(gpu, scene)?),
+            true => Some(view::decide(gpu, scene, has(Pass::Render))?),
             false => None,
         };
         let ao = match (&pipe, has(Pass::Ao)) {
@@ -218,6 +239,10 @@ impl<'s, 'g> Executor<'s, 'g> {
             gl_pose: false,
             interop,
             shared_drawn: None,
+            vis: None,
+            frame: None,
+            layers: None,
+            chains: [0; 2],
             segs: Vec::new(),
             lines_ran: None,
             edges_ran: None,
@@ -231,27 +256,30 @@ impl<'s, 'g> Executor<'s, 'g> {
         })
     }
 
-    /// The renderer's GL description.
+    /// The renderer's GL description (none when no frame is drawn).
     pub(super) fn gl_info(&self) -> String {
-        self.renderer.gl_info()
+        (self.renderer.as_ref()).map_or_else(|| "none (no frame drawn)".into(), |r| r.gl_info())
     }
 
     /// The renderer's mesh uploads so far.
     pub(super) fn uploads(&self) -> crate::render::Uploads {
-        self.renderer.uploads()
+        (self.renderer.as_ref()).map_or_else(Default::default, |r| r.uploads())
     }
 
     /// The renderer, for the next scene of the session (the shared edge
     /// buffer freed first).
-    pub(super) fn into_renderer(self) -> Renderer {
+    pub(super) fn into_renderer(self) -> Option<Renderer> {
         self.into_parts().1
     }
 
     /// The loaded input and the renderer, for the next executor of a live
     /// scene whose input stays.
-    pub(super) fn into_parts(mut self) -> (Loaded, Renderer) {
-        if let Some(sh) = self.topo.as_mut().and_then(|t| t.shared.take()) {
-            sh.free(&mut self.renderer);
+    pub(super) fn into_parts(mut self) -> (Loaded, Option<Renderer>) {
+        if let (Some(sh), Some(r)) = (
+            self.topo.as_mut().and_then(|t| t.shared.take()),
+            self.renderer.as_mut(),
+        ) {
+            sh.free(r);
         }
         (self.loaded, self.renderer)
     }
@@ -429,6 +457,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 self.rec.kernels(pass, &t, "dcurv");
             }
             Pass::Ao => self.ao(frame)?,
+            Pass::Bvh => self.bvh_pass(frame)?,
             Pass::SdfLines => self.sdf_lines()?,
             Pass::LinesPose => {
                 // The curvature run of this pose makes the extractor's pose
@@ -445,7 +474,9 @@ impl<'s, 'g> Executor<'s, 'g> {
             | Pass::LinesCurves
             | Pass::Edges
             | Pass::Caps
-            | Pass::Render => {
+            | Pass::Visibility
+            | Pass::Render
+            | Pass::Svg => {
                 unreachable!("{pass:?} is a view pass")
             }
         }
@@ -483,6 +514,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         };
         let t = self.topo.as_mut().expect("made above");
         t.edges = Some(EdgeStage::new(self.gpu.clone(), &t.mesh, &et)?);
+        t.edge_pairs = et.edges.iter().map(|e| [e[0], e[1]]).collect();
         self.rec.wall(
             Pass::EdgeBuffer,
             ms_since(t0),
@@ -712,86 +744,4 @@ impl<'s, 'g> Executor<'s, 'g> {
         self.strokes = out;
         Ok(())
     }
-}
-
-/// The line extractor's options: the contour families and the curvature
-/// line cues' families and controls the plan holds.
-fn line_options(scene: &Scene, plan: &Plan) -> LineOptions {
-    let fx = &scene.effects;
-    LineOptions {
-        contours: plan.contains(Pass::Contours),
-        suggestive: plan.contains(Pass::SuggestiveContours),
-        threshold: fx.suggestive_threshold,
-        fade: fx.suggestive_fade,
-        // The curvature line cues' families and controls.
-        curves: fx.lines.curves_for(&fx.cues),
-    }
-}
-
-/// The skinning pipeline of a skinned input (skinning, and curvature and
-/// AO where planned); none for other inputs.
-fn skinning_pipeline(
-    loaded: &Loaded,
-    plan: &Plan,
-    gpu: &Arc<Gpu>,
-    scene: &Scene,
-    curv_opts: CurvatureOptions,
-) -> Result<Option<PosePipeline>> {
-    let has = |p: Pass| plan.contains(p);
-    Ok(match loaded {
-        Loaded::Skinned { mesh, .. } if has(Pass::Skinning) => Some(PosePipeline::with_stages(
-            gpu.clone(),
-            mesh,
-            PipelineOptions {
-                curvature: curv_opts,
-                ao_mode: scene.effects.ao_mode,
-                ..PipelineOptions::default()
-            },
-            PipelineStages {
-                curvature: has(Pass::OneRings),
-                ao: has(Pass::Ao),
-                // The lines are per topology for every input (contours
-                // alone are found from host normals, without curvature).
-                lines: false,
-            },
-        )?),
-        _ => None,
-    })
-}
-
-/// The isosurfacer of a volume input, when the isosurface is planned.
-fn isosurfacer(loaded: &Loaded, plan: &Plan, gpu: &Arc<Gpu>) -> Result<Option<Isosurfacer>> {
-    Ok(match loaded {
-        Loaded::Volume(v, ..) if plan.contains(Pass::Isosurface) => {
-            Some(Isosurfacer::new(gpu.clone(), v)?)
-        }
-        _ => None,
-    })
-}
-
-/// The curvature-directed strokes stage of a volume input and its voxel
-/// size, when the strokes are planned.
-fn strokes_stage(
-    loaded: &Loaded,
-    plan: &Plan,
-    gpu: &Arc<Gpu>,
-    scene: &Scene,
-) -> Result<Option<(SdfLines, f64)>> {
-    Ok(match loaded {
-        Loaded::Volume(v, iso, _) if plan.contains(Pass::SdfLines) => {
-            let st = &scene.effects.strokes;
-            // The loader negated an `above` volume: inside is below iso.
-            let opts = SdfLineOptions {
-                iso: *iso,
-                inside: Inside::Below,
-                sampling: st.sampling.clone(),
-                spacing: st.spacing,
-                width: st.width,
-                ..SdfLineOptions::default()
-            };
-            let voxel = crate::spec::sdf_lines::voxel_size(v.spacing);
-            Some((SdfLines::new(gpu.clone(), v, &opts)?, voxel))
-        }
-        _ => None,
-    })
 }

@@ -32,6 +32,9 @@ impl Executor<'_, '_> {
         self.lines_ran = None;
         self.edges_ran = None;
         self.shared_drawn = None;
+        self.vis = None;
+        self.frame = None;
+        self.layers = None;
     }
 
     /// Runs one view pass from `cam`; the render pass writes `paths`.
@@ -82,7 +85,9 @@ impl Executor<'_, '_> {
                 let how = format!("caps_{}", self.scene.effects.caps.name());
                 self.rec.kernels(pass, timing, &how);
             }
+            Pass::Visibility => self.visibility_pass(cam)?,
             Pass::Render => self.render_pass(pass, cam, paths)?,
+            Pass::Svg => self.svg_pass(cam, paths)?,
             _ => unreachable!("{pass:?} is not a view pass"),
         }
         Ok(())
@@ -125,7 +130,7 @@ impl Executor<'_, '_> {
     /// drawn reaches GL through the shared buffer or comes back compacted.
     fn edges_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
         let p = self.edge_params(cam)?;
-        let caps = self.scene.effects.caps;
+        let caps = self.caps();
         // The external-memory route draws from the shared buffer (CL-GL
         // sharing is not built: `GL_SHARING_BUILT`).
         let shared =
@@ -152,6 +157,15 @@ impl Executor<'_, '_> {
         Ok(())
     }
 
+    /// The cap variant drawn: the scene's, where the plan draws caps (a
+    /// frame is drawn; an SVG's polylines need none).
+    fn caps(&self) -> crate::spec::edges::CapMode {
+        match self.plan.contains(Pass::Caps) {
+            true => self.scene.effects.caps,
+            false => crate::spec::edges::CapMode::None,
+        }
+    }
+
     /// The edge stage's parameters for `cam`, from the scene's effects.
     fn edge_params(&self, cam: &Camera) -> Result<EdgeParams> {
         let fx = &self.scene.effects;
@@ -171,14 +185,19 @@ impl Executor<'_, '_> {
     /// made by the first view); only the kinds (and the quads for an SVG)
     /// come back.
     fn compact_shared(&mut self, svg: bool) -> Result<EdgeOutput> {
-        let caps = self.scene.effects.caps;
+        let caps = self.caps();
         let t = self.topo.as_mut().expect("a pose ran");
         let es = t.edges.as_mut().expect("planned with the edge buffer");
         let sh = match &mut t.shared {
             Some(sh) => sh,
-            None => t
-                .shared
-                .insert(SharedEdges::new(self.gpu, &mut self.renderer, es, caps)?),
+            None => t.shared.insert(SharedEdges::new(
+                self.gpu,
+                self.renderer
+                    .as_mut()
+                    .expect("the external-memory route is taken only where a frame is drawn"),
+                es,
+                caps,
+            )?),
         };
         let d = sh.compact(self.gpu, es)?;
         let mut out = EdgeOutput {
@@ -192,32 +211,45 @@ impl Executor<'_, '_> {
         Ok(out)
     }
 
-    /// The render pass: draws the view, writes `paths`, keeps the view's
-    /// outputs when asked and counts its segments.
+    /// The render pass: draws the view and writes its PNG `paths`; the
+    /// frame is kept (with its depth where the SVG's hidden lines come from
+    /// it) for the SVG pass and the caller.
     fn render_pass(&mut self, pass: Pass, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
         let t0 = Instant::now();
         self.upload_mesh()?;
-        let d = self.draw(cam, paths)?;
-        let drawn = d.segments;
-        if self.keep_image {
-            self.kept = Some(self.kept_view(cam, d));
-        }
+        let pngs: Vec<&PathBuf> = paths.iter().copied().filter(|p| draw::is_png(p)).collect();
+        let depth = self.plan.contains(Pass::Svg)
+            && !self.plan.contains(Pass::Visibility)
+            && (pngs.len() < paths.len() || self.keep_layers);
+        let frame = self.draw(cam, &pngs, depth)?;
         self.rec.wall(
             pass,
             ms_since(t0),
             "draw mesh, line quads, edge quads and stroke strips; read back",
         );
-        self.count_segments(drawn);
-        self.outputs.extend(paths.iter().map(|p| (*p).clone()));
+        self.outputs.extend(pngs.into_iter().cloned());
+        self.frame = Some(frame);
         Ok(())
+    }
+
+    /// Ends a view: counts its segments, and keeps its outputs when asked.
+    pub(in crate::scene::exec) fn end_view(&mut self, cam: &Camera) {
+        self.count_segments();
+        if self.keep_image {
+            self.kept = Some(self.kept_view(cam));
+        }
     }
 
     /// The mesh to GL once per topology (faces) and once per pose
     /// (positions, normals, colours), not once per view.
     fn upload_mesh(&mut self) -> Result<()> {
         let t = self.topo.as_ref().expect("a pose ran");
+        let r = self
+            .renderer
+            .as_mut()
+            .expect("a renderer is made where the plan draws a frame");
         if !self.gl_topology {
-            self.renderer.upload_topology(&t.mesh.faces)?;
+            r.upload_topology(&t.mesh.faces)?;
             self.gl_topology = true;
         }
         if !self.gl_pose {
@@ -227,58 +259,79 @@ impl Executor<'_, '_> {
                 &self.pose,
                 self.color_scale.unwrap_or(1.0),
             );
-            self.renderer
-                .upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
+            r.upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
             self.gl_pose = true;
         }
         Ok(())
     }
 
-    /// Draws the view's mesh, lines, edges and strokes from `cam` and
-    /// writes `paths` ([`draw::draw_view`]).
-    fn draw(&mut self, cam: &Camera, paths: &[&PathBuf]) -> Result<draw::DrawnView> {
-        let t = self.topo.as_ref().expect("a pose ran");
+    /// Draws the view's mesh, lines, edges and strokes from `cam`, writes
+    /// the PNG `paths` ([`draw::draw_view`]) and returns the frame (with its
+    /// depth when `depth`).
+    fn draw(
+        &mut self,
+        cam: &Camera,
+        paths: &[&PathBuf],
+        depth: bool,
+    ) -> Result<crate::render::Frame> {
         let strokes = self.scene_strokes();
-        let shared = (t.shared.as_ref()).zip(self.shared_drawn.as_ref());
+        let t = self.topo.as_ref().expect("a pose ran");
         let lines = ViewLines {
             segments: &self.segs,
             edges: self.edges_ran.as_ref().map(|e| &e.1),
-            shared,
+            shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
             strokes: &strokes,
-            // Half a voxel towards the eye: the strokes lie on the
-            // interpolated surface, which marching cubes cuts as chords.
-            stroke_lift: self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32,
+            stroke_lift: self.stroke_lift(),
         };
-        let want_layers = self.keep_image && self.keep_layers;
-        draw::draw_view(
-            &mut self.renderer,
-            self.scene,
-            self.plan,
-            cam,
-            lines,
-            paths,
-            want_layers,
-        )
+        let r = (self.renderer.as_mut()).expect("a renderer is made where the plan draws a frame");
+        draw::draw_view(r, self.scene, self.plan, cam, lines, paths, depth)
     }
 
-    /// Adds the view's drawn contour and suggestive-contour segments, and
-    /// its segments of each curvature line family, to the run's counts.
-    fn count_segments(&mut self, drawn: [usize; 2]) {
-        self.segments[0] += drawn[0];
-        self.segments[1] += drawn[1];
+    /// What the view draws on top of the mesh, with `strokes` in the scene
+    /// frame.
+    pub(super) fn view_lines<'a>(&'a self, strokes: &'a [Stroke]) -> ViewLines<'a> {
+        let t = self.topo.as_ref().expect("a pose ran");
+        ViewLines {
+            segments: &self.segs,
+            edges: self.edges_ran.as_ref().map(|e| &e.1),
+            shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
+            strokes,
+            stroke_lift: self.stroke_lift(),
+        }
+    }
+
+    /// The strokes' lift towards the eye: half a voxel (they lie on the
+    /// interpolated surface, which marching cubes cuts as chords).
+    fn stroke_lift(&self) -> f32 {
+        self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32
+    }
+
+    /// Adds the view's contour and suggestive-contour segments, and its
+    /// segments of each curvature line family, to the run's counts (drawn
+    /// segments: none of no strength).
+    fn count_segments(&mut self) {
+        for (k, n) in self.segments.iter_mut().enumerate() {
+            *n += (self.segs.iter())
+                .filter(|s| s.2 == k as u32 && draw::shown(s))
+                .count();
+        }
         let fx = &self.scene.effects;
         for st in &fx.lines.styles_for(&fx.cues) {
             let kind = st.family as u32;
-            // Drawn segments, as for the contours (none of no strength).
             let n = (self.segs.iter())
                 .filter(|s| s.2 == kind && draw::shown(s))
                 .count();
             *self.line_segments.entry(st.family.name()).or_default() += n;
         }
+        if let Some(v) = &self.vis {
+            let visible = v.chains.iter().filter(|c| c.visible);
+            self.chains[0] += visible.clone().count();
+            self.chains[1] += visible.map(|c| c.pieces.len()).sum::<usize>();
+        }
     }
 
     /// The strokes in the scene frame (world minus the scene origin).
-    fn scene_strokes(&self) -> Vec<Stroke> {
+    pub(super) fn scene_strokes(&self) -> Vec<Stroke> {
         let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
         (self.strokes.strokes.iter())
@@ -294,7 +347,7 @@ impl Executor<'_, '_> {
     /// groups, the segments (world coordinates), the edge stage's outputs,
     /// the strokes, the camera (world coordinates) and the kernel time of
     /// the pose and the view.
-    fn kept_view(&self, cam: &Camera, d: draw::DrawnView) -> draw::ViewOutputs {
+    fn kept_view(&mut self, cam: &Camera) -> draw::ViewOutputs {
         let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let world =
             |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
@@ -310,8 +363,9 @@ impl Executor<'_, '_> {
         }
         let topo = self.topo.as_ref();
         draw::ViewOutputs {
-            image: d.image,
-            layers: d.layers,
+            image: self.frame.take(),
+            layers: self.layers.take(),
+            visible: self.vis.as_ref().map(|v| v.shifted(o)),
             segments: (self.segs.iter())
                 .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
                 .collect(),
@@ -333,7 +387,7 @@ impl Executor<'_, '_> {
                         (None, None) => 0,
                     },
                 }),
-            uploads: self.renderer.uploads(),
+            uploads: self.uploads(),
             feature_size: topo.and_then(|t| t.feature_size),
             timing,
         }
@@ -445,16 +499,29 @@ fn resolve_feature_size(
 
 /// The route of the edges frame's buffers to GL, decided once per run from
 /// the scene's mode and what the device, GL and Vulkan offer. An
-/// isosurface's topology changes every pose, so it always reads back.
-pub(super) fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, InteropOffer)> {
+/// isosurface's topology changes every pose, so it always reads back; a
+/// plan that draws no frame (`drawn` false: an SVG with exact visibility)
+/// has no GL to share with.
+pub(super) fn decide(
+    gpu: &Gpu,
+    scene: &Scene,
+    drawn: bool,
+) -> Result<(InteropDecision, InteropOffer)> {
     const ISO: &str = "an isosurface's topology changes every pose, so its edges read back";
-    if scene.source.input() == crate::scene::planner::Input::Volume {
+    const UNDRAWN: &str = "no frame is drawn (an SVG with exact visibility needs no GL), \
+                           so the edges read back";
+    let why = match (scene.source.input(), drawn) {
+        (crate::scene::planner::Input::Volume, _) => Some(ISO),
+        (_, false) => Some(UNDRAWN),
+        _ => None,
+    };
+    if let Some(why) = why {
         // Nothing a probe could answer changes the route: no GL context
         // or Vulkan instance is made for it.
         if scene.interop == crate::spec::interop::InteropMode::On {
             return Err(crate::error::Error::gl_sharing_required(
                 &gpu.info.name,
-                ISO,
+                why,
             ));
         }
         let offer = InteropOffer {
@@ -464,7 +531,7 @@ pub(super) fn decide(gpu: &Gpu, scene: &Scene) -> Result<(InteropDecision, Inter
         let d = InteropDecision {
             route: InteropRoute::Host,
             shared: false,
-            reason: format!("host path: {ISO}"),
+            reason: format!("host path: {why}"),
             passed_over: Vec::new(),
         };
         return Ok((d, offer));

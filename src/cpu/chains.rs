@@ -1,0 +1,248 @@
+//! Chains of the `visibility` family: the visible (or hidden) pieces of a
+//! view's line segments joined into the longest polylines across faces, as
+//! Blender's Line Art chains its lines. A host step after the device's
+//! classification (joining is a walk over a few thousand pieces; no kernel).
+//!
+//! Pieces meet where they share an end key ([`EndKey`]): the mesh edge a
+//! line crosses (the same key in the two faces beside it, however the two
+//! crossings round), the mesh vertex a feature edge ends at, or for an end
+//! inside a face (a line's own test cut it, or an intersection line) its
+//! position on a grid of about a millionth of the scene's size. An end where visibility changes inside a segment is a cut
+//! ([`EndKey::Cut`]) that no other piece shares: a chain ends there.
+//!
+//! The walk: the pieces are first put in a canonical order (by layer, then
+//! keys), so the chains do not depend on the input order; chains start at
+//! ends not shared by exactly two pieces of their layer and visibility,
+//! then closed loops remain. At a branch (three or more pieces at one end,
+//! as at a corner of feature edges) a chain goes on along the first unused
+//! piece in canonical order and the others start chains of their own.
+
+use std::collections::HashMap;
+
+/// How a piece's end is matched with others'.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum EndKey {
+    /// On a mesh edge (its two vertices, smaller first).
+    Edge(u32, u32),
+    /// At a mesh vertex.
+    Vertex(u32),
+    /// Inside a face, by position ([`point_key`]).
+    Point([i64; 3]),
+    /// Where a segment's visibility changes (segment, bits of `t`): shared
+    /// by no other piece.
+    Cut(u32, u32),
+}
+
+/// The key of an end inside a face: each coordinate rounded to a grid of
+/// `scale × 2⁻²⁰` (`scale` the scene's size), so that ends computed apart
+/// from the same point (f32 rounding, about `scale × 2⁻²⁴`) meet, unless
+/// they straddle a grid line.
+pub fn point_key(p: [f32; 3], scale: f32) -> EndKey {
+    let step = (f64::from(scale.abs().max(f32::MIN_POSITIVE))) * 2f64.powi(-20);
+    EndKey::Point(p.map(|c| (f64::from(c) / step).round() as i64))
+}
+
+/// A piece to chain: part `[t0, t1]` of segment `seg`, in `layer` (a
+/// family, or the feature edges), visible or hidden, with its end keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChainPiece {
+    /// The layer it is drawn in; only pieces of one layer and visibility join.
+    pub layer: u32,
+    /// Visible or hidden.
+    pub visible: bool,
+    /// The segment it is part of.
+    pub seg: u32,
+    /// Its part of the segment.
+    pub t: [f32; 2],
+    /// Its end keys (at `t0` and at `t1`).
+    pub keys: [EndKey; 2],
+}
+
+/// A chain: pieces in walking order, each with whether it is walked from
+/// `t1` to `t0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chain {
+    /// The layer of its pieces.
+    pub layer: u32,
+    /// Visible or hidden.
+    pub visible: bool,
+    /// Indices into the pieces given to [`chain`], and reversed flags.
+    pub pieces: Vec<(u32, bool)>,
+}
+
+/// Joins `pieces` into chains (see the module note). Every piece is in
+/// exactly one chain.
+pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
+    let mut order: Vec<u32> = (0..pieces.len() as u32).collect();
+    let sorted_keys = |p: &ChainPiece| {
+        let mut k = p.keys;
+        k.sort();
+        (p.layer, p.visible, k)
+    };
+    order.sort_by(|&a, &b| {
+        let (pa, pb) = (&pieces[a as usize], &pieces[b as usize]);
+        sorted_keys(pa)
+            .cmp(&sorted_keys(pb))
+            .then(pa.seg.cmp(&pb.seg))
+            .then(pa.t[0].total_cmp(&pb.t[0]))
+    });
+    let mut at: HashMap<(u32, bool, EndKey), Vec<u32>> = HashMap::new();
+    for &i in &order {
+        let p = &pieces[i as usize];
+        for k in p.keys {
+            at.entry((p.layer, p.visible, k)).or_default().push(i);
+        }
+    }
+    let mut used = vec![false; pieces.len()];
+    let mut out = Vec::new();
+    let degree = |p: &ChainPiece, end: usize| at[&(p.layer, p.visible, p.keys[end])].len();
+    for &i in &order {
+        for end in 0..2 {
+            if !used[i as usize] && degree(&pieces[i as usize], end) != 2 {
+                out.push(walk(pieces, &at, &mut used, i, end));
+            }
+        }
+    }
+    for &i in &order {
+        if !used[i as usize] {
+            out.push(walk(pieces, &at, &mut used, i, 0));
+        }
+    }
+    out
+}
+
+/// The chain from piece `first`, leaving it by the end opposite `from`.
+fn walk(
+    pieces: &[ChainPiece],
+    at: &HashMap<(u32, bool, EndKey), Vec<u32>>,
+    used: &mut [bool],
+    first: u32,
+    from: usize,
+) -> Chain {
+    let p = &pieces[first as usize];
+    used[first as usize] = true;
+    let mut c = Chain {
+        layer: p.layer,
+        visible: p.visible,
+        pieces: vec![(first, from == 1)],
+    };
+    let mut tip = p.keys[1 - from];
+    loop {
+        let next = at[&(p.layer, p.visible, tip)]
+            .iter()
+            .copied()
+            .find(|&j| !used[j as usize]);
+        let Some(j) = next else { break };
+        used[j as usize] = true;
+        let q = &pieces[j as usize];
+        // Entered at the end that matches the tip (the first, for a piece
+        // whose two ends match it, a loop of one piece).
+        let entered = if q.keys[0] == tip { 0 } else { 1 };
+        c.pieces.push((j, entered == 1));
+        tip = q.keys[1 - entered];
+    }
+    c
+}
+
+/// Mean pieces per chain (0 for none).
+pub fn mean_length(chains: &[Chain]) -> f64 {
+    if chains.is_empty() {
+        return 0.0;
+    }
+    let n: usize = chains.iter().map(|c| c.pieces.len()).sum();
+    n as f64 / chains.len() as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn piece(seg: u32, a: EndKey, b: EndKey) -> ChainPiece {
+        ChainPiece {
+            layer: 0,
+            visible: true,
+            seg,
+            t: [0.0, 1.0],
+            keys: [a, b],
+        }
+    }
+
+    #[test]
+    fn pieces_sharing_mesh_edges_form_one_chain_whatever_their_order() {
+        let e = EndKey::Edge;
+        let ps = vec![
+            piece(0, e(2, 3), e(1, 2)),
+            piece(1, e(0, 1), e(1, 2)),
+            piece(2, e(2, 3), e(3, 4)),
+        ];
+        let c = chain(&ps);
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert_eq!(c[0].pieces.len(), 3);
+        let mut rev = ps.clone();
+        rev.reverse();
+        let c2 = chain(&rev);
+        assert_eq!(c2.len(), 1);
+        // Same segments in the same walking order.
+        let segs = |c: &Chain, ps: &[ChainPiece]| -> Vec<u32> {
+            c.pieces.iter().map(|&(i, _)| ps[i as usize].seg).collect()
+        };
+        assert_eq!(segs(&c[0], &ps), segs(&c2[0], &rev));
+        assert_eq!(mean_length(&c), 3.0);
+    }
+
+    #[test]
+    fn cuts_layers_and_visibility_end_chains() {
+        let e = EndKey::Edge;
+        let mut hidden = piece(1, e(1, 2), EndKey::Cut(1, 0));
+        hidden.visible = false;
+        let mut other_layer = piece(2, e(1, 2), e(5, 6));
+        other_layer.layer = 1;
+        let ps = vec![piece(0, e(0, 1), e(1, 2)), hidden, other_layer];
+        let c = chain(&ps);
+        assert_eq!(c.len(), 3, "{c:?}");
+        assert!(c.iter().all(|c| c.pieces.len() == 1));
+    }
+
+    #[test]
+    fn a_loop_is_one_chain_and_a_branch_starts_another() {
+        let v = EndKey::Vertex;
+        let square = vec![
+            piece(0, v(0), v(1)),
+            piece(1, v(1), v(2)),
+            piece(2, v(2), v(3)),
+            piece(3, v(3), v(0)),
+        ];
+        let c = chain(&square);
+        assert_eq!(c.len(), 1);
+        assert_eq!(c[0].pieces.len(), 4);
+        let y = vec![
+            piece(0, v(0), v(9)),
+            piece(1, v(9), v(1)),
+            piece(2, v(9), v(2)),
+        ];
+        let c = chain(&y);
+        assert_eq!(c.len(), 2, "{c:?}");
+        assert_eq!(c.iter().map(|c| c.pieces.len()).sum::<usize>(), 3);
+    }
+
+    #[test]
+    fn walking_order_reverses_pieces_entered_at_their_second_end() {
+        let v = EndKey::Vertex;
+        let ps = vec![piece(0, v(0), v(1)), piece(1, v(2), v(1))];
+        let c = chain(&ps);
+        assert_eq!(c.len(), 1);
+        // From the free end of one piece, through vertex 1, into the other
+        // piece at its second end.
+        let flags: Vec<bool> = c[0].pieces.iter().map(|p| p.1).collect();
+        assert_eq!(flags.iter().filter(|&&r| r).count(), 1, "{c:?}");
+    }
+
+    #[test]
+    fn point_keys_meet_for_nearly_equal_points_only() {
+        let a = point_key([1.0, 2.0, 3.0], 8.0);
+        let b = point_key([1.0 + 1e-7, 2.0, 3.0 - 1e-7], 8.0);
+        let far = point_key([1.001, 2.0, 3.0], 8.0);
+        assert_eq!(a, b);
+        assert_ne!(a, far);
+    }
+}

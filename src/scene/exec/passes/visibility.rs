@@ -1,0 +1,100 @@
+//! The passes of a vector drawing: the BVH per pose, exact visibility of
+//! the view's lines, and the SVG of the view (its hidden lines from the
+//! visibility pass, or from the rendered depth).
+
+use super::super::vector::{classify_view, gather, svg_layers_exact};
+use super::*;
+
+impl Executor<'_, '_> {
+    /// The BVH of this pose's mesh: built when its topology first appears,
+    /// refitted to later poses (same faces, new positions).
+    pub(super) fn bvh_pass(&mut self, frame: usize) -> Result<()> {
+        self.host_pose(frame)?;
+        let t = self.topo.as_mut().expect("made by the host copies");
+        let how = match &mut t.bvh {
+            Some(b) => {
+                b.refit(&self.pose.pos)?;
+                "bvh_refit (boxes of the same tree to this pose)"
+            }
+            None => {
+                let mut b = Bvh::new(self.gpu.clone(), t.mesh.n_vertices(), &t.mesh.faces)?;
+                b.build(&self.pose.pos)?;
+                t.bvh = Some(b);
+                "bvh_morton, radix sort, bvh_build, bvh_refit (a new topology: Karras's tree)"
+            }
+        };
+        let timing = t.bvh.as_ref().expect("made above").timing().clone();
+        self.rec.kernels(Pass::Bvh, &timing, how);
+        Ok(())
+    }
+
+    /// Exact visibility of the lines the SVG draws: split where their
+    /// visibility changes, by occlusion queries towards the eye over the
+    /// BVH, and chained.
+    pub(super) fn visibility_pass(&mut self, cam: &Camera) -> Result<()> {
+        let t0 = Instant::now();
+        let [w, h] = self.scene.size;
+        let view = cam.view(w, h);
+        let t = self.topo.as_mut().expect("a pose ran");
+        let edges = (self.edges_ran.as_ref()).map(|e| (&e.1, t.edge_pairs.as_slice()));
+        let segs = gather(&self.scene.effects, &self.segs, edges, &self.pose.pos);
+        let n = segs.len();
+        let scale = self.framing.as_ref().map_or(1.0, |f| {
+            let (lo, hi) = f.bounds;
+            (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max) as f32
+        });
+        let bvh = t.bvh.as_mut().expect("planned with the BVH pass");
+        let mesh = (self.pose.pos.as_slice(), t.mesh.faces.as_slice());
+        let (vis, c) = classify_view(bvh, mesh, segs, &view, scale)?;
+        let host = ms_since(t0) - c.timing.kernel_ms;
+        let how = format!(
+            "bvh_occluded: {n} segments, {} queries in {} rounds, {} chains \
+             ({:.1} segments each); {host:.1} ms on the host (plan, rounds, chains)",
+            c.queries,
+            c.rounds,
+            vis.chains.iter().filter(|c| c.visible).count(),
+            vis.mean_chain_length(),
+        );
+        self.rec.kernels(Pass::Visibility, &c.timing, &how);
+        self.vis = Some(vis);
+        Ok(())
+    }
+
+    /// The SVG of the view: its groups from the chains of the visibility
+    /// pass, or from the frame's depth; written to the SVG `paths`, kept
+    /// for the caller when asked.
+    pub(super) fn svg_pass(&mut self, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
+        let t0 = Instant::now();
+        let svgs: Vec<&PathBuf> = paths.iter().copied().filter(|p| !draw::is_png(p)).collect();
+        if svgs.is_empty() && !self.keep_layers {
+            // Nothing asked for in this view (a live view without an SVG
+            // request): the pass does not run.
+            return Ok(());
+        }
+        let layers = match (&self.vis, &self.frame) {
+            (Some(vis), _) => svg_layers_exact(self.scene, cam, vis),
+            (None, Some(frame)) if self.plan.contains(Pass::Render) => {
+                let strokes = self.scene_strokes();
+                let lines = self.view_lines(&strokes);
+                draw::svg_layers(self.scene, self.plan, cam, &lines, frame)
+            }
+            // No line is drawn: empty groups of the families asked for.
+            _ => Vec::new(),
+        };
+        let [w, h] = self.scene.size;
+        for p in svgs {
+            crate::export::svg::write_svg_layers(p, &layers, w, h)?;
+            self.outputs.push(p.clone());
+        }
+        let how = if self.vis.is_some() {
+            "SVG groups of the visible chains (exact visibility)"
+        } else {
+            "SVG groups of the lines visible against the frame's depth"
+        };
+        self.rec.wall(Pass::Svg, ms_since(t0), how);
+        if self.keep_layers {
+            self.layers = Some(layers);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,271 @@
+//! The vector drawing of one view with exact visibility: the segments the
+//! SVG draws ([`gather`]: the drawn line families' segments, then the
+//! drawn feature edges), split where their visibility changes by the
+//! `visibility` family over the mesh's BVH, joined into chains
+//! ([`crate::cpu::chains`]), and the SVG groups of those chains
+//! ([`svg_layers_exact`]): one polyline per chain, in the same groups, ids
+//! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
+
+use super::draw::{line_styles, shown};
+use crate::cpu::chains::{Chain, ChainPiece, EndKey, chain, point_key};
+use crate::cpu::visibility::Plan as VisPlan;
+use crate::error::Result;
+use crate::export::svg::{SvgLayer, SvgPolyline, pixel};
+use crate::render::Camera;
+use crate::scene::file::{Effects, LineStyle, Scene};
+use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
+use crate::spec::feature_lines::{Hidden, LINE_FREE, Segment, hidden_id};
+use crate::spec::view::View;
+use crate::spec::visibility::{Pieces, VisibilityOptions};
+use crate::stages::bvh::Bvh;
+use crate::stages::visibility::{Classified, classify_planned};
+
+/// The layer of the feature edges (the line families' layers are their
+/// kinds, [`crate::spec::feature_lines::LineFamily`] as `u32`).
+pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
+
+/// The lines of one view, classified and chained.
+#[derive(Clone, Debug, Default)]
+pub struct VisibleLines {
+    /// The classified segments: the drawn families' segments, then the
+    /// drawn feature edges (ends at mesh vertices `[v, v]`, kind
+    /// [`LAYER_FEATURE_EDGES`], strength 1).
+    pub segments: Vec<Segment>,
+    /// The faces each segment lies on (at most four; left out of its
+    /// queries).
+    pub faces: Vec<Vec<u32>>,
+    /// The pieces of each segment, `(t0, t1, visible)`.
+    pub pieces: Vec<Pieces>,
+    /// Every piece of every segment, as chained.
+    pub chain_pieces: Vec<ChainPiece>,
+    /// The chains (one SVG polyline each).
+    pub chains: Vec<Chain>,
+}
+
+impl VisibleLines {
+    /// The point at `t` of segment `seg`.
+    pub fn point(&self, seg: u32, t: f32) -> [f32; 3] {
+        let s = &self.segments[seg as usize];
+        std::array::from_fn(|k| s.0[k] + t * (s.1[k] - s.0[k]))
+    }
+
+    /// The points of a chain, in walking order.
+    pub fn chain_points(&self, c: &Chain) -> Vec<[f32; 3]> {
+        let mut out = Vec::with_capacity(c.pieces.len() + 1);
+        for (n, &(i, reversed)) in c.pieces.iter().enumerate() {
+            let p = &self.chain_pieces[i as usize];
+            let (from, to) = if reversed {
+                (p.t[1], p.t[0])
+            } else {
+                (p.t[0], p.t[1])
+            };
+            if n == 0 {
+                out.push(self.point(p.seg, from));
+            }
+            out.push(self.point(p.seg, to));
+        }
+        out
+    }
+
+    /// Mean pieces per visible chain.
+    pub fn mean_chain_length(&self) -> f64 {
+        let visible: Vec<Chain> = self.chains.iter().filter(|c| c.visible).cloned().collect();
+        crate::cpu::chains::mean_length(&visible)
+    }
+
+    /// The same lines moved by `shift` (scene frame to world).
+    pub(super) fn shifted(&self, shift: [f64; 3]) -> VisibleLines {
+        let mv = |p: [f32; 3]| -> [f32; 3] {
+            std::array::from_fn(|i| (f64::from(p[i]) + shift[i]) as f32)
+        };
+        VisibleLines {
+            segments: (self.segments.iter())
+                .map(|s| (mv(s.0), mv(s.1), s.2, s.3, s.4))
+                .collect(),
+            ..self.clone()
+        }
+    }
+}
+
+/// The segments the SVG draws, each its layer its kind: the shown segments
+/// of the families the scene draws, then the drawn feature edges of `edges`
+/// (the edge stage's output and each edge entry's two vertices) between
+/// the `positions` of their vertices.
+pub(super) fn gather(
+    fx: &Effects,
+    segs: &[Segment],
+    edges: Option<(&EdgeOutput, &[[u32; 2]])>,
+    positions: &[[f32; 3]],
+) -> Vec<Segment> {
+    let kinds: Vec<u32> = line_styles(fx).iter().map(|s| s.0.family as u32).collect();
+    let mut out: Vec<Segment> = (segs.iter())
+        .filter(|s| kinds.contains(&s.2) && shown(s))
+        .copied()
+        .collect();
+    if let Some((eo, pairs)) = edges {
+        for (k, pair) in eo.kind.iter().zip(pairs) {
+            if k & KIND_DRAWN == 0 {
+                continue;
+            }
+            let [a, b] = *pair;
+            let (pa, pb) = (positions[a as usize], positions[b as usize]);
+            out.push((pa, pb, LAYER_FEATURE_EDGES, 1.0, [[a, a], [b, b]]));
+        }
+    }
+    out
+}
+
+/// The key of a segment's own end `e` (see [`crate::cpu::chains`]).
+fn own_key(s: &Segment, e: usize, scale: f32) -> EndKey {
+    let [u, v] = s.4[e];
+    let p = if e == 0 { s.0 } else { s.1 };
+    if u == LINE_FREE || u == u32::MAX {
+        point_key(p, scale)
+    } else if u == v {
+        EndKey::Vertex(u)
+    } else {
+        EndKey::Edge(u.min(v), u.max(v))
+    }
+}
+
+/// Classifies `segments` seen in `view` over the mesh (`positions`, `faces`)
+/// whose tree `bvh` holds, and chains the pieces; `scale` is the scene's
+/// size (for the keys of ends inside faces).
+pub(super) fn classify_view(
+    bvh: &mut Bvh,
+    mesh: (&[[f32; 3]], &[[u32; 3]]),
+    segments: Vec<Segment>,
+    view: &View,
+    scale: f32,
+) -> Result<(VisibleLines, Classified)> {
+    let (positions, faces) = mesh;
+    let opts = VisibilityOptions::default();
+    let plan = VisPlan::new(positions, faces, &segments, view, &opts)?;
+    let c = classify_planned(bvh, &plan)?;
+    let mut chain_pieces = Vec::new();
+    for (i, (s, ps)) in segments.iter().zip(&c.pieces).enumerate() {
+        let key = |t: f32, e: usize| {
+            if t == [0.0, 1.0][e] {
+                own_key(s, e, scale)
+            } else {
+                EndKey::Cut(i as u32, t.to_bits())
+            }
+        };
+        for &(t0, t1, visible) in ps {
+            chain_pieces.push(ChainPiece {
+                layer: s.2,
+                visible,
+                seg: i as u32,
+                t: [t0, t1],
+                keys: [key(t0, 0), key(t1, 1)],
+            });
+        }
+    }
+    let chains = chain(&chain_pieces);
+    let vis = VisibleLines {
+        segments,
+        faces: plan.segs.into_iter().map(|s| s.exclude).collect(),
+        pieces: c.pieces.clone(),
+        chain_pieces,
+        chains,
+    };
+    Ok((vis, c))
+}
+
+/// The SVG groups of one view from its chains: for each line family the
+/// scene draws ([`line_styles`]) its hidden chains (as its style asks) under
+/// its visible ones, then the visible feature edges; one polyline per
+/// chain. A faded family's polyline has its pieces' mean strength as its
+/// opacity.
+pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) -> Vec<SvgLayer> {
+    let fx = &scene.effects;
+    let [w, h] = scene.size;
+    let vp = cam.view_proj(w as f32 / h as f32);
+    let mut layers = Vec::new();
+    for (st, faded) in line_styles(fx) {
+        if st.hidden != Hidden::Remove {
+            let opacity = if st.hidden == Hidden::Faded { 0.3 } else { 1.0 };
+            layers.push(SvgLayer {
+                id: hidden_id(st.family),
+                stroke_width: 0.5 * st.width,
+                color: st.color,
+                lines: polylines(vis, st.family as u32, false, vp, [w, h], |_| opacity),
+                dashed: st.hidden == Hidden::Dashed,
+            });
+        }
+        layers.push(family_layer(vis, &st, faded, vp, [w, h]));
+    }
+    if fx.cues.contains(&crate::scene::planner::Cue::FeatureEdges) {
+        layers.push(SvgLayer {
+            id: "feature-edges",
+            stroke_width: fx.edge.0,
+            color: fx.edge.1,
+            lines: polylines(vis, LAYER_FEATURE_EDGES, true, vp, [w, h], |_| 1.0),
+            dashed: false,
+        });
+    }
+    layers
+}
+
+/// A family's visible group.
+fn family_layer(
+    vis: &VisibleLines,
+    st: &LineStyle,
+    faded: bool,
+    vp: glam::Mat4,
+    size: [u32; 2],
+) -> SvgLayer {
+    let strength = |c: &Chain| -> f32 {
+        if !faded {
+            return 1.0;
+        }
+        let sum: f32 = (c.pieces.iter())
+            .map(|&(i, _)| {
+                let seg = vis.chain_pieces[i as usize].seg;
+                vis.segments[seg as usize].3.clamp(0.0, 1.0)
+            })
+            .sum();
+        sum / c.pieces.len().max(1) as f32
+    };
+    SvgLayer {
+        id: st.family.name(),
+        stroke_width: st.width,
+        color: st.color,
+        lines: polylines(vis, st.family as u32, true, vp, size, strength),
+        dashed: false,
+    }
+}
+
+/// The polylines (image pixels) of the chains of `layer` of one
+/// visibility, each with `opacity(chain)`; a chain with a point behind the
+/// eye is cut there.
+fn polylines(
+    vis: &VisibleLines,
+    layer: u32,
+    visible: bool,
+    vp: glam::Mat4,
+    [w, h]: [u32; 2],
+    opacity: impl Fn(&Chain) -> f32,
+) -> Vec<SvgPolyline> {
+    let mut out = Vec::new();
+    for c in (vis.chains.iter()).filter(|c| c.layer == layer && c.visible == visible) {
+        let o = opacity(c);
+        let mut run: Vec<[f32; 2]> = Vec::new();
+        for p in vis.chain_points(c) {
+            match pixel(vp, p, w, h) {
+                Some(q) => run.push(q),
+                None => flush(&mut out, &mut run, o),
+            }
+        }
+        flush(&mut out, &mut run, o);
+    }
+    out
+}
+
+/// Ends the polyline in `run` (two points or more) into `out`.
+fn flush(out: &mut Vec<SvgPolyline>, run: &mut Vec<[f32; 2]>, opacity: f32) {
+    let points = std::mem::take(run);
+    if points.len() >= 2 {
+        out.push(SvgPolyline { points, opacity });
+    }
+}
