@@ -291,3 +291,72 @@ fn curvature_strokes_plan_per_input_kind() {
     let text = v.explain(1, 2);
     assert!(text.contains("sdf_lines"), "{text}");
 }
+
+#[test]
+fn outputs_decide_the_drawing_passes() {
+    use shapecue::scene::planner::{Outputs, plan_for};
+    use shapecue::spec::edges::CapMode;
+    use shapecue::spec::visibility::VisibilityMethod::{Depth, Exact};
+    let out = |raster, vector, visibility| Outputs {
+        raster,
+        vector,
+        visibility,
+    };
+    let cues = [Cue::Shading, Cue::Contours, Cue::FeatureEdges];
+    for input in INPUTS {
+        let p = |o| plan_for(&cues, input, CapMode::Adjacency, o);
+        // A raster image only: as before, no vector pass.
+        let png = p(Outputs::RASTER);
+        assert_eq!(png, plan(&cues, input));
+        assert!(png.contains(Pass::Render) && !png.contains(Pass::Svg));
+        assert!(!png.contains(Pass::Bvh) && !png.contains(Pass::Visibility));
+        // An SVG with exact visibility: no render (no GL), no caps, no
+        // shading normals; the BVH per pose and the visibility per view.
+        let svg = p(out(false, true, Exact));
+        for (pass, planned) in [
+            (Pass::Render, false),
+            (Pass::Caps, false),
+            (Pass::CapBuffer, false),
+            (Pass::Bvh, true),
+            (Pass::Visibility, true),
+            (Pass::Svg, true),
+            (Pass::Edges, true),
+            (Pass::Contours, true),
+        ] {
+            assert_eq!(svg.contains(pass), planned, "{input:?} {pass:?}");
+        }
+        assert_eq!(svg.reads(Pass::Svg), vec![Pass::Visibility]);
+        let reads = svg.reads(Pass::Visibility);
+        assert!(reads.contains(&Pass::Bvh) && reads.contains(&Pass::Contours));
+        assert!(reads.contains(&Pass::Edges));
+        // Depth visibility needs the frame, not the tree.
+        let depth = p(out(false, true, Depth));
+        assert!(depth.contains(Pass::Render) && depth.contains(Pass::Svg));
+        assert!(!depth.contains(Pass::Bvh) && !depth.contains(Pass::Visibility));
+        assert_eq!(depth.reads(Pass::Svg), vec![Pass::Render]);
+        // Both: the frame with its caps, and the exact SVG.
+        let both = p(out(true, true, Exact));
+        assert!(both.contains(Pass::Render) && both.contains(Pass::Caps));
+        assert!(both.contains(Pass::Visibility));
+        // Shading alone in an SVG: nothing to classify.
+        let shade = plan_for(
+            &[Cue::Shading],
+            input,
+            CapMode::Adjacency,
+            out(false, true, Exact),
+        );
+        assert!(!shade.contains(Pass::Visibility) && !shade.contains(Pass::VertexNormals));
+        assert!(shade.contains(Pass::Svg));
+        // Lifetimes: the tree per pose, the classification per view.
+        assert_eq!(Pass::Bvh.lifetime(input), Lifetime::Pose);
+        assert_eq!(Pass::Visibility.lifetime(input), Lifetime::View);
+    }
+    // A volume's tree is built on its isosurface.
+    let v = plan_for(
+        &[Cue::CurvatureStrokes],
+        Input::Volume,
+        CapMode::Adjacency,
+        out(false, true, Exact),
+    );
+    assert!(v.contains(Pass::Isosurface) && v.contains(Pass::Bvh));
+}

@@ -590,6 +590,10 @@ pub fn plan_for(cues: &[Cue], input: Input, caps: CapMode, outputs: Outputs) -> 
             p => vec![p],
         })
         .collect();
+    // An SVG is written whatever it holds (its groups may be empty).
+    if outputs.vector && !cues.is_empty() {
+        stack.push(Pass::Svg);
+    }
     while let Some(p) = stack.pop() {
         let dropped = match caps {
             CapMode::Adjacency => false,

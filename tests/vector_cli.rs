@@ -1,0 +1,201 @@
+//! Vector output with no OpenGL: `lines`, `edges` and a scene write SVG
+//! (and segments) with exact visibility while no EGL vendor can be found
+//! (`__EGL_VENDOR_LIBRARY_DIRS` at an empty folder), and agree with the
+//! depth-buffer method's SVG (where GL is available) on how much line is
+//! visible.
+
+mod common;
+
+use common::{cli, cli_gl_missing, scratch};
+use std::path::Path;
+use std::process::Output;
+
+/// The command with no EGL vendor to load.
+fn no_gl(dir: &Path, args: &[&str]) -> Output {
+    let empty = dir.join("no-egl-vendors");
+    std::fs::create_dir_all(&empty).unwrap();
+    cli()
+        .env("__EGL_VENDOR_LIBRARY_DIRS", &empty)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The polylines of each SVG group: (id, polylines, length in pixels).
+fn groups(svg: &str) -> Vec<(String, usize, f64)> {
+    let mut out = Vec::new();
+    for g in svg.split("<g id=\"").skip(1) {
+        let id = g.split('"').next().unwrap().to_string();
+        let body = g.split("</g>").next().unwrap();
+        let mut n = 0;
+        let mut len = 0.0;
+        for pl in body.split("points=\"").skip(1) {
+            let pts: Vec<[f64; 2]> = (pl.split('"').next().unwrap().split_whitespace())
+                .map(|p| {
+                    let mut c = p.split(',').map(|x| x.parse::<f64>().unwrap());
+                    [c.next().unwrap(), c.next().unwrap()]
+                })
+                .collect();
+            n += 1;
+            len += (pts.windows(2))
+                .map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt())
+                .sum::<f64>();
+        }
+        out.push((id, n, len));
+    }
+    out
+}
+
+fn spot() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj").to_string()
+}
+
+#[test]
+fn lines_write_svg_and_segments_with_no_gl() {
+    let d = scratch("lines-no-gl");
+    let (svg, json) = (d.join("spot.svg"), d.join("spot.json"));
+    let out = no_gl(
+        &d,
+        &[
+            "lines",
+            &spot(),
+            "--lines",
+            "contours,suggestive,ridges",
+            "-o",
+            svg.to_str().unwrap(),
+            "--segments",
+            json.to_str().unwrap(),
+        ],
+    );
+    ok(&out);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let g = groups(&text);
+    let ids: Vec<&str> = g.iter().map(|x| x.0.as_str()).collect();
+    assert_eq!(ids, ["contours", "suggestive", "ridges"], "{text}");
+    // The contours are drawn, as chains of several segments.
+    assert!(g[0].1 >= 3 && g[0].2 > 500.0, "{g:?}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(doc["visibility"], "exact");
+    let segs = doc["segments"].as_array().unwrap();
+    let visible = segs.iter().filter(|s| s["visible"] == true).count();
+    let hidden = segs.iter().filter(|s| s["visible"] == false).count();
+    // Spot from the default view: both visible and hidden lines.
+    assert!(visible > 100 && hidden > 10, "{visible} {hidden}");
+    for s in segs {
+        let faces = s["faces"].as_array().unwrap();
+        assert!(!faces.is_empty() && faces.len() <= 4, "{s}");
+        assert!(s["chain"].as_u64().unwrap() < doc["chains"].as_array().unwrap().len() as u64);
+    }
+    let mean = doc["mean_visible_chain_segments"].as_f64().unwrap();
+    assert!(mean > 2.0, "{mean}");
+}
+
+#[test]
+fn edges_write_svg_with_no_gl_and_refuse_other_names() {
+    let d = scratch("edges-no-gl");
+    let (svg, stats) = (d.join("e.svg"), d.join("e.json"));
+    let out = no_gl(
+        &d,
+        &[
+            "edges",
+            &spot(),
+            "-o",
+            svg.to_str().unwrap(),
+            "--stats",
+            stats.to_str().unwrap(),
+        ],
+    );
+    ok(&out);
+    let g = groups(&std::fs::read_to_string(&svg).unwrap());
+    assert_eq!(g.len(), 1);
+    assert_eq!(g[0].0, "feature-edges");
+    assert!(g[0].1 > 10 && g[0].2 > 1000.0, "{g:?}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    // No frame drawn: the edges are read back, no caps are made.
+    assert_eq!(doc["interop"]["route"], "host", "{doc}");
+    assert_eq!(doc["cap_pairs"], 0, "{doc}");
+    assert!(doc["phases_ms"]["visibility"].as_f64().unwrap() >= 0.0);
+    let bad = d.join("e.ply");
+    let out = no_gl(&d, &["edges", &spot(), "-o", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains(".png") && e.contains(".svg"), "{e}");
+    assert!(!bad.exists());
+}
+
+#[test]
+fn a_scene_of_svg_only_opens_no_gl_and_reports_its_chains() {
+    let d = scratch("scene-no-gl");
+    let scene = d.join("cow.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[input]\nmesh = {:?}\n[[camera]]\norbit = 3\n[effects]\ncontours = {{}}\n\
+             suggestive_contours = {{}}\nfeature_edges = {{}}\nshading = {{}}\n\
+             [output]\nformats = [\"svg\"]\ndir = {:?}\n",
+            spot(),
+            d.join("out").to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = no_gl(&d, &["render", scene.to_str().unwrap()]);
+    ok(&out);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("out/cow_report.json")).unwrap()).unwrap();
+    let passes: Vec<&str> = (report["passes"].as_array().unwrap().iter())
+        .map(|p| p["pass"].as_str().unwrap())
+        .collect();
+    assert!(
+        passes.contains(&"bvh") && passes.contains(&"visibility"),
+        "{passes:?}"
+    );
+    assert!(
+        !passes.contains(&"render") && !passes.contains(&"caps"),
+        "{passes:?}"
+    );
+    assert!(report["renderer"].as_str().unwrap().starts_with("none"));
+    assert!(
+        report["chains"]["mean_length"].as_f64().unwrap() > 1.0,
+        "{report}"
+    );
+    let bvh = (report["passes"].as_array().unwrap().iter())
+        .find(|p| p["pass"] == "bvh")
+        .unwrap();
+    // Built once for the static mesh, however many views.
+    assert_eq!(bvh["runs"], 1);
+    assert_eq!(report["outputs"].as_array().unwrap().len(), 3);
+}
+
+#[test]
+fn exact_and_depth_svgs_agree_on_the_visible_length() {
+    let d = scratch("exact-vs-depth");
+    let (exact, depth) = (d.join("exact.svg"), d.join("depth.svg"));
+    let run = |o: &Path, method: &str| {
+        cli()
+            .args(["lines", &spot(), "--visibility", method, "-o"])
+            .arg(o)
+            .output()
+            .unwrap()
+    };
+    ok(&run(&exact, "exact"));
+    let out = run(&depth, "depth");
+    if cli_gl_missing(&out) {
+        return;
+    }
+    ok(&out);
+    let a = groups(&std::fs::read_to_string(&exact).unwrap());
+    let b = groups(&std::fs::read_to_string(&depth).unwrap());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.0, y.0);
+        let rel = (x.2 - y.2).abs() / y.2.max(1.0);
+        assert!(rel < 0.05, "{x:?} against {y:?}");
+    }
+}
