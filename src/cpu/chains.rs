@@ -17,8 +17,6 @@
 //! as at a corner of feature edges) a chain goes on along the first unused
 //! piece in canonical order and the others start chains of their own.
 
-use std::collections::HashMap;
-
 /// How a piece's end is matched with others'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum EndKey {
@@ -70,55 +68,93 @@ pub struct Chain {
     pub pieces: Vec<(u32, bool)>,
 }
 
+/// The ends of the pieces grouped by where they meet: sorted by (layer,
+/// visibility, key, the piece's canonical rank), each group a run of equal
+/// keys, its members in canonical order.
+struct Ends {
+    /// `(layer, visible, key, rank, piece, end)`, sorted.
+    ends: Vec<(u32, bool, EndKey, u32, u32, u8)>,
+    /// The group of each piece's end (`2 × piece + end`).
+    group_of: Vec<u32>,
+    /// Each group's first index into `ends`, and one past the last group.
+    start: Vec<u32>,
+}
+
+impl Ends {
+    fn new(pieces: &[ChainPiece], rank: &[u32]) -> Ends {
+        let mut ends: Vec<_> = (pieces.iter().enumerate())
+            .flat_map(|(i, p)| {
+                (0..2).map(move |e| (p.layer, p.visible, p.keys[e], rank[i], i as u32, e as u8))
+            })
+            .collect();
+        ends.sort_unstable();
+        let mut group_of = vec![0u32; ends.len()];
+        let mut start = Vec::new();
+        for (k, x) in ends.iter().enumerate() {
+            let new = k == 0 || {
+                let y = &ends[k - 1];
+                (y.0, y.1, y.2) != (x.0, x.1, x.2)
+            };
+            if new {
+                start.push(k as u32);
+            }
+            group_of[2 * x.4 as usize + x.5 as usize] = (start.len() - 1) as u32;
+        }
+        start.push(ends.len() as u32);
+        Ends {
+            ends,
+            group_of,
+            start,
+        }
+    }
+
+    /// The members of the group of piece `i`'s end `e`: `(piece, end)`.
+    fn at(&self, i: u32, e: usize) -> impl Iterator<Item = (u32, usize)> + '_ {
+        let g = self.group_of[2 * i as usize + e] as usize;
+        let (a, b) = (self.start[g] as usize, self.start[g + 1] as usize);
+        self.ends[a..b].iter().map(|x| (x.4, x.5 as usize))
+    }
+
+    fn degree(&self, i: u32, e: usize) -> usize {
+        let g = self.group_of[2 * i as usize + e] as usize;
+        (self.start[g + 1] - self.start[g]) as usize
+    }
+}
+
 /// Joins `pieces` into chains (see the module note). Every piece is in
 /// exactly one chain.
 pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
     let mut order: Vec<u32> = (0..pieces.len() as u32).collect();
-    let sorted_keys = |p: &ChainPiece| {
-        let mut k = p.keys;
-        k.sort();
-        (p.layer, p.visible, k)
-    };
-    order.sort_by(|&a, &b| {
-        let (pa, pb) = (&pieces[a as usize], &pieces[b as usize]);
-        sorted_keys(pa)
-            .cmp(&sorted_keys(pb))
-            .then(pa.seg.cmp(&pb.seg))
-            .then(pa.t[0].total_cmp(&pb.t[0]))
-    });
-    let mut at: HashMap<(u32, bool, EndKey), Vec<u32>> = HashMap::new();
-    for &i in &order {
+    order.sort_by_cached_key(|&i| {
         let p = &pieces[i as usize];
-        for k in p.keys {
-            at.entry((p.layer, p.visible, k)).or_default().push(i);
-        }
+        let mut k = p.keys;
+        k.sort_unstable();
+        (p.layer, p.visible, k, p.seg, p.t[0].to_bits())
+    });
+    let mut rank = vec![0u32; pieces.len()];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i as usize] = r as u32;
     }
+    let ends = Ends::new(pieces, &rank);
     let mut used = vec![false; pieces.len()];
     let mut out = Vec::new();
-    let degree = |p: &ChainPiece, end: usize| at[&(p.layer, p.visible, p.keys[end])].len();
     for &i in &order {
         for end in 0..2 {
-            if !used[i as usize] && degree(&pieces[i as usize], end) != 2 {
-                out.push(walk(pieces, &at, &mut used, i, end));
+            if !used[i as usize] && ends.degree(i, end) != 2 {
+                out.push(walk(pieces, &ends, &mut used, i, end));
             }
         }
     }
     for &i in &order {
         if !used[i as usize] {
-            out.push(walk(pieces, &at, &mut used, i, 0));
+            out.push(walk(pieces, &ends, &mut used, i, 0));
         }
     }
     out
 }
 
 /// The chain from piece `first`, leaving it by the end opposite `from`.
-fn walk(
-    pieces: &[ChainPiece],
-    at: &HashMap<(u32, bool, EndKey), Vec<u32>>,
-    used: &mut [bool],
-    first: u32,
-    from: usize,
-) -> Chain {
+fn walk(pieces: &[ChainPiece], ends: &Ends, used: &mut [bool], first: u32, from: usize) -> Chain {
     let p = &pieces[first as usize];
     used[first as usize] = true;
     let mut c = Chain {
@@ -126,20 +162,15 @@ fn walk(
         visible: p.visible,
         pieces: vec![(first, from == 1)],
     };
-    let mut tip = p.keys[1 - from];
+    let (mut at, mut tip) = (first, 1 - from);
     loop {
-        let next = at[&(p.layer, p.visible, tip)]
-            .iter()
-            .copied()
-            .find(|&j| !used[j as usize]);
-        let Some(j) = next else { break };
+        // The first unused piece at the tip, entered at its matching end
+        // (the first, for a loop of one piece).
+        let next = ends.at(at, tip).find(|&(j, _)| !used[j as usize]);
+        let Some((j, entered)) = next else { break };
         used[j as usize] = true;
-        let q = &pieces[j as usize];
-        // Entered at the end that matches the tip (the first, for a piece
-        // whose two ends match it, a loop of one piece).
-        let entered = if q.keys[0] == tip { 0 } else { 1 };
         c.pieces.push((j, entered == 1));
-        tip = q.keys[1 - entered];
+        (at, tip) = (j, 1 - entered);
     }
     c
 }

@@ -38,9 +38,10 @@ fn hex(c: [f32; 3]) -> String {
 /// zero length, where a contour passes through a vertex) are written once.
 fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
     s.push_str("<polyline points=\"");
-    let mut last = String::new();
+    let (mut here, mut last) = (String::with_capacity(32), String::with_capacity(32));
     for p in points {
-        let here = format!("{:.2},{:.2}", p[0], p[1]);
+        here.clear();
+        let _ = write!(here, "{:.2},{:.2}", p[0], p[1]);
         if here == last {
             continue;
         }
@@ -48,7 +49,7 @@ fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
             s.push(' ');
         }
         s.push_str(&here);
-        last = here;
+        std::mem::swap(&mut here, &mut last);
     }
     s.push('"');
     if let Some(o) = opacity.filter(|&o| o < 0.995) {
