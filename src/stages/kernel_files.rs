@@ -136,6 +136,14 @@ pub const BVH: KernelFile = KernelFile {
     includes: &[],
 };
 
+/// `kernels/intersections.cl`: where faces cross, over the bvh family's tree.
+pub const INTERSECTIONS: KernelFile = KernelFile {
+    name: "kernels/intersections.cl",
+    source: include_str!("../../kernels/intersections.cl"),
+    headers: BVH_TREE_HEADERS,
+    includes: &[],
+};
+
 /// Every family's kernel file.
 pub const ALL: &[KernelFile] = &[
     CURVATURE,
@@ -151,6 +159,7 @@ pub const ALL: &[KernelFile] = &[
     SDF_LINES,
     MESH_SDF,
     BVH,
+    INTERSECTIONS,
 ];
 
 /// A kernel file with the common headers and no includes.
