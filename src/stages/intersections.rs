@@ -127,8 +127,9 @@ impl Intersections {
         }
         let mut counts = self.run(&tree)?;
         if counts[0] as usize > self.cap {
+            // the buffer first: a refused allocation leaves the old room
+            self.out = self.gpu.buffer(counts[0] as usize)?;
             self.cap = counts[0] as usize;
-            self.out = self.gpu.buffer(self.cap)?;
             stats.reran = true;
             counts = self.run(&tree)?;
         }
