@@ -1,7 +1,8 @@
 // bvh.cl: a linear BVH over a mesh's faces (Karras 2012, "Maximizing
 // parallelism in the construction of BVHs, octrees and k-d trees").
-// Layout and constants: src/spec/bvh.rs (BvhNode, BvhBox, BvhQuery mirrored
-// below); CPU twin: src/cpu/bvh.rs, operation for operation.
+// Layout and constants: src/spec/bvh.rs (BvhQuery mirrored below; BvhNode,
+// BvhBox and the tree's helpers in common/bvh_tree.h, shared with
+// kernels/intersections.cl); CPU twin: src/cpu/bvh.rs, operation for operation.
 // The host passes -DBVH_STACK, -DBVH_EDGE_EPS, -DBVH_END_EPS, -DBVH_BOX_PAD.
 // Steps: bvh_morton (codes of the face centroids) -> the project's radix sort
 // of (code, face) pairs -> bvh_build (internal nodes) -> bvh_refit (boxes,
@@ -14,27 +15,10 @@
 #define BVH_OVERFLOW 2u
 
 typedef struct {
-    uint left;
-    uint right;
-    uint parent;
-    uint pad;
-} BvhNode;
-
-typedef struct {
-    float4 lo;
-    float4 hi;
-} BvhBox;
-
-typedef struct {
     float4 origin;
     float4 target;
     uint exclude[4];
 } BvhQuery;
-
-// a < b ? a : b as the twin writes it (fmin's choice between -0 and +0 is
-// the device's own).
-SC_INLINE float bvh_lesser(float a, float b) { return b < a ? b : a; }
-SC_INLINE float bvh_greater(float a, float b) { return b > a ? b : a; }
 
 SC_INLINE uint bvh_expand(uint v)
 {
@@ -53,11 +37,6 @@ SC_INLINE uint bvh_cell(float s, float lo3, float scale)
     if (isnan(v) || v <= 0.0f) return 0u;
     if (v >= 1023.0f) return 1023u;
     return (uint)v;
-}
-
-SC_INLINE float3 bvh_vertex(__global const float *pos, uint v)
-{
-    return (float3)(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
 }
 
 // One work-item per face: keys[f] = Morton code of its centroid, values[f] = f.
@@ -238,12 +217,6 @@ SC_INLINE bool bvh_segment_hits(float3 o, float3 d, float3 a, float3 b, float3 c
     const float slack = BVH_EDGE_EPS * det;
     const float trim = BVH_END_EPS * det;
     return u >= -slack && v >= -slack && u + v <= det + slack && t > trim && t < det - trim;
-}
-
-SC_INLINE BvhBox bvh_box_of(__global const BvhBox *node_boxes, __global const BvhBox *leaf_boxes,
-                            uint c)
-{
-    return (c & BVH_LEAF) ? leaf_boxes[c & ~BVH_LEAF] : node_boxes[c];
 }
 
 // One work-item per query: stack traversal from the root (n faces; root is

@@ -143,6 +143,11 @@ fn every_kernel_file_builds_and_holds_every_entry_its_enum_names() {
         .into_iter()
         .filter(|n| *n != "bvh_probe_layout") // appended by the layout probe test
         .collect();
+    let isect_opts = shapecue::stages::intersections::build_options();
+    let isect: Vec<_> = names(shapecue::spec::intersections::IsectKernel::ALL)
+        .into_iter()
+        .filter(|n| *n != "isect_probe_layout") // appended by the layout probe test
+        .collect();
     let cases: Vec<(KernelFile, &str, Vec<&str>)> = vec![
         (kernel_files::CURVATURE, "", atomic),
         (kernel_files::CURVATURE, "-DSC_GATHER", gather),
@@ -166,6 +171,7 @@ fn every_kernel_file_builds_and_holds_every_entry_its_enum_names() {
         (kernel_files::SDF_LINES, "", names(SdflKernel::ALL)),
         (kernel_files::MESH_SDF, &msdf_opts, names(MsdfKernel::ALL)),
         (kernel_files::BVH, &bvh_opts, bvh),
+        (kernel_files::INTERSECTIONS, &isect_opts, isect),
     ];
     assert_eq!(
         kernel_files::ALL.len(),

@@ -15,6 +15,7 @@ pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
 pub mod interop;
+pub mod intersections;
 pub mod kernels;
 pub mod limits;
 pub mod marching_cubes;

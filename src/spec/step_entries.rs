@@ -9,6 +9,7 @@ use super::bvh::BvhKernel;
 use super::curvature::CurvKernel;
 use super::edges::EdgesKernel;
 use super::feature_lines::{LinesCurvesKernel, LinesKernel};
+use super::intersections::IsectKernel;
 use super::marching_cubes::McKernel;
 use super::mesh_sdf::MsdfKernel;
 use super::sdf_lines::SdflKernel;
@@ -77,6 +78,7 @@ impl Step {
             Step::BvhBuild => BvhKernel::Build.name(),
             Step::BvhRefit => BvhKernel::Refit.name(),
             Step::BvhOccluded => BvhKernel::Occluded.name(),
+            Step::IsectFind => IsectKernel::Find.name(),
         }
     }
 }

@@ -39,6 +39,8 @@ pub enum Family {
     MeshSdf,
     /// `kernels/bvh.cl` (a linear BVH over a mesh's faces, Karras 2012).
     Bvh,
+    /// `kernels/intersections.cl` (where faces cross, over the bvh tree).
+    Intersections,
 }
 
 /// A step of a stage: a kernel entry point `<prefix>_<step>` of
@@ -175,6 +177,8 @@ pub enum Step {
     BvhRefit,
     /// `bvh_occluded`: segment occlusion queries.
     BvhOccluded,
+    /// `isect_find`: face pairs from the tree, their crossing segments.
+    IsectFind,
 }
 
 impl Step {
@@ -193,6 +197,7 @@ impl Step {
             Family::SdfLines => &k["sdfl_".len()..],
             Family::MeshSdf => &k["msdf_".len()..],
             Family::Bvh => &k["bvh_".len()..],
+            Family::Intersections => &k["isect_".len()..],
             Family::Scan | Family::RadixSort | Family::Edges => k,
         }
     }
@@ -220,6 +225,7 @@ impl Step {
             | SdflStrips | SdflSweep => Family::SdfLines,
             MsdfBand | MsdfJfa | MsdfRefine | MsdfSign | MsdfFinish => Family::MeshSdf,
             BvhMorton | BvhBuild | BvhRefit | BvhOccluded => Family::Bvh,
+            IsectFind => Family::Intersections,
         }
     }
 }

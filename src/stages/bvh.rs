@@ -271,6 +271,33 @@ impl Bvh {
         Ok((result, overflows[0]))
     }
 
+    /// The built tree's device buffers as kernel arguments, for the kernels
+    /// of other families that traverse it (`kernels/intersections.cl`):
+    /// positions `f32[3·V]` (of the last build or refit), faces `u32[3·F]`,
+    /// faces_sorted `u32[F]`, nodes, node boxes, leaf boxes (the layout of
+    /// `kernels/common/bvh_tree.h`). Errors before [`Bvh::build`] and when
+    /// `gpu` is not the device the tree lives on.
+    pub fn tree_args(&self, gpu: &Gpu) -> Result<[Arg; 6]> {
+        if !self.built {
+            return Err(Error::InvalidArgument(
+                "bvh tree: not built yet (call build with the first pose)".into(),
+            ));
+        }
+        if !std::ptr::eq(gpu, &*self.gpu) {
+            return Err(Error::InvalidArgument(
+                "bvh tree: it lives on another Gpu (open one Gpu and share it)".into(),
+            ));
+        }
+        Ok([
+            buf(&self.pos),
+            buf(&self.faces),
+            buf(&self.faces_sorted),
+            buf(&self.nodes),
+            buf(&self.node_boxes),
+            buf(&self.leaf_boxes),
+        ])
+    }
+
     /// Kernel steps of the last call ([`Bvh::build`], [`Bvh::refit`] or
     /// [`Bvh::occluded`]).
     pub fn timing(&self) -> &Timing {

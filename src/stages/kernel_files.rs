@@ -20,6 +20,7 @@ const HASH_H: Source = source!("common/hash.h");
 const MC_EDGE_H: Source = source!("common/mc_edge.h");
 const MC_CELL_H: Source = source!("common/mc_cell.h");
 const MC_DIRECT_H: Source = source!("common/mc_direct.h");
+const BVH_TREE_H: Source = source!("common/bvh_tree.h");
 
 /// `kernels/curvature.cl`: the shared passes, then (by `#include`) the face
 /// arithmetic, the lane loads, and one accumulation scheme's file
@@ -123,8 +124,25 @@ pub const MESH_SDF: KernelFile = plain(
     include_str!("../../kernels/mesh_sdf.cl"),
 );
 
+/// The headers of the files that read the bvh family's tree: the common
+/// ones and bvh_tree.h (its node and box layout).
+const BVH_TREE_HEADERS: &[Source] = &[COMMON_HEADERS[0], COMMON_HEADERS[1], BVH_TREE_H];
+
 /// `kernels/bvh.cl`: a linear BVH over a mesh's faces and segment queries.
-pub const BVH: KernelFile = plain("kernels/bvh.cl", include_str!("../../kernels/bvh.cl"));
+pub const BVH: KernelFile = KernelFile {
+    name: "kernels/bvh.cl",
+    source: include_str!("../../kernels/bvh.cl"),
+    headers: BVH_TREE_HEADERS,
+    includes: &[],
+};
+
+/// `kernels/intersections.cl`: where faces cross, over the bvh family's tree.
+pub const INTERSECTIONS: KernelFile = KernelFile {
+    name: "kernels/intersections.cl",
+    source: include_str!("../../kernels/intersections.cl"),
+    headers: BVH_TREE_HEADERS,
+    includes: &[],
+};
 
 /// Every family's kernel file.
 pub const ALL: &[KernelFile] = &[
@@ -141,6 +159,7 @@ pub const ALL: &[KernelFile] = &[
     SDF_LINES,
     MESH_SDF,
     BVH,
+    INTERSECTIONS,
 ];
 
 /// A kernel file with the common headers and no includes.

@@ -8,6 +8,7 @@ pub mod curvature;
 pub mod edges;
 pub mod feature_lines;
 pub mod feature_lines_curves;
+pub mod intersections;
 pub mod kernel_files;
 pub mod marching_cubes;
 pub mod mesh_sdf;
