@@ -81,11 +81,13 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
         ],
         Cue::Isophotes => vec![VertexNormals, LinesView, LinesCurves, Render],
         Cue::Boundaries => vec![VertexNormals, LinesCurves, Render],
+        // Found over the BVH of the pose.
+        Cue::IntersectionLines => vec![Bvh, Intersections, Render],
     };
     let needs_geometry = v.iter().any(|p| {
         matches!(
             p,
-            VertexNormals | FaceNormals | OneRings | EdgeBuffer | CapBuffer
+            VertexNormals | FaceNormals | OneRings | EdgeBuffer | CapBuffer | Bvh
         )
     });
     if needs_geometry {

@@ -199,3 +199,57 @@ fn exact_and_depth_svgs_agree_on_the_visible_length() {
         assert!(rel < 0.05, "{x:?} against {y:?}");
     }
 }
+
+/// Two icospheres crossing (the second shifted off the first's symmetry
+/// planes) as one OBJ.
+fn crossing_spheres_obj() -> String {
+    let a = shapecue::mesh::icosphere(1.0, 3);
+    let b = shapecue::mesh::icosphere(1.0, 3);
+    let n = a.positions.len() as u32;
+    let pos = (a.positions.iter().copied()).chain(
+        b.positions
+            .iter()
+            .map(|p| [p[0] + 1.0, p[1] + 0.013, p[2] + 0.007]),
+    );
+    let faces: Vec<[u32; 3]> = (a.faces.iter().copied())
+        .chain(b.faces.iter().map(|f| f.map(|v| v + n)))
+        .collect();
+    common::obj_text(pos, &faces)
+}
+
+#[test]
+fn intersection_lines_are_a_scene_cue_chained_into_a_loop() {
+    let d = scratch("intersection-lines");
+    let obj = d.join("two.obj");
+    std::fs::write(&obj, crossing_spheres_obj()).unwrap();
+    let scene = d.join("two.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[input]\nmesh = {:?}\n[[camera]]\ndirection = [0.3, 1.0, 0.5]\n[effects]\n\
+             intersection_lines = {{ width = 1.5 }}\n[output]\nformats = [\"svg\"]\ndir = {:?}\n",
+            obj.to_str().unwrap(),
+            d.join("out").to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = no_gl(&d, &["render", scene.to_str().unwrap()]);
+    ok(&out);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("out/two_report.json")).unwrap()).unwrap();
+    let passes: Vec<&str> = (report["passes"].as_array().unwrap().iter())
+        .map(|p| p["pass"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        passes,
+        ["bvh", "intersections", "visibility", "svg"],
+        "{report}"
+    );
+    let svg = std::fs::read_to_string(d.join("out/two_f0000_v00.svg")).unwrap();
+    let g = groups(&svg);
+    assert_eq!(g.len(), 1, "{svg}");
+    assert_eq!(g[0].0, "intersection-lines");
+    // The circle x = 0.5 seen from the side: its near half visible, one
+    // chain or a few, never one polyline per segment.
+    assert!(g[0].1 >= 1 && g[0].1 <= 4 && g[0].2 > 50.0, "{g:?}");
+}

@@ -58,11 +58,14 @@ pub enum Cue {
     DwkrZero,
     /// Mesh boundaries (edges with one face), as a line family.
     Boundaries,
+    /// Intersection lines: where faces of the mesh cross (Blender Line
+    /// Art's "intersection" lines), from the BVH (family `intersections`).
+    IntersectionLines,
 }
 
 impl Cue {
     /// Every cue.
-    pub const ALL: [Cue; 17] = [
+    pub const ALL: [Cue; 18] = [
         Cue::Shading,
         Cue::CurvatureColors,
         Cue::AmbientOcclusion,
@@ -80,6 +83,7 @@ impl Cue {
         Cue::HZero,
         Cue::DwkrZero,
         Cue::Boundaries,
+        Cue::IntersectionLines,
     ];
 
     /// The curvature line families (`kernels/feature_lines_curves.cl`),
@@ -146,6 +150,7 @@ impl Cue {
             Cue::HZero => "h_zero",
             Cue::DwkrZero => "dwkr_zero",
             Cue::Boundaries => "boundaries",
+            Cue::IntersectionLines => "intersection_lines",
         }
     }
 
@@ -179,6 +184,7 @@ impl Cue {
             Cue::SuggestiveHighlights | Cue::DwkrZero => &[Dcurv, LinesCurves, Render],
             Cue::Isophotes => &[LinesView, LinesCurves, Render],
             Cue::Boundaries => &[LinesCurves, Render],
+            Cue::IntersectionLines => &[Pass::Intersections, Render],
         }
     }
 }
@@ -242,6 +248,9 @@ pub enum Pass {
     /// The mesh's BVH for exact visibility (family `bvh`): built when a
     /// topology first appears, refitted to every later pose.
     Bvh,
+    /// Intersection lines of this pose (family `intersections`): faces that
+    /// cross, found over the BVH.
+    Intersections,
     /// Curvature-directed strokes traced on the volume itself (family
     /// `sdf_lines`): dense samples, Poisson-disk seeds, curvature from the
     /// Hessian, RK4 tracing along d1, tapered strips. Reads no mesh pass.
@@ -340,6 +349,7 @@ impl Pass {
             Pass::Ao => "ao",
             Pass::LinesPose => "lines_pose",
             Pass::Bvh => "bvh",
+            Pass::Intersections => "intersections",
             Pass::Visibility => "visibility",
             Pass::Svg => "svg",
             Pass::LinesView => "lines_view",
@@ -411,6 +421,7 @@ impl Pass {
             Pass::Caps => &[CapsMh, CapsAdjacency],
             Pass::Bvh => &[BvhMorton, RadixSortPairs, BvhBuild, BvhRefit],
             Pass::Visibility => &[BvhOccluded],
+            Pass::Intersections => &[IsectFind],
             Pass::LoadFrame
             | Pass::EdgeBuffer
             | Pass::CapBuffer
@@ -462,6 +473,7 @@ impl Pass {
             Pass::Render => vec![],
             // What else these read depends on the plan ([`Plan::reads`]).
             Pass::Visibility => vec![Pass::Bvh],
+            Pass::Intersections => vec![Pass::Bvh],
             Pass::Svg => vec![],
         };
         v.sort();
@@ -634,6 +646,7 @@ impl Plan {
         let mut v = pass.needs(self.input);
         let extra: &[Pass] = match pass {
             Pass::Visibility => &[
+                Pass::Intersections,
                 Pass::SdfLines,
                 Pass::Contours,
                 Pass::SuggestiveContours,

@@ -155,6 +155,8 @@ pub(super) fn line_styles(fx: &Effects) -> Vec<(LineStyle, bool)> {
 pub(super) struct ViewLines<'a> {
     /// Contour and suggestive-contour segments (scene frame).
     pub(super) segments: &'a [Segment],
+    /// Intersection lines (scene frame).
+    pub(super) intersections: &'a [Segment],
     /// The edge stage's outputs, when feature edges are planned.
     pub(super) edges: Option<&'a EdgeOutput>,
     /// On the external-memory route, the shared buffer and what the stage
@@ -258,6 +260,13 @@ fn draw_edges_and_strokes(
     lines: &ViewLines<'_>,
 ) -> Result<()> {
     let fx = &scene.effects;
+    if !lines.intersections.is_empty() {
+        let pts: Vec<[f32; 3]> = (lines.intersections.iter())
+            .flat_map(|s| [s.0, s.1])
+            .collect();
+        let [r, g, b] = fx.intersection.1;
+        renderer.draw_lines(&pts, [r, g, b, 1.0], fx.intersection.0)?;
+    }
     if let Some(eo) = lines.edges {
         let [r, g, b] = fx.edge.1;
         match lines.shared {
@@ -294,6 +303,17 @@ pub(super) fn svg_layers(
     let mut layers = Vec::new();
     for (st, faded) in line_styles(fx) {
         family_layers(&mut layers, &st, faded, lines.segments, vp, image);
+    }
+    if plan.contains(Pass::Intersections) {
+        let kind = super::vector::LAYER_INTERSECTIONS;
+        let clip = segment_lines(vp, lines.intersections, kind, |_| 1.0);
+        layers.push(SvgLayer {
+            id: "intersection-lines",
+            stroke_width: fx.intersection.0,
+            color: fx.intersection.1,
+            lines: visible_joined(&clip, image, DEFAULT_BIAS),
+            dashed: false,
+        });
     }
     if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
         let clip = crate::export::svg::edge_out_lines(&eo.edge_out);

@@ -23,6 +23,8 @@ use crate::stages::visibility::{Classified, classify_planned};
 /// The layer of the feature edges (the line families' layers are their
 /// kinds, [`crate::spec::feature_lines::LineFamily`] as `u32`).
 pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
+/// The layer of the intersection lines.
+pub const LAYER_INTERSECTIONS: u32 = (1 << 16) + 1;
 
 /// The lines of one view, classified and chained.
 #[derive(Clone, Debug, Default)]
@@ -194,6 +196,18 @@ pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) 
             });
         }
         layers.push(family_layer(vis, &st, faded, vp, [w, h]));
+    }
+    if fx
+        .cues
+        .contains(&crate::scene::planner::Cue::IntersectionLines)
+    {
+        layers.push(SvgLayer {
+            id: "intersection-lines",
+            stroke_width: fx.intersection.0,
+            color: fx.intersection.1,
+            lines: polylines(vis, LAYER_INTERSECTIONS, true, vp, [w, h], |_| 1.0),
+            dashed: false,
+        });
     }
     if fx.cues.contains(&crate::scene::planner::Cue::FeatureEdges) {
         layers.push(SvgLayer {

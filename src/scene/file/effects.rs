@@ -26,6 +26,8 @@ pub struct Effects {
     pub contour: (f32, [f32; 3]),
     /// Suggestive contour width and colour.
     pub suggestive: (f32, [f32; 3]),
+    /// Intersection line width and colour.
+    pub intersection: (f32, [f32; 3]),
     /// Suggestive-contour threshold (rtsc's `sug_thresh`, default 0.01).
     pub suggestive_threshold: f32,
     /// rtsc's fade of suggestive contours and highlights (default 0.03; 0:

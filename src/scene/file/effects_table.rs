@@ -29,6 +29,7 @@ pub(super) fn resolve(
     let contour = t.contours(&fx, &mut cues)?;
     let sc = t.suggestive(&fx, &mut cues)?;
     let fe = t.feature_edges(&fx, &mut cues)?;
+    let intersection = t.intersection_lines(&fx, &mut cues)?;
     let strokes = t.strokes(&fx, &mut cues)?;
     let lines = lines::resolve(&fx, &mut cues).map_err(|p| t.err(p))?;
     t.check_cues(&cues, input, kind)?;
@@ -41,6 +42,7 @@ pub(super) fn resolve(
         ao_radius,
         contour,
         suggestive: sc.style,
+        intersection,
         suggestive_threshold: sc.threshold,
         suggestive_fade: sc.fade,
         edge: fe.style,
@@ -150,6 +152,18 @@ impl Table<'_> {
         Ok((
             positive(c.width, 2.0, "contours.width").map_err(|p| self.err(p))?,
             color(c.color, [0.0; 3], "contours.color").map_err(|p| self.err(p))?,
+        ))
+    }
+
+    /// `intersection_lines`: their width and colour.
+    fn intersection_lines(&self, fx: &EffectsSpec, cues: &mut Vec<Cue>) -> Result<Style> {
+        let c = fx.intersection_lines.clone().unwrap_or_default();
+        if fx.intersection_lines.is_some() {
+            cues.push(Cue::IntersectionLines);
+        }
+        Ok((
+            positive(c.width, 2.0, "intersection_lines.width").map_err(|p| self.err(p))?,
+            color(c.color, [0.0; 3], "intersection_lines.color").map_err(|p| self.err(p))?,
         ))
     }
 

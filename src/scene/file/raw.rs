@@ -213,6 +213,8 @@ pub struct EffectsSpec {
     pub suggestive_contours: Option<SuggestiveSpec>,
     /// Feature edges with caps.
     pub feature_edges: Option<EdgeSpec>,
+    /// Intersection lines: where faces cross (Line Art's "intersection").
+    pub intersection_lines: Option<LineSpec>,
     /// Curvature-directed strokes (volume inputs only).
     pub curvature_strokes: Option<StrokeSpec>,
     /// Ridges.

@@ -70,9 +70,11 @@ struct Topology {
     shared: Option<SharedEdges>,
     /// The two vertices of each edge entry (for the SVG's feature edges).
     edge_pairs: Vec<[u32; 2]>,
-    /// The BVH of exact visibility (built on the first pose, refitted to
-    /// later ones).
+    /// The BVH of exact visibility and intersection lines (built on the
+    /// first pose, refitted to later ones).
     bvh: Option<Bvh>,
+    /// The intersection lines' search (made by the first pose).
+    isect: Option<crate::stages::intersections::Intersections>,
 }
 
 impl Topology {
@@ -89,6 +91,7 @@ impl Topology {
             shared: None,
             edge_pairs: Vec::new(),
             bvh: None,
+            isect: None,
         }
     }
 }
@@ -162,6 +165,8 @@ pub(super) struct Executor<'s, 'g> {
     layers: Option<Vec<crate::export::svg::SvgLayer>>,
     /// Visible chains and their pieces over all views.
     pub(super) chains: [usize; 2],
+    /// This pose: its intersection lines (scene frame).
+    isect_segs: Vec<Segment>,
     /// This view: the lines and the edge stage's run and outputs.
     segs: Vec<Segment>,
     lines_ran: Option<Timing>,
@@ -243,6 +248,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             frame: None,
             layers: None,
             chains: [0; 2],
+            isect_segs: Vec::new(),
             segs: Vec::new(),
             lines_ran: None,
             edges_ran: None,
@@ -458,6 +464,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
             Pass::Ao => self.ao(frame)?,
             Pass::Bvh => self.bvh_pass(frame)?,
+            Pass::Intersections => self.intersections_pass()?,
             Pass::SdfLines => self.sdf_lines()?,
             Pass::LinesPose => {
                 // The curvature run of this pose makes the extractor's pose

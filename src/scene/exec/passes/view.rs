@@ -278,6 +278,7 @@ impl Executor<'_, '_> {
         let t = self.topo.as_ref().expect("a pose ran");
         let lines = ViewLines {
             segments: &self.segs,
+            intersections: &self.isect_segs,
             edges: self.edges_ran.as_ref().map(|e| &e.1),
             shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
             strokes: &strokes,
@@ -293,6 +294,7 @@ impl Executor<'_, '_> {
         let t = self.topo.as_ref().expect("a pose ran");
         ViewLines {
             segments: &self.segs,
+            intersections: &self.isect_segs,
             edges: self.edges_ran.as_ref().map(|e| &e.1),
             shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
             strokes,

@@ -28,6 +28,39 @@ impl Executor<'_, '_> {
         Ok(())
     }
 
+    /// The intersection lines of this pose: the faces that cross, over the
+    /// BVH (scene frame), as segments of the intersection layer whose ends
+    /// lie in their two faces.
+    pub(super) fn intersections_pass(&mut self) -> Result<()> {
+        use crate::spec::feature_lines::LINE_FREE;
+        use crate::stages::intersections::Intersections;
+        let t = self.topo.as_mut().expect("a pose ran");
+        let bvh = t.bvh.as_ref().expect("planned after the BVH");
+        let search = match &mut t.isect {
+            Some(s) => s,
+            None => t.isect.insert(Intersections::new(
+                self.gpu.clone(),
+                t.mesh.n_faces(),
+                &Default::default(),
+            )?),
+        };
+        let (segs, stats) = search.find(bvh)?;
+        let layer = super::super::vector::LAYER_INTERSECTIONS;
+        self.isect_segs = (segs.iter())
+            .map(|s| {
+                let ends = [[LINE_FREE, s.faces[0]], [LINE_FREE, s.faces[1]]];
+                (s.a, s.b, layer, 1.0, ends)
+            })
+            .collect();
+        let how = format!(
+            "isect_find: {} face pairs tested, {} segments (Möller's interval test)",
+            stats.pairs_tested, stats.segments
+        );
+        self.rec
+            .kernels(Pass::Intersections, &search.timing().clone(), &how);
+        Ok(())
+    }
+
     /// Exact visibility of the lines the SVG draws: split where their
     /// visibility changes, by occlusion queries towards the eye over the
     /// BVH, and chained.
@@ -37,7 +70,8 @@ impl Executor<'_, '_> {
         let view = cam.view(w, h);
         let t = self.topo.as_mut().expect("a pose ran");
         let edges = (self.edges_ran.as_ref()).map(|e| (&e.1, t.edge_pairs.as_slice()));
-        let segs = gather(&self.scene.effects, &self.segs, edges, &self.pose.pos);
+        let mut segs = gather(&self.scene.effects, &self.segs, edges, &self.pose.pos);
+        segs.extend_from_slice(&self.isect_segs);
         let n = segs.len();
         let scale = self.framing.as_ref().map_or(1.0, |f| {
             let (lo, hi) = f.bounds;
