@@ -3,6 +3,7 @@
 //! the PNG and SVG files of one view.
 
 use super::interop::SharedEdges;
+pub(super) use super::vector::{line_styles, shown};
 use crate::error::Result;
 use crate::export::svg::{
     DEFAULT_BIAS, SvgLayer, SvgPolyline, pixel, segment_lines, visible_joined,
@@ -13,7 +14,7 @@ use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
 use crate::scene::file::{CameraKind, Effects, LineStyle, Scene, ViewSpec};
 use crate::scene::planner::{Cue, Pass, Plan};
 use crate::spec::edges::EdgeOutput;
-use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
+use crate::spec::feature_lines::{Hidden, Segment, hidden_id};
 use crate::spec::interop::{InteropDecision, InteropOffer};
 use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
 use crate::spec::timing::Timing;
@@ -104,51 +105,6 @@ pub(super) fn mesh_colors(
 /// The opacity bin (0..4) of a faded segment's strength in (0, 1].
 fn strength_bin(strength: f32) -> usize {
     ((strength.clamp(0.0, 1.0) * 4.0).ceil() as usize).clamp(1, 4) - 1
-}
-
-/// Whether a segment is drawn at all: one of no strength (faded out, or a
-/// non-finite test) is not, in the image nor in the SVG.
-pub(super) fn shown(s: &Segment) -> bool {
-    s.3 > 0.0
-}
-
-/// Every line family a scene draws, in drawing order (contours, suggestive
-/// contours, then the curvature line cues in family order), each with its
-/// stroke and whether its strength fades it: suggestive contours always
-/// (DeCarlo et al. fade them out as they approach the contour generator,
-/// where they are unstable), the curvature line families when `[lines]`
-/// fades them, contours never.
-pub(super) fn line_styles(fx: &Effects) -> Vec<(LineStyle, bool)> {
-    let hidden = |f: LineFamily| {
-        fx.lines
-            .styles
-            .iter()
-            .find(|s| s.family == f)
-            .map_or(Hidden::Remove, |s| s.hidden)
-    };
-    let mut out = Vec::new();
-    for (cue, family, (width, color), faded) in [
-        (Cue::Contours, LineFamily::Contours, fx.contour, false),
-        (
-            Cue::SuggestiveContours,
-            LineFamily::Suggestive,
-            fx.suggestive,
-            true,
-        ),
-    ] {
-        if fx.cues.contains(&cue) {
-            let style = LineStyle {
-                family,
-                width,
-                color,
-                hidden: hidden(family),
-            };
-            out.push((style, faded));
-        }
-    }
-    let fade = fx.lines.curves.fade;
-    out.extend(fx.lines.styles_for(&fx.cues).into_iter().map(|s| (s, fade)));
-    out
 }
 
 /// What one view draws on top of the mesh.

@@ -6,15 +6,15 @@
 //! ([`svg_layers_exact`]): one polyline per chain, in the same groups, ids
 //! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
 
-use super::draw::{line_styles, shown};
 use crate::cpu::chains::{Chain, ChainPiece, EndKey, chain, point_key};
 use crate::cpu::visibility::Plan as VisPlan;
 use crate::error::Result;
 use crate::export::svg::{SvgLayer, SvgPolyline, pixel};
 use crate::render::Camera;
 use crate::scene::file::{Effects, LineStyle, Scene};
+use crate::scene::planner::Cue;
 use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
-use crate::spec::feature_lines::{Hidden, LINE_FREE, Segment, hidden_id};
+use crate::spec::feature_lines::{Hidden, LINE_FREE, LineFamily, Segment, hidden_id};
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
@@ -25,6 +25,51 @@ use crate::stages::visibility::{Classified, classify_planned};
 pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
 /// The layer of the intersection lines.
 pub const LAYER_INTERSECTIONS: u32 = (1 << 16) + 1;
+
+/// Whether a segment is drawn at all: one of no strength (faded out, or a
+/// non-finite test) is not, in the image nor in the SVG.
+pub(super) fn shown(s: &Segment) -> bool {
+    s.3 > 0.0
+}
+
+/// Every line family a scene draws, in drawing order (contours, suggestive
+/// contours, then the curvature line cues in family order), each with its
+/// stroke and whether its strength fades it: suggestive contours always
+/// (DeCarlo et al. fade them out as they approach the contour generator,
+/// where they are unstable), the curvature line families when `[lines]`
+/// fades them, contours never.
+pub(super) fn line_styles(fx: &Effects) -> Vec<(LineStyle, bool)> {
+    let hidden = |f: LineFamily| {
+        fx.lines
+            .styles
+            .iter()
+            .find(|s| s.family == f)
+            .map_or(Hidden::Remove, |s| s.hidden)
+    };
+    let mut out = Vec::new();
+    for (cue, family, (width, color), faded) in [
+        (Cue::Contours, LineFamily::Contours, fx.contour, false),
+        (
+            Cue::SuggestiveContours,
+            LineFamily::Suggestive,
+            fx.suggestive,
+            true,
+        ),
+    ] {
+        if fx.cues.contains(&cue) {
+            let style = LineStyle {
+                family,
+                width,
+                color,
+                hidden: hidden(family),
+            };
+            out.push((style, faded));
+        }
+    }
+    let fade = fx.lines.curves.fade;
+    out.extend(fx.lines.styles_for(&fx.cues).into_iter().map(|s| (s, fade)));
+    out
+}
 
 /// The lines of one view, classified and chained.
 #[derive(Clone, Debug, Default)]
@@ -197,10 +242,7 @@ pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) 
         }
         layers.push(family_layer(vis, &st, faded, vp, [w, h]));
     }
-    if fx
-        .cues
-        .contains(&crate::scene::planner::Cue::IntersectionLines)
-    {
+    if fx.cues.contains(&Cue::IntersectionLines) {
         layers.push(SvgLayer {
             id: "intersection-lines",
             stroke_width: fx.intersection.0,
@@ -209,7 +251,7 @@ pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) 
             dashed: false,
         });
     }
-    if fx.cues.contains(&crate::scene::planner::Cue::FeatureEdges) {
+    if fx.cues.contains(&Cue::FeatureEdges) {
         layers.push(SvgLayer {
             id: "feature-edges",
             stroke_width: fx.edge.0,
