@@ -9,45 +9,25 @@
 //! segments, no segment, bad segments (errors, no panic).
 
 mod common;
+mod visibility_support;
 
 use std::time::Instant;
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use shapecue::cpu::bvh::Tree;
-use shapecue::cpu::visibility::{Plan, agreement, classify_reference, classify_twin};
-use shapecue::mesh::{Mesh, icosphere, topology::vertex_normals, torus};
-use shapecue::render::visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
-use shapecue::render::{Camera, Frame, MeshStyle, RenderOptions, Renderer};
+use shapecue::cpu::visibility::{Plan, classify_reference, classify_twin};
+use shapecue::mesh::{Mesh, icosphere, torus};
+use shapecue::render::Camera;
 use shapecue::spec::feature_lines::{LINE_FREE, Segment};
 use shapecue::spec::view::View;
 use shapecue::spec::visibility::{Pieces, Spacing, VisibilityOptions};
 use shapecue::stages::bvh::Bvh;
-use shapecue::stages::visibility::classify;
-
-const W: u32 = 480;
-const H: u32 = 360;
-
-fn f32s(m: &Mesh) -> Vec<[f32; 3]> {
-    common::to_f32(&m.positions)
-}
+use shapecue::stages::visibility::{classify, spatial_order};
+use visibility_support::*;
 
 fn spot() -> Mesh {
     let p = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
     shapecue::mesh::load(std::path::Path::new(p), &Default::default()).unwrap()
-}
-
-/// A camera fitted to the mesh from `dir`, orthographic when `ortho`.
-fn camera(m: &Mesh, dir: Vec3, ortho: bool) -> Camera {
-    let p = f32s(m);
-    let lo = p.iter().fold(Vec3::INFINITY, |a, q| a.min(Vec3::from(*q)));
-    let hi = p
-        .iter()
-        .fold(Vec3::NEG_INFINITY, |a, q| a.max(Vec3::from(*q)));
-    let cam = Camera::fit(lo, hi, dir, W as f32 / H as f32).unwrap();
-    Camera {
-        ortho_height: ortho.then(|| 1.1 * (hi - lo).length()),
-        ..cam
-    }
 }
 
 fn segments(m: &Mesh, view: View) -> Vec<Segment> {
@@ -85,41 +65,6 @@ fn all_three(
     (dev, twin, reference, [ms, twin_ms])
 }
 
-fn seg_len(s: &Segment) -> f64 {
-    (0..3)
-        .map(|k| f64::from(s.1[k] - s.0[k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Length share on which `a` and `b` agree.
-fn share(segs: &[Segment], a: &[Pieces], b: &[Pieces]) -> f64 {
-    let (mut same, mut total) = (0.0, 0.0);
-    for ((s, a), b) in segs.iter().zip(a).zip(b) {
-        let (x, y) = agreement(a, b, seg_len(s));
-        same += x;
-        total += y;
-    }
-    if total > 0.0 { same / total } else { 1.0 }
-}
-
-/// Hidden share of the length of `segs`.
-fn hidden_share(segs: &[Segment], pieces: &[Pieces]) -> f64 {
-    let hidden: f64 = segs
-        .iter()
-        .zip(pieces)
-        .map(|(g, p)| {
-            let h: f64 = p
-                .iter()
-                .filter(|q| !q.2)
-                .map(|q| f64::from(q.1 - q.0))
-                .sum();
-            h * seg_len(g)
-        })
-        .sum();
-    hidden / segs.iter().map(seg_len).sum::<f64>().max(1e-30)
-}
-
 /// The reference with samples ten times closer (1/2000 of the view): what
 /// the default spacing misses between two samples shows against it.
 fn fine_reference(m: &Mesh, segs: &[Segment], view: &View) -> Vec<Pieces> {
@@ -129,60 +74,6 @@ fn fine_reference(m: &Mesh, segs: &[Segment], view: &View) -> Vec<Pieces> {
     };
     let plan = Plan::new(&f32s(m), &m.faces, segs, view, &opts).unwrap();
     classify_reference(&m.positions, &m.faces, &plan).unwrap()
-}
-
-/// Whether `pieces` show the point at `t`.
-fn shown(pieces: &Pieces, t: f32) -> bool {
-    pieces.iter().find(|p| t <= p.1).is_some_and(|p| p.2)
-}
-
-/// The depth-buffer method's agreement with `reference` (length share,
-/// 32 points per segment), or `None` without headless GL.
-fn depth_share(m: &Mesh, segs: &[Segment], cam: &Camera, reference: &[Pieces]) -> Option<f64> {
-    let o = RenderOptions {
-        width: W,
-        height: H,
-        msaa: 0,
-        background: [1.0; 4],
-    };
-    let mut r = common::unless_no_gl(Renderer::new(o))?.unwrap();
-    let p = f32s(m);
-    r.begin(cam).unwrap();
-    r.draw_mesh(&p, &vertex_normals(m), &[], &m.faces, MeshStyle::default())
-        .unwrap();
-    let frame: Frame = r.finish().unwrap();
-    let vp = cam.view_proj(W as f32 / H as f32);
-    let px = |q: [f32; 3]| {
-        let c = vp * Vec4::new(q[0], q[1], q[2], 1.0);
-        [
-            (c.x / c.w * 0.5 + 0.5) * W as f32,
-            (0.5 - c.y / c.w * 0.5) * H as f32,
-        ]
-    };
-    let (mut same, mut total) = (0.0, 0.0);
-    for (s, refp) in segs.iter().zip(reference) {
-        let lines = segment_lines(vp, std::slice::from_ref(s), s.2, |_| 1.0);
-        let vis = visible_joined(&lines, &frame, DEFAULT_BIAS);
-        let (a, b) = (px(s.0), px(s.1));
-        let d = [b[0] - a[0], b[1] - a[1]];
-        let dd = (d[0] * d[0] + d[1] * d[1]).max(1e-12);
-        let param = |q: [f32; 2]| ((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / dd;
-        let len = seg_len(s) / 32.0;
-        for k in 0..32 {
-            let t = (k as f32 + 0.5) / 32.0;
-            let q = px(std::array::from_fn(|i| s.0[i] + t * (s.1[i] - s.0[i])));
-            let u = param(q);
-            let on = vis.iter().any(|l| {
-                let (u0, u1) = (param(l.points[0]), param(*l.points.last().unwrap()));
-                u >= u0.min(u1) - 1e-4 && u <= u0.max(u1) + 1e-4
-            });
-            total += len;
-            if on == shown(refp, t) {
-                same += len;
-            }
-        }
-    }
-    Some(if total > 0.0 { same / total } else { 1.0 })
 }
 
 #[test]
@@ -369,20 +260,28 @@ fn no_segment_gives_no_piece_and_bad_segments_are_plain_errors() {
     bvh.build(&p).unwrap();
     let opts = VisibilityOptions::default();
     let ok = in_face(&m, 0);
+    // Each bad segment lies below and left of the others, so that the
+    // device's order (Morton, of the midpoints) takes it first; the error
+    // still names it by the caller's index.
+    let c = [-10.0f32; 3];
     let cases: [(&str, Segment); 3] = [
         (
             "face 99999999",
-            (ok.0, ok.1, 0, 1.0, [[LINE_FREE, 99_999_999], ok.4[1]]),
+            (c, c, 0, 1.0, [[LINE_FREE, 99_999_999], ok.4[1]]),
         ),
         (
             "vertex 4000000000",
-            (ok.0, ok.1, 0, 1.0, [ok.4[0], [7, 4_000_000_000]]),
+            (c, c, 0, 1.0, [ok.4[0], [7, 4_000_000_000]]),
         ),
-        ("non-finite", ([f32::NAN, 0.0, 0.0], ok.1, 0, 1.0, ok.4)),
+        ("non-finite", ([f32::NAN, -10.0, -10.0], c, 0, 1.0, ok.4)),
     ];
+    let others = [in_face(&m, 1), in_face(&m, 2), in_face(&m, 3)];
     for (want, seg) in cases {
-        let e = classify(&mut bvh, &p, &m.faces, &[ok, seg], &view, &opts).unwrap_err();
+        let segs = [others[0], others[1], seg, others[2]];
+        assert_eq!(spatial_order(&segs)[0], 2, "{want}: taken first");
+        let e = classify(&mut bvh, &p, &m.faces, &segs, &view, &opts).unwrap_err();
         assert!(e.to_string().contains(want), "{e}");
+        assert!(e.to_string().contains("segment 2"), "{e}");
     }
     let e = classify(&mut bvh, &p, &m.faces[1..], &[ok], &view, &opts).unwrap_err();
     assert!(e.to_string().contains("faces"), "{e}");

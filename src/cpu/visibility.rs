@@ -21,8 +21,6 @@
 //! faces both ends name (normally one); where they share none (an edge
 //! unknown to the mesh), on the union. The first four are kept.
 
-use std::collections::HashMap;
-
 use crate::cpu::bvh::{Tree, occluded_brute};
 use crate::error::{Error, Result};
 use crate::spec::bvh::{BvhQuery, OCCLUDED};
@@ -61,66 +59,112 @@ pub struct Plan {
     pub bisect: u32,
 }
 
-/// Faces around each vertex and on each edge.
-struct Topology {
-    around: Vec<Vec<u32>>,
-    edges: HashMap<(u32, u32), Vec<u32>>,
+/// Faces around each vertex, in compressed rows: `around[start[v]..start[v
+/// + 1]]`, in face order, a face once per corner at the vertex.
+struct Topology<'a> {
+    faces: &'a [[u32; 3]],
+    start: Vec<usize>,
+    around: Vec<u32>,
 }
 
-impl Topology {
-    fn new(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
-        let mut around = vec![Vec::new(); n_vertices];
-        let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+impl<'a> Topology<'a> {
+    fn new(n_vertices: usize, faces: &'a [[u32; 3]]) -> Topology<'a> {
+        let mut start = vec![0usize; n_vertices + 1];
+        for &v in faces.iter().flatten() {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..n_vertices {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut around = vec![0u32; 3 * faces.len()];
         for (f, t) in faces.iter().enumerate() {
-            for k in 0..3 {
-                let (u, v) = (t[k], t[(k + 1) % 3]);
-                around[u as usize].push(f as u32);
-                edges
-                    .entry((u.min(v), u.max(v)))
-                    .or_default()
-                    .push(f as u32);
+            for &v in t {
+                around[next[v as usize]] = f as u32;
+                next[v as usize] += 1;
             }
         }
-        Topology { around, edges }
+        Topology {
+            faces,
+            start,
+            around,
+        }
     }
 
-    /// The faces an end names (see the module note), or a plain-words error.
-    fn end_faces(&self, n_faces: usize, e: [u32; 2], what: &str) -> Result<Vec<u32>> {
+    fn around(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.around[self.start[v]..self.start[v + 1]]
+    }
+
+    /// Appends the faces on the edge `(u, v)` (`u ≠ v`) to `out`, in face
+    /// order, a face once per side it has on the edge.
+    fn edge_faces(&self, u: u32, v: u32, out: &mut Vec<u32>) {
+        let key = (u.min(v), u.max(v));
+        let mut last = None;
+        for &f in self.around(u) {
+            if last.replace(f) == Some(f) {
+                continue;
+            }
+            let t = self.faces[f as usize];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if (a.min(b), a.max(b)) == key {
+                    out.push(f);
+                }
+            }
+        }
+    }
+
+    /// The faces an end names (see the module note) into `out` (cleared
+    /// first), or a plain-words error naming segment `i`'s `which` end.
+    fn end_faces(&self, e: [u32; 2], i: usize, which: &str, out: &mut Vec<u32>) -> Result<()> {
+        out.clear();
+        let n_faces = self.faces.len();
         if e[0] == u32::MAX || e[0] == LINE_FREE {
             if e[1] as usize >= n_faces {
                 return Err(Error::InvalidArgument(format!(
-                    "{what}: names face {} of a mesh of {n_faces} faces",
+                    "segment {i}, {which} end: names face {} of a mesh of {n_faces} faces",
                     e[1]
                 )));
             }
-            return Ok(vec![e[1]]);
+            out.push(e[1]);
+            return Ok(());
         }
-        if e.iter().any(|&v| v as usize >= self.around.len()) {
+        let n_vertices = self.start.len() - 1;
+        if e.iter().any(|&v| v as usize >= n_vertices) {
             return Err(Error::InvalidArgument(format!(
-                "{what}: names vertex {} of a mesh of {} vertices",
+                "segment {i}, {which} end: names vertex {} of a mesh of {n_vertices} vertices",
                 e[0].max(e[1]),
-                self.around.len()
             )));
         }
         if e[0] == e[1] {
-            return Ok(self.around[e[0] as usize].clone());
+            out.extend_from_slice(self.around(e[0]));
+        } else {
+            self.edge_faces(e[0], e[1], out);
         }
-        let key = (e[0].min(e[1]), e[0].max(e[1]));
-        Ok(self.edges.get(&key).cloned().unwrap_or_default())
+        Ok(())
     }
 }
 
-/// The faces segment `s` lies on (at most four).
-fn lies_on(topo: &Topology, n_faces: usize, s: &Segment, i: usize) -> Result<Vec<u32>> {
-    let f0 = topo.end_faces(n_faces, s.4[0], &format!("segment {i}, first end"))?;
-    let f1 = topo.end_faces(n_faces, s.4[1], &format!("segment {i}, second end"))?;
-    let mut both: Vec<u32> = f0.iter().copied().filter(|f| f1.contains(f)).collect();
-    if both.is_empty() {
-        both = f0;
-        both.extend(f1.iter().filter(|f| !both.contains(f)).collect::<Vec<_>>());
+/// The faces segment `s` (index `i`) lies on (at most four); `f0` and `f1`
+/// are scratch space for its ends' faces.
+fn lies_on(
+    topo: &Topology,
+    s: &Segment,
+    i: usize,
+    [f0, f1]: [&mut Vec<u32>; 2],
+) -> Result<Vec<u32>> {
+    topo.end_faces(s.4[0], i, "first", f0)?;
+    topo.end_faces(s.4[1], i, "second", f1)?;
+    let both: Vec<u32> = (f0.iter().copied())
+        .filter(|f| f1.contains(f))
+        .take(4)
+        .collect();
+    if !both.is_empty() {
+        return Ok(both);
     }
-    both.truncate(4);
-    Ok(both)
+    let rest = f1.iter().copied().filter(|f| !f0.contains(f));
+    Ok(f0.iter().copied().chain(rest).take(4).collect())
 }
 
 fn sub(x: [f32; 3], y: [f32; 3]) -> [f32; 3] {
@@ -193,13 +237,14 @@ impl Plan {
         let sphere = bounding_sphere(positions);
         let diag = (2.0 * sphere.1).max(f32::MIN_POSITIVE);
         let mut segs = Vec::with_capacity(segments.len());
+        let (mut f0, mut f1) = (Vec::new(), Vec::new());
         for (i, s) in segments.iter().enumerate() {
             if !s.0.iter().chain(&s.1).all(|c| c.is_finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "visibility: segment {i} has a non-finite end"
                 )));
             }
-            let exclude = lies_on(&topo, faces.len(), s, i)?;
+            let exclude = lies_on(&topo, s, i, [&mut f0, &mut f1])?;
             let edge = match exclude.first() {
                 Some(&f) => {
                     let p = faces[f as usize].map(|v| positions[v as usize]);

@@ -6,6 +6,14 @@
 //! come from the twin's [`classify_by`], so the device's pieces equal
 //! [`crate::cpu::visibility::classify_twin`]'s bit for bit. No kernel of
 //! its own: the work is the `bvh` family's `bvh_occluded`.
+//!
+//! The segments are classified in the Morton order of their midpoints
+//! ([`spatial_order`]), so that neighbouring work-items of a round walk the
+//! same part of the tree: on the Stanford bunny (PoCL, every line family)
+//! the sample round's kernel takes 15–30 % less time than in the
+//! extraction's order. The plan is built from the sorted segments, so that
+//! its own arrays are read in order too. Each segment's pieces depend only
+//! on its own queries: the order changes the time, not the answer.
 
 use crate::cpu::visibility::{Plan, classify_by, hidden_from, queries_of};
 use crate::error::{Error, Result};
@@ -35,9 +43,20 @@ pub fn classify(
             faces.len()
         )));
     }
-    let plan = Plan::new(positions, faces, segments, view, opts)?;
+    let order = spatial_order(segments);
+    let sorted: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
+    let plan = match Plan::new(positions, faces, &sorted, view, opts) {
+        Ok(plan) => plan,
+        // The error names a segment by its place in `sorted`: the caller's
+        // order names it by the caller's index.
+        Err(e) => {
+            return Err(Plan::new(positions, faces, segments, view, opts)
+                .err()
+                .unwrap_or(e));
+        }
+    };
     let c = classify_planned(bvh, &plan)?;
-    Ok((c.pieces, c.overflows))
+    Ok((unsort(&order, c.pieces), c.overflows))
 }
 
 /// What [`classify_planned`] found and what it cost.
@@ -47,7 +66,7 @@ pub struct Classified {
     pub pieces: Vec<Pieces>,
     /// Query stack overflows (answered visible; none at the spec's depth).
     pub overflows: u32,
-    /// Rounds (one `bvh_occluded` launch each) and queries in all.
+    /// Rounds (one `bvh_occluded` launch each).
     pub rounds: usize,
     /// Queries in all.
     pub queries: usize,
@@ -56,7 +75,9 @@ pub struct Classified {
 }
 
 /// [`classify`] of segments already read into a [`Plan`] (whose faces each
-/// segment lies on the caller may want too), over a tree of the plan's mesh.
+/// segment lies on the caller may want too), in the plan's order (build it
+/// from segments in [`spatial_order`] for speed), over a tree of the plan's
+/// mesh.
 pub fn classify_planned(bvh: &mut Bvh, plan: &Plan) -> Result<Classified> {
     let mut c = Classified::default();
     let pieces = classify_by(plan, |casts| {
@@ -70,4 +91,56 @@ pub fn classify_planned(bvh: &mut Bvh, plan: &Plan) -> Result<Classified> {
     })?;
     c.pieces = pieces;
     Ok(c)
+}
+
+/// The order in which [`classify`] takes `segments`: the Morton order of
+/// their midpoints (10 bits per axis over the midpoints' box; ties in
+/// segment order), as indices into `segments`.
+pub fn spatial_order(segments: &[Segment]) -> Vec<usize> {
+    if segments.len() > u32::MAX as usize {
+        return (0..segments.len()).collect();
+    }
+    let mid = |s: &Segment| -> [f32; 3] { std::array::from_fn(|k| 0.5 * s.0[k] + 0.5 * s.1[k]) };
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for m in segments.iter().map(mid) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(m[k]);
+            hi[k] = hi[k].max(m[k]);
+        }
+    }
+    let scale: [f32; 3] = std::array::from_fn(|k| {
+        let e = hi[k] - lo[k];
+        if e > 0.0 && e.is_finite() {
+            1023.0 / e
+        } else {
+            0.0
+        }
+    });
+    // NaN and the infinities land in a cell like any other value (`as`
+    // saturates); Plan::new rejects them after.
+    let spread = |v: u64| (0..10).fold(0, |m, b| m | (((v >> b) & 1) << (3 * b)));
+    let cell =
+        |m: [f32; 3], k: usize| spread(((m[k] - lo[k]) * scale[k]).clamp(0.0, 1023.0) as u64);
+    let mut keyed: Vec<u64> = (segments.iter().enumerate())
+        .map(|(i, s)| {
+            let m = mid(s);
+            let code = (cell(m, 0) << 2) | (cell(m, 1) << 1) | cell(m, 2);
+            (code << 32) | i as u64
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed
+        .into_iter()
+        .map(|k| (k & 0xffff_ffff) as usize)
+        .collect()
+}
+
+/// Pieces in [`spatial_order`]'s `order`, put back in the segments' own
+/// order.
+pub fn unsort(order: &[usize], sorted: Vec<Pieces>) -> Vec<Pieces> {
+    let mut pieces = vec![Pieces::new(); sorted.len()];
+    for (&i, p) in order.iter().zip(sorted) {
+        pieces[i] = p;
+    }
+    pieces
 }

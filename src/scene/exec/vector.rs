@@ -18,7 +18,7 @@ use crate::spec::feature_lines::{Hidden, LINE_FREE, LineFamily, Segment, hidden_
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
-use crate::stages::visibility::{Classified, classify_planned};
+use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
 /// The layer of the feature edges (the line families' layers are their
 /// kinds, [`crate::spec::feature_lines::LineFamily`] as `u32`).
@@ -187,6 +187,10 @@ pub(super) fn classify_view(
 ) -> Result<(VisibleLines, Classified)> {
     let (positions, faces) = mesh;
     let opts = VisibilityOptions::default();
+    // Classified (and kept) in the Morton order of their midpoints: the
+    // queries of neighbouring work-items walk the same part of the tree.
+    let order = spatial_order(&segments);
+    let segments: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
     let plan = VisPlan::new(positions, faces, &segments, view, &opts)?;
     let c = classify_planned(bvh, &plan)?;
     let mut chain_pieces = Vec::new();
