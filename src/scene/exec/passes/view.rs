@@ -235,7 +235,10 @@ impl Executor<'_, '_> {
     /// Ends a view: counts its segments, and keeps its outputs when asked.
     pub(in crate::scene::exec) fn end_view(&mut self, cam: &Camera) {
         self.count_segments();
-        if self.keep_image {
+        // A plan with nothing to draw or write keeps nothing: the caller
+        // says there is nothing to draw.
+        let drawn = self.plan.contains(Pass::Render) || self.plan.contains(Pass::Svg);
+        if self.keep_image && drawn {
             self.kept = Some(self.kept_view(cam));
         }
     }
