@@ -160,7 +160,7 @@ __kernel void bvh_refit(uint n, __global const float *pos, __global const uint *
 
 // Slab test of o + t d, t in [0, 1], against the box padded by BVH_BOX_PAD
 // of its largest extent (cpu::bvh::box_hit).
-SC_INLINE bool bvh_box_hit(BvhBox b, float3 o, float3 d)
+SC_INLINE bool bvh_box_hit(BvhBox b, float3 o, float3 d, float3 invd)
 {
     const float ext = bvh_greater(bvh_greater(b.hi.x - b.lo.x, b.hi.y - b.lo.y), b.hi.z - b.lo.z);
     const float pad = BVH_BOX_PAD * ext + 1e-30f;
@@ -168,15 +168,15 @@ SC_INLINE bool bvh_box_hit(BvhBox b, float3 o, float3 d)
     const float hi[3] = {b.hi.x + pad, b.hi.y + pad, b.hi.z + pad};
     const float os[3] = {o.x, o.y, o.z};
     const float ds[3] = {d.x, d.y, d.z};
+    const float is[3] = {invd.x, invd.y, invd.z};
     float tmin = 0.0f, tmax = 1.0f;
     for (int k = 0; k < 3; ++k) {
         if (ds[k] == 0.0f) {
             if (os[k] < lo[k] || os[k] > hi[k]) return false;
             continue;
         }
-        const float inv = 1.0f / ds[k];
-        float t1 = (lo[k] - os[k]) * inv;
-        float t2 = (hi[k] - os[k]) * inv;
+        float t1 = (lo[k] - os[k]) * is[k];
+        float t2 = (hi[k] - os[k]) * is[k];
         if (t1 > t2) {
             const float t = t1;
             t1 = t2;
@@ -232,11 +232,14 @@ __kernel void bvh_occluded(uint nq, uint n, __global const BvhQuery *queries,
     const BvhQuery qu = queries[gid];
     const float3 o = qu.origin.xyz;
     const float3 d = qu.target.xyz - o;
+    // The slab test's reciprocals, once per query (1/0 is never used).
+    const float3 invd = (float3)(d.x != 0.0f ? 1.0f / d.x : 0.0f, d.y != 0.0f ? 1.0f / d.y : 0.0f,
+                                 d.z != 0.0f ? 1.0f / d.z : 0.0f);
     uint out = BVH_VISIBLE;
     uint stack[BVH_STACK];
     int sp = 0;
     const uint root = n == 1u ? BVH_LEAF : 0u;
-    if (n > 0u && bvh_box_hit(bvh_box_of(node_boxes, leaf_boxes, root), o, d)) stack[sp++] = root;
+    if (n > 0u && bvh_box_hit(bvh_box_of(node_boxes, leaf_boxes, root), o, d, invd)) stack[sp++] = root;
     while (sp > 0 && out == BVH_VISIBLE) {
         const uint r = stack[--sp];
         if (r & BVH_LEAF) {
@@ -253,7 +256,7 @@ __kernel void bvh_occluded(uint nq, uint n, __global const BvhQuery *queries,
         const BvhNode nd = nodes[r];
         const uint kids[2] = {nd.left, nd.right};
         for (int k = 0; k < 2 && out == BVH_VISIBLE; ++k) {
-            if (!bvh_box_hit(bvh_box_of(node_boxes, leaf_boxes, kids[k]), o, d)) continue;
+            if (!bvh_box_hit(bvh_box_of(node_boxes, leaf_boxes, kids[k]), o, d, invd)) continue;
             if (sp == BVH_STACK) {
                 atomic_inc(&counters[0]);
                 out = BVH_OVERFLOW;

@@ -189,7 +189,9 @@ fn measure(m: &Mesh, tree: &Tree, segs: &[Segment], dev: &[Pieces], cam: &Camera
     assert!(dev == twin, "device vs twin differ");
     let at = subset(&plan, m.faces.len());
     let sub = pick(segs, &at);
-    let sub_plan = Plan::new(&p, &m.faces, &sub, &view, &opts).unwrap();
+    // The subset's ends sampled as in the whole view (shared with the
+    // segments left out).
+    let sub_plan = plan.subset(&at);
     let reference = classify_reference(&m.positions, &m.faces, &sub_plan).unwrap();
     Measured {
         subset: sub.len(),

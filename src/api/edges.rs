@@ -156,7 +156,8 @@ impl EdgePicture {
 /// let mut opts = shapecue::EdgePictureOptions::default();
 /// opts.shot.eye = None;
 /// let pic = shapecue::feature_edges_picture(&mesh, "torus", &opts)?;
-/// assert_eq!((pic.frame.width, pic.frame.height), (800, 600));
+/// let frame = pic.frame.as_ref().expect("the picture is drawn (`image` is on)");
+/// assert_eq!((frame.width, frame.height), (800, 600));
 /// assert!(pic.count(KIND_CONTOUR) > 0);
 /// # Ok::<(), shapecue::Error>(())
 /// ```

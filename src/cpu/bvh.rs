@@ -305,9 +305,10 @@ impl Tree {
         let o = [q.origin[0], q.origin[1], q.origin[2]];
         let t = [q.target[0], q.target[1], q.target[2]];
         let d = [t[0] - o[0], t[1] - o[1], t[2] - o[2]];
+        let inv = inverse(d);
         let mut stack = [0u32; STACK_DEPTH];
         let mut sp = 0usize;
-        if box_hit(&self.child_box(root), o, d) {
+        if box_hit_inv(&self.child_box(root), o, d, inv) {
             stack[0] = root;
             sp = 1;
         }
@@ -328,7 +329,7 @@ impl Tree {
             }
             let n = self.nodes[r as usize];
             for c in [n.left, n.right] {
-                if box_hit(&self.child_box(c), o, d) {
+                if box_hit_inv(&self.child_box(c), o, d, inv) {
                     if sp == depth {
                         return OVERFLOW;
                     }
@@ -344,6 +345,18 @@ impl Tree {
 /// The traversal's slab test of the segment `o + t·d`, t ∈ [0, 1], against
 /// a box padded by [`BOX_PAD`] of its largest extent (+1e-30).
 pub fn box_hit(b: &BvhBox, o: [f32; 3], d: [f32; 3]) -> bool {
+    box_hit_inv(b, o, d, inverse(d))
+}
+
+/// The reciprocals of `d`'s components (0 for a zero component, which the
+/// slab test does not divide by), computed once per query.
+pub fn inverse(d: [f32; 3]) -> [f32; 3] {
+    d.map(|c| if c != 0.0 { 1.0 / c } else { 0.0 })
+}
+
+/// [`box_hit`] with `d`'s reciprocals ([`inverse`]) given, as the kernel
+/// computes them once per query.
+pub fn box_hit_inv(b: &BvhBox, o: [f32; 3], d: [f32; 3], inv: [f32; 3]) -> bool {
     let ext = greater(
         greater(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1]),
         b.hi[2] - b.lo[2],
@@ -358,9 +371,8 @@ pub fn box_hit(b: &BvhBox, o: [f32; 3], d: [f32; 3]) -> bool {
             }
             continue;
         }
-        let inv = 1.0 / d[k];
-        let mut t1 = (lo - o[k]) * inv;
-        let mut t2 = (hi - o[k]) * inv;
+        let mut t1 = (lo - o[k]) * inv[k];
+        let mut t2 = (hi - o[k]) * inv[k];
         if t1 > t2 {
             std::mem::swap(&mut t1, &mut t2);
         }

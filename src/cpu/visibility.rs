@@ -44,6 +44,25 @@ pub struct SegPlan {
     pub intervals: usize,
     /// Start of each query along the ray (world units).
     pub offset: f32,
+    /// Its ends' samples ([`Plan::ends`]).
+    pub end_ids: [u32; 2],
+}
+
+/// The sample at a segment end, shared by the segments that end there: the
+/// ends on one mesh edge (where a line crosses it into the next face), or
+/// at one mesh vertex, are sampled once. Its point is the least of their
+/// points (by the bits of their coordinates: they differ by rounding, and the choice
+/// does not depend on the segments' order), it leaves out the faces they
+/// lie on and starts at the largest of their offsets. Where they lie on
+/// more than four faces (more than a query leaves out), each keeps its own.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EndPlan {
+    /// The point sampled.
+    pub p: [f32; 3],
+    /// Faces left out of its query.
+    pub exclude: Vec<u32>,
+    /// Start of its query along the ray (world units).
+    pub offset: f32,
 }
 
 /// The segments of one view, ready to classify.
@@ -51,6 +70,8 @@ pub struct SegPlan {
 pub struct Plan {
     /// Per segment.
     pub segs: Vec<SegPlan>,
+    /// The segments' end samples, shared where ends meet.
+    pub ends: Vec<EndPlan>,
     /// The view's eye, unit view direction, near plane and projection kind.
     pub view: View,
     /// Centre and radius of the mesh's bounding sphere (orthographic casts).
@@ -257,24 +278,39 @@ impl Plan {
                 a: s.0,
                 b: s.1,
                 exclude,
-                intervals: intervals(view, opts.spacing, diag, s.0, s.1),
+                intervals: intervals(view, opts.spacing, diag, s.0, s.1).max(grazing_intervals(s)),
                 offset: opts.contour_offset * edge,
+                end_ids: [0; 2],
             });
         }
+        let ends = shared_ends(segments, &mut segs);
         Ok(Plan {
             segs,
+            ends,
             view: *view,
             sphere,
             bisect: opts.bisect,
         })
     }
 
+    /// The plan of the segments `at` only (indices into [`Plan::segs`]),
+    /// their ends sampled as in the whole view (shared with segments left
+    /// out): a reference over a subset answers as over every segment.
+    pub fn subset(&self, at: &[usize]) -> Plan {
+        Plan {
+            segs: at.iter().map(|&i| self.segs[i].clone()).collect(),
+            ends: self.ends.clone(),
+            view: self.view,
+            sphere: self.sphere,
+            bisect: self.bisect,
+        }
+    }
+
     /// The f32 query of a cast, or `None` where the point is behind the
     /// eye (hidden without a query). The device and the twin both take
     /// their queries from here.
-    pub fn query(&self, (seg, t): Cast) -> Option<BvhQuery> {
-        let s = &self.segs[seg as usize];
-        let p: [f32; 3] = std::array::from_fn(|k| s.a[k] + t * (s.b[k] - s.a[k]));
+    pub fn query(&self, cast: Cast) -> Option<BvhQuery> {
+        let (p, exclude, offset) = self.sample(cast);
         let eye = self.view.eye.to_array();
         let dir = self.view.unit_dir().to_array();
         let (u, far) = if self.view.ortho {
@@ -289,23 +325,56 @@ impl Plan {
             let len = norm(d);
             (d.map(|c| -c / len), len)
         };
-        let off = s.offset.min(0.5 * far);
+        let off = offset.min(0.5 * far);
         let origin = std::array::from_fn(|k| p[k] + off * u[k]);
         let target = if self.view.ortho {
             std::array::from_fn(|k| p[k] + far * u[k])
         } else {
             eye
         };
-        Some(BvhQuery::new(origin, target, &s.exclude))
+        Some(BvhQuery::new(origin, target, exclude))
+    }
+
+    /// The point, left-out faces and offset of a cast: a segment's end
+    /// (`t` 0 or 1) is its shared end sample ([`EndPlan`]), any other `t`
+    /// its own point.
+    fn sample(&self, (seg, t): Cast) -> ([f32; 3], &[u32], f32) {
+        let s = &self.segs[seg as usize];
+        let end = match t {
+            0.0 => Some(s.end_ids[0]),
+            1.0 => Some(s.end_ids[1]),
+            _ => None,
+        };
+        match end {
+            Some(e) => {
+                let e = &self.ends[e as usize];
+                (e.p, &e.exclude, e.offset)
+            }
+            None => (
+                std::array::from_fn(|k| s.a[k] + t * (s.b[k] - s.a[k])),
+                &s.exclude,
+                s.offset,
+            ),
+        }
     }
 
     /// The f64 answer of a cast (the reference): the same construction as
     /// [`Plan::query`] in f64, tested by [`occluded_brute`].
-    pub fn hidden_f64(&self, positions: &[[f64; 3]], faces: &[[u32; 3]], (seg, t): Cast) -> bool {
-        let s = &self.segs[seg as usize];
-        let t = f64::from(t);
+    pub fn hidden_f64(&self, positions: &[[f64; 3]], faces: &[[u32; 3]], cast: Cast) -> bool {
+        let s = &self.segs[cast.0 as usize];
+        let t = f64::from(cast.1);
         let (a, b) = (s.a.map(f64::from), s.b.map(f64::from));
-        let p: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]));
+        let (p, exclude, offset): ([f64; 3], &[u32], f32) = match cast.1 {
+            0.0 | 1.0 => {
+                let (p, exclude, offset) = self.sample(cast);
+                (p.map(f64::from), exclude, offset)
+            }
+            _ => (
+                std::array::from_fn(|k| a[k] + t * (b[k] - a[k])),
+                &s.exclude,
+                s.offset,
+            ),
+        };
         let eye = self.view.eye.as_dvec3().to_array();
         let dir = self.view.dir.as_dvec3().normalize().to_array();
         let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
@@ -324,15 +393,100 @@ impl Plan {
             let len = n3(d);
             (d.map(|c| -c / len), len)
         };
-        let off = f64::from(s.offset).min(0.5 * far);
+        let off = f64::from(offset).min(0.5 * far);
         let origin = std::array::from_fn(|k| p[k] + off * u[k]);
         let target = if self.view.ortho {
             std::array::from_fn(|k| p[k] + far * u[k])
         } else {
             eye
         };
-        occluded_brute(positions, faces, origin, target, &s.exclude)
+        occluded_brute(positions, faces, origin, target, exclude)
     }
+}
+
+/// The least intervals of a segment: 2 for the contour families (occluding
+/// and suggestive contours, kinds 0 and 1), which lie on the grazing set,
+/// where a short segment can be hidden in its middle behind the fold it
+/// bounds while both its ends are seen; 1 for the others.
+fn grazing_intervals(s: &Segment) -> usize {
+    if s.2 <= 1 { 2 } else { 1 }
+}
+
+/// The key of a segment's end `e` where other ends may meet it: its mesh
+/// edge or vertex; `None` for an end inside a face.
+fn end_key(s: &Segment, e: usize) -> Option<u64> {
+    let [u, v] = s.4[e];
+    if u == LINE_FREE || u == u32::MAX {
+        return None;
+    }
+    Some((u64::from(u.min(v)) << 32) | u64::from(u.max(v)))
+}
+
+/// The shared end samples of `segs` (setting each one's `end_ids`): ends
+/// with one key ([`end_key`]) share one, in the order of the key, then of
+/// the segment.
+fn shared_ends(segments: &[Segment], segs: &mut [SegPlan]) -> Vec<EndPlan> {
+    let mut keyed: Vec<(u64, u32, u8)> = Vec::with_capacity(2 * segments.len());
+    let mut ends = Vec::new();
+    for (i, s) in segments.iter().enumerate() {
+        for e in 0..2 {
+            match end_key(s, e) {
+                Some(k) => keyed.push((k, i as u32, e as u8)),
+                None => {
+                    let sp = &mut segs[i];
+                    sp.end_ids[e] = ends.len() as u32;
+                    let p = if e == 0 { sp.a } else { sp.b };
+                    ends.push(EndPlan {
+                        p,
+                        exclude: sp.exclude.clone(),
+                        offset: sp.offset,
+                    });
+                }
+            }
+        }
+    }
+    keyed.sort_unstable();
+    let least = |p: [f32; 3], q: [f32; 3]| {
+        let key = |x: [f32; 3]| x.map(f32::to_bits);
+        if key(q) < key(p) { q } else { p }
+    };
+    for group in keyed.chunk_by(|x, y| x.0 == y.0) {
+        let mut faces: Vec<u32> = (group.iter())
+            .flat_map(|&(_, i, _)| segs[i as usize].exclude.iter().copied())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        if faces.len() > 4 {
+            // More faces than a query leaves out (ends at a vertex of high
+            // valence): each end keeps its own sample and faces.
+            for &(_, i, e) in group {
+                let sp = &mut segs[i as usize];
+                sp.end_ids[e as usize] = ends.len() as u32;
+                ends.push(EndPlan {
+                    p: if e == 0 { sp.a } else { sp.b },
+                    exclude: sp.exclude.clone(),
+                    offset: sp.offset,
+                });
+            }
+            continue;
+        }
+        let id = ends.len() as u32;
+        let mut end = EndPlan {
+            p: [f32::NAN; 3],
+            exclude: Vec::new(),
+            offset: 0.0,
+        };
+        for (n, &(_, i, e)) in group.iter().enumerate() {
+            let sp = &mut segs[i as usize];
+            sp.end_ids[e as usize] = id;
+            let p = if e == 0 { sp.a } else { sp.b };
+            end.p = if n == 0 { p } else { least(end.p, p) };
+            end.offset = end.offset.max(sp.offset);
+        }
+        end.exclude = faces;
+        ends.push(end);
+    }
+    ends
 }
 
 /// The queries of `casts` that need one, and for each cast the index of
@@ -360,6 +514,39 @@ pub fn hidden_from(at: &[Option<usize>], answers: &[u32]) -> Vec<bool> {
         .collect()
 }
 
+/// The first round's casts: every segment's samples `t = k / n`, its ends
+/// sampled once per shared end ([`EndPlan`]); for each sample (segments in
+/// order, `k` in order) its cast's index; each segment's first sample.
+fn sample_casts(plan: &Plan) -> (Vec<Cast>, Vec<usize>, Vec<usize>) {
+    let mut casts = Vec::new();
+    let mut slots = Vec::new();
+    let mut first = Vec::with_capacity(plan.segs.len());
+    let mut end_cast = vec![usize::MAX; plan.ends.len()];
+    for (i, s) in plan.segs.iter().enumerate() {
+        first.push(slots.len());
+        let n = s.intervals;
+        for k in 0..=n {
+            let end = match k {
+                0 => Some(s.end_ids[0] as usize),
+                k if k == n => Some(s.end_ids[1] as usize),
+                _ => None,
+            };
+            let c = match end.map(|e| (e, end_cast[e])) {
+                Some((_, c)) if c != usize::MAX => c,
+                _ => {
+                    casts.push((i as u32, k as f32 / n as f32));
+                    if let Some(e) = end {
+                        end_cast[e] = casts.len() - 1;
+                    }
+                    casts.len() - 1
+                }
+            };
+            slots.push(c);
+        }
+    }
+    (casts, slots, first)
+}
+
 /// A bracket between two samples whose answers differ.
 struct Bracket {
     seg: u32,
@@ -375,19 +562,16 @@ pub fn classify_by(
     plan: &Plan,
     mut cast: impl FnMut(&[Cast]) -> Result<Vec<bool>>,
 ) -> Result<Vec<Pieces>> {
-    let mut casts = Vec::new();
-    let mut first = Vec::with_capacity(plan.segs.len());
-    for (i, s) in plan.segs.iter().enumerate() {
-        first.push(casts.len());
-        casts.extend((0..=s.intervals).map(|k| (i as u32, k as f32 / s.intervals as f32)));
-    }
-    let hidden = cast(&casts)?;
+    let (casts, slots, first) = sample_casts(plan);
+    let answers = cast(&casts)?;
+    let hidden: Vec<bool> = slots.iter().map(|&c| answers[c]).collect();
     let mut brackets = Vec::new();
     for (i, s) in plan.segs.iter().enumerate() {
         for k in 0..s.intervals {
             let (h0, h1) = (hidden[first[i] + k], hidden[first[i] + k + 1]);
             if h0 != h1 {
-                let (lo, hi) = (casts[first[i] + k].1, casts[first[i] + k + 1].1);
+                let n = s.intervals as f32;
+                let (lo, hi) = (k as f32 / n, (k + 1) as f32 / n);
                 let (seg, interval, hidden_lo) = (i as u32, k, h0);
                 brackets.push(Bracket {
                     seg,
@@ -549,7 +733,10 @@ mod tests {
             contour_offset: 0.0,
         };
         let seg = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0, 1.0, [[0, 0], [1, 1]]);
-        let plan = Plan::new(&p, &f, &[seg, seg], &view, &opts).unwrap();
+        // The same line with ends of its own (ends at one vertex share
+        // their sample: see the next test).
+        let other = (seg.0, seg.1, 0, 1.0, [[2, 2], [3, 3]]);
+        let plan = Plan::new(&p, &f, &[seg, other], &view, &opts).unwrap();
         let mut rounds = 0;
         let got = classify_by(&plan, |casts| {
             rounds += 1;
@@ -562,6 +749,59 @@ mod tests {
         assert_eq!(got[0].len(), 2);
         assert!((got[0][0].1 - 0.3).abs() < 1e-4, "{:?}", got[0]);
         assert!(got[0][0].2 && !got[0][1].2);
+        let (same, len) = agreement(&got[0], &got[1], 2.0);
+        assert!((same - 0.6).abs() < 1e-3 && len == 2.0, "{same}");
+    }
+
+    #[test]
+    fn ends_on_one_edge_or_vertex_share_one_sample() {
+        let (p, f, view) = quad();
+        let opts = VisibilityOptions {
+            spacing: Spacing::Diagonal(10.0),
+            ..Default::default()
+        };
+        // Two lines crossing edge (1, 2) from faces 0 and 1, meeting there
+        // (their crossings differ by rounding), and a third on its own.
+        let a = ([0.1, 0.1, 0.0], [0.5, 0.5, 0.0], 0, 1.0, [[0, 1], [1, 2]]);
+        let b = (
+            [0.5000001, 0.5, 0.0],
+            [0.9, 0.9, 0.0],
+            0,
+            1.0,
+            [[2, 1], [1, 3]],
+        );
+        let c = (
+            [0.2, 0.0, 0.0],
+            [0.3, 0.0, 0.0],
+            0,
+            1.0,
+            [[LINE_FREE, 0], [LINE_FREE, 0]],
+        );
+        let plan = Plan::new(&p, &f, &[a, b, c], &view, &opts).unwrap();
+        assert_eq!(plan.segs[0].end_ids[1], plan.segs[1].end_ids[0]);
+        assert_eq!(plan.ends.len(), 5);
+        let shared = &plan.ends[plan.segs[0].end_ids[1] as usize];
+        // The least point (by its bits), both faces left out.
+        assert_eq!(shared.p, a.1);
+        assert_eq!(shared.exclude, vec![0, 1]);
+        let mut casts = Vec::new();
+        classify_by(&plan, |c| {
+            casts.extend_from_slice(c);
+            Ok(vec![false; c.len()])
+        })
+        .unwrap();
+        // Six ends, one shared: five samples in the first round.
+        assert_eq!(casts.len(), 5, "{casts:?}");
+        let q = plan.query((1, 0.0)).unwrap();
+        assert_eq!(q, plan.query((0, 1.0)).unwrap());
+    }
+
+    #[test]
+    fn agreement_is_length_weighted() {
+        let got = [
+            vec![(0.0, 0.3, true), (0.3, 1.0, false)],
+            vec![(0.0, 1.0, true)],
+        ];
         let (same, len) = agreement(&got[0], &got[1], 2.0);
         assert!((same - 0.6).abs() < 1e-3 && len == 2.0, "{same}");
     }
