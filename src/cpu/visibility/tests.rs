@@ -70,20 +70,20 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
         spacing: Spacing::Diagonal(10.0),
         ..Default::default()
     };
-    // Two lines crossing edge (1, 2) from faces 0 and 1, meeting there
-    // (their crossings differ by rounding), and a third on its own.
-    let a = ([0.1, 0.1, 0.0], [0.5, 0.5, 0.0], 0, 1.0, [[0, 1], [1, 2]]);
+    // Two ridges (one interval each) crossing edge (1, 2) from faces 0 and
+    // 1, meeting there (their crossings differ by rounding), and a third.
+    let a = ([0.1, 0.1, 0.0], [0.5, 0.5, 0.0], 2, 1.0, [[0, 1], [1, 2]]);
     let b = (
         [0.5000001, 0.5, 0.0],
         [0.9, 0.9, 0.0],
-        0,
+        2,
         1.0,
         [[2, 1], [1, 3]],
     );
     let c = (
         [0.2, 0.0, 0.0],
         [0.3, 0.0, 0.0],
-        0,
+        2,
         1.0,
         [[LINE_FREE, 0], [LINE_FREE, 0]],
     );
