@@ -253,3 +253,34 @@ fn intersection_lines_are_a_scene_cue_chained_into_a_loop() {
     // chain or a few, never one polyline per segment.
     assert!(g[0].1 >= 1 && g[0].1 <= 4 && g[0].2 > 50.0, "{g:?}");
 }
+
+#[test]
+fn strokes_write_svg_with_no_gl() {
+    let d = scratch("strokes-no-gl");
+    let svg = d.join("torus.svg");
+    let args = [
+        "strokes",
+        "--sdf",
+        "torus",
+        "--resolution",
+        "48",
+        "--size",
+        "300x300",
+        "-o",
+        svg.to_str().unwrap(),
+    ];
+    let out = no_gl(&d, &args);
+    ok(&out);
+    let g = groups(&std::fs::read_to_string(&svg).unwrap());
+    assert_eq!(g.len(), 1);
+    assert_eq!(g[0].0, "curvature-strokes");
+    // The torus seen from the fitted direction: strokes on its near side,
+    // chained into polylines (not one per traced step).
+    assert!(g[0].1 >= 5 && g[0].2 > 300.0, "{g:?}");
+    // --svg (the facing strokes as outlines) goes beside a PNG only.
+    let both = no_gl(
+        &d,
+        &[&args[..8], &[svg.to_str().unwrap(), "--svg", "x.svg"]].concat(),
+    );
+    assert!(!both.status.success());
+}

@@ -17,6 +17,7 @@ use crate::spec::sdf_lines::{
     Sampling, SdfLineOptions, SdfLineStats, SdfLinesOutput, Seed, Stroke,
 };
 use crate::spec::timing::Timing;
+use crate::spec::visibility::VisibilityMethod;
 use crate::stages::mesh_sdf::MeshSdfStats;
 use crate::stages::sdf_lines::SdfLines;
 use crate::volume::Volume;
@@ -46,6 +47,14 @@ pub struct PictureOptions {
     /// Shade the surface; `false` draws it in the background colour, so it
     /// still hides the strokes behind it.
     pub surface: bool,
+    /// Draw the image (GL). Off, with `svg` on and exact visibility, no GL
+    /// context is opened.
+    pub image: bool,
+    /// Also find the SVG group of the visible strokes (their centre lines).
+    pub svg: bool,
+    /// How the SVG's hidden strokes are found: exactly, over the
+    /// isosurface's BVH (default), or against the image's depth.
+    pub visibility: VisibilityMethod,
 }
 
 impl Default for PictureOptions {
@@ -58,6 +67,9 @@ impl Default for PictureOptions {
                 ..Shot::default()
             },
             surface: true,
+            image: true,
+            svg: false,
+            visibility: VisibilityMethod::Exact,
         }
     }
 }
@@ -104,8 +116,10 @@ pub struct MeshField {
 /// (f32 precision far from 0): positions are world minus [`Picture::centre`].
 #[derive(Clone, Debug)]
 pub struct Picture {
-    /// The image.
-    pub frame: Frame,
+    /// The image, where one was drawn ([`PictureOptions::image`]).
+    pub frame: Option<Frame>,
+    /// The SVG groups (the visible strokes' centre lines), where asked for.
+    pub layers: Option<Vec<crate::export::svg::SvgLayer>>,
     /// The camera it was drawn with (centred frame).
     pub camera: Camera,
     /// World position of the frame's origin (the surface's bounding-box centre).
@@ -227,11 +241,9 @@ pub fn strokes_on(
                     ..s.clone()
                 })
                 .collect();
-            let frame = v.image.ok_or_else(|| {
-                crate::error::Error::InvalidArgument("the strokes picture drew no image".into())
-            })?;
             let picture = Picture {
-                frame,
+                frame: v.image,
+                layers: v.layers,
                 camera: v.camera,
                 centre: o,
                 strokes,
@@ -265,7 +277,9 @@ fn strokes_scene(vol: Arc<Volume>, iso: f32, opts: &StrokesOptions, p: &PictureO
     let [r, g, b, _] = RenderOptions::default().background;
     s.background = [r, g, b];
     s.msaa = RenderOptions::default().msaa;
-    s.png = true;
+    s.png = p.image;
+    s.svg = p.svg;
+    s.visibility = p.visibility;
     let fx = &mut s.effects;
     fx.cues = match p.surface {
         true => vec![Cue::Shading, Cue::CurvatureStrokes],

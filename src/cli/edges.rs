@@ -115,12 +115,7 @@ pub fn run(device: Option<&str>, a: EdgesArgs) -> Result<()> {
     let out_svg = super::has_extension(output, "svg");
     // The options first: their messages name the flag at fault.
     let opts = picture_options(&a, out_svg)?;
-    if !out_svg && !super::has_extension(output, "png") {
-        bail!(
-            "-o {}: give a name ending in .png (a picture) or .svg (the visible edges)",
-            output.display()
-        );
-    }
+    super::png_or_svg("-o", output, "the visible edges")?;
     if out_svg && a.svg.is_some() {
         bail!(
             "-o {} is an SVG already: --svg adds one beside a PNG",

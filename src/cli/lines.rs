@@ -146,17 +146,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let width = a.width.unwrap_or(2.0f32.min(w.max(h) as f32));
     super::width_arg(width, (w, h), "line")?;
-    let svg = match (
-        super::has_extension(&a.output, "svg"),
-        super::has_extension(&a.output, "png"),
-    ) {
-        (true, _) => true,
-        (_, true) => false,
-        _ => bail!(
-            "--output {}: give a name ending in .png (a picture) or .svg (a group per family)",
-            a.output.display()
-        ),
-    };
+    let svg = super::png_or_svg("--output", &a.output, "a group per family")?;
     if !svg && a.hidden != Hidden::Remove {
         bail!(
             "--hidden {}: hidden parts are drawn in SVG output only; a PNG shows the visible lines",

@@ -245,16 +245,18 @@ pub fn has_extension(path: &Path, ext: &str) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
-/// Refuses an image output whose name does not end in `.png` (shapecue
-/// writes PNG only; a `.jpg` name would hold PNG bytes).
-pub fn require_png(option: &str, path: &Path) -> anyhow::Result<()> {
-    if !has_extension(path, "png") {
-        anyhow::bail!(
-            "{option} {}: images are written as PNG; give a name ending in .png",
+/// Whether a picture output is an SVG (`true`) or a PNG (`false`); any
+/// other name is refused (a `.jpg` name would hold PNG bytes). `svg_is`
+/// says what the SVG holds, for the message.
+pub fn png_or_svg(option: &str, path: &Path, svg_is: &str) -> anyhow::Result<bool> {
+    match (has_extension(path, "svg"), has_extension(path, "png")) {
+        (true, _) => Ok(true),
+        (_, true) => Ok(false),
+        _ => anyhow::bail!(
+            "{option} {}: give a name ending in .png (a picture) or .svg ({svg_is})",
             path.display()
-        );
+        ),
     }
-    Ok(())
 }
 
 /// The command-line parser of a library option enum ([`shapecue::spec::Choice`]):

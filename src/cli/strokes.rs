@@ -10,7 +10,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use shapecue::api::Gpu;
+use shapecue::api::{Gpu, VisibilityMethod};
 use shapecue::export::output::{check_outputs, write_bytes_atomic};
 use shapecue::spec::sdf_lines::{Inside, Sampling};
 use shapecue::volume::{self, Volume};
@@ -65,9 +65,16 @@ pub struct StrokesArgs {
     /// world units.
     #[arg(long, default_value = "auto")]
     pub sampling: String,
-    /// Output PNG.
+    /// Output: .png (the shaded surface with its strokes) or .svg (the
+    /// visible strokes' centre lines; with exact visibility no OpenGL is
+    /// needed).
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
+    /// How the hidden strokes of an -o .svg are found: exact (in object
+    /// space, by rays towards the eye over a BVH of the isosurface) or
+    /// depth (against the drawn picture's depth buffer).
+    #[arg(long, value_parser = super::choice::<VisibilityMethod>(), default_value = "exact")]
+    pub visibility: VisibilityMethod,
     /// Also write the strokes facing the eye as SVG (each a filled
     /// variable-width outline).
     #[arg(long)]
@@ -104,7 +111,13 @@ pub struct StrokesArgs {
 pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
     let (w, h) = super::size_arg(&a.size)?;
     let output = a.output.clone().expect("clap requires -o");
-    super::require_png("-o", &output)?;
+    let out_svg = super::png_or_svg("-o", &output, "the visible strokes")?;
+    if out_svg && a.svg.is_some() {
+        bail!(
+            "-o {} is an SVG already: --svg adds the strokes facing the eye beside a PNG",
+            output.display()
+        );
+    }
     let outputs: Vec<&Path> = [
         Some(&output),
         a.svg.as_ref(),
@@ -136,7 +149,13 @@ pub fn run(device: Option<&str>, a: StrokesArgs) -> Result<()> {
         );
     }
     let picture = out.picture.as_ref().expect("a picture was asked for");
-    picture.frame.save_png(&output)?;
+    match (&picture.frame, &picture.layers) {
+        (_, Some(layers)) if out_svg => {
+            shapecue::export::svg::write_svg_layers(&output, layers, w, h)?
+        }
+        (Some(frame), _) => frame.save_png(&output)?,
+        _ => bail!("the picture drew no image for {}", output.display()),
+    }
     print_summary(&name, &out, &output)?;
     if let Some(p) = &a.svg {
         let facing = picture.facing_strokes();
@@ -194,6 +213,9 @@ fn strokes_options(a: &StrokesArgs, input: &Input, (w, h): (u32, u32)) -> Result
                 ..PictureOptions::default().shot
             },
             surface: !a.no_surface,
+            image: !super::has_extension(a.output.as_deref().unwrap_or(Path::new("")), "svg"),
+            svg: super::has_extension(a.output.as_deref().unwrap_or(Path::new("")), "svg"),
+            visibility: a.visibility,
         }),
     })
 }

@@ -17,7 +17,8 @@
 //! Which faces a segment lies on, from its ends' edges ([`Segment`]): an
 //! end on a mesh edge names the edge's faces, an end at a face centre or
 //! cut by a test (`[u32::MAX or LINE_FREE, face]`) its face, an end at a
-//! vertex (`[v, v]`) the faces around the vertex. The segment lies on the
+//! vertex (`[v, v]`) the faces around the vertex, an end on no face
+//! ([`NO_FACE`]: a stroke on a distance field) none. The segment lies on the
 //! faces both ends name (normally one); where they share none (an edge
 //! unknown to the mesh), on the union. The first four are kept.
 
@@ -26,7 +27,7 @@ use crate::error::{Error, Result};
 use crate::spec::bvh::{BvhQuery, OCCLUDED};
 use crate::spec::feature_lines::{LINE_FREE, Segment};
 use crate::spec::view::View;
-use crate::spec::visibility::{MAX_INTERVALS, Pieces, Spacing, VisibilityOptions};
+use crate::spec::visibility::{MAX_INTERVALS, NO_FACE, Pieces, Spacing, VisibilityOptions};
 
 /// One sample of one segment: `(segment index, t)`.
 pub type Cast = (u32, f32);
@@ -141,6 +142,9 @@ impl<'a> Topology<'a> {
     fn end_faces(&self, e: [u32; 2], i: usize, which: &str, out: &mut Vec<u32>) -> Result<()> {
         out.clear();
         let n_faces = self.faces.len();
+        if e == NO_FACE {
+            return Ok(());
+        }
         if e[0] == u32::MAX || e[0] == LINE_FREE {
             if e[1] as usize >= n_faces {
                 return Err(Error::InvalidArgument(format!(

@@ -30,6 +30,7 @@ use glam::Mat4;
 
 use super::{Frame, clip_segment};
 use crate::spec::feature_lines::{LINE_FREE, Segment, edge_key};
+use crate::spec::visibility::NO_FACE;
 
 /// Default depth bias (window depth units) of [`visible_joined`].
 pub const DEFAULT_BIAS: f32 = 1e-3;
@@ -110,7 +111,10 @@ pub fn segment_lines(
         };
         // A cut end no longer lies on its mesh edge; an end that a line's
         // test cut inside a face never lay on one.
-        let edge = |i: usize| (!cut[i] && s.4[i][0] != LINE_FREE).then(|| edge_key(s.4[i]));
+        // An end on no face (a stroke on a distance field) has no edge.
+        let edge = |i: usize| {
+            (!cut[i] && s.4[i][0] != LINE_FREE && s.4[i] != NO_FACE).then(|| edge_key(s.4[i]))
+        };
         out.push(ClipLine {
             ends: [a.to_array(), b.to_array()],
             edges: [edge(0), edge(1)],

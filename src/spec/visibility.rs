@@ -131,6 +131,13 @@ impl VisibilityOptions {
     }
 }
 
+/// A segment end on no face of the mesh (the ends' field of
+/// [`crate::spec::feature_lines::Segment`]): a curve on another surface,
+/// as a curvature-directed stroke on a distance field's isosurface (the
+/// mesh is its marching-cubes chords). Its queries leave no face out and
+/// start the contour offset × the segment's length along the ray.
+pub const NO_FACE: [u32; 2] = [u32::MAX, u32::MAX];
+
 /// A piece of a segment: `(t0, t1, visible)`, `t` the fraction of the way
 /// from its first end to its second (`0 ≤ t0 < t1 ≤ 1`, or `(0, 1)` for a
 /// zero-length segment).

@@ -260,6 +260,18 @@ pub(super) fn svg_layers(
     for (st, faded) in line_styles(fx) {
         family_layers(&mut layers, &st, faded, lines.segments, vp, image);
     }
+    if plan.contains(Pass::SdfLines) {
+        let view = cam.view(scene.size[0], scene.size[1]);
+        let segs = super::vector::stroke_segments(lines.strokes, &view, lines.stroke_lift);
+        let clip = segment_lines(vp, &segs, super::vector::LAYER_STROKES, |_| 1.0);
+        layers.push(SvgLayer {
+            id: "curvature-strokes",
+            stroke_width: super::vector::STROKE_PX,
+            color: fx.strokes.color,
+            lines: visible_joined(&clip, image, DEFAULT_BIAS),
+            dashed: false,
+        });
+    }
     if plan.contains(Pass::Intersections) {
         let kind = super::vector::LAYER_INTERSECTIONS;
         let clip = segment_lines(vp, lines.intersections, kind, |_| 1.0);

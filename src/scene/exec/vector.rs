@@ -15,8 +15,9 @@ use crate::scene::file::{Effects, LineStyle, Scene};
 use crate::scene::planner::Cue;
 use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
 use crate::spec::feature_lines::{Hidden, LINE_FREE, LineFamily, Segment, hidden_id};
+use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
-use crate::spec::visibility::{Pieces, VisibilityOptions};
+use crate::spec::visibility::{NO_FACE, Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
@@ -25,6 +26,34 @@ use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
 /// The layer of the intersection lines.
 pub const LAYER_INTERSECTIONS: u32 = (1 << 16) + 1;
+/// The layer of the curvature-directed strokes.
+pub const LAYER_STROKES: u32 = (1 << 16) + 2;
+
+/// The centre lines of `strokes` (scene frame) as segments of the strokes'
+/// layer, each point moved `lift` towards the eye of `view` (the strokes
+/// lie on the interpolated surface, which marching cubes cuts as chords:
+/// half a voxel lifts them off the chords that would hide them), their
+/// ends on no face of the mesh ([`NO_FACE`]).
+pub(super) fn stroke_segments(strokes: &[Stroke], view: &View, lift: f32) -> Vec<Segment> {
+    let eye = view.eye;
+    let towards = |p: &[f64; 3]| -> [f32; 3] {
+        let q = glam::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+        let d = if view.ortho {
+            -view.unit_dir()
+        } else {
+            eye - q
+        };
+        (q + lift * d.normalize_or_zero()).to_array()
+    };
+    let mut out = Vec::new();
+    for st in strokes {
+        let pts: Vec<[f32; 3]> = st.points.iter().map(towards).collect();
+        for w in pts.windows(2) {
+            out.push((w[0], w[1], LAYER_STROKES, 1.0, [NO_FACE, NO_FACE]));
+        }
+    }
+    out
+}
 
 /// Whether a segment is drawn at all: one of no strength (faded out, or a
 /// non-finite test) is not, in the image nor in the SVG.
@@ -70,6 +99,11 @@ pub(super) fn line_styles(fx: &Effects) -> Vec<(LineStyle, bool)> {
     out.extend(fx.lines.styles_for(&fx.cues).into_iter().map(|s| (s, fade)));
     out
 }
+
+/// The stroke width of the curvature-directed strokes' SVG polylines, in
+/// pixels (their tapered strips are the frame's and the strokes command's
+/// `--svg` outlines).
+pub const STROKE_PX: f32 = 1.5;
 
 /// The lines of one view, classified and chained.
 #[derive(Clone, Debug, Default)]
@@ -245,6 +279,15 @@ pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) 
             });
         }
         layers.push(family_layer(vis, &st, faded, vp, [w, h]));
+    }
+    if fx.cues.contains(&Cue::CurvatureStrokes) {
+        layers.push(SvgLayer {
+            id: "curvature-strokes",
+            stroke_width: STROKE_PX,
+            color: fx.strokes.color,
+            lines: polylines(vis, LAYER_STROKES, true, vp, [w, h], |_| 1.0),
+            dashed: false,
+        });
     }
     if fx.cues.contains(&Cue::IntersectionLines) {
         layers.push(SvgLayer {

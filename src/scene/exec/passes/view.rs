@@ -307,7 +307,7 @@ impl Executor<'_, '_> {
 
     /// The strokes' lift towards the eye: half a voxel (they lie on the
     /// interpolated surface, which marching cubes cuts as chords).
-    fn stroke_lift(&self) -> f32 {
+    pub(super) fn stroke_lift(&self) -> f32 {
         self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32
     }
 

@@ -2,7 +2,7 @@
 //! the view's lines, and the SVG of the view (its hidden lines from the
 //! visibility pass, or from the rendered depth).
 
-use super::super::vector::{classify_view, gather, svg_layers_exact};
+use super::super::vector::{classify_view, gather, stroke_segments, svg_layers_exact};
 use super::*;
 
 impl Executor<'_, '_> {
@@ -68,10 +68,15 @@ impl Executor<'_, '_> {
         let t0 = Instant::now();
         let [w, h] = self.scene.size;
         let view = cam.view(w, h);
+        let strokes = match self.plan.contains(Pass::SdfLines) {
+            true => stroke_segments(&self.scene_strokes(), &view, self.stroke_lift()),
+            false => Vec::new(),
+        };
         let t = self.topo.as_mut().expect("a pose ran");
         let edges = (self.edges_ran.as_ref()).map(|e| (&e.1, t.edge_pairs.as_slice()));
         let mut segs = gather(&self.scene.effects, &self.segs, edges, &self.pose.pos);
         segs.extend_from_slice(&self.isect_segs);
+        segs.extend(strokes);
         let n = segs.len();
         let scale = self.framing.as_ref().map_or(1.0, |f| {
             let (lo, hi) = f.bounds;
