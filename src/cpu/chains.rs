@@ -31,6 +31,32 @@ pub enum EndKey {
     Cut(u32, u32),
 }
 
+impl EndKey {
+    /// A code equal for equal keys, cheap to sort: exact for an edge, a
+    /// vertex and a cut; a position's by a 64-bit hash (two positions share
+    /// one with a chance of about 2⁻⁶⁴).
+    pub fn code(self) -> u128 {
+        let (tag, payload): (u128, u128) = match self {
+            EndKey::Edge(u, v) => (0, (u128::from(u) << 32) | u128::from(v)),
+            EndKey::Vertex(v) => (1, u128::from(v)),
+            EndKey::Cut(s, t) => (2, (u128::from(s) << 32) | u128::from(t)),
+            EndKey::Point(p) => {
+                // SplitMix64 steps over the three coordinates.
+                let mix = |mut z: u64| {
+                    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+                    z ^ (z >> 31)
+                };
+                let h = p.iter().fold(0x9e37_79b9_7f4a_7c15u64, |h, &c| {
+                    mix(h ^ (c as u64).wrapping_add(0x9e37_79b9_7f4a_7c15))
+                });
+                (3, u128::from(h))
+            }
+        };
+        (tag << 120) | payload
+    }
+}
+
 /// The key of an end inside a face: each coordinate rounded to a grid of
 /// `scale × 2⁻²⁰` (`scale` the scene's size), so that ends computed apart
 /// from the same point (f32 rounding, about `scale × 2⁻²⁴`) meet, unless
@@ -72,8 +98,8 @@ pub struct Chain {
 /// visibility, key, the piece's canonical rank), each group a run of equal
 /// keys, its members in canonical order.
 struct Ends {
-    /// `(layer, visible, key, rank, piece, end)`, sorted.
-    ends: Vec<(u32, bool, EndKey, u32, u32, u8)>,
+    /// `(layer and visibility, key's code, rank, piece, end)`, sorted.
+    ends: Vec<(u64, u128, u32, u32, u8)>,
     /// The group of each piece's end (`2 × piece + end`).
     group_of: Vec<u32>,
     /// Each group's first index into `ends`, and one past the last group.
@@ -84,7 +110,7 @@ impl Ends {
     fn new(pieces: &[ChainPiece], rank: &[u32]) -> Ends {
         let mut ends: Vec<_> = (pieces.iter().enumerate())
             .flat_map(|(i, p)| {
-                (0..2).map(move |e| (p.layer, p.visible, p.keys[e], rank[i], i as u32, e as u8))
+                (0..2).map(move |e| (layer_vis(p), p.keys[e].code(), rank[i], i as u32, e as u8))
             })
             .collect();
         ends.sort_unstable();
@@ -93,12 +119,12 @@ impl Ends {
         for (k, x) in ends.iter().enumerate() {
             let new = k == 0 || {
                 let y = &ends[k - 1];
-                (y.0, y.1, y.2) != (x.0, x.1, x.2)
+                (y.0, y.1) != (x.0, x.1)
             };
             if new {
                 start.push(k as u32);
             }
-            group_of[2 * x.4 as usize + x.5 as usize] = (start.len() - 1) as u32;
+            group_of[2 * x.3 as usize + x.4 as usize] = (start.len() - 1) as u32;
         }
         start.push(ends.len() as u32);
         Ends {
@@ -112,7 +138,7 @@ impl Ends {
     fn at(&self, i: u32, e: usize) -> impl Iterator<Item = (u32, usize)> + '_ {
         let g = self.group_of[2 * i as usize + e] as usize;
         let (a, b) = (self.start[g] as usize, self.start[g + 1] as usize);
-        self.ends[a..b].iter().map(|x| (x.4, x.5 as usize))
+        self.ends[a..b].iter().map(|x| (x.3, x.4 as usize))
     }
 
     fn degree(&self, i: u32, e: usize) -> usize {
@@ -121,15 +147,19 @@ impl Ends {
     }
 }
 
+/// A piece's layer and visibility in one sort key.
+fn layer_vis(p: &ChainPiece) -> u64 {
+    (u64::from(p.layer) << 1) | u64::from(p.visible)
+}
+
 /// Joins `pieces` into chains (see the module note). Every piece is in
 /// exactly one chain.
 pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
     let mut order: Vec<u32> = (0..pieces.len() as u32).collect();
     order.sort_by_cached_key(|&i| {
         let p = &pieces[i as usize];
-        let mut k = p.keys;
-        k.sort_unstable();
-        (p.layer, p.visible, k, p.seg, p.t[0].to_bits())
+        let (a, b) = (p.keys[0].code(), p.keys[1].code());
+        (layer_vis(p), a.min(b), a.max(b), p.seg, p.t[0].to_bits())
     });
     let mut rank = vec![0u32; pieces.len()];
     for (r, &i) in order.iter().enumerate() {

@@ -455,12 +455,22 @@ fn shared_ends(segments: &[Segment], segs: &mut [SegPlan]) -> Vec<EndPlan> {
         if key(q) < key(p) { q } else { p }
     };
     for group in keyed.chunk_by(|x, y| x.0 == y.0) {
-        let mut faces: Vec<u32> = (group.iter())
-            .flat_map(|&(_, i, _)| segs[i as usize].exclude.iter().copied())
-            .collect();
-        faces.sort_unstable();
-        faces.dedup();
-        if faces.len() > 4 {
+        // The faces they lie on, up to five (five: more than a query
+        // leaves out), without an allocation per end.
+        let (mut faces, mut n) = ([0u32; 5], 0usize);
+        'all: for &(_, i, _) in group {
+            for &f in &segs[i as usize].exclude {
+                if !faces[..n].contains(&f) {
+                    if n == 5 {
+                        break 'all;
+                    }
+                    faces[n] = f;
+                    n += 1;
+                }
+            }
+        }
+        faces[..n].sort_unstable();
+        if n > 4 {
             // More faces than a query leaves out (ends at a vertex of high
             // valence): each end keeps its own sample and faces.
             for &(_, i, e) in group {
@@ -487,7 +497,7 @@ fn shared_ends(segments: &[Segment], segs: &mut [SegPlan]) -> Vec<EndPlan> {
             end.p = if n == 0 { p } else { least(end.p, p) };
             end.offset = end.offset.max(sp.offset);
         }
-        end.exclude = faces;
+        end.exclude = faces[..n].to_vec();
         ends.push(end);
     }
     ends

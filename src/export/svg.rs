@@ -41,7 +41,9 @@ fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
     let (mut here, mut last) = (String::with_capacity(32), String::with_capacity(32));
     for p in points {
         here.clear();
-        let _ = write!(here, "{:.2},{:.2}", p[0], p[1]);
+        push_hundredths(&mut here, p[0]);
+        here.push(',');
+        push_hundredths(&mut here, p[1]);
         if here == last {
             continue;
         }
@@ -56,6 +58,19 @@ fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
         let _ = write!(s, " stroke-opacity=\"{o:.2}\"");
     }
     s.push_str("/>\n");
+}
+
+/// Writes `x` with two decimals (rounded to the nearest hundredth, as
+/// `{:.2}` does but without its exact decimal expansion: a drawing's
+/// coordinates differ at most in a tie); a non-finite value as `0.00`.
+fn push_hundredths(s: &mut String, x: f32) {
+    let h = f64::from(x) * 100.0;
+    let h = if h.is_finite() { h.round() as i64 } else { 0 };
+    if h < 0 {
+        s.push('-');
+    }
+    let a = h.unsigned_abs();
+    let _ = write!(s, "{}.{:02}", a / 100, a % 100);
 }
 
 fn svg_open(width: u32, height: u32) -> String {
