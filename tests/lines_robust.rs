@@ -134,6 +134,9 @@ fn a_broken_file_is_an_error_naming_the_element() {
     let out = lines(&d, &bad, "index");
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("index.obj") && err.contains("9999"), "{err}");
+    assert!(
+        err.contains("index.obj") && err.contains("face 320") && err.contains("10000"),
+        "{err}"
+    );
     assert!(!d.join("nan.svg").exists() && !d.join("index.svg").exists());
 }
