@@ -12,7 +12,7 @@ use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame, RenderOptions};
 use crate::scene::exec::{ExecOptions, PassRecord, Session, VisibleLines};
-use crate::scene::file::{HeldMesh, LineStyle, Scene, Shot, Source};
+use crate::scene::file::{HeldMesh, LineStyle, Scene, Shot, Source, ViewSpec};
 use crate::scene::planner::Cue;
 use crate::spec::curvature::CurvatureOptions;
 use crate::spec::feature_lines::{FeatureSize, LineFamily, Segment};
@@ -173,6 +173,23 @@ pub fn lines_scene(mesh: Arc<Mesh>, opts: &LinesPictureOptions) -> Scene {
             hidden: opts.hidden,
         });
     }
+    s
+}
+
+/// The scene of a lines drawing from many views in one run: the scene of
+/// [`lines_scene`] (its shot gives the image size) with `views` instead of
+/// the shot's camera. The executor runs the pose passes (curvature, the
+/// feature size) once and the view passes (the lines, their visibility,
+/// the drawing) once per view; [`crate::scene::exec::Session::run_each`]
+/// hands each view's lines to the caller. Set the scene's `out_dir` and
+/// `prefix` for its files.
+pub fn lines_views_scene(
+    mesh: Arc<Mesh>,
+    opts: &LinesPictureOptions,
+    views: Vec<ViewSpec>,
+) -> Scene {
+    let mut s = lines_scene(mesh, opts);
+    s.views = views;
     s
 }
 

@@ -53,10 +53,14 @@ pub use crate::cpu::curvature::curvature as curvature_reference;
 pub use crate::gpu::{DeviceInfo, Gpu, list_devices};
 pub use crate::render::{Camera, Placement, framed};
 pub use crate::scene::exec::{
-    Checked, ExecOptions, LAYER_FEATURE_EDGES, RunReport, Session, VisibleLines, check_scenes,
-    explain, run as run_scene, run_on as run_scene_on,
+    Checked, ExecOptions, LAYER_FEATURE_EDGES, RunReport, Session, ViewDone, VisibleLines,
+    check_scenes, explain, output_paths, run as run_scene, run_on as run_scene_on,
 };
-pub use crate::scene::file::{HeldMesh, HeldVolume, Scene, Source};
+pub use crate::scene::file::{
+    CameraDefaults, CameraKind, HeldMesh, HeldVolume, Scene, Source, ViewSpec, fibonacci_views,
+    load_camera_file, parse_camera_file,
+};
+pub use crate::spec::cameras::{MAX_VIEWS, fibonacci_directions};
 pub use crate::spec::visibility::VisibilityMethod;
 pub use crate::stages::curvature::{
     CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
@@ -64,7 +68,7 @@ pub use crate::stages::curvature::{
 pub use crate::stages::feature_lines::LineOptions;
 pub use lines::{
     Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
-    line_segments_on, lines_picture, lines_picture_on, lines_scene, wanted,
+    line_segments_on, lines_picture, lines_picture_on, lines_scene, lines_views_scene, wanted,
 };
 
 pub use strokes::{

@@ -2,18 +2,21 @@
 //! real-time suggestive contours program) on one mesh from one camera, by
 //! one front-door call ([`shapecue::lines_picture_on`]): a PNG of the lines
 //! over the mesh, or an SVG with a group per family, and optionally the 3-D
-//! segments (family, strength) as JSON.
+//! segments (family, strength) as JSON. With `--views N` or `--cameras
+//! FILE` and `--out DIR`, many views of the mesh in one run ([`views`]).
+
+mod views;
 
 use super::{check_outputs, write_json};
 use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::LinesPictureOptions;
 use shapecue::api::Gpu;
-use shapecue::api::{Hidden, LineSetup, VisibilityMethod};
+use shapecue::api::{Hidden, LineSetup, VisibilityMethod, VisibleLines};
 use shapecue::mesh::LoadOptions;
 use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions};
 use shapecue::spec::feature_lines::FeatureSize;
-use shapecue::spec::feature_lines::{FamilySet, LineFamily};
+use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -125,20 +128,55 @@ pub struct LinesArgs {
     hidden: Hidden,
     /// Output: .png (picture) or .svg (a group per family).
     #[arg(short, long)]
-    output: PathBuf,
+    output: Option<PathBuf>,
     /// Also write the 3-D segments as JSON: with exact visibility, each
     /// drawn segment split where its visibility changes (family, strength,
     /// ends, visible, the faces it lies on, its chain) and the chains;
-    /// else every segment (family, strength, ends).
+    /// else every segment (family, strength, ends). With --views or
+    /// --cameras, give no file: each view's go next to its SVG.
+    #[arg(long, num_args = 0..=1, value_name = "FILE")]
+    segments: Option<Option<PathBuf>>,
+    /// Many views in one run: N views fitted to the mesh from directions
+    /// spread evenly over the sphere (the Fibonacci lattice), an SVG each
+    /// in --out.
+    #[arg(long, value_name = "N")]
+    views: Option<usize>,
+    /// Many views in one run: the cameras of a JSON file
+    /// ({"cameras": [{"eye": [x,y,z], "target": [x,y,z]}, ...]}, with
+    /// optional "up", "fov" and "ortho" height), an SVG each in --out.
+    #[arg(long, value_name = "FILE.json")]
+    cameras: Option<PathBuf>,
+    /// The folder of --views or --cameras: an SVG per view (and a PNG with
+    /// --png, segments with --segments), the run's report and manifest.json.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// With --views or --cameras: also a PNG per view (needs OpenGL).
     #[arg(long)]
-    segments: Option<PathBuf>,
+    png: bool,
+    /// With --views or --cameras: print the plan (the passes, per pose or
+    /// per view, and how often each runs) and the files, and run nothing.
+    #[arg(long)]
+    explain: bool,
     /// Overwrite existing output files.
     #[arg(long)]
     force: bool,
 }
 
-/// Runs `shapecue lines`.
-pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
+/// What the two ways of `shapecue lines` share, checked: the image size,
+/// the families, the line width, the feature size and where the mesh comes
+/// from.
+struct Common {
+    size: (u32, u32),
+    fams: FamilySet,
+    width: f32,
+    feature_size: FeatureSize,
+    path: PathBuf,
+    /// A generated mesh's vertex count (`None`: a file).
+    generated: Option<usize>,
+}
+
+/// The checks of both ways of `shapecue lines`.
+fn common(a: &LinesArgs) -> Result<Common> {
     let (w, h) = super::size_arg(&a.size)?;
     let fams = FamilySet::parse(&a.lines)?;
     if fams == FamilySet::NONE {
@@ -146,13 +184,6 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let width = a.width.unwrap_or(2.0f32.min(w.max(h) as f32));
     super::width_arg(width, (w, h), "line")?;
-    let svg = super::png_or_svg("--output", &a.output, "a group per family")?;
-    if !svg && a.hidden != Hidden::Remove {
-        bail!(
-            "--hidden {}: hidden parts are drawn in SVG output only; a PNG shows the visible lines",
-            a.hidden.name()
-        );
-    }
     if fams.has(LineFamily::Isophotes) && a.isophotes == 0 {
         bail!("--isophotes 0: isophotes need at least 1 level");
     }
@@ -166,63 +197,109 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         );
     }
     let vertices = a.vertices.unwrap_or(20_000);
-    let inputs: Vec<&std::path::Path> = if generated {
-        vec![]
-    } else {
-        vec![path.as_path()]
-    };
-    let outputs: Vec<&std::path::Path> = std::iter::once(a.output.as_path())
-        .chain(a.segments.as_deref())
-        .collect();
     if generated {
         shapecue::spec::limits::check_mesh_vertices("--vertices", vertices)?;
     }
-    check_outputs(inputs, outputs, a.force)?;
-    let mesh = if generated {
-        shapecue::mesh::generated_by_name(&a.mesh, vertices)
-            .expect("checked above")
-            .1
-    } else {
-        shapecue::mesh::load(&path, &LoadOptions::default())?
+    Ok(Common {
+        size: (w, h),
+        fams,
+        width,
+        feature_size,
+        path,
+        generated: generated.then_some(vertices),
+    })
+}
+
+impl Common {
+    /// The files the run reads (none for a generated mesh).
+    fn inputs(&self) -> Vec<&std::path::Path> {
+        match self.generated {
+            Some(_) => vec![],
+            None => vec![self.path.as_path()],
+        }
+    }
+
+    /// The mesh, loaded or generated.
+    fn mesh(&self, name: &str) -> Result<shapecue::Mesh> {
+        Ok(match self.generated {
+            Some(n) => {
+                (shapecue::mesh::generated_by_name(name, n))
+                    .expect("checked by common")
+                    .1
+            }
+            None => shapecue::mesh::load(&self.path, &LoadOptions::default())?,
+        })
+    }
+}
+
+/// Runs `shapecue lines`.
+pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
+    if a.views.is_some() || a.cameras.is_some() || a.out.is_some() {
+        return views::run(device, a);
+    }
+    for (on, flag) in [(a.png, "--png"), (a.explain, "--explain")] {
+        if on {
+            bail!("{flag} goes with --views N or --cameras FILE (and --out DIR)");
+        }
+    }
+    let Some(output) = a.output.clone() else {
+        bail!(
+            "give -o FILE.svg or -o FILE.png for one picture, or --views N or --cameras \
+             FILE.json with --out DIR for many views"
+        );
     };
-    let opts = picture_options(&a, fams, (w, h), width, svg, feature_size)?;
+    let segments = match &a.segments {
+        Some(None) => bail!("--segments FILE: give the file the segments go to"),
+        Some(Some(p)) => Some(p.clone()),
+        None => None,
+    };
+    let c = common(&a)?;
+    let (w, h) = c.size;
+    let svg = super::png_or_svg("--output", &output, "a group per family")?;
+    if !svg && a.hidden != Hidden::Remove {
+        bail!(
+            "--hidden {}: hidden parts are drawn in SVG output only; a PNG shows the visible lines",
+            a.hidden.name()
+        );
+    }
+    let outputs: Vec<&std::path::Path> = std::iter::once(output.as_path())
+        .chain(segments.as_deref())
+        .collect();
+    check_outputs(c.inputs(), outputs, a.force)?;
+    let mesh = c.mesh(&a.mesh)?;
+    let mut opts = picture_options(&a, &c)?;
+    // The segments' visibility comes with the SVG groups.
+    opts.image = !svg;
+    opts.svg = svg || segments.is_some();
     let gpu = Arc::new(Gpu::new(device)?);
     let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
     match (&pic.layers, &pic.frame) {
-        (Some(layers), _) if svg => {
-            shapecue::export::svg::write_svg_layers(&a.output, layers, w, h)?
-        }
-        (_, Some(frame)) => frame.save_png(&a.output)?,
-        _ => bail!("the picture drew no image for {}", a.output.display()),
+        (Some(layers), _) if svg => shapecue::export::svg::write_svg_layers(&output, layers, w, h)?,
+        (_, Some(frame)) => frame.save_png(&output)?,
+        _ => bail!("the picture drew no image for {}", output.display()),
     }
-    if let Some(p) = &a.segments {
-        write_segments(p, &pic)?;
+    if let Some(p) = &segments {
+        let doc = segments_doc(pic.visible.as_ref(), &pic.segments, pic.feature_size);
+        write_json(p, &doc)?;
     }
     let found = summary(&pic.segments);
     super::print(format_args!(
         "{}: {found}, kernels {:.2} ms",
-        a.output.display(),
+        output.display(),
         pic.timing.kernel_ms
     ))?;
     Ok(())
 }
 
-/// The picture's options from the arguments (checked by [`run`]).
-fn picture_options(
-    a: &LinesArgs,
-    fams: FamilySet,
-    (w, h): (u32, u32),
-    width: f32,
-    svg: bool,
-    feature_size: FeatureSize,
-) -> Result<LinesPictureOptions> {
+/// The picture's options from the arguments (checked by [`common`]); the
+/// caller sets `image` and `svg`.
+fn picture_options(a: &LinesArgs, c: &Common) -> Result<LinesPictureOptions> {
+    let (w, h) = c.size;
+    let fams = c.fams;
     let mut opts = LinesPictureOptions {
         shot: super::shot_arg([&a.eye, &a.target, &a.up], a.fov, a.ortho, [w, h])?,
-        line_width: width,
+        line_width: c.width,
         hidden: a.hidden,
-        // The segments' visibility comes with the SVG groups.
-        image: !svg,
-        svg: svg || a.segments.is_some(),
         visibility: a.visibility,
         setup: LineSetup {
             curvature: CurvatureOptions {
@@ -230,7 +307,7 @@ fn picture_options(
                 compat: a.compat,
                 ..Default::default()
             },
-            feature_size,
+            feature_size: c.feature_size,
         },
         ..Default::default()
     };
@@ -257,12 +334,16 @@ fn picture_options(
     Ok(opts)
 }
 
-/// Writes the segments and the feature size as JSON (`--segments`): with
-/// exact visibility the drawn segments split into their pieces and the
-/// chains, else every segment.
-fn write_segments(path: &std::path::Path, pic: &shapecue::LinesPicture) -> Result<()> {
+/// The segments document of `--segments` (one picture's, or one view's):
+/// with exact visibility (`visible`) the drawn segments split into their
+/// pieces and the chains, else every segment; with the feature size.
+fn segments_doc(
+    visible: Option<&VisibleLines>,
+    segments: &[Segment],
+    feature_size: f32,
+) -> serde_json::Value {
     let family = |k: u32| LineFamily::from_kind(k).map_or("unknown", |f| f.name());
-    let doc = match &pic.visible {
+    match visible {
         Some(v) => {
             let mut chain_of = vec![0usize; v.chain_pieces.len()];
             for (c, ch) in v.chains.iter().enumerate() {
@@ -291,7 +372,7 @@ fn write_segments(path: &std::path::Path, pic: &shapecue::LinesPicture) -> Resul
                 })
                 .collect();
             serde_json::json!({
-                "feature_size": pic.feature_size,
+                "feature_size": feature_size,
                 "visibility": "exact",
                 "segments": pieces,
                 "chains": chains,
@@ -299,17 +380,16 @@ fn write_segments(path: &std::path::Path, pic: &shapecue::LinesPicture) -> Resul
             })
         }
         None => {
-            let segs: Vec<serde_json::Value> = (pic.segments.iter())
+            let segs: Vec<serde_json::Value> = (segments.iter())
                 .map(|s| serde_json::json!({"family": family(s.2), "strength": s.3, "a": s.0, "b": s.1}))
                 .collect();
-            serde_json::json!({"feature_size": pic.feature_size, "segments": segs})
+            serde_json::json!({"feature_size": feature_size, "segments": segs})
         }
-    };
-    write_json(path, &doc)
+    }
 }
 
 /// What the run found, in words: the segments per family.
-fn summary(segments: &[shapecue::spec::feature_lines::Segment]) -> String {
+fn summary(segments: &[Segment]) -> String {
     let mut counts = std::collections::BTreeMap::<&str, usize>::new();
     for s in segments {
         if let Some(f) = LineFamily::from_kind(s.2) {

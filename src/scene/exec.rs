@@ -45,7 +45,7 @@ mod passes;
 mod report;
 mod vector;
 
-pub use draw::{EdgeCounts, EdgeInfo, ViewOutputs};
+pub use draw::{EdgeCounts, EdgeInfo, ViewDone, ViewOutputs};
 pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
@@ -108,7 +108,24 @@ impl Session {
         opts: &ExecOptions,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<RunReport> {
-        run_loaded(self, scene, None, opts, progress)
+        run_loaded(self, scene, None, opts, progress, None)
+    }
+
+    /// [`run`] in this session, handing each view's lines to `each` as soon
+    /// as the view is done ([`ViewDone`]: the camera as resolved, the
+    /// segments and, with exact visibility, their visible pieces and
+    /// chains, all in world coordinates), so that a caller writes per-view
+    /// outputs of its own without holding every view. An error from `each`
+    /// stops the run, which then removes what it created, as any failed
+    /// run does (what `each` wrote is the caller's to remove).
+    pub fn run_each(
+        &mut self,
+        scene: &Scene,
+        opts: &ExecOptions,
+        progress: &mut dyn FnMut(usize, usize),
+        each: &mut dyn FnMut(ViewDone) -> Result<()>,
+    ) -> Result<RunReport> {
+        run_loaded(self, scene, None, opts, progress, Some(each))
     }
 
     /// [`run_checked`] in this session.
@@ -120,7 +137,7 @@ impl Session {
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<RunReport> {
         let pre = checked.input.filter(|_| checked.scene == scene.path);
-        run_loaded(self, scene, pre, opts, progress)
+        run_loaded(self, scene, pre, opts, progress, None)
     }
 
     /// The session's device, opened on first use.
@@ -205,14 +222,19 @@ pub fn run_checked(
     Session::new().run_checked(scene, checked, opts, progress)
 }
 
+/// What a run hands its caller after each view, where asked.
+type EachView<'a> = Option<&'a mut dyn FnMut(ViewDone) -> Result<()>>;
+
 /// A scene run in `session` on an input already loaded (`pre`: the input and what
-/// loading it said), or loading it when `pre` is `None`.
+/// loading it said), or loading it when `pre` is `None`; `each` is handed
+/// every view when done.
 fn run_loaded(
     session: &mut Session,
     scene: &Scene,
     pre: Option<(load::Loaded, Vec<String>)>,
     opts: &ExecOptions,
     progress: &mut dyn FnMut(usize, usize),
+    each: EachView<'_>,
 ) -> Result<RunReport> {
     let t_all = Instant::now();
     let (loaded, notes) = match pre {
@@ -241,7 +263,10 @@ fn run_loaded(
                 source,
             })
         })
-        .and_then(|()| render_all(session, scene, opts, progress, input, &outputs));
+        .and_then(|()| {
+            let calls = Calls { progress, each };
+            render_all(session, scene, opts, calls, input, &outputs)
+        });
     if result.is_err() {
         outputs.remove_created();
     }
@@ -309,6 +334,13 @@ struct RunInput {
     t_all: Instant,
 }
 
+/// What a run calls back: `progress(done, total)` after each view, and
+/// `each` with the view's lines where asked.
+struct Calls<'a, 'b> {
+    progress: &'a mut dyn FnMut(usize, usize),
+    each: EachView<'b>,
+}
+
 /// The rendering of [`run_loaded`] after the outputs are checked and the
 /// folder exists: builds the executor, runs the frames ([`run_frames`]) and
 /// writes the report last.
@@ -316,7 +348,7 @@ fn render_all(
     session: &mut Session,
     scene: &Scene,
     opts: &ExecOptions,
-    progress: &mut dyn FnMut(usize, usize),
+    calls: Calls<'_, '_>,
     input: RunInput,
     outputs: &RunOutputs,
 ) -> Result<RunReport> {
@@ -331,7 +363,7 @@ fn render_all(
     let renderer = session.renderer(scene, &plan)?;
     let uploads_before = renderer.as_ref().map(|r| r.uploads()).unwrap_or_default();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-    let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, progress)?;
+    let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, calls)?;
 
     let (vertices, faces) = ex.counts();
     let passes = ex.rec.in_plan_order(&plan);
@@ -384,16 +416,20 @@ fn render_all(
 /// The frame loop: the plan's passes frame by frame and view by view, by
 /// lifetime (topology passes on a new topology, pose passes per pose, view
 /// passes per camera), each view writing its `images`; calls
-/// `progress(done, total)` after each view. Returns the pose, view and
-/// render laps.
+/// `progress(done, total)` after each view, and hands `each` the view
+/// where asked. Returns the pose, view and render laps (the passes'
+/// clocks), and the wall-clock laps `pose_wall` (a pose's passes, topology
+/// passes with the first) and `view_wall` (a view's passes, drawing and
+/// writing included; not what `each` does with it).
 fn run_frames(
     ex: &mut Executor<'_, '_>,
     scene: &Scene,
     plan: &Plan,
     frames: &[usize],
     images: &[(usize, usize, PathBuf)],
-    progress: &mut dyn FnMut(usize, usize),
+    calls: Calls<'_, '_>,
 ) -> Result<crate::spec::timing::Timing> {
+    let Calls { progress, mut each } = calls;
     let input = scene.source.input();
     // The plan's passes by lifetime, each list in plan order.
     let of = |keep: &dyn Fn(Lifetime) -> bool| -> Vec<Pass> {
@@ -414,14 +450,17 @@ fn run_frames(
         // Pose passes: once in all for a static mesh; topology passes with
         // the first pose (an isosurface's are pose passes).
         if fi == 0 || input != Input::Static {
+            let t_pose = Instant::now();
             ex.begin_pose();
             for &p in if fi == 0 { &first_pose } else { &later_poses } {
                 ex.pose_pass(p, frame)?;
             }
             ex.end_pose(frame)?;
             timing.lap("pose", ex.rec.lap());
+            timing.lap("pose_wall", ms_since(t_pose));
         }
         for (vi, cam) in ex.cameras().iter().enumerate() {
+            let t_view = Instant::now();
             let paths: Vec<&PathBuf> = images
                 .iter()
                 .filter(|i| i.0 == frame && i.1 == vi)
@@ -438,6 +477,11 @@ fn run_frames(
             }
             ex.end_view(cam);
             timing.lap("render", ex.rec.lap());
+            timing.lap("view_wall", ms_since(t_view));
+            if let Some(each) = each.as_deref_mut() {
+                let files = paths.into_iter().cloned().collect();
+                each(ex.view_done((frame, vi), cam, files))?;
+            }
             done += 1;
             progress(done, total_views);
         }

@@ -48,6 +48,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod camera_file;
 mod effects;
 mod effects_table;
 mod held;
@@ -59,6 +60,7 @@ mod settings;
 mod toml_words;
 mod views;
 
+pub use camera_file::{CameraDefaults, fibonacci_views, load_camera_file, parse_camera_file};
 pub use effects::{Effects, StrokeEffect};
 pub use held::{HeldMesh, HeldVolume, Shot};
 pub use lines::{LineEffects, LineStyle};

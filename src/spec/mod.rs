@@ -11,6 +11,7 @@
 
 pub mod ao;
 pub mod bvh;
+pub mod cameras;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

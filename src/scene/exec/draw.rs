@@ -401,6 +401,29 @@ impl ViewOutputs {
     }
 }
 
+/// What a run hands its caller after each view
+/// ([`Session::run_each`](super::Session::run_each)), before the next view
+/// starts: the view's lines in world coordinates and the files it wrote.
+pub struct ViewDone {
+    /// The frame (its index in the input's frames).
+    pub frame: usize,
+    /// The view (its index in the scene's views).
+    pub view: usize,
+    /// The camera as resolved (a fitted view's eye placed), world
+    /// coordinates.
+    pub camera: Camera,
+    /// The line segments found for this view (world coordinates).
+    pub segments: Vec<Segment>,
+    /// The lines classified and chained by exact visibility (world
+    /// coordinates), where the plan ran it.
+    pub visible: Option<super::vector::VisibleLines>,
+    /// The feature size the line families' thresholds were scaled by, when
+    /// lines were found.
+    pub feature_size: Option<f32>,
+    /// The images the view wrote (PNG, SVG).
+    pub files: Vec<PathBuf>,
+}
+
 /// The edge buffer's counts (House & Li's edge buffer and the adjacency
 /// caps' pairs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]

@@ -212,22 +212,23 @@ pub fn frame_indices(scene: &Scene, available: usize) -> Result<Vec<usize>> {
     Ok((start..end).step_by(step).collect())
 }
 
-/// The image files a run writes, in order (frame-major), and the report.
+/// The image files a run writes, in order (frame-major), and the report:
+/// `<prefix>_f<frame>_v<view>.png` and `.svg`, the frame in 4 digits and
+/// the view in 2, or as many as the last view's index has (so that the
+/// names of a run sort in view order), and `<prefix>_report.json`.
 pub fn output_paths(
     scene: &Scene,
     frames: &[usize],
     out_dir: &Path,
 ) -> (Vec<(usize, usize, PathBuf)>, PathBuf) {
     let mut v = Vec::new();
+    let digits = (scene.views.len().saturating_sub(1).to_string().len()).max(2);
     for &f in frames {
         for view in 0..scene.views.len() {
             for (on, ext) in [(scene.png, "png"), (scene.svg, "svg")] {
                 if on {
-                    v.push((
-                        f,
-                        view,
-                        out_dir.join(format!("{}_f{f:04}_v{view:02}.{ext}", scene.prefix)),
-                    ));
+                    let name = format!("{}_f{f:04}_v{view:0digits$}.{ext}", scene.prefix);
+                    v.push((f, view, out_dir.join(name)));
                 }
             }
         }

@@ -74,7 +74,11 @@ pub struct RunReport {
     /// The wall time of the whole run, and one phase entry per pose
     /// (`pose`: its passes, their own clocks), per view (`view`: the view
     /// passes other than rendering) and per render (`render`: draw + read
-    /// back), in order; medians are the reader's ([`Timing::laps`]).
+    /// back), in order; medians are the reader's ([`Timing::laps`]). Those
+    /// sum what the passes recorded, each on its own clock (topology passes
+    /// left out); `pose_wall` (per pose, topology passes with the first) and
+    /// `view_wall` (per view, drawing and writing included) are wall-clock
+    /// laps of the same loop.
     pub timing: Timing,
 }
 

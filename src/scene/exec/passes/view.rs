@@ -348,6 +348,35 @@ impl Executor<'_, '_> {
             .collect()
     }
 
+    /// What a run hands its caller after the view of `frame` and `view`
+    /// from `cam` that wrote `files` (world coordinates).
+    pub(in crate::scene::exec) fn view_done(
+        &self,
+        (frame, view): (usize, usize),
+        cam: &Camera,
+        files: Vec<PathBuf>,
+    ) -> draw::ViewDone {
+        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let world =
+            |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
+        let shift = glam::DVec3::from(o).as_vec3();
+        draw::ViewDone {
+            frame,
+            view,
+            camera: Camera {
+                eye: cam.eye + shift,
+                target: cam.target + shift,
+                ..*cam
+            },
+            segments: (self.segs.iter())
+                .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
+                .collect(),
+            visible: self.vis.as_ref().map(|v| v.shifted(o)),
+            feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
+            files,
+        }
+    }
+
     /// What a view drawn into memory hands its caller: the image, the SVG
     /// groups, the segments (world coordinates), the edge stage's outputs,
     /// the strokes, the camera (world coordinates) and the kernel time of

@@ -1,0 +1,343 @@
+//! `shapecue lines MESH --views N --out DIR` and `--cameras FILE.json`:
+//! many views of one mesh in one run of the scene executor (the pose passes
+//! once, the view passes per camera). Per view an SVG (exact visibility
+//! needs no OpenGL), with `--png` a PNG, with `--segments` the segments
+//! document of `shapecue lines --segments`; then `manifest.json`: the mesh,
+//! the options, each view's camera and files, and the run's timing.
+
+use super::{LinesArgs, check_outputs, common, picture_options, segments_doc};
+use anyhow::{Result, bail};
+use serde_json::{Value, json};
+use shapecue::api::{
+    CameraDefaults, ExecOptions, Gpu, MAX_VIEWS, RunReport, Session, ViewDone, fibonacci_views,
+    lines_views_scene, load_camera_file, output_paths,
+};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The files of a views run, before it starts.
+struct Files {
+    /// Each view's images (PNG, SVG) in view order.
+    images: Vec<(usize, PathBuf)>,
+    /// The executor's report.
+    report: PathBuf,
+    /// Each view's segments document, where asked.
+    segments: Option<Vec<PathBuf>>,
+    /// The manifest.
+    manifest: PathBuf,
+}
+
+/// Runs the views mode of `shapecue lines`.
+pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
+    let out = check_flags(&a)?;
+    let c = common(&a)?;
+    let (scene, mesh, load_ms) = views_scene(&a, &c, &out)?;
+    let files = files(&scene, &out, a.segments.is_some());
+    if a.explain {
+        let mut s = shapecue::api::explain(&scene, &ExecOptions::default())?;
+        if let Some(seg) = &files.segments {
+            s.push_str(&format!("  and {} segments file(s)\n", seg.len()));
+        }
+        s.push_str(&format!("  and {}\n", files.manifest.display()));
+        super::super::print_str(&s)?;
+        return Ok(());
+    }
+    let outputs = (files.images.iter().map(|i| i.1.as_path()))
+        .chain([files.report.as_path(), files.manifest.as_path()])
+        .chain(files.segments.iter().flatten().map(|p| p.as_path()));
+    // The folders the run makes (deepest first), to remove if it fails.
+    let new_dirs: Vec<PathBuf> = (out.ancestors())
+        .filter(|d| !d.as_os_str().is_empty() && !d.exists())
+        .map(PathBuf::from)
+        .collect();
+    check_outputs(c.inputs(), outputs, a.force)?;
+    let t_run = Instant::now();
+    let mut run = ViewsRun {
+        segments: files.segments.as_deref(),
+        entries: Vec::new(),
+        written: Vec::new(),
+        hand_ms: 0.0,
+    };
+    let exec = ExecOptions {
+        force: a.force,
+        ..Default::default()
+    };
+    let result = Gpu::new(device).and_then(|gpu| {
+        Session::on(Arc::new(gpu)).run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
+    });
+    let report = match result {
+        Ok(r) => r,
+        Err(e) => {
+            run.remove_written(&new_dirs);
+            return Err(e.into());
+        }
+    };
+    let run_ms = ms_since(t_run);
+    let timing = timing_doc(&report, (load_ms, run_ms, run.hand_ms));
+    let doc = json!({
+        "mesh": a.mesh,
+        "vertices": mesh.n_vertices(),
+        "faces": mesh.n_faces(),
+        "options": options_doc(&a, &c),
+        "device": report.device,
+        "renderer": report.renderer,
+        "report": name(&files.report),
+        "views": run.entries,
+        "timing": &timing,
+    });
+    let text = serde_json::to_string_pretty(&doc)? + "\n";
+    shapecue::export::output::write_bytes_atomic(&files.manifest, text.as_bytes())?;
+    super::super::print(format_args!(
+        "{}: {} views ({} files); pose {:.1} ms, views {:.1} ms ({:.2} views/s); {}",
+        out.display(),
+        report.views,
+        // The images, the segments, the report and the manifest.
+        report.outputs.len() + files.segments.map_or(0, |s| s.len()) + 2,
+        timing["pose_ms"].as_f64().unwrap_or(0.0),
+        timing["views_ms"].as_f64().unwrap_or(0.0),
+        timing["views_per_second"].as_f64().unwrap_or(0.0),
+        files.manifest.display()
+    ))?;
+    Ok(())
+}
+
+/// The scene of the views: the camera set, the mesh (and the ms loading
+/// it took), the lines' options with an SVG per view (and a PNG with
+/// `--png`), the files named after the mesh in `out`.
+fn views_scene(
+    a: &LinesArgs,
+    c: &super::Common,
+    out: &Path,
+) -> Result<(shapecue::api::Scene, Arc<shapecue::Mesh>, f64)> {
+    let defaults = CameraDefaults {
+        fov: a.fov,
+        ortho: a.ortho,
+    };
+    let views = match (a.views, &a.cameras) {
+        (Some(n), None) => fibonacci_views(n, defaults)?,
+        (None, Some(f)) => load_camera_file(f, defaults)?,
+        _ => unreachable!("check_flags asks for one of --views and --cameras"),
+    };
+    let t_load = Instant::now();
+    let mesh = Arc::new(c.mesh(&a.mesh)?);
+    let load_ms = ms_since(t_load);
+    let mut opts = picture_options(a, c)?;
+    opts.image = a.png;
+    opts.svg = true;
+    let mut scene = lines_views_scene(mesh.clone(), &opts, views);
+    scene.out_dir = out.to_path_buf();
+    scene.prefix = stem(&a.mesh);
+    scene.path = c.path.clone();
+    Ok((scene, mesh, load_ms))
+}
+
+/// Checks the flags of the views mode; returns the output folder.
+fn check_flags(a: &LinesArgs) -> Result<PathBuf> {
+    if a.output.is_some() {
+        bail!(
+            "-o writes one picture; --views and --cameras write a file per view into --out DIR: \
+             give one or the other"
+        );
+    }
+    match (a.views, &a.cameras) {
+        (Some(_), Some(_)) => bail!("give --views N or --cameras FILE, not both"),
+        (None, None) => bail!("--out DIR goes with --views N or --cameras FILE.json"),
+        (Some(n), None) if !(1..=MAX_VIEWS).contains(&n) => {
+            bail!("--views {n}: give 1 to {MAX_VIEWS} views")
+        }
+        _ => {}
+    }
+    if a.eye.is_some() || a.target.is_some() || a.up.is_some() {
+        bail!(
+            "--eye, --target and --up set the one camera of -o; --views fits its cameras to the \
+             mesh, and a --cameras file gives each its eye, target and up"
+        );
+    }
+    if let Some(Some(p)) = &a.segments {
+        bail!(
+            "--segments {}: with --views or --cameras give --segments alone; each view's \
+             segments go next to its SVG in --out",
+            p.display()
+        );
+    }
+    let Some(out) = a.out.clone() else {
+        bail!("--views and --cameras write into a folder: give --out DIR");
+    };
+    if out.is_file() {
+        bail!("--out {}: is a file; give a folder", out.display());
+    }
+    Ok(out)
+}
+
+/// The file name prefix of a mesh: its file stem (a generated mesh's name).
+fn stem(mesh: &str) -> String {
+    let s = Path::new(mesh).file_stem().and_then(|s| s.to_str());
+    s.filter(|s| !s.is_empty()).unwrap_or("mesh").to_string()
+}
+
+/// Every file of the run: the executor's images and report (frame 0 of a
+/// static mesh), the segments next to each SVG, the manifest.
+fn files(scene: &shapecue::api::Scene, out: &Path, segments: bool) -> Files {
+    let (images, report) = output_paths(scene, &[0], out);
+    let segments = segments.then(|| {
+        (images.iter())
+            .filter(|i| i.2.extension().is_some_and(|e| e == "svg"))
+            .map(|i| segments_path(&i.2))
+            .collect()
+    });
+    Files {
+        images: images.into_iter().map(|i| (i.1, i.2)).collect(),
+        report,
+        segments,
+        manifest: out.join("manifest.json"),
+    }
+}
+
+/// The segments document beside an SVG: `X.svg` → `X_segments.json`.
+fn segments_path(svg: &Path) -> PathBuf {
+    let stem = svg
+        .file_stem()
+        .map(|s| s.to_string_lossy())
+        .unwrap_or_default();
+    svg.with_file_name(format!("{stem}_segments.json"))
+}
+
+/// What the run gathers view by view.
+struct ViewsRun<'a> {
+    /// Each view's segments file, where asked (in view order).
+    segments: Option<&'a [PathBuf]>,
+    /// Each view's manifest entry.
+    entries: Vec<Value>,
+    /// The segments files written so far.
+    written: Vec<PathBuf>,
+    /// Wall time spent here (writing the segments documents, gathering the
+    /// manifest's entries), outside the executor's view laps.
+    hand_ms: f64,
+}
+
+impl ViewsRun<'_> {
+    /// One view done: its segments written (whole), its entry kept.
+    fn view(&mut self, v: ViewDone) -> shapecue::Result<()> {
+        let t = Instant::now();
+        let mut files: Vec<String> = v.files.iter().map(|p| name(p)).collect();
+        if let Some(paths) = self.segments {
+            let p = &paths[v.view];
+            let doc = segments_doc(
+                v.visible.as_ref(),
+                &v.segments,
+                v.feature_size.unwrap_or(0.0),
+            );
+            let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
+            let fresh = !p.exists();
+            shapecue::export::output::write_bytes_atomic(p, text.as_bytes())?;
+            if fresh {
+                self.written.push(p.clone());
+            }
+            files.push(name(p));
+        }
+        let cam = v.camera;
+        self.entries.push(json!({
+            "index": v.view,
+            "camera": {
+                "eye": cam.eye.to_array(),
+                "target": cam.target.to_array(),
+                "up": cam.up.to_array(),
+                "fov": cam.fov_y_deg,
+                "ortho": cam.ortho_height,
+                "near": cam.near,
+                "far": cam.far,
+            },
+            "segments": v.segments.iter().filter(|s| s.3 > 0.0).count(),
+            "files": files,
+        }));
+        self.hand_ms += ms_since(t);
+        Ok(())
+    }
+
+    /// After a failed run: removes the segments files it created, and the
+    /// folders the run made (`new_dirs`, deepest first) where they are left
+    /// empty (the executor removes its own files).
+    fn remove_written(&self, new_dirs: &[PathBuf]) {
+        for p in &self.written {
+            let _ = std::fs::remove_file(p);
+        }
+        for d in new_dirs {
+            let _ = std::fs::remove_dir(d);
+        }
+    }
+}
+
+/// The run's timing: the pose part (topology and pose passes, wall clock),
+/// the view part (every view's passes, drawing and writing, wall clock),
+/// views per second over the view part and over the whole run, the time
+/// spent writing segments documents (outside the view part), and the
+/// passes' own clocks.
+fn timing_doc(r: &RunReport, (load_ms, run_ms, hand_ms): (f64, f64, f64)) -> Value {
+    let t = &r.timing;
+    let (pose_ms, views_ms) = (t.phase_ms("pose_wall"), t.phase_ms("view_wall"));
+    let n = r.views.max(1) as f64;
+    json!({
+        "load_ms": load_ms,
+        "run_ms": run_ms,
+        "pose_ms": pose_ms,
+        "views_ms": views_ms,
+        "per_view_ms": views_ms / n,
+        "views_per_second": if views_ms > 0.0 { 1e3 * n / views_ms } else { 0.0 },
+        "run_views_per_second": if run_ms > 0.0 { 1e3 * n / run_ms } else { 0.0 },
+        "segments_ms": hand_ms,
+        "passes_ms": {
+            "pose": t.phase_ms("pose"),
+            "view": t.phase_ms("view"),
+            "render": t.phase_ms("render"),
+        },
+    })
+}
+
+/// The options of the run, as the manifest lists them.
+fn options_doc(a: &LinesArgs, c: &super::Common) -> Value {
+    let fams: Vec<&str> = c.fams.iter().map(|f| f.name()).collect();
+    json!({
+        "lines": fams,
+        "views": a.views,
+        "cameras": a.cameras,
+        "size": [c.size.0, c.size.1],
+        "line_width": plain(c.width),
+        "fov": plain(a.fov),
+        "ortho": a.ortho,
+        "visibility": a.visibility.name(),
+        "hidden": a.hidden.name(),
+        "png": a.png,
+        "segments": a.segments.is_some(),
+        "feature_size": a.feature_size,
+        "sc_threshold": plain(a.sc_threshold),
+        "fade": plain(a.fade),
+        "rv_threshold": plain(a.rv_threshold),
+        "ar_threshold": plain(a.ar_threshold),
+        "ph_threshold": plain(a.ph_threshold),
+        "sh_threshold": plain(a.sh_threshold),
+        "isophotes": a.isophotes,
+        "compat": a.compat.name(),
+        "cull": !a.no_cull,
+        "test": !a.no_test,
+        "fade_lines": !a.no_fade,
+        "hermite": a.hermite,
+        "hermite_kh": a.hermite_kh,
+    })
+}
+
+/// A file's name (the manifest lists the files of its own folder).
+fn name(p: &Path) -> String {
+    p.file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+}
+
+/// An option's value as written (0.1, not the f32's 0.10000000149).
+fn plain(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
+/// Milliseconds since `t`.
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}

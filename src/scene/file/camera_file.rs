@@ -1,0 +1,224 @@
+//! Camera sets as scene views: the fitted views of evenly spread directions
+//! ([`fibonacci_views`]) and camera files ([`load_camera_file`]), JSON
+//! lists of explicit cameras:
+//!
+//! ```json
+//! {"cameras": [
+//!   {"eye": [0, 0.5, 3], "target": [0, 0.5, 0]},
+//!   {"eye": [3, 1, 0], "target": [0, 0.5, 0], "up": [0, 1, 0], "fov": 30},
+//!   {"eye": [0, 4, 0.1], "target": [0, 0, 0], "ortho": 2.5}
+//! ]}
+//! ```
+//!
+//! `eye` and `target` are required (world coordinates); `up` defaults to
+//! +Y (+Z when looking along Y); `fov` is the vertical field of view in
+//! degrees; `ortho` an orthographic projection showing that world-space
+//! height at the target (a view takes `fov` or `ortho`, not both). Cameras
+//! are counted from 0, as the views they become.
+
+use super::{CameraKind, ViewSpec};
+use crate::error::{Error, Result};
+use crate::spec::cameras::{MAX_VIEWS, fibonacci_directions};
+use std::path::Path;
+
+/// What a camera of a set takes when it does not say: the vertical field
+/// of view in degrees and whether the view is orthographic (showing the
+/// height the perspective view shows at the target).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDefaults {
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov: f32,
+    /// Orthographic.
+    pub ortho: bool,
+}
+
+impl Default for CameraDefaults {
+    fn default() -> Self {
+        CameraDefaults {
+            fov: 40.0,
+            ortho: false,
+        }
+    }
+}
+
+/// One camera of a camera file, as written.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraEntry {
+    eye: [f32; 3],
+    target: [f32; 3],
+    up: Option<[f32; 3]>,
+    fov: Option<f32>,
+    ortho: Option<f32>,
+}
+
+/// `n` views fitted to the bounds (the bounding sphere filling the view
+/// with a 5 % margin) from the directions of
+/// [`fibonacci_directions`], each looking at the centre of the bounds.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for `n` outside 1..=[`MAX_VIEWS`] or a field
+/// of view outside (0, 180) degrees.
+pub fn fibonacci_views(n: usize, defaults: CameraDefaults) -> Result<Vec<ViewSpec>> {
+    if !(1..=MAX_VIEWS).contains(&n) {
+        return Err(Error::InvalidArgument(format!(
+            "a camera set holds 1 to {MAX_VIEWS} views, not {n}"
+        )));
+    }
+    check_fov(defaults.fov).map_err(Error::InvalidArgument)?;
+    Ok(fibonacci_directions(n)
+        .into_iter()
+        .map(|d| ViewSpec {
+            kind: CameraKind::Fit(d),
+            up: None,
+            fov: defaults.fov,
+            ortho: defaults.ortho,
+        })
+        .collect())
+}
+
+/// The views of the camera file at `path` (see the module's format), one
+/// per camera in order, each with `defaults` where it says nothing.
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read; [`Error::InvalidInput`]
+/// naming the file, the camera and the problem otherwise
+/// ([`parse_camera_file`]).
+pub fn load_camera_file(path: &Path, defaults: CameraDefaults) -> Result<Vec<ViewSpec>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_camera_file(&text, &path.display().to_string(), defaults)
+}
+
+/// The views of a camera file's `text`; errors name `name` (the file).
+///
+/// # Errors
+/// [`Error::InvalidInput`] naming the file and the camera (counted from 0)
+/// for text that is not JSON, a document without its `cameras` list, an
+/// empty list or one of more than [`MAX_VIEWS`], and a camera with a
+/// missing or unknown key, a non-finite number, eye and target at one
+/// point, a zero `up` or one along the view, a field of view outside
+/// (0, 180) degrees, a height that is not positive, or both `fov` and
+/// `ortho`.
+pub fn parse_camera_file(
+    text: &str,
+    name: &str,
+    defaults: CameraDefaults,
+) -> Result<Vec<ViewSpec>> {
+    let bad = |element: &str, problem: String| Error::input(name, element, problem);
+    let doc: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| bad("the file", format!("not JSON ({e})")))?;
+    let list = (doc.as_object())
+        .and_then(|o| o.get("cameras"))
+        .and_then(|c| c.as_array())
+        .ok_or_else(|| {
+            bad(
+                "the file",
+                "expected an object with a \"cameras\" list, as {\"cameras\": [{\"eye\": \
+                 [0, 0, 3], \"target\": [0, 0, 0]}]}"
+                    .into(),
+            )
+        })?;
+    if let Some(k) = (doc.as_object().into_iter().flat_map(|o| o.keys())).find(|k| *k != "cameras")
+    {
+        return Err(bad(
+            "the file",
+            format!("unknown key \"{k}\" (only \"cameras\")"),
+        ));
+    }
+    if list.is_empty() {
+        return Err(bad(
+            "cameras",
+            "the list is empty: give at least one camera".into(),
+        ));
+    }
+    if list.len() > MAX_VIEWS {
+        return Err(bad(
+            "cameras",
+            format!(
+                "{} cameras, more than the {MAX_VIEWS} a set may hold",
+                list.len()
+            ),
+        ));
+    }
+    (list.iter().enumerate())
+        .map(|(i, v)| {
+            let element = format!("camera {i}");
+            let entry: CameraEntry =
+                serde_json::from_value(v.clone()).map_err(|e| bad(&element, e.to_string()))?;
+            camera_view(&entry, defaults).map_err(|p| bad(&element, p))
+        })
+        .collect()
+}
+
+/// One camera's view; the error is the problem in words.
+fn camera_view(c: &CameraEntry, defaults: CameraDefaults) -> std::result::Result<ViewSpec, String> {
+    let vectors = [
+        ("eye", Some(c.eye)),
+        ("target", Some(c.target)),
+        ("up", c.up),
+    ];
+    for (key, v) in vectors {
+        if let Some(v) = v
+            && !v.iter().all(|x| x.is_finite())
+        {
+            return Err(format!(
+                "{key} has a number that is not finite (or too large)"
+            ));
+        }
+    }
+    let (eye, target) = (glam::Vec3::from(c.eye), glam::Vec3::from(c.target));
+    let dir = target - eye;
+    let scale = eye.abs().max(target.abs()).max_element().max(1.0);
+    if dir.length() <= 1e-6 * scale {
+        return Err("eye and target are at one point: the camera looks nowhere".into());
+    }
+    if let Some(u) = c.up {
+        let u = glam::Vec3::from(u);
+        if u.length() == 0.0 || !u.length().is_finite() {
+            return Err("up is zero: give the direction that is up in the image".into());
+        }
+        if dir.normalize().cross(u.normalize()).length() < 1e-4 {
+            return Err(
+                "up lies along the view (eye to target): the image would have no up".into(),
+            );
+        }
+    }
+    let (fov, ortho) = match (c.fov, c.ortho) {
+        (Some(_), Some(_)) => {
+            return Err("give fov (perspective) or ortho (orthographic height), not both".into());
+        }
+        (Some(f), None) => (f, false),
+        // The executor's orthographic view shows the height the
+        // perspective view of `fov` shows at the target: the fov whose
+        // view shows `h` there.
+        (None, Some(h)) => {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(format!("ortho {h} must be a positive height"));
+            }
+            (2.0 * (0.5 * h / dir.length()).atan().to_degrees(), true)
+        }
+        (None, None) => (defaults.fov, defaults.ortho),
+    };
+    check_fov(fov)?;
+    Ok(ViewSpec {
+        kind: CameraKind::LookAt {
+            eye: c.eye,
+            target: Some(c.target),
+        },
+        up: c.up,
+        fov,
+        ortho,
+    })
+}
+
+/// A field of view in (0, 180) degrees.
+fn check_fov(fov: f32) -> std::result::Result<(), String> {
+    if fov > 0.0 && fov < 180.0 {
+        Ok(())
+    } else {
+        Err(format!("fov {fov} must be in (0, 180) degrees"))
+    }
+}
