@@ -1,5 +1,5 @@
 //! Shared types of the `visibility` family: exact, object-space visibility
-//! of line segments (the issue "Exact visibility on the device"), by
+//! of line segments, for SVG output without a rasterizer, by
 //! occlusion queries towards the eye over the `bvh` family's tree. The
 //! options ([`VisibilityOptions`], [`Spacing`]), the output ([`Piece`],
 //! [`Pieces`]) and its bound ([`visibility_bound`], [`MAX_INTERVALS`]).
