@@ -414,3 +414,68 @@ fn one_picture_and_many_views_are_exclusive() {
     assert_eq!(runs("contours"), "5");
     assert!(!out.exists());
 }
+
+/// The `.npy` header of `name` in an NPZ's bytes: its dtype and shape text.
+fn npy_header(npz: &[u8], name: &str) -> String {
+    let entry = format!("{name}.npy");
+    let at = (npz.windows(entry.len()))
+        .position(|w| w == entry.as_bytes())
+        .unwrap_or_else(|| panic!("no {entry}"));
+    let magic = b"\x93NUMPY";
+    let start = at
+        + (npz[at..].windows(magic.len()))
+            .position(|w| w == magic)
+            .expect("an .npy after its name");
+    let head = &npz[start..(start + 200).min(npz.len())];
+    String::from_utf8_lossy(head).into_owned()
+}
+
+#[test]
+fn npz_segments_hold_the_pieces_of_the_json_document() {
+    let d = scratch("views-npz");
+    let out = d.join("out");
+    let o = out.to_str().unwrap();
+    let args = [
+        "lines",
+        &spot(),
+        "--views",
+        "2",
+        "--out",
+        o,
+        "--segments",
+        "--npz",
+    ];
+    ok(&no_gl(&d, &args));
+    let manifest = read_json(&out.join("manifest.json"));
+    assert_eq!(manifest["family_codes"]["0"], "contours");
+    for i in 0..2 {
+        let npz = std::fs::read(out.join(format!("spot_f0000_v{i:02}_segments.npz"))).unwrap();
+        let doc = read_json(&out.join(format!("spot_f0000_v{i:02}_segments.json")));
+        let n = doc["segments"].as_array().unwrap().len();
+        assert!(n > 0);
+        assert_eq!(&npz[..4], b"PK\x03\x04", "a zip");
+        let a = npy_header(&npz, "a");
+        assert!(
+            a.contains("'<f4'") && a.contains(&format!("({n}, 3)")),
+            "{a}"
+        );
+        let faces = npy_header(&npz, "faces");
+        assert!(
+            faces.contains("'<i8'") && faces.contains(&format!("({n}, 4)")),
+            "{faces}"
+        );
+        for name in ["family", "strength", "visible", "chain"] {
+            let h = npy_header(&npz, name);
+            assert!(h.contains(&format!("({n},)")), "{name}: {h}");
+        }
+        let files = &manifest["views"][i]["files"];
+        assert_eq!(files[2], format!("spot_f0000_v{i:02}_segments.npz"));
+    }
+    // One picture has no --npz.
+    let svg = d.join("one.svg");
+    let one = no_gl(
+        &d,
+        &["lines", &spot(), "-o", svg.to_str().unwrap(), "--npz"],
+    );
+    failed_with(&one, &["--npz", "--views"]);
+}

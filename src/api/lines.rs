@@ -244,3 +244,32 @@ pub fn wanted(o: &LineOptions) -> Vec<LineFamily> {
     v.extend(o.curves.families.curves().iter());
     v
 }
+
+/// The pieces of a view's classified lines as NPZ-ready arrays
+/// ([`crate::export::npz`]): one row per piece (world coordinates), its
+/// segment's family or layer code (a [`LineFamily`] as `u32`, or the
+/// feature edges', intersection lines' or strokes' layer), strength,
+/// visibility, the faces it lies on (`-1` past the last) and its chain.
+pub fn segment_arrays(v: &VisibleLines) -> crate::export::npz::SegmentArrays {
+    let mut chain_of = vec![0u32; v.chain_pieces.len()];
+    for (c, ch) in v.chains.iter().enumerate() {
+        for &(i, _) in &ch.pieces {
+            chain_of[i as usize] = c as u32;
+        }
+    }
+    let mut out = crate::export::npz::SegmentArrays::default();
+    for (i, p) in v.chain_pieces.iter().enumerate() {
+        let s = &v.segments[p.seg as usize];
+        out.a.push(v.point(p.seg, p.t[0]));
+        out.b.push(v.point(p.seg, p.t[1]));
+        out.family.push(s.2);
+        out.strength.push(s.3);
+        out.visible.push(u8::from(p.visible));
+        let f = &v.faces[p.seg as usize];
+        out.faces.push(std::array::from_fn(|k| {
+            f.get(k).map_or(-1, |&x| i64::from(x))
+        }));
+        out.chain.push(chain_of[i]);
+    }
+    out
+}

@@ -136,6 +136,11 @@ pub struct LinesArgs {
     /// --cameras, give no file: each view's go next to its SVG.
     #[arg(long, num_args = 0..=1, value_name = "FILE")]
     segments: Option<Option<PathBuf>>,
+    /// With --views or --cameras: each view's segment pieces also as NPZ
+    /// arrays next to its SVG (a, b, family, strength, visible, faces,
+    /// chain; `numpy.load`).
+    #[arg(long)]
+    npz: bool,
     /// Many views in one run: N views fitted to the mesh from directions
     /// spread evenly over the sphere (the Fibonacci lattice), an SVG each
     /// in --out.
@@ -237,7 +242,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if a.views.is_some() || a.cameras.is_some() || a.out.is_some() {
         return views::run(device, a);
     }
-    for (on, flag) in [(a.png, "--png"), (a.explain, "--explain")] {
+    for (on, flag) in [(a.png, "--png"), (a.explain, "--explain"), (a.npz, "--npz")] {
         if on {
             bail!("{flag} goes with --views N or --cameras FILE (and --out DIR)");
         }

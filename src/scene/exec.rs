@@ -49,7 +49,7 @@ pub use draw::{EdgeCounts, EdgeInfo, ViewDone, ViewOutputs};
 pub use live::{Change, LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
-pub use vector::{LAYER_FEATURE_EDGES, VisibleLines};
+pub use vector::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES, VisibleLines};
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;

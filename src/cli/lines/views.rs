@@ -24,6 +24,8 @@ struct Files {
     report: PathBuf,
     /// Each view's segments document, where asked.
     segments: Option<Vec<PathBuf>>,
+    /// Each view's segment arrays (NPZ), where asked.
+    npz: Option<Vec<PathBuf>>,
     /// The manifest.
     manifest: PathBuf,
 }
@@ -33,11 +35,14 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let out = check_flags(&a)?;
     let c = common(&a)?;
     let (scene, mesh, load_ms) = views_scene(&a, &c, &out)?;
-    let files = files(&scene, &out, a.segments.is_some());
+    let files = files(&scene, &out, a.segments.is_some(), a.npz);
     if a.explain {
         let mut s = shapecue::api::explain(&scene, &ExecOptions::default())?;
         if let Some(seg) = &files.segments {
             s.push_str(&format!("  and {} segments file(s)\n", seg.len()));
+        }
+        if let Some(npz) = &files.npz {
+            s.push_str(&format!("  and {} NPZ file(s)\n", npz.len()));
         }
         s.push_str(&format!("  and {}\n", files.manifest.display()));
         super::super::print_str(&s)?;
@@ -45,7 +50,8 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let outputs = (files.images.iter().map(|i| i.1.as_path()))
         .chain([files.report.as_path(), files.manifest.as_path()])
-        .chain(files.segments.iter().flatten().map(|p| p.as_path()));
+        .chain(files.segments.iter().flatten().map(|p| p.as_path()))
+        .chain(files.npz.iter().flatten().map(|p| p.as_path()));
     // The folders the run makes (deepest first), to remove if it fails.
     let new_dirs: Vec<PathBuf> = (out.ancestors())
         .filter(|d| !d.as_os_str().is_empty() && !d.exists())
@@ -55,6 +61,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let t_run = Instant::now();
     let mut run = ViewsRun {
         segments: files.segments.as_deref(),
+        npz: files.npz.as_deref(),
         entries: Vec::new(),
         written: Vec::new(),
         hand_ms: 0.0,
@@ -83,6 +90,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         "device": report.device,
         "renderer": report.renderer,
         "report": name(&files.report),
+        "family_codes": family_codes(),
         "views": run.entries,
         "timing": &timing,
     });
@@ -93,7 +101,10 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         out.display(),
         report.views,
         // The images, the segments, the report and the manifest.
-        report.outputs.len() + files.segments.map_or(0, |s| s.len()) + 2,
+        report.outputs.len()
+            + files.segments.map_or(0, |s| s.len())
+            + files.npz.map_or(0, |s| s.len())
+            + 2,
         timing["pose_ms"].as_f64().unwrap_or(0.0),
         timing["views_ms"].as_f64().unwrap_or(0.0),
         timing["views_per_second"].as_f64().unwrap_or(0.0),
@@ -178,35 +189,42 @@ fn stem(mesh: &str) -> String {
 
 /// Every file of the run: the executor's images and report (frame 0 of a
 /// static mesh), the segments next to each SVG, the manifest.
-fn files(scene: &shapecue::api::Scene, out: &Path, segments: bool) -> Files {
+fn files(scene: &shapecue::api::Scene, out: &Path, segments: bool, npz: bool) -> Files {
     let (images, report) = output_paths(scene, &[0], out);
-    let segments = segments.then(|| {
-        (images.iter())
-            .filter(|i| i.2.extension().is_some_and(|e| e == "svg"))
-            .map(|i| segments_path(&i.2))
-            .collect()
-    });
+    let beside = |on: bool, ext: &str| {
+        on.then(|| {
+            (images.iter())
+                .filter(|i| i.2.extension().is_some_and(|e| e == "svg"))
+                .map(|i| segments_path(&i.2, ext))
+                .collect()
+        })
+    };
+    let (segments, npz) = (beside(segments, "json"), beside(npz, "npz"));
     Files {
         images: images.into_iter().map(|i| (i.1, i.2)).collect(),
         report,
         segments,
+        npz,
         manifest: out.join("manifest.json"),
     }
 }
 
-/// The segments document beside an SVG: `X.svg` → `X_segments.json`.
-fn segments_path(svg: &Path) -> PathBuf {
+/// The segments file beside an SVG: `X.svg` → `X_segments.json` (or
+/// `.npz`).
+fn segments_path(svg: &Path, ext: &str) -> PathBuf {
     let stem = svg
         .file_stem()
         .map(|s| s.to_string_lossy())
         .unwrap_or_default();
-    svg.with_file_name(format!("{stem}_segments.json"))
+    svg.with_file_name(format!("{stem}_segments.{ext}"))
 }
 
 /// What the run gathers view by view.
 struct ViewsRun<'a> {
     /// Each view's segments file, where asked (in view order).
     segments: Option<&'a [PathBuf]>,
+    /// Each view's NPZ file, where asked (in view order).
+    npz: Option<&'a [PathBuf]>,
     /// Each view's manifest entry.
     entries: Vec<Value>,
     /// The segments files written so far.
@@ -231,6 +249,15 @@ impl ViewsRun<'_> {
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
             let fresh = !p.exists();
             shapecue::export::output::write_bytes_atomic(p, text.as_bytes())?;
+            if fresh {
+                self.written.push(p.clone());
+            }
+            files.push(name(p));
+        }
+        if let (Some(paths), Some(vis)) = (self.npz, v.visible.as_ref()) {
+            let p = &paths[v.view];
+            let fresh = !p.exists();
+            shapecue::export::npz::write_segments(p, &shapecue::api::segment_arrays(vis))?;
             if fresh {
                 self.written.push(p.clone());
             }
@@ -266,6 +293,27 @@ impl ViewsRun<'_> {
             let _ = std::fs::remove_dir(d);
         }
     }
+}
+
+/// The codes of the NPZ files' `family` array: the line families', and the
+/// feature edges', intersection lines' and strokes' layers.
+fn family_codes() -> Value {
+    use shapecue::api::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES};
+    use shapecue::spec::feature_lines::LineFamily;
+    let mut m = serde_json::Map::new();
+    for k in 0..64 {
+        if let Some(f) = LineFamily::from_kind(k) {
+            m.insert(k.to_string(), f.name().into());
+        }
+    }
+    for (k, n) in [
+        (LAYER_FEATURE_EDGES, "feature-edges"),
+        (LAYER_INTERSECTIONS, "intersection-lines"),
+        (LAYER_STROKES, "curvature-strokes"),
+    ] {
+        m.insert(k.to_string(), n.into());
+    }
+    Value::Object(m)
 }
 
 /// The run's timing: the pose part (topology and pose passes, wall clock),
@@ -309,6 +357,7 @@ fn options_doc(a: &LinesArgs, c: &super::Common) -> Value {
         "hidden": a.hidden.name(),
         "png": a.png,
         "segments": a.segments.is_some(),
+        "npz": a.npz,
         "feature_size": a.feature_size,
         "sc_threshold": plain(a.sc_threshold),
         "fade": plain(a.fade),
