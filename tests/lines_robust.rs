@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{cli, obj_text, scratch, write};
+use common::{cli_no_gl, obj_text, scratch, write};
 use shapecue::mesh::{Mesh, icosphere, torus};
 use std::path::Path;
 
@@ -73,10 +73,7 @@ fn cases() -> Vec<(&'static str, String)> {
 }
 
 fn lines(dir: &Path, mesh: &Path, tag: &str) -> std::process::Output {
-    let empty = dir.join("no-egl-vendors");
-    std::fs::create_dir_all(&empty).unwrap();
-    cli()
-        .env("__EGL_VENDOR_LIBRARY_DIRS", &empty)
+    cli_no_gl(dir)
         .arg("lines")
         .arg(mesh)
         .args(["--lines", "contours,suggestive,ridges,valleys,boundaries"])

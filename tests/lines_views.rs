@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{cli, scratch};
+use common::{assert_succeeded, cli_no_gl, scratch};
 use serde_json::Value;
 use shapecue::api::{
     CameraDefaults, CameraKind, LinesPictureOptions, fibonacci_directions, fibonacci_views,
@@ -18,21 +18,11 @@ use std::process::Output;
 
 /// The command with no EGL vendor to load.
 fn no_gl(dir: &Path, args: &[&str]) -> Output {
-    let empty = dir.join("no-egl-vendors");
-    std::fs::create_dir_all(&empty).unwrap();
-    cli()
-        .env("__EGL_VENDOR_LIBRARY_DIRS", &empty)
-        .args(args)
-        .output()
-        .unwrap()
+    cli_no_gl(dir).args(args).output().unwrap()
 }
 
 fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_succeeded(out);
 }
 
 fn failed_with(out: &Output, words: &[&str]) {

@@ -6,27 +6,17 @@
 
 mod common;
 
-use common::{cli, cli_gl_missing, scratch};
+use common::{assert_succeeded, cli, cli_gl_missing, cli_no_gl, scratch};
 use std::path::Path;
 use std::process::Output;
 
 /// The command with no EGL vendor to load.
 fn no_gl(dir: &Path, args: &[&str]) -> Output {
-    let empty = dir.join("no-egl-vendors");
-    std::fs::create_dir_all(&empty).unwrap();
-    cli()
-        .env("__EGL_VENDOR_LIBRARY_DIRS", &empty)
-        .args(args)
-        .output()
-        .unwrap()
+    cli_no_gl(dir).args(args).output().unwrap()
 }
 
 fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_succeeded(out);
 }
 
 /// The polylines of each SVG group: (id, polylines, length in pixels).

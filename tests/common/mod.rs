@@ -201,6 +201,16 @@ pub fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_shapecue"))
 }
 
+/// [`cli`] with no EGL vendor to load (`__EGL_VENDOR_LIBRARY_DIRS` at an
+/// empty folder made in `dir`): what a server without OpenGL runs.
+pub fn cli_no_gl(dir: &Path) -> Command {
+    let empty = dir.join("no-egl-vendors");
+    std::fs::create_dir_all(&empty).unwrap();
+    let mut c = cli();
+    c.env("__EGL_VENDOR_LIBRARY_DIRS", &empty);
+    c
+}
+
 /// Fails the test, with the command's stderr, unless it exited with success.
 pub fn assert_succeeded(out: &Output) {
     assert!(
