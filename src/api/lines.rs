@@ -251,12 +251,7 @@ pub fn wanted(o: &LineOptions) -> Vec<LineFamily> {
 /// feature edges', intersection lines' or strokes' layer), strength,
 /// visibility, the faces it lies on (`-1` past the last) and its chain.
 pub fn segment_arrays(v: &VisibleLines) -> crate::export::npz::SegmentArrays {
-    let mut chain_of = vec![0u32; v.chain_pieces.len()];
-    for (c, ch) in v.chains.iter().enumerate() {
-        for &(i, _) in &ch.pieces {
-            chain_of[i as usize] = c as u32;
-        }
-    }
+    let chain_of = v.chain_of_pieces();
     let mut out = crate::export::npz::SegmentArrays::default();
     for (i, p) in v.chain_pieces.iter().enumerate() {
         let s = &v.segments[p.seg as usize];

@@ -350,12 +350,7 @@ fn segments_doc(
     let family = |k: u32| LineFamily::from_kind(k).map_or("unknown", |f| f.name());
     match visible {
         Some(v) => {
-            let mut chain_of = vec![0usize; v.chain_pieces.len()];
-            for (c, ch) in v.chains.iter().enumerate() {
-                for &(i, _) in &ch.pieces {
-                    chain_of[i as usize] = c;
-                }
-            }
+            let chain_of = v.chain_of_pieces();
             let pieces: Vec<serde_json::Value> = (v.chain_pieces.iter().enumerate())
                 .map(|(i, p)| {
                     let s = &v.segments[p.seg as usize];

@@ -206,12 +206,14 @@ fn walk(pieces: &[ChainPiece], ends: &Ends, used: &mut [bool], first: u32, from:
 }
 
 /// Mean pieces per chain (0 for none).
-pub fn mean_length(chains: &[Chain]) -> f64 {
-    if chains.is_empty() {
-        return 0.0;
+pub fn mean_length<'a>(chains: impl IntoIterator<Item = &'a Chain>) -> f64 {
+    let (n, pieces) =
+        (chains.into_iter()).fold((0usize, 0usize), |(n, p), c| (n + 1, p + c.pieces.len()));
+    if n == 0 {
+        0.0
+    } else {
+        pieces as f64 / n as f64
     }
-    let n: usize = chains.iter().map(|c| c.pieces.len()).sum();
-    n as f64 / chains.len() as f64
 }
 
 #[cfg(test)]

@@ -8,6 +8,10 @@ pub mod cache;
 mod device;
 pub mod external;
 mod launch;
+#[cfg(test)]
+mod probe;
+#[cfg(test)]
+pub(crate) use probe::{check_layout, probe_layout};
 mod program;
 pub mod vulkan;
 
@@ -754,37 +758,4 @@ pub(crate) fn test_gpu() -> Arc<Gpu> {
         Ok(g) => Arc::new(g),
         Err(e) => panic!("this test needs an OpenCL device (PoCL on CPU is enough): {e}"),
     }
-}
-
-/// What the device compiler sees of a family's `#[repr(C)]` structs: a probe
-/// kernel `entry` appended to `base` (built with `options`) writes the value
-/// of each C expression (`sizeof(T)`, `__builtin_offsetof(T, f)`), read back
-/// in order. The layout tests of the families that pass structs call it.
-#[cfg(test)]
-pub(crate) fn probe_layout(
-    base: &KernelFile,
-    options: &str,
-    entry: impl crate::spec::kernels::KernelEntry,
-    exprs: &[String],
-) -> Vec<u32> {
-    let gpu = test_gpu();
-    let mut probe = format!("\n__kernel void {}(__global uint* out) {{\n", entry.entry());
-    for (i, expr) in exprs.iter().enumerate() {
-        probe += &format!("    out[{i}] = (uint)({expr});\n");
-    }
-    probe += "}\n";
-    let file = KernelFile {
-        name: Box::leak(format!("{} (layout probe)", base.name).into_boxed_str()),
-        source: Box::leak((base.source.to_string() + &probe).into_boxed_str()),
-        ..*base
-    };
-    let prog = gpu.program(&file, options).unwrap();
-    let k = gpu.entry(&prog, entry).unwrap();
-    let mut out: Buffer<u32> = gpu.buffer(exprs.len()).unwrap();
-    gpu.write(&mut out, &vec![u32::MAX; exprs.len()]).unwrap();
-    launch(&gpu, &k, 1, &[buf(&out)]).unwrap();
-    gpu.finish().unwrap();
-    let mut got = vec![0u32; exprs.len()];
-    gpu.read(&out, &mut got).unwrap();
-    got
 }

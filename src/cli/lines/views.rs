@@ -37,16 +37,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let (scene, mesh, load_ms) = views_scene(&a, &c, &out)?;
     let files = files(&scene, &out, a.segments.is_some(), a.npz);
     if a.explain {
-        let mut s = shapecue::api::explain(&scene, &ExecOptions::default())?;
-        if let Some(seg) = &files.segments {
-            s.push_str(&format!("  and {} segments file(s)\n", seg.len()));
-        }
-        if let Some(npz) = &files.npz {
-            s.push_str(&format!("  and {} NPZ file(s)\n", npz.len()));
-        }
-        s.push_str(&format!("  and {}\n", files.manifest.display()));
-        super::super::print_str(&s)?;
-        return Ok(());
+        return explain(&scene, &files);
     }
     let outputs = (files.images.iter().map(|i| i.1.as_path()))
         .chain([files.report.as_path(), files.manifest.as_path()])
@@ -110,6 +101,21 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         timing["views_per_second"].as_f64().unwrap_or(0.0),
         files.manifest.display()
     ))?;
+    Ok(())
+}
+
+/// `--explain`: the plan, its lifetimes and run counts, and the files; runs
+/// nothing.
+fn explain(scene: &shapecue::api::Scene, files: &Files) -> Result<()> {
+    let mut s = shapecue::api::explain(scene, &ExecOptions::default())?;
+    if let Some(seg) = &files.segments {
+        s.push_str(&format!("  and {} segments file(s)\n", seg.len()));
+    }
+    if let Some(npz) = &files.npz {
+        s.push_str(&format!("  and {} NPZ file(s)\n", npz.len()));
+    }
+    s.push_str(&format!("  and {}\n", files.manifest.display()));
+    super::super::print_str(&s)?;
     Ok(())
 }
 

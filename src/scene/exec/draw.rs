@@ -3,6 +3,7 @@
 //! the PNG and SVG files of one view.
 
 use super::interop::SharedEdges;
+use super::vector::{LAYER_INTERSECTIONS, LAYER_STROKES, other_groups, stroke_segments};
 pub(super) use super::vector::{line_styles, shown};
 use crate::error::Result;
 use crate::export::svg::{
@@ -245,11 +246,12 @@ fn draw_edges_and_strokes(
 
 /// The SVG groups of one view: for each line family the scene draws
 /// ([`line_styles`]) its visible parts (against `image`'s depth), and under
-/// them, as the family's `hidden` asks, its hidden parts; then the feature
-/// edges. The one SVG layer writer of every picture.
+/// them, as the family's `hidden` asks, its hidden parts; then the strokes,
+/// intersection lines and feature edges ([`other_groups`]). The SVG layer
+/// writer of the depth-buffer method ([`super::vector::svg_layers_exact`]
+/// is the exact method's).
 pub(super) fn svg_layers(
     scene: &Scene,
-    plan: &Plan,
     cam: &Camera,
     lines: &ViewLines<'_>,
     image: &Frame,
@@ -260,35 +262,24 @@ pub(super) fn svg_layers(
     for (st, faded) in line_styles(fx) {
         family_layers(&mut layers, &st, faded, lines.segments, vp, image);
     }
-    if plan.contains(Pass::SdfLines) {
-        let view = cam.view(scene.size[0], scene.size[1]);
-        let segs = super::vector::stroke_segments(lines.strokes, &view, lines.stroke_lift);
-        let clip = segment_lines(vp, &segs, super::vector::LAYER_STROKES, |_| 1.0);
+    let view = cam.view(scene.size[0], scene.size[1]);
+    for (cue, id, (stroke_width, color), layer) in other_groups(fx) {
+        if !fx.cues.contains(&cue) {
+            continue;
+        }
+        let clip = match (layer, lines.edges) {
+            (LAYER_STROKES, _) => {
+                let segs = stroke_segments(lines.strokes, &view, lines.stroke_lift);
+                segment_lines(vp, &segs, layer, |_| 1.0)
+            }
+            (LAYER_INTERSECTIONS, _) => segment_lines(vp, lines.intersections, layer, |_| 1.0),
+            (_, Some(eo)) => crate::export::svg::edge_out_lines(&eo.edge_out),
+            (_, None) => continue,
+        };
         layers.push(SvgLayer {
-            id: "curvature-strokes",
-            stroke_width: super::vector::STROKE_PX,
-            color: fx.strokes.color,
-            lines: visible_joined(&clip, image, DEFAULT_BIAS),
-            dashed: false,
-        });
-    }
-    if plan.contains(Pass::Intersections) {
-        let kind = super::vector::LAYER_INTERSECTIONS;
-        let clip = segment_lines(vp, lines.intersections, kind, |_| 1.0);
-        layers.push(SvgLayer {
-            id: "intersection-lines",
-            stroke_width: fx.intersection.0,
-            color: fx.intersection.1,
-            lines: visible_joined(&clip, image, DEFAULT_BIAS),
-            dashed: false,
-        });
-    }
-    if let Some(eo) = lines.edges.filter(|_| plan.contains(Pass::Edges)) {
-        let clip = crate::export::svg::edge_out_lines(&eo.edge_out);
-        layers.push(SvgLayer {
-            id: "feature-edges",
-            stroke_width: fx.edge.0,
-            color: fx.edge.1,
+            id,
+            stroke_width,
+            color,
             lines: visible_joined(&clip, image, DEFAULT_BIAS),
             dashed: false,
         });

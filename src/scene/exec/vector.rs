@@ -148,10 +148,20 @@ impl VisibleLines {
         out
     }
 
-    /// Mean pieces per visible chain.
+    /// Mean pieces per visible chain (0 without one).
     pub fn mean_chain_length(&self) -> f64 {
-        let visible: Vec<Chain> = self.chains.iter().filter(|c| c.visible).cloned().collect();
-        crate::cpu::chains::mean_length(&visible)
+        crate::cpu::chains::mean_length(self.chains.iter().filter(|c| c.visible))
+    }
+
+    /// The chain of each piece of [`VisibleLines::chain_pieces`].
+    pub fn chain_of_pieces(&self) -> Vec<u32> {
+        let mut chain_of = vec![0u32; self.chain_pieces.len()];
+        for (c, ch) in self.chains.iter().enumerate() {
+            for &(i, _) in &ch.pieces {
+                chain_of[i as usize] = c as u32;
+            }
+        }
+        chain_of
     }
 
     /// The same lines moved by `shift` (scene frame to world).
@@ -280,34 +290,48 @@ pub(super) fn svg_layers_exact(scene: &Scene, cam: &Camera, vis: &VisibleLines) 
         }
         layers.push(family_layer(vis, &st, faded, vp, [w, h]));
     }
-    if fx.cues.contains(&Cue::CurvatureStrokes) {
-        layers.push(SvgLayer {
-            id: "curvature-strokes",
-            stroke_width: STROKE_PX,
-            color: fx.strokes.color,
-            lines: polylines(vis, LAYER_STROKES, true, vp, [w, h], |_| 1.0),
-            dashed: false,
-        });
-    }
-    if fx.cues.contains(&Cue::IntersectionLines) {
-        layers.push(SvgLayer {
-            id: "intersection-lines",
-            stroke_width: fx.intersection.0,
-            color: fx.intersection.1,
-            lines: polylines(vis, LAYER_INTERSECTIONS, true, vp, [w, h], |_| 1.0),
-            dashed: false,
-        });
-    }
-    if fx.cues.contains(&Cue::FeatureEdges) {
-        layers.push(SvgLayer {
-            id: "feature-edges",
-            stroke_width: fx.edge.0,
-            color: fx.edge.1,
-            lines: polylines(vis, LAYER_FEATURE_EDGES, true, vp, [w, h], |_| 1.0),
-            dashed: false,
-        });
+    for (cue, id, (stroke_width, color), layer) in other_groups(fx) {
+        if fx.cues.contains(&cue) {
+            layers.push(SvgLayer {
+                id,
+                stroke_width,
+                color,
+                lines: polylines(vis, layer, true, vp, [w, h], |_| 1.0),
+                dashed: false,
+            });
+        }
     }
     layers
+}
+
+/// An SVG group after the line families: its cue, id, stroke (width in
+/// pixels, colour) and layer.
+pub(super) type Group = (Cue, &'static str, (f32, [f32; 3]), u32);
+
+/// The SVG groups after the line families, in drawing order: each one's
+/// cue, id, stroke (width in pixels, colour) and layer. Both visibility
+/// methods write them ([`svg_layers_exact`], `draw::svg_layers`).
+pub(super) fn other_groups(fx: &Effects) -> [Group; 3] {
+    [
+        (
+            Cue::CurvatureStrokes,
+            "curvature-strokes",
+            (STROKE_PX, fx.strokes.color),
+            LAYER_STROKES,
+        ),
+        (
+            Cue::IntersectionLines,
+            "intersection-lines",
+            fx.intersection,
+            LAYER_INTERSECTIONS,
+        ),
+        (
+            Cue::FeatureEdges,
+            "feature-edges",
+            fx.edge,
+            LAYER_FEATURE_EDGES,
+        ),
+    ]
 }
 
 /// A family's visible group.

@@ -115,7 +115,7 @@ impl Executor<'_, '_> {
             (None, Some(frame)) if self.plan.contains(Pass::Render) => {
                 let strokes = self.scene_strokes();
                 let lines = self.view_lines(&strokes);
-                draw::svg_layers(self.scene, self.plan, cam, &lines, frame)
+                draw::svg_layers(self.scene, cam, &lines, frame)
             }
             // No line is drawn: empty groups of the families asked for.
             _ => Vec::new(),
