@@ -303,6 +303,7 @@ fn outputs_decide_the_drawing_passes() {
         raster,
         vector,
         visibility,
+        fields: false,
     };
     let cues = [Cue::Shading, Cue::Contours, Cue::FeatureEdges];
     for input in INPUTS {
@@ -349,6 +350,19 @@ fn outputs_decide_the_drawing_passes() {
         );
         assert!(!shade.contains(Pass::Visibility) && !shade.contains(Pass::VertexNormals));
         assert!(shade.contains(Pass::Svg));
+        // The view fields: read after the line passes, with the curvature's
+        // derivative and the view terms; none for shading or edges alone.
+        let fields = Outputs {
+            fields: true,
+            ..out(false, true, Exact)
+        };
+        let f = plan_for(&cues, input, CapMode::Adjacency, fields);
+        assert!(f.contains(Pass::ViewFields) && f.contains(Pass::LinesView));
+        assert!(f.contains(Pass::Dcurv));
+        assert!(!svg.contains(Pass::ViewFields) && !svg.contains(Pass::LinesView));
+        assert_eq!(Pass::ViewFields.lifetime(input), Lifetime::View);
+        let edges = plan_for(&[Cue::FeatureEdges], input, CapMode::Adjacency, fields);
+        assert!(!edges.contains(Pass::ViewFields) && !edges.contains(Pass::Dcurv));
         // Lifetimes: the tree per pose, the classification per view.
         assert_eq!(Pass::Bvh.lifetime(input), Lifetime::Pose);
         assert_eq!(Pass::Visibility.lifetime(input), Lifetime::View);

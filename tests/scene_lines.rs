@@ -23,6 +23,7 @@ fn both_exact() -> Outputs {
         raster: true,
         vector: true,
         visibility: VisibilityMethod::Exact,
+        fields: false,
     }
 }
 use std::path::Path;

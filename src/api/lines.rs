@@ -249,14 +249,28 @@ pub fn wanted(o: &LineOptions) -> Vec<LineFamily> {
 /// ([`crate::export::npz`]): one row per piece (world coordinates), its
 /// segment's family or layer code (a [`LineFamily`] as `u32`, or the
 /// feature edges', intersection lines' or strokes' layer), strength,
-/// visibility, the faces it lies on (`-1` past the last) and its chain.
-pub fn segment_arrays(v: &VisibleLines) -> crate::export::npz::SegmentArrays {
+/// visibility, the faces it lies on (`-1` past the last), its chain, and
+/// the face of `mesh` it lies in with each end's barycentric coordinates
+/// there ([`crate::mesh::barycentric::face_of_segment`]; `-1` and zeros for
+/// a line on no face).
+pub fn segment_arrays(v: &VisibleLines, mesh: &Mesh) -> crate::export::npz::SegmentArrays {
     let chain_of = v.chain_of_pieces();
     let mut out = crate::export::npz::SegmentArrays::default();
+    let wide = |p: [f32; 3]| p.map(f64::from);
     for (i, p) in v.chain_pieces.iter().enumerate() {
         let s = &v.segments[p.seg as usize];
-        out.a.push(v.point(p.seg, p.t[0]));
-        out.b.push(v.point(p.seg, p.t[1]));
+        let (a, b) = (v.point(p.seg, p.t[0]), v.point(p.seg, p.t[1]));
+        let on = crate::mesh::barycentric::face_of_segment(
+            (wide(a), wide(b)),
+            &v.faces[p.seg as usize],
+            &mesh.positions,
+            &mesh.faces,
+        );
+        out.face.push(on.map_or(-1, |o| i64::from(o.0)));
+        out.bary
+            .push(on.map_or([[0.0; 3]; 2], |o| o.1.map(|w| w.map(|x| x as f32))));
+        out.a.push(a);
+        out.b.push(b);
         out.family.push(s.2);
         out.strength.push(s.3);
         out.visible.push(u8::from(p.visible));

@@ -138,9 +138,15 @@ pub struct LinesArgs {
     segments: Option<Option<PathBuf>>,
     /// With --views or --cameras: each view's segment pieces also as NPZ
     /// arrays next to its SVG (a, b, family, strength, visible, faces,
-    /// chain; `numpy.load`).
+    /// chain, and the face each piece lies in with its ends' barycentric
+    /// coordinates; `numpy.load`).
     #[arg(long)]
     npz: bool,
+    /// With --views or --cameras: each view's per-vertex fields as NPZ next
+    /// to its SVG (n·v, κr sin²θ, D_w κr and q1 as rtsc keeps them, world
+    /// units; ndotv, kr, dwkr, q1).
+    #[arg(long)]
+    fields: bool,
     /// Many views in one run: N views fitted to the mesh from directions
     /// spread evenly over the sphere (the Fibonacci lattice), an SVG each
     /// in --out.
@@ -242,7 +248,12 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if a.views.is_some() || a.cameras.is_some() || a.out.is_some() {
         return views::run(device, a);
     }
-    for (on, flag) in [(a.png, "--png"), (a.explain, "--explain"), (a.npz, "--npz")] {
+    for (on, flag) in [
+        (a.png, "--png"),
+        (a.explain, "--explain"),
+        (a.npz, "--npz"),
+        (a.fields, "--fields"),
+    ] {
         if on {
             bail!("{flag} goes with --views N or --cameras FILE (and --out DIR)");
         }

@@ -1,15 +1,17 @@
-//! NPZ (numpy's zip of `.npy` arrays) of a view's line segments, for
-//! dataset builders who load them with `numpy.load`: one row per segment
-//! piece, written whole or not at all. The arrays are built by the caller
+//! NPZ (numpy's zip of `.npy` arrays) of a view's line segments and of its
+//! per-vertex fields, for dataset builders who load them with
+//! `numpy.load`: one row per segment piece, or one value per vertex,
+//! written whole or not at all. The arrays are built by the caller
 //! ([`SegmentArrays`]); the `.npy` and zip encoding is `ndarray-npy`'s.
 
 use std::io::Cursor;
 use std::path::Path;
 
-use ndarray::{Array1, Array2};
+use ndarray::{Array, Array1, Array2, Array3, ShapeError};
 use ndarray_npy::NpzWriter;
 
 use crate::error::{Error, Result};
+use crate::spec::feature_lines::ViewFields;
 
 /// The segment pieces of one view, row by row.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -28,10 +30,17 @@ pub struct SegmentArrays {
     pub faces: Vec<[i64; 4]>,
     /// The chain of each piece, `(n,)` uint32.
     pub chain: Vec<u32>,
+    /// The face the piece lies in (`-1` for a line on no face, such as a
+    /// stroke traced on a volume), `(n,)` int64.
+    pub face: Vec<i64>,
+    /// The barycentric coordinates of each end in `face` (zero where
+    /// none), `(n, 2, 3)` float32.
+    pub bary: Vec<[[f32; 3]; 2]>,
 }
 
 /// Writes `arrays` to `path` as an uncompressed NPZ (`a`, `b`, `family`,
-/// `strength`, `visible`, `faces`, `chain`), whole or not at all.
+/// `strength`, `visible`, `faces`, `chain`, `face`, `bary`), whole or not
+/// at all.
 ///
 /// # Errors
 ///
@@ -46,43 +55,128 @@ pub fn write_segments(path: &Path, arrays: &SegmentArrays) -> Result<()> {
         arrays.visible.len(),
         arrays.faces.len(),
         arrays.chain.len(),
+        arrays.face.len(),
+        arrays.bary.len(),
     ];
     if lens.iter().any(|&l| l != n) {
         return Err(Error::InvalidArgument(format!(
-            "{}: segment arrays of unequal lengths ({n} and {lens:?})",
+            "{}: segment arrays of unequal lengths ({n} and {})",
+            path.display(),
+            lens.map(|l| l.to_string()).join(", ")
+        )));
+    }
+    write(path, encode(arrays))
+}
+
+/// A view's per-vertex fields ([`ViewFields`]: `ndotv`, `kr`, `dwkr`,
+/// `q1`, each `(V,)` float32) as an uncompressed NPZ, whole or not at all.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] for fields of unequal lengths, [`Error::Write`]
+/// naming the file.
+pub fn write_fields(path: &Path, f: &ViewFields) -> Result<()> {
+    let n = f.ndotv.len();
+    if [f.kr.len(), f.dwkr.len(), f.q1.len()]
+        .iter()
+        .any(|&l| l != n)
+    {
+        return Err(Error::InvalidArgument(format!(
+            "{}: view fields of unequal lengths",
             path.display()
         )));
     }
-    let bytes = encode(arrays).map_err(|e| Error::Write {
+    let mut npz = Npz::new();
+    for (name, v) in [
+        ("ndotv", &f.ndotv),
+        ("kr", &f.kr),
+        ("dwkr", &f.dwkr),
+        ("q1", &f.q1),
+    ] {
+        npz.add(name, &Array1::from(v.clone()));
+    }
+    write(path, npz.finish())
+}
+
+/// Writes encoded bytes, or the encoder's error naming the file.
+fn write(path: &Path, bytes: std::result::Result<Vec<u8>, String>) -> Result<()> {
+    let bytes = bytes.map_err(|e| Error::Write {
         path: path.to_path_buf(),
         source: std::io::Error::other(e),
     })?;
     crate::output::write_bytes_atomic(path, &bytes)
 }
 
+/// An NPZ in memory; the first error of any step is kept and given by
+/// [`Npz::finish`].
+struct Npz {
+    w: NpzWriter<Cursor<Vec<u8>>>,
+    err: Option<String>,
+}
+
+impl Npz {
+    fn new() -> Npz {
+        Npz {
+            w: NpzWriter::new(Cursor::new(Vec::new())),
+            err: None,
+        }
+    }
+
+    /// Adds `array` as `name.npy`.
+    fn add<S, D>(&mut self, name: &str, array: &ndarray::ArrayBase<S, D>)
+    where
+        S: ndarray::Data,
+        S::Elem: ndarray_npy::WritableElement,
+        D: ndarray::Dimension,
+    {
+        if self.err.is_none()
+            && let Err(e) = self.w.add_array(name, array)
+        {
+            self.err = Some(format!("{name}: {e}"));
+        }
+    }
+
+    /// Adds a shaped array, or keeps the shape error.
+    fn add_shaped<T, D>(&mut self, name: &str, a: std::result::Result<Array<T, D>, ShapeError>)
+    where
+        T: ndarray_npy::WritableElement,
+        D: ndarray::Dimension,
+    {
+        match a {
+            Ok(a) => self.add(name, &a),
+            Err(e) => {
+                self.err.get_or_insert(format!("{name}: {e}"));
+            }
+        }
+    }
+
+    fn finish(self) -> std::result::Result<Vec<u8>, String> {
+        if let Some(e) = self.err {
+            return Err(e);
+        }
+        let cursor = self.w.finish().map_err(|e| e.to_string())?;
+        Ok(cursor.into_inner())
+    }
+}
+
 /// The NPZ bytes of `arrays` (of equal lengths).
 fn encode(arrays: &SegmentArrays) -> std::result::Result<Vec<u8>, String> {
     let n = arrays.a.len();
-    let rows3 = |v: &[[f32; 3]]| Array2::from_shape_vec((n, 3), v.concat());
-    let faces = Array2::from_shape_vec((n, 4), arrays.faces.concat());
-    let mut npz = NpzWriter::new(Cursor::new(Vec::new()));
-    let e = |e: &dyn std::fmt::Display| e.to_string();
-    npz.add_array("a", &rows3(&arrays.a).map_err(|x| e(&x))?)
-        .map_err(|x| e(&x))?;
-    npz.add_array("b", &rows3(&arrays.b).map_err(|x| e(&x))?)
-        .map_err(|x| e(&x))?;
-    npz.add_array("family", &Array1::from(arrays.family.clone()))
-        .map_err(|x| e(&x))?;
-    npz.add_array("strength", &Array1::from(arrays.strength.clone()))
-        .map_err(|x| e(&x))?;
-    npz.add_array("visible", &Array1::from(arrays.visible.clone()))
-        .map_err(|x| e(&x))?;
-    npz.add_array("faces", &faces.map_err(|x| e(&x))?)
-        .map_err(|x| e(&x))?;
-    npz.add_array("chain", &Array1::from(arrays.chain.clone()))
-        .map_err(|x| e(&x))?;
-    let cursor = npz.finish().map_err(|x| e(&x))?;
-    Ok(cursor.into_inner())
+    let mut npz = Npz::new();
+    npz.add_shaped("a", Array2::from_shape_vec((n, 3), arrays.a.concat()));
+    npz.add_shaped("b", Array2::from_shape_vec((n, 3), arrays.b.concat()));
+    npz.add("family", &Array1::from(arrays.family.clone()));
+    npz.add("strength", &Array1::from(arrays.strength.clone()));
+    npz.add("visible", &Array1::from(arrays.visible.clone()));
+    npz.add_shaped(
+        "faces",
+        Array2::from_shape_vec((n, 4), arrays.faces.concat()),
+    );
+    npz.add("chain", &Array1::from(arrays.chain.clone()));
+    npz.add("face", &Array1::from(arrays.face.clone()));
+    let bary: Vec<f32> = arrays.bary.iter().flatten().flatten().copied().collect();
+    npz.add_shaped("bary", Array3::from_shape_vec((n, 2, 3), bary));
+    npz.finish()
 }
 
 #[cfg(test)]
@@ -99,11 +193,16 @@ mod tests {
             visible: vec![1],
             faces: vec![[7, -1, -1, -1]],
             chain: vec![0],
+            face: vec![7],
+            bary: vec![[[1.0, 0.0, 0.0], [0.0, 0.5, 0.5]]],
         };
         let bytes = encode(&arrays).unwrap();
-        // A zip (local file header) holding the seven .npy files.
+        // A zip (local file header) holding the nine .npy files.
         assert_eq!(&bytes[..4], b"PK\x03\x04");
-        for name in ["a", "b", "family", "strength", "visible", "faces", "chain"] {
+        let names = [
+            "a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary",
+        ];
+        for name in names {
             let entry = format!("{name}.npy");
             assert!(
                 bytes.windows(entry.len()).any(|w| w == entry.as_bytes()),
@@ -120,6 +219,19 @@ mod tests {
         assert!(!p.exists());
         write_segments(&p, &arrays).unwrap();
         assert!(std::fs::metadata(&p).unwrap().len() > 100);
+        let f = dir.join("f.npz");
+        let mut fields = ViewFields {
+            ndotv: vec![0.5, -0.5],
+            kr: vec![1.0, 2.0],
+            dwkr: vec![0.0, 1.0],
+            q1: vec![3.0, 4.0],
+        };
+        write_fields(&f, &fields).unwrap();
+        assert!(std::fs::metadata(&f).unwrap().len() > 100);
+        fields.q1.pop();
+        std::fs::remove_file(&f).unwrap();
+        assert!(write_fields(&f, &fields).is_err());
+        assert!(!f.exists());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

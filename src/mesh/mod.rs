@@ -6,6 +6,7 @@
 //! or at an extreme scale survives until the stage that uploads it, which
 //! centres and scales it before rounding to the device's precision.
 
+pub mod barycentric;
 pub mod edges;
 pub mod feature_size;
 pub mod flipbook;

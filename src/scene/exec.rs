@@ -183,6 +183,7 @@ fn plan_of(scene: &Scene, image: bool) -> crate::scene::planner::Plan {
         raster: scene.png || image,
         vector: scene.svg,
         visibility: scene.visibility,
+        fields: scene.fields,
     };
     plan_for(&fx.cues, scene.source.input(), fx.caps, outputs)
 }

@@ -179,6 +179,10 @@ pub struct Scene {
     /// space over the mesh's BVH, with no GL context when no PNG is
     /// written; `depth`: against the rendered depth).
     pub visibility: crate::spec::visibility::VisibilityMethod,
+    /// Keep each view's per-vertex fields (n·v, κr, D_w κr, q1) beside its
+    /// lines, for a caller of [`crate::scene::exec::Session::run_each`]
+    /// (not a scene file's key: a scene writes no fields).
+    pub fields: bool,
 }
 
 /// 1-based line and column of a byte offset.
@@ -317,6 +321,7 @@ impl Scene {
             background: out.background,
             interop: out.interop,
             visibility: out.visibility,
+            fields: false,
         })
     }
 }

@@ -269,6 +269,10 @@ pub enum Pass {
     /// The segments of every requested curvature line family
     /// (`lines_curves`, with the `lines_vertex` terms n·v, κr and D_w κr).
     LinesCurves,
+    /// The view's per-vertex fields beside its lines (n·v, κr, D_w κr and
+    /// q1, read back from the line passes' terms), where the outputs ask
+    /// for them.
+    ViewFields,
     /// Feature-edge detection into the edge-out buffer (family `edges`).
     Edges,
     /// Cap geometry into the cap-out buffers.
@@ -355,6 +359,7 @@ impl Pass {
             Pass::LinesView => "lines_view",
             Pass::LinesDt1q1 => "lines_dt1q1",
             Pass::LinesCurves => "lines_curves",
+            Pass::ViewFields => "view_fields",
             Pass::SdfLines => "sdf_lines",
             Pass::Contours => "contours",
             Pass::SuggestiveContours => "suggestive_contours",
@@ -427,6 +432,7 @@ impl Pass {
             | Pass::CapBuffer
             | Pass::FaceNormals
             | Pass::Render
+            | Pass::ViewFields
             | Pass::Svg => &[],
         }
     }
@@ -463,6 +469,8 @@ impl Pass {
             Pass::LinesDt1q1 => vec![Pass::LinesView],
             // n·v per vertex, for back-face culling and fading.
             Pass::LinesCurves => vec![Pass::VertexNormals],
+            // κr needs the curvature, D_w κr its derivative, q1 the view terms.
+            Pass::ViewFields => vec![Pass::Dcurv, Pass::LinesView, Pass::VertexNormals],
             Pass::Edges => vec![Pass::EdgeBuffer, Pass::FaceNormals],
             Pass::Caps => vec![Pass::Edges, Pass::CapBuffer],
             // The strokes are traced on the field, not on the isosurface.
@@ -491,6 +499,7 @@ impl Pass {
             | Pass::LinesView
             | Pass::LinesDt1q1
             | Pass::LinesCurves
+            | Pass::ViewFields
             | Pass::Edges
             | Pass::Caps
             | Pass::Visibility
@@ -514,6 +523,8 @@ pub struct Outputs {
     pub vector: bool,
     /// How the vector drawing's hidden lines are found.
     pub visibility: VisibilityMethod,
+    /// The per-vertex view fields are kept beside the lines.
+    pub fields: bool,
 }
 
 impl Outputs {
@@ -522,6 +533,7 @@ impl Outputs {
         raster: true,
         vector: false,
         visibility: VisibilityMethod::Exact,
+        fields: false,
     };
 
     /// The passes that end a view drawn from `cues`.
@@ -536,6 +548,12 @@ impl Outputs {
             if self.visibility == VisibilityMethod::Exact && lines {
                 v.push(Pass::Visibility);
             }
+        }
+        // The fields are those of the line families (not of edges alone).
+        let families = (cues.iter())
+            .any(|c| c.family().is_some() || matches!(c, Cue::Contours | Cue::SuggestiveContours));
+        if self.fields && families {
+            v.push(Pass::ViewFields);
         }
         v
     }

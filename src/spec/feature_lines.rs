@@ -11,6 +11,40 @@
 /// where a test cut the segment, `[u32::MAX, face]` at a face centre.
 pub type Segment = ([f32; 3], [f32; 3], u32, f32, [[u32; 2]; 2]);
 
+/// The per-vertex fields of one view that rtsc's line families are zero
+/// crossings of, in world units, one value per vertex: what dataset
+/// builders keep beside the lines (`shapecue lines --fields`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ViewFields {
+    /// n·v, the unit normal against the unit direction towards the eye
+    /// (the occluding contours are its zeros).
+    pub ndotv: Vec<f32>,
+    /// κr sin²θ = k1 u² + k2 v² (u, v: the unit view direction along the
+    /// principal directions), as rtsc keeps it; its zeros are the
+    /// suggestive contours (1 / length).
+    pub kr: Vec<f32>,
+    /// D_w κr, the radial curvature's derivative along the projected view
+    /// direction, as rtsc's suggestive-contour test reads it (1 / length²).
+    pub dwkr: Vec<f32>,
+    /// q1, the view-dependent curvature of Judd et al.'s apparent ridges
+    /// as their code and rtsc keep it: the largest eigenvalue of QᵀQ
+    /// (1 / length²).
+    pub q1: Vec<f32>,
+}
+
+impl ViewFields {
+    /// The fields computed in coordinates `scale` times smaller than the
+    /// world's (world = local · scale + centre), in world units.
+    pub fn from_local(mut self, scale: f64) -> ViewFields {
+        let s = scale as f32;
+        let s2 = (scale * scale) as f32;
+        self.kr.iter_mut().for_each(|x| *x /= s);
+        self.dwkr.iter_mut().for_each(|x| *x /= s2);
+        self.q1.iter_mut().for_each(|x| *x /= s2);
+        self
+    }
+}
+
 /// One number per mesh edge (a sorted vertex pair), for chaining segments.
 pub fn edge_key(e: [u32; 2]) -> u64 {
     (u64::from(e[0]) << 32) | u64::from(e[1])

@@ -14,6 +14,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
+use crate::spec::feature_lines::ViewFields;
 use crate::spec::feature_lines::{
     CurveOptions, LineInputs, Segment, segments_bound, segments_estimate,
 };
@@ -125,6 +126,10 @@ pub struct LineExtractor {
     /// The faces, kept to build the curve stage when first asked for.
     host_faces: Vec<[u32; 3]>,
     curves: Option<CurveStage>,
+    /// Keep the view fields of each run ([`LineExtractor::keep_view_fields`]).
+    view_fields: bool,
+    /// The world length of one unit of the last run's coordinates.
+    scale: f64,
 }
 
 impl LineExtractor {
@@ -160,6 +165,8 @@ impl LineExtractor {
             counter: gpu.buffer(1)?,
             host_faces: faces.to_vec(),
             curves: None,
+            view_fields: false,
+            scale: 1.0,
             gpu,
             nv,
             nf: faces.len(),
@@ -201,8 +208,45 @@ impl LineExtractor {
         g.write(&mut self.inputs[4], x.k.as_flattened())?;
         g.write(&mut self.inputs[5], x.dk.as_flattened())?;
         self.pose_changed();
+        self.scale = 1.0;
         let inputs = self.inputs.each_ref().map(buf);
         self.run(inputs, view, feature_size, opts)
+    }
+
+    /// Whether each run also computes the view fields that
+    /// [`LineExtractor::read_view_fields`] reads (q1 needs `lines_view`,
+    /// which otherwise runs only for the families that read it).
+    pub fn keep_view_fields(&mut self, on: bool) {
+        self.view_fields = on;
+    }
+
+    /// The per-vertex fields of the last run's view (n·v, κr sin²θ, D_w κr,
+    /// q1), in world units; the run must have kept them
+    /// ([`LineExtractor::keep_view_fields`]).
+    pub fn read_view_fields(&self) -> Result<ViewFields> {
+        let stage = match (&self.curves, self.view_fields) {
+            (Some(c), true) => c,
+            _ => {
+                return Err(Error::InvalidArgument(
+                    "feature lines: the view fields were not kept by the last run".into(),
+                ));
+            }
+        };
+        let n = self.nv;
+        let mut f = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
+        if n > 0 {
+            for (out, b) in f.iter_mut().zip(&self.terms) {
+                self.gpu.read(b, out)?;
+            }
+        }
+        let [ndotv, kr, dwkr] = f;
+        let fields = ViewFields {
+            ndotv,
+            kr,
+            dwkr,
+            q1: stage.read_q1()?,
+        };
+        Ok(fields.from_local(self.scale))
     }
 
     /// The curve families' stage, once a run has asked for one of them.
@@ -276,6 +320,7 @@ impl LineExtractor {
         // Huge world values may not survive the mapping into f32.
         check_view(local, size)?;
         let inputs = [d.pos, d.nrm, d.d1, d.d2, d.k, d.dk].map(buf);
+        self.scale = norm.scale;
         let (mut segs, stats) = self.run(inputs, local, size, opts)?;
         let world = |p: [f32; 3]| -> [f32; 3] {
             std::array::from_fn(|i| {
@@ -301,6 +346,9 @@ impl LineExtractor {
         opts: LineOptions,
     ) -> Result<(Vec<Segment>, LineStats)> {
         opts.check()?;
+        if let Some(c) = self.curves.as_mut() {
+            c.view_changed();
+        }
         self.gpu.zero(&mut self.counter, 1)?;
         let e1 = self.lines_vertex(inputs, view, &opts)?;
         let curve_fams = opts.curves.families.curves();
@@ -318,6 +366,9 @@ impl LineExtractor {
             let (more, t) = self.curve_lines(inputs, view, feature_size, &opts)?;
             timing.extend(&t);
             segs.extend(more);
+        }
+        if self.view_fields {
+            timing.extend(&self.view_terms(inputs, view, &opts)?);
         }
         let stats = LineStats {
             segments: segs.len(),
@@ -439,6 +490,32 @@ impl LineExtractor {
             .collect())
     }
 
+    /// The curve stage, built the first time it is asked for.
+    fn curve_stage_mut(&mut self) -> Result<&mut CurveStage> {
+        if self.curves.is_none() {
+            let stage = CurveStage::new(self.gpu.clone(), self.nv, &self.host_faces)?;
+            self.curves = Some(stage);
+        }
+        Ok(self.curves.as_mut().expect("built above"))
+    }
+
+    /// The view terms of this run (q1 for the view fields), where its
+    /// families did not compute them.
+    fn view_terms(
+        &mut self,
+        inputs: [Arg; 6],
+        view: ([f32; 3], bool),
+        opts: &LineOptions,
+    ) -> Result<Timing> {
+        let args = CurveArgs {
+            inputs,
+            terms: self.terms.each_ref().map(buf),
+            faces: buf(&self.faces),
+        };
+        let stage = self.curve_stage_mut()?;
+        stage.view_terms(&args, view, &opts.curves)
+    }
+
     /// The curvature line families' segments, by the curve stage (built the
     /// first time one is asked for) on the same inputs and terms.
     fn curve_lines(
@@ -448,16 +525,12 @@ impl LineExtractor {
         feature_size: f32,
         opts: &LineOptions,
     ) -> Result<(Vec<Segment>, Timing)> {
-        if self.curves.is_none() {
-            let stage = CurveStage::new(self.gpu.clone(), self.nv, &self.host_faces)?;
-            self.curves = Some(stage);
-        }
         let args = CurveArgs {
             inputs,
             terms: self.terms.each_ref().map(buf),
             faces: buf(&self.faces),
         };
-        let stage = self.curves.as_mut().expect("built above");
+        let stage = self.curve_stage_mut()?;
         let sc = (
             opts.scaled_threshold(feature_size),
             opts.scaled_fade(feature_size),

@@ -52,6 +52,8 @@ pub struct CurveStage {
     counter: Buffer<u32>,
     /// Whether `pose` holds this pose's terms (and with gradients).
     pose_done: Option<bool>,
+    /// Whether `view` holds the last run's view terms.
+    view_done: bool,
 }
 
 impl CurveStage {
@@ -93,6 +95,7 @@ impl CurveStage {
             cap: 1,
             counter: gpu.buffer(1)?,
             pose_done: None,
+            view_done: false,
             gpu,
             nv,
             nf,
@@ -102,6 +105,11 @@ impl CurveStage {
     /// Marks the per-pose terms stale: the next run recomputes them.
     pub fn pose_changed(&mut self) {
         self.pose_done = None;
+    }
+
+    /// Marks the view terms stale (a new view starts).
+    pub fn view_changed(&mut self) {
+        self.view_done = false;
     }
 
     fn grow(&mut self, cap: usize) -> Result<()> {
@@ -141,7 +149,8 @@ impl CurveStage {
         if needs_pose(fams) && !pose_ok {
             self.lines_pose(a, grads, &mut events)?;
         }
-        if needs_view(fams) {
+        self.view_done = needs_view(fams);
+        if self.view_done {
             self.lines_view(a, view, opts, &mut events)?;
         }
         if fams.has(LineFamily::ApparentRidges) {
@@ -190,6 +199,38 @@ impl CurveStage {
         time(events, Step::LinesPose, e);
         self.pose_done = Some(grads);
         Ok(())
+    }
+
+    /// The view terms of the last [`CurveStage::run`]: `lines_view` runs
+    /// now for `view` where that run's families did not need it (a caller
+    /// that keeps q1 beside the lines). Returns the launch's timing.
+    pub fn view_terms(
+        &mut self,
+        a: &CurveArgs,
+        view: ([f32; 3], bool),
+        opts: &CurveOptions,
+    ) -> Result<Timing> {
+        let mut events = Vec::new();
+        if !self.view_done {
+            self.lines_view(a, view, opts, &mut events)?;
+            self.view_done = true;
+        }
+        let mut timing = Timing::default();
+        for (step, e) in &events {
+            e.wait().map_err(|e| Error::cl("clWaitForEvents", e))?;
+            timing.add(*step, event_ms(e));
+        }
+        Ok(timing)
+    }
+
+    /// q1 per vertex from the view terms (after [`CurveStage::view_terms`]),
+    /// in the coordinates of the inputs.
+    pub fn read_q1(&self) -> Result<Vec<f32>> {
+        let mut v = vec![0f32; 8 * self.nv];
+        if self.nv > 0 {
+            self.gpu.read(&self.view, &mut v)?;
+        }
+        Ok(v.chunks_exact(8).map(|c| c[0]).collect())
     }
 
     /// `lines_view`: the per-view terms for the eye (or direction) `view`

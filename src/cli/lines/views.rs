@@ -26,6 +26,8 @@ struct Files {
     segments: Option<Vec<PathBuf>>,
     /// Each view's segment arrays (NPZ), where asked.
     npz: Option<Vec<PathBuf>>,
+    /// Each view's per-vertex fields (NPZ), where asked.
+    fields: Option<Vec<PathBuf>>,
     /// The manifest.
     manifest: PathBuf,
 }
@@ -35,14 +37,15 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let out = check_flags(&a)?;
     let c = common(&a)?;
     let (scene, mesh, load_ms) = views_scene(&a, &c, &out)?;
-    let files = files(&scene, &out, a.segments.is_some(), a.npz);
+    let files = files(&scene, &out, [a.segments.is_some(), a.npz, a.fields]);
     if a.explain {
         return explain(&scene, &files);
     }
     let outputs = (files.images.iter().map(|i| i.1.as_path()))
         .chain([files.report.as_path(), files.manifest.as_path()])
         .chain(files.segments.iter().flatten().map(|p| p.as_path()))
-        .chain(files.npz.iter().flatten().map(|p| p.as_path()));
+        .chain(files.npz.iter().flatten().map(|p| p.as_path()))
+        .chain(files.fields.iter().flatten().map(|p| p.as_path()));
     // The folders the run makes (deepest first), to remove if it fails.
     let new_dirs: Vec<PathBuf> = (out.ancestors())
         .filter(|d| !d.as_os_str().is_empty() && !d.exists())
@@ -51,8 +54,10 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     check_outputs(c.inputs(), outputs, a.force)?;
     let t_run = Instant::now();
     let mut run = ViewsRun {
+        mesh: &mesh,
         segments: files.segments.as_deref(),
         npz: files.npz.as_deref(),
+        fields: files.fields.as_deref(),
         entries: Vec::new(),
         written: Vec::new(),
         hand_ms: 0.0,
@@ -95,6 +100,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         report.outputs.len()
             + files.segments.map_or(0, |s| s.len())
             + files.npz.map_or(0, |s| s.len())
+            + files.fields.map_or(0, |s| s.len())
             + 2,
         timing["pose_ms"].as_f64().unwrap_or(0.0),
         timing["views_ms"].as_f64().unwrap_or(0.0),
@@ -112,7 +118,10 @@ fn explain(scene: &shapecue::api::Scene, files: &Files) -> Result<()> {
         s.push_str(&format!("  and {} segments file(s)\n", seg.len()));
     }
     if let Some(npz) = &files.npz {
-        s.push_str(&format!("  and {} NPZ file(s)\n", npz.len()));
+        s.push_str(&format!("  and {} NPZ file(s) of segments\n", npz.len()));
+    }
+    if let Some(f) = &files.fields {
+        s.push_str(&format!("  and {} NPZ file(s) of fields\n", f.len()));
     }
     s.push_str(&format!("  and {}\n", files.manifest.display()));
     super::super::print_str(&s)?;
@@ -143,6 +152,7 @@ fn views_scene(
     opts.image = a.png;
     opts.svg = true;
     let mut scene = lines_views_scene(mesh.clone(), &opts, views);
+    scene.fields = a.fields;
     scene.out_dir = out.to_path_buf();
     scene.prefix = stem(&a.mesh);
     scene.path = c.path.clone();
@@ -195,42 +205,46 @@ fn stem(mesh: &str) -> String {
 
 /// Every file of the run: the executor's images and report (frame 0 of a
 /// static mesh), the segments next to each SVG, the manifest.
-fn files(scene: &shapecue::api::Scene, out: &Path, segments: bool, npz: bool) -> Files {
+fn files(scene: &shapecue::api::Scene, out: &Path, [segments, npz, fields]: [bool; 3]) -> Files {
     let (images, report) = output_paths(scene, &[0], out);
-    let beside = |on: bool, ext: &str| {
+    let beside = |on: bool, what: &str| {
         on.then(|| {
             (images.iter())
                 .filter(|i| i.2.extension().is_some_and(|e| e == "svg"))
-                .map(|i| segments_path(&i.2, ext))
+                .map(|i| beside_svg(&i.2, what))
                 .collect()
         })
     };
-    let (segments, npz) = (beside(segments, "json"), beside(npz, "npz"));
     Files {
+        segments: beside(segments, "segments.json"),
+        npz: beside(npz, "segments.npz"),
+        fields: beside(fields, "fields.npz"),
         images: images.into_iter().map(|i| (i.1, i.2)).collect(),
         report,
-        segments,
-        npz,
         manifest: out.join("manifest.json"),
     }
 }
 
-/// The segments file beside an SVG: `X.svg` → `X_segments.json` (or
-/// `.npz`).
-fn segments_path(svg: &Path, ext: &str) -> PathBuf {
+/// A file beside an SVG: `X.svg` → `X_segments.json` for `what` =
+/// `segments.json`.
+fn beside_svg(svg: &Path, what: &str) -> PathBuf {
     let stem = svg
         .file_stem()
         .map(|s| s.to_string_lossy())
         .unwrap_or_default();
-    svg.with_file_name(format!("{stem}_segments.{ext}"))
+    svg.with_file_name(format!("{stem}_{what}"))
 }
 
 /// What the run gathers view by view.
 struct ViewsRun<'a> {
+    /// The mesh (the faces and barycentric coordinates of the segments).
+    mesh: &'a shapecue::Mesh,
     /// Each view's segments file, where asked (in view order).
     segments: Option<&'a [PathBuf]>,
     /// Each view's NPZ file, where asked (in view order).
     npz: Option<&'a [PathBuf]>,
+    /// Each view's fields file, where asked (in view order).
+    fields: Option<&'a [PathBuf]>,
     /// Each view's manifest entry.
     entries: Vec<Value>,
     /// The segments files written so far.
@@ -246,28 +260,26 @@ impl ViewsRun<'_> {
         let t = Instant::now();
         let mut files: Vec<String> = v.files.iter().map(|p| name(p)).collect();
         if let Some(paths) = self.segments {
-            let p = &paths[v.view];
             let doc = segments_doc(
                 v.visible.as_ref(),
                 &v.segments,
                 v.feature_size.unwrap_or(0.0),
             );
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
-            let fresh = !p.exists();
-            shapecue::export::output::write_bytes_atomic(p, text.as_bytes())?;
-            if fresh {
-                self.written.push(p.clone());
-            }
-            files.push(name(p));
+            files.push(self.keep(&paths[v.view], |p| {
+                shapecue::export::output::write_bytes_atomic(p, text.as_bytes())
+            })?);
         }
         if let (Some(paths), Some(vis)) = (self.npz, v.visible.as_ref()) {
-            let p = &paths[v.view];
-            let fresh = !p.exists();
-            shapecue::export::npz::write_segments(p, &shapecue::api::segment_arrays(vis))?;
-            if fresh {
-                self.written.push(p.clone());
-            }
-            files.push(name(p));
+            let arrays = shapecue::api::segment_arrays(vis, self.mesh);
+            files.push(self.keep(&paths[v.view], |p| {
+                shapecue::export::npz::write_segments(p, &arrays)
+            })?);
+        }
+        if let (Some(paths), Some(f)) = (self.fields, v.fields.as_ref()) {
+            files.push(self.keep(&paths[v.view], |p| {
+                shapecue::export::npz::write_fields(p, f)
+            })?);
         }
         let cam = v.camera;
         self.entries.push(json!({
@@ -286,6 +298,21 @@ impl ViewsRun<'_> {
         }));
         self.hand_ms += ms_since(t);
         Ok(())
+    }
+
+    /// Writes `p` (whole, by `write`), remembering it if the run created
+    /// it; returns its name for the manifest.
+    fn keep(
+        &mut self,
+        p: &Path,
+        write: impl FnOnce(&Path) -> shapecue::Result<()>,
+    ) -> shapecue::Result<String> {
+        let fresh = !p.exists();
+        write(p)?;
+        if fresh {
+            self.written.push(p.to_path_buf());
+        }
+        Ok(name(p))
     }
 
     /// After a failed run: removes the segments files it created, and the
@@ -364,6 +391,7 @@ fn options_doc(a: &LinesArgs, c: &super::Common) -> Value {
         "png": a.png,
         "segments": a.segments.is_some(),
         "npz": a.npz,
+        "fields": a.fields,
         "feature_size": a.feature_size,
         "sc_threshold": plain(a.sc_threshold),
         "fade": plain(a.fade),

@@ -408,6 +408,9 @@ pub struct ViewDone {
     /// The lines classified and chained by exact visibility (world
     /// coordinates), where the plan ran it.
     pub visible: Option<super::vector::VisibleLines>,
+    /// The per-vertex fields of the view (world units), where the scene
+    /// keeps them ([`crate::scene::file::Scene::fields`]).
+    pub fields: Option<crate::spec::feature_lines::ViewFields>,
     /// The feature size the line families' thresholds were scaled by, when
     /// lines were found.
     pub feature_size: Option<f32>,

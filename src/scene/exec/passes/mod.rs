@@ -161,6 +161,8 @@ pub(super) struct Executor<'s, 'g> {
     /// This view: its lines classified and chained (exact visibility), the
     /// frame drawn and the SVG groups found.
     vis: Option<VisibleLines>,
+    /// This view's per-vertex fields, where the plan keeps them.
+    fields: Option<crate::spec::feature_lines::ViewFields>,
     frame: Option<crate::render::Frame>,
     layers: Option<Vec<crate::export::svg::SvgLayer>>,
     /// Visible chains and their pieces over all views.
@@ -245,6 +247,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             interop,
             shared_drawn: None,
             vis: None,
+            fields: None,
             frame: None,
             layers: None,
             chains: [0; 2],
@@ -479,6 +482,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             | Pass::LinesView
             | Pass::LinesDt1q1
             | Pass::LinesCurves
+            | Pass::ViewFields
             | Pass::Edges
             | Pass::Caps
             | Pass::Visibility

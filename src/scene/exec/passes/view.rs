@@ -33,6 +33,7 @@ impl Executor<'_, '_> {
         self.edges_ran = None;
         self.shared_drawn = None;
         self.vis = None;
+        self.fields = None;
         self.frame = None;
         self.layers = None;
     }
@@ -79,6 +80,7 @@ impl Executor<'_, '_> {
                 self.rec.kernels(pass, &t, how);
             }
             Pass::LinesCurves => self.line_curves_pass(pass, cam)?,
+            Pass::ViewFields => self.view_fields_pass(cam)?,
             Pass::Edges => self.edges_pass(pass, cam, paths)?,
             Pass::Caps => {
                 let (timing, _) = self.edges_ran.as_ref().expect("planned after the edges");
@@ -123,6 +125,24 @@ impl Executor<'_, '_> {
             let how = format!("lines_vertex + lines_curves ({})", families.join(", "));
             self.rec.kernels(pass, &t, &how);
         }
+        Ok(())
+    }
+
+    /// The view's per-vertex fields, read back from the line passes' terms
+    /// (which kept them: the extraction of this view ran `lines_view` for
+    /// q1 if its families did not).
+    fn view_fields_pass(&mut self, cam: &Camera) -> Result<()> {
+        self.lines(cam)?;
+        let t0 = std::time::Instant::now();
+        let lx = (self.topo.as_ref())
+            .and_then(|t| t.lines.as_ref())
+            .expect("the lines ran");
+        self.fields = Some(lx.read_view_fields()?);
+        self.rec.wall(
+            Pass::ViewFields,
+            ms_since(t0),
+            "n·v, κr, D_w κr and q1 per vertex read back",
+        );
         Ok(())
     }
 
@@ -351,7 +371,7 @@ impl Executor<'_, '_> {
     /// What a run hands its caller after the view of `frame` and `view`
     /// from `cam` that wrote `files` (world coordinates).
     pub(in crate::scene::exec) fn view_done(
-        &self,
+        &mut self,
         (frame, view): (usize, usize),
         cam: &Camera,
         files: Vec<PathBuf>,
@@ -372,6 +392,7 @@ impl Executor<'_, '_> {
                 .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
                 .collect(),
             visible: self.vis.as_ref().map(|v| v.shifted(o)),
+            fields: self.fields.take(),
             feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
             files,
         }
@@ -458,6 +479,7 @@ impl Executor<'_, '_> {
                 &mesh.faces,
             )?),
         };
+        lx.keep_view_fields(self.plan.contains(Pass::ViewFields));
         let feature_size = match *feature_size {
             Some(fs) => fs,
             None => {
