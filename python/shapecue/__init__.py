@@ -25,7 +25,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from typing import Any, Iterator, Optional, Sequence, Tuple, Union
+from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -38,6 +38,7 @@ __all__ = [
     "DeviceError",
     "FeatureEdges",
     "Isosurface",
+    "LineView",
     "Lines",
     "RenderError",
     "Volume",
@@ -512,11 +513,86 @@ class Lines:
         return self.segments[self.family == family]
 
 
+@dataclass
+class LineView:
+    """One view of :func:`lines` with ``cameras``: its lines split where
+    their visibility changes (exact, in object space) and chained, one row
+    per piece.
+
+    ``a``, ``b`` (P, 3) float32 piece ends (world coordinates); ``family``
+    (P,) family names and ``kind`` their codes; ``strength`` (P,) in
+    [0, 1]; ``visible`` (P,) bool; ``chain`` (P,) the chain (polyline) of
+    each piece; provenance: ``faces`` (P, 4) the faces its segment lies on
+    (-1 past the last), ``face`` (P,) the face it lies in and ``bary``
+    (P, 2, 3) each end's barycentric coordinates in that face, so that
+    ``a == (bary[:, 0, :, None] * vertices[faces_of_mesh[face]]).sum(1)``.
+    ``fields`` (with ``fields=True``): per vertex ``ndotv``, ``kr`` (κr
+    sin²θ), ``dwkr`` (D_w κr) and ``q1`` (apparent ridges' view-dependent
+    curvature, as rtsc keeps it), world units. ``camera``: eye, target, up,
+    fov (degrees) or ortho (height). ``passes``: the passes that ran for
+    this view (the first view also runs the pose's: curvature, the feature
+    size, the BVH) and ``passes_ms`` their total."""
+
+    a: np.ndarray
+    b: np.ndarray
+    kind: np.ndarray
+    family: np.ndarray
+    strength: np.ndarray
+    visible: np.ndarray
+    chain: np.ndarray
+    faces: np.ndarray
+    face: np.ndarray
+    bary: np.ndarray
+    fields: Optional[dict]
+    camera: dict
+    passes: list
+    passes_ms: float
+    feature_size: float
+    device: str
+
+    def of(self, family: str, visible_only: bool = True) -> np.ndarray:
+        """The (k, 2, 3) pieces of one family (the visible ones only, by
+        default)."""
+        keep = self.family == family
+        if visible_only:
+            keep &= self.visible
+        return np.stack([self.a[keep], self.b[keep]], axis=1)
+
+
+def _camera_set(cameras: Any) -> Tuple[Optional[str], Optional[int]]:
+    """The cameras of :func:`lines`: ``(json_text, None)`` or ``(None, n)``."""
+    if isinstance(cameras, (bool, np.bool_)):
+        raise ValueError("cameras: a number of views, a list of cameras or a JSON file")
+    if isinstance(cameras, (int, np.integer)):
+        return None, int(cameras)
+    if isinstance(cameras, (str, os.PathLike)):
+        with open(os.fspath(cameras), encoding="utf-8") as fh:
+            return fh.read(), None
+    if isinstance(cameras, dict) and "cameras" in cameras:
+        cameras = cameras["cameras"]
+    try:
+        cams = [dict(c) for c in cameras]
+    except (TypeError, ValueError):
+        raise ValueError(
+            "cameras: a number of views, a list of {eye, target, up?, fov? | ortho?} "
+            "dicts, or a camera JSON file"
+        ) from None
+
+    def plain(x: Any) -> Any:
+        return x.tolist() if isinstance(x, np.ndarray) else x
+
+    return json.dumps({"cameras": [{k: plain(v) for k, v in c.items()} for c in cams]}), None
+
+
 def lines(
     vertices: Any,
     faces: Any = None,
     *,
     lines: Union[str, Sequence[str]] = "contours,suggestive",
+    cameras: Any = None,
+    fields: bool = False,
+    size: Tuple[int, int] = (800, 600),
+    fov: float = 40.0,
     eye: Optional[Sequence[float]] = None,
     direction: Sequence[float] = (1.0, 1.0, 1.0),
     ortho: bool = False,
@@ -537,7 +613,7 @@ def lines(
     compat: str = "exact",
     accumulate: str = "auto",
     device: Union[int, str, None] = None,
-) -> Lines:
+) -> Union[Lines, List[LineView]]:
     """The line families of rtsc (Rusinkiewicz and DeCarlo) on a mesh seen
     from ``eye`` (a point; with ``ortho``, the direction towards the viewer),
     by default three bounding radii from the centre along ``direction``.
@@ -551,9 +627,46 @@ def lines(
     shapecue's for K = 0 and H = 0) and its feature size (``feature_size``:
     "rtsc", "edge" for the median edge length, or a length). ``compat =
     "trimesh2"`` computes the curvature as trimesh2 (and so rtsc) does.
+
+    ``vertices`` may also be a mesh file (.obj/.ply/.off), read by
+    :func:`load_mesh`.
+
+    **Many views** (``cameras``: a number N of views on the Fibonacci
+    lattice around the mesh, a list of ``{"eye", "target", "up"?, "fov"? |
+    "ortho"?}`` dicts, or a camera JSON file as ``shapecue lines
+    --cameras`` reads): returns a list of :class:`LineView`, one per camera,
+    computed in one setup (curvature and the BVH once, the view passes per
+    camera), each view's lines split by exact visibility and chained, with
+    their faces and barycentric coordinates, and with ``fields=True`` the
+    per-vertex fields. ``size`` (width, height) is the image the fitted
+    views frame and the visibility's sample spacing is for; ``fov`` and
+    ``ortho`` are the cameras' defaults. No OpenGL is needed.
     """
+    if isinstance(vertices, (str, os.PathLike)) and faces is None:
+        vertices, faces = load_mesh(vertices)
     v, f = _mesh_arrays(vertices, faces)
     names = lines if isinstance(lines, str) else ",".join(lines)
+    thresholds = (
+        float(sc_threshold),
+        float(rv_threshold),
+        float(ar_threshold),
+        float(ph_threshold),
+        float(sh_threshold),
+        float(sc_fade),
+    )
+    switches = (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh))
+    setup = (str(feature_size), str(compat), str(accumulate))
+    l3 = tuple(float(c) for c in light)
+    if cameras is not None:
+        if eye is not None:
+            raise ValueError("eye sets the one camera; with cameras give each its eye")
+        text, n = _camera_set(cameras)
+        w, h = (int(x) for x in size)
+        views = _shapecue.lines_views(
+            v, f, names, text, n, (float(fov), bool(ortho), w, h),
+            thresholds, int(isophotes), l3, switches, setup, bool(fields), _device(device),
+        )
+        return [_line_view(d) for d in views]
     if eye is None:
         lo, hi = v.min(axis=0), v.max(axis=0)
         d = np.asarray(direction, dtype=np.float64)
@@ -563,7 +676,6 @@ def lines(
         r = 0.5 * float(np.linalg.norm(hi - lo))
         eye = d if ortho else 0.5 * (lo + hi) + 3.0 * max(r, 1e-30) * d
     e = tuple(float(c) for c in eye)
-    l3 = tuple(float(c) for c in light)
     if len(e) != 3 or len(l3) != 3:
         raise ValueError("eye and light: expected three numbers")
     d = _shapecue.lines(
@@ -572,23 +684,27 @@ def lines(
         names,
         e,
         bool(ortho),
-        (
-            float(sc_threshold),
-            float(rv_threshold),
-            float(ar_threshold),
-            float(ph_threshold),
-            float(sh_threshold),
-            float(sc_fade),
-        ),
+        thresholds,
         int(isophotes),
         l3,
-        (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh)),
-        (str(feature_size), str(compat), str(accumulate)),
+        switches,
+        setup,
         _device(device),
     )
     fam_names = np.asarray(d.pop("family_names"))
     kind = d["kind"]
     return Lines(family=fam_names[kind] if len(kind) else np.asarray([], dtype=str), **d)
+
+
+def _line_view(d: dict) -> LineView:
+    fields = None
+    if "ndotv" in d:
+        fields = {k: d.pop(k) for k in ("ndotv", "kr", "dwkr", "q1")}
+    fam_names = np.asarray(d.pop("family_names"))
+    kind = d["kind"]
+    family = fam_names[kind] if len(kind) else np.asarray([], dtype=str)
+    d["visible"] = d["visible"].astype(bool)
+    return LineView(family=family, fields=fields, **d)
 
 
 def load_mesh(path: Union[str, os.PathLike], *, weld: bool = False) -> Tuple[np.ndarray, np.ndarray]:

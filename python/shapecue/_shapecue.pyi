@@ -72,6 +72,21 @@ def lines(
     setup: Tuple[str, str, str],
     device: Optional[str],
 ) -> dict[str, Any]: ...
+def lines_views(
+    vertices: npt.NDArray[np.floating],
+    faces: npt.NDArray[np.integer],
+    families: str,
+    cameras: Optional[str],
+    views: Optional[int],
+    camera: Tuple[float, bool, int, int],
+    thresholds: Tuple[float, float, float, float, float, float],
+    isophotes: int,
+    light: Tuple[float, float, float],
+    switches: Tuple[bool, bool, bool, bool, bool],
+    setup: Tuple[str, str, str],
+    fields: bool,
+    device: Optional[str],
+) -> list[dict[str, Any]]: ...
 def render_file(path: str, out_dir: Optional[str], force: bool, device: Optional[str]) -> str: ...
 def render_text(
     json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]

@@ -28,7 +28,18 @@ Tasks:
 - ``"isosurface"``: a volume file to ``<stem>.npz`` with ``vertices``,
   ``faces`` (and the curvature arrays with ``options={"curvature": True}``);
   ``options={"iso": value}`` is required;
-- ``"render"``: a scene file, its images and report into ``<stem>/``.
+- ``"render"``: a scene file, its images and report into ``<stem>/``;
+- ``"lines"``: a mesh file's line drawings from many views
+  (:func:`shapecue.lines` with ``cameras``) into ``<stem>/``: per view
+  ``view_NNN.npz`` with the pieces (``a``, ``b``, ``kind``, ``strength``,
+  ``visible``, ``chain``, provenance ``faces``, ``face``, ``bary``), the
+  per-vertex fields (``ndotv``, ``kr``, ``dwkr``, ``q1``; unless
+  ``options={"fields": False}``) and the camera (``eye``, ``target``,
+  ``up``), and ``views.json`` (the family names of ``kind``, each view's
+  camera and piece count, the timing). ``options``: ``views`` (a number of
+  views, default 16) or ``cameras`` (a list of camera dicts, or a camera
+  JSON file), ``lines``, ``size``, the thresholds of :func:`shapecue.lines`.
+  The folder is written whole (made beside it, then renamed).
 """
 
 from __future__ import annotations
@@ -43,7 +54,7 @@ from typing import Any, Dict, Iterable, List, Optional, Union
 
 import numpy as np
 
-TASKS = ("curvature", "isosurface", "render")
+TASKS = ("curvature", "isosurface", "render", "lines")
 MANIFEST = "manifest.jsonl"
 
 __all__ = ["run", "read_manifest", "TASKS", "MANIFEST"]
@@ -60,7 +71,7 @@ def _inputs(inputs: Union[str, Iterable[str]]) -> List[str]:
 
 def _output_name(path: str, task: str, out_dir: str) -> str:
     stem = os.path.splitext(os.path.basename(path))[0]
-    if task == "render":
+    if task in ("render", "lines"):
         return os.path.join(out_dir, stem)
     return os.path.join(out_dir, stem + ".npz")
 
@@ -98,6 +109,86 @@ def _save_npz(path: str, arrays: Dict[str, np.ndarray]) -> None:
     tmp = path + ".part.npz"
     np.savez(tmp, **arrays)
     os.replace(tmp, path)
+
+
+def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, Any]) -> Dict[str, Any]:
+    """The ``lines`` task: returns the record's extra fields and the
+    compute-phase split (ms)."""
+    import shutil
+
+    import shapecue
+
+    cameras = options.pop("cameras", None)
+    n = options.pop("views", None)
+    if cameras is not None and n is not None:
+        raise ValueError("give views or cameras, not both")
+    cameras = cameras if cameras is not None else int(n if n is not None else 16)
+    fields = bool(options.pop("fields", True))
+    t0 = time.perf_counter()
+    v, f = shapecue.load_mesh(path)
+    t1 = time.perf_counter()
+    views = shapecue.lines(v, f, cameras=cameras, fields=fields, device=device, **options)
+    t2 = time.perf_counter()
+    part = f"{out}.part-{uuid.uuid4().hex[:8]}"
+    os.makedirs(part)
+    try:
+        digits = max(3, len(str(len(views) - 1)))
+        entries = []
+        for i, view in enumerate(views):
+            arrays = {
+                k: getattr(view, k)
+                for k in ("a", "b", "kind", "strength", "visible", "chain", "faces", "face", "bary")
+            }
+            arrays["visible"] = arrays["visible"].astype(np.uint8)
+            for k in ("eye", "target", "up"):
+                arrays[k] = np.asarray(view.camera[k], dtype=np.float32)
+            if view.fields is not None:
+                arrays.update(view.fields)
+            name = f"view_{i:0{digits}d}.npz"
+            np.savez(os.path.join(part, name), **arrays)
+            entries.append(
+                {"file": name, "camera": view.camera, "pieces": int(len(view.a)),
+                 "passes_ms": view.passes_ms}
+            )
+        doc = {
+            "input": path,
+            "vertices": int(len(v)),
+            "faces": int(len(f)),
+            "family_names": sorted(set().union(*(set(x.family.tolist()) for x in views))),
+            "kind_names": _kind_names(views),
+            "views": entries,
+            "timing": {
+                "load_ms": (t1 - t0) * 1e3,
+                "compute_ms": (t2 - t1) * 1e3,
+                "first_view_ms": views[0].passes_ms if views else 0.0,
+                "later_views_ms": sum(x.passes_ms for x in views[1:]),
+            },
+        }
+        with open(os.path.join(part, "views.json"), "w", encoding="utf-8") as fh:
+            json.dump(doc, fh, indent=1)
+        if os.path.isdir(out):
+            shutil.rmtree(out)
+        os.replace(part, out)
+    except BaseException:
+        shutil.rmtree(part, ignore_errors=True)
+        raise
+    later = len(views) - 1
+    per_view = doc["timing"]["later_views_ms"] / later if later > 0 else None
+    return {
+        "views": len(views),
+        "views_per_second": (1e3 / per_view) if per_view else None,
+        "load_ms": (t1 - t0) * 1e3,
+        "compute_ms": (t2 - t1) * 1e3,
+    }
+
+
+def _kind_names(views: List[Any]) -> Dict[str, str]:
+    """The family name of each ``kind`` code the views hold."""
+    names: Dict[str, str] = {}
+    for x in views:
+        for k, fam in zip(x.kind.tolist(), x.family.tolist()):
+            names.setdefault(str(k), fam)
+    return dict(sorted(names.items(), key=lambda kv: int(kv[0])))
 
 
 def process_one(
@@ -146,6 +237,11 @@ def process_one(
             if s.curvature is not None:
                 arrays.update(_curvature_arrays("curvature_", s.curvature))
             _save_npz(out, arrays)
+        elif task == "lines":
+            extra = _lines_task(path, out, device, options)
+            t1 = t0 + extra.pop("load_ms") / 1e3
+            t2 = t1 + extra.pop("compute_ms") / 1e3
+            rec.update(extra)
         elif task == "render":
             t1 = time.perf_counter()
             report = shapecue.render(path, out, device=device, force=True, **options)

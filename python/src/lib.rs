@@ -754,6 +754,7 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::render_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_text, m)?)?;
     m.add_function(wrap_pyfunction!(lines::lines, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::lines_views, m)?)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(load_volume, m)?)?;
     m.add_class::<PyEstimator>()?;

@@ -4,8 +4,11 @@
 //! strength, no picture.
 
 use super::*;
-use shapecue::api::LineOptions;
-use shapecue::api::LineSetup;
+use pyo3::types::PyList;
+use shapecue::api::{
+    CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot, VisibilityMethod,
+    fibonacci_views, line_views_on, parse_camera_file, segment_arrays,
+};
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
 use shapecue::spec::view::View;
 
@@ -142,5 +145,140 @@ fn lines_with<'py>(
     d.set_item("feature_size", ls.feature_size)?;
     d.set_item("kernel_ms", ls.timing.kernel_ms)?;
     d.set_item("device", name)?;
+    Ok(d)
+}
+
+/// lines_views(vertices, faces, families, cameras, views, camera, thresholds,
+/// isophotes, light, switches, setup, fields, device) -> list of dicts
+///
+/// The lines of many views in one setup (the pose passes once, the view
+/// passes per view), each split by exact visibility and chained. `cameras`:
+/// the JSON text of a camera file (`{"cameras": [...]}`), or `None` with
+/// `views` cameras on the Fibonacci lattice; `camera`: (fov, ortho, width,
+/// height), the cameras' defaults and the image size the fitted views and
+/// the visibility's spacing are for.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, families, cameras, views, camera, thresholds, isophotes, light, switches, setup, fields, device))]
+#[allow(clippy::too_many_arguments)]
+pub fn lines_views<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+    families: &str,
+    cameras: Option<String>,
+    views: Option<usize>,
+    camera: (f32, bool, u32, u32),
+    thresholds: [f32; 6],
+    isophotes: u32,
+    light: [f32; 3],
+    switches: [bool; 5],
+    setup: (String, String, String),
+    fields: bool,
+    device: Option<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let args = LinesArgs {
+        families,
+        eye: [0.0; 3],
+        ortho: camera.1,
+        thresholds,
+        isophotes,
+        light,
+        switches,
+        setup,
+        device,
+    };
+    let mesh = Arc::new(read_mesh(vertices, faces)?);
+    let opts = LinesPictureOptions {
+        shot: Shot {
+            fov_deg: camera.0,
+            ortho: camera.1,
+            size: [camera.2, camera.3],
+            ..Default::default()
+        },
+        lines: args.line_options()?,
+        image: false,
+        svg: true,
+        visibility: VisibilityMethod::Exact,
+        setup: args.setup()?,
+        ..Default::default()
+    };
+    let defaults = CameraDefaults {
+        fov: camera.0,
+        ortho: camera.1,
+    };
+    let specs = match (cameras, views) {
+        (Some(text), None) => parse_camera_file(&text, "cameras", defaults),
+        (None, Some(n)) => fibonacci_views(n, defaults),
+        _ => return Err(value_err("give cameras or views, not both")),
+    }
+    .map_err(to_py)?;
+    let device = args.device.clone();
+    let done = py
+        .detach(|| {
+            let gpu = open_gpu(device.as_deref())?;
+            let mut out = Vec::with_capacity(specs.len());
+            line_views_on(&gpu, mesh.clone(), &opts, &specs, fields, &mut |_, v| {
+                out.push(v);
+                Ok(())
+            })?;
+            Ok::<_, Error>((out, gpu.info.name.clone()))
+        })
+        .map_err(to_py)?;
+    let (views, name) = done;
+    let list = PyList::empty(py);
+    for v in views {
+        list.append(view_dict(py, &mesh, v, &name)?)?;
+    }
+    Ok(list)
+}
+
+/// One view of [`lines_views`] as a dict of numpy arrays.
+fn view_dict<'py>(
+    py: Python<'py>,
+    mesh: &Mesh,
+    v: LineView,
+    device: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let vis = v
+        .visible
+        .as_ref()
+        .ok_or_else(|| value_err("internal: the view was not classified"))?;
+    let s = segment_arrays(vis, mesh);
+    let n = s.a.len();
+    let flat3 = |v: &[[f32; 3]]| v.concat();
+    d.set_item("a", array(py, flat3(&s.a), &[n, 3])?)?;
+    d.set_item("b", array(py, flat3(&s.b), &[n, 3])?)?;
+    d.set_item("kind", array(py, s.family, &[n])?)?;
+    d.set_item("strength", array(py, s.strength, &[n])?)?;
+    d.set_item("visible", array(py, s.visible, &[n])?)?;
+    d.set_item("faces", array(py, s.faces.concat(), &[n, 4])?)?;
+    d.set_item("chain", array(py, s.chain, &[n])?)?;
+    d.set_item("face", array(py, s.face, &[n])?)?;
+    let bary: Vec<f32> = s.bary.iter().flatten().flatten().copied().collect();
+    d.set_item("bary", array(py, bary, &[n, 2, 3])?)?;
+    if let Some(f) = v.fields {
+        let nv = f.ndotv.len();
+        d.set_item("ndotv", array(py, f.ndotv, &[nv])?)?;
+        d.set_item("kr", array(py, f.kr, &[nv])?)?;
+        d.set_item("dwkr", array(py, f.dwkr, &[nv])?)?;
+        d.set_item("q1", array(py, f.q1, &[nv])?)?;
+    }
+    let c = v.camera;
+    let cam = PyDict::new(py);
+    cam.set_item("eye", c.eye.to_array())?;
+    cam.set_item("target", c.target.to_array())?;
+    cam.set_item("up", c.up.to_array())?;
+    cam.set_item("fov", c.fov_y_deg)?;
+    cam.set_item("ortho", c.ortho_height)?;
+    d.set_item("camera", cam)?;
+    let ms: f64 = v.passes.iter().map(|p| p.ms).sum();
+    d.set_item("passes_ms", ms)?;
+    let passes: Vec<&str> = v.passes.iter().map(|p| p.pass.name()).collect();
+    d.set_item("passes", passes)?;
+    d.set_item("feature_size", v.feature_size)?;
+    d.set_item("device", device)?;
+    let names: Vec<&str> = LineFamily::ALL.iter().map(|f| f.name()).collect();
+    d.set_item("family_names", names)?;
     Ok(d)
 }

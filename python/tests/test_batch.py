@@ -133,3 +133,66 @@ def test_resources_without_a_client(device, tmp_path):
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=300
     )
     assert out.returncode == 0 and "ran 1" in out.stdout, out.stderr[-2000:]
+
+
+def awkward_meshes(src):
+    """A generated collection of the meshes real datasets hold, each
+    expected to give lines, and of broken files, each expected to fail
+    with the element named."""
+    v, f = torus(24, 12)
+    f = np.asarray(f)
+    good = {
+        "two_components": (np.concatenate([v, v + [3.0, 0, 0]]), np.concatenate([f, f + len(v)])),
+        # Half the torus's faces: an open boundary.
+        "open_boundary": (v, f[: len(f) // 2]),
+        "isolated_vertices": (np.concatenate([v, [[9.0, 9, 9], [-9.0, 2, 1]]]), f),
+        "degenerate_faces": (v, np.concatenate([f, [[0, 0, 1], [2, 2, 2]]])),
+        "duplicate_faces": (v, np.concatenate([f, f[:40]])),
+        # A fin: one edge of the torus shared by a third face.
+        "non_manifold": (
+            np.concatenate([v, [[0.0, 0.0, 2.0]]]),
+            np.concatenate([f, [[f[0][0], f[0][1], len(v)]]]),
+        ),
+        "huge": (v * 1e6 + 3e6, f),
+        "tiny": (v * 1e-6 - 2e-6, f),
+    }
+    for name, (vv, ff) in good.items():
+        write_obj(src / f"{name}.obj", vv, ff)
+    (src / "nan_vertex.obj").write_text("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
+    (src / "bad_index.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
+    (src / "empty.obj").write_text("")
+    return sorted(good), {"nan_vertex": "vertex 1: non-finite", "bad_index": "7", "empty": "empty.obj"}
+
+
+def test_lines_batch_over_awkward_and_broken_meshes(device, client, tmp_path):
+    from shapecue import batch
+
+    src = tmp_path / "in"
+    src.mkdir()
+    good, broken = awkward_meshes(src)
+    out = tmp_path / "out"
+    opts = {"views": 3, "lines": "contours,suggestive,ridges", "size": (320, 240)}
+    recs = batch.run(str(src / "*.obj"), out, task="lines", client=client, options=opts)
+    by = {r["input"].rsplit("/", 1)[-1][:-4]: r for r in recs}
+    assert sorted(by) == sorted(good + list(broken))
+    for name in good:
+        r = by[name]
+        assert r["status"] == "ok", (name, r["error"])
+        assert r["views"] == 3
+        doc = json.loads((out / name / "views.json").read_text())
+        assert [e["file"] for e in doc["views"]] == ["view_000.npz", "view_001.npz", "view_002.npz"]
+        z = np.load(out / name / "view_001.npz")
+        for k in ("a", "b", "kind", "visible", "face", "bary", "ndotv", "q1", "eye"):
+            assert k in z.files, (name, k)
+        assert np.all(np.isfinite(z["a"])) and np.all(np.isfinite(z["ndotv"]))
+        assert len(z["ndotv"]) == doc["vertices"]
+    assert sum(len(json.loads((out / n / "views.json").read_text())["views"]) for n in good) == 3 * len(good)
+    for name, words in broken.items():
+        r = by[name]
+        assert r["status"] == "error" and words in r["error"], (name, r["error"])
+        assert not (out / name).exists()
+    # Nothing half-written is left beside the outputs.
+    assert not [p for p in out.iterdir() if ".part" in p.name]
+    # A rerun runs only the failures again.
+    again = batch.run(str(src / "*.obj"), out, task="lines", client=client, options=opts)
+    assert sorted(r["input"].rsplit("/", 1)[-1][:-4] for r in again) == sorted(broken)

@@ -44,3 +44,63 @@ def test_auto_accumulation_is_the_default_and_unknown_names_the_choices():
     msg = r'unknown accumulation "sometimes": expected auto, atomic, atomic-native, gather'
     with pytest.raises(ValueError, match=msg):
         shapecue.lines(v, f, accumulate="sometimes")
+
+
+def test_many_views_share_the_pose_and_carry_provenance_and_fields():
+    v, f = torus()
+    v = v * 3.0 + np.array([40.0, -10.0, 5.0])
+    centre = np.array([40.0, -10.0, 5.0])
+    cams = [
+        {"eye": (centre + [0.0, -12.0, 6.0]).tolist(), "target": centre.tolist()},
+        {"eye": centre + np.array([9.0, 0.0, 9.0]), "target": centre, "ortho": 10.0},
+    ]
+    views = shapecue.lines(v, f, lines="contours,suggestive,ridges", cameras=cams, fields=True)
+    assert len(views) == 2
+    # The pose passes ran with the first view only.
+    assert "curvature" in views[0].passes and "bvh" in views[0].passes
+    assert "curvature" not in views[1].passes and "bvh" not in views[1].passes
+    assert "visibility" in views[1].passes and "view_fields" in views[1].passes
+    assert views[1].camera["ortho"] == pytest.approx(10.0)
+    for view, cam in zip(views, cams):
+        n = len(view.a)
+        assert n > 100 and view.bary.shape == (n, 2, 3) and view.faces.shape == (n, 4)
+        assert view.visible.dtype == bool and 0 < view.visible.mean() < 1
+        assert set(view.family) <= {"contours", "suggestive", "ridges"}
+        # Each end rebuilt from its face's corners and its barycentric
+        # coordinates.
+        assert np.all(view.face >= 0)
+        corners = v[f[view.face]]
+        for end, pts in ((0, view.a), (1, view.b)):
+            rebuilt = np.einsum("pj,pjc->pc", view.bary[:, end], corners)
+            assert np.abs(rebuilt - pts).max() < 1e-4 * 3.0
+        # n·v per vertex from the vertex positions (the torus's normals).
+        nd = view.fields["ndotv"]
+        assert nd.shape == (len(v),)
+        eye = np.asarray(cam["eye"], dtype=float)
+        to_eye = eye - v if "ortho" not in cam else np.broadcast_to(eye - centre, v.shape)
+        to_eye = to_eye / np.linalg.norm(to_eye, axis=1, keepdims=True)
+        q = (v - centre) / 3.0
+        ring = q.copy()
+        ring[:, 2] = 0.0
+        ring = ring / np.linalg.norm(ring, axis=1, keepdims=True)
+        normal = q - ring * 1.0
+        normal = normal / np.linalg.norm(normal, axis=1, keepdims=True)
+        assert np.abs(nd - np.sum(normal * to_eye, axis=1)).max() < 0.02
+        assert all(np.all(np.isfinite(view.fields[k])) for k in ("kr", "dwkr", "q1"))
+    # A number of views: the Fibonacci cameras, the same for the same count.
+    a = shapecue.lines(v, f, cameras=3)
+    b = shapecue.lines(v, f, cameras=3)
+    assert [x.camera["eye"] for x in a] == [x.camera["eye"] for x in b]
+    assert a[0].fields is None
+
+
+def test_bad_cameras_are_clear_errors():
+    v, f = torus(nu=24, nv=12)
+    with pytest.raises(ValueError, match="camera 1"):
+        shapecue.lines(v, f, cameras=[{"eye": [0, 0, 3], "target": [0, 0, 0]}, {"eye": [0, 0, 3]}])
+    with pytest.raises(ValueError, match="cameras"):
+        shapecue.lines(v, f, cameras=True)
+    with pytest.raises(ValueError, match="eye"):
+        shapecue.lines(v, f, cameras=2, eye=(0, 0, 3))
+    with pytest.raises(ValueError, match="0 views|1 to"):
+        shapecue.lines(v, f, cameras=0)

@@ -193,6 +193,85 @@ pub fn lines_views_scene(
     s
 }
 
+/// One view of [`line_views_on`], world coordinates.
+pub struct LineView {
+    /// The camera as resolved (a fitted view's eye placed).
+    pub camera: Camera,
+    /// The line segments found for this view.
+    pub segments: Vec<Segment>,
+    /// The segments classified and chained by exact visibility (where the
+    /// options ask for it).
+    pub visible: Option<VisibleLines>,
+    /// The per-vertex fields of the view, where asked.
+    pub fields: Option<crate::spec::feature_lines::ViewFields>,
+    /// The passes that ran for this view (the first view also runs the
+    /// pose's), with their ms.
+    pub passes: Vec<PassRecord>,
+    /// The feature size the thresholds were scaled by.
+    pub feature_size: f32,
+}
+
+/// The lines of `mesh` from each of `views`, in memory and in one setup of
+/// the scene executor (the scene of [`lines_scene`] with the SVG groups
+/// found, no file written, no GL context unless the options draw a
+/// picture): the pose passes (curvature, the feature size, the BVH) run
+/// once and the view passes once per view, as `shapecue lines --views`
+/// runs them. `fields` keeps each view's per-vertex fields. Each view goes
+/// to `each` as it is done; an error of a view, or of `each`, ends the run
+/// with it.
+pub fn line_views_on(
+    gpu: &Arc<Gpu>,
+    mesh: Arc<Mesh>,
+    opts: &LinesPictureOptions,
+    views: &[ViewSpec],
+    fields: bool,
+    each: &mut dyn FnMut(usize, LineView) -> Result<()>,
+) -> Result<()> {
+    if wanted(&opts.lines).is_empty() {
+        return Err(crate::error::Error::InvalidArgument(
+            "no line family is asked for, so there is nothing to draw".into(),
+        ));
+    }
+    let mut scene = lines_scene(mesh, opts);
+    scene.svg = true;
+    scene.fields = fields;
+    let request = |i: usize| {
+        let mut s = scene.clone();
+        s.views = vec![views[i].clone()];
+        crate::scene::exec::LiveRequest {
+            scene: s,
+            svg: None,
+        }
+    };
+    let Some(first) = views.first().map(|_| request(0)) else {
+        return Ok(());
+    };
+    let mut done = 0;
+    let mut failed = None;
+    let mut next = |f: Result<crate::scene::exec::LiveFrame>| {
+        let handed = f.and_then(|f| {
+            let v = f.view;
+            let view = LineView {
+                camera: v.world_camera(),
+                segments: v.segments,
+                visible: v.visible,
+                fields: v.fields,
+                passes: f.passes,
+                feature_size: v.feature_size.unwrap_or(0.0),
+            };
+            each(done, view)
+        });
+        if let Err(e) = handed {
+            failed = Some(e);
+            return None;
+        }
+        done += 1;
+        (done < views.len()).then(|| request(done))
+    };
+    Session::on(gpu.clone()).live(&ExecOptions::default(), first, &mut next);
+    failed.map_or(Ok(()), Err)
+}
+
 /// The segments of [`line_segments_on`].
 pub struct LineSegments {
     /// Every segment, world coordinates, with its family (`kind`) and strength.

@@ -62,15 +62,16 @@ pub use crate::scene::file::{
     load_camera_file, parse_camera_file,
 };
 pub use crate::spec::cameras::{MAX_VIEWS, fibonacci_directions};
+pub use crate::spec::feature_lines::ViewFields;
 pub use crate::spec::visibility::VisibilityMethod;
 pub use crate::stages::curvature::{
     CurvatureEstimator, KernelBuild, OrderedEstimator, build_kernels,
 };
 pub use crate::stages::feature_lines::LineOptions;
 pub use lines::{
-    Hidden, LineSegments, LineSetup, LinesPicture, LinesPictureOptions, family_style, hidden_id,
-    line_segments_on, lines_picture, lines_picture_on, lines_scene, lines_views_scene,
-    segment_arrays, wanted,
+    Hidden, LineSegments, LineSetup, LineView, LinesPicture, LinesPictureOptions, family_style,
+    hidden_id, line_segments_on, line_views_on, lines_picture, lines_picture_on, lines_scene,
+    lines_views_scene, segment_arrays, wanted,
 };
 
 pub use strokes::{

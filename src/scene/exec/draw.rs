@@ -351,6 +351,9 @@ pub struct ViewOutputs {
     /// The lines classified and chained by exact visibility (world
     /// coordinates), where the plan ran it.
     pub visible: Option<super::vector::VisibleLines>,
+    /// The per-vertex fields of the view (world units), where the scene
+    /// keeps them ([`crate::scene::file::Scene::fields`]).
+    pub fields: Option<crate::spec::feature_lines::ViewFields>,
     /// The line segments found for this view (world coordinates).
     pub segments: Vec<Segment>,
     /// The edge stage's outputs as drawn, when feature edges are planned.

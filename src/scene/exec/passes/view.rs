@@ -421,6 +421,7 @@ impl Executor<'_, '_> {
             image: self.frame.take(),
             layers: self.layers.take(),
             visible: self.vis.as_ref().map(|v| v.shifted(o)),
+            fields: self.fields.take(),
             segments: (self.segs.iter())
                 .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
                 .collect(),
