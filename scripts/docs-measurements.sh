@@ -27,6 +27,7 @@ args_of() {
         pipeline) echo "report pipeline $model" ;;
         caps) echo "report caps --width 10 --fov 20" ;;
         memory) echo "report memory" ;;
+        lines-batch) echo "report lines-batch" ;;
         *) echo "docs-measurements: unknown topic $1" >&2; return 1 ;;
     esac
 }

@@ -184,6 +184,61 @@ fn caps_report_on_a_small_image() {
 }
 
 #[test]
+fn lines_batch_report_splits_pose_and_views() {
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
+    let (text, doc) = report(
+        &[
+            "lines-batch",
+            spot,
+            "--views",
+            "3",
+            "--generated-faces",
+            "2000",
+            "--generated-views",
+            "2",
+            "--size",
+            "160x120",
+        ],
+        &["views"],
+        &[
+            "mesh",
+            "faces",
+            "families",
+            "pose_ms",
+            "per_view_ms",
+            "npz_ms",
+            "views_per_second",
+        ],
+    )
+    .expect("no GL needed");
+    let rows = doc["tables"]["views"].as_array().unwrap();
+    // Two meshes, two family sets each.
+    assert_eq!(rows.len(), 4, "{text}");
+    assert_eq!(rows[0]["mesh"], "spot.obj");
+    assert_eq!(rows[0]["families"], "every family");
+    assert_eq!(rows[1]["families"], "contours + suggestive");
+    for r in rows {
+        let (pose, view) = (
+            r["pose_ms"].as_f64().unwrap(),
+            r["per_view_ms"].as_f64().unwrap(),
+        );
+        assert!(
+            pose > 0.0 && view > 0.0 && r["npz_ms"].as_f64().unwrap() <= view,
+            "{r}"
+        );
+        assert!(r["pieces_per_view"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    // Every family draws more than the contours alone.
+    assert!(rows[0]["pieces_per_view"].as_f64() > rows[1]["pieces_per_view"].as_f64());
+    assert!(
+        rows[2]["mesh"]
+            .as_str()
+            .unwrap()
+            .starts_with("generated torus")
+    );
+}
+
+#[test]
 fn memory_report_needs_no_device() {
     let (text, doc) = report(
         &["memory"],

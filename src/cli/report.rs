@@ -110,6 +110,29 @@ enum Topic {
         #[command(flatten)]
         out: Outputs,
     },
+    /// Line drawings from many views in one run (`shapecue lines --views N
+    /// --npz`): views per second with every line family and with contours
+    /// and suggestive contours only, split into the per-pose and per-view
+    /// parts, on the meshes given (default: the Stanford bunny of the shared
+    /// data, else spot) and on a generated mesh of about a million faces.
+    LinesBatch {
+        /// Meshes to time.
+        meshes: Vec<PathBuf>,
+        /// Views of each mesh (Fibonacci cameras).
+        #[arg(long, default_value_t = 32)]
+        views: usize,
+        /// Faces of the generated torus (0: none).
+        #[arg(long, default_value_t = 1_000_000)]
+        generated_faces: usize,
+        /// Views of the generated mesh.
+        #[arg(long, default_value_t = 4)]
+        generated_views: usize,
+        /// Image size, e.g. 800x600.
+        #[arg(long, default_value = "800x600")]
+        size: String,
+        #[command(flatten)]
+        out: Outputs,
+    },
     /// Memory of the feature edges: bits per mesh of each cap variant, from
     /// the buffer sizes (no device needed).
     Memory {
@@ -230,6 +253,39 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
                 ortho,
             };
             (report::caps::report(&gpu()?, o)?, out)
+        }
+        Topic::LinesBatch {
+            meshes,
+            views,
+            generated_faces,
+            generated_views,
+            size,
+            out,
+        } => {
+            let (w, h) = super::size_arg(&size)?;
+            for (n, flag) in [(views, "--views"), (generated_views, "--generated-views")] {
+                if !(2..=shapecue::api::MAX_VIEWS).contains(&n) {
+                    bail!("{flag} {n}: give 2 to {} views", shapecue::api::MAX_VIEWS);
+                }
+            }
+            if generated_faces > 0 {
+                shapecue::spec::limits::check_mesh_vertices("--generated-faces", generated_faces)?;
+            }
+            for m in &meshes {
+                if !m.exists() {
+                    bail!("{}: not found (give the meshes to time)", m.display());
+                }
+            }
+            let paths: Vec<&Path> = meshes.iter().map(PathBuf::as_path).collect();
+            check(&paths, &out)?;
+            let o = report::lines_batch::LinesBatchOptions {
+                meshes,
+                views,
+                generated_faces,
+                generated_views,
+                size: [w, h],
+            };
+            (report::lines_batch::report(&gpu()?, &o)?, out)
         }
         Topic::Memory { out } => {
             check(&[], &out)?;

@@ -13,6 +13,7 @@ pub mod curvature;
 pub mod frames;
 pub mod isosurface;
 pub mod lines;
+pub mod lines_batch;
 pub mod memory;
 pub mod metrics;
 pub mod pipeline;

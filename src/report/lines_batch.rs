@@ -1,0 +1,256 @@
+//! `shapecue report lines-batch`: views per second of line drawings from
+//! many cameras in one run, as `shapecue lines MESH --views N --out DIR
+//! --npz` makes them (exact visibility, an SVG and the segment pieces as
+//! NPZ per view), split into the per-pose part (one-rings, normals,
+//! curvature and its derivative, the feature size, the BVH: once) and the
+//! per-view part (the line kernels, their visibility and chains, the SVG
+//! and the NPZ: once per view), with every line family of rtsc and with
+//! contours and suggestive contours only, on the meshes given and on a
+//! generated mesh of about a million faces.
+
+use super::metrics::median;
+use super::{Block, Cell, Chart, Column, Report, Row, Table};
+use crate::api::{
+    CameraDefaults, ExecOptions, LinesPictureOptions, Session, fibonacci_views, lines_views_scene,
+    segment_arrays,
+};
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::mesh::{self, Mesh};
+use crate::spec::feature_lines::{FamilySet, LineFamily};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// What `shapecue report lines-batch` measures.
+#[derive(Clone, Debug)]
+pub struct LinesBatchOptions {
+    /// Meshes to time (default: the full-resolution Stanford bunny of the
+    /// shared data, else spot bundled with the repository).
+    pub meshes: Vec<PathBuf>,
+    /// Views of each given mesh (Fibonacci cameras).
+    pub views: usize,
+    /// Faces of the generated torus (0: none).
+    pub generated_faces: usize,
+    /// Views of the generated mesh.
+    pub generated_views: usize,
+    /// Image size the views frame.
+    pub size: [u32; 2],
+}
+
+impl Default for LinesBatchOptions {
+    fn default() -> Self {
+        LinesBatchOptions {
+            meshes: Vec::new(),
+            views: 32,
+            generated_faces: 1_000_000,
+            generated_views: 4,
+            size: [800, 600],
+        }
+    }
+}
+
+/// The meshes of the report when none is given.
+pub fn default_meshes() -> Vec<PathBuf> {
+    let bunny = super::shared_data().join("meshes/stanford-bunny.obj");
+    if bunny.exists() {
+        return vec![bunny];
+    }
+    vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("data/spot.obj")]
+}
+
+/// One timed run of many views.
+struct Timed {
+    /// Wall ms of the pose part (every pose pass, once).
+    pose_ms: f64,
+    /// Wall ms of each view (its passes, the SVG, the NPZ).
+    view_ms: Vec<f64>,
+    /// Of which the NPZ (the arrays with their provenance, and the file).
+    npz_ms: Vec<f64>,
+    /// Pieces per view (mean).
+    pieces: f64,
+}
+
+/// Measures the report.
+///
+/// # Errors
+/// A mesh that cannot be loaded, device failures, or the scratch folder.
+pub fn report(gpu: &Arc<Gpu>, o: &LinesBatchOptions) -> Result<Report> {
+    let mut r = Report::new("lines-batch", gpu.info.name.clone());
+    r.text(format!(
+        "Views per second of `shapecue lines MESH --views N --out DIR --npz`: one run per mesh \
+         and family set, Fibonacci cameras at {}x{}, exact visibility, an SVG and the segment \
+         pieces as NPZ written per view. Pose: wall ms of the passes that run once (one-rings, \
+         normals, curvature and its derivative, the feature size, the BVH). Per view: median \
+         wall ms of a view's passes (line kernels, visibility, chains, SVG) and its NPZ, over \
+         the views after the first, and of the NPZ alone (the pieces' arrays with their faces \
+         and barycentric coordinates, and the file); views/s from the per-view ms. The kernels \
+         are built before any timing. rtsc 1.6 draws a view of the bunny with \
+         every family in about 0.2 s on one core.",
+        o.size[0], o.size[1]
+    ));
+    let mut t = Table::new(
+        "views",
+        vec![
+            Column::new("mesh", "mesh"),
+            Column::new("faces", "faces"),
+            Column::new("families", "families"),
+            Column::new("views", "views"),
+            Column::new("pose ms", "pose_ms"),
+            Column::new("per view ms", "per_view_ms"),
+            Column::new("of which NPZ ms", "npz_ms"),
+            Column::new("views/s", "views_per_second"),
+            Column::new("pieces per view", "pieces_per_view"),
+        ],
+    );
+    let mut meshes: Vec<(String, Arc<Mesh>, usize)> = Vec::new();
+    let paths = match o.meshes.is_empty() {
+        true => default_meshes(),
+        false => o.meshes.clone(),
+    };
+    for p in &paths {
+        let m = mesh::load(p, &Default::default())?;
+        let name = p
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into());
+        meshes.push((name, Arc::new(m), o.views));
+    }
+    if o.generated_faces > 0 {
+        let m = generated_torus(o.generated_faces);
+        let name = format!("generated torus ({} faces)", m.n_faces());
+        meshes.push((name, Arc::new(m), o.generated_views));
+    }
+    // Each family set's programs are built once, before any timing.
+    let small = Arc::new(mesh::icosphere(1.0, 2));
+    for (_, fams) in families() {
+        measure(gpu, &small, fams, 2, o.size)?;
+    }
+    let mut series: Vec<(String, Vec<f64>)> = (families().iter())
+        .map(|(label, _)| (label.to_string(), Vec::new()))
+        .collect();
+    for (name, m, views) in &meshes {
+        for (k, (label, fams)) in families().into_iter().enumerate() {
+            let timed = measure(gpu, m, fams, *views, o.size)?;
+            let (row, vps) = row(name, m, label, *views, timed);
+            t.rows.push(row);
+            series[k].1.push(vps);
+        }
+    }
+    r.blocks.push(Block::Table(t));
+    r.charts.push(Chart::Bars {
+        title: "Views per second after the first (SVG and NPZ written)".into(),
+        y_label: "views/s".into(),
+        log_y: true,
+        groups: meshes.iter().map(|m| m.0.clone()).collect(),
+        series,
+    });
+    Ok(r)
+}
+
+/// The two family sets timed.
+fn families() -> [(&'static str, FamilySet); 2] {
+    [
+        ("every family", FamilySet::of(&LineFamily::ALL)),
+        (
+            "contours + suggestive",
+            FamilySet::of(&[LineFamily::Contours, LineFamily::Suggestive]),
+        ),
+    ]
+}
+
+/// A torus of about `faces` faces (two per grid cell, 2:1 around).
+fn generated_torus(faces: usize) -> Mesh {
+    let nv = ((faces as f64 / 4.0).sqrt().round() as usize).max(3);
+    mesh::torus(1.0, 0.4, 2 * nv, nv)
+}
+
+/// One row of the table, and its views per second.
+fn row(name: &str, m: &Mesh, label: &str, views: usize, mut t: Timed) -> (Row, f64) {
+    let per_view = median(&mut t.view_ms);
+    let npz = median(&mut t.npz_ms);
+    let vps = if per_view > 0.0 { 1e3 / per_view } else { 0.0 };
+    let row = Row::new(vec![
+        Cell::text(name),
+        Cell::int(m.n_faces() as u64),
+        Cell::text(label),
+        Cell::int(views as u64),
+        Cell::num(t.pose_ms, format!("{:.1}", t.pose_ms)),
+        Cell::num(per_view, format!("{per_view:.1}")),
+        Cell::num(npz, format!("{npz:.1}")),
+        Cell::num(vps, format!("{vps:.1}")),
+        Cell::num(t.pieces, format!("{:.0}", t.pieces)),
+    ]);
+    (row, vps)
+}
+
+/// Runs `views` Fibonacci views of `m` with `fams` as the command does,
+/// writing into a scratch folder removed afterwards.
+fn measure(
+    gpu: &Arc<Gpu>,
+    m: &Arc<Mesh>,
+    fams: FamilySet,
+    views: usize,
+    size: [u32; 2],
+) -> Result<Timed> {
+    let mut opts = LinesPictureOptions {
+        image: false,
+        svg: true,
+        ..Default::default()
+    };
+    opts.shot.size = size;
+    opts.lines.contours = fams.has(LineFamily::Contours);
+    opts.lines.suggestive = fams.has(LineFamily::Suggestive);
+    opts.lines.curves.families = fams.curves();
+    let cams = fibonacci_views(views, CameraDefaults::default())?;
+    let dir = scratch_dir()?;
+    let mut scene = lines_views_scene(m.clone(), &opts, cams);
+    scene.out_dir = dir.clone();
+    scene.prefix = "view".into();
+    let exec = ExecOptions {
+        force: true,
+        ..Default::default()
+    };
+    let mut npz_ms = vec![0.0; views];
+    let mut pieces = 0usize;
+    let run = Session::on(gpu.clone()).run_each(&scene, &exec, &mut |_, _| {}, &mut |v| {
+        let t = Instant::now();
+        if let Some(vis) = &v.visible {
+            let a = segment_arrays(vis, m);
+            pieces += a.a.len();
+            let p = dir.join(format!("view_{:04}.npz", v.view));
+            crate::export::npz::write_segments(&p, &a)?;
+        }
+        npz_ms[v.view] = t.elapsed().as_secs_f64() * 1e3;
+        Ok(())
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    let rep = run?;
+    let laps = rep.timing.laps("view_wall");
+    let first = 1.min(laps.len().saturating_sub(1));
+    let view_ms: Vec<f64> = (laps.iter().zip(&npz_ms))
+        .skip(first)
+        .map(|(a, b)| a + b)
+        .collect();
+    Ok(Timed {
+        pose_ms: rep.timing.phase_ms("pose_wall"),
+        view_ms,
+        npz_ms: npz_ms[first.min(npz_ms.len())..].to_vec(),
+        pieces: pieces as f64 / views.max(1) as f64,
+    })
+}
+
+/// A fresh scratch folder of this process.
+fn scratch_dir() -> Result<PathBuf> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "shapecue-lines-batch-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
+        path: dir.clone(),
+        source,
+    })?;
+    Ok(dir)
+}
