@@ -82,6 +82,19 @@ fn lines_write_svg_and_segments_with_no_gl() {
     for s in segs {
         let faces = s["faces"].as_array().unwrap();
         assert!(!faces.is_empty() && faces.len() <= 4, "{s}");
+        // The face the piece lies in is one of its segment's, with each
+        // end's barycentric coordinates there (each summing to 1).
+        assert!(faces.contains(&s["face"]), "{s}");
+        for end in s["bary"].as_array().unwrap() {
+            let w: Vec<f64> = end
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-4, "{s}");
+            assert!(w.iter().all(|x| *x > -1e-3), "{s}");
+        }
         assert!(s["chain"].as_u64().unwrap() < doc["chains"].as_array().unwrap().len() as u64);
     }
     let mean = doc["mean_visible_chain_segments"].as_f64().unwrap();

@@ -295,7 +295,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         _ => bail!("the picture drew no image for {}", output.display()),
     }
     if let Some(p) = &segments {
-        let doc = segments_doc(pic.visible.as_ref(), &pic.segments, pic.feature_size);
+        let doc = segments_doc(pic.visible.as_ref(), &pic.segments, pic.feature_size, &mesh);
         write_json(p, &doc)?;
     }
     let found = summary(&pic.segments);
@@ -357,22 +357,28 @@ fn segments_doc(
     visible: Option<&VisibleLines>,
     segments: &[Segment],
     feature_size: f32,
+    mesh: &shapecue::Mesh,
 ) -> serde_json::Value {
     let family = |k: u32| LineFamily::from_kind(k).map_or("unknown", |f| f.name());
     match visible {
         Some(v) => {
-            let chain_of = v.chain_of_pieces();
+            // The pieces as the NPZ arrays hold them, with their face and
+            // their ends' barycentric coordinates in it.
+            let arr = shapecue::api::segment_arrays(v, mesh);
             let pieces: Vec<serde_json::Value> = (v.chain_pieces.iter().enumerate())
                 .map(|(i, p)| {
                     let s = &v.segments[p.seg as usize];
+                    let face = (arr.face[i] >= 0).then_some(arr.face[i]);
                     serde_json::json!({
                         "family": family(s.2),
                         "strength": s.3,
-                        "a": v.point(p.seg, p.t[0]),
-                        "b": v.point(p.seg, p.t[1]),
+                        "a": arr.a[i],
+                        "b": arr.b[i],
                         "visible": p.visible,
                         "faces": v.faces[p.seg as usize],
-                        "chain": chain_of[i],
+                        "chain": arr.chain[i],
+                        "face": face,
+                        "bary": face.map(|_| arr.bary[i]),
                     })
                 })
                 .collect();

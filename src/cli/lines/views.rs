@@ -264,6 +264,7 @@ impl ViewsRun<'_> {
                 v.visible.as_ref(),
                 &v.segments,
                 v.feature_size.unwrap_or(0.0),
+                self.mesh,
             );
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
             files.push(self.keep(&paths[v.view], |p| {
