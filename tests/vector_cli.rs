@@ -287,3 +287,74 @@ fn strokes_write_svg_with_no_gl() {
     );
     assert!(!both.status.success());
 }
+
+/// The intersection pass's segment count, from the run report.
+fn isect_segments(report: &Path) -> u64 {
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(report).unwrap()).unwrap();
+    let pass = (r["passes"].as_array().unwrap().iter())
+        .find(|p| p["pass"] == "intersections")
+        .unwrap_or_else(|| panic!("{r}"));
+    let how = pass["how"].as_str().unwrap();
+    let n = how
+        .split(" segments")
+        .next()
+        .unwrap()
+        .rsplit(' ')
+        .next()
+        .unwrap();
+    n.parse().unwrap_or_else(|_| panic!("{how}"))
+}
+
+#[test]
+fn intersection_lines_cross_the_files_of_a_scene_not_each_file() {
+    let d = scratch("intersection-files");
+    // a: two crossing spheres (a self-intersecting file); b: a third
+    // sphere crossing the first of a only.
+    let a = d.join("a.obj");
+    std::fs::write(&a, crossing_spheres_obj()).unwrap();
+    let s = shapecue::mesh::icosphere(1.0, 3);
+    let moved = |p: &[f64; 3]| [p[0] - 0.9, p[1] + 0.011, p[2] + 0.9];
+    let b_pos: Vec<[f64; 3]> = s.positions.iter().map(moved).collect();
+    let b = d.join("b.obj");
+    std::fs::write(&b, common::obj_text(b_pos.clone(), &s.faces)).unwrap();
+    let ma = shapecue::mesh::load(&a, &Default::default()).unwrap();
+    let bm = shapecue::Mesh::new(b_pos, s.faces.clone(), "b").unwrap();
+    let union = shapecue::Mesh::concat(&[ma, bm], "union").unwrap();
+    let u = d.join("union.obj");
+    std::fs::write(&u, common::obj_text(union.positions, &union.faces)).unwrap();
+    let run = |name: &str, input: String| {
+        let scene = d.join(format!("{name}.toml"));
+        let text = format!(
+            "[input]\n{input}\n[[camera]]\ndirection = [0.3, 1.0, 0.5]\n[effects]\n\
+             intersection_lines = {{ width = 1.5 }}\n[output]\nformats = [\"svg\"]\ndir = {:?}\n",
+            d.join(name).to_str().unwrap()
+        );
+        std::fs::write(&scene, text).unwrap();
+        no_gl(&d, &["render", scene.to_str().unwrap()])
+    };
+    let q = |p: &Path| format!("{:?}", p.to_str().unwrap());
+    ok(&run("files", format!("meshes = [{}, {}]", q(&a), q(&b))));
+    ok(&run("a", format!("mesh = {}", q(&a))));
+    ok(&run("union", format!("mesh = {}", q(&u))));
+    let files = isect_segments(&d.join("files/files_report.json"));
+    let own = isect_segments(&d.join("a/a_report.json"));
+    let all = isect_segments(&d.join("union/union_report.json"));
+    // The files' crossing alone: every crossing of the union but a's own.
+    assert!(files > 50 && own > 50, "{files} {own}");
+    assert_eq!(files, all - own, "files {files}, a {own}, union {all}");
+    let svg = std::fs::read_to_string(d.join("files/files_f0000_v00.svg")).unwrap();
+    assert_eq!(groups(&svg)[0].0, "intersection-lines");
+    // One file is `mesh`; a missing file is named.
+    let one = run("one", format!("meshes = [{}]", q(&a)));
+    assert!(!one.status.success());
+    assert!(String::from_utf8_lossy(&one.stderr).contains("two or more"));
+    let gone = run(
+        "gone",
+        format!("meshes = [{}, {}]", q(&a), q(&d.join("nope.obj"))),
+    );
+    let err = String::from_utf8_lossy(&gone.stderr);
+    assert!(
+        !gone.status.success() && err.contains("meshes[1]") && err.contains("nope.obj"),
+        "{err}"
+    );
+}

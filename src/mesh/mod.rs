@@ -60,6 +60,32 @@ impl Mesh {
         self.faces.len()
     }
 
+    /// The meshes as one: their vertices and faces in order, each mesh's
+    /// indices offset by the vertices before it; `what` names the result
+    /// in errors.
+    ///
+    /// # Errors
+    /// More vertices in all than 32-bit indices address.
+    pub fn concat(meshes: &[Mesh], what: &str) -> crate::error::Result<Mesh> {
+        let total: usize = meshes.iter().map(Mesh::n_vertices).sum();
+        if total > u32::MAX as usize {
+            return Err(crate::error::Error::InvalidArgument(format!(
+                "{what}: {total} vertices in all, more than 32-bit indices address"
+            )));
+        }
+        let mut out = Mesh {
+            positions: Vec::with_capacity(total),
+            faces: Vec::new(),
+        };
+        for m in meshes {
+            let base = out.positions.len() as u32;
+            out.positions.extend_from_slice(&m.positions);
+            out.faces
+                .extend(m.faces.iter().map(|f| f.map(|v| v + base)));
+        }
+        Ok(out)
+    }
+
     /// Rejects what no stage can work with: no faces, indices out of range,
     /// non-finite coordinates, or more elements than 32-bit indices address.
     pub fn validate(&self, source: &str) -> Result<()> {

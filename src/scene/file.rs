@@ -76,6 +76,9 @@ use toml_words::plain_toml_message;
 pub enum Source {
     /// A mesh file.
     Mesh(PathBuf),
+    /// Several mesh files, drawn as one mesh (their faces concatenated in
+    /// order); the intersection lines cross the files, not each file itself.
+    Meshes(Vec<PathBuf>),
     /// A generated mesh (kind, vertex count).
     Generate(String, usize),
     /// A glTF skin and clip (`None`: clip 0, or the rest pose when the file
@@ -99,7 +102,9 @@ impl Source {
     /// The planner's input kind.
     pub fn input(&self) -> Input {
         match self {
-            Source::Mesh(_) | Source::Generate(..) | Source::Held(_) => Input::Static,
+            Source::Mesh(_) | Source::Meshes(_) | Source::Generate(..) | Source::Held(_) => {
+                Input::Static
+            }
             Source::Gltf(..) | Source::Lbs(_) => Input::Skinned,
             Source::Flipbook(_) => Input::Flipbook,
             Source::Volume(..) | Source::Sdf(..) | Source::HeldVolume(..) => Input::Volume,

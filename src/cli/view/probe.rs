@@ -59,6 +59,14 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
                 )));
             }
         },
+        Source::Meshes(ps) => {
+            files.extend(ps.iter().cloned());
+            let ms = (ps.iter())
+                .map(|p| shapecue::mesh::load(p, &opts))
+                .collect::<shapecue::Result<Vec<_>>>()?;
+            let m = shapecue::Mesh::concat(&ms, &scene.path.display().to_string())?;
+            (1, mesh_bounds(&m.positions, &m.faces))
+        }
         Source::Gltf(p, clip) => {
             files.push(p.clone());
             let m = shapecue::mesh::skinned::load_gltf(p)?;

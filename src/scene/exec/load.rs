@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 
 /// The geometry of a scene, loaded on the host.
 pub(super) enum Loaded {
-    Static(Mesh),
+    /// A static mesh, and the faces of each file where it joins several
+    /// (`[input] meshes`; empty for one).
+    Static(Mesh, Vec<usize>),
     Skinned {
         mesh: Box<SkinnedMesh>,
         /// Joint matrices per frame index.
@@ -31,7 +33,7 @@ impl Loaded {
     /// Frames available (None: unbounded, a static mesh's one frame repeats).
     pub(super) fn frames(&self) -> usize {
         match self {
-            Loaded::Static(_) | Loaded::Volume(..) => 1,
+            Loaded::Static(..) | Loaded::Volume(..) => 1,
             Loaded::Skinned { frames, .. } => *frames,
             Loaded::Flipbook(f) => f.frames.len(),
         }
@@ -69,9 +71,17 @@ fn weld_skinned(
 pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
     let opts = LoadOptions { weld: scene.weld };
     Ok(match &scene.source {
-        Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?),
+        Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?, Vec::new()),
+        Source::Meshes(ps) => {
+            let meshes = (ps.iter())
+                .map(|p| crate::mesh::load(p, &opts))
+                .collect::<Result<Vec<_>>>()?;
+            let counts = meshes.iter().map(Mesh::n_faces).collect();
+            let what = scene.path.display().to_string();
+            Loaded::Static(Mesh::concat(&meshes, &what)?, counts)
+        }
         Source::Generate(kind, n) => match crate::mesh::generated_by_name(kind, *n) {
-            Some((_, m)) => Loaded::Static(m),
+            Some((_, m)) => Loaded::Static(m, Vec::new()),
             None => {
                 return Err(Error::InvalidArgument(format!(
                     "unknown generated mesh {kind:?}"
@@ -89,7 +99,7 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         Source::Sdf(kind, res, iso, above) => {
             inside_below(crate::volume::sdf::sdf_by_name(kind, *res)?, *iso, *above)
         }
-        Source::Held(m) => Loaded::Static(m.0.as_ref().clone()),
+        Source::Held(m) => Loaded::Static(m.0.as_ref().clone(), Vec::new()),
         Source::HeldVolume(v, iso, above) => inside_below(v.0.as_ref().clone(), *iso, *above),
     })
 }

@@ -62,6 +62,7 @@ impl Table<'_> {
         let inp = self.inp;
         let given: Vec<&'static str> = [
             ("mesh", inp.mesh.is_some()),
+            ("meshes", inp.meshes.is_some()),
             ("generate", inp.generate.is_some()),
             ("gltf", inp.gltf.is_some()),
             ("flipbook", inp.flipbook.is_some()),
@@ -74,7 +75,7 @@ impl Table<'_> {
         .collect();
         if given.len() != 1 {
             return Err(self.err(format!(
-                "[input] needs exactly one of mesh, generate, gltf, flipbook, lbs, volume, sdf; got {}",
+                "[input] needs exactly one of mesh, meshes, generate, gltf, flipbook, lbs, volume, sdf; got {}",
                 if given.is_empty() {
                     "none".to_string()
                 } else {
@@ -113,6 +114,7 @@ impl Table<'_> {
             "weld",
             !inp.weld
                 || inp.mesh.is_some()
+                || inp.meshes.is_some()
                 || inp.flipbook.is_some()
                 || inp.gltf.is_some()
                 || inp.lbs.is_some(),
@@ -139,6 +141,8 @@ impl Table<'_> {
         let (ck, inp) = (self.ck, self.inp);
         Ok(if let Some(m) = &inp.mesh {
             Source::Mesh(ck.existing(m)?)
+        } else if let Some(ms) = &inp.meshes {
+            self.meshes(ms)?
         } else if let Some(g) = &inp.generate {
             use crate::mesh::GENERATED_NAMES as NAMES;
             if !NAMES.contains(&g.get_ref().as_str()) {
@@ -159,6 +163,27 @@ impl Table<'_> {
         } else {
             self.sdf(inp.sdf.as_ref().expect("one source is given"))?
         })
+    }
+
+    /// Several mesh files: at least two, each existing.
+    fn meshes(&self, ms: &Spanned<Vec<String>>) -> Result<Source> {
+        let ck = self.ck;
+        if ms.get_ref().len() < 2 {
+            return Err(ck.err(
+                ms.span(),
+                "meshes: give two or more files (one file is `mesh`)",
+            ));
+        }
+        let mut paths = Vec::new();
+        for (i, m) in ms.get_ref().iter().enumerate() {
+            let p = ck.relative(m);
+            if !p.exists() {
+                let problem = format!("meshes[{i}]: {} does not exist", p.display());
+                return Err(ck.err(ms.span(), problem));
+            }
+            paths.push(p);
+        }
+        Ok(Source::Meshes(paths))
     }
 
     /// A volume source: the file, `iso` (required) and `inside`.

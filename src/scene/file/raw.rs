@@ -80,6 +80,10 @@ pub struct CurvatureSpec {
 pub struct InputSpec {
     /// A static mesh file (OBJ, PLY, OFF).
     pub mesh: Option<Spanned<String>>,
+    /// Several static mesh files drawn as one scene (their faces
+    /// concatenated; intersection lines are where faces of different files
+    /// cross).
+    pub meshes: Option<Spanned<Vec<String>>>,
     /// A generated mesh: torus, sphere, ellipsoid, cylinder or plane.
     pub generate: Option<Spanned<String>>,
     /// Vertex count of a generated mesh, or grid resolution of an SDF (default 40000 / 128).

@@ -331,7 +331,7 @@ impl<'s, 'g> Executor<'s, 'g> {
     fn topology(&mut self, frame: usize) -> Result<&mut Topology> {
         if self.topo.is_none() {
             let mesh = match &self.loaded {
-                Loaded::Static(m) => m.clone(),
+                Loaded::Static(m, _) => m.clone(),
                 Loaded::Skinned { mesh, .. } => mesh.rest.clone(),
                 Loaded::Flipbook(fb) => {
                     let p = match self.frame_pos.take() {

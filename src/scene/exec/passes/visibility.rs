@@ -4,6 +4,8 @@
 
 use super::super::vector::{classify_view, gather, stroke_segments, svg_layers_exact};
 use super::*;
+use crate::scene::exec::load::Loaded;
+use crate::spec::intersections::IntersectionOptions;
 
 impl Executor<'_, '_> {
     /// The BVH of this pose's mesh: built when its topology first appears,
@@ -34,6 +36,13 @@ impl Executor<'_, '_> {
     pub(super) fn intersections_pass(&mut self) -> Result<()> {
         use crate::spec::feature_lines::LINE_FREE;
         use crate::stages::intersections::Intersections;
+        // Several files drawn as one: only faces of different files cross.
+        let opts = match &self.loaded {
+            Loaded::Static(_, counts) if !counts.is_empty() => {
+                IntersectionOptions::by_input(counts)
+            }
+            _ => IntersectionOptions::default(),
+        };
         let t = self.topo.as_mut().expect("a pose ran");
         let bvh = t.bvh.as_ref().expect("planned after the BVH");
         let search = match &mut t.isect {
@@ -41,7 +50,7 @@ impl Executor<'_, '_> {
             None => t.isect.insert(Intersections::new(
                 self.gpu.clone(),
                 t.mesh.n_faces(),
-                &Default::default(),
+                &opts,
             )?),
         };
         let (segs, stats) = search.find(bvh)?;
