@@ -360,7 +360,7 @@ fn segments_doc(
                         "a": v.point(p.seg, p.t[0]),
                         "b": v.point(p.seg, p.t[1]),
                         "visible": p.visible,
-                        "faces": v.faces[p.seg as usize],
+                        "faces": v.faces[p.seg as usize].as_slice(),
                         "chain": chain_of[i],
                     })
                 })

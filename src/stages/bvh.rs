@@ -63,6 +63,7 @@ pub struct Bvh {
     leaf_parent: Buffer<u32>,
     node_boxes: Buffer<BvhBox>,
     leaf_boxes: Buffer<BvhBox>,
+    child_boxes: Buffer<BvhBox>,
     visits: Buffer<u32>,
     counters: Buffer<u32>,
     built: bool,
@@ -118,6 +119,7 @@ impl Bvh {
             leaf_parent: gpu.buffer(l1)?,
             node_boxes: gpu.buffer(i1)?,
             leaf_boxes: gpu.buffer(l1)?,
+            child_boxes: gpu.buffer(2 * i1)?,
             visits: gpu.buffer(i1)?,
             counters: gpu.buffer(1)?,
             built: false,
@@ -211,6 +213,7 @@ impl Bvh {
             buf(&self.leaf_parent),
             buf(&self.leaf_boxes),
             buf(&self.node_boxes),
+            buf(&self.child_boxes),
             buf(&self.visits),
         ];
         self.run(Step::BvhRefit, 2, n, &args)
@@ -255,7 +258,7 @@ impl Bvh {
             buf(&qbuf),
         ];
         args.extend(self.tree_bufs());
-        args.extend([buf(&out), buf(&self.counters)]);
+        args.extend([buf(&self.child_boxes), buf(&out), buf(&self.counters)]);
         self.timing = Timing::default();
         self.run(Step::BvhOccluded, 3, nq, &args)?;
         let mut result = vec![0u32; nq];
@@ -315,6 +318,7 @@ impl Bvh {
             leaf_parent: vec![0; n],
             node_boxes: vec![BvhBox::default(); internal],
             leaf_boxes: vec![BvhBox::default(); n],
+            child_boxes: vec![BvhBox::default(); 2 * internal],
         };
         if !self.built || n == 0 {
             t.keys.clear();
@@ -330,6 +334,7 @@ impl Bvh {
         if internal > 0 {
             self.gpu.read(&self.nodes, &mut t.nodes)?;
             self.gpu.read(&self.node_boxes, &mut t.node_boxes)?;
+            self.gpu.read(&self.child_boxes, &mut t.child_boxes)?;
         }
         Ok(t)
     }
