@@ -6,8 +6,9 @@
 //! search, its split by a binary search on the common prefix of the
 //! augmented key (code, index)), `refit` (leaf boxes from the triangles,
 //! internal boxes bottom-up with one visit counter per node: the second
-//! child to arrive computes the parent) and `occluded` (stack traversal with
-//! the kernel's f32 arithmetic). Boxes are min/max of f32 values, exact in
+//! child to arrive computes the parent, and writes both children's boxes
+//! padded for the queries, [`Tree::child_boxes`]) and `occluded` (stack
+//! traversal with the kernel's f32 arithmetic, over the padded child boxes). Boxes are min/max of f32 values, exact in
 //! any order, so they equal the device's bit for bit.
 //!
 //! [`occluded_brute`] is the f64 brute-force reference the tests compare

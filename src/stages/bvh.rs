@@ -10,13 +10,15 @@
 //! keys, stable: ties keep face order), `bvh_build` (internal nodes and
 //! parents), then [`Bvh::refit`]. Morton codes depend on positions, but the
 //! tree is kept: a later pose only reruns `bvh_refit` (leaf boxes and
-//! internal boxes bottom-up, one visit counter per node, zeroed first), so
+//! internal boxes bottom-up, one visit counter per node, zeroed first, and
+//! each node's two children's boxes padded for the queries), so
 //! the tree stays valid (boxes contain their subtrees) but may loosen when a
 //! pose moves far from the first.
 //!
 //! Buffers ([`bvh_bound`]): positions `f32[3·V]`, faces `u32[3·F]`, keys and
 //! faces_sorted `u32[F]`, nodes `BvhNode[F−1]`, leaf_parent `u32[F]`,
-//! boxes `BvhBox[F−1]` and `BvhBox[F]`, visits `u32[F−1]`, counters `u32[1]`
+//! boxes `BvhBox[F−1]` and `BvhBox[F]`, padded child boxes `BvhBox[2(F−1)]`,
+//! visits `u32[F−1]`, counters `u32[1]`
 //! (stack overflows of the last query batch). An empty face list is an empty
 //! tree: nothing is launched and every query is visible.
 
