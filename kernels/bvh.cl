@@ -122,13 +122,27 @@ SC_INLINE BvhBox bvh_child_box(volatile __global const BvhBox *node_boxes,
     return b;
 }
 
+// A box padded by BVH_BOX_PAD of its largest extent (cpu::bvh::padded).
+SC_INLINE BvhBox bvh_padded(BvhBox b)
+{
+    const float ext = bvh_greater(bvh_greater(b.hi.x - b.lo.x, b.hi.y - b.lo.y), b.hi.z - b.lo.z);
+    const float pad = BVH_BOX_PAD * ext + 1e-30f;
+    BvhBox p;
+    p.lo = (float4)(b.lo.x - pad, b.lo.y - pad, b.lo.z - pad, 0.0f);
+    p.hi = (float4)(b.hi.x + pad, b.hi.y + pad, b.hi.z + pad, 0.0f);
+    return p;
+}
+
 // One work-item per leaf: the leaf's box, then up the tree; at each node the
 // first child to arrive stops (atomic visit counter, zeroed by the host), the
-// second computes the node's box from both children's and goes on.
+// second computes the node's box from both children's and goes on, and
+// writes the children's padded boxes side by side (child_boxes[2 node + k],
+// what the queries read).
 __kernel void bvh_refit(uint n, __global const float *pos, __global const uint *faces,
                         __global const uint *faces_sorted, __global const BvhNode *nodes,
                         __global const uint *leaf_parent, volatile __global BvhBox *leaf_boxes,
-                        volatile __global BvhBox *node_boxes, volatile __global uint *visits)
+                        volatile __global BvhBox *node_boxes, __global BvhBox *child_boxes,
+                        volatile __global uint *visits)
 {
     GID_OR_RETURN(n);
     const uint f = faces_sorted[gid];
@@ -150,43 +164,50 @@ __kernel void bvh_refit(uint n, __global const float *pos, __global const uint *
         if (atomic_inc(&visits[node]) == 0u) return;
         mem_fence(CLK_GLOBAL_MEM_FENCE);
         const BvhNode nd = nodes[node];
-        const BvhBox u = bvh_union(bvh_child_box(node_boxes, leaf_boxes, nd.left),
-                                   bvh_child_box(node_boxes, leaf_boxes, nd.right));
+        const BvhBox l = bvh_child_box(node_boxes, leaf_boxes, nd.left);
+        const BvhBox r = bvh_child_box(node_boxes, leaf_boxes, nd.right);
+        const BvhBox u = bvh_union(l, r);
         node_boxes[node].lo = u.lo;
         node_boxes[node].hi = u.hi;
+        child_boxes[2 * node] = bvh_padded(l);
+        child_boxes[2 * node + 1] = bvh_padded(r);
         node = nd.parent;
     }
 }
 
-// Slab test of o + t d, t in [0, 1], against the box padded by BVH_BOX_PAD
-// of its largest extent (cpu::bvh::box_hit).
+// One axis of the slab test: narrows [tmin, tmax] to where o + t d lies
+// between lo and hi; false where the segment misses (the loop body of
+// cpu::bvh::padded_hit, written out per axis: no private arrays).
+SC_INLINE bool bvh_slab(float lo, float hi, float o, float d, float inv, float *tmin, float *tmax)
+{
+    if (d == 0.0f) return !(o < lo || o > hi);
+    float t1 = (lo - o) * inv;
+    float t2 = (hi - o) * inv;
+    if (t1 > t2) {
+        const float t = t1;
+        t1 = t2;
+        t2 = t;
+    }
+    *tmin = bvh_greater(*tmin, t1);
+    *tmax = bvh_lesser(*tmax, t2);
+    return !(*tmin > *tmax);
+}
+
+// Slab test of o + t d, t in [0, 1], against a box padded already
+// (bvh_padded; cpu::bvh::padded_hit).
+SC_INLINE bool bvh_padded_hit(BvhBox b, float3 o, float3 d, float3 invd)
+{
+    float tmin = 0.0f, tmax = 1.0f;
+    return bvh_slab(b.lo.x, b.hi.x, o.x, d.x, invd.x, &tmin, &tmax) &&
+           bvh_slab(b.lo.y, b.hi.y, o.y, d.y, invd.y, &tmin, &tmax) &&
+           bvh_slab(b.lo.z, b.hi.z, o.z, d.z, invd.z, &tmin, &tmax);
+}
+
+// The slab test against the box padded by BVH_BOX_PAD of its largest extent
+// (cpu::bvh::box_hit).
 SC_INLINE bool bvh_box_hit(BvhBox b, float3 o, float3 d, float3 invd)
 {
-    const float ext = bvh_greater(bvh_greater(b.hi.x - b.lo.x, b.hi.y - b.lo.y), b.hi.z - b.lo.z);
-    const float pad = BVH_BOX_PAD * ext + 1e-30f;
-    const float lo[3] = {b.lo.x - pad, b.lo.y - pad, b.lo.z - pad};
-    const float hi[3] = {b.hi.x + pad, b.hi.y + pad, b.hi.z + pad};
-    const float os[3] = {o.x, o.y, o.z};
-    const float ds[3] = {d.x, d.y, d.z};
-    const float is[3] = {invd.x, invd.y, invd.z};
-    float tmin = 0.0f, tmax = 1.0f;
-    for (int k = 0; k < 3; ++k) {
-        if (ds[k] == 0.0f) {
-            if (os[k] < lo[k] || os[k] > hi[k]) return false;
-            continue;
-        }
-        float t1 = (lo[k] - os[k]) * is[k];
-        float t2 = (hi[k] - os[k]) * is[k];
-        if (t1 > t2) {
-            const float t = t1;
-            t1 = t2;
-            t2 = t;
-        }
-        tmin = bvh_greater(tmin, t1);
-        tmax = bvh_lesser(tmax, t2);
-        if (tmin > tmax) return false;
-    }
-    return true;
+    return bvh_padded_hit(bvh_padded(b), o, d, invd);
 }
 
 SC_INLINE float3 bvh_cross(float3 x, float3 y)
@@ -219,14 +240,26 @@ SC_INLINE bool bvh_segment_hits(float3 o, float3 d, float3 a, float3 b, float3 c
     return u >= -slack && v >= -slack && u + v <= det + slack && t > trim && t < det - trim;
 }
 
+// Pushes child reference c: BVH_VISIBLE, or BVH_OVERFLOW where the stack is
+// full.
+SC_INLINE uint bvh_push(uint *stack, int *sp, uint c)
+{
+    if (*sp == BVH_STACK) return BVH_OVERFLOW;
+    stack[(*sp)++] = c;
+    return BVH_VISIBLE;
+}
+
 // One work-item per query: stack traversal from the root (n faces; root is
-// leaf 0 when n == 1). result[q]: BVH_VISIBLE, BVH_OCCLUDED, or BVH_OVERFLOW
-// when the stack was full (counted in counters[0], never written past).
+// leaf 0 when n == 1), a node's children tested against their padded boxes
+// (child_boxes, written by bvh_refit). result[q]: BVH_VISIBLE, BVH_OCCLUDED,
+// or BVH_OVERFLOW when the stack was full (counted in counters[0], never
+// written past).
 __kernel void bvh_occluded(uint nq, uint n, __global const BvhQuery *queries,
                            __global const float *pos, __global const uint *faces,
                            __global const uint *faces_sorted, __global const BvhNode *nodes,
                            __global const BvhBox *node_boxes, __global const BvhBox *leaf_boxes,
-                           __global uint *result, volatile __global uint *counters)
+                           __global const BvhBox *child_boxes, __global uint *result,
+                           volatile __global uint *counters)
 {
     GID_OR_RETURN(nq);
     const BvhQuery qu = queries[gid];
@@ -254,16 +287,10 @@ __kernel void bvh_occluded(uint nq, uint n, __global const BvhQuery *queries,
             continue;
         }
         const BvhNode nd = nodes[r];
-        const uint kids[2] = {nd.left, nd.right};
-        for (int k = 0; k < 2 && out == BVH_VISIBLE; ++k) {
-            if (!bvh_box_hit(bvh_box_of(node_boxes, leaf_boxes, kids[k]), o, d, invd)) continue;
-            if (sp == BVH_STACK) {
-                atomic_inc(&counters[0]);
-                out = BVH_OVERFLOW;
-            } else {
-                stack[sp++] = kids[k];
-            }
-        }
+        if (bvh_padded_hit(child_boxes[2 * r], o, d, invd)) out = bvh_push(stack, &sp, nd.left);
+        if (out == BVH_VISIBLE && bvh_padded_hit(child_boxes[2 * r + 1], o, d, invd))
+            out = bvh_push(stack, &sp, nd.right);
+        if (out == BVH_OVERFLOW) atomic_inc(&counters[0]);
     }
     result[gid] = out;
 }

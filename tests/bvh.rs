@@ -56,6 +56,11 @@ fn same(what: &str, dev: &Tree, cpu: &Tree) {
         bits(&cpu.node_boxes),
         "{what}: node boxes"
     );
+    assert_eq!(
+        bits(&dev.child_boxes),
+        bits(&cpu.child_boxes),
+        "{what}: padded child boxes"
+    );
 }
 
 fn inside(b: &BvhBox, p: [f32; 3]) -> bool {

@@ -287,7 +287,7 @@ fn old_report_flags_are_gone_and_unknown_topics_are_refused() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("speed")
-            && err.contains("curvature, isosurface, strokes, pipeline, caps, memory"),
+            && err.contains("curvature, isosurface, strokes, pipeline, caps, lines-batch, memory"),
         "{err}"
     );
     let d = scratch("report-refusals");

@@ -375,7 +375,7 @@ fn segments_doc(
                         "a": arr.a[i],
                         "b": arr.b[i],
                         "visible": p.visible,
-                        "faces": v.faces[p.seg as usize],
+                        "faces": v.faces[p.seg as usize].as_slice(),
                         "chain": arr.chain[i],
                         "face": face,
                         "bary": face.map(|_| arr.bary[i]),

@@ -6,8 +6,9 @@
 //! search, its split by a binary search on the common prefix of the
 //! augmented key (code, index)), `refit` (leaf boxes from the triangles,
 //! internal boxes bottom-up with one visit counter per node: the second
-//! child to arrive computes the parent) and `occluded` (stack traversal with
-//! the kernel's f32 arithmetic). Boxes are min/max of f32 values, exact in
+//! child to arrive computes the parent, and writes both children's boxes
+//! padded for the queries, [`Tree::child_boxes`]) and `occluded` (stack
+//! traversal with the kernel's f32 arithmetic, over the padded child boxes). Boxes are min/max of f32 values, exact in
 //! any order, so they equal the device's bit for bit.
 //!
 //! [`occluded_brute`] is the f64 brute-force reference the tests compare
@@ -37,6 +38,10 @@ pub struct Tree {
     pub node_boxes: Vec<BvhBox>,
     /// Box of each leaf.
     pub leaf_boxes: Vec<BvhBox>,
+    /// The two children's boxes of each internal node, padded as the
+    /// traversal tests them ([`padded`]): `2·node` the left, `2·node + 1`
+    /// the right (one read of 64 bytes per node visited).
+    pub child_boxes: Vec<BvhBox>,
 }
 
 /// Checks that every face names existing vertices and that the tree can
@@ -248,6 +253,7 @@ impl Tree {
             })
             .collect();
         self.node_boxes = vec![BvhBox::default(); self.nodes.len()];
+        self.child_boxes = vec![BvhBox::default(); 2 * self.nodes.len()];
         let mut visits = vec![0u32; self.nodes.len()];
         for leaf in 0..self.leaf_boxes.len() {
             let mut node = self.leaf_parent[leaf];
@@ -257,8 +263,10 @@ impl Tree {
                     break;
                 }
                 let n = self.nodes[node as usize];
-                self.node_boxes[node as usize] =
-                    union(&self.child_box(n.left), &self.child_box(n.right));
+                let (l, r) = (self.child_box(n.left), self.child_box(n.right));
+                self.node_boxes[node as usize] = union(&l, &r);
+                self.child_boxes[2 * node as usize] = padded(&l);
+                self.child_boxes[2 * node as usize + 1] = padded(&r);
                 node = n.parent;
             }
         }
@@ -328,8 +336,8 @@ impl Tree {
                 continue;
             }
             let n = self.nodes[r as usize];
-            for c in [n.left, n.right] {
-                if box_hit_inv(&self.child_box(c), o, d, inv) {
+            for (k, c) in [n.left, n.right].into_iter().enumerate() {
+                if padded_hit(&self.child_boxes[2 * r as usize + k], o, d, inv) {
                     if sp == depth {
                         return OVERFLOW;
                     }
@@ -357,14 +365,30 @@ pub fn inverse(d: [f32; 3]) -> [f32; 3] {
 /// [`box_hit`] with `d`'s reciprocals ([`inverse`]) given, as the kernel
 /// computes them once per query.
 pub fn box_hit_inv(b: &BvhBox, o: [f32; 3], d: [f32; 3], inv: [f32; 3]) -> bool {
+    padded_hit(&padded(b), o, d, inv)
+}
+
+/// A box padded by [`BOX_PAD`] of its largest extent (+1e-30), as the
+/// traversal tests it (the kernels' `bvh_padded`).
+pub fn padded(b: &BvhBox) -> BvhBox {
     let ext = greater(
         greater(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1]),
         b.hi[2] - b.lo[2],
     );
     let pad = BOX_PAD * ext + 1e-30;
+    let mut p = BvhBox::default();
+    for k in 0..3 {
+        (p.lo[k], p.hi[k]) = (b.lo[k] - pad, b.hi[k] + pad);
+    }
+    p
+}
+
+/// The slab test of [`box_hit_inv`] against a box padded already
+/// ([`padded`]).
+pub fn padded_hit(b: &BvhBox, o: [f32; 3], d: [f32; 3], inv: [f32; 3]) -> bool {
     let (mut tmin, mut tmax) = (0.0f32, 1.0f32);
     for k in 0..3 {
-        let (lo, hi) = (b.lo[k] - pad, b.hi[k] + pad);
+        let (lo, hi) = (b.lo[k], b.hi[k]);
         if d[k] == 0.0 {
             if o[k] < lo || o[k] > hi {
                 return false;

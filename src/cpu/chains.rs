@@ -94,43 +94,66 @@ pub struct Chain {
     pub pieces: Vec<(u32, bool)>,
 }
 
-/// The ends of the pieces grouped by where they meet: sorted by (layer,
-/// visibility, key, the piece's canonical rank), each group a run of equal
-/// keys, its members in canonical order.
+/// The ends of the pieces grouped by where they meet: groups in the order
+/// of (layer and visibility, key's code), each group's members `(piece,
+/// end)` in the pieces' canonical order (then first end first).
 struct Ends {
-    /// `(layer and visibility, key's code, rank, piece, end)`, sorted.
-    ends: Vec<(u64, u128, u32, u32, u8)>,
+    /// The members of every group, group after group.
+    members: Vec<(u32, u8)>,
     /// The group of each piece's end (`2 × piece + end`).
     group_of: Vec<u32>,
-    /// Each group's first index into `ends`, and one past the last group.
+    /// Each group's first index into `members`, and one past the last group.
     start: Vec<u32>,
 }
 
 impl Ends {
-    fn new(pieces: &[ChainPiece], rank: &[u32]) -> Ends {
-        let mut ends: Vec<_> = (pieces.iter().enumerate())
+    /// The groups of the ends of `pieces` (no members yet: see
+    /// [`Ends::fill`]). One sort of packed 128-bit keys: the layer and
+    /// visibility's dense rank, the code's tag and 64-bit payload
+    /// ([`EndKey::code`]), and the end's index.
+    fn group(pieces: &[ChainPiece]) -> Ends {
+        let mut lv: Vec<u64> = pieces.iter().map(layer_vis).collect();
+        lv.sort_unstable();
+        lv.dedup();
+        let lv_rank = |p: &ChainPiece| lv.binary_search(&layer_vis(p)).unwrap_or(0) as u128;
+        let mut keys: Vec<u128> = (pieces.iter().enumerate())
             .flat_map(|(i, p)| {
-                (0..2).map(move |e| (layer_vis(p), p.keys[e].code(), rank[i], i as u32, e as u8))
+                let r = lv_rank(p);
+                (0..2).map(move |e| {
+                    let c = p.keys[e].code();
+                    let (tag, payload) = (c >> 120, c & u128::from(u64::MAX));
+                    (r << 98) | (tag << 96) | (payload << 32) | (2 * i + e) as u128
+                })
             })
             .collect();
-        ends.sort_unstable();
-        let mut group_of = vec![0u32; ends.len()];
+        keys.sort_unstable();
+        let mut group_of = vec![0u32; keys.len()];
         let mut start = Vec::new();
-        for (k, x) in ends.iter().enumerate() {
-            let new = k == 0 || {
-                let y = &ends[k - 1];
-                (y.0, y.1) != (x.0, x.1)
-            };
-            if new {
+        for (k, x) in keys.iter().enumerate() {
+            if k == 0 || keys[k - 1] >> 32 != x >> 32 {
                 start.push(k as u32);
             }
-            group_of[2 * x.3 as usize + x.4 as usize] = (start.len() - 1) as u32;
+            group_of[(x & 0xffff_ffff) as usize] = (start.len() - 1) as u32;
         }
-        start.push(ends.len() as u32);
+        start.push(keys.len() as u32);
         Ends {
-            ends,
+            members: Vec::new(),
             group_of,
             start,
+        }
+    }
+
+    /// Puts the ends into their groups, pieces in `order` (then first end
+    /// first).
+    fn fill(&mut self, order: &[u32]) {
+        let mut next = self.start.clone();
+        self.members = vec![(0, 0); self.group_of.len()];
+        for &i in order {
+            for e in 0..2u8 {
+                let g = self.group_of[2 * i as usize + e as usize] as usize;
+                self.members[next[g] as usize] = (i, e);
+                next[g] += 1;
+            }
         }
     }
 
@@ -138,7 +161,7 @@ impl Ends {
     fn at(&self, i: u32, e: usize) -> impl Iterator<Item = (u32, usize)> + '_ {
         let g = self.group_of[2 * i as usize + e] as usize;
         let (a, b) = (self.start[g] as usize, self.start[g + 1] as usize);
-        self.ends[a..b].iter().map(|x| (x.3, x.4 as usize))
+        self.members[a..b].iter().map(|x| (x.0, x.1 as usize))
     }
 
     fn degree(&self, i: u32, e: usize) -> usize {
@@ -154,18 +177,27 @@ fn layer_vis(p: &ChainPiece) -> u64 {
 
 /// Joins `pieces` into chains (see the module note). Every piece is in
 /// exactly one chain.
+///
+/// The canonical order is (layer and visibility, the lesser end key's
+/// code, the greater's, segment, `t0`); the groups' ranks stand for the
+/// first three (a group's rank follows its layer, visibility and code), so
+/// it is one sort of 128-bit keys.
 pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
-    let mut order: Vec<u32> = (0..pieces.len() as u32).collect();
-    order.sort_by_cached_key(|&i| {
-        let p = &pieces[i as usize];
-        let (a, b) = (p.keys[0].code(), p.keys[1].code());
-        (layer_vis(p), a.min(b), a.max(b), p.seg, p.t[0].to_bits())
-    });
-    let mut rank = vec![0u32; pieces.len()];
-    for (r, &i) in order.iter().enumerate() {
-        rank[i as usize] = r as u32;
-    }
-    let ends = Ends::new(pieces, &rank);
+    let mut ends = Ends::group(pieces);
+    let mut keyed: Vec<(u128, u32)> = (pieces.iter().enumerate())
+        .map(|(i, p)| {
+            let g = |e: usize| u128::from(ends.group_of[2 * i + e]);
+            let (a, b) = (g(0), g(1));
+            let key = (a.min(b) << 96)
+                | (a.max(b) << 64)
+                | (u128::from(p.seg) << 32)
+                | u128::from(p.t[0].to_bits());
+            (key, i as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    let order: Vec<u32> = keyed.into_iter().map(|k| k.1).collect();
+    ends.fill(&order);
     let mut used = vec![false; pieces.len()];
     let mut out = Vec::new();
     for &i in &order {

@@ -27,7 +27,7 @@ use crate::error::{Error, Result};
 use crate::spec::bvh::{BvhQuery, OCCLUDED};
 use crate::spec::feature_lines::{LINE_FREE, Segment};
 use crate::spec::view::View;
-use crate::spec::visibility::{MAX_INTERVALS, NO_FACE, Pieces, Spacing, VisibilityOptions};
+use crate::spec::visibility::{Faces, MAX_INTERVALS, NO_FACE, Pieces, Spacing, VisibilityOptions};
 
 /// One sample of one segment: `(segment index, t)`.
 pub type Cast = (u32, f32);
@@ -40,7 +40,7 @@ pub struct SegPlan {
     /// Second end.
     pub b: [f32; 3],
     /// Faces left out of its queries (at most four).
-    pub exclude: Vec<u32>,
+    pub exclude: Faces,
     /// Sampling intervals (1 to [`MAX_INTERVALS`]).
     pub intervals: usize,
     /// Start of each query along the ray (world units).
@@ -61,7 +61,7 @@ pub struct EndPlan {
     /// The point sampled.
     pub p: [f32; 3],
     /// Faces left out of its query.
-    pub exclude: Vec<u32>,
+    pub exclude: Faces,
     /// Start of its query along the ray (world units).
     pub offset: f32,
 }
@@ -173,23 +173,26 @@ impl<'a> Topology<'a> {
 
 /// The faces segment `s` (index `i`) lies on (at most four); `f0` and `f1`
 /// are scratch space for its ends' faces.
-fn lies_on(
-    topo: &Topology,
-    s: &Segment,
-    i: usize,
-    [f0, f1]: [&mut Vec<u32>; 2],
-) -> Result<Vec<u32>> {
+fn lies_on(topo: &Topology, s: &Segment, i: usize, [f0, f1]: [&mut Vec<u32>; 2]) -> Result<Faces> {
     topo.end_faces(s.4[0], i, "first", f0)?;
     topo.end_faces(s.4[1], i, "second", f1)?;
-    let both: Vec<u32> = (f0.iter().copied())
-        .filter(|f| f1.contains(f))
-        .take(4)
-        .collect();
+    let mut both = Faces::default();
+    for &f in f0.iter().filter(|f| f1.contains(f)) {
+        if !both.push(f) {
+            break;
+        }
+    }
     if !both.is_empty() {
         return Ok(both);
     }
-    let rest = f1.iter().copied().filter(|f| !f0.contains(f));
-    Ok(f0.iter().copied().chain(rest).take(4).collect())
+    let mut all = Faces::default();
+    let rest = f1.iter().filter(|f| !f0.contains(f));
+    for &f in f0.iter().chain(rest) {
+        if !all.push(f) {
+            break;
+        }
+    }
+    Ok(all)
 }
 
 fn sub(x: [f32; 3], y: [f32; 3]) -> [f32; 3] {
@@ -287,7 +290,7 @@ impl Plan {
                 end_ids: [0; 2],
             });
         }
-        let ends = shared_ends(segments, &mut segs);
+        let ends = shared_ends(segments, &mut segs, positions.len());
         Ok(Plan {
             segs,
             ends,
@@ -352,11 +355,11 @@ impl Plan {
         match end {
             Some(e) => {
                 let e = &self.ends[e as usize];
-                (e.p, &e.exclude, e.offset)
+                (e.p, e.exclude.as_slice(), e.offset)
             }
             None => (
                 std::array::from_fn(|k| s.a[k] + t * (s.b[k] - s.a[k])),
-                &s.exclude,
+                s.exclude.as_slice(),
                 s.offset,
             ),
         }
@@ -375,7 +378,7 @@ impl Plan {
             }
             _ => (
                 std::array::from_fn(|k| a[k] + t * (b[k] - a[k])),
-                &s.exclude,
+                s.exclude.as_slice(),
                 s.offset,
             ),
         };
@@ -426,81 +429,120 @@ fn end_key(s: &Segment, e: usize) -> Option<u64> {
     Some((u64::from(u.min(v)) << 32) | u64::from(u.max(v)))
 }
 
+/// A keyed end ([`end_key`]) with what its shared sample reads of it, so
+/// that the samples are made from these in key order (no random reads of
+/// the segments' plans).
+#[derive(Clone, Copy, Default)]
+struct KeyedEnd {
+    key: u64,
+    /// `2 × segment + end`.
+    at: u32,
+    p: [f32; 3],
+    offset: f32,
+    exclude: Faces,
+}
+
 /// The shared end samples of `segs` (setting each one's `end_ids`): ends
 /// with one key ([`end_key`]) share one, in the order of the key, then of
-/// the segment.
-fn shared_ends(segments: &[Segment], segs: &mut [SegPlan]) -> Vec<EndPlan> {
-    let mut keyed: Vec<(u64, u32, u8)> = Vec::with_capacity(2 * segments.len());
+/// the segment. The keyed ends are put in that order by a counting sort on
+/// the key's lesser vertex (`n_vertices` of them, checked by the plan),
+/// then a sort of each vertex's few.
+fn shared_ends(segments: &[Segment], segs: &mut [SegPlan], n_vertices: usize) -> Vec<EndPlan> {
     let mut ends = Vec::new();
+    let mut start = vec![0u32; n_vertices + 1];
     for (i, s) in segments.iter().enumerate() {
         for e in 0..2 {
             match end_key(s, e) {
-                Some(k) => keyed.push((k, i as u32, e as u8)),
+                Some(k) => start[(k >> 32) as usize + 1] += 1,
                 None => {
                     let sp = &mut segs[i];
                     sp.end_ids[e] = ends.len() as u32;
-                    let p = if e == 0 { sp.a } else { sp.b };
                     ends.push(EndPlan {
-                        p,
-                        exclude: sp.exclude.clone(),
+                        p: if e == 0 { sp.a } else { sp.b },
+                        exclude: sp.exclude,
                         offset: sp.offset,
                     });
                 }
             }
         }
     }
-    keyed.sort_unstable();
-    let least = |p: [f32; 3], q: [f32; 3]| {
-        let key = |x: [f32; 3]| x.map(f32::to_bits);
-        if key(q) < key(p) { q } else { p }
-    };
-    for group in keyed.chunk_by(|x, y| x.0 == y.0) {
-        // The faces they lie on, up to five (five: more than a query
-        // leaves out), without an allocation per end.
-        let (mut faces, mut n) = ([0u32; 5], 0usize);
-        'all: for &(_, i, _) in group {
-            for &f in &segs[i as usize].exclude {
-                if !faces[..n].contains(&f) {
-                    if n == 5 {
-                        break 'all;
-                    }
-                    faces[n] = f;
-                    n += 1;
-                }
-            }
-        }
-        faces[..n].sort_unstable();
-        if n > 4 {
-            // More faces than a query leaves out (ends at a vertex of high
-            // valence): each end keeps its own sample and faces.
-            for &(_, i, e) in group {
-                let sp = &mut segs[i as usize];
-                sp.end_ids[e as usize] = ends.len() as u32;
-                ends.push(EndPlan {
+    for v in 0..n_vertices {
+        start[v + 1] += start[v];
+    }
+    let mut keyed = vec![KeyedEnd::default(); start[n_vertices] as usize];
+    let mut next = start.clone();
+    for (i, (s, sp)) in segments.iter().zip(segs.iter()).enumerate() {
+        for e in 0..2 {
+            if let Some(key) = end_key(s, e) {
+                let at = &mut next[(key >> 32) as usize];
+                keyed[*at as usize] = KeyedEnd {
+                    key,
+                    at: (2 * i + e) as u32,
                     p: if e == 0 { sp.a } else { sp.b },
-                    exclude: sp.exclude.clone(),
                     offset: sp.offset,
-                });
+                    exclude: sp.exclude,
+                };
+                *at += 1;
             }
-            continue;
         }
-        let id = ends.len() as u32;
-        let mut end = EndPlan {
-            p: [f32::NAN; 3],
-            exclude: Vec::new(),
-            offset: 0.0,
-        };
-        for (n, &(_, i, e)) in group.iter().enumerate() {
-            let sp = &mut segs[i as usize];
-            sp.end_ids[e as usize] = id;
-            let p = if e == 0 { sp.a } else { sp.b };
-            end.p = if n == 0 { p } else { least(end.p, p) };
-            end.offset = end.offset.max(sp.offset);
-        }
-        end.exclude = faces[..n].to_vec();
-        ends.push(end);
+    }
+    for v in 0..n_vertices {
+        keyed[start[v] as usize..start[v + 1] as usize].sort_unstable_by_key(|x| (x.key, x.at));
+    }
+    for group in keyed.chunk_by(|x, y| x.key == y.key) {
+        share_end(group, segs, &mut ends);
     }
     ends
+}
+
+/// The end sample of one `group` of ends with one key (in order) into
+/// `ends`, or each end's own where they lie on more than four faces.
+fn share_end(group: &[KeyedEnd], segs: &mut [SegPlan], ends: &mut Vec<EndPlan>) {
+    let mut set_id = |x: &KeyedEnd, id: usize| {
+        segs[(x.at / 2) as usize].end_ids[(x.at % 2) as usize] = id as u32;
+    };
+    // The faces they lie on, up to five (five: more than a query leaves
+    // out).
+    let (mut faces, mut n) = ([0u32; 5], 0usize);
+    'all: for x in group {
+        for &f in x.exclude.iter() {
+            if !faces[..n].contains(&f) {
+                if n == 5 {
+                    break 'all;
+                }
+                faces[n] = f;
+                n += 1;
+            }
+        }
+    }
+    faces[..n].sort_unstable();
+    if n > 4 {
+        // More faces than a query leaves out (ends at a vertex of high
+        // valence): each end keeps its own sample and faces.
+        for x in group {
+            set_id(x, ends.len());
+            ends.push(EndPlan {
+                p: x.p,
+                exclude: x.exclude,
+                offset: x.offset,
+            });
+        }
+        return;
+    }
+    let bits = |x: [f32; 3]| x.map(f32::to_bits);
+    let mut end = EndPlan {
+        p: group[0].p,
+        exclude: Faces::of(&faces[..n]),
+        offset: 0.0,
+    };
+    for x in group {
+        set_id(x, ends.len());
+        if bits(x.p) < bits(end.p) {
+            end.p = x.p;
+        }
+        end.offset = end.offset.max(x.offset);
+    }
+    ends.push(end);
 }
 
 /// The queries of `casts` that need one, and for each cast the index of

@@ -136,7 +136,8 @@ pub fn field_offsets() -> [(&'static str, usize); 12] {
 /// Sizes of a tree over `n_faces` faces: `(leaves, internal nodes)` =
 /// `(n, n − 1)` (`(0, 0)` for no face). Buffers: `keys`, `faces_sorted`,
 /// `leaf_parent`, `leaf_boxes` hold `leaves`; `nodes`, `node_boxes`,
-/// `visits` hold `internal` (each at least one element on the device).
+/// `visits` hold `internal`, `child_boxes` twice that (each at least one
+/// element on the device).
 pub fn bvh_bound(n_faces: usize) -> (usize, usize) {
     (n_faces, n_faces.saturating_sub(1))
 }

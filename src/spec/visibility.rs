@@ -138,6 +138,50 @@ impl VisibilityOptions {
 /// start the contour offset × the segment's length along the ray.
 pub const NO_FACE: [u32; 2] = [u32::MAX, u32::MAX];
 
+/// The faces a segment lies on, or an end sample leaves out of its query:
+/// at most four (as many as a query leaves out), in a fixed array (no
+/// allocation per segment). Reads as a slice.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Faces {
+    n: u8,
+    f: [u32; 4],
+}
+
+impl Faces {
+    /// The first four of `faces`.
+    pub fn of(faces: &[u32]) -> Faces {
+        let mut out = Faces::default();
+        for &f in faces.iter().take(4) {
+            out.push(f);
+        }
+        out
+    }
+
+    /// Adds `face` where fewer than four are held; whether it was added.
+    pub fn push(&mut self, face: u32) -> bool {
+        let n = self.n as usize;
+        if n == 4 {
+            return false;
+        }
+        self.f[n] = face;
+        self.n += 1;
+        true
+    }
+
+    /// The faces, in order.
+    pub fn as_slice(&self) -> &[u32] {
+        &self.f[..self.n as usize]
+    }
+}
+
+impl std::ops::Deref for Faces {
+    type Target = [u32];
+
+    fn deref(&self) -> &[u32] {
+        self.as_slice()
+    }
+}
+
 /// A piece of a segment: `(t0, t1, visible)`, `t` the fraction of the way
 /// from its first end to its second (`0 ≤ t0 < t1 ≤ 1`, or `(0, 1)` for a
 /// zero-length segment).

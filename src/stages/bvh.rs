@@ -10,13 +10,15 @@
 //! keys, stable: ties keep face order), `bvh_build` (internal nodes and
 //! parents), then [`Bvh::refit`]. Morton codes depend on positions, but the
 //! tree is kept: a later pose only reruns `bvh_refit` (leaf boxes and
-//! internal boxes bottom-up, one visit counter per node, zeroed first), so
+//! internal boxes bottom-up, one visit counter per node, zeroed first, and
+//! each node's two children's boxes padded for the queries), so
 //! the tree stays valid (boxes contain their subtrees) but may loosen when a
 //! pose moves far from the first.
 //!
 //! Buffers ([`bvh_bound`]): positions `f32[3·V]`, faces `u32[3·F]`, keys and
 //! faces_sorted `u32[F]`, nodes `BvhNode[F−1]`, leaf_parent `u32[F]`,
-//! boxes `BvhBox[F−1]` and `BvhBox[F]`, visits `u32[F−1]`, counters `u32[1]`
+//! boxes `BvhBox[F−1]` and `BvhBox[F]`, padded child boxes `BvhBox[2(F−1)]`,
+//! visits `u32[F−1]`, counters `u32[1]`
 //! (stack overflows of the last query batch). An empty face list is an empty
 //! tree: nothing is launched and every query is visible.
 
@@ -63,6 +65,7 @@ pub struct Bvh {
     leaf_parent: Buffer<u32>,
     node_boxes: Buffer<BvhBox>,
     leaf_boxes: Buffer<BvhBox>,
+    child_boxes: Buffer<BvhBox>,
     visits: Buffer<u32>,
     counters: Buffer<u32>,
     built: bool,
@@ -118,6 +121,7 @@ impl Bvh {
             leaf_parent: gpu.buffer(l1)?,
             node_boxes: gpu.buffer(i1)?,
             leaf_boxes: gpu.buffer(l1)?,
+            child_boxes: gpu.buffer(2 * i1)?,
             visits: gpu.buffer(i1)?,
             counters: gpu.buffer(1)?,
             built: false,
@@ -211,6 +215,7 @@ impl Bvh {
             buf(&self.leaf_parent),
             buf(&self.leaf_boxes),
             buf(&self.node_boxes),
+            buf(&self.child_boxes),
             buf(&self.visits),
         ];
         self.run(Step::BvhRefit, 2, n, &args)
@@ -255,7 +260,7 @@ impl Bvh {
             buf(&qbuf),
         ];
         args.extend(self.tree_bufs());
-        args.extend([buf(&out), buf(&self.counters)]);
+        args.extend([buf(&self.child_boxes), buf(&out), buf(&self.counters)]);
         self.timing = Timing::default();
         self.run(Step::BvhOccluded, 3, nq, &args)?;
         let mut result = vec![0u32; nq];
@@ -315,6 +320,7 @@ impl Bvh {
             leaf_parent: vec![0; n],
             node_boxes: vec![BvhBox::default(); internal],
             leaf_boxes: vec![BvhBox::default(); n],
+            child_boxes: vec![BvhBox::default(); 2 * internal],
         };
         if !self.built || n == 0 {
             t.keys.clear();
@@ -330,6 +336,7 @@ impl Bvh {
         if internal > 0 {
             self.gpu.read(&self.nodes, &mut t.nodes)?;
             self.gpu.read(&self.node_boxes, &mut t.node_boxes)?;
+            self.gpu.read(&self.child_boxes, &mut t.child_boxes)?;
         }
         Ok(t)
     }

@@ -29,7 +29,7 @@ fn a_segment_lies_on_the_faces_both_ends_name() {
         s([0, 3], [0, 3]),         // no such edge: nothing
     ];
     let plan = Plan::new(&p, &f, &segs, &view, &opts).unwrap();
-    let ex: Vec<Vec<u32>> = plan.segs.iter().map(|s| s.exclude.clone()).collect();
+    let ex: Vec<Vec<u32>> = plan.segs.iter().map(|s| s.exclude.to_vec()).collect();
     assert_eq!(ex, vec![vec![0], vec![0, 1], vec![1], vec![0, 1], vec![]]);
     assert!(plan.segs.iter().all(|s| s.offset > 0.0 && s.intervals >= 1));
 }
@@ -93,7 +93,7 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
     let shared = &plan.ends[plan.segs[0].end_ids[1] as usize];
     // The least point (by its bits), both faces left out.
     assert_eq!(shared.p, a.1);
-    assert_eq!(shared.exclude, vec![0, 1]);
+    assert_eq!(shared.exclude.to_vec(), vec![0, 1]);
     let mut casts = Vec::new();
     classify_by(&plan, |c| {
         casts.extend_from_slice(c);

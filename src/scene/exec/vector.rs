@@ -17,7 +17,7 @@ use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
 use crate::spec::feature_lines::{Hidden, LINE_FREE, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
-use crate::spec::visibility::{NO_FACE, Pieces, VisibilityOptions};
+use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
@@ -114,7 +114,7 @@ pub struct VisibleLines {
     pub segments: Vec<Segment>,
     /// The faces each segment lies on (at most four; left out of its
     /// queries).
-    pub faces: Vec<Vec<u32>>,
+    pub faces: Vec<Faces>,
     /// The pieces of each segment, `(t0, t1, visible)`.
     pub pieces: Vec<Pieces>,
     /// Every piece of every segment, as chained.
@@ -221,7 +221,8 @@ fn own_key(s: &Segment, e: usize, scale: f32) -> EndKey {
 
 /// Classifies `segments` seen in `view` over the mesh (`positions`, `faces`)
 /// whose tree `bvh` holds, and chains the pieces; `scale` is the scene's
-/// size (for the keys of ends inside faces).
+/// size (for the keys of ends inside faces). The pieces move into the
+/// [`VisibleLines`]: the [`Classified`] keeps the counts and the timing.
 pub(super) fn classify_view(
     bvh: &mut Bvh,
     mesh: (&[[f32; 3]], &[[u32; 3]]),
@@ -236,7 +237,7 @@ pub(super) fn classify_view(
     let order = spatial_order(&segments);
     let segments: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
     let plan = VisPlan::new(positions, faces, &segments, view, &opts)?;
-    let c = classify_planned(bvh, &plan)?;
+    let mut c = classify_planned(bvh, &plan)?;
     let mut chain_pieces = Vec::new();
     for (i, (s, ps)) in segments.iter().zip(&c.pieces).enumerate() {
         let key = |t: f32, e: usize| {
@@ -259,8 +260,8 @@ pub(super) fn classify_view(
     let chains = chain(&chain_pieces);
     let vis = VisibleLines {
         segments,
-        faces: plan.segs.into_iter().map(|s| s.exclude).collect(),
-        pieces: c.pieces.clone(),
+        faces: plan.segs.iter().map(|s| s.exclude).collect(),
+        pieces: std::mem::take(&mut c.pieces),
         chain_pieces,
         chains,
     };
