@@ -128,20 +128,21 @@ pub fn depth_renderer(width: u32, height: u32) -> Result<Renderer> {
     })
 }
 
-/// The mesh drawn from `cam` (its depth is what the method tests against);
-/// `normals` as [`vertex_normals`] gives them.
+/// The mesh (`positions` rounded to f32, `faces`) drawn from `cam`: its
+/// depth is what the method tests against; `normals` as [`vertex_normals`]
+/// gives them.
 ///
 /// # Errors
 /// OpenGL failures, a camera the renderer refuses.
 pub fn depth_frame(
     r: &mut Renderer,
-    m: &Mesh,
+    positions: &[[f32; 3]],
+    faces: &[[u32; 3]],
     normals: &[[f32; 3]],
     cam: &Camera,
 ) -> Result<Frame> {
     r.begin(cam)?;
-    let p = f32_positions(&m.positions);
-    r.draw_mesh(&p, normals, &[], &m.faces, MeshStyle::default())?;
+    r.draw_mesh(positions, normals, &[], faces, MeshStyle::default())?;
     r.finish()
 }
 
@@ -159,7 +160,8 @@ pub fn depth_share(
     cam: &Camera,
     reference: &[Pieces],
 ) -> Result<f64> {
-    let frame = depth_frame(r, m, &vertex_normals(m), cam)?;
+    let p = f32_positions(&m.positions);
+    let frame = depth_frame(r, &p, &m.faces, &vertex_normals(m), cam)?;
     Ok(depth_share_in(&frame, cam, segs, reference))
 }
 

@@ -570,7 +570,7 @@ impl<'a> MeshRun<'a> {
         let mut frame = None;
         for _ in 0..runs {
             let t0 = Instant::now();
-            let f = la::depth_frame(r, self.m, &self.normals, cam)?;
+            let f = la::depth_frame(r, &self.p, &self.m.faces, &self.normals, cam)?;
             let lines: Vec<_> = (kinds.iter())
                 .flat_map(|&k| segment_lines(vp, segs, k, |_| 1.0))
                 .collect();
