@@ -28,6 +28,7 @@ args_of() {
         caps) echo "report caps --width 10 --fov 20" ;;
         memory) echo "report memory" ;;
         lines-batch) echo "report lines-batch" ;;
+        visibility) echo "report visibility" ;;
         *) echo "docs-measurements: unknown topic $1" >&2; return 1 ;;
     esac
 }

@@ -238,6 +238,68 @@ fn lines_batch_report_splits_pose_and_views() {
     );
 }
 
+/// `report visibility` on spot alone, small: a row per view with the
+/// exact method's agreement beside its ms, and the depth-buffer method's
+/// (or "no OpenGL" in its cells where the machine has none).
+#[test]
+fn visibility_report_on_spot() {
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
+    let (text, doc) = report(
+        &[
+            "visibility",
+            spot,
+            "--runs",
+            "1",
+            "--size",
+            "160x120",
+            "--reference-tests",
+            "3e6",
+        ],
+        &["meshes", "views"],
+        &[
+            "mesh",
+            "faces",
+            "bvh_build_ms",
+            "view",
+            "segments",
+            "checked_segments",
+            "exact_agreement_percent",
+            "exact_ms",
+            "depth_agreement_percent",
+            "depth_ms",
+            "line_kernels_ms",
+        ],
+    )
+    .expect("the depth-buffer cells say when there is no OpenGL");
+    let rows = doc["tables"]["views"].as_array().unwrap();
+    assert_eq!(rows.len(), 3, "{text}");
+    assert_eq!(doc["tables"]["meshes"][0]["mesh"], "spot.obj");
+    let gl = !text.contains("no OpenGL");
+    for r in rows {
+        let (n, checked) = (
+            r["segments"].as_u64().unwrap(),
+            r["checked_segments"].as_u64().unwrap(),
+        );
+        assert!(n > 0 && (1..=n).contains(&checked), "{r}");
+        assert!(
+            r["exact_agreement_percent"].as_f64().unwrap() >= 99.0,
+            "{r}"
+        );
+        assert!(r["exact_ms"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["line_kernels_ms"].as_f64().unwrap() > 0.0, "{r}");
+        assert_eq!(r["depth_ms"].is_number(), gl, "{r}");
+        if gl {
+            assert!(r["depth_agreement_percent"].as_f64().unwrap() > 50.0, "{r}");
+        }
+    }
+    assert!(
+        rows[2]["view"]
+            .as_str()
+            .unwrap()
+            .starts_with("orthographic")
+    );
+}
+
 #[test]
 fn memory_report_needs_no_device() {
     let (text, doc) = report(
@@ -287,7 +349,9 @@ fn old_report_flags_are_gone_and_unknown_topics_are_refused() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("speed")
-            && err.contains("curvature, isosurface, strokes, pipeline, caps, lines-batch, memory"),
+            && err.contains(
+                "curvature, isosurface, strokes, pipeline, caps, lines-batch, visibility, memory"
+            ),
         "{err}"
     );
     let d = scratch("report-refusals");

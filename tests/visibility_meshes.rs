@@ -33,45 +33,24 @@ mod visibility_support;
 use std::time::Instant;
 
 use glam::Vec3;
-use shapecue::api::LineSetup;
 use shapecue::cpu::bvh::{Tree, box_hit, segment_hits_f32};
 use shapecue::cpu::visibility::{Plan, classify_by, classify_reference, classify_twin};
 use shapecue::cpu::visibility::{hidden_from, queries_of};
 use shapecue::mesh::Mesh;
-use shapecue::mesh::skinned::{SkinnedMesh, load_gltf};
 use shapecue::render::Camera;
+use shapecue::report::line_agreement::{pick, reference_subset};
 use shapecue::spec::bvh::{BvhQuery, LEAF};
-use shapecue::spec::curvature::CurvatureOptions;
-use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
+// The views and the families (the bunny: every family) of the report.
+use shapecue::report::visibility::{MeshLines, NAMED, VIEWS, middle_frame};
+use shapecue::spec::feature_lines::{LineFamily, Segment};
 use shapecue::spec::visibility::{Pieces, VisibilityOptions};
 use shapecue::stages::bvh::Bvh;
-use shapecue::stages::curvature::CurvatureEstimator;
-use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 use shapecue::stages::visibility::{classify, spatial_order, unsort};
 use visibility_support::*;
 
 /// Most ray–face tests of the reference per view (about 2 s in f64 on
-/// one core).
-const REFERENCE_BUDGET: f64 = 2e8;
-
-const VIEWS: [(&str, Vec3, bool); 3] = [
-    ("perspective (1, 0.6, 0.8)", Vec3::new(1.0, 0.6, 0.8), false),
-    (
-        "perspective (-0.8, 0.3, -0.6)",
-        Vec3::new(-0.8, 0.3, -0.6),
-        false,
-    ),
-    ("orthographic (0.2, 0.5, 1)", Vec3::new(0.2, 0.5, 1.0), true),
-];
-
-/// The families measured on BrainStem (the bunny: every family).
-const NAMED: [LineFamily; 5] = [
-    LineFamily::Contours,
-    LineFamily::Suggestive,
-    LineFamily::Ridges,
-    LineFamily::Valleys,
-    LineFamily::ApparentRidges,
-];
+/// one core), as `shapecue report visibility` checks by default.
+const REFERENCE_BUDGET: f64 = shapecue::report::visibility::REFERENCE_TESTS;
 
 fn ms(t0: Instant) -> f64 {
     t0.elapsed().as_secs_f64() * 1e3
@@ -81,77 +60,29 @@ fn ms(t0: Instant) -> f64 {
 /// twin, or `None` (after saying so) where the file is absent.
 fn brainstem() -> Option<Mesh> {
     let path = common::model_path("BrainStem.glb")?;
-    let (m, _) = load_gltf(&path).unwrap().welded();
-    let t = 0.5 * m.clips[0].duration;
-    let mats = SkinnedMesh::flatten(&m.joint_matrices(Some(0), t).unwrap());
-    let rest = common::to_f32(&m.rest.positions);
-    let posed = shapecue::cpu::skinning::skin_lbs(&rest, &m.joints, &m.weights, &mats);
-    Some(Mesh {
-        positions: posed.iter().map(|q| q.map(f64::from)).collect(),
-        faces: m.rest.faces.clone(),
-    })
+    Some(middle_frame(&path).unwrap())
 }
 
 /// Lines of one mesh: the curvature once (as `line_segments_on` runs it),
-/// then the lines of each view.
-struct Lines {
-    est: CurvatureEstimator,
-    ex: LineExtractor,
-    feature_size: f32,
-}
+/// then the lines of each view ([`MeshLines`], shared with the report).
+struct Lines(MeshLines);
 
 impl Lines {
     fn new(m: &Mesh) -> Lines {
-        let setup = LineSetup::default();
-        let copts = CurvatureOptions {
-            dcurv: true,
-            ..setup.curvature
-        };
-        let g = common::gpu();
-        let mut est = CurvatureEstimator::new(g.clone(), m.n_vertices(), &m.faces, copts).unwrap();
-        est.set_positions(&m.positions).unwrap();
-        est.run().unwrap();
-        let fs = est
-            .feature_size(setup.feature_size, &m.positions, &m.faces)
-            .unwrap();
-        let ex = LineExtractor::new(g, m.n_vertices(), &m.faces).unwrap();
-        Lines {
-            est,
-            ex,
-            feature_size: fs as f32,
-        }
+        Lines(MeshLines::new(common::gpu(), m).unwrap())
     }
 
     /// The segments of `families` seen in `view`, sorted, and the line
     /// kernels' ms.
     fn of(&mut self, view: &Camera, families: &[LineFamily]) -> (Vec<Segment>, f64) {
-        let mut opts = LineOptions {
-            contours: families.contains(&LineFamily::Contours),
-            suggestive: families.contains(&LineFamily::Suggestive),
-            ..Default::default()
-        };
-        opts.curves.families = FamilySet::of(families).curves();
-        let (mut segs, stats) = (self.ex)
-            .extract_device(&self.est, view.view(W, H), self.feature_size, opts)
-            .unwrap();
-        // The extraction appends segments in the order its work-items
-        // finish; sorted, the reference's subset is the same every run.
-        segs.sort_by_key(|s| (s.2, s.0.map(f32::to_bits), s.1.map(f32::to_bits), s.4));
-        (segs, stats.timing.kernel_ms)
+        self.0.of(view.view(W, H), families).unwrap()
     }
 }
 
 /// Every k-th segment (k ≥ 1), k the least that keeps the reference's
 /// ray–face tests of the subset within [`REFERENCE_BUDGET`].
 fn subset(plan: &Plan, n_faces: usize) -> Vec<usize> {
-    let casts: usize = plan.segs.iter().map(|s| s.intervals + 1).sum();
-    let work = casts as f64 * n_faces as f64;
-    let k = (work / REFERENCE_BUDGET).ceil().max(1.0) as usize;
-    (0..plan.segs.len()).step_by(k).collect()
-}
-
-fn pick<T: Clone>(all: &[T], at: &[usize]) -> Vec<T> {
-    at.iter().map(|&i| all[i].clone()).collect()
+    reference_subset(plan, n_faces, REFERENCE_BUDGET)
 }
 
 /// What one view measured.
@@ -343,7 +274,7 @@ fn run_mesh(name: &str, m: &Mesh, families: &[LineFamily]) {
         m.faces.len()
     );
     for (vname, dir, ortho) in VIEWS {
-        let cam = camera(m, dir, ortho);
+        let cam = camera(m, Vec3::from(dir), ortho);
         let (segs, mut lines_ms) = lines.of(&cam, families);
         for _ in 0..2 {
             lines_ms = lines_ms.min(lines.of(&cam, families).1);

@@ -1,6 +1,7 @@
 //! `shapecue report <topic>`: the measurement tables of [`shapecue::report`]
 //! (accuracy against time of the curvature variants, the isosurfaces and
-//! the strokes; the per-frame pipeline; the edges' cap quality and memory).
+//! the strokes, and of the visibility methods of lines; the per-frame
+//! pipeline and many-view line drawings; the edges' cap quality and memory).
 //! Parses, calls the library's report, prints its Markdown and writes its
 //! numbers (`--json`) and charts (`--plot`), atomically.
 
@@ -133,12 +134,42 @@ enum Topic {
         #[command(flatten)]
         out: Outputs,
     },
+    /// Exact visibility of lines against its f64 reference, with the
+    /// depth-buffer method beside it: per mesh and view, the share of line
+    /// length each method agrees with the reference on, and its ms (default
+    /// meshes: spot, and the Stanford bunny and BrainStem's middle frame of
+    /// the shared data where present).
+    Visibility(VisibilityArgs),
     /// Memory of the feature edges: bits per mesh of each cap variant, from
     /// the buffer sizes (no device needed).
     Memory {
         #[command(flatten)]
         out: Outputs,
     },
+}
+
+/// The arguments of `shapecue report visibility`.
+#[derive(Args)]
+struct VisibilityArgs {
+    /// Meshes to measure (OBJ, PLY, OFF, STL; a glTF model: the middle
+    /// frame of its first clip).
+    meshes: Vec<PathBuf>,
+    /// Every line family on the given meshes (else contours,
+    /// suggestive contours, ridges, valleys and apparent ridges).
+    #[arg(long)]
+    every_family: bool,
+    /// Timed runs per view (medians).
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
+    /// Image size the views frame (and the depth buffer's), e.g. 480x360.
+    #[arg(long, default_value = "480x360")]
+    size: String,
+    /// Most ray–face tests of the f64 reference per view (it checks
+    /// every k-th segment, k the least that keeps within them).
+    #[arg(long, default_value_t = report::visibility::REFERENCE_TESTS)]
+    reference_tests: f64,
+    #[command(flatten)]
+    out: Outputs,
 }
 
 /// Reports a command line clap refused and exits with clap's code; a topic
@@ -202,28 +233,12 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
             resolution,
             runs: n,
             out,
-        } => {
-            let o = report::curvature::CurvatureReportOptions {
-                resolution,
-                runs: runs(n)?,
-            };
-            shapecue::spec::limits::check_mesh_vertices("--resolution", resolution)?;
-            check(&[], &out)?;
-            (report::curvature::report(&gpu()?, o)?, out)
-        }
+        } => (curvature(&gpu, resolution, n, &out)?, out),
         Topic::Isosurface {
             max_resolution,
             runs: n,
             out,
-        } => {
-            let o = report::isosurface::IsosurfaceReportOptions {
-                max_resolution,
-                runs: runs(n)?,
-            };
-            shapecue::spec::limits::check_volume_resolution("--max-resolution", max_resolution)?;
-            check(&[], &out)?;
-            (report::isosurface::report(&gpu()?, o)?, out)
-        }
+        } => (isosurface(&gpu, max_resolution, n, &out)?, out),
         Topic::Strokes {
             max_resolution,
             out,
@@ -262,37 +277,56 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
             size,
             out,
         } => {
-            let (w, h) = super::size_arg(&size)?;
-            for (n, flag) in [(views, "--views"), (generated_views, "--generated-views")] {
-                if !(2..=shapecue::api::MAX_VIEWS).contains(&n) {
-                    bail!("{flag} {n}: give 2 to {} views", shapecue::api::MAX_VIEWS);
-                }
-            }
-            if generated_faces > 0 {
-                shapecue::spec::limits::check_mesh_vertices("--generated-faces", generated_faces)?;
-            }
-            for m in &meshes {
-                if !m.exists() {
-                    bail!("{}: not found (give the meshes to time)", m.display());
-                }
-            }
-            let paths: Vec<&Path> = meshes.iter().map(PathBuf::as_path).collect();
-            check(&paths, &out)?;
             let o = report::lines_batch::LinesBatchOptions {
                 meshes,
                 views,
                 generated_faces,
                 generated_views,
-                size: [w, h],
+                size: super::size_arg(&size).map(|(w, h)| [w, h])?,
             };
-            (report::lines_batch::report(&gpu()?, &o)?, out)
+            (lines_batch(&gpu, o, &out)?, out)
         }
+        Topic::Visibility(v) => visibility(&gpu, v)?,
         Topic::Memory { out } => {
             check(&[], &out)?;
             (report::memory::report()?, out)
         }
     };
     write(report.with_command(command_line()), &out)
+}
+
+/// `shapecue report curvature`: checks the runs, the torus and the
+/// outputs, then measures.
+fn curvature(
+    gpu: &dyn Fn() -> Result<Arc<Gpu>>,
+    resolution: usize,
+    n: usize,
+    out: &Outputs,
+) -> Result<Report> {
+    let o = report::curvature::CurvatureReportOptions {
+        resolution,
+        runs: runs(n)?,
+    };
+    shapecue::spec::limits::check_mesh_vertices("--resolution", resolution)?;
+    check(&[], out)?;
+    Ok(report::curvature::report(&gpu()?, o)?)
+}
+
+/// `shapecue report isosurface`: checks the runs, the largest grid and the
+/// outputs, then measures.
+fn isosurface(
+    gpu: &dyn Fn() -> Result<Arc<Gpu>>,
+    max_resolution: usize,
+    n: usize,
+    out: &Outputs,
+) -> Result<Report> {
+    let o = report::isosurface::IsosurfaceReportOptions {
+        max_resolution,
+        runs: runs(n)?,
+    };
+    shapecue::spec::limits::check_volume_resolution("--max-resolution", max_resolution)?;
+    check(&[], out)?;
+    Ok(report::isosurface::report(&gpu()?, o)?)
 }
 
 /// `shapecue report strokes`: checks the sweep's largest grid and the
@@ -349,6 +383,61 @@ fn pipeline(
         runs: runs(n.max(1))?,
     };
     Ok(report::pipeline::report(&gpu()?, &paths, o)?)
+}
+
+/// `shapecue report lines-batch`: checks the views, the generated mesh,
+/// the meshes and the outputs, then measures.
+fn lines_batch(
+    gpu: &dyn Fn() -> Result<Arc<Gpu>>,
+    o: report::lines_batch::LinesBatchOptions,
+    out: &Outputs,
+) -> Result<Report> {
+    for (n, flag) in [
+        (o.views, "--views"),
+        (o.generated_views, "--generated-views"),
+    ] {
+        if !(2..=shapecue::api::MAX_VIEWS).contains(&n) {
+            bail!("{flag} {n}: give 2 to {} views", shapecue::api::MAX_VIEWS);
+        }
+    }
+    if o.generated_faces > 0 {
+        shapecue::spec::limits::check_mesh_vertices("--generated-faces", o.generated_faces)?;
+    }
+    for m in &o.meshes {
+        if !m.exists() {
+            bail!("{}: not found (give the meshes to time)", m.display());
+        }
+    }
+    let paths: Vec<&Path> = o.meshes.iter().map(PathBuf::as_path).collect();
+    check(&paths, out)?;
+    Ok(report::lines_batch::report(&gpu()?, &o)?)
+}
+
+/// `shapecue report visibility`: checks the size, the runs, the meshes,
+/// the reference's budget and the outputs, then measures.
+fn visibility(gpu: &dyn Fn() -> Result<Arc<Gpu>>, a: VisibilityArgs) -> Result<(Report, Outputs)> {
+    if !(a.reference_tests.is_finite() && a.reference_tests >= 1.0) {
+        bail!(
+            "--reference-tests {}: give the most ray–face tests of the reference per view \
+             (1 or more, e.g. 2e8)",
+            a.reference_tests
+        );
+    }
+    for m in &a.meshes {
+        if !m.exists() {
+            bail!("{}: not found (give the meshes to measure)", m.display());
+        }
+    }
+    let o = report::visibility::VisibilityReportOptions {
+        size: super::size_arg(&a.size).map(|(w, h)| [w, h])?,
+        runs: runs(a.runs.max(1))?,
+        meshes: a.meshes,
+        every_family: a.every_family,
+        reference_tests: a.reference_tests,
+    };
+    let paths: Vec<&Path> = o.meshes.iter().map(PathBuf::as_path).collect();
+    check(&paths, &a.out)?;
+    Ok((report::visibility::report(&gpu()?, &o)?, a.out))
 }
 
 /// Checks the outputs before any measuring: `--plot` must be `.svg`, and

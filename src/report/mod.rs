@@ -12,6 +12,7 @@ pub mod caps;
 pub mod curvature;
 pub mod frames;
 pub mod isosurface;
+pub mod line_agreement;
 pub mod lines;
 pub mod lines_batch;
 pub mod memory;
@@ -19,6 +20,7 @@ pub mod metrics;
 pub mod pipeline;
 pub mod plot;
 pub mod strokes;
+pub mod visibility;
 
 use crate::mesh::{self, LoadOptions, Mesh};
 use serde_json::{Map, Value, json};
@@ -28,7 +30,8 @@ use std::path::PathBuf;
 /// order, and the charts of its numbers.
 #[derive(Clone, Debug)]
 pub struct Report {
-    /// The topic (`curvature`, `isosurface`, `strokes`, `pipeline`, `caps`, `memory`).
+    /// The topic (`curvature`, `isosurface`, `strokes`, `pipeline`, `caps`,
+    /// `lines-batch`, `visibility`, `memory`).
     pub topic: &'static str,
     /// The device measured on (its name), or what computed the numbers.
     pub device: String,
