@@ -657,6 +657,8 @@ def lines(
     switches = (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh))
     setup = (str(feature_size), str(compat), str(accumulate))
     l3 = tuple(float(c) for c in light)
+    if cameras is None and fields:
+        raise ValueError("fields come with the views of cameras=; one eye gives the segments only")
     if cameras is not None:
         if eye is not None:
             raise ValueError("eye sets the one camera; with cameras give each its eye")

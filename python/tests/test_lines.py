@@ -104,3 +104,5 @@ def test_bad_cameras_are_clear_errors():
         shapecue.lines(v, f, cameras=2, eye=(0, 0, 3))
     with pytest.raises(ValueError, match="0 views|1 to"):
         shapecue.lines(v, f, cameras=0)
+    with pytest.raises(ValueError, match="fields"):
+        shapecue.lines(v, f, fields=True)
