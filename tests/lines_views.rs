@@ -468,4 +468,22 @@ fn npz_segments_hold_the_pieces_of_the_json_document() {
         &["lines", &spot(), "-o", svg.to_str().unwrap(), "--npz"],
     );
     failed_with(&one, &["--npz", "--views"]);
+    // The pieces come from exact visibility.
+    let o = d.join("depth");
+    let depth = no_gl(
+        &d,
+        &[
+            "lines",
+            &spot(),
+            "--views",
+            "2",
+            "--out",
+            o.to_str().unwrap(),
+            "--npz",
+            "--visibility",
+            "depth",
+        ],
+    );
+    failed_with(&depth, &["--npz", "exact visibility"]);
+    assert!(!o.exists());
 }

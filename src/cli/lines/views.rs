@@ -188,6 +188,12 @@ fn check_flags(a: &LinesArgs) -> Result<PathBuf> {
             p.display()
         );
     }
+    if a.npz && a.visibility != shapecue::api::VisibilityMethod::Exact {
+        bail!(
+            "--npz writes the pieces that exact visibility splits and chains; with \
+             --visibility depth give --segments for the segments"
+        );
+    }
     let Some(out) = a.out.clone() else {
         bail!("--views and --cameras write into a folder: give --out DIR");
     };
