@@ -12,8 +12,8 @@
 //! - `visibility/plan/bunny`: `cpu::visibility::Plan::new` alone (the
 //!   segments in Morton order, as `classify` takes them);
 //! - `visibility/chains/bunny`: `cpu::chains::chain` over the classified
-//!   pieces (keys as the vector drawing makes them: mesh edge, vertex, or
-//!   a cut where visibility changes).
+//!   pieces (keyed by `cpu::chains::chain_pieces`, as the vector drawing
+//!   keys them: mesh edge, vertex, or a cut where visibility changes).
 //!
 //! The curvature and the segments are computed once, before the groups.
 //! `SHAPECUE_DEVICE` picks the device as for the CLI.
@@ -23,12 +23,12 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::api::LineSetup;
-use shapecue::cpu::chains::{ChainPiece, EndKey, chain, point_key};
+use shapecue::cpu::chains::{chain, chain_pieces};
 use shapecue::cpu::visibility::Plan;
 use shapecue::render::Camera;
 use shapecue::spec::curvature::CurvatureOptions;
-use shapecue::spec::feature_lines::{FamilySet, LINE_FREE, LineFamily, Segment};
-use shapecue::spec::visibility::{Pieces, VisibilityOptions};
+use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
+use shapecue::spec::visibility::VisibilityOptions;
 use shapecue::stages::bvh::Bvh;
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
@@ -38,35 +38,6 @@ use std::time::Duration;
 
 const W: u32 = 480;
 const H: u32 = 360;
-
-/// The chain pieces of `segs` classified into `pieces`.
-fn chain_pieces(segs: &[Segment], pieces: &[Pieces]) -> Vec<ChainPiece> {
-    let key = |s: &Segment, i: usize, t: f32, e: usize| {
-        let [u, v] = s.4[e];
-        if t != [0.0, 1.0][e] {
-            EndKey::Cut(i as u32, t.to_bits())
-        } else if u == LINE_FREE || u == u32::MAX {
-            point_key(if e == 0 { s.0 } else { s.1 }, 1.0)
-        } else if u == v {
-            EndKey::Vertex(u)
-        } else {
-            EndKey::Edge(u.min(v), u.max(v))
-        }
-    };
-    let mut out = Vec::new();
-    for (i, (s, ps)) in segs.iter().zip(pieces).enumerate() {
-        for &(t0, t1, visible) in ps {
-            out.push(ChainPiece {
-                layer: s.2,
-                visible,
-                seg: i as u32,
-                t: [t0, t1],
-                keys: [key(s, i, t0, 0), key(s, i, t1, 1)],
-            });
-        }
-    }
-    out
-}
 
 fn bench(c: &mut Criterion) {
     let Some(gpu) = common::gpu("visibility") else {
@@ -107,7 +78,9 @@ fn bench(c: &mut Criterion) {
     let order = spatial_order(&segs);
     let sorted: Vec<Segment> = order.iter().map(|&i| segs[i]).collect();
     let (pieces, _) = classify(&mut bvh, &p, &m.faces, &sorted, &view, &vopts).expect("classify");
-    let cps = chain_pieces(&sorted, &pieces);
+    // Ends inside faces keyed on the grid of the mesh's largest extent, as
+    // the vector drawing keys them.
+    let cps = chain_pieces(&sorted, &pieces, (hi - lo).max_element());
     eprintln!(
         "visibility bench: bunny, {} segments, {} pieces",
         segs.len(),

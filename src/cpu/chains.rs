@@ -17,6 +17,9 @@
 //! as at a corner of feature edges) a chain goes on along the first unused
 //! piece in canonical order and the others start chains of their own.
 
+use crate::spec::feature_lines::{LINE_FREE, Segment};
+use crate::spec::visibility::Pieces;
+
 /// How a piece's end is matched with others'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum EndKey {
@@ -64,6 +67,48 @@ impl EndKey {
 pub fn point_key(p: [f32; 3], scale: f32) -> EndKey {
     let step = (f64::from(scale.abs().max(f32::MIN_POSITIVE))) * 2f64.powi(-20);
     EndKey::Point(p.map(|c| (f64::from(c) / step).round() as i64))
+}
+
+/// The key of segment `s`'s own end `e` (0: `s.0`, 1: `s.1`): the mesh
+/// edge or vertex it lies on, or for an end inside a face its
+/// [`point_key`] at the scene size `scale`.
+pub fn end_key(s: &Segment, e: usize, scale: f32) -> EndKey {
+    let [u, v] = s.4[e];
+    let p = if e == 0 { s.0 } else { s.1 };
+    if u == LINE_FREE || u == u32::MAX {
+        point_key(p, scale)
+    } else if u == v {
+        EndKey::Vertex(u)
+    } else {
+        EndKey::Edge(u.min(v), u.max(v))
+    }
+}
+
+/// The pieces to chain of `segments` split into `pieces` (per segment, its
+/// `(t0, t1, visible)` parts): an end at the segment's own end takes its
+/// [`end_key`], an end inside the segment (where its visibility changes)
+/// a [`EndKey::Cut`].
+pub fn chain_pieces(segments: &[Segment], pieces: &[Pieces], scale: f32) -> Vec<ChainPiece> {
+    let mut out = Vec::new();
+    for (i, (s, ps)) in segments.iter().zip(pieces).enumerate() {
+        let key = |t: f32, e: usize| {
+            if t == [0.0, 1.0][e] {
+                end_key(s, e, scale)
+            } else {
+                EndKey::Cut(i as u32, t.to_bits())
+            }
+        };
+        for &(t0, t1, visible) in ps {
+            out.push(ChainPiece {
+                layer: s.2,
+                visible,
+                seg: i as u32,
+                t: [t0, t1],
+                keys: [key(t0, 0), key(t1, 1)],
+            });
+        }
+    }
+    out
 }
 
 /// A piece to chain: part `[t0, t1]` of segment `seg`, in `layer` (a

@@ -6,7 +6,7 @@
 //! ([`svg_layers_exact`]): one polyline per chain, in the same groups, ids
 //! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
 
-use crate::cpu::chains::{Chain, ChainPiece, EndKey, chain, point_key};
+use crate::cpu::chains::{Chain, ChainPiece, chain, chain_pieces};
 use crate::cpu::visibility::Plan as VisPlan;
 use crate::error::Result;
 use crate::export::svg::{SvgLayer, SvgPolyline, pixel};
@@ -14,7 +14,7 @@ use crate::render::Camera;
 use crate::scene::file::{Effects, LineStyle, Scene};
 use crate::scene::planner::Cue;
 use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
-use crate::spec::feature_lines::{Hidden, LINE_FREE, LineFamily, Segment, hidden_id};
+use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
 use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
@@ -206,19 +206,6 @@ pub(super) fn gather(
     out
 }
 
-/// The key of a segment's own end `e` (see [`crate::cpu::chains`]).
-fn own_key(s: &Segment, e: usize, scale: f32) -> EndKey {
-    let [u, v] = s.4[e];
-    let p = if e == 0 { s.0 } else { s.1 };
-    if u == LINE_FREE || u == u32::MAX {
-        point_key(p, scale)
-    } else if u == v {
-        EndKey::Vertex(u)
-    } else {
-        EndKey::Edge(u.min(v), u.max(v))
-    }
-}
-
 /// Classifies `segments` seen in `view` over the mesh (`positions`, `faces`)
 /// whose tree `bvh` holds, and chains the pieces; `scale` is the scene's
 /// size (for the keys of ends inside faces). The pieces move into the
@@ -238,25 +225,7 @@ pub(super) fn classify_view(
     let segments: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
     let plan = VisPlan::new(positions, faces, &segments, view, &opts)?;
     let mut c = classify_planned(bvh, &plan)?;
-    let mut chain_pieces = Vec::new();
-    for (i, (s, ps)) in segments.iter().zip(&c.pieces).enumerate() {
-        let key = |t: f32, e: usize| {
-            if t == [0.0, 1.0][e] {
-                own_key(s, e, scale)
-            } else {
-                EndKey::Cut(i as u32, t.to_bits())
-            }
-        };
-        for &(t0, t1, visible) in ps {
-            chain_pieces.push(ChainPiece {
-                layer: s.2,
-                visible,
-                seg: i as u32,
-                t: [t0, t1],
-                keys: [key(t0, 0), key(t1, 1)],
-            });
-        }
-    }
+    let chain_pieces = chain_pieces(&segments, &c.pieces, scale);
     let chains = chain(&chain_pieces);
     let vis = VisibleLines {
         segments,
