@@ -327,13 +327,11 @@ fn picture_options(a: &LinesArgs, c: &Common) -> Result<LinesPictureOptions> {
         },
         ..Default::default()
     };
+    opts.lines = opts.lines.with_families(fams);
     let l = &mut opts.lines;
-    l.contours = fams.has(LineFamily::Contours);
-    l.suggestive = fams.has(LineFamily::Suggestive);
     l.threshold = a.sc_threshold;
     l.fade = a.fade;
     let c = &mut l.curves;
-    c.families = fams.curves();
     c.ridge_threshold = a.rv_threshold;
     c.apparent_threshold = a.ar_threshold;
     c.principal_threshold = a.ph_threshold;

@@ -198,9 +198,7 @@ fn measure(
         ..Default::default()
     };
     opts.shot.size = size;
-    opts.lines.contours = fams.has(LineFamily::Contours);
-    opts.lines.suggestive = fams.has(LineFamily::Suggestive);
-    opts.lines.curves.families = fams.curves();
+    opts.lines = opts.lines.with_families(fams);
     let cams = fibonacci_views(views, CameraDefaults::default())?;
     let dir = scratch_dir()?;
     let mut scene = lines_views_scene(m.clone(), &opts, cams);

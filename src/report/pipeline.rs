@@ -14,7 +14,7 @@ use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::spec::ao::AoMode;
-use crate::spec::feature_lines::{CurveOptions, FamilySet, LineFamily};
+use crate::spec::feature_lines::{FamilySet, LineFamily};
 use crate::spec::timing::Family;
 use crate::spec::view::View;
 use crate::stages::feature_lines::LineOptions;
@@ -208,15 +208,7 @@ fn family_runs(b: &mut Bench) -> Result<Vec<(String, f64)>> {
         .chain(std::iter::once(("lines: every family".to_string(), every)))
         .collect();
     for (label, set) in sets {
-        let opts = LineOptions {
-            contours: set.has(LineFamily::Contours),
-            suggestive: set.has(LineFamily::Suggestive),
-            curves: CurveOptions {
-                families: set.curves(),
-                ..Default::default()
-            },
-            ..Default::default()
-        };
+        let opts = LineOptions::default().with_families(set);
         let mut ms = Vec::new();
         for mats in &b.poses {
             b.p.skin(mats)?;

@@ -235,12 +235,7 @@ impl MeshLines {
     /// # Errors
     /// Device failures, a view the extraction refuses.
     pub fn of(&mut self, view: View, families: &[LineFamily]) -> Result<(Vec<Segment>, f64)> {
-        let mut opts = LineOptions {
-            contours: families.contains(&LineFamily::Contours),
-            suggestive: families.contains(&LineFamily::Suggestive),
-            ..Default::default()
-        };
-        opts.curves.families = FamilySet::of(families).curves();
+        let opts = LineOptions::default().with_families(FamilySet::of(families));
         let (mut segs, stats) =
             (self.ex).extract_device(&self.est, view, self.feature_size, opts)?;
         la::sort_segments(&mut segs);

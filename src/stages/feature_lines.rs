@@ -14,10 +14,10 @@
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
-use crate::spec::feature_lines::ViewFields;
 use crate::spec::feature_lines::{
     CurveOptions, LineInputs, Segment, segments_bound, segments_estimate,
 };
+use crate::spec::feature_lines::{FamilySet, LineFamily, ViewFields};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
@@ -62,6 +62,16 @@ impl Default for LineOptions {
 }
 
 impl LineOptions {
+    /// These options drawing exactly the families of `set`: the contours
+    /// and suggestive contours where it holds them, and its curvature line
+    /// families; the thresholds and switches stay.
+    pub fn with_families(mut self, set: FamilySet) -> LineOptions {
+        self.contours = set.has(LineFamily::Contours);
+        self.suggestive = set.has(LineFamily::Suggestive);
+        self.curves.families = set.curves();
+        self
+    }
+
     /// The suggestive-contour threshold for a feature size `s`: threshold / s².
     pub fn scaled_threshold(&self, s: f32) -> f32 {
         self.threshold / (s * s)
