@@ -500,6 +500,16 @@ impl LineExtractor {
             .collect())
     }
 
+    /// The curve stage's arguments: `inputs`, this extractor's per-vertex
+    /// terms and its faces.
+    fn curve_args(&self, inputs: [Arg; 6]) -> CurveArgs {
+        CurveArgs {
+            inputs,
+            terms: self.terms.each_ref().map(buf),
+            faces: buf(&self.faces),
+        }
+    }
+
     /// The curve stage, built the first time it is asked for.
     fn curve_stage_mut(&mut self) -> Result<&mut CurveStage> {
         if self.curves.is_none() {
@@ -517,11 +527,7 @@ impl LineExtractor {
         view: ([f32; 3], bool),
         opts: &LineOptions,
     ) -> Result<Timing> {
-        let args = CurveArgs {
-            inputs,
-            terms: self.terms.each_ref().map(buf),
-            faces: buf(&self.faces),
-        };
+        let args = self.curve_args(inputs);
         let stage = self.curve_stage_mut()?;
         stage.view_terms(&args, view, &opts.curves)
     }
@@ -535,11 +541,7 @@ impl LineExtractor {
         feature_size: f32,
         opts: &LineOptions,
     ) -> Result<(Vec<Segment>, Timing)> {
-        let args = CurveArgs {
-            inputs,
-            terms: self.terms.each_ref().map(buf),
-            faces: buf(&self.faces),
-        };
+        let args = self.curve_args(inputs);
         let stage = self.curve_stage_mut()?;
         let sc = (
             opts.scaled_threshold(feature_size),
