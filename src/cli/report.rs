@@ -367,15 +367,10 @@ fn pipeline(
             report::pipeline::MAX_MODELS
         );
     }
-    for m in &models {
-        if !m.exists() {
-            bail!(
-                "{}: not found (give the glTF files to time: \
-                 `shapecue report pipeline MODEL.glb`)",
-                m.display()
-            );
-        }
-    }
+    found(
+        &models,
+        "give the glTF files to time: `shapecue report pipeline MODEL.glb`",
+    )?;
     let paths: Vec<&Path> = models.iter().map(PathBuf::as_path).collect();
     check(&paths, out)?;
     let o = report::pipeline::PipelineReportOptions {
@@ -403,11 +398,7 @@ fn lines_batch(
     if o.generated_faces > 0 {
         shapecue::spec::limits::check_mesh_vertices("--generated-faces", o.generated_faces)?;
     }
-    for m in &o.meshes {
-        if !m.exists() {
-            bail!("{}: not found (give the meshes to time)", m.display());
-        }
-    }
+    found(&o.meshes, "give the meshes to time")?;
     let paths: Vec<&Path> = o.meshes.iter().map(PathBuf::as_path).collect();
     check(&paths, out)?;
     Ok(report::lines_batch::report(&gpu()?, &o)?)
@@ -423,11 +414,7 @@ fn visibility(gpu: &dyn Fn() -> Result<Arc<Gpu>>, a: VisibilityArgs) -> Result<(
             a.reference_tests
         );
     }
-    for m in &a.meshes {
-        if !m.exists() {
-            bail!("{}: not found (give the meshes to measure)", m.display());
-        }
-    }
+    found(&a.meshes, "give the meshes to measure")?;
     let o = report::visibility::VisibilityReportOptions {
         size: super::size_arg(&a.size).map(|(w, h)| [w, h])?,
         runs: runs(a.runs.max(1))?,
@@ -438,6 +425,15 @@ fn visibility(gpu: &dyn Fn() -> Result<Arc<Gpu>>, a: VisibilityArgs) -> Result<(
     let paths: Vec<&Path> = o.meshes.iter().map(PathBuf::as_path).collect();
     check(&paths, &a.out)?;
     Ok((report::visibility::report(&gpu()?, &o)?, a.out))
+}
+
+/// Refuses the first of `inputs` that does not exist, with `hint` (what to
+/// give instead).
+fn found(inputs: &[PathBuf], hint: &str) -> Result<()> {
+    match inputs.iter().find(|m| !m.exists()) {
+        Some(m) => bail!("{}: not found ({hint})", m.display()),
+        None => Ok(()),
+    }
 }
 
 /// Checks the outputs before any measuring: `--plot` must be `.svg`, and
