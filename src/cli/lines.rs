@@ -13,6 +13,7 @@ use clap::Args;
 use shapecue::LinesPictureOptions;
 use shapecue::api::Gpu;
 use shapecue::api::{Hidden, LineSetup, VisibilityMethod, VisibleLines};
+use shapecue::export::npz::SegmentArrays;
 use shapecue::mesh::LoadOptions;
 use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions};
 use shapecue::spec::feature_lines::FeatureSize;
@@ -295,7 +296,9 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         _ => bail!("the picture drew no image for {}", output.display()),
     }
     if let Some(p) = &segments {
-        let doc = segments_doc(pic.visible.as_ref(), &pic.segments, pic.feature_size, &mesh);
+        let arrays = (pic.visible.as_ref()).map(|v| (v, shapecue::api::segment_arrays(v, &mesh)));
+        let visible = arrays.as_ref().map(|(v, a)| (*v, a));
+        let doc = segments_doc(visible, &pic.segments, pic.feature_size);
         write_json(p, &doc)?;
     }
     let found = summary(&pic.segments);
@@ -349,20 +352,18 @@ fn picture_options(a: &LinesArgs, c: &Common) -> Result<LinesPictureOptions> {
 }
 
 /// The segments document of `--segments` (one picture's, or one view's):
-/// with exact visibility (`visible`) the drawn segments split into their
-/// pieces and the chains, else every segment; with the feature size.
+/// with exact visibility (`visible`, with its pieces as the NPZ arrays hold
+/// them: [`shapecue::api::segment_arrays`], their faces and barycentric
+/// coordinates included) the drawn segments split into their pieces and
+/// the chains, else every segment; with the feature size.
 fn segments_doc(
-    visible: Option<&VisibleLines>,
+    visible: Option<(&VisibleLines, &SegmentArrays)>,
     segments: &[Segment],
     feature_size: f32,
-    mesh: &shapecue::Mesh,
 ) -> serde_json::Value {
     let family = |k: u32| LineFamily::from_kind(k).map_or("unknown", |f| f.name());
     match visible {
-        Some(v) => {
-            // The pieces as the NPZ arrays hold them, with their face and
-            // their ends' barycentric coordinates in it.
-            let arr = shapecue::api::segment_arrays(v, mesh);
+        Some((v, arr)) => {
             let pieces: Vec<serde_json::Value> = (v.chain_pieces.iter().enumerate())
                 .map(|(i, p)| {
                     let s = &v.segments[p.seg as usize];

@@ -265,22 +265,22 @@ impl ViewsRun<'_> {
     fn view(&mut self, v: ViewDone) -> shapecue::Result<()> {
         let t = Instant::now();
         let mut files: Vec<String> = v.files.iter().map(|p| name(p)).collect();
+        // The pieces' arrays once, for the JSON and the NPZ.
+        let arrays = match (&v.visible, self.segments.is_some() || self.npz.is_some()) {
+            (Some(vis), true) => Some((vis, shapecue::api::segment_arrays(vis, self.mesh))),
+            _ => None,
+        };
         if let Some(paths) = self.segments {
-            let doc = segments_doc(
-                v.visible.as_ref(),
-                &v.segments,
-                v.feature_size.unwrap_or(0.0),
-                self.mesh,
-            );
+            let visible = arrays.as_ref().map(|(v, a)| (*v, a));
+            let doc = segments_doc(visible, &v.segments, v.feature_size.unwrap_or(0.0));
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
             files.push(self.keep(&paths[v.view], |p| {
                 shapecue::export::output::write_bytes_atomic(p, text.as_bytes())
             })?);
         }
-        if let (Some(paths), Some(vis)) = (self.npz, v.visible.as_ref()) {
-            let arrays = shapecue::api::segment_arrays(vis, self.mesh);
+        if let (Some(paths), Some((_, a))) = (self.npz, &arrays) {
             files.push(self.keep(&paths[v.view], |p| {
-                shapecue::export::npz::write_segments(p, &arrays)
+                shapecue::export::npz::write_segments(p, a)
             })?);
         }
         if let (Some(paths), Some(f)) = (self.fields, v.fields.as_ref()) {
