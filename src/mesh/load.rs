@@ -80,6 +80,23 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Mesh> {
     Ok(mesh)
 }
 
+/// Several mesh files as one mesh ([`Mesh::concat`], `what` naming it in
+/// errors), with each file's face count in order.
+///
+/// # Errors
+/// As [`load`] for each file, and as [`Mesh::concat`].
+pub fn load_several(
+    paths: &[std::path::PathBuf],
+    opts: &LoadOptions,
+    what: &str,
+) -> Result<(Mesh, Vec<usize>)> {
+    let meshes = (paths.iter())
+        .map(|p| load(p, opts))
+        .collect::<Result<Vec<_>>>()?;
+    let counts = meshes.iter().map(Mesh::n_faces).collect();
+    Ok((Mesh::concat(&meshes, what)?, counts))
+}
+
 /// The vertex and face (polygon) counts that a PLY or OFF file's header
 /// declares, read from the header alone: a cheap check of a file's size
 /// before it is loaded (a flipbook's frames against its first). `None` for

@@ -21,7 +21,7 @@ mod solids;
 pub mod topology;
 
 pub use generate::*;
-pub use load::{LoadOptions, header_counts, load};
+pub use load::{LoadOptions, header_counts, load, load_several};
 pub use quality::{MeshQuality, quality};
 pub use solids::*;
 

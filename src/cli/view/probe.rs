@@ -61,10 +61,8 @@ pub fn probe(scene: &Scene) -> Result<Probe> {
         },
         Source::Meshes(ps) => {
             files.extend(ps.iter().cloned());
-            let ms = (ps.iter())
-                .map(|p| shapecue::mesh::load(p, &opts))
-                .collect::<shapecue::Result<Vec<_>>>()?;
-            let m = shapecue::Mesh::concat(&ms, &scene.path.display().to_string())?;
+            let what = scene.path.display().to_string();
+            let (m, _) = shapecue::mesh::load_several(ps, &opts, &what)?;
             (1, mesh_bounds(&m.positions, &m.faces))
         }
         Source::Gltf(p, clip) => {

@@ -73,12 +73,9 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
     Ok(match &scene.source {
         Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?, Vec::new()),
         Source::Meshes(ps) => {
-            let meshes = (ps.iter())
-                .map(|p| crate::mesh::load(p, &opts))
-                .collect::<Result<Vec<_>>>()?;
-            let counts = meshes.iter().map(Mesh::n_faces).collect();
             let what = scene.path.display().to_string();
-            Loaded::Static(Mesh::concat(&meshes, &what)?, counts)
+            let (m, counts) = crate::mesh::load_several(ps, &opts, &what)?;
+            Loaded::Static(m, counts)
         }
         Source::Generate(kind, n) => match crate::mesh::generated_by_name(kind, *n) {
             Some((_, m)) => Loaded::Static(m, Vec::new()),
