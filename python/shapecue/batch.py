@@ -150,12 +150,13 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
                 {"file": name, "camera": view.camera, "pieces": int(len(view.a)),
                  "passes_ms": view.passes_ms}
             )
+        kind_names = _kind_names(views)
         doc = {
             "input": path,
             "vertices": int(len(v)),
             "faces": int(len(f)),
-            "family_names": sorted(set().union(*(set(x.family.tolist()) for x in views))),
-            "kind_names": _kind_names(views),
+            "family_names": sorted(set(kind_names.values())),
+            "kind_names": kind_names,
             "views": entries,
             "timing": {
                 "load_ms": (t1 - t0) * 1e3,
@@ -186,8 +187,9 @@ def _kind_names(views: List[Any]) -> Dict[str, str]:
     """The family name of each ``kind`` code the views hold."""
     names: Dict[str, str] = {}
     for x in views:
-        for k, fam in zip(x.kind.tolist(), x.family.tolist()):
-            names.setdefault(str(k), fam)
+        kinds, first = np.unique(x.kind, return_index=True)
+        for k, i in zip(kinds.tolist(), first.tolist()):
+            names.setdefault(str(k), str(x.family[i]))
     return dict(sorted(names.items(), key=lambda kv: int(kv[0])))
 
 
