@@ -78,7 +78,8 @@ enum Cmd {
 
 fn main() {
     shapecue::export::output::install_interrupt_cleanup(
-        "; a render's report is written when its scenes finish, so an interrupted render has none",
+        "; a render's report is written when its scenes finish, so an interrupted render has \
+         none; shapecue lines --out continues an interrupted run with --resume",
     );
     let cli = Cli::try_parse().unwrap_or_else(|e| cli::report::parse_error(e));
     let device = cli.device.as_deref();

@@ -56,6 +56,12 @@ fn identity(path: &Path) -> Option<Identity> {
     }
 }
 
+/// Whether `a` and `b` name one existing file (by device and inode where
+/// the platform has them, so hard links and other spellings count).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    matches!((identity(a), identity(b)), (Some(x), Some(y)) if x == y)
+}
+
 /// Where a path that may not exist yet would be: its folder made canonical
 /// (when that folder exists) joined with its file name.
 /// Where `path` is: its folder made canonical where it exists, and its name.

@@ -39,6 +39,7 @@ fn run(s: &Scene, dir: &Path) -> Option<Result<RunReport, Error>> {
         out_dir: Some(dir.join("out")),
         force: true,
         device: None,
+        ..Default::default()
     };
     unless_no_gl(exec::run(s, &opts, &mut |_, _| {}))
 }

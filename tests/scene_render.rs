@@ -30,6 +30,7 @@ fn run(s: &Scene, dir: &Path, force: bool) -> Option<Result<RunReport, Error>> {
         out_dir: Some(dir.join("out")),
         force,
         device: None,
+        ..Default::default()
     };
     unless_no_gl(exec::run(s, &opts, &mut |_, _| {}))
 }
@@ -514,6 +515,7 @@ fn a_scene_that_fails_midway_leaves_no_images_and_no_new_folder() {
         out_dir: Some(out.clone()),
         force: false,
         device: None,
+        ..Default::default()
     };
     let Some(r) = unless_no_gl(exec::run(&s, &opts, &mut |_, _| {})) else {
         return;
@@ -581,6 +583,7 @@ fn scenes_in_one_session_share_the_device_and_the_gl_context_and_draw_the_same()
         out_dir: Some(dir.join(sub)),
         force: false,
         device: None,
+        ..Default::default()
     };
     let mut session = exec::Session::new();
     for s in &scenes {

@@ -206,6 +206,7 @@ pub(crate) fn render_file(
         out_dir,
         force,
         device: None,
+        ..Default::default()
     };
     let report = py
         .detach(|| shapecue::render_scene_on(&open_gpu(device.as_deref())?, &path, &opts))
@@ -234,6 +235,7 @@ pub(crate) fn render_text(
         out_dir,
         force,
         device: None,
+        ..Default::default()
     };
     let report = py
         .detach(|| {

@@ -58,8 +58,8 @@ pub use crate::scene::exec::{
     run_on as run_scene_on,
 };
 pub use crate::scene::file::{
-    CameraDefaults, CameraKind, HeldMesh, HeldVolume, Scene, Source, ViewSpec, fibonacci_views,
-    load_camera_file, parse_camera_file,
+    CameraDefaults, CameraKind, HeldMesh, HeldVolume, Scene, Source, ViewSpec, check_fov,
+    fibonacci_views, load_camera_file, parse_camera_file,
 };
 pub use crate::spec::cameras::{MAX_VIEWS, fibonacci_directions};
 pub use crate::spec::feature_lines::ViewFields;

@@ -169,9 +169,16 @@ pub struct LinesArgs {
     /// per view, and how often each runs) and the files, and run nothing.
     #[arg(long)]
     explain: bool,
-    /// Overwrite existing output files.
+    /// Overwrite existing output files. With --out, the files of the
+    /// earlier run that manifest.json lists and this run does not write are
+    /// removed, so that the folder holds one run.
     #[arg(long)]
     force: bool,
+    /// With --out: continue an interrupted or failed run. Each view whose
+    /// files match manifest.json is kept, the others are computed; refused
+    /// if the mesh, the cameras or an option changed.
+    #[arg(long)]
+    resume: bool,
 }
 
 /// What the two ways of `shapecue lines` share, checked: the image size,
@@ -254,6 +261,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         (a.explain, "--explain"),
         (a.npz, "--npz"),
         (a.fields, "--fields"),
+        (a.resume, "--resume"),
     ] {
         if on {
             bail!("{flag} goes with --views N or --cameras FILE (and --out DIR)");

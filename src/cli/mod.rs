@@ -159,6 +159,7 @@ pub fn shot_arg(
     ortho: bool,
     size: [u32; 2],
 ) -> anyhow::Result<shapecue::Shot> {
+    shapecue::api::check_fov(fov).map_err(|e| anyhow::anyhow!("--fov: {e}"))?;
     Ok(shapecue::Shot {
         eye: vec3_arg(eye, "eye")?,
         target: vec3_arg(target, "target")?,

@@ -34,6 +34,7 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
         out_dir: a.out.clone(),
         force: a.force,
         device: device.map(str::to_string),
+        ..Default::default()
     };
     // Check every scene before running any, so a typo in the last one does
     // not surface after minutes of rendering.

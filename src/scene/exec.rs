@@ -72,6 +72,21 @@ pub struct ExecOptions {
     pub force: bool,
     /// OpenCL device selector.
     pub device: Option<String>,
+    /// Only these views (indices into the scene's views; `None`: all). The
+    /// files of a view keep its number, so that a run continued after an
+    /// interruption writes the views it lacks under their own names.
+    pub views: Option<Vec<usize>>,
+    /// On failure, keep the views finished before it (their files are
+    /// whole), so that the caller can continue the run; by default a
+    /// failed run removes what it created.
+    pub keep_done: bool,
+}
+
+impl ExecOptions {
+    /// Whether view `v` runs.
+    fn runs_view(&self, v: usize) -> bool {
+        self.views.as_ref().is_none_or(|set| set.contains(&v))
+    }
 }
 
 /// What the scene runs of one process share: the OpenCL device (its
@@ -250,7 +265,11 @@ fn run_loaded(
         .out_dir
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
-    let outputs = RunOutputs::new(scene, &frames, &out_dir);
+    let mut outputs = RunOutputs::new(scene, &frames, &out_dir);
+    outputs.images.retain(|i| opts.runs_view(i.1));
+    outputs
+        .new_files
+        .retain(|f| f == &outputs.report || outputs.images.iter().any(|i| &i.2 == f));
     let input = RunInput {
         loaded,
         frames,
@@ -268,7 +287,7 @@ fn run_loaded(
             let calls = Calls { progress, each };
             render_all(session, scene, opts, calls, input, &outputs)
         });
-    if result.is_err() {
+    if result.is_err() && !opts.keep_done {
         outputs.remove_created();
     }
     result
@@ -364,7 +383,12 @@ fn render_all(
     let renderer = session.renderer(scene, &plan)?;
     let uploads_before = renderer.as_ref().map(|r| r.uploads()).unwrap_or_default();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-    let timing = run_frames(&mut ex, scene, &plan, &frames, &outputs.images, calls)?;
+    let laps = Laps {
+        frames: &frames,
+        images: &outputs.images,
+        views: opts.views.as_deref(),
+    };
+    let timing = run_frames(&mut ex, scene, &plan, laps, calls)?;
 
     let (vertices, faces) = ex.counts();
     let passes = ex.rec.in_plan_order(&plan);
@@ -414,6 +438,14 @@ fn render_all(
     Ok(report)
 }
 
+/// What the frame loop walks: the frames, each view's images, and the
+/// views it runs (`None`: all).
+struct Laps<'a> {
+    frames: &'a [usize],
+    images: &'a [(usize, usize, PathBuf)],
+    views: Option<&'a [usize]>,
+}
+
 /// The frame loop: the plan's passes frame by frame and view by view, by
 /// lifetime (topology passes on a new topology, pose passes per pose, view
 /// passes per camera), each view writing its `images`; calls
@@ -426,11 +458,16 @@ fn run_frames(
     ex: &mut Executor<'_, '_>,
     scene: &Scene,
     plan: &Plan,
-    frames: &[usize],
-    images: &[(usize, usize, PathBuf)],
+    laps: Laps<'_>,
     calls: Calls<'_, '_>,
 ) -> Result<crate::spec::timing::Timing> {
     let Calls { progress, mut each } = calls;
+    let Laps {
+        frames,
+        images,
+        views,
+    } = laps;
+    let runs = |v: usize| views.is_none_or(|set| set.contains(&v));
     let input = scene.source.input();
     // The plan's passes by lifetime, each list in plan order.
     let of = |keep: &dyn Fn(Lifetime) -> bool| -> Vec<Pass> {
@@ -445,7 +482,7 @@ fn run_frames(
     let view_passes = of(&|l| l == Lifetime::View);
 
     let mut timing = crate::spec::timing::Timing::default();
-    let total_views = frames.len() * scene.views.len();
+    let total_views = frames.len() * (0..scene.views.len()).filter(|&v| runs(v)).count();
     let mut done = 0;
     for (fi, &frame) in frames.iter().enumerate() {
         // Pose passes: once in all for a static mesh; topology passes with
@@ -461,6 +498,9 @@ fn run_frames(
             timing.lap("pose_wall", ms_since(t_pose));
         }
         for (vi, cam) in ex.cameras().iter().enumerate() {
+            if !runs(vi) {
+                continue;
+            }
             let t_view = Instant::now();
             let paths: Vec<&PathBuf> = images
                 .iter()

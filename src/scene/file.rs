@@ -60,7 +60,10 @@ mod settings;
 mod toml_words;
 mod views;
 
-pub use camera_file::{CameraDefaults, fibonacci_views, load_camera_file, parse_camera_file};
+pub use camera_file::{
+    CameraDefaults, FOV_RANGE, MAX_CAMERA_FILE_BYTES, check_fov, fibonacci_views, load_camera_file,
+    parse_camera_file,
+};
 pub use effects::{Effects, StrokeEffect};
 pub use held::{HeldMesh, HeldVolume, Shot};
 pub use lines::{LineEffects, LineStyle};

@@ -50,6 +50,25 @@ pub fn edge_key(e: [u32; 2]) -> u64 {
     (u64::from(e[0]) << 32) | u64::from(e[1])
 }
 
+/// Puts `segments` in the documented order every output keeps: by family,
+/// then by the edges (or faces) their two ends lie on, then by the bits of
+/// their ends and strength. The extraction appends segments with an atomic
+/// counter, so the device hands them back in whatever order its work-items
+/// ran; after this sort the same inputs give the same rows, whatever the
+/// device, its lane count or the run.
+pub fn sort_canonical(segments: &mut [Segment]) {
+    let bits = |p: [f32; 3]| p.map(f32::to_bits);
+    segments.sort_unstable_by(|a, b| {
+        (a.2, a.4, bits(a.0), bits(a.1), a.3.to_bits()).cmp(&(
+            b.2,
+            b.4,
+            bits(b.0),
+            bits(b.1),
+            b.3.to_bits(),
+        ))
+    });
+}
+
 /// The first entry of a segment end's "edge" where a test cut the segment
 /// inside a face (the second is the face): such an end chains with no
 /// other by its edge.

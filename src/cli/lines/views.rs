@@ -5,6 +5,8 @@
 //! document of `shapecue lines --segments`; then `manifest.json`: the mesh,
 //! the options, each view's camera and files, and the run's timing.
 
+mod manifest;
+
 use super::{LinesArgs, check_outputs, common, picture_options, segments_doc};
 use anyhow::{Result, bail};
 use serde_json::{Value, json};
@@ -41,70 +43,126 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     if a.explain {
         return explain(&scene, &files);
     }
-    let outputs = (files.images.iter().map(|i| i.1.as_path()))
-        .chain([files.report.as_path(), files.manifest.as_path()])
-        .chain(files.segments.iter().flatten().map(|p| p.as_path()))
-        .chain(files.npz.iter().flatten().map(|p| p.as_path()))
-        .chain(files.fields.iter().flatten().map(|p| p.as_path()));
+    let inputs: Vec<&Path> = c.inputs().into_iter().chain(a.cameras.as_deref()).collect();
+    let gpu = Arc::new(Gpu::new(device)?);
+    let mut head = manifest::Head::new(
+        &a,
+        &c,
+        &mesh,
+        &gpu.info.name,
+        scene.views.len(),
+        options_doc(&a, &c)?,
+    )?;
+    head.insert("report", name(&files.report).into());
+    head.insert("family_codes", family_codes());
+    let earlier = manifest::read(&files.manifest)?;
+    if let (Some(r), true) = (earlier.as_ref().and_then(|m| m.renderer()), a.resume) {
+        head.insert("renderer", r);
+    }
+    if earlier.is_some() && !a.force && !a.resume {
+        bail!(
+            "{} holds an earlier run ({}): --resume continues it, --force replaces it",
+            out.display(),
+            name(&files.manifest)
+        );
+    }
+    // The views an earlier run of the same options left whole (--resume).
+    let kept = match (&earlier, a.resume) {
+        (Some(m), true) => m.views_to_keep(&head, &files.manifest, &out)?,
+        (None, true) => bail!(
+            "--resume: {} has no manifest.json of an earlier run to continue; run without \
+             --resume (add --force to overwrite what is there)",
+            out.display()
+        ),
+        _ => Vec::new(),
+    };
+    let todo: Vec<usize> = (0..scene.views.len())
+        .filter(|v| !kept.iter().any(|k| k.index == *v))
+        .collect();
+    let per_view = files.per_view();
+    let outputs = (todo.iter().flat_map(|&v| per_view[v].iter()))
+        .map(|p| p.as_path())
+        .chain([files.report.as_path(), files.manifest.as_path()]);
     // The folders the run makes (deepest first), to remove if it fails.
     let new_dirs: Vec<PathBuf> = (out.ancestors())
         .filter(|d| !d.as_os_str().is_empty() && !d.exists())
         .map(PathBuf::from)
         .collect();
-    check_outputs(c.inputs(), outputs, a.force)?;
+    // --resume overwrites only the files of its own run (the manifest names
+    // them); the inputs are never outputs, with or without it.
+    check_outputs(inputs.iter().copied(), outputs, a.force || a.resume)?;
+    if let (Some(m), true, false) = (&earlier, a.force, a.resume) {
+        m.remove_stale(&out, &per_view, &inputs);
+    }
     let t_run = Instant::now();
     let mut run = ViewsRun {
         mesh: &mesh,
         segments: files.segments.as_deref(),
         npz: files.npz.as_deref(),
         fields: files.fields.as_deref(),
-        entries: Vec::new(),
+        dir: &out,
+        log: manifest::Log::new(head, kept, files.manifest.clone()),
         written: Vec::new(),
         hand_ms: 0.0,
     };
+    // Written before the first view: an interrupted run can be resumed.
+    run.log.write(None)?;
     let exec = ExecOptions {
-        force: a.force,
+        force: true,
+        views: Some(todo.clone()),
+        keep_done: true,
         ..Default::default()
     };
-    let result = Gpu::new(device).and_then(|gpu| {
-        Session::on(Arc::new(gpu)).run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
-    });
+    let result = if todo.is_empty() {
+        Ok(None)
+    } else {
+        Session::on(gpu)
+            .run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
+            .map(Some)
+    };
     let report = match result {
         Ok(r) => r,
         Err(e) => {
-            run.remove_written(&new_dirs);
-            return Err(e.into());
+            // The views finished before the failure are whole and listed:
+            // the run can be continued with --resume.
+            let listed = run.log.write(None).is_ok() && run.log.views() > 0;
+            if !listed {
+                run.remove_written(&new_dirs);
+            }
+            let hint = if listed {
+                format!(
+                    "; the {} view(s) finished are kept: continue with --resume",
+                    run.log.views()
+                )
+            } else {
+                String::new()
+            };
+            return Err(anyhow::Error::from(e).context(format!(
+                "shapecue lines --out {}: the run stopped{hint}",
+                out.display()
+            )));
         }
     };
     let run_ms = ms_since(t_run);
-    let timing = timing_doc(&report, (load_ms, run_ms, run.hand_ms));
-    let doc = json!({
-        "mesh": a.mesh,
-        "vertices": mesh.n_vertices(),
-        "faces": mesh.n_faces(),
-        "options": options_doc(&a, &c),
-        "device": report.device,
-        "renderer": report.renderer,
-        "report": name(&files.report),
-        "family_codes": family_codes(),
-        "views": run.entries,
-        "timing": &timing,
+    let timing = Some(match &report {
+        Some(r) => timing_doc(r, todo.len(), (load_ms, run_ms, run.hand_ms)),
+        None => json!({"load_ms": load_ms, "run_ms": run_ms, "views_computed": 0}),
     });
-    let text = serde_json::to_string_pretty(&doc)? + "\n";
-    shapecue::export::output::write_bytes_atomic(&files.manifest, text.as_bytes())?;
+    let renderer = report.as_ref().map(|r| r.renderer.clone());
+    run.log.finish(renderer, timing.clone())?;
+    let views_per_second = (timing.as_ref())
+        .and_then(|t| t["views_per_second"].as_f64())
+        .unwrap_or(0.0);
     super::super::print(format_args!(
-        "{}: {} views ({} files); pose {:.1} ms, views {:.1} ms ({:.2} views/s); {}",
+        "{}: {} views ({} computed, {} kept from the earlier run); views {:.1} ms ({:.2} views/s); {}",
         out.display(),
-        report.views,
-        // The images, the segments, the report and the manifest.
-        report.outputs.len()
-            + files.segments.map_or(0, |s| s.len())
-            + files.npz.map_or(0, |s| s.len())
-            + files.fields.map_or(0, |s| s.len())
-            + 2,
-        timing["pose_ms"].as_f64().unwrap_or(0.0),
-        timing["views_ms"].as_f64().unwrap_or(0.0),
-        timing["views_per_second"].as_f64().unwrap_or(0.0),
+        scene.views.len(),
+        todo.len(),
+        scene.views.len() - todo.len(),
+        timing
+            .as_ref()
+            .map_or(0.0, |t| t["views_ms"].as_f64().unwrap_or(0.0)),
+        views_per_second,
         files.manifest.display()
     ))?;
     Ok(())
@@ -194,6 +252,12 @@ fn check_flags(a: &LinesArgs) -> Result<PathBuf> {
              --visibility depth give --segments for the segments"
         );
     }
+    if a.resume && a.force {
+        bail!(
+            "--resume keeps the earlier run's finished views and --force replaces the run: give \
+             one or the other"
+        );
+    }
     let Some(out) = a.out.clone() else {
         bail!("--views and --cameras write into a folder: give --out DIR");
     };
@@ -207,6 +271,26 @@ fn check_flags(a: &LinesArgs) -> Result<PathBuf> {
 fn stem(mesh: &str) -> String {
     let s = Path::new(mesh).file_stem().and_then(|s| s.to_str());
     s.filter(|s| !s.is_empty()).unwrap_or("mesh").to_string()
+}
+
+impl Files {
+    /// Each view's files (its images, segments, NPZ and fields), by view.
+    fn per_view(&self) -> Vec<Vec<PathBuf>> {
+        let n = self.images.iter().map(|i| i.0 + 1).max().unwrap_or(0);
+        let mut out = vec![Vec::new(); n];
+        for (v, p) in &self.images {
+            out[*v].push(p.clone());
+        }
+        for list in [&self.segments, &self.npz, &self.fields]
+            .into_iter()
+            .flatten()
+        {
+            for (v, p) in list.iter().enumerate() {
+                out[v].push(p.clone());
+            }
+        }
+        out
+    }
 }
 
 /// Every file of the run: the executor's images and report (frame 0 of a
@@ -243,6 +327,8 @@ fn beside_svg(svg: &Path, what: &str) -> PathBuf {
 
 /// What the run gathers view by view.
 struct ViewsRun<'a> {
+    /// The output folder.
+    dir: &'a Path,
     /// The mesh (the faces and barycentric coordinates of the segments).
     mesh: &'a shapecue::Mesh,
     /// Each view's segments file, where asked (in view order).
@@ -251,8 +337,8 @@ struct ViewsRun<'a> {
     npz: Option<&'a [PathBuf]>,
     /// Each view's fields file, where asked (in view order).
     fields: Option<&'a [PathBuf]>,
-    /// Each view's manifest entry.
-    entries: Vec<Value>,
+    /// The manifest, written as the views finish.
+    log: manifest::Log,
     /// The segments files written so far.
     written: Vec<PathBuf>,
     /// Wall time spent here (writing the segments documents, gathering the
@@ -288,21 +374,22 @@ impl ViewsRun<'_> {
                 shapecue::export::npz::write_fields(p, f)
             })?);
         }
-        let cam = v.camera;
-        self.entries.push(json!({
-            "index": v.view,
-            "camera": {
-                "eye": cam.eye.to_array(),
-                "target": cam.target.to_array(),
-                "up": cam.up.to_array(),
-                "fov": cam.fov_y_deg,
-                "ortho": cam.ortho_height,
-                "near": cam.near,
-                "far": cam.far,
-            },
-            "segments": v.segments.iter().filter(|s| s.3 > 0.0).count(),
-            "files": files,
-        }));
+        let listed = (files.iter())
+            .map(|f| {
+                manifest::sha256_file(&self.dir.join(f)).map(|h| json!({"name": f, "sha256": h}))
+            })
+            .collect::<shapecue::Result<Vec<Value>>>()?;
+        let entry = manifest::ViewEntry {
+            index: v.view,
+            doc: json!({
+                "index": v.view,
+                "camera": manifest::camera_doc(&v.camera),
+                "segments": v.segments.iter().filter(|s| s.3 > 0.0).count(),
+                "files": listed,
+            }),
+        };
+        self.log.push(entry);
+        self.log.write_now_and_then()?;
         self.hand_ms += ms_since(t);
         Ok(())
     }
@@ -361,11 +448,12 @@ fn family_codes() -> Value {
 /// views per second over the view part and over the whole run, the time
 /// spent writing segments documents (outside the view part), and the
 /// passes' own clocks.
-fn timing_doc(r: &RunReport, (load_ms, run_ms, hand_ms): (f64, f64, f64)) -> Value {
+fn timing_doc(r: &RunReport, views: usize, (load_ms, run_ms, hand_ms): (f64, f64, f64)) -> Value {
     let t = &r.timing;
     let (pose_ms, views_ms) = (t.phase_ms("pose_wall"), t.phase_ms("view_wall"));
-    let n = r.views.max(1) as f64;
+    let n = views.max(1) as f64;
     json!({
+        "views_computed": views,
         "load_ms": load_ms,
         "run_ms": run_ms,
         "pose_ms": pose_ms,
@@ -383,9 +471,14 @@ fn timing_doc(r: &RunReport, (load_ms, run_ms, hand_ms): (f64, f64, f64)) -> Val
 }
 
 /// The options of the run, as the manifest lists them.
-fn options_doc(a: &LinesArgs, c: &super::Common) -> Value {
+fn options_doc(a: &LinesArgs, c: &super::Common) -> Result<Value> {
     let fams: Vec<&str> = c.fams.iter().map(|f| f.name()).collect();
-    json!({
+    let cameras_sha256 = match &a.cameras {
+        Some(p) => Some(manifest::sha256_file(p)?),
+        None => None,
+    };
+    Ok(json!({
+        "cameras_sha256": cameras_sha256,
         "lines": fams,
         "views": a.views,
         "cameras": a.cameras,
@@ -413,7 +506,9 @@ fn options_doc(a: &LinesArgs, c: &super::Common) -> Value {
         "fade_lines": !a.no_fade,
         "hermite": a.hermite,
         "hermite_kh": a.hermite_kh,
-    })
+        "accumulate": a.accumulate.name(),
+        "light": a.light,
+    }))
 }
 
 /// A file's name (the manifest lists the files of its own folder).

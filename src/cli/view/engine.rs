@@ -71,6 +71,7 @@ impl Engine {
             out_dir: Some(dir.clone()),
             force: true,
             device,
+            ..Default::default()
         };
         let thread = std::thread::Builder::new()
             .name("shapecue-view-compute".into())

@@ -26,7 +26,7 @@ use std::path::Path;
 /// height the perspective view shows at the target).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraDefaults {
-    /// Vertical field of view in degrees, in (0, 180).
+    /// Vertical field of view in degrees, within [`FOV_RANGE`].
     pub fov: f32,
     /// Orthographic.
     pub ortho: bool,
@@ -41,16 +41,33 @@ impl Default for CameraDefaults {
     }
 }
 
-/// One camera of a camera file, as written.
+/// One camera of a camera file, as written (read as f64, so that a value
+/// too large for the renderer is named as written rather than as the
+/// infinity an f32 would make of it).
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraEntry {
-    eye: [f32; 3],
-    target: [f32; 3],
-    up: Option<[f32; 3]>,
-    fov: Option<f32>,
-    ortho: Option<f32>,
+    eye: [f64; 3],
+    target: [f64; 3],
+    up: Option<[f64; 3]>,
+    fov: Option<f64>,
+    ortho: Option<f64>,
 }
+
+/// The largest coordinate (and orthographic height) a camera may have, in
+/// the mesh's units: the renderer and the line kernels work in f32, whose
+/// squared distances overflow past about 1e19.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// The fields of view a camera may have, in degrees: below the smallest
+/// the projection of a fitted view needs more than f32 precision; towards
+/// 180 every line projects onto a point.
+pub const FOV_RANGE: (f32, f32) = (0.01, 170.0);
+
+/// The largest camera file read: a set of [`MAX_VIEWS`] cameras written
+/// with long numbers takes a few MB; a larger file is refused before it is
+/// parsed.
+pub const MAX_CAMERA_FILE_BYTES: u64 = 16 << 20;
 
 /// `n` views fitted to the bounds (the bounding sphere filling the view
 /// with a 5 % margin) from the directions of
@@ -85,10 +102,22 @@ pub fn fibonacci_views(n: usize, defaults: CameraDefaults) -> Result<Vec<ViewSpe
 /// naming the file, the camera and the problem otherwise
 /// ([`parse_camera_file`]).
 pub fn load_camera_file(path: &Path, defaults: CameraDefaults) -> Result<Vec<ViewSpec>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let len = std::fs::metadata(path).map_err(io)?.len();
+    if len > MAX_CAMERA_FILE_BYTES {
+        return Err(Error::input(
+            path.display().to_string(),
+            "the file",
+            format!(
+                "{len} bytes, more than the {MAX_CAMERA_FILE_BYTES} a camera file may hold \
+                 ({MAX_VIEWS} cameras at most)"
+            ),
+        ));
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
     parse_camera_file(&text, &path.display().to_string(), defaults)
 }
 
@@ -148,9 +177,31 @@ pub fn parse_camera_file(
             let element = format!("camera {i}");
             let entry: CameraEntry =
                 serde_json::from_value(v.clone()).map_err(|e| bad(&element, e.to_string()))?;
+            check_magnitudes(v).map_err(|p| bad(&element, p))?;
             camera_view(&entry, defaults).map_err(|p| bad(&element, p))
         })
         .collect()
+}
+
+/// Refuses a coordinate or height beyond [`MAX_COORDINATE`], naming the
+/// key and the value as written.
+fn check_magnitudes(v: &serde_json::Value) -> std::result::Result<(), String> {
+    for key in ["eye", "target", "ortho"] {
+        let numbers: Vec<&serde_json::Value> = match v.get(key) {
+            Some(serde_json::Value::Array(a)) => a.iter().collect(),
+            Some(x) => vec![x],
+            None => vec![],
+        };
+        for n in numbers {
+            if n.as_f64().is_some_and(|x| x.abs() > MAX_COORDINATE) {
+                return Err(format!(
+                    "{key} has {n}, beyond the {MAX_COORDINATE:e} a camera may have (the \
+                     drawing works in single precision)"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One camera's view; the error is the problem in words.
@@ -169,14 +220,15 @@ fn camera_view(c: &CameraEntry, defaults: CameraDefaults) -> std::result::Result
             ));
         }
     }
-    let (eye, target) = (glam::Vec3::from(c.eye), glam::Vec3::from(c.target));
+    let f = |v: [f64; 3]| v.map(|x| x as f32);
+    let (eye, target) = (glam::Vec3::from(f(c.eye)), glam::Vec3::from(f(c.target)));
     let dir = target - eye;
     let scale = eye.abs().max(target.abs()).max_element().max(1.0);
     if dir.length() <= 1e-6 * scale {
         return Err("eye and target are at one point: the camera looks nowhere".into());
     }
     if let Some(u) = c.up {
-        let u = glam::Vec3::from(u);
+        let u = glam::DVec3::from(u).normalize_or_zero().as_vec3();
         if u.length() == 0.0 || !u.length().is_finite() {
             return Err("up is zero: give the direction that is up in the image".into());
         }
@@ -190,7 +242,7 @@ fn camera_view(c: &CameraEntry, defaults: CameraDefaults) -> std::result::Result
         (Some(_), Some(_)) => {
             return Err("give fov (perspective) or ortho (orthographic height), not both".into());
         }
-        (Some(f), None) => (f, false),
+        (Some(f), None) => (f as f32, false),
         // The executor's orthographic view shows the height the
         // perspective view of `fov` shows at the target: the fov whose
         // view shows `h` there.
@@ -198,27 +250,46 @@ fn camera_view(c: &CameraEntry, defaults: CameraDefaults) -> std::result::Result
             if !(h.is_finite() && h > 0.0) {
                 return Err(format!("ortho {h} must be a positive height"));
             }
-            (2.0 * (0.5 * h / dir.length()).atan().to_degrees(), true)
+            let fov = 2.0 * (0.5 * h / f64::from(dir.length())).atan().to_degrees();
+            return finish(c, fov as f32, true).map_err(|_| {
+                format!(
+                    "ortho {h} from {} away gives a field of view of {fov:.4} degrees, outside \
+                     [{}, {}]: give a height nearer the eye's distance",
+                    dir.length(),
+                    FOV_RANGE.0,
+                    FOV_RANGE.1
+                )
+            });
         }
         (None, None) => (defaults.fov, defaults.ortho),
     };
+    finish(c, fov, ortho)
+}
+
+/// The view of a checked camera with its field of view.
+fn finish(c: &CameraEntry, fov: f32, ortho: bool) -> std::result::Result<ViewSpec, String> {
     check_fov(fov)?;
+    let f = |v: [f64; 3]| v.map(|x| x as f32);
     Ok(ViewSpec {
         kind: CameraKind::LookAt {
-            eye: c.eye,
-            target: Some(c.target),
+            eye: f(c.eye),
+            target: Some(f(c.target)),
         },
-        up: c.up,
+        up: c.up.map(f),
         fov,
         ortho,
     })
 }
 
-/// A field of view in (0, 180) degrees.
-fn check_fov(fov: f32) -> std::result::Result<(), String> {
-    if fov > 0.0 && fov < 180.0 {
+/// A field of view within [`FOV_RANGE`] degrees.
+pub fn check_fov(fov: f32) -> std::result::Result<(), String> {
+    let (lo, hi) = FOV_RANGE;
+    if (lo..=hi).contains(&fov) {
         Ok(())
     } else {
-        Err(format!("fov {fov} must be in (0, 180) degrees"))
+        Err(format!(
+            "fov {fov} degrees is outside [{lo}, {hi}]: narrower views need more than single \
+             precision, and towards 180 degrees every line projects onto a point"
+        ))
     }
 }

@@ -30,9 +30,7 @@ pub(super) fn resolve(ck: &Checker<'_>, cameras: &[Spanned<CameraSpec>]) -> Resu
 /// caller adds the line.
 fn camera(s: &CameraSpec) -> std::result::Result<Vec<ViewSpec>, String> {
     let fov = s.fov.unwrap_or(35.0);
-    if !(fov > 0.0 && fov < 180.0) {
-        return Err(format!("fov {fov} must be in (0, 180) degrees"));
-    }
+    super::camera_file::check_fov(fov)?;
     check_vectors(s)?;
     check_mode(s)?;
     let view = |kind| ViewSpec {
