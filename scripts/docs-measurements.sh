@@ -21,7 +21,7 @@ model="${SHAPECUE_PIPELINE_MODEL:-$shared/animations/gltf/BrainStem.glb}"
 # The command of each topic (as it appears in the pages' headers).
 args_of() {
     case "$1" in
-        curvature) echo "report curvature --resolution 40000" ;;
+        curvature) echo "report curvature --vertices 40000" ;;
         isosurface) echo "report isosurface --max-resolution 256 --runs 3" ;;
         strokes) echo "report strokes" ;;
         pipeline) echo "report pipeline $model" ;;

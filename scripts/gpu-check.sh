@@ -131,7 +131,7 @@ table() {
             row "curvature-$scheme-${m%%:*}" "$bin" curvature "${m#*:}" --accumulate "$scheme" \
                 --runs "$runs" --stats "$outdir/curvature-$scheme-${m%%:*}.json"
         done
-        row "curvature-$scheme-torus" "$bin" curvature --generate torus --resolution "$torus" \
+        row "curvature-$scheme-torus" "$bin" curvature torus --vertices "$torus" \
             --accumulate "$scheme" --runs "$runs" --stats "$outdir/curvature-$scheme-torus.json"
     done
     for res in "$r1" "$r2"; do

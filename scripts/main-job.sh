@@ -20,9 +20,9 @@ $bin devices
 # cache, so that no later command compiles them.
 $bin build-kernels
 $bin curvature data/spot.obj -o out/spot.ply --stats out/spot.json --force
-$bin curvature --generate torus --resolution 40000 -o out/torus.ply --stats out/torus.json --force
-$bin curvature --generate ellipsoid --resolution 40000 -o out/ellipsoid.ply --stats out/ellipsoid.json --force
-$bin report curvature --resolution 40000 --plot out/curvature-report.svg --force
+$bin curvature torus --vertices 40000 -o out/torus.ply --stats out/torus.json --force
+$bin curvature ellipsoid --vertices 40000 -o out/ellipsoid.ply --stats out/ellipsoid.json --force
+$bin report curvature --vertices 40000 --plot out/curvature-report.svg --force
 # Isosurfaces: marching cubes + vertex fusion on the device, then curvature
 # of the fused mesh without a host round trip, on procedural fields.
 $bin isosurface data/bucky.nhdr --iso 51 --curvature -o out/bucky-iso.ply --stats out/bucky-iso.json --force

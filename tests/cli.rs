@@ -623,7 +623,8 @@ fn sizes_are_checked_before_allocating() {
         "-o",
         o,
     ]);
-    assert!(e.contains("--resolution") && e.contains("50000000"), "{e}");
+    // --resolution is the older name of --vertices (both spellings work).
+    assert!(e.contains("--vertices") && e.contains("50000000"), "{e}");
     let e = run(&["report", "curvature", "--runs", "0"]);
     assert!(e.contains("--runs"), "{e}");
     let e = run(&["edges", "missing.obj", "--size", "0x10", "-o", o]);

@@ -32,15 +32,19 @@ use std::time::Instant;
 /// The arguments of `shapecue curvature`.
 #[derive(Args)]
 pub struct CurvatureArgs {
-    /// Input mesh (.obj, .ply, .off).
+    /// Input mesh (.obj, .ply, .off), or a generated one: torus, sphere,
+    /// ellipsoid, cylinder or plane (with --vertices), as `shapecue lines`
+    /// takes it.
     #[arg(required_unless_present = "generate")]
     input: Option<PathBuf>,
-    /// Use a generated mesh instead of a file.
+    /// A generated mesh instead of a file (the same as giving its name as
+    /// the input; kept for older scripts).
     #[arg(long, value_parser = super::choice::<Generated>(), conflicts_with = "input")]
     generate: Option<Generated>,
-    /// Approximate vertex count of a generated mesh.
-    #[arg(long, default_value_t = 40_000)]
-    resolution: usize,
+    /// Vertices of a generated mesh (about; default 40000). `--resolution`
+    /// is its older name, kept as an alias.
+    #[arg(long, alias = "resolution")]
+    vertices: Option<usize>,
     /// Output PLY (binary little-endian). Never the input file.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -169,18 +173,36 @@ fn check_args(a: &CurvatureArgs) -> Result<MeshSource> {
     if let Some(n) = a.runs {
         shapecue::spec::limits::check_count("--runs", n, 10_000)?;
     }
+    // A name that is no file but a generated mesh's is that mesh, as in
+    // `shapecue lines`.
+    let named = (a.input.as_ref())
+        .filter(|p| !p.exists())
+        .and_then(|p| p.to_str())
+        .and_then(|n| Generated::ALL.into_iter().find(|g| g.name() == n));
+    let generate = a.generate.or(named);
+    let input = a.input.as_deref().filter(|_| named.is_none());
     check_outputs(
-        a.input.as_deref(),
+        input,
         a.output.iter().chain(a.stats.iter()).map(PathBuf::as_path),
         a.force,
     )?;
-    Ok(match (&a.input, a.generate) {
+    Ok(match (input, generate) {
         (_, Some(kind)) => {
+            let n = a.vertices.unwrap_or(40_000);
             // Checked here first: the message names the flag.
-            shapecue::spec::limits::check_mesh_vertices("--resolution", a.resolution)?;
-            MeshSource::Generated(kind, a.resolution)
+            shapecue::spec::limits::check_mesh_vertices("--vertices", n)?;
+            MeshSource::Generated(kind, n)
         }
-        (Some(path), None) => MeshSource::File(path.clone(), LoadOptions { weld: a.weld }),
+        (Some(path), None) => {
+            if a.vertices.is_some() {
+                bail!(
+                    "--vertices is for generated meshes (torus, sphere, ellipsoid, cylinder, \
+                     plane); {} is a file",
+                    path.display()
+                );
+            }
+            MeshSource::File(path.to_path_buf(), LoadOptions { weld: a.weld })
+        }
         (None, None) => bail!("give an input mesh or --generate"),
     })
 }

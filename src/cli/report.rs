@@ -43,8 +43,9 @@ enum Topic {
     /// analytic curvature and the f64 CPU reference, median kernel and wall
     /// ms; then the refinement sweep (error against edge length h).
     Curvature {
-        /// Approximate vertex count of the torus.
-        #[arg(long, default_value_t = 40_000)]
+        /// Vertices of the torus (about). `--resolution` is its older
+        /// name, kept as an alias.
+        #[arg(long = "vertices", alias = "resolution", default_value_t = 40_000)]
         resolution: usize,
         /// Timed runs per variant (medians).
         #[arg(long, default_value_t = 7)]
@@ -307,7 +308,7 @@ fn curvature(
         resolution,
         runs: runs(n)?,
     };
-    shapecue::spec::limits::check_mesh_vertices("--resolution", resolution)?;
+    shapecue::spec::limits::check_mesh_vertices("--vertices", resolution)?;
     check(&[], out)?;
     Ok(report::curvature::report(&gpu()?, o)?)
 }

@@ -35,10 +35,14 @@ fn hex(c: [f32; 3]) -> String {
 }
 
 /// Writes one polyline; consecutive points that print the same (pieces of
-/// zero length, where a contour passes through a vertex) are written once.
+/// zero length, where a contour passes through a vertex) are written once,
+/// and a polyline left with one point (a line shorter than a hundredth of
+/// a pixel) is not written: it draws nothing.
 fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
+    let start = s.len();
     s.push_str("<polyline points=\"");
     let (mut here, mut last) = (String::with_capacity(32), String::with_capacity(32));
+    let mut written = 0;
     for p in points {
         here.clear();
         push_hundredths(&mut here, p[0]);
@@ -51,7 +55,12 @@ fn push_polyline(s: &mut String, points: &[[f32; 2]], opacity: Option<f32>) {
             s.push(' ');
         }
         s.push_str(&here);
+        written += 1;
         std::mem::swap(&mut here, &mut last);
+    }
+    if written < 2 {
+        s.truncate(start);
+        return;
     }
     s.push('"');
     if let Some(o) = opacity.filter(|&o| o < 0.995) {
@@ -162,6 +171,10 @@ mod tests {
         assert!(t.contains("id=\"suggestive-contours\" class=\"suggestive-contours\" fill=\"none\" stroke=\"#ff8000\" stroke-width=\"1.5\""));
         assert!(t.contains("points=\"0.00,0.00 1.00,1.00 2.00,0.00\" stroke-opacity=\"0.50\""));
         assert!(t.contains("points=\"0.00,0.00 1.00,1.00\"/>"));
+        // A line shorter than a hundredth of a pixel prints one point: none.
+        let mut one = String::new();
+        push_polyline(&mut one, &[[3.0, 4.0], [3.001, 4.002]], None);
+        assert_eq!(one, "");
         assert!(t.contains("stroke-dasharray=\"4.5 3.0\""));
         assert_eq!(t.matches("stroke-dasharray").count(), 1);
     }

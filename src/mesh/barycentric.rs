@@ -13,8 +13,7 @@ pub fn barycentric(p: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
     let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
     let det = a * c - b * b;
     // No area, or a NaN: the nearest corner.
-    let flat = det.partial_cmp(&(1e-24 * a.max(c) * a.max(c))) != Some(std::cmp::Ordering::Greater);
-    if flat {
+    if !has_area(t) {
         let dist = |q: [f64; 3]| dot(sub(p, q), sub(p, q));
         let k = (0..3)
             .min_by(|&i, &j| dist(t[i]).total_cmp(&dist(t[j])))
@@ -30,8 +29,9 @@ pub fn barycentric(p: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
 }
 
 /// Of `candidates` (face indices into `faces`), the face both `a` and `b`
-/// lie in best (the least negative barycentric weight over both ends, then
-/// the nearer plane), with each end's coordinates in it; `None` when there
+/// lie in best (a face with area before one without, whose weights would
+/// only name its nearest corner; then the least negative barycentric weight
+/// over both ends), with each end's coordinates in it; `None` when there
 /// is no candidate.
 pub fn face_of_segment(
     (a, b): ([f64; 3], [f64; 3]),
@@ -40,18 +40,29 @@ pub fn face_of_segment(
     faces: &[[u32; 3]],
 ) -> Option<(u32, [[f64; 3]; 2])> {
     let corners = |f: u32| faces[f as usize].map(|v| positions[v as usize]);
-    let score = |f: u32| -> (f64, [[f64; 3]; 2]) {
+    let score = |f: u32| -> (bool, f64, [[f64; 3]; 2]) {
         let t = corners(f);
         let w = [barycentric(a, t), barycentric(b, t)];
         let worst = w.iter().flatten().fold(0.0f64, |m, &x| m.min(x));
-        (worst, w)
+        (has_area(t), worst, w)
     };
     candidates
         .iter()
         .filter(|&&f| (f as usize) < faces.len())
         .map(|&f| (f, score(f)))
-        .max_by(|x, y| x.1.0.total_cmp(&y.1.0))
-        .map(|(f, (_, w))| (f, w))
+        .max_by(|x, y| x.1.0.cmp(&y.1.0).then(x.1.1.total_cmp(&y.1.1)))
+        .map(|(f, (_, _, w))| (f, w))
+}
+
+/// Whether the triangle `t` has an area [`barycentric`] can place points
+/// in (not a repeated corner, not three corners on a line, no NaN).
+fn has_area(t: [[f64; 3]; 3]) -> bool {
+    let sub = |a: [f64; 3], b: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (e1, e2) = (sub(t[1], t[0]), sub(t[2], t[0]));
+    let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+    let det = a * c - b * b;
+    det.partial_cmp(&(1e-24 * a.max(c) * a.max(c))) == Some(std::cmp::Ordering::Greater)
 }
 
 #[cfg(test)]

@@ -310,6 +310,9 @@ impl Scene {
             Some(c) => settings::curvature(&ck, c)?,
             None => CurvatureOptions::default(),
         };
+        if let Some(p) = (file.curvature.as_ref()).and_then(|c| c.precision.as_ref()) {
+            settings::check_precision(&ck, p.span(), &curvature, &effects, input.source.input())?;
+        }
         Ok(Scene {
             curvature,
             path: path.to_path_buf(),

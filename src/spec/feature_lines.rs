@@ -50,23 +50,29 @@ pub fn edge_key(e: [u32; 2]) -> u64 {
     (u64::from(e[0]) << 32) | u64::from(e[1])
 }
 
-/// Puts `segments` in the documented order every output keeps: by family,
-/// then by the edges (or faces) their two ends lie on, then by the bits of
-/// their ends and strength. The extraction appends segments with an atomic
-/// counter, so the device hands them back in whatever order its work-items
-/// ran; after this sort the same inputs give the same rows, whatever the
-/// device, its lane count or the run.
-pub fn sort_canonical(segments: &mut [Segment]) {
+/// Puts the extraction's `segments` in the documented order every output
+/// keeps, and leaves out what a face without area or a repeated face
+/// makes:
+/// - the order: by family, then by the edges (or faces) their two ends lie
+///   on, then by the bits of their ends and strength. The extraction
+///   appends segments with an atomic counter, so the device hands them back
+///   in whatever order its work-items ran; after this sort the same inputs
+///   give the same rows, whatever the device, its lane count or the run;
+/// - a segment of a face with a repeated vertex (`f 1 1 2`): both its ends
+///   lie on one edge (a sign change along the edge from a vertex to itself
+///   is impossible, so the face's two crossings are on its one other
+///   edge). Such a face has no area, and its piece no place on the
+///   surface. A boundary's ends are vertices (`[v, v]`), two of them;
+/// - the second of two identical segments: a face given twice (the same
+///   corners in the same order) draws its lines twice, which would break
+///   every chain through it.
+pub fn canonical(segments: &mut Vec<Segment>) {
+    let on_edge = |e: [u32; 2]| e[0] != LINE_FREE && e[0] != u32::MAX;
+    segments.retain(|s| !(on_edge(s.4[0]) && s.4[0] == s.4[1]));
     let bits = |p: [f32; 3]| p.map(f32::to_bits);
-    segments.sort_unstable_by(|a, b| {
-        (a.2, a.4, bits(a.0), bits(a.1), a.3.to_bits()).cmp(&(
-            b.2,
-            b.4,
-            bits(b.0),
-            bits(b.1),
-            b.3.to_bits(),
-        ))
-    });
+    let key = |s: &Segment| (s.2, s.4, bits(s.0), bits(s.1), s.3.to_bits());
+    segments.sort_unstable_by_key(key);
+    segments.dedup_by_key(|s| key(s));
 }
 
 /// The first entry of a segment end's "edge" where a test cut the segment

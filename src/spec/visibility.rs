@@ -157,8 +157,12 @@ impl Faces {
         out
     }
 
-    /// Adds `face` where fewer than four are held; whether it was added.
+    /// Adds `face` where fewer than four are held; whether it is held (a
+    /// face already held is not held twice).
     pub fn push(&mut self, face: u32) -> bool {
+        if self.as_slice().contains(&face) {
+            return true;
+        }
         let n = self.n as usize;
         if n == 4 {
             return false;

@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::LinesKernel;
 use crate::spec::feature_lines::{
-    CurveOptions, LineInputs, Segment, segments_bound, segments_estimate, sort_canonical,
+    CurveOptions, LineInputs, Segment, canonical, segments_bound, segments_estimate,
 };
 use crate::spec::feature_lines::{FamilySet, LineFamily, ViewFields};
 use crate::spec::timing::{Step, Timing};
@@ -381,7 +381,7 @@ impl LineExtractor {
             timing.extend(&self.view_terms(inputs, view, &opts)?);
         }
         // The appends' order is the device's; the rows' order is documented.
-        sort_canonical(&mut segs);
+        canonical(&mut segs);
         let stats = LineStats {
             segments: segs.len(),
             timing,

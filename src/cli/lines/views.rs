@@ -61,11 +61,18 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     if earlier.is_some() && !a.force && !a.resume {
         bail!(
-            "{} holds an earlier run ({}): --resume continues it, --force replaces it",
-            out.display(),
-            name(&files.manifest)
+            "{} exists: {} holds an earlier run; --resume continues it, --force replaces it",
+            files.manifest.display(),
+            out.display()
         );
     }
+    let manifest_fresh = earlier.is_none();
+    // The images the executor will create (it keeps them on failure, for
+    // --resume; they go again where no view is listed).
+    let new_images: Vec<PathBuf> = (files.images.iter())
+        .map(|i| i.1.clone())
+        .filter(|p| !p.exists())
+        .collect();
     // The views an earlier run of the same options left whole (--resume).
     let kept = match (&earlier, a.resume) {
         (Some(m), true) => m.views_to_keep(&head, &files.manifest, &out)?,
@@ -127,6 +134,12 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
             // the run can be continued with --resume.
             let listed = run.log.write(None).is_ok() && run.log.views() > 0;
             if !listed {
+                if manifest_fresh {
+                    let _ = std::fs::remove_file(&files.manifest);
+                }
+                for p in &new_images {
+                    let _ = std::fs::remove_file(p);
+                }
                 run.remove_written(&new_dirs);
             }
             let hint = if listed {

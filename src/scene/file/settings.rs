@@ -44,6 +44,41 @@ pub(super) fn curvature(ck: &Checker<'_>, c: &CurvatureSpec) -> Result<Curvature
     Ok(o)
 }
 
+/// Refuses `[curvature] precision = "f64"` (at `span`) where a cue reads
+/// the curvature on the device: the line families and ambient occlusion
+/// take the estimator's buffers as they are, in f32.
+pub(super) fn check_precision(
+    ck: &Checker<'_>,
+    span: std::ops::Range<usize>,
+    o: &CurvatureOptions,
+    fx: &Effects,
+    input: crate::scene::planner::Input,
+) -> Result<()> {
+    use crate::scene::planner::{Outputs, Pass, plan_for};
+    use crate::spec::curvature::Precision;
+    if o.precision != Precision::F64 {
+        return Ok(());
+    }
+    let plan = plan_for(&fx.cues, input, fx.caps, Outputs::RASTER);
+    let chained = [
+        Pass::Ao,
+        Pass::Contours,
+        Pass::SuggestiveContours,
+        Pass::LinesPose,
+        Pass::LinesView,
+        Pass::LinesCurves,
+    ];
+    if plan.contains(Pass::Curvature) && chained.iter().any(|&p| plan.contains(p)) {
+        return Err(ck.err(
+            span,
+            "curvature.precision = \"f64\": the line families and ambient occlusion read the \
+             curvature on the device in f32; give precision = \"f32\" (the default) for these \
+             cues",
+        ));
+    }
+    Ok(())
+}
+
 /// `[lines]`, into the effects.
 pub(super) fn lines(ck: &Checker<'_>, l: &Spanned<LinesSpec>, fx: &mut Effects) -> Result<()> {
     let span = l.span();
