@@ -443,3 +443,50 @@ fn an_unreachable_display_is_named_without_library_internals() {
     assert!(err.contains(":55") && err.contains("X11 display"), "{err}");
     assert!(!err.contains(".rs") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn a_small_window_shows_its_picture_and_status() {
+    if !xvfb() {
+        return;
+    }
+    let dir = scratch("view-small");
+    let mesh = data("spot.obj");
+    let m = mesh.to_str().unwrap();
+    let script = "wait\ncapture window.png\nscreenshot frame.png\n";
+    let Some(out) = view(&dir, &[m, "--size", "400x300"], script) else {
+        return;
+    };
+    assert!(String::from_utf8_lossy(&out.stdout).contains("wrote"));
+    let window = image::open(dir.join("window.png")).unwrap().to_rgba8();
+    let frame = image::open(dir.join("frame.png")).unwrap().to_rgba8();
+    // The picture is the window's white rectangle (the scene's background;
+    // the controls are dark).
+    let white = |p: &image::Rgba<u8>| p.0[..3].iter().all(|&c| c >= 250);
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (x, y, p) in window.enumerate_pixels() {
+        if white(p) {
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+        }
+    }
+    assert_eq!(
+        (x1 + 1 - x0, y1 + 1 - y0),
+        frame.dimensions(),
+        "the picture is shown whole, at its size"
+    );
+    // What covers it (the passes overlay) hides little of it.
+    let covered = frame
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            let q = window.get_pixel(x0 + x, y0 + y);
+            p.0[..3]
+                .iter()
+                .zip(&q.0[..3])
+                .any(|(a, b)| a.abs_diff(*b) > 24)
+        })
+        .count();
+    let total = (frame.width() * frame.height()) as usize;
+    assert!(
+        covered * 20 <= total,
+        "the overlay covers {covered} of {total} pixels of a 400x300 picture"
+    );
+}

@@ -327,6 +327,9 @@ impl App {
             }
             self.fresh = false;
         }
+        // The frame time and any error in a line of their own under
+        // everything, where a small window still shows them whole.
+        egui::Panel::bottom("status").show(ui, |ui| self.timings(ui));
         egui::Panel::left("controls")
             .resizable(false)
             .default_size(260.0)
@@ -391,8 +394,6 @@ impl App {
                 self.save_svg();
             }
         });
-        ui.separator();
-        self.timings(ui);
         if (self.state.enabled(), self.state.request_scene()) != before {
             self.dirty = true;
         }
@@ -401,10 +402,13 @@ impl App {
     /// Frame times and the passes that ran for the frame on screen.
     fn timings(&self, ui: &mut egui::Ui) {
         if let Some(d) = &self.shown {
-            ui.label(format!(
-                "frame {:.1} ms (compute thread), UI {:.1} ms",
-                d.wall_ms, self.ui_frame.1
-            ));
+            ui.add(
+                egui::Label::new(format!(
+                    "frame {:.1} ms (compute thread), UI {:.1} ms",
+                    d.wall_ms, self.ui_frame.1
+                ))
+                .wrap(),
+            );
             if d.dropped > 0 {
                 ui.label(format!("{} stale request(s) dropped", d.dropped));
             }
@@ -448,12 +452,24 @@ impl App {
         }
         if let Some(d) = &self.shown {
             let at = resp.rect.left_top() + egui::vec2(6.0, 6.0);
+            // The list of passes where it takes at most a third of the
+            // picture; else one line, so that a small window still shows
+            // its picture.
+            let row = ui.text_style_height(&egui::TextStyle::Monospace) + 2.0;
+            let list = egui::vec2(54.0 * 0.6 * row, row * (d.passes.len() as f32 + 2.0));
+            let fits = list.x * list.y <= resp.rect.area() / 3.0
+                && list.x <= resp.rect.width() - 12.0
+                && list.y <= resp.rect.height() - 12.0;
             egui::Area::new(egui::Id::unique("passes"))
                 .fixed_pos(at)
                 .interactable(false)
                 .fade_in(false)
                 .show(ui.ctx(), |ui| {
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        if !fits {
+                            ui.label(format!("{:.1} ms, {} passes", d.wall_ms, d.passes.len()));
+                            return;
+                        }
                         ui.label(format!("{:.1} ms", d.wall_ms));
                         for p in &d.passes {
                             ui.monospace(format!(

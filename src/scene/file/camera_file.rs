@@ -288,8 +288,9 @@ pub fn check_fov(fov: f32) -> std::result::Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "fov {fov} degrees is outside [{lo}, {hi}]: narrower views need more than single \
-             precision, and towards 180 degrees every line projects onto a point"
+            "fov {fov} degrees is outside [{lo}, {hi}], the field of view a camera may have: \
+             narrower views need more than single precision, and towards 180 degrees every line \
+             projects onto a point"
         ))
     }
 }
