@@ -122,6 +122,18 @@ fn three_runs_write_the_same_bytes() {
     assert_eq!(manifest["shapecue"], env!("CARGO_PKG_VERSION"));
     assert_eq!(manifest["complete"], true);
     assert_eq!(manifest["options"]["lines"].as_array().unwrap().len(), 12);
+    // Every NPZ of pieces names its family codes.
+    let npz = std::fs::read(
+        d.join("run0")
+            .join(files.keys().find(|n| n.ends_with("_segments.npz")).unwrap()),
+    )
+    .unwrap();
+    for entry in ["family_codes.npy", "family_names.npy", "<U24"] {
+        assert!(
+            npz.windows(entry.len()).any(|w| w == entry.as_bytes()),
+            "{entry}"
+        );
+    }
     // No polyline of one point (a line shorter than a hundredth of a pixel
     // draws nothing).
     for name in files.keys().filter(|n| n.ends_with(".svg")) {
@@ -512,4 +524,43 @@ fn a_scene_with_line_cues_refuses_f64_curvature_where_it_is_written() {
     let ok = "[input]\ngenerate = \"torus\"\n[effects]\ncurvature_colors = {}\n\
               [curvature]\nprecision = \"f64\"\n";
     assert!(shapecue::api::Scene::from_str(Path::new("torus.toml"), ok).is_ok());
+}
+
+#[test]
+fn every_lane_count_draws_the_same_bytes() {
+    use shapecue::spec::curvature::{Accumulate, Lanes};
+    use shapecue::{LinesPictureOptions, lines_picture_on};
+    let mesh = match shared("meshes/stanford-bunny.obj") {
+        Some(p) => shapecue::mesh::load(&p, &Default::default()).unwrap(),
+        None => shapecue::mesh::load(&spot(), &Default::default()).unwrap(),
+    };
+    let gpu = common::gpu();
+    let d = scratch("lanes");
+    let mut seen: Option<(Vec<u8>, String)> = None;
+    for lanes in [1, 4, 16] {
+        let mut o = LinesPictureOptions {
+            svg: true,
+            image: false,
+            ..Default::default()
+        };
+        o.lines = o
+            .lines
+            .with_families(shapecue::spec::feature_lines::FamilySet::parse(EVERY_FAMILY).unwrap());
+        o.setup.curvature.accumulate = Accumulate::Gather;
+        o.setup.curvature.lanes = Lanes::Fixed(lanes);
+        let pic = lines_picture_on(&gpu, &mesh, &o).unwrap();
+        let npz = d.join(format!("{lanes}.npz"));
+        let arrays = shapecue::api::segment_arrays(pic.visible.as_ref().unwrap(), &mesh);
+        shapecue::export::npz::write_segments(&npz, &arrays).unwrap();
+        let [w, h] = o.shot.size;
+        let svg = shapecue::export::svg::svg_layers_text(pic.layers.as_ref().unwrap(), w, h);
+        let now = (std::fs::read(&npz).unwrap(), svg);
+        match &seen {
+            None => seen = Some(now),
+            Some(first) => {
+                assert!(first.0 == now.0, "{lanes} lanes: another NPZ");
+                assert!(first.1 == now.1, "{lanes} lanes: another SVG");
+            }
+        }
+    }
 }

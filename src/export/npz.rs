@@ -39,7 +39,9 @@ pub struct SegmentArrays {
 }
 
 /// Writes `arrays` to `path` as an uncompressed NPZ (`a`, `b`, `family`,
-/// `strength`, `visible`, `faces`, `chain`, `face`, `bary`), whole or not
+/// `strength`, `visible`, `faces`, `chain`, `face`, `bary`, and the table
+/// naming the codes of `family`: `family_codes` (uint32) and `family_names`
+/// (`<U24`), [`crate::spec::feature_lines::family_codes`]), whole or not
 /// at all.
 ///
 /// # Errors
@@ -176,7 +178,61 @@ fn encode(arrays: &SegmentArrays) -> std::result::Result<Vec<u8>, String> {
     npz.add("face", &Array1::from(arrays.face.clone()));
     let bary: Vec<f32> = arrays.bary.iter().flatten().flatten().copied().collect();
     npz.add_shaped("bary", Array3::from_shape_vec((n, 2, 3), bary));
+    // The code-to-name table of `family`, in every file.
+    let table = crate::spec::feature_lines::family_codes();
+    npz.add(
+        "family_codes",
+        &Array1::from(table.iter().map(|t| t.0).collect::<Vec<u32>>()),
+    );
+    npz.add(
+        "family_names",
+        &Array1::from(table.iter().map(|t| Name::of(t.1)).collect::<Vec<Name>>()),
+    );
     npz.finish()
+}
+
+/// A family name as a NumPy unicode string of [`Name::CHARS`] characters
+/// (`<U24`, UCS-4), so that `numpy.load` gives the names as `str`s.
+#[derive(Clone, Copy)]
+struct Name([u32; Name::CHARS]);
+
+impl Name {
+    const CHARS: usize = 24;
+
+    /// `s`, cut at [`Name::CHARS`] characters (every family name is shorter).
+    fn of(s: &str) -> Name {
+        let mut n = [0u32; Name::CHARS];
+        for (slot, c) in n.iter_mut().zip(s.chars()) {
+            *slot = c as u32;
+        }
+        Name(n)
+    }
+}
+
+impl ndarray_npy::WritableElement for Name {
+    fn type_descriptor() -> py_literal::Value {
+        py_literal::Value::String(format!("<U{}", Name::CHARS))
+    }
+
+    fn write<W: std::io::Write>(
+        &self,
+        mut w: W,
+    ) -> std::result::Result<(), ndarray_npy::WriteDataError> {
+        for c in self.0 {
+            w.write_all(&c.to_le_bytes())?;
+        }
+        Ok(())
+    }
+
+    fn write_slice<W: std::io::Write>(
+        slice: &[Self],
+        mut w: W,
+    ) -> std::result::Result<(), ndarray_npy::WriteDataError> {
+        for n in slice {
+            n.write(&mut w)?;
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -200,7 +256,17 @@ mod tests {
         // A zip (local file header) holding the nine .npy files.
         assert_eq!(&bytes[..4], b"PK\x03\x04");
         let names = [
-            "a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary",
+            "a",
+            "b",
+            "family",
+            "strength",
+            "visible",
+            "faces",
+            "chain",
+            "face",
+            "bary",
+            "family_codes",
+            "family_names",
         ];
         for name in names {
             let entry = format!("{name}.npy");

@@ -75,6 +75,30 @@ pub fn canonical(segments: &mut Vec<Segment>) {
     segments.dedup_by_key(|s| key(s));
 }
 
+/// The layer of the feature edges (the line families' layers are their
+/// kinds, [`LineFamily`] as `u32`).
+pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
+/// The layer of the intersection lines.
+pub const LAYER_INTERSECTIONS: u32 = (1 << 16) + 1;
+/// The layer of the curvature-directed strokes.
+pub const LAYER_STROKES: u32 = (1 << 16) + 2;
+
+/// Every family code a segment or piece may carry, with its name, in
+/// code order: the line families' ([`LineFamily`] as `u32`), then the
+/// feature edges', intersection lines' and strokes' layers. The one table
+/// the NPZ files, the manifests and Python name the codes by.
+pub fn family_codes() -> Vec<(u32, &'static str)> {
+    let mut v: Vec<(u32, &'static str)> = (LineFamily::ALL.iter())
+        .map(|&f| (f as u32, f.name()))
+        .collect();
+    v.extend([
+        (LAYER_FEATURE_EDGES, "feature-edges"),
+        (LAYER_INTERSECTIONS, "intersection-lines"),
+        (LAYER_STROKES, "curvature-strokes"),
+    ]);
+    v
+}
+
 /// The first entry of a segment end's "edge" where a test cut the segment
 /// inside a face (the second is the face): such an end chains with no
 /// other by its edge.

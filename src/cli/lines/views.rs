@@ -438,21 +438,10 @@ impl ViewsRun<'_> {
 /// The codes of the NPZ files' `family` array: the line families', and the
 /// feature edges', intersection lines' and strokes' layers.
 fn family_codes() -> Value {
-    use shapecue::api::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES};
-    use shapecue::spec::feature_lines::LineFamily;
-    let mut m = serde_json::Map::new();
-    for k in 0..64 {
-        if let Some(f) = LineFamily::from_kind(k) {
-            m.insert(k.to_string(), f.name().into());
-        }
-    }
-    for (k, n) in [
-        (LAYER_FEATURE_EDGES, "feature-edges"),
-        (LAYER_INTERSECTIONS, "intersection-lines"),
-        (LAYER_STROKES, "curvature-strokes"),
-    ] {
-        m.insert(k.to_string(), n.into());
-    }
+    let m: serde_json::Map<String, Value> = (shapecue::spec::feature_lines::family_codes())
+        .into_iter()
+        .map(|(k, n)| (k.to_string(), n.into()))
+        .collect();
     Value::Object(m)
 }
 

@@ -21,13 +21,7 @@ use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
 use crate::stages::bvh::Bvh;
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
-/// The layer of the feature edges (the line families' layers are their
-/// kinds, [`crate::spec::feature_lines::LineFamily`] as `u32`).
-pub const LAYER_FEATURE_EDGES: u32 = 1 << 16;
-/// The layer of the intersection lines.
-pub const LAYER_INTERSECTIONS: u32 = (1 << 16) + 1;
-/// The layer of the curvature-directed strokes.
-pub const LAYER_STROKES: u32 = (1 << 16) + 2;
+pub use crate::spec::feature_lines::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES};
 
 /// The centre lines of `strokes` (scene frame) as segments of the strokes'
 /// layer, each point moved `lift` towards the eye of `view` (the strokes
