@@ -302,7 +302,7 @@ def test_batch_outputs_are_the_same_bytes_every_run(device, client, tmp_path):
     outs = []
     for k in range(2):
         if k:
-            time.sleep(2.1)  # zip stamps are to two seconds
+            time.sleep(2.1)  # a zip stamp of the time of writing (to 2 s) would differ
         out = tmp_path / f"out{k}"
         for task, o in (("lines", opts), ("curvature", {"accumulate": "gather"})):
             recs = batch.run(str(src / "*.obj"), out, task=task, client=client, options=o)
