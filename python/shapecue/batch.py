@@ -35,9 +35,9 @@ Tasks:
   ``view_NNN.npz`` with the pieces under the names and in the row order of
   ``shapecue lines --views N --npz`` (``a``, ``b``, ``family`` (uint32
   codes), ``strength``, ``visible``, ``faces``, ``chain``, ``face``,
-  ``bary``), the code table ``family_codes`` (uint32) and ``family_names``
-  (str; ``family_names[i]`` is the name of code ``family_codes[i]``, as
-  :data:`shapecue.FAMILY_CODES`), the per-vertex fields (``ndotv``, ``kr``,
+  ``bary``) followed by the code table ``family_codes`` (uint32) and
+  ``family_names`` (``<U24``; ``family_names[i]`` is the name of code
+  ``family_codes[i]``, as :data:`shapecue.FAMILY_CODES`), then the per-vertex fields (``ndotv``, ``kr``,
   ``dwkr``, ``q1``; unless ``options={"fields": False}``) and the camera
   (``eye``, ``target``, ``up``); and ``views.json`` (the input, its vertex
   and face counts, the device, the options, the same code table
@@ -294,9 +294,10 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
     views = shapecue.lines(v, f, device=device, **kwargs)
     t2 = time.perf_counter()
     codes = sorted(shapecue.FAMILY_CODES.items())
+    # The code table as the command line's NPZ holds it (names as <U24).
     table = {
         "family_codes": np.asarray([c for c, _ in codes], dtype=np.uint32),
-        "family_names": np.asarray([n for _, n in codes]),
+        "family_names": np.asarray([n for _, n in codes], dtype="<U24"),
     }
     part = f"{out}.part-{uuid.uuid4().hex[:8]}"
     os.makedirs(part)
@@ -304,7 +305,8 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
         digits = max(3, len(str(len(views) - 1)))
         entries = []
         for i, view in enumerate(views):
-            # The command line's NPZ: its names, dtypes and order.
+            # The command line's NPZ first (its names, dtypes and order),
+            # then the fields and the camera.
             arrays: Dict[str, Any] = {
                 "a": view.a,
                 "b": view.b,
@@ -315,12 +317,12 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
                 "chain": view.chain,
                 "face": view.face,
                 "bary": view.bary,
+                **table,
             }
             if view.fields is not None:
                 arrays.update(view.fields)
             for k in ("eye", "target", "up"):
                 arrays[k] = np.asarray(view.camera[k], dtype=np.float32)
-            arrays.update(table)
             name = f"view_{i:0{digits}d}.npz"
             _write_npz(os.path.join(part, name), arrays)
             entries.append({"file": name, "camera": view.camera, "pieces": int(len(view.a))})

@@ -312,10 +312,13 @@ def test_batch_outputs_are_the_same_bytes_every_run(device, client, tmp_path):
     assert outs[0] == outs[1]
 
     z = np.load(tmp_path / "out0" / "t0" / "view_001.npz")
-    cli_names = ["a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary"]
+    cli_names = ["a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary",
+                 "family_codes", "family_names"]
     assert z.files[: len(cli_names)] == cli_names
-    dtypes = ["float32", "float32", "uint32", "float32", "uint8", "int64", "uint32", "int64", "float32"]
-    assert [str(z[k].dtype) for k in cli_names] == dtypes
+    dtypes = ["float32", "float32", "uint32", "float32", "uint8", "int64", "uint32", "int64",
+              "float32", "uint32", "<U24"]
+    assert [str(z[k].dtype) for k in cli_names[:-1]] == dtypes[:-1]
+    assert z["family_names"].dtype.str == "<U24"
     assert "kind" not in z.files
     table = dict(zip(z["family_codes"].tolist(), z["family_names"].tolist()))
     assert table == shapecue.FAMILY_CODES
