@@ -23,7 +23,9 @@ files :class:`OSError`; device problems :class:`DeviceError` and GL problems
 from __future__ import annotations
 
 import json
+import math
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 
@@ -36,8 +38,10 @@ __all__ = [
     "Curvature",
     "CurvatureEstimator",
     "DeviceError",
+    "FAMILY_CODES",
     "FeatureEdges",
     "Isosurface",
+    "LINE_FAMILIES",
     "LineView",
     "Lines",
     "RenderError",
@@ -52,6 +56,18 @@ __all__ = [
     "load_volume",
     "render",
 ]
+
+#: The code of each line family or layer in the ``family`` arrays of the
+#: NPZ files (those of ``shapecue lines --npz`` and of the batch's ``lines``
+#: task) and in :attr:`Lines.family_code` / :attr:`LineView.family_code`,
+#: with its name: the line families 0 to 11, the layers of feature edges,
+#: intersection lines and curvature strokes above 65535. The same table as
+#: the ``family_codes`` of the command line's manifest.
+FAMILY_CODES: dict = dict(_shapecue.family_codes())
+
+#: The line families by code (0 to 11): the names ``lines=`` takes and
+#: :meth:`Lines.of` / :meth:`LineView.of` select.
+LINE_FAMILIES: tuple = tuple(n for c, n in sorted(FAMILY_CODES.items()) if c < 1 << 16)
 
 _VERTEX_DTYPES = (np.float64, np.float32)
 _FACE_DTYPES = (np.int32, np.int64, np.uint32)
@@ -493,49 +509,108 @@ def render(
     return json.loads(text)
 
 
+def _family_names(codes: np.ndarray) -> np.ndarray:
+    """The family name (str) of each code of a ``family`` array."""
+    codes = np.asarray(codes)
+    if not len(codes):
+        return np.asarray([], dtype=str)
+    uniq, inverse = np.unique(codes, return_inverse=True)
+    names = np.asarray([FAMILY_CODES.get(int(c), f"unknown code {int(c)}") for c in uniq])
+    return names[inverse.reshape(-1)]
+
+
+def _known_family(family: Any) -> str:
+    """``family`` when it names a line family, else a ValueError listing them."""
+    if not isinstance(family, str) or family not in LINE_FAMILIES:
+        raise ValueError(
+            f"unknown line family {family!r}: the families are {', '.join(LINE_FAMILIES)}"
+        )
+    return family
+
+
+def _deprecated_kind(owner: str) -> None:
+    warnings.warn(
+        f"{owner}.kind is deprecated: it is family_code (the number files hold under "
+        f"'family'); family gives the names",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
 @dataclass
 class Lines:
-    """Line segments of :func:`lines`: ``segments`` (S, 2, 3) float32 end
-    points, ``family`` (S,) family names, ``kind`` (S,) their indices,
-    ``strength`` (S,) in [0, 1], and the feature size the thresholds were
-    scaled by (the median edge length)."""
+    """Line segments of :func:`lines` from one eye, one row per segment.
+
+    ``segments`` (S, 2, 3) float32 end points (world coordinates);
+    ``family`` (S,) each segment's family name (str, as ``lines=`` names
+    them); ``family_code`` (S,) uint32 its code, the number that NPZ files
+    hold in their ``family`` array (:data:`FAMILY_CODES` maps codes to
+    names); ``strength`` (S,) float32 in [0, 1]; ``feature_size`` the length
+    the dimensionless thresholds were scaled by: with ``feature_size="rtsc"``
+    (the default) rtsc's, 0.01 over the 10th percentile of |k1| and |k2| at
+    500 sampled vertices and at most 5 % of the bounding sphere's radius,
+    with ``"edge"`` the median edge length, or the length given;
+    ``kernel_ms`` the kernels' time; ``device`` the device's name.
+
+    ``kind``: deprecated, the earlier name of ``family_code`` (reading it
+    warns).
+    """
 
     segments: np.ndarray
-    kind: np.ndarray
+    family_code: np.ndarray
     family: np.ndarray
     strength: np.ndarray
     feature_size: float
     kernel_ms: float
     device: str
 
+    @property
+    def kind(self) -> np.ndarray:
+        """Deprecated: :attr:`family_code` under its earlier name."""
+        _deprecated_kind("Lines")
+        return self.family_code
+
     def of(self, family: str) -> np.ndarray:
-        """The (n, 2, 3) segments of one family."""
-        return self.segments[self.family == family]
+        """The (n, 2, 3) segments of one family (a name of
+        :data:`LINE_FAMILIES`; another name raises :class:`ValueError`)."""
+        return self.segments[self.family == _known_family(family)]
 
 
 @dataclass
 class LineView:
     """One view of :func:`lines` with ``cameras``: its lines split where
     their visibility changes (exact, in object space) and chained, one row
-    per piece.
+    per piece, in the library's canonical order (the same rows, in the same
+    order, as the NPZ of ``shapecue lines --views N --npz``).
 
     ``a``, ``b`` (P, 3) float32 piece ends (world coordinates); ``family``
-    (P,) family names and ``kind`` their codes; ``strength`` (P,) in
-    [0, 1]; ``visible`` (P,) bool; ``chain`` (P,) the chain (polyline) of
-    each piece; provenance: ``faces`` (P, 4) the faces its segment lies on
-    (-1 past the last), ``face`` (P,) the face it lies in and ``bary``
-    (P, 2, 3) each end's barycentric coordinates in that face, so that
-    ``a == (bary[:, 0, :, None] * vertices[faces_of_mesh[face]]).sum(1)``.
-    ``fields`` (with ``fields=True``): per vertex ``ndotv``, ``kr`` (κr
-    sin²θ), ``dwkr`` (D_w κr) and ``q1`` (apparent ridges' view-dependent
-    curvature, as rtsc keeps it), world units. ``camera``: eye, target, up,
-    fov (degrees) or ortho (height). ``passes``: the passes that ran for
-    this view (the first view also runs the pose's: curvature, the feature
-    size, the BVH) and ``passes_ms`` their total."""
+    (P,) each piece's family name (str) and ``family_code`` (P,) uint32 its
+    code, the number NPZ files hold in their ``family`` array
+    (:data:`FAMILY_CODES` maps codes to names); ``strength`` (P,) float32 in
+    [0, 1]; ``visible`` (P,) bool; ``chain`` (P,) uint32 the chain
+    (polyline) of each piece; provenance: ``faces`` (P, 4) int64 the faces
+    its segment lies on (-1 past the last), ``face`` (P,) int64 the face it
+    lies in and ``bary`` (P, 2, 3) float32 each end's barycentric
+    coordinates in that face, so that ``a == (bary[:, 0, :, None] *
+    vertices[faces_of_mesh[face]]).sum(1)``. ``fields`` (with
+    ``fields=True``): per vertex ``ndotv``, ``kr`` (κr sin²θ), ``dwkr`` (D_w
+    κr) and ``q1`` (apparent ridges' view-dependent curvature, as rtsc keeps
+    it), world units. ``camera``: eye, target, up, fov (degrees) or ortho
+    (height). ``passes``: the passes that ran for this view (the first view
+    also runs the pose's: curvature, the feature size, the BVH) and
+    ``passes_ms`` their own clocks summed; ``wall_ms`` the wall-clock ms
+    from the end of the view before (for the first, from the start of the
+    call: opening the device and the pose passes included) to the end of
+    this one. ``feature_size``: the length the thresholds were scaled by
+    (see :class:`Lines`).
+
+    ``kind``: deprecated, the earlier name of ``family_code`` (reading it
+    warns).
+    """
 
     a: np.ndarray
     b: np.ndarray
-    kind: np.ndarray
+    family_code: np.ndarray
     family: np.ndarray
     strength: np.ndarray
     visible: np.ndarray
@@ -547,41 +622,106 @@ class LineView:
     camera: dict
     passes: list
     passes_ms: float
+    wall_ms: float
     feature_size: float
     device: str
 
+    @property
+    def kind(self) -> np.ndarray:
+        """Deprecated: :attr:`family_code` under its earlier name."""
+        _deprecated_kind("LineView")
+        return self.family_code
+
     def of(self, family: str, visible_only: bool = True) -> np.ndarray:
-        """The (k, 2, 3) pieces of one family (the visible ones only, by
-        default)."""
-        keep = self.family == family
+        """The (k, 2, 3) pieces of one family (a name of
+        :data:`LINE_FAMILIES`; another name raises :class:`ValueError`),
+        the visible ones only by default."""
+        keep = self.family == _known_family(family)
         if visible_only:
             keep &= self.visible
         return np.stack([self.a[keep], self.b[keep]], axis=1)
 
 
-def _camera_set(cameras: Any) -> Tuple[Optional[str], Optional[int]]:
-    """The cameras of :func:`lines`: ``(json_text, None)`` or ``(None, n)``."""
+_CAMERA_SET_WORDS = "a number of views from 1 to {}, a list of camera dicts or a camera JSON file"
+
+
+def _plain(x: Any) -> Any:
+    """``x`` with numpy arrays and scalars as lists and Python numbers."""
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, (list, tuple)):
+        return [_plain(y) for y in x]
+    return x
+
+
+def _non_finite(x: Any) -> bool:
+    if isinstance(x, float):
+        return not math.isfinite(x)
+    if isinstance(x, list):
+        return any(_non_finite(y) for y in x)
+    return False
+
+
+def _camera_set(cameras: Any) -> Tuple[Optional[str], Optional[str], Optional[int]]:
+    """The cameras of :func:`lines`, one of ``(json_text, None, None)``,
+    ``(None, file, None)`` or ``(None, None, n)``; the library checks each
+    camera, these checks what it cannot word (values JSON has no text for,
+    a count below zero)."""
+    words = _CAMERA_SET_WORDS.format(_shapecue.MAX_VIEWS)
     if isinstance(cameras, (bool, np.bool_)):
-        raise ValueError("cameras: a number of views, a list of cameras or a JSON file")
+        raise ValueError(f"cameras={cameras!r}: give {words}")
     if isinstance(cameras, (int, np.integer)):
-        return None, int(cameras)
+        n = int(cameras)
+        if not 1 <= n <= _shapecue.MAX_VIEWS:
+            raise ValueError(f"cameras={n}: give {words}")
+        return None, None, n
     if isinstance(cameras, (str, os.PathLike)):
-        with open(os.fspath(cameras), encoding="utf-8") as fh:
-            return fh.read(), None
-    if isinstance(cameras, dict) and "cameras" in cameras:
+        return None, os.fspath(cameras), None
+    if isinstance(cameras, dict):
+        if "cameras" not in cameras:
+            raise ValueError(
+                f"cameras: one dict ({', '.join(map(str, cameras))}); give {words}, or "
+                f'{{"cameras": [...]}}'
+            )
         cameras = cameras["cameras"]
+    if isinstance(cameras, np.ndarray) or not hasattr(cameras, "__iter__"):
+        raise ValueError(f"cameras: give {words}, not {type(cameras).__name__}")
+    cams = list(cameras)
+    if not cams:
+        raise ValueError("cameras: the list is empty: give at least one camera")
+    out = []
+    for i, c in enumerate(cams):
+        if not hasattr(c, "items"):
+            raise ValueError(
+                f"cameras: camera {i}: expected a dict with eye and target, got "
+                f"{type(c).__name__} {c!r}"
+            )
+        d = {str(k): _plain(v) for k, v in c.items()}
+        for k, v in d.items():
+            if _non_finite(v):
+                raise ValueError(
+                    f"cameras: camera {i}: {k} has {c[k]!r}, a number that is not finite"
+                )
+        out.append(d)
     try:
-        cams = [dict(c) for c in cameras]
-    except (TypeError, ValueError):
-        raise ValueError(
-            "cameras: a number of views, a list of {eye, target, up?, fov? | ortho?} "
-            "dicts, or a camera JSON file"
-        ) from None
+        text = json.dumps({"cameras": out}, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"cameras: a value is not a number or a list of numbers ({e})") from None
+    return text, None, None
 
-    def plain(x: Any) -> Any:
-        return x.tolist() if isinstance(x, np.ndarray) else x
 
-    return json.dumps({"cameras": [{k: plain(v) for k, v in c.items()} for c in cams]}), None
+def _levels(isophotes: Any) -> int:
+    """``isophotes`` as a count of levels (0 or more; the library refuses 0
+    where isophotes are drawn)."""
+    if isinstance(isophotes, (bool, np.bool_)) or not isinstance(isophotes, (int, np.integer)):
+        if not (isinstance(isophotes, float) and isophotes.is_integer()):
+            raise ValueError(f"isophotes={isophotes!r}: give a whole number of levels, 1 or more")
+    n = int(isophotes)
+    if not 0 <= n < 1 << 32:
+        raise ValueError(f"isophotes={n}: give a whole number of levels, 1 or more")
+    return n
 
 
 def lines(
@@ -625,7 +765,11 @@ def lines(
     lines``), its fade ``sc_fade`` of suggestive contours and highlights, its
     tests (``test``), its Hermite placement (``hermite``; ``hermite_kh`` is
     shapecue's for K = 0 and H = 0) and its feature size (``feature_size``:
-    "rtsc", "edge" for the median edge length, or a length). ``compat =
+    "rtsc", rtsc's own, 0.01 over the 10th percentile of |k1| and |k2| at
+    500 sampled vertices and at most 5 % of the bounding sphere's radius;
+    "edge" for the median edge length; or a length in the mesh's units).
+    ``isophotes``: the levels N of isophotes, n·l = j/N for |j| < N (at
+    least 1 when isophotes are drawn, as on the command line). ``compat =
     "trimesh2"`` computes the curvature as trimesh2 (and so rtsc) does.
 
     ``vertices`` may also be a mesh file (.obj/.ply/.off), read by
@@ -640,7 +784,11 @@ def lines(
     their faces and barycentric coordinates, and with ``fields=True`` the
     per-vertex fields. ``size`` (width, height) is the image the fitted
     views frame and the visibility's sample spacing is for; ``fov`` and
-    ``ortho`` are the cameras' defaults. No OpenGL is needed.
+    ``ortho`` are the cameras' defaults. No OpenGL is needed. The rows are
+    the same, in the same order, as those of ``shapecue lines MESH --views N
+    --npz`` (or ``--cameras FILE``) with the same options, and the same
+    bytes every call. Ctrl-C (``KeyboardInterrupt``) stops a call of many
+    views within one view's time.
     """
     if isinstance(vertices, (str, os.PathLike)) and faces is None:
         vertices, faces = load_mesh(vertices)
@@ -657,16 +805,17 @@ def lines(
     switches = (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh))
     setup = (str(feature_size), str(compat), str(accumulate))
     l3 = tuple(float(c) for c in light)
+    levels = _levels(isophotes)
     if cameras is None and fields:
         raise ValueError("fields come with the views of cameras=; one eye gives the segments only")
     if cameras is not None:
         if eye is not None:
             raise ValueError("eye sets the one camera; with cameras give each its eye")
-        text, n = _camera_set(cameras)
+        text, file, n = _camera_set(cameras)
         w, h = (int(x) for x in size)
         views = _shapecue.lines_views(
-            v, f, names, text, n, (float(fov), bool(ortho), w, h),
-            thresholds, int(isophotes), l3, switches, setup, bool(fields), _device(device),
+            v, f, names, text, file, n, (float(fov), bool(ortho), w, h),
+            thresholds, levels, l3, switches, setup, bool(fields), _device(device),
         )
         return [_line_view(d) for d in views]
     if eye is None:
@@ -687,26 +836,21 @@ def lines(
         e,
         bool(ortho),
         thresholds,
-        int(isophotes),
+        levels,
         l3,
         switches,
         setup,
         _device(device),
     )
-    fam_names = np.asarray(d.pop("family_names"))
-    kind = d["kind"]
-    return Lines(family=fam_names[kind] if len(kind) else np.asarray([], dtype=str), **d)
+    return Lines(family=_family_names(d["family_code"]), **d)
 
 
 def _line_view(d: dict) -> LineView:
     fields = None
     if "ndotv" in d:
         fields = {k: d.pop(k) for k in ("ndotv", "kr", "dwkr", "q1")}
-    fam_names = np.asarray(d.pop("family_names"))
-    kind = d["kind"]
-    family = fam_names[kind] if len(kind) else np.asarray([], dtype=str)
     d["visible"] = d["visible"].astype(bool)
-    return LineView(family=family, fields=fields, **d)
+    return LineView(family=_family_names(d["family_code"]), fields=fields, **d)
 
 
 def load_mesh(path: Union[str, os.PathLike], *, weld: bool = False) -> Tuple[np.ndarray, np.ndarray]:

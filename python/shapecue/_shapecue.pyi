@@ -77,6 +77,7 @@ def lines_views(
     faces: npt.NDArray[np.integer],
     families: str,
     cameras: Optional[str],
+    camera_file: Optional[str],
     views: Optional[int],
     camera: Tuple[float, bool, int, int],
     thresholds: Tuple[float, float, float, float, float, float],
@@ -87,6 +88,18 @@ def lines_views(
     fields: bool,
     device: Optional[str],
 ) -> list[dict[str, Any]]: ...
+def check_cameras(
+    cameras: Optional[str],
+    camera_file: Optional[str],
+    views: Optional[int],
+    fov: float,
+    ortho: bool,
+) -> int: ...
+def line_families(names: str) -> list[str]: ...
+def family_codes() -> list[Tuple[int, str]]: ...
+
+MAX_VIEWS: int
+
 def render_file(path: str, out_dir: Optional[str], force: bool, device: Optional[str]) -> str: ...
 def render_text(
     json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]

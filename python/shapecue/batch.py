@@ -19,7 +19,8 @@ client appends one JSON line per task to ``out_dir/manifest.jsonl``::
      "task": "curvature", "worker": "tcp://..."}
 
 A rerun with the same ``out_dir`` skips the inputs whose last record is "ok"
-and whose output still exists, so an interrupted batch resumes.
+and whose output still exists (for the ``lines`` task, made with the same
+options), so an interrupted batch resumes.
 
 Tasks:
 
@@ -31,26 +32,47 @@ Tasks:
 - ``"render"``: a scene file, its images and report into ``<stem>/``;
 - ``"lines"``: a mesh file's line drawings from many views
   (:func:`shapecue.lines` with ``cameras``) into ``<stem>/``: per view
-  ``view_NNN.npz`` with the pieces (``a``, ``b``, ``kind``, ``strength``,
-  ``visible``, ``chain``, provenance ``faces``, ``face``, ``bary``), the
-  per-vertex fields (``ndotv``, ``kr``, ``dwkr``, ``q1``; unless
-  ``options={"fields": False}``) and the camera (``eye``, ``target``,
-  ``up``), and ``views.json`` (the family names of ``kind``, each view's
-  camera and piece count, the timing). ``options``: ``views`` (a number of
-  views, default 16) or ``cameras`` (a list of camera dicts, or a camera
-  JSON file), ``lines``, ``size``, the thresholds of :func:`shapecue.lines`.
-  The folder is written whole (made beside it, then renamed).
+  ``view_NNN.npz`` with the pieces under the names and in the row order of
+  ``shapecue lines --views N --npz`` (``a``, ``b``, ``family`` (uint32
+  codes), ``strength``, ``visible``, ``faces``, ``chain``, ``face``,
+  ``bary``) followed by the code table ``family_codes`` (uint32) and
+  ``family_names`` (``<U24``; ``family_names[i]`` is the name of code
+  ``family_codes[i]``, as :data:`shapecue.FAMILY_CODES`), then the per-vertex fields (``ndotv``, ``kr``,
+  ``dwkr``, ``q1``; unless ``options={"fields": False}``) and the camera
+  (``eye``, ``target``, ``up``); and ``views.json`` (the input, its vertex
+  and face counts, the device, the options, the same code table
+  ``family_codes`` as the command line's manifest, each view's file,
+  camera and piece count). ``options``: ``views`` (a number of views,
+  default 16) or ``cameras`` (a list of camera dicts, or a camera JSON
+  file), ``fields``, and the keyword options of :func:`shapecue.lines`
+  (``lines``, ``size``, ``fov``, ``ortho``, the thresholds, ...), checked
+  by :func:`run` before any task starts. The folder is written whole
+  (made beside it, then renamed). The task's record adds the options as
+  ``views.json`` lists them, ``views``, ``views_per_second`` (the views
+  over the wall-clock time of computing them) and, in ``timings``, the
+  wall-clock ``first_view_ms`` (device set-up and the pose passes
+  included) and ``later_views_ms``. A rerun redoes an input whose
+  options changed.
+
+The curvature, isosurface and lines tasks give the same bytes for the same
+inputs and options: the NPZ files are written with fixed zip time stamps
+(``numpy.savez`` stamps the time of writing) and ``views.json`` holds no
+timing; the run's timings and workers are in ``manifest.jsonl`` (and a
+render task's scene report, written by the library, has its own).
 """
 
 from __future__ import annotations
 
 import glob as _glob
+import hashlib
+import inspect
 import json
 import os
 import time
 import traceback
 import uuid
-from typing import Any, Dict, Iterable, List, Optional, Union
+import zipfile
+from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -103,12 +125,159 @@ def _curvature_arrays(prefix: str, c) -> Dict[str, np.ndarray]:
     return d
 
 
+#: The time stamp of every zip entry the batch writes (the earliest a zip
+#: holds): np.savez stamps the current time, so its bytes differ run to run.
+_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+
+def _write_npz(path: str, arrays: Dict[str, Any]) -> None:
+    """An uncompressed NPZ, as :func:`numpy.savez` writes it (``np.load``
+    reads it) but the same bytes for the same arrays: fixed time stamps and
+    attributes, entries in the order given."""
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+        for name, a in arrays.items():
+            info = zipfile.ZipInfo(name + ".npy", date_time=_ZIP_TIME)
+            info.create_system = 3
+            info.external_attr = 0o644 << 16
+            with zf.open(info, "w", force_zip64=True) as fh:
+                np.lib.format.write_array(fh, np.asanyarray(a), allow_pickle=False)
+
+
 def _save_npz(path: str, arrays: Dict[str, np.ndarray]) -> None:
     # Written whole or not at all: a task killed mid-write leaves no output
     # that a rerun would take for finished.
     tmp = path + ".part.npz"
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
+    try:
+        _write_npz(tmp, arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def _jsonable(x: Any) -> Any:
+    """``x`` as JSON holds it: tuples and numpy arrays as lists, numpy
+    scalars as numbers."""
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, os.PathLike):
+        return os.fspath(x)
+    return x
+
+
+def _sha256(path: str) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+#: What the lines task takes besides the keyword options of shapecue.lines.
+_LINES_TASK_KEYS = ("views", "cameras", "fields", "device")
+#: Keyword options of shapecue.lines the task does not take: they set the
+#: one camera of a single view.
+_LINES_ONE_EYE = ("eye", "direction")
+
+
+def _lines_defaults() -> Dict[str, Any]:
+    """The keyword options of :func:`shapecue.lines` the task passes on,
+    with their defaults."""
+    import shapecue
+
+    skip = set(_LINES_TASK_KEYS) | set(_LINES_ONE_EYE)
+    return {
+        k: p.default
+        for k, p in inspect.signature(shapecue.lines).parameters.items()
+        if p.kind is inspect.Parameter.KEYWORD_ONLY and k not in skip
+    }
+
+
+def _lines_options(options: Optional[Dict[str, Any]]) -> Tuple[Dict[str, Any], Dict[str, Any]]:
+    """The ``lines`` task's options checked: the keywords of
+    :func:`shapecue.lines` (cameras and fields included, the device not) and
+    the options as the output and the record list them (every option with
+    its default filled in, the families in code order, a camera file's
+    SHA-256), so that a rerun compares them. Raises :class:`ValueError`
+    naming the option for an unknown one, ``views`` and ``cameras``
+    together, a count of views outside 1 to 10000, cameras the library
+    would refuse, unknown families, and isophotes of no level."""
+    import shapecue
+    from shapecue import _shapecue
+
+    given = dict(options or {})
+    given.pop("device", None)
+    defaults = _lines_defaults()
+    for k in given:
+        if k in _LINES_ONE_EYE:
+            raise ValueError(
+                f"the lines task: option {k!r} sets the one camera of shapecue.lines; the task "
+                f"draws views: give views (a number) or cameras (a list or a camera file)"
+            )
+        if k not in defaults and k not in _LINES_TASK_KEYS:
+            known = ", ".join(sorted(set(defaults) | set(_LINES_TASK_KEYS)))
+            raise ValueError(f"the lines task: unknown option {k!r}: the options are {known}")
+    views = given.pop("views", None)
+    cameras = given.pop("cameras", None)
+    if views is not None and cameras is not None:
+        raise ValueError("the lines task: give the option views or cameras, not both")
+    if views is not None:
+        if isinstance(views, (bool, np.bool_)) or not isinstance(views, (int, np.integer)):
+            raise ValueError(
+                f"the lines task: views={views!r}: give a number of views from 1 to "
+                f"{_shapecue.MAX_VIEWS}"
+            )
+        if not 1 <= int(views) <= _shapecue.MAX_VIEWS:
+            raise ValueError(
+                f"the lines task: views={int(views)}: give a number of views from 1 to "
+                f"{_shapecue.MAX_VIEWS}"
+            )
+        views = int(views)
+    elif cameras is None:
+        views = 16
+    fields = given.pop("fields", True)
+    if not isinstance(fields, (bool, np.bool_)):
+        raise ValueError(f"the lines task: fields={fields!r}: give True or False")
+    merged = {**defaults, **given}
+    names = merged["lines"]
+    try:
+        families = _shapecue.line_families(names if isinstance(names, str) else ",".join(names))
+    except ValueError as e:
+        raise ValueError(f"the lines task: option lines: {e}") from None
+    if not families:
+        raise ValueError(f"the lines task: lines={names!r} names no line family")
+    levels = shapecue._levels(merged["isophotes"])
+    if "isophotes" in families and levels == 0:
+        raise ValueError("the lines task: isophotes=0: isophotes need at least 1 level")
+    fov, ortho = float(merged["fov"]), bool(merged["ortho"])
+    doc: Dict[str, Any] = {"views": views, "cameras": None}
+    if cameras is not None:
+        text, file, n = shapecue._camera_set(cameras)
+        _shapecue.check_cameras(text, file, n, fov, ortho)
+        if file is not None:
+            file = os.path.abspath(file)
+            doc["cameras"] = file
+            doc["cameras_sha256"] = _sha256(file)
+            cameras = file
+        elif n is not None:
+            doc["views"] = n
+        else:
+            doc["cameras"] = json.loads(text)["cameras"]
+    else:
+        _shapecue.check_cameras(None, None, views, fov, ortho)
+    doc["fields"] = bool(fields)
+    doc.update(_jsonable({k: v for k, v in merged.items() if k != "lines"}))
+    doc["lines"] = list(families)
+    doc = json.loads(json.dumps(doc, sort_keys=True))
+    kwargs = dict(merged, cameras=cameras if cameras is not None else views, fields=bool(fields))
+    return kwargs, doc
 
 
 def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, Any]) -> Dict[str, Any]:
@@ -118,79 +287,75 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
 
     import shapecue
 
-    cameras = options.pop("cameras", None)
-    n = options.pop("views", None)
-    if cameras is not None and n is not None:
-        raise ValueError("give views or cameras, not both")
-    cameras = cameras if cameras is not None else int(n if n is not None else 16)
-    fields = bool(options.pop("fields", True))
+    kwargs, doc_options = _lines_options(options)
     t0 = time.perf_counter()
     v, f = shapecue.load_mesh(path)
     t1 = time.perf_counter()
-    views = shapecue.lines(v, f, cameras=cameras, fields=fields, device=device, **options)
+    views = shapecue.lines(v, f, device=device, **kwargs)
     t2 = time.perf_counter()
+    codes = sorted(shapecue.FAMILY_CODES.items())
+    # The code table as the command line's NPZ holds it (names as <U24).
+    table = {
+        "family_codes": np.asarray([c for c, _ in codes], dtype=np.uint32),
+        "family_names": np.asarray([n for _, n in codes], dtype="<U24"),
+    }
     part = f"{out}.part-{uuid.uuid4().hex[:8]}"
     os.makedirs(part)
     try:
         digits = max(3, len(str(len(views) - 1)))
         entries = []
         for i, view in enumerate(views):
-            arrays = {
-                k: getattr(view, k)
-                for k in ("a", "b", "kind", "strength", "visible", "chain", "faces", "face", "bary")
+            # The command line's NPZ first (its names, dtypes and order),
+            # then the fields and the camera.
+            arrays: Dict[str, Any] = {
+                "a": view.a,
+                "b": view.b,
+                "family": view.family_code,
+                "strength": view.strength,
+                "visible": view.visible.astype(np.uint8),
+                "faces": view.faces,
+                "chain": view.chain,
+                "face": view.face,
+                "bary": view.bary,
+                **table,
             }
-            arrays["visible"] = arrays["visible"].astype(np.uint8)
-            for k in ("eye", "target", "up"):
-                arrays[k] = np.asarray(view.camera[k], dtype=np.float32)
             if view.fields is not None:
                 arrays.update(view.fields)
+            for k in ("eye", "target", "up"):
+                arrays[k] = np.asarray(view.camera[k], dtype=np.float32)
             name = f"view_{i:0{digits}d}.npz"
-            np.savez(os.path.join(part, name), **arrays)
-            entries.append(
-                {"file": name, "camera": view.camera, "pieces": int(len(view.a)),
-                 "passes_ms": view.passes_ms}
-            )
-        kind_names = _kind_names(views)
+            _write_npz(os.path.join(part, name), arrays)
+            entries.append({"file": name, "camera": view.camera, "pieces": int(len(view.a))})
         doc = {
             "input": path,
             "vertices": int(len(v)),
             "faces": int(len(f)),
-            "family_names": sorted(set(kind_names.values())),
-            "kind_names": kind_names,
+            "device": views[0].device if views else None,
+            "options": doc_options,
+            "family_codes": {str(c): n for c, n in codes},
             "views": entries,
-            "timing": {
-                "load_ms": (t1 - t0) * 1e3,
-                "compute_ms": (t2 - t1) * 1e3,
-                "first_view_ms": views[0].passes_ms if views else 0.0,
-                "later_views_ms": sum(x.passes_ms for x in views[1:]),
-            },
         }
         with open(os.path.join(part, "views.json"), "w", encoding="utf-8") as fh:
             json.dump(doc, fh, indent=1)
+            fh.write("\n")
         if os.path.isdir(out):
             shutil.rmtree(out)
         os.replace(part, out)
     except BaseException:
         shutil.rmtree(part, ignore_errors=True)
         raise
-    later = len(views) - 1
-    per_view = doc["timing"]["later_views_ms"] / later if later > 0 else None
+    compute_s = t2 - t1
     return {
+        "options": doc_options,
         "views": len(views),
-        "views_per_second": (1e3 / per_view) if per_view else None,
+        # Wall clock: the views over the time the call computing them took
+        # (not the passes' own clocks, which leave out what lies between).
+        "views_per_second": len(views) / compute_s if views and compute_s > 0 else None,
+        "first_view_ms": views[0].wall_ms if views else 0.0,
+        "later_views_ms": float(sum(x.wall_ms for x in views[1:])),
         "load_ms": (t1 - t0) * 1e3,
-        "compute_ms": (t2 - t1) * 1e3,
+        "compute_ms": compute_s * 1e3,
     }
-
-
-def _kind_names(views: List[Any]) -> Dict[str, str]:
-    """The family name of each ``kind`` code the views hold."""
-    names: Dict[str, str] = {}
-    for x in views:
-        kinds, first = np.unique(x.kind, return_index=True)
-        for k, i in zip(kinds.tolist(), first.tolist()):
-            names.setdefault(str(k), str(x.family[i]))
-    return dict(sorted(names.items(), key=lambda kv: int(kv[0])))
 
 
 def process_one(
@@ -243,6 +408,7 @@ def process_one(
             extra = _lines_task(path, out, device, options)
             t1 = t0 + extra.pop("load_ms") / 1e3
             t2 = t1 + extra.pop("compute_ms") / 1e3
+            view_ms = {k: extra.pop(k) for k in ("first_view_ms", "later_views_ms")}
             rec.update(extra)
         elif task == "render":
             t1 = time.perf_counter()
@@ -257,6 +423,8 @@ def process_one(
             "compute_ms": (t2 - t1) * 1e3,
             "write_ms": (t3 - t2) * 1e3,
         }
+        if task == "lines":
+            timings.update(view_ms)
         rec["status"] = "ok"
     except Exception as e:  # recorded, the batch goes on
         rec["error"] = f"{type(e).__name__}: {e}"
@@ -300,7 +468,11 @@ def run(
     inputs are not run again and have no record here).
 
     ``options`` go to the shapecue call (``accumulate``, ``precision``,
-    ``iso``, ``fusion``, ``curvature``, ``device``, ...). ``resources``,
+    ``iso``, ``fusion``, ``curvature``, ``device``, ...). The isosurface
+    task's ``iso`` and the lines task's options (known names, ``views`` from
+    1 to 10000 or ``cameras``, not both, the families, the cameras
+    themselves) are checked here, before any cluster or client is started
+    or asked for: a bad one raises :class:`ValueError` and nothing runs. ``resources``,
     e.g. ``{"GPU": 1}``, are passed to ``client.submit`` so that each task
     takes one unit of a worker resource (start workers with
     ``dask worker ... --resources GPU=1`` and ``SHAPECUE_DEVICE=<index>``).
@@ -312,6 +484,10 @@ def run(
         raise ValueError(f"unknown task {task!r}: expected one of {', '.join(TASKS)}")
     if task == "isosurface" and "iso" not in (options or {}):
         raise ValueError('the isosurface task needs options={"iso": value}')
+    # The lines task's options are checked here, before any cluster starts,
+    # and listed as its records list them, to find the inputs whose options
+    # changed since their last run.
+    wanted = _lines_options(options)[1] if task == "lines" else None
     out_dir = os.path.abspath(os.fspath(out_dir))
     os.makedirs(out_dir, exist_ok=True)
     paths = _inputs(inputs)
@@ -325,13 +501,12 @@ def run(
     for r in read_manifest(out_dir):
         if r.get("task") == task:
             last[r.get("input")] = r
-    todo = [
-        p
-        for p in paths
-        if not (
-            last.get(p, {}).get("status") == "ok" and os.path.exists(last[p].get("output", ""))
-        )
-    ]
+    def finished(p: str) -> bool:
+        r = last.get(p, {})
+        same = wanted is None or r.get("options") == wanted
+        return r.get("status") == "ok" and same and os.path.exists(r.get("output", ""))
+
+    todo = [p for p in paths if not finished(p)]
     if not todo:
         return []
 

@@ -755,6 +755,10 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::render_text, m)?)?;
     m.add_function(wrap_pyfunction!(lines::lines, m)?)?;
     m.add_function(wrap_pyfunction!(lines::lines_views, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::check_cameras, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::line_families, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::family_codes, m)?)?;
+    m.add("MAX_VIEWS", shapecue::api::MAX_VIEWS)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(load_volume, m)?)?;
     m.add_class::<PyEstimator>()?;

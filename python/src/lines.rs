@@ -6,11 +6,14 @@
 use super::*;
 use pyo3::types::PyList;
 use shapecue::api::{
-    CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot, VisibilityMethod,
-    fibonacci_views, line_views_on, parse_camera_file, segment_arrays,
+    CameraDefaults, LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES, LineOptions,
+    LineSetup, LineView, LinesPictureOptions, Shot, ViewSpec, VisibilityMethod, fibonacci_views,
+    line_views_on, load_camera_file, parse_camera_file, segment_arrays,
 };
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
 use shapecue::spec::view::View;
+use std::path::PathBuf;
+use std::time::Instant;
 
 /// lines(vertices, faces, families, eye, ortho, thresholds, isophotes,
 /// light, switches, setup, device) -> dict
@@ -67,9 +70,15 @@ struct LinesArgs<'a> {
 }
 
 impl LinesArgs<'_> {
-    /// The line families and their thresholds and switches.
+    /// The line families and their thresholds and switches; as the
+    /// command line, refuses isophotes of no level (they would find no line).
     fn line_options(&self) -> PyResult<LineOptions> {
         let fams = FamilySet::parse(self.families).map_err(to_py)?;
+        if fams.has(LineFamily::Isophotes) && self.isophotes == 0 {
+            return Err(value_err(
+                "isophotes=0: isophotes need at least 1 level (n·l = j/N for |j| < N)",
+            ));
+        }
         let [sc, rv, ar, ph, sh, sc_fade] = self.thresholds;
         let [cull, test, fade, hermite, hermite_kh] = self.switches;
         Ok(LineOptions {
@@ -134,31 +143,37 @@ fn lines_with<'py>(
         .iter()
         .flat_map(|s| s.0.into_iter().chain(s.1))
         .collect();
-    let kind: Vec<u32> = ls.segments.iter().map(|s| s.2).collect();
+    let code: Vec<u32> = ls.segments.iter().map(|s| s.2).collect();
     let strength: Vec<f32> = ls.segments.iter().map(|s| s.3).collect();
     let d = PyDict::new(py);
     d.set_item("segments", array(py, pts, &[n, 2, 3])?)?;
-    d.set_item("kind", array(py, kind, &[n])?)?;
+    d.set_item("family_code", array(py, code, &[n])?)?;
     d.set_item("strength", array(py, strength, &[n])?)?;
-    let names: Vec<&str> = LineFamily::ALL.iter().map(|f| f.name()).collect();
-    d.set_item("family_names", names)?;
     d.set_item("feature_size", ls.feature_size)?;
     d.set_item("kernel_ms", ls.timing.kernel_ms)?;
     d.set_item("device", name)?;
     Ok(d)
 }
 
-/// lines_views(vertices, faces, families, cameras, views, camera, thresholds,
-/// isophotes, light, switches, setup, fields, device) -> list of dicts
+/// lines_views(vertices, faces, families, cameras, camera_file, views,
+/// camera, thresholds, isophotes, light, switches, setup, fields, device)
+/// -> list of dicts
 ///
 /// The lines of many views in one setup (the pose passes once, the view
-/// passes per view), each split by exact visibility and chained. `cameras`:
-/// the JSON text of a camera file (`{"cameras": [...]}`), or `None` with
-/// `views` cameras on the Fibonacci lattice; `camera`: (fov, ortho, width,
-/// height), the cameras' defaults and the image size the fitted views and
-/// the visibility's spacing are for.
+/// passes per view), each split by exact visibility and chained. The
+/// cameras, one of three: `cameras`, the JSON text of a camera list
+/// (`{"cameras": [...]}`, errors name `cameras` and the camera);
+/// `camera_file`, a camera file read as the command line reads it (errors
+/// name the file); `views`, that many cameras on the Fibonacci lattice.
+/// `camera`: (fov, ortho, width, height), the cameras' defaults and the
+/// image size the fitted views and the visibility's spacing are for.
+///
+/// Between views the thread takes the GIL back for a moment to see whether
+/// Python has a signal waiting (Ctrl-C): the Python handler's exception
+/// (`KeyboardInterrupt`) ends the run, so a call of many views stops within
+/// one view's time instead of at its end.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, families, cameras, views, camera, thresholds, isophotes, light, switches, setup, fields, device))]
+#[pyo3(signature = (vertices, faces, families, cameras, camera_file, views, camera, thresholds, isophotes, light, switches, setup, fields, device))]
 #[allow(clippy::too_many_arguments)]
 pub fn lines_views<'py>(
     py: Python<'py>,
@@ -166,6 +181,7 @@ pub fn lines_views<'py>(
     faces: &Bound<'py, PyAny>,
     families: &str,
     cameras: Option<String>,
+    camera_file: Option<PathBuf>,
     views: Option<usize>,
     camera: (f32, bool, u32, u32),
     thresholds: [f32; 6],
@@ -206,30 +222,104 @@ pub fn lines_views<'py>(
         fov: camera.0,
         ortho: camera.1,
     };
-    let specs = match (cameras, views) {
-        (Some(text), None) => parse_camera_file(&text, "cameras", defaults),
-        (None, Some(n)) => fibonacci_views(n, defaults),
-        _ => return Err(value_err("give cameras or views, not both")),
-    }
-    .map_err(to_py)?;
+    let specs = camera_specs(cameras, camera_file, views, defaults)?;
     let device = args.device.clone();
-    let done = py
-        .detach(|| {
-            let gpu = open_gpu(device.as_deref())?;
-            let mut out = Vec::with_capacity(specs.len());
-            line_views_on(&gpu, mesh.clone(), &opts, &specs, fields, &mut |_, v| {
-                out.push(v);
-                Ok(())
-            })?;
-            Ok::<_, Error>((out, gpu.info.name.clone()))
-        })
-        .map_err(to_py)?;
-    let (views, name) = done;
+    let mut interrupt: Option<PyErr> = None;
+    let done = py.detach(|| {
+        let start = Instant::now();
+        let gpu = open_gpu(device.as_deref())?;
+        let mut out = Vec::with_capacity(specs.len());
+        let mut last = start;
+        line_views_on(&gpu, mesh.clone(), &opts, &specs, fields, &mut |_, v| {
+            let now = Instant::now();
+            out.push((v, (now - last).as_secs_f64() * 1e3));
+            last = now;
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                interrupt = Some(e);
+                // Only ends the run: the Python exception is raised below.
+                return Err(Error::InvalidArgument("interrupted".into()));
+            }
+            Ok(())
+        })?;
+        Ok::<_, Error>((out, gpu.info.name.clone()))
+    });
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    let (views, name) = done.map_err(to_py)?;
     let list = PyList::empty(py);
-    for v in views {
-        list.append(view_dict(py, &mesh, v, &name)?)?;
+    for (v, wall_ms) in views {
+        let d = view_dict(py, &mesh, v, &name)?;
+        d.set_item("wall_ms", wall_ms)?;
+        list.append(d)?;
     }
     Ok(list)
+}
+
+/// The cameras of [`lines_views`]: one of a camera list's JSON text, a
+/// camera file or a number of fitted views.
+fn camera_specs(
+    cameras: Option<String>,
+    camera_file: Option<PathBuf>,
+    views: Option<usize>,
+    defaults: CameraDefaults,
+) -> PyResult<Vec<ViewSpec>> {
+    match (cameras, camera_file, views) {
+        (Some(text), None, None) => parse_camera_file(&text, "cameras", defaults),
+        (None, Some(path), None) => load_camera_file(&path, defaults),
+        (None, None, Some(n)) => fibonacci_views(n, defaults),
+        _ => {
+            return Err(value_err(
+                "cameras: give a number of views, a list of camera dicts or a camera JSON file",
+            ));
+        }
+    }
+    .map_err(to_py)
+}
+
+/// check_cameras(cameras, camera_file, views, fov, ortho) -> int
+///
+/// The number of views a camera set of [`lines_views`] gives, or the error
+/// it would raise, without a device: the batch checks its options before
+/// any task runs.
+#[pyfunction]
+#[pyo3(signature = (cameras, camera_file, views, fov, ortho))]
+pub fn check_cameras(
+    cameras: Option<String>,
+    camera_file: Option<PathBuf>,
+    views: Option<usize>,
+    fov: f32,
+    ortho: bool,
+) -> PyResult<usize> {
+    let defaults = CameraDefaults { fov, ortho };
+    Ok(camera_specs(cameras, camera_file, views, defaults)?.len())
+}
+
+/// line_families(names) -> list of str
+///
+/// The line families of a comma-separated list of names, in code order
+/// (each once), or the error naming the unknown name and the known ones.
+#[pyfunction]
+pub fn line_families(names: &str) -> PyResult<Vec<&'static str>> {
+    let set = FamilySet::parse(names).map_err(to_py)?;
+    Ok(set.iter().map(|f| f.name()).collect())
+}
+
+/// family_codes() -> list of (int, str)
+///
+/// Each code of the `family` arrays (as the command line's NPZ files and
+/// the `family_codes` of its manifest give them) with its name: the line
+/// families (0 to 11), and the layers of feature edges, intersection lines
+/// and curvature strokes.
+#[pyfunction]
+pub fn family_codes() -> Vec<(u32, &'static str)> {
+    let families = LineFamily::ALL.iter().map(|&f| (f as u32, f.name()));
+    let layers = [
+        (LAYER_FEATURE_EDGES, "feature-edges"),
+        (LAYER_INTERSECTIONS, "intersection-lines"),
+        (LAYER_STROKES, "curvature-strokes"),
+    ];
+    families.chain(layers).collect()
 }
 
 /// One view of [`lines_views`] as a dict of numpy arrays.
@@ -249,7 +339,7 @@ fn view_dict<'py>(
     let flat3 = |v: &[[f32; 3]]| v.concat();
     d.set_item("a", array(py, flat3(&s.a), &[n, 3])?)?;
     d.set_item("b", array(py, flat3(&s.b), &[n, 3])?)?;
-    d.set_item("kind", array(py, s.family, &[n])?)?;
+    d.set_item("family_code", array(py, s.family, &[n])?)?;
     d.set_item("strength", array(py, s.strength, &[n])?)?;
     d.set_item("visible", array(py, s.visible, &[n])?)?;
     d.set_item("faces", array(py, s.faces.concat(), &[n, 4])?)?;
@@ -278,7 +368,5 @@ fn view_dict<'py>(
     d.set_item("passes", passes)?;
     d.set_item("feature_size", v.feature_size)?;
     d.set_item("device", device)?;
-    let names: Vec<&str> = LineFamily::ALL.iter().map(|f| f.name()).collect();
-    d.set_item("family_names", names)?;
     Ok(d)
 }

@@ -86,11 +86,32 @@ def device():
     return devs
 
 
+def main_checkout():
+    """The main checkout when this one is a git worktree (its `.git` is a
+    file naming `<main>/.git/worktrees/<name>`), else None."""
+    git = REPO / ".git"
+    if not git.is_file():
+        return None
+    line = git.read_text().strip()
+    if not line.startswith("gitdir:"):
+        return None
+    gitdir = (REPO / line[len("gitdir:"):].strip()).resolve()
+    if gitdir.parent.name != "worktrees":
+        return None
+    return gitdir.parent.parent.parent
+
+
 @pytest.fixture(scope="session")
 def cli():
-    """The shapecue command line built by `cargo test --release`."""
+    """The shapecue command line built by `cargo test --release`:
+    $SHAPECUE_BIN, else in $CARGO_TARGET_DIR (default target/), else, in a
+    git worktree, in the main checkout's target/."""
     target = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
     exe = os.environ.get("SHAPECUE_BIN") or str(target / "release" / "shapecue")
+    main = main_checkout()
+    if not (os.path.exists(exe) or shutil.which(exe)) and main is not None:
+        if (main / "target" / "release" / "shapecue").exists():
+            exe = str(main / "target" / "release" / "shapecue")
     if not (os.path.exists(exe) or shutil.which(exe)):
         pytest.skip(f"the shapecue command line is not built ({exe}); run cargo build --release")
     return exe

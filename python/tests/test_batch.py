@@ -182,7 +182,7 @@ def test_lines_batch_over_awkward_and_broken_meshes(device, client, tmp_path):
         doc = json.loads((out / name / "views.json").read_text())
         assert [e["file"] for e in doc["views"]] == ["view_000.npz", "view_001.npz", "view_002.npz"]
         z = np.load(out / name / "view_001.npz")
-        for k in ("a", "b", "kind", "visible", "face", "bary", "ndotv", "q1", "eye"):
+        for k in ("a", "b", "family", "family_codes", "family_names", "visible", "face", "bary", "ndotv", "q1", "eye"):
             assert k in z.files, (name, k)
         assert np.all(np.isfinite(z["a"])) and np.all(np.isfinite(z["ndotv"]))
         assert len(z["ndotv"]) == doc["vertices"]
@@ -196,3 +196,133 @@ def test_lines_batch_over_awkward_and_broken_meshes(device, client, tmp_path):
     # A rerun runs only the failures again.
     again = batch.run(str(src / "*.obj"), out, task="lines", client=client, options=opts)
     assert sorted(r["input"].rsplit("/", 1)[-1][:-4] for r in again) == sorted(broken)
+
+
+def test_lines_options_are_refused_before_any_cluster_starts(tmp_path, monkeypatch):
+    """As the isosurface task's iso: a bad option of the lines task is a
+    ValueError of run() itself, with no cluster, client or task started."""
+    from shapecue import batch
+
+    v, f = torus(12, 8)
+    write_obj(tmp_path / "t.obj", v, f)
+
+    def no_cluster(*a, **k):
+        raise AssertionError("a cluster or client was started")
+
+    monkeypatch.setattr(distributed, "LocalCluster", no_cluster)
+    monkeypatch.setattr(distributed, "Client", no_cluster)
+    monkeypatch.setattr(distributed, "get_client", no_cluster)
+    cams = [{"eye": [0, 0, 3], "target": [0, 0, 0]}]
+    cases = [
+        ({"views": 0}, "views=0: give a number of views from 1 to 10000"),
+        ({"views": 10001}, "views=10001"),
+        ({"views": True}, "views=True"),
+        ({"vews": 4}, "unknown option 'vews': the options are "),
+        ({"views": 4, "cameras": cams}, "give the option views or cameras, not both"),
+        ({"eye": [0, 0, 3]}, "option 'eye' sets the one camera"),
+        ({"lines": "contours,creases"}, "creases"),
+        ({"lines": "isophotes", "isophotes": 0}, "isophotes=0"),
+        ({"cameras": []}, "cameras: the list is empty"),
+        ({"cameras": [{"eye": [0, 0, 3]}]}, "cameras: camera 0: "),
+        ({"cameras": str(tmp_path / "absent.json")}, "absent.json"),
+    ]
+    for options, words in cases:
+        with pytest.raises((ValueError, OSError)) as e:
+            batch.run([str(tmp_path / "t.obj")], tmp_path / "out", task="lines", options=options)
+        assert words in str(e.value), (options, str(e.value))
+        assert not (tmp_path / "out" / "manifest.jsonl").exists()
+
+
+def test_lines_batch_records_its_options_and_redoes_what_changed(device, client, tmp_path):
+    """A rerun with other options redoes the inputs (it used to keep the
+    earlier views and return no record); views_per_second is the views over
+    the wall-clock time of computing them."""
+    from shapecue import batch
+
+    src = tmp_path / "in"
+    src.mkdir()
+    for i in range(2):
+        v, f = torus(20 + 4 * i, 10)
+        write_obj(src / f"t{i}.obj", v, f)
+    out = tmp_path / "out"
+    first = batch.run(str(src / "*.obj"), out, task="lines", client=client,
+                      options={"views": 4, "size": (320, 240)})
+    assert [r["status"] for r in first] == ["ok", "ok"], first
+    for r in first:
+        assert r["options"]["views"] == 4 and r["options"]["size"] == [320, 240]
+        assert r["options"]["lines"] == ["contours", "suggestive"]
+        # Wall clock: the views over the call that computed them.
+        assert r["views_per_second"] == pytest.approx(4 / (r["timings"]["compute_ms"] / 1e3))
+        t = r["timings"]
+        assert 0 < t["first_view_ms"] + t["later_views_ms"] <= t["compute_ms"] * 1.001 + 1
+        doc = json.loads((out / r["output"].rsplit("/", 1)[-1] / "views.json").read_text())
+        assert doc["options"] == r["options"] and len(doc["views"]) == 4
+    # The same options, written in other words (the defaults given, a list
+    # of families): nothing to do.
+    same = {"views": 4, "size": [320, 240], "lines": ["suggestive", "contours"], "fields": True}
+    assert batch.run(str(src / "*.obj"), out, task="lines", client=client, options=same) == []
+    again = batch.run(str(src / "*.obj"), out, task="lines", client=client,
+                      options={"views": 8, "size": (320, 240)})
+    assert sorted(r["input"].rsplit("/", 1)[-1] for r in again) == ["t0.obj", "t1.obj"]
+    for r in again:
+        assert r["status"] == "ok" and r["views"] == 8 and r["options"]["views"] == 8
+        folder = out / r["output"].rsplit("/", 1)[-1]
+        doc = json.loads((folder / "views.json").read_text())
+        assert len(doc["views"]) == 8 and doc["options"]["views"] == 8
+        assert len(list(folder.glob("view_*.npz"))) == 8
+    assert batch.run(str(src / "*.obj"), out, task="lines", client=client,
+                     options={"views": 8, "size": (320, 240)}) == []
+
+
+def sha256_tree(folder):
+    import hashlib
+
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and p.name != "manifest.jsonl"
+    }
+
+
+def test_batch_outputs_are_the_same_bytes_every_run(device, client, tmp_path):
+    """Two runs into two folders write the same bytes in every file but the
+    manifest (the run's log, with its timings and workers); the lines NPZ
+    holds the command line's arrays, by its names and in its order, with the
+    code table."""
+    import time
+
+    from shapecue import batch
+
+    src = tmp_path / "in"
+    src.mkdir()
+    for i in range(2):
+        v, f = torus(20 + 4 * i, 10)
+        write_obj(src / f"t{i}.obj", v, f)
+    opts = {"views": 3, "lines": "contours,suggestive,ridges", "size": (320, 240)}
+    outs = []
+    for k in range(2):
+        if k:
+            time.sleep(2.1)  # a zip stamp of the time of writing (to 2 s) would differ
+        out = tmp_path / f"out{k}"
+        for task, o in (("lines", opts), ("curvature", {"accumulate": "gather"})):
+            recs = batch.run(str(src / "*.obj"), out, task=task, client=client, options=o)
+            assert [r["status"] for r in recs] == ["ok", "ok"], recs
+        outs.append(sha256_tree(out))
+    assert len(outs[0]) == 2 * (1 + 3) + 2, sorted(outs[0])
+    assert outs[0] == outs[1]
+
+    z = np.load(tmp_path / "out0" / "t0" / "view_001.npz")
+    cli_names = ["a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary",
+                 "family_codes", "family_names"]
+    assert z.files[: len(cli_names)] == cli_names
+    dtypes = ["float32", "float32", "uint32", "float32", "uint8", "int64", "uint32", "int64",
+              "float32", "uint32", "<U24"]
+    assert [str(z[k].dtype) for k in cli_names[:-1]] == dtypes[:-1]
+    assert z["family_names"].dtype.str == "<U24"
+    assert "kind" not in z.files
+    table = dict(zip(z["family_codes"].tolist(), z["family_names"].tolist()))
+    assert table == shapecue.FAMILY_CODES
+    assert set(z["family"].tolist()) <= {0, 1, 2}
+    doc = json.loads((tmp_path / "out0" / "t0" / "views.json").read_text())
+    assert {int(c): n for c, n in doc["family_codes"].items()} == shapecue.FAMILY_CODES
+    assert "timing" not in doc and not any("ms" in k for e in doc["views"] for k in e)

@@ -40,7 +40,7 @@ def test_auto_accumulation_is_the_default_and_unknown_names_the_choices():
     auto = shapecue.lines(v, f, lines="k-zero,contours", cull=False, accumulate="auto")
     assert auto.segments.shape == default.segments.shape
     np.testing.assert_allclose(auto.segments, default.segments, rtol=1e-4, atol=1e-5)
-    np.testing.assert_array_equal(auto.kind, default.kind)
+    np.testing.assert_array_equal(auto.family_code, default.family_code)
     msg = r'unknown accumulation "sometimes": expected auto, atomic, atomic-native, gather'
     with pytest.raises(ValueError, match=msg):
         shapecue.lines(v, f, accumulate="sometimes")
@@ -106,3 +106,230 @@ def test_bad_cameras_are_clear_errors():
         shapecue.lines(v, f, cameras=0)
     with pytest.raises(ValueError, match="fields"):
         shapecue.lines(v, f, fields=True)
+
+
+def test_isophotes_of_no_level_are_refused_as_on_the_command_line():
+    """`--isophotes 0` is refused by the command line; Python used to return
+    no segment instead."""
+    v, f = torus(nu=24, nv=12)
+    for call in (
+        lambda: shapecue.lines(v, f, lines="contours,isophotes", isophotes=0),
+        lambda: shapecue.lines(v, f, lines="isophotes", isophotes=0, cameras=2),
+    ):
+        with pytest.raises(ValueError, match=r"isophotes=0: isophotes need at least 1 level"):
+            call()
+    with pytest.raises(ValueError, match=r"isophotes=-1"):
+        shapecue.lines(v, f, lines="isophotes", isophotes=-1)
+    # Without isophotes among the families the count is not read.
+    assert len(shapecue.lines(v, f, lines="contours", isophotes=0, cull=False).segments) > 0
+    assert len(shapecue.lines(v, f, lines="isophotes", isophotes=1, cull=False).segments) > 0
+
+
+def test_pieces_of_an_unknown_family_are_refused_naming_the_families():
+    v, f = torus(nu=24, nv=12)
+    one = shapecue.lines(v, f, lines="contours", cull=False)
+    view = shapecue.lines(v, f, lines="contours", cameras=1)[0]
+    for call in (lambda: one.of("bogus"), lambda: view.of("bogus"), lambda: view.of(3)):
+        with pytest.raises(ValueError) as e:
+            call()
+        msg = str(e.value)
+        assert "unknown line family" in msg and "contours, suggestive, ridges" in msg, msg
+    # A known family that was not asked for has no pieces, and no error.
+    assert one.of("ridges").shape == (0, 2, 3) and view.of("ridges").shape == (0, 2, 3)
+    assert len(one.of("contours")) == len(one.segments)
+
+
+def test_family_codes_are_the_files_codes_with_names_beside_them():
+    v, f = torus(nu=24, nv=12)
+    one = shapecue.lines(v, f, lines="contours,k-zero", cull=False)
+    view = shapecue.lines(v, f, lines="contours,k-zero", cameras=1)[0]
+    table = shapecue.FAMILY_CODES
+    assert table[0] == "contours" and table[8] == "k-zero" and table[1 << 16] == "feature-edges"
+    assert shapecue.LINE_FAMILIES[:2] == ("contours", "suggestive") and len(shapecue.LINE_FAMILIES) == 12
+    for x in (one, view):
+        assert x.family_code.dtype == np.uint32 and set(x.family_code.tolist()) == {0, 8}
+        assert [table[c] for c in x.family_code.tolist()] == x.family.tolist()
+        # The earlier name still answers, with a deprecation warning.
+        with pytest.warns(DeprecationWarning, match="family_code"):
+            np.testing.assert_array_equal(x.kind, x.family_code)
+
+
+def test_camera_mistakes_are_worded_as_given():
+    v, f = torus(nu=24, nv=12)
+    target = [0.0, 0.0, 0.0]
+    cases = [
+        # A NaN used to reach the library as JSON it cannot read ("the file:
+        # not JSON").
+        ([{"eye": [0, 0, 3], "target": target}, {"eye": [0, 0, float("nan")], "target": target}],
+         "cameras: camera 1: eye has [0, 0, nan], a number that is not finite"),
+        ([{"eye": [0, 0, 3], "target": target, "fov": float("inf")}],
+         "cameras: camera 0: fov has inf, a number that is not finite"),
+        # Used to be a bare OverflowError.
+        (-1, "cameras=-1: give a number of views from 1 to 10000, a list of camera dicts or a "
+             "camera JSON file"),
+        (10001, "cameras=10001: give a number of views from 1 to 10000"),
+        # Used to read "cameras: cameras: the list is empty".
+        ([], "cameras: the list is empty: give at least one camera"),
+        ({"cameras": []}, "cameras: the list is empty: give at least one camera"),
+        ([[0, 0, 3]], "cameras: camera 0: expected a dict with eye and target"),
+    ]
+    for cams, words in cases:
+        with pytest.raises(ValueError) as e:
+            shapecue.lines(v, f, cameras=cams)
+        msg = str(e.value)
+        assert msg.startswith(words), msg
+        assert "cameras: cameras" not in msg and "not JSON" not in msg, msg
+    # numpy values are numbers like any other.
+    cam = {"eye": np.array([0.0, 0.5, 3.0]), "target": np.zeros(3, np.float32), "fov": np.float32(30)}
+    assert len(shapecue.lines(v, f, cameras=[cam])) == 1
+
+
+def test_a_camera_file_is_named_in_its_errors(tmp_path):
+    v, f = torus(nu=24, nv=12)
+    p = tmp_path / "cams.json"
+    p.write_text('{"cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0]}, {"eye": [0, 0, 3]}]}')
+    with pytest.raises(ValueError, match=r"cams\.json: camera 1: .*target"):
+        shapecue.lines(v, f, cameras=p)
+    with pytest.raises(FileNotFoundError, match=r"absent\.json"):
+        shapecue.lines(v, f, cameras=tmp_path / "absent.json")
+
+
+def sphere(subdivisions=5):
+    """An icosphere of radius 1 (10242 vertices at 5 subdivisions)."""
+    trimesh = pytest.importorskip("trimesh")
+    m = trimesh.creation.icosphere(subdivisions=subdivisions)
+    return np.asarray(m.vertices), np.asarray(m.faces)
+
+
+def test_ctrl_c_stops_a_call_of_many_views_within_a_view(device):
+    """SIGINT (Ctrl-C) during a call of thousands of views raises
+    KeyboardInterrupt between two views, not once the call has ended."""
+    import os
+    import signal
+    import threading
+    import time
+
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach the main thread only")
+    v, f = sphere()
+    fams = "contours,suggestive,isophotes"
+    shapecue.lines(v, f, lines=fams, cameras=1)  # the device opened, the kernels built
+    t0 = time.perf_counter()
+    shapecue.lines(v, f, lines=fams, cameras=1)
+    t1 = time.perf_counter()
+    shapecue.lines(v, f, lines=fams, cameras=9)
+    t9 = time.perf_counter()
+    first = t1 - t0
+    per_view = max((t9 - t1) - first, 1e-3) / 8
+    delay = 0.5
+    # Room for one view, the pose passes and a slow machine; a call that
+    # ran to its end takes six times longer (as many views as that needs).
+    limit = delay + 2.0 + first + 10 * per_view
+    n = min(shapecue._shapecue.MAX_VIEWS, max(1000, int(6 * limit / per_view)))
+    whole = n * per_view
+    if whole < 3 * limit:
+        pytest.skip(f"{n} views take {whole:.1f} s here: too few to tell an interrupt from the end")
+    timer = threading.Timer(delay, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            shapecue.lines(v, f, lines=fams, cameras=n)
+            # Without a check between views Python sees the signal only here,
+            # once every view is done.
+        elapsed = time.perf_counter() - t0
+    finally:
+        timer.cancel()
+    assert elapsed < limit, f"KeyboardInterrupt after {elapsed:.1f} s; the whole call takes ~{whole:.0f} s"
+    # The device is usable afterwards.
+    assert len(shapecue.lines(v, f, lines=fams, cameras=2)) == 2
+
+
+def test_many_views_give_the_same_bytes_every_call():
+    v, f = torus(nu=48, nv=24)
+    keys = ("a", "b", "family_code", "strength", "visible", "chain", "faces", "face", "bary")
+    runs = [shapecue.lines(v, f, lines="contours,suggestive,ridges", cameras=4, fields=True)
+            for _ in range(3)]
+    for other in runs[1:]:
+        for x, y in zip(runs[0], other):
+            assert len(x.a) > 0
+            for k in keys:
+                assert getattr(x, k).tobytes() == getattr(y, k).tobytes(), k
+            for k in x.fields:
+                assert x.fields[k].tobytes() == y.fields[k].tobytes(), k
+            assert x.camera == y.camera
+
+
+@pytest.mark.parametrize("mesh", ["torus", "bunny"])
+def test_views_are_the_command_lines_rows(device, cli, mesh, tmp_path, request):
+    """shapecue.lines(path, cameras=N) gives the rows of `shapecue lines
+    PATH --views N --out DIR --npz`, in the same order, bit for bit; and the
+    same for a camera file."""
+    import json
+    import subprocess
+    from conftest import write_obj
+
+    if mesh == "bunny":
+        path = request.getfixturevalue("bunny")
+    else:
+        v, f = torus(nu=48, nv=24)
+        path = tmp_path / "torus.obj"
+        write_obj(path, v, f)
+    fams = "contours,suggestive,ridges,valleys"
+    cams = tmp_path / "cams.json"
+    # Fitted views on the bounds would need the bounds here: two explicit
+    # cameras, one perspective, one orthographic, around the mesh's centre.
+    lo, hi = shapecue.load_mesh(path)[0].min(0), shapecue.load_mesh(path)[0].max(0)
+    c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
+    cams.write_text(json.dumps({"cameras": [
+        {"eye": (c + [0.3 * r, 0.2 * r, 1.5 * r]).tolist(), "target": c.tolist()},
+        {"eye": (c + [-1.5 * r, 0.4 * r, 0.1 * r]).tolist(), "target": c.tolist(), "ortho": 1.2 * r},
+    ]}))
+    for how, arg, cameras in (("views", "3", 3), ("cameras", str(cams), cams)):
+        out = tmp_path / f"cli-{how}"
+        run = subprocess.run(
+            [cli, "lines", str(path), f"--{how}", arg, "--out", str(out), "--npz", "--lines", fams],
+            capture_output=True, text=True, timeout=600,
+        )
+        assert run.returncode == 0, run.stderr
+        manifest = json.loads((out / "manifest.json").read_text())
+        assert {int(k): n for k, n in manifest["family_codes"].items()} == shapecue.FAMILY_CODES
+        views = shapecue.lines(path, lines=fams, cameras=cameras)
+        assert len(views) == len(manifest["views"])
+        for mv, view in zip(manifest["views"], views):
+            npz = next(x["name"] for x in mv["files"] if x["name"].endswith("_segments.npz"))
+            z = np.load(out / npz)
+            assert len(z["a"]) > 0
+            np.testing.assert_array_equal(view.camera["eye"], mv["camera"]["eye"])
+            ours = {
+                "a": view.a, "b": view.b, "family": view.family_code, "strength": view.strength,
+                "visible": view.visible.astype(np.uint8), "faces": view.faces, "chain": view.chain,
+                "face": view.face, "bary": view.bary,
+            }
+            # The code table (family_codes, family_names) may follow.
+            assert list(z.files)[: len(ours)] == list(ours)
+            if "family_codes" in z.files:
+                table = dict(zip(z["family_codes"].tolist(), z["family_names"].tolist()))
+                assert table == shapecue.FAMILY_CODES
+            for k, a in ours.items():
+                assert z[k].dtype == a.dtype and z[k].shape == a.shape, k
+                assert z[k].tobytes() == a.tobytes(), (how, mv["index"], k)
+
+
+def test_the_feature_size_is_rtscs_unless_asked_otherwise():
+    """The thresholds scale by rtsc's feature size (0.01 / the 10th
+    percentile of |k|, at most 5 % of the bounding radius), not by the median
+    edge length, which `feature_size="edge"` asks for."""
+    v, f = sphere(4)
+    rtsc = shapecue.lines(v, f).feature_size
+    edge = shapecue.lines(v, f, feature_size="edge").feature_size
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    e = np.unique(e, axis=0)
+    median_edge = float(np.median(np.linalg.norm(v[e[:, 0]] - v[e[:, 1]], axis=1)))
+    # |k| is about 1 on the unit sphere: 0.01 / 1, below 0.05 · 1.
+    assert rtsc == pytest.approx(0.01, rel=0.05)
+    assert edge == pytest.approx(median_edge, rel=0.05) and abs(edge - rtsc) > 0.02
+    assert shapecue.lines(v, f, feature_size=0.5).feature_size == pytest.approx(0.5)
+    for doc in (shapecue.Lines.__doc__, shapecue.lines.__doc__):
+        assert "rtsc" in doc and "10th percentile" in doc
+    assert "scaled by (the median edge length)" not in shapecue.Lines.__doc__
