@@ -109,6 +109,10 @@ pub enum Error {
     /// A caller passed an argument that makes no sense.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// The caller stopped a run between two views (a signal, Ctrl-C in
+    /// Python); what finished before is whole.
+    #[error("interrupted: the run stopped between two views")]
+    Interrupted,
     /// Headless OpenGL is unavailable: libEGL could not be loaded, or EGL found
     /// no display or no OpenGL configuration (no Mesa driver).
     #[error(

@@ -170,7 +170,23 @@ fn bad_camera_files_name_the_file_and_the_camera() {
         ),
         (
             r#"{"cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0], "zoom": 2}]}"#.into(),
-            &["camera 0", "zoom"],
+            &[
+                "camera 0",
+                "unknown key \"zoom\"",
+                "eye, target, up, fov and ortho",
+            ],
+        ),
+        (
+            r#"{"cameras": [{"eye": 0.0, "target": [0, 0, 0]}]}"#.into(),
+            &["camera 0", "eye must be three numbers [x, y, z], not 0.0"],
+        ),
+        (
+            r#"{"cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0], "fov": "wide"}]}"#.into(),
+            &["camera 0", "fov must be a number, not \"wide\""],
+        ),
+        (
+            r#"{"cameras": [3]}"#.into(),
+            &["camera 0", "3 is not a camera"],
         ),
         (
             format!(r#"{{"cameras": [{}]}}"#, vec![cam; 10_001].join(",")),
@@ -184,7 +200,11 @@ fn bad_camera_files_name_the_file_and_the_camera() {
         for w in words {
             assert!(e.contains(w), "{w:?} not in {e:?}");
         }
-        assert!(!e.contains("Some(") && !e.contains("[f32"), "{e}");
+        assert!(
+            !e.contains("Some(") && !e.contains("[f32") && !e.contains('`'),
+            "{e}"
+        );
+        assert!(!e.contains("cameras: cameras"), "{e}");
     }
 }
 

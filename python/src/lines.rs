@@ -6,9 +6,9 @@
 use super::*;
 use pyo3::types::PyList;
 use shapecue::api::{
-    CameraDefaults, LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES, LineOptions,
-    LineSetup, LineView, LinesPictureOptions, Shot, ViewSpec, VisibilityMethod, fibonacci_views,
-    line_views_on, load_camera_file, parse_camera_file, segment_arrays,
+    CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot, ViewSpec,
+    VisibilityMethod, fibonacci_views, line_views_on, load_camera_file, parse_camera_file,
+    segment_arrays,
 };
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
 use shapecue::spec::view::View;
@@ -237,7 +237,7 @@ pub fn lines_views<'py>(
             if let Err(e) = Python::attach(|py| py.check_signals()) {
                 interrupt = Some(e);
                 // Only ends the run: the Python exception is raised below.
-                return Err(Error::InvalidArgument("interrupted".into()));
+                return Err(Error::Interrupted);
             }
             Ok(())
         })?;
@@ -313,13 +313,7 @@ pub fn line_families(names: &str) -> PyResult<Vec<&'static str>> {
 /// and curvature strokes.
 #[pyfunction]
 pub fn family_codes() -> Vec<(u32, &'static str)> {
-    let families = LineFamily::ALL.iter().map(|&f| (f as u32, f.name()));
-    let layers = [
-        (LAYER_FEATURE_EDGES, "feature-edges"),
-        (LAYER_INTERSECTIONS, "intersection-lines"),
-        (LAYER_STROKES, "curvature-strokes"),
-    ];
-    families.chain(layers).collect()
+    shapecue::spec::feature_lines::family_codes()
 }
 
 /// One view of [`lines_views`] as a dict of numpy arrays.

@@ -49,6 +49,26 @@ pub struct SegmentArrays {
 /// [`Error::InvalidArgument`] for arrays of unequal lengths, [`Error::Write`]
 /// naming the file.
 pub fn write_segments(path: &Path, arrays: &SegmentArrays) -> Result<()> {
+    check_lengths(arrays)
+        .map_err(|e| Error::InvalidArgument(format!("{}: {e}", path.display())))?;
+    write(path, encode(arrays))
+}
+
+/// The bytes [`write_segments`] writes, for a caller that stores them
+/// itself (the Python package's batches): the same bytes for the same
+/// arrays, whoever writes them.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] for arrays of unequal lengths or an array the
+/// encoder refuses.
+pub fn segments_npz_bytes(arrays: &SegmentArrays) -> Result<Vec<u8>> {
+    check_lengths(arrays).map_err(Error::InvalidArgument)?;
+    encode(arrays).map_err(Error::InvalidArgument)
+}
+
+/// Equal lengths of every array, or what differs.
+fn check_lengths(arrays: &SegmentArrays) -> std::result::Result<(), String> {
     let n = arrays.a.len();
     let lens = [
         arrays.b.len(),
@@ -61,13 +81,12 @@ pub fn write_segments(path: &Path, arrays: &SegmentArrays) -> Result<()> {
         arrays.bary.len(),
     ];
     if lens.iter().any(|&l| l != n) {
-        return Err(Error::InvalidArgument(format!(
-            "{}: segment arrays of unequal lengths ({n} and {})",
-            path.display(),
+        return Err(format!(
+            "segment arrays of unequal lengths ({n} and {})",
             lens.map(|l| l.to_string()).join(", ")
-        )));
+        ));
     }
-    write(path, encode(arrays))
+    Ok(())
 }
 
 /// A view's per-vertex fields ([`ViewFields`]: `ndotv`, `kr`, `dwkr`,
@@ -78,16 +97,38 @@ pub fn write_segments(path: &Path, arrays: &SegmentArrays) -> Result<()> {
 /// [`Error::InvalidArgument`] for fields of unequal lengths, [`Error::Write`]
 /// naming the file.
 pub fn write_fields(path: &Path, f: &ViewFields) -> Result<()> {
-    let n = f.ndotv.len();
-    if [f.kr.len(), f.dwkr.len(), f.q1.len()]
-        .iter()
-        .any(|&l| l != n)
-    {
+    if !fields_equal_lengths(f) {
         return Err(Error::InvalidArgument(format!(
             "{}: view fields of unequal lengths",
             path.display()
         )));
     }
+    write(path, encode_fields(f))
+}
+
+/// The bytes [`write_fields`] writes (see [`segments_npz_bytes`]).
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] for fields of unequal lengths.
+pub fn fields_npz_bytes(f: &ViewFields) -> Result<Vec<u8>> {
+    if !fields_equal_lengths(f) {
+        return Err(Error::InvalidArgument(
+            "view fields of unequal lengths".into(),
+        ));
+    }
+    encode_fields(f).map_err(Error::InvalidArgument)
+}
+
+fn fields_equal_lengths(f: &ViewFields) -> bool {
+    let n = f.ndotv.len();
+    [f.kr.len(), f.dwkr.len(), f.q1.len()]
+        .iter()
+        .all(|&l| l == n)
+}
+
+/// The NPZ bytes of `f` (of equal lengths).
+fn encode_fields(f: &ViewFields) -> std::result::Result<Vec<u8>, String> {
     let mut npz = Npz::new();
     for (name, v) in [
         ("ndotv", &f.ndotv),
@@ -97,7 +138,7 @@ pub fn write_fields(path: &Path, f: &ViewFields) -> Result<()> {
     ] {
         npz.add(name, &Array1::from(v.clone()));
     }
-    write(path, npz.finish())
+    npz.finish()
 }
 
 /// Writes encoded bytes, or the encoder's error naming the file.

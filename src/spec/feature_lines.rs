@@ -387,6 +387,11 @@ impl CurveOptions {
                 "the light direction must be finite and non-zero".into(),
             ));
         }
+        if self.isophotes == 0 && self.families.has(LineFamily::Isophotes) {
+            return Err(crate::error::Error::InvalidArgument(
+                "isophotes = 0: isophotes need at least 1 level".into(),
+            ));
+        }
         if self.isophotes > 1000 {
             return Err(crate::error::Error::InvalidArgument(format!(
                 "at most 1000 isophote levels, got {}",

@@ -159,13 +159,13 @@ pub fn parse_camera_file(
     }
     if list.is_empty() {
         return Err(bad(
-            "cameras",
-            "the list is empty: give at least one camera".into(),
+            "the camera list",
+            "it is empty: give at least one camera".into(),
         ));
     }
     if list.len() > MAX_VIEWS {
         return Err(bad(
-            "cameras",
+            "the camera list",
             format!(
                 "{} cameras, more than the {MAX_VIEWS} a set may hold",
                 list.len()
@@ -175,12 +175,56 @@ pub fn parse_camera_file(
     (list.iter().enumerate())
         .map(|(i, v)| {
             let element = format!("camera {i}");
+            check_shape(v).map_err(|p| bad(&element, p))?;
             let entry: CameraEntry =
                 serde_json::from_value(v.clone()).map_err(|e| bad(&element, e.to_string()))?;
             check_magnitudes(v).map_err(|p| bad(&element, p))?;
             camera_view(&entry, defaults).map_err(|p| bad(&element, p))
         })
         .collect()
+}
+
+/// Checks that a camera is an object of the keys a camera takes, each of
+/// its kind (three numbers, or one), in words rather than the JSON
+/// parser's.
+fn check_shape(v: &serde_json::Value) -> std::result::Result<(), String> {
+    const KEYS: &str = "eye, target, up, fov and ortho";
+    let Some(o) = v.as_object() else {
+        return Err(format!(
+            "{v} is not a camera: give an object such as {{\"eye\": [0, 0, 3], \"target\": [0, 0, 0]}}"
+        ));
+    };
+    if let Some(k) = o
+        .keys()
+        .find(|k| !["eye", "target", "up", "fov", "ortho"].contains(&k.as_str()))
+    {
+        return Err(format!("unknown key \"{k}\" (a camera takes {KEYS})"));
+    }
+    for key in ["eye", "target"] {
+        if !o.contains_key(key) {
+            return Err(format!(
+                "no \"{key}\": every camera needs an eye and a target"
+            ));
+        }
+    }
+    for (key, x) in o {
+        let three = matches!(key.as_str(), "eye" | "target" | "up");
+        let ok = match x {
+            serde_json::Value::Array(a) if three => a.len() == 3 && a.iter().all(|c| c.is_number()),
+            serde_json::Value::Number(_) => !three,
+            serde_json::Value::Null => key == "up" || key == "fov" || key == "ortho",
+            _ => false,
+        };
+        if !ok {
+            let want = if three {
+                "three numbers [x, y, z]"
+            } else {
+                "a number"
+            };
+            return Err(format!("{key} must be {want}, not {x}"));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a coordinate or height beyond [`MAX_COORDINATE`], naming the
