@@ -307,6 +307,16 @@ fn force_replaces_the_earlier_run_and_only_its_files() {
     let manifest = read_json(&out.join("manifest.json"));
     assert_eq!(manifest["views"].as_array().unwrap().len(), 4);
     assert_eq!(manifest["options"]["views"], 4);
+    // The report names the curvature scheme that ran (gather, the default).
+    let report = read_json(&out.join("spot_report.json"));
+    let curvature = (report["passes"].as_array().unwrap().iter())
+        .find(|p| p["pass"] == "curvature")
+        .unwrap();
+    let how = curvature["how"].as_str().unwrap();
+    assert!(
+        how.contains("gather accumulation") && how.contains("f32"),
+        "{how}"
+    );
 }
 
 #[test]

@@ -458,8 +458,15 @@ impl<'s, 'g> Executor<'s, 'g> {
             Pass::FaceNormals => self.face_normals(frame)?,
             Pass::Curvature => {
                 let t = self.curvature_run(frame)?;
-                self.rec
-                    .kernels(pass, &t, "tensor + principal (Rusinkiewicz, atomic f32)");
+                // What ran, as the options chose it.
+                let o = self.curv_opts;
+                let how = format!(
+                    "tensor + principal (Rusinkiewicz; {} accumulation, {}, {} least squares)",
+                    o.accumulate.name(),
+                    o.precision.name(),
+                    o.compat.name()
+                );
+                self.rec.kernels(pass, &t, &how);
             }
             Pass::Dcurv => {
                 let t = self.curvature_run(frame)?;
