@@ -9,10 +9,10 @@
 //! time:
 //! - `visibility/classify/bunny`: `stages::visibility::classify` (order,
 //!   plan, the sample round and the bisection rounds, transfers);
-//! - `visibility/plan/bunny`: `cpu::visibility::Plan::new` alone (the
+//! - `visibility/plan/bunny`: `spec::visibility_plan::Plan::new` alone (the
 //!   segments in Morton order, as `classify` takes them);
-//! - `visibility/chains/bunny`: `cpu::chains::chain` over the classified
-//!   pieces (keyed by `cpu::chains::chain_pieces`, as the vector drawing
+//! - `visibility/chains/bunny`: `stages::chains::chain` over the classified
+//!   pieces (keyed by `stages::chains::chain_pieces`, as the vector drawing
 //!   keys them: mesh edge, vertex, or a cut where visibility changes).
 //!
 //! The curvature and the segments are computed once, before the groups.
@@ -23,13 +23,13 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::api::LineSetup;
-use shapecue::cpu::chains::{chain, chain_pieces};
-use shapecue::cpu::visibility::Plan;
 use shapecue::render::Camera;
 use shapecue::spec::curvature::CurvatureOptions;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use shapecue::spec::visibility::VisibilityOptions;
+use shapecue::spec::visibility_plan::Plan;
 use shapecue::stages::bvh::Bvh;
+use shapecue::stages::chains::{chain, chain_pieces};
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 use shapecue::stages::visibility::{classify, spatial_order};

@@ -41,7 +41,10 @@
 #     (or folders) of any module folder (src/cpu/, src/stages/, ...): a
 #     cycle is printed with the file:line of each of its imports;
 #   - src/spec/ imports nothing from crate::mesh or crate::volume: data
-#     builds on the spec, never the reverse.
+#     builds on the spec, never the reverse;
+#   - src/stages/, src/scene/ and src/api/ import nothing from crate::cpu:
+#     the twins are never on the product's path (the front door may
+#     re-export a CPU reference with `pub use`).
 #   These two read code outside `#[cfg(test)] mod` blocks (a unit test may
 #   name another module's items to check that names agree), and resolve
 #   `super::`, `self::` and re-exports (`pub use`) to the module that
@@ -303,6 +306,23 @@ for crate, parent in sorted({(c, m[:k]) for c, m in where.values() for k in rang
             for at in edges['spec'].get(dst, []):
                 found = True
                 print(f"{at}: src/spec must not use crate::{dst} (data builds on the spec, never the reverse)")
+# The twins stay off the product's path: nothing under src/stages,
+# src/scene or src/api uses crate::cpu outside its unit tests, but the
+# front door's re-exports of a CPU reference (`pub use` in src/api, offered
+# to callers beside the device's call, never called by the library).
+for f in files:
+    crate, mod = where[f]
+    if crate != 'lib' or mod[:1] not in (('stages',), ('scene',), ('api',)):
+        continue
+    text = code[f]
+    pub_uses = [(text.count('\n', 0, m.start()) + 1)
+                for m in re.finditer(r'\bpub\s+use\s+crate::cpu::', text)]
+    for line, a in uses[f]:
+        if a[:1] == ('cpu',) and not (mod[:1] == ('api',) and line in pub_uses):
+            found = True
+            print(f"{f}:{line}: {'/'.join(('src',) + mod[:1])} must not use crate::{'::'.join(a)} "
+                  "(src/cpu holds the twins and references; a host step of the product is a stage, "
+                  "and what both sides need is in src/spec)")
 sys.exit(1 if found else 0)
 PY
 

@@ -224,6 +224,22 @@ fn pending(path: &Path, add: bool) {
     }
 }
 
+/// Creates the temporary file `path` and lists it as pending, under the
+/// lock the interrupt handler holds while it removes them and exits: a
+/// file is either listed (and removed by the handler) or never created.
+fn create_pending(path: &Path) -> std::io::Result<File> {
+    let mut list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    if interrupted() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "the process is being interrupted",
+        ));
+    }
+    let f = File::create(path)?;
+    list.push(path.to_path_buf());
+    Ok(f)
+}
+
 /// The temporary file of [`write_atomic`]: a file whose written bytes are
 /// handed to the disk every 8 MiB (Linux: `sync_file_range` with
 /// `SYNC_FILE_RANGE_WRITE`, which starts the write-back and returns), so
@@ -317,9 +333,8 @@ pub fn write_atomic(
         path: path.to_path_buf(),
         source,
     };
-    pending(&tmp, true);
     let result = (|| {
-        let file = OutputFile::new(File::create(&tmp).map_err(err)?);
+        let file = OutputFile::new(create_pending(&tmp).map_err(err)?);
         let mut w = BufWriter::with_capacity(1 << 20, file);
         write(&mut w)?;
         let file = w.into_inner().map_err(|e| err(e.into_error()))?.file;
@@ -359,8 +374,13 @@ pub fn install_interrupt_cleanup(note: &'static str) {
         // If a handler cannot be installed (another one exists), writes are
         // still atomic; only a leftover hidden `.partial` file is possible.
         let _ = ctrlc::set_handler(move || {
+            // The lock is held until the process exits, so that no
+            // temporary file is created after the pending ones are removed.
+            let list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
             INTERRUPTED.store(true, Ordering::SeqCst);
-            remove_pending();
+            for p in list.iter() {
+                let _ = std::fs::remove_file(p);
+            }
             eprintln!(
                 "interrupted: files finished before the interrupt are whole, the one being \
                  written was removed{note}"

@@ -15,12 +15,13 @@ use std::time::Instant;
 
 use glam::Vec3;
 use shapecue::cpu::bvh::Tree;
-use shapecue::cpu::visibility::{Plan, classify_reference, classify_twin};
+use shapecue::cpu::visibility::{classify_reference, classify_twin};
 use shapecue::mesh::{Mesh, icosphere, torus};
 use shapecue::render::Camera;
 use shapecue::spec::feature_lines::{LINE_FREE, Segment};
 use shapecue::spec::view::View;
 use shapecue::spec::visibility::{Pieces, Spacing, VisibilityOptions};
+use shapecue::spec::visibility_plan::Plan;
 use shapecue::stages::bvh::Bvh;
 use shapecue::stages::visibility::{classify, spatial_order};
 use visibility_support::*;

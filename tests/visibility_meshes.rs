@@ -34,12 +34,13 @@ use std::time::Instant;
 
 use glam::Vec3;
 use shapecue::cpu::bvh::{Tree, box_hit, segment_hits_f32};
-use shapecue::cpu::visibility::{Plan, classify_by, classify_reference, classify_twin};
-use shapecue::cpu::visibility::{hidden_from, queries_of};
+use shapecue::cpu::visibility::{classify_reference, classify_twin};
 use shapecue::mesh::Mesh;
 use shapecue::render::Camera;
 use shapecue::report::line_agreement::{pick, reference_subset};
 use shapecue::spec::bvh::{BvhQuery, LEAF};
+use shapecue::spec::visibility_plan::{Plan, classify_by};
+use shapecue::spec::visibility_plan::{hidden_from, queries_of};
 // The views and the families (the bunny: every family) of the report.
 use shapecue::report::visibility::{MeshLines, NAMED, VIEWS, middle_frame};
 use shapecue::spec::feature_lines::{LineFamily, Segment};

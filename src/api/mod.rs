@@ -219,7 +219,7 @@ pub fn isosurface_on(
     let (ipos, faces) = ex.read_index_space()?;
     let normals = opts
         .gradient_normals
-        .then(|| crate::cpu::marching_cubes::gradient_normals(&vol, &ipos));
+        .then(|| crate::volume::gradient::gradient_normals(&vol, &ipos));
     Ok(Isosurface {
         mesh: ex.world_mesh(&ipos, faces),
         normals,

@@ -16,75 +16,12 @@
 //! determinant so there is no division; epsilons [`EDGE_EPS`] and
 //! [`END_EPS`]) in f64 over every face.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::spec::bvh::{
-    BOX_PAD, BvhBox, BvhNode, BvhQuery, EDGE_EPS, END_EPS, LEAF, MAX_FACES, MortonFrame, NONE,
-    OCCLUDED, OVERFLOW, STACK_DEPTH, VISIBLE, bvh_bound,
+    BOX_PAD, BvhBox, BvhNode, BvhQuery, EDGE_EPS, END_EPS, LEAF, MortonFrame, NONE, OCCLUDED,
+    OVERFLOW, STACK_DEPTH, VISIBLE, bvh_bound,
 };
-
-/// A built tree: sorted codes and faces (leaf order), internal nodes, leaf
-/// parents and boxes, as the device's buffers hold them.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Tree {
-    /// Morton codes in leaf order.
-    pub keys: Vec<u32>,
-    /// The face of each leaf.
-    pub faces_sorted: Vec<u32>,
-    /// Internal nodes (node 0 the root).
-    pub nodes: Vec<BvhNode>,
-    /// Parent of each leaf ([`NONE`] for a lone leaf).
-    pub leaf_parent: Vec<u32>,
-    /// Box of each internal node.
-    pub node_boxes: Vec<BvhBox>,
-    /// Box of each leaf.
-    pub leaf_boxes: Vec<BvhBox>,
-    /// The two children's boxes of each internal node, padded as the
-    /// traversal tests them ([`padded`]): `2·node` the left, `2·node + 1`
-    /// the right (one read of 64 bytes per node visited).
-    pub child_boxes: Vec<BvhBox>,
-}
-
-/// Checks that every face names existing vertices and that the tree can
-/// number the faces; `what` names the mesh in errors.
-pub fn check_faces(what: &str, n_vertices: usize, faces: &[[u32; 3]]) -> Result<()> {
-    if faces.len() > MAX_FACES {
-        return Err(Error::InvalidArgument(format!(
-            "{what}: {} faces, a BVH holds at most {MAX_FACES}",
-            faces.len()
-        )));
-    }
-    for (i, f) in faces.iter().enumerate() {
-        if let Some(&v) = f.iter().find(|&&v| v as usize >= n_vertices) {
-            return Err(Error::InvalidInput {
-                source_name: what.to_string(),
-                element: format!("face {i}"),
-                problem: format!("vertex index {v} out of range ({n_vertices} vertices)"),
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Checks that there are `n_vertices` finite positions.
-pub fn check_positions(what: &str, n_vertices: usize, positions: &[[f32; 3]]) -> Result<()> {
-    if positions.len() != n_vertices {
-        return Err(Error::InvalidArgument(format!(
-            "{what}: {} positions for {n_vertices} vertices",
-            positions.len()
-        )));
-    }
-    match positions
-        .iter()
-        .position(|p| p.iter().any(|c| !c.is_finite()))
-    {
-        Some(i) => Err(Error::InvalidInput {
-            source_name: what.to_string(),
-            element: format!("vertex {i}"),
-            problem: "position is not finite".to_string(),
-        }),
-        None => Ok(()),
-    }
-}
+pub use crate::spec::bvh::{Tree, check_faces, check_positions};
 
 /// Step `morton`: the code of each face (mesh order).
 pub fn morton(positions: &[[f32; 3]], faces: &[[u32; 3]], frame: &MortonFrame) -> Vec<u32> {

@@ -9,6 +9,7 @@
 pub use super::feature_lines::zero_hermite;
 use super::feature_lines::{VertexTerms, emit_tested};
 use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
+pub use crate::spec::feature_lines::{ScaledThresholds, boundary_mask};
 use crate::spec::view::View;
 
 type V3 = [f32; 3];
@@ -187,31 +188,6 @@ pub fn lines_dt1q1(
         .collect()
 }
 
-/// Marks the boundary edges of each face: bit j when edge (v[j], v[j+1])
-/// belongs to no other face (computed once per topology).
-pub fn boundary_mask(faces: &[[u32; 3]]) -> Vec<u32> {
-    let mut count: std::collections::HashMap<(u32, u32), u32> = Default::default();
-    for f in faces {
-        for j in 0..3 {
-            let (a, b) = (f[j], f[(j + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    faces
-        .iter()
-        .map(|f| {
-            (0..3).fold(0, |m, j| {
-                let (a, b) = (f[j], f[(j + 1) % 3]);
-                if count[&(a.min(b), a.max(b))] == 1 {
-                    m | 1 << j
-                } else {
-                    m
-                }
-            })
-        })
-        .collect()
-}
-
 /// Everything `lines_curves` reads besides the faces and positions.
 pub struct CurveTerms<'a> {
     /// `lines_vertex`'s output.
@@ -224,43 +200,6 @@ pub struct CurveTerms<'a> {
     pub dt: &'a [f32],
     /// [`boundary_mask`].
     pub bnd: &'a [u32],
-}
-
-/// Thresholds of `lines_curves`, divided by the feature size s as rtsc
-/// scales them: ridge/valley (÷ s), apparent ridge, principal and suggestive
-/// highlight, suggestive contour (÷ s²), and the fade of suggestive
-/// highlights (÷ s², 0 for none).
-#[derive(Clone, Copy, Debug)]
-pub struct ScaledThresholds {
-    /// Ridges and valleys (|k| > rv).
-    pub rv: f32,
-    /// Apparent ridges (q1 > ar, q1 a squared curvature).
-    pub ar: f32,
-    /// Principal highlights.
-    pub ph: f32,
-    /// Suggestive highlights.
-    pub sh: f32,
-    /// The suggestive-contour threshold (D_w κr = 0 is the zero set of
-    /// sinθ D_w κr − sc (n·v)).
-    pub sc: f32,
-    /// The fade of suggestive highlights.
-    pub sh_fade: f32,
-}
-
-impl ScaledThresholds {
-    /// The options' thresholds for a mesh of feature size `s`, with the
-    /// suggestive-contour threshold and fade `sc` already scaled (as
-    /// [`crate::stages::feature_lines::LineOptions`] scales them).
-    pub fn of(o: &CurveOptions, s: f32, sc: (f32, f32)) -> ScaledThresholds {
-        ScaledThresholds {
-            rv: o.ridge_threshold / s,
-            ar: o.apparent_threshold / (s * s),
-            ph: o.principal_threshold / (s * s),
-            sh: o.highlight_threshold / (s * s),
-            sc: sc.0,
-            sh_fade: sc.1,
-        }
-    }
 }
 
 struct Out<'a> {

@@ -1,11 +1,12 @@
 //! Plain Rust reference implementations of the device stages, in f64, with
 //! the same step names as the kernels. Deliberately simple: they are the
-//! oracles the tests compare the device with. `chains` is the one host-only
-//! step (the visibility family's joining of pieces into chains).
+//! oracles the tests compare the device with, and never on the path the
+//! product runs (`scripts/check-layers.sh` refuses an import of them from
+//! `stages`, `scene` or `api`). Host steps of the product are stages
+//! (`stages::chains`); what both sides need is in `spec`.
 
 pub mod ao;
 pub mod bvh;
-pub mod chains;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

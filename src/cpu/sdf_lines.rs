@@ -28,8 +28,12 @@
 //! [`run`] chains them like the device's `SdfLines::run`.
 
 use crate::cpu::marching_cubes::{grid_gradient, mc_vertex};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::spec::sdf_lines::*;
+// The host steps the device stage shares, under the twin's names too.
+pub use crate::spec::sdf_lines::{
+    DenseSample, Principal, cell_count, cells_overflow, check_points, dense_overflow, stats,
+};
 use crate::volume::Volume;
 use std::time::Instant;
 
@@ -54,56 +58,17 @@ pub fn priority(key: u32, seed: u32) -> u32 {
 
 /// The kernels' parameter block for `vol` with the resolved parameters.
 pub fn params(vol: &Volume, opts: &SdfLineOptions, r: &Resolved) -> SdflParams {
-    let cell = poisson_cell(r.spacing);
-    let cells = poisson_cells(extent(vol), cell);
-    SdflParams {
-        dims: [
-            vol.dims[0] as u32,
-            vol.dims[1] as u32,
-            vol.dims[2] as u32,
-            0,
-        ],
-        spacing: [
-            vol.spacing[0] as f32,
-            vol.spacing[1] as f32,
-            vol.spacing[2] as f32,
-            0.0,
-        ],
-        cells: [cells[0] as u32, cells[1] as u32, cells[2] as u32, 0],
-        iso: opts.iso,
-        sign: match opts.inside {
-            Inside::Below => 1.0,
-            Inside::Above => -1.0,
-        },
-        h: r.sampling as f32,
-        step: r.step as f32,
-        cell,
-        r2: (r.spacing * r.spacing) as f32,
-        umbilic_rel: opts.umbilic_rel as f32,
-        umbilic_abs: r.umbilic_abs as f32,
-        length: r.length as f32,
-        width: r.width as f32,
-        length_low: opts.length_low as f32,
-        width_low: opts.width_low as f32,
-        seed: opts.seed,
-        max_steps: r.max_steps,
-        newton: NEWTON_STEPS,
-        pad: 0,
-    }
+    params_for(vol.dims, vol.spacing, opts, r)
 }
 
 /// The volume's extent in world units from voxel 0 (`(n − 1) · spacing`).
 pub fn extent(vol: &Volume) -> [f64; 3] {
-    std::array::from_fn(|a| vol.dims[a].saturating_sub(1) as f64 * vol.spacing[a])
+    extent_of(vol.dims, vol.spacing)
 }
 
-/// One dense surface sample.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DenseSample {
-    /// Local world position (world − origin), f32 as on the device.
-    pub p: [f32; 3],
-    /// Edge key `3 · g + axis` (g: linear index of the edge's lower grid point).
-    pub key: u32,
+/// Validates the volume and options and returns the dense bound.
+pub fn check(vol: &Volume, opts: &SdfLineOptions) -> Result<usize> {
+    check_for(vol.dims, opts)
 }
 
 /// True when the grid edge from `v0` to `v1` crosses iso: both finite and on
@@ -119,7 +84,7 @@ pub fn crosses(v0: f32, v1: f32, iso: f32) -> bool {
 /// [`Error::InvalidArgument`] when there are more than `bound` samples
 /// (naming the count) or the volume has 2³² / 3 voxels or more.
 pub fn dense(vol: &Volume, iso: f32, bound: usize) -> Result<Vec<DenseSample>> {
-    check_dims(vol)?;
+    check_dims(vol.dims)?;
     let [nx, ny, nz] = vol.dims;
     let sp = vol.spacing.map(|s| s as f32);
     let mut out = Vec::new();
@@ -154,24 +119,6 @@ pub fn dense(vol: &Volume, iso: f32, bound: usize) -> Result<Vec<DenseSample>> {
     Ok(out)
 }
 
-/// The error for `count` dense samples over `bound`.
-pub fn dense_overflow(count: usize, bound: usize) -> Error {
-    Error::InvalidArgument(format!(
-        "curvature-directed strokes: the surface has {count} dense samples, more than the \
-         bound of {bound}; raise the bound or lower the resolution"
-    ))
-}
-
-fn check_dims(vol: &Volume) -> Result<()> {
-    let n = vol.voxel_count() as u64;
-    if n.saturating_mul(3) >= u32::MAX as u64 {
-        return Err(Error::InvalidArgument(format!(
-            "curvature-directed strokes: volume of {n} voxels; at most (2^32 − 1)/3 voxels"
-        )));
-    }
-    Ok(())
-}
-
 /// Poisson cell of a local position (f32, as the kernel computes it).
 pub fn cell_of(p: [f32; 3], cell: f32, cells: [u32; 4]) -> usize {
     let c: [usize; 3] = std::array::from_fn(|a| {
@@ -179,23 +126,6 @@ pub fn cell_of(p: [f32; 3], cell: f32, cells: [u32; 4]) -> usize {
         (q.max(0.0) as usize).min(cells[a] as usize - 1)
     });
     c[0] + cells[0] as usize * (c[1] + cells[1] as usize * c[2])
-}
-
-/// The error for a Poisson grid of `count` cells over `bound`.
-pub fn cells_overflow(count: u128, bound: usize, r: f64) -> Error {
-    Error::InvalidArgument(format!(
-        "curvature-directed strokes: a seed spacing of {r} needs a Poisson grid of {count} \
-         cells, more than the bound of {bound}; raise the spacing"
-    ))
-}
-
-/// Total cells of the parameter block's grid, checked against `bound`.
-pub fn cell_count(p: &SdflParams, bound: usize, r: f64) -> Result<usize> {
-    let n = p.cells[..3].iter().map(|&c| c as u128).product::<u128>();
-    if n > bound as u128 {
-        return Err(cells_overflow(n, bound, r));
-    }
-    Ok(n as usize)
 }
 
 /// Squared distance in f32 with the kernel's operation order (no fused
@@ -402,21 +332,6 @@ impl<'a> Field<'a> {
     pub fn curvature(&self, p: V3, h: f64) -> Principal {
         principal(self.grad(p), self.hessian(p, h))
     }
-}
-
-/// Principal curvatures and the first principal direction at a point.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Principal {
-    /// Outward unit normal ∇f/|∇f|.
-    pub n: V3,
-    /// Larger (signed) principal curvature.
-    pub k1: f64,
-    /// Smaller principal curvature.
-    pub k2: f64,
-    /// Unit tangent direction of κ1.
-    pub d1: V3,
-    /// False when |∇f| is zero or anything is not finite (then all zero).
-    pub valid: bool,
 }
 
 /// The tangent basis of unit normal `n`: `u = normalize(n × e)` with `e` the
@@ -649,18 +564,6 @@ pub fn strips(tr: &Traced) -> (Vec<f64>, Vec<V3>) {
     (widths, verts)
 }
 
-/// Validates the volume and options and returns the dense bound.
-pub fn check(vol: &Volume, opts: &SdfLineOptions) -> Result<usize> {
-    check_dims(vol)?;
-    if !opts.iso.is_finite() {
-        return Err(Error::InvalidArgument(format!(
-            "curvature-directed strokes: the iso value must be finite, got {}",
-            opts.iso
-        )));
-    }
-    Ok(opts.max_dense.unwrap_or_else(|| dense_bound(vol.dims)))
-}
-
 /// The whole family on the CPU, like `stages::sdf_lines::SdfLines::run`.
 ///
 /// # Errors
@@ -743,46 +646,4 @@ pub fn run(vol: &Volume, opts: &SdfLineOptions) -> Result<SdfLinesOutput> {
     out.stats = stats(samples.len(), &out, res, sweep, lo, hi);
     out.stats.timing.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(out)
-}
-
-/// Checks the traced-point bound for `seeds` seeds.
-///
-/// # Errors
-///
-/// [`Error::InvalidArgument`] naming the seed count when
-/// [`stroke_points_bound`] exceeds `max_points`.
-pub fn check_points(seeds: usize, res: &Resolved, max_points: usize) -> Result<()> {
-    let need = stroke_points_bound(seeds, res.points_per_stroke());
-    if need > max_points {
-        return Err(Error::InvalidArgument(format!(
-            "curvature-directed strokes: {seeds} seeds × {} points per stroke = {need} traced \
-             points, more than the bound of {max_points}; raise the seed spacing (now {})",
-            res.points_per_stroke(),
-            res.spacing
-        )));
-    }
-    Ok(())
-}
-
-/// The stats of an output (counts from its strokes).
-pub fn stats(
-    dense: usize,
-    out: &SdfLinesOutput,
-    res: Resolved,
-    sweep: Vec<CvPoint>,
-    lo: f64,
-    hi: f64,
-) -> SdfLineStats {
-    SdfLineStats {
-        dense,
-        seeds: out.seeds.len(),
-        strokes: out.strokes.len(),
-        segments: out.strokes.iter().map(|s| s.points.len() - 1).sum(),
-        strip_vertices: out.strokes.iter().map(|s| s.strip.len()).sum(),
-        params: Some(res),
-        sweep,
-        k1_min: lo,
-        k1_max: hi,
-        ..Default::default()
-    }
 }

@@ -173,17 +173,4 @@ pub fn fuse_finish(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Fused {
     }
 }
 
-/// A triangle's sorted vertex set and whether its winding is an even
-/// permutation of it (same rule as the kernel's `tri_set`).
-pub fn tri_set(f: [u32; 3]) -> ([u32; 3], bool) {
-    let mut s = f;
-    s.sort_unstable();
-    let even = if f[0] == s[0] {
-        f[1] < f[2]
-    } else if f[1] == s[0] {
-        f[2] < f[0]
-    } else {
-        f[0] < f[1]
-    };
-    (s, even)
-}
+pub use crate::spec::vertex_fusion::tri_set;

@@ -12,13 +12,14 @@
 //! so the subset's reference pieces are those of a reference over every
 //! segment.
 
-use crate::cpu::visibility::{Plan, agreement};
 use crate::error::Result;
 use crate::mesh::{Mesh, topology::vertex_normals};
 use crate::render::visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
 use crate::render::{Camera, Frame, MeshStyle, RenderOptions, Renderer};
 use crate::spec::feature_lines::Segment;
 use crate::spec::visibility::Pieces;
+use crate::spec::visibility_plan::Plan;
+use crate::spec::visibility_plan::agreement;
 use glam::{Vec3, Vec4};
 
 /// Points per segment at which the depth-buffer method is read.

@@ -232,6 +232,77 @@ crate::spec::kernels::kernel_entries! {
     }
 }
 
+/// A built tree: sorted codes and faces (leaf order), internal nodes, leaf
+/// parents and boxes, as the device's buffers hold them (the device stage
+/// reads it back; the twin builds and walks it, `cpu::bvh`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tree {
+    /// Morton codes in leaf order.
+    pub keys: Vec<u32>,
+    /// The face of each leaf.
+    pub faces_sorted: Vec<u32>,
+    /// Internal nodes (node 0 the root).
+    pub nodes: Vec<BvhNode>,
+    /// Parent of each leaf ([`NONE`] for a lone leaf).
+    pub leaf_parent: Vec<u32>,
+    /// Box of each internal node.
+    pub node_boxes: Vec<BvhBox>,
+    /// Box of each leaf.
+    pub leaf_boxes: Vec<BvhBox>,
+    /// The two children's boxes of each internal node, padded as the
+    /// traversal tests them (`cpu::bvh::padded`): `2·node` the left, `2·node + 1`
+    /// the right (one read of 64 bytes per node visited).
+    pub child_boxes: Vec<BvhBox>,
+}
+
+/// The input checks of a BVH's mesh, which the device stage and the twin
+/// both run before they build.
+/// Checks that every face names existing vertices and that the tree can
+/// number the faces; `what` names the mesh in errors.
+pub fn check_faces(what: &str, n_vertices: usize, faces: &[[u32; 3]]) -> crate::error::Result<()> {
+    if faces.len() > MAX_FACES {
+        return Err(crate::error::Error::InvalidArgument(format!(
+            "{what}: {} faces, a BVH holds at most {MAX_FACES}",
+            faces.len()
+        )));
+    }
+    for (i, f) in faces.iter().enumerate() {
+        if let Some(&v) = f.iter().find(|&&v| v as usize >= n_vertices) {
+            return Err(crate::error::Error::InvalidInput {
+                source_name: what.to_string(),
+                element: format!("face {i}"),
+                problem: format!("vertex index {v} out of range ({n_vertices} vertices)"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that there are `n_vertices` finite positions.
+pub fn check_positions(
+    what: &str,
+    n_vertices: usize,
+    positions: &[[f32; 3]],
+) -> crate::error::Result<()> {
+    if positions.len() != n_vertices {
+        return Err(crate::error::Error::InvalidArgument(format!(
+            "{what}: {} positions for {n_vertices} vertices",
+            positions.len()
+        )));
+    }
+    match positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        Some(i) => Err(crate::error::Error::InvalidInput {
+            source_name: what.to_string(),
+            element: format!("vertex {i}"),
+            problem: "position is not finite".to_string(),
+        }),
+        None => Ok(()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

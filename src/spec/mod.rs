@@ -30,6 +30,7 @@ pub mod timing;
 pub mod vertex_fusion;
 pub mod view;
 pub mod visibility;
+pub mod visibility_plan;
 
 /// An option enum named by words (`atomic`, `gather`, ...): every choice and
 /// its name, the same on the command line, in scene files and in stats.

@@ -16,6 +16,7 @@
 //! world coordinates (world − origin) so that a volume far from the origin
 //! keeps its float precision; the host adds the origin back in f64.
 
+use crate::error::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 
 /// Hessian sampling distances tried by the automatic choice, in voxels (the
@@ -486,5 +487,163 @@ crate::spec::kernels::kernel_entries! {
         Trace = "sdfl_trace",
         /// Tapered triangle strips.
         Strips = "sdfl_strips",
+    }
+}
+
+// ---- Host steps the device stage and its twin share ----
+
+/// The kernels' parameter block for a volume of `dims` samples `spacing`
+/// apart with the resolved parameters.
+pub fn params_for(
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    opts: &SdfLineOptions,
+    r: &Resolved,
+) -> SdflParams {
+    let cell = poisson_cell(r.spacing);
+    let cells = poisson_cells(extent_of(dims, spacing), cell);
+    SdflParams {
+        dims: [dims[0] as u32, dims[1] as u32, dims[2] as u32, 0],
+        spacing: [spacing[0] as f32, spacing[1] as f32, spacing[2] as f32, 0.0],
+        cells: [cells[0] as u32, cells[1] as u32, cells[2] as u32, 0],
+        iso: opts.iso,
+        sign: match opts.inside {
+            Inside::Below => 1.0,
+            Inside::Above => -1.0,
+        },
+        h: r.sampling as f32,
+        step: r.step as f32,
+        cell,
+        r2: (r.spacing * r.spacing) as f32,
+        umbilic_rel: opts.umbilic_rel as f32,
+        umbilic_abs: r.umbilic_abs as f32,
+        length: r.length as f32,
+        width: r.width as f32,
+        length_low: opts.length_low as f32,
+        width_low: opts.width_low as f32,
+        seed: opts.seed,
+        max_steps: r.max_steps,
+        newton: NEWTON_STEPS,
+        pad: 0,
+    }
+}
+
+/// A volume's extent in world units from voxel 0 (`(n − 1) · spacing`).
+pub fn extent_of(dims: [usize; 3], spacing: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|a| dims[a].saturating_sub(1) as f64 * spacing[a])
+}
+
+/// One dense surface sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DenseSample {
+    /// Local world position (world − origin), f32 as on the device.
+    pub p: [f32; 3],
+    /// Edge key `3 · g + axis` (g: linear index of the edge's lower grid point).
+    pub key: u32,
+}
+
+/// The error for `count` dense samples over `bound`.
+pub fn dense_overflow(count: usize, bound: usize) -> Error {
+    Error::InvalidArgument(format!(
+        "curvature-directed strokes: the surface has {count} dense samples, more than the \
+         bound of {bound}; raise the bound or lower the resolution"
+    ))
+}
+
+/// Refuses a volume too large for the edge keys (`3 · voxel + axis` in u32).
+pub fn check_dims(dims: [usize; 3]) -> Result<()> {
+    let n = dims.iter().map(|&d| d as u64).product::<u64>();
+    if n.saturating_mul(3) >= u32::MAX as u64 {
+        return Err(Error::InvalidArgument(format!(
+            "curvature-directed strokes: volume of {n} voxels; at most (2^32 − 1)/3 voxels"
+        )));
+    }
+    Ok(())
+}
+
+/// The error for a Poisson grid of `count` cells over `bound`.
+pub fn cells_overflow(count: u128, bound: usize, r: f64) -> Error {
+    Error::InvalidArgument(format!(
+        "curvature-directed strokes: a seed spacing of {r} needs a Poisson grid of {count} \
+         cells, more than the bound of {bound}; raise the spacing"
+    ))
+}
+
+/// Total cells of the parameter block's grid, checked against `bound`.
+pub fn cell_count(p: &SdflParams, bound: usize, r: f64) -> Result<usize> {
+    let n = p.cells[..3].iter().map(|&c| c as u128).product::<u128>();
+    if n > bound as u128 {
+        return Err(cells_overflow(n, bound, r));
+    }
+    Ok(n as usize)
+}
+
+/// Principal curvatures and the first principal direction at a point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Principal {
+    /// Outward unit normal ∇f/|∇f|.
+    pub n: [f64; 3],
+    /// Larger (signed) principal curvature.
+    pub k1: f64,
+    /// Smaller principal curvature.
+    pub k2: f64,
+    /// Unit tangent direction of κ1.
+    pub d1: [f64; 3],
+    /// False when |∇f| is zero or anything is not finite (then all zero).
+    pub valid: bool,
+}
+
+/// Validates a volume of `dims` samples and the options; returns the
+/// dense bound.
+pub fn check_for(dims: [usize; 3], opts: &SdfLineOptions) -> Result<usize> {
+    check_dims(dims)?;
+    if !opts.iso.is_finite() {
+        return Err(Error::InvalidArgument(format!(
+            "curvature-directed strokes: the iso value must be finite, got {}",
+            opts.iso
+        )));
+    }
+    Ok(opts.max_dense.unwrap_or_else(|| dense_bound(dims)))
+}
+
+/// Checks the traced-point bound for `seeds` seeds.
+///
+/// # Errors
+///
+/// [`Error::InvalidArgument`] naming the seed count when
+/// [`stroke_points_bound`] exceeds `max_points`.
+pub fn check_points(seeds: usize, res: &Resolved, max_points: usize) -> Result<()> {
+    let need = stroke_points_bound(seeds, res.points_per_stroke());
+    if need > max_points {
+        return Err(Error::InvalidArgument(format!(
+            "curvature-directed strokes: {seeds} seeds × {} points per stroke = {need} traced \
+             points, more than the bound of {max_points}; raise the seed spacing (now {})",
+            res.points_per_stroke(),
+            res.spacing
+        )));
+    }
+    Ok(())
+}
+
+/// The stats of an output (counts from its strokes).
+pub fn stats(
+    dense: usize,
+    out: &SdfLinesOutput,
+    res: Resolved,
+    sweep: Vec<CvPoint>,
+    lo: f64,
+    hi: f64,
+) -> SdfLineStats {
+    SdfLineStats {
+        dense,
+        seeds: out.seeds.len(),
+        strokes: out.strokes.len(),
+        segments: out.strokes.iter().map(|s| s.points.len() - 1).sum(),
+        strip_vertices: out.strokes.iter().map(|s| s.strip.len()).sum(),
+        params: Some(res),
+        sweep,
+        k1_min: lo,
+        k1_max: hi,
+        ..Default::default()
     }
 }

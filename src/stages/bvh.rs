@@ -22,13 +22,13 @@
 //! (stack overflows of the last query batch). An empty face list is an empty
 //! tree: nothing is launched and every query is visible.
 
-use crate::cpu::bvh::{Tree, check_faces, check_positions};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::bvh::{
     BOX_PAD, BvhBox, BvhKernel, BvhNode, BvhQuery, EDGE_EPS, END_EPS, MORTON_BITS, MortonFrame,
     NONE, STACK_DEPTH, bvh_bound,
 };
+use crate::spec::bvh::{Tree, check_faces, check_positions};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::kernel_files;
 use crate::stages::radix_sort::RadixSort;

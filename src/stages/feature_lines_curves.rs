@@ -9,12 +9,12 @@
 //! view and only for the families that read them. CPU twin:
 //! [`crate::cpu::feature_lines_curves`].
 
-use crate::cpu::feature_lines_curves::{ScaledThresholds, boundary_mask};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::feature_lines::{
     CurveOptions, FamilySet, LineFamily, LinesCurvesKernel, Segment, curve_segments_estimate,
 };
+use crate::spec::feature_lines::{ScaledThresholds, boundary_mask};
 use crate::spec::timing::{Step, Timing};
 use crate::stages::kernel_files;
 use opencl3::kernel::Kernel;

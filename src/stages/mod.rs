@@ -4,6 +4,7 @@
 
 pub mod ao;
 pub mod bvh;
+pub mod chains;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

@@ -13,9 +13,6 @@
 //! the count. Nothing is ever written past a buffer (kernels check
 //! capacities and count what did not fit).
 
-use crate::cpu::sdf_lines::{
-    self as twin, DenseSample, Principal, cell_count, check, check_points, dense_overflow,
-};
 use crate::error::{Error, Result};
 use crate::gpu::{Arg, Gpu, buf, event_ms, launch};
 use crate::spec::sdf_lines::SdflKernel;
@@ -143,7 +140,7 @@ impl SdfLines {
     /// Invalid options (non-finite iso), a volume of 2³²/3 voxels or more, or
     /// one the device cannot hold, or an OpenCL failure.
     pub fn new(gpu: Arc<Gpu>, vol: &Volume, opts: &SdfLineOptions) -> Result<SdfLines> {
-        let dense_bound = check(vol, opts)?;
+        let dense_bound = check_for(vol.dims, opts)?;
         let p = gpu.program(&kernel_files::SDF_LINES, "")?;
         let kernel = |k: SdflKernel| gpu.entry(&p, k);
         let k = Kernels {
@@ -188,23 +185,12 @@ impl SdfLines {
         &self.gpu
     }
 
-    fn volume_shape(&self) -> Volume {
-        Volume {
-            dims: self.dims,
-            spacing: self.spacing,
-            origin: self.origin,
-            values: Vec::new(),
-        }
-    }
-
     fn set_params(&mut self, p: &SdflParams) -> Result<()> {
         self.gpu.write(&mut self.params, std::slice::from_ref(p))
     }
 
     fn base_params(&self, res: &Resolved) -> SdflParams {
-        let shape = self.volume_shape();
-        // cpu::sdf_lines::params only reads the geometry of the volume.
-        twin::params(&shape, &self.opts, res)
+        params_for(self.dims, self.spacing, &self.opts, res)
     }
 
     fn n_voxels(&self) -> usize {
@@ -496,7 +482,7 @@ impl SdfLines {
         // Read back.
         let (lo, hi) = read_range(&self.gpu, &range)?;
         let mut out = self.read_strokes(&seeds, &curv, &traced, &strips, kk)?;
-        out.stats = twin::stats(dense, &out, res, sweep, lo, hi);
+        out.stats = stats(dense, &out, res, sweep, lo, hi);
         let mut t = self.ms;
         t.total =
             t.dense + t.thin + t.gradient + t.curvature + t.range + t.trace + t.strips + t.sweep;

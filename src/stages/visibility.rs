@@ -15,12 +15,12 @@
 //! its own arrays are read in order too. Each segment's pieces depend only
 //! on its own queries: the order changes the time, not the answer.
 
-use crate::cpu::visibility::{Plan, classify_by, hidden_from, queries_of};
 use crate::error::{Error, Result};
 use crate::spec::feature_lines::Segment;
 use crate::spec::timing::Timing;
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
+use crate::spec::visibility_plan::{Plan, classify_by, hidden_from, queries_of};
 use crate::stages::bvh::Bvh;
 
 /// The pieces of `segments` seen in `view` over the mesh (`positions`,

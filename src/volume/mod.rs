@@ -37,6 +37,7 @@
 mod data_files;
 mod decode;
 mod format;
+pub mod gradient;
 mod load;
 mod mhd;
 mod nrrd;

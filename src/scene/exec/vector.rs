@@ -2,12 +2,10 @@
 //! SVG draws ([`gather`]: the drawn line families' segments, then the
 //! drawn feature edges), split where their visibility changes by the
 //! `visibility` family over the mesh's BVH, joined into chains
-//! ([`crate::cpu::chains`]), and the SVG groups of those chains
+//! ([`crate::stages::chains`]), and the SVG groups of those chains
 //! ([`svg_layers_exact`]): one polyline per chain, in the same groups, ids
 //! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
 
-use crate::cpu::chains::{Chain, ChainPiece, chain, chain_pieces};
-use crate::cpu::visibility::Plan as VisPlan;
 use crate::error::Result;
 use crate::export::svg::{SvgLayer, SvgPolyline, pixel};
 use crate::render::Camera;
@@ -18,7 +16,9 @@ use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
 use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
+use crate::spec::visibility_plan::Plan as VisPlan;
 use crate::stages::bvh::Bvh;
+use crate::stages::chains::{Chain, ChainPiece, chain, chain_pieces};
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
 pub use crate::spec::feature_lines::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES};
@@ -144,7 +144,7 @@ impl VisibleLines {
 
     /// Mean pieces per visible chain (0 without one).
     pub fn mean_chain_length(&self) -> f64 {
-        crate::cpu::chains::mean_length(self.chains.iter().filter(|c| c.visible))
+        crate::stages::chains::mean_length(self.chains.iter().filter(|c| c.visible))
     }
 
     /// The chain of each piece of [`VisibleLines::chain_pieces`].

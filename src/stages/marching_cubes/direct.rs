@@ -627,7 +627,7 @@ impl Direct {
 fn hit_twins(rec: &[u32]) -> bool {
     let mut seen: std::collections::HashMap<[u32; 3], u8> = Default::default();
     for r in rec.chunks_exact(3) {
-        let (set, even) = crate::cpu::vertex_fusion::tri_set([r[0], r[1], r[2]]);
+        let (set, even) = crate::spec::vertex_fusion::tri_set([r[0], r[1], r[2]]);
         let w = seen.entry(set).or_default();
         *w |= if even { 1 } else { 2 };
         if *w == 3 {

@@ -584,7 +584,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let gradient =
             self.plan.contains(Pass::VertexNormals) && !self.plan.contains(Pass::Curvature);
         self.iso_normals = gradient.then(|| {
-            crate::cpu::marching_cubes::gradient_normals(v, &ipos)
+            crate::volume::gradient::gradient_normals(v, &ipos)
                 .iter()
                 .map(|n| n.map(|c| c as f32))
                 .collect()
