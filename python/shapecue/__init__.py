@@ -59,14 +59,14 @@ __all__ = [
 
 #: The code of each line family or layer in the ``family`` arrays of the
 #: NPZ files (those of ``shapecue lines --npz`` and of the batch's ``lines``
-#: task) and in :attr:`Lines.family_code` / :attr:`LineView.family_code`,
-#: with its name: the line families 0 to 11, the layers of feature edges,
-#: intersection lines and curvature strokes above 65535. The same table as
-#: the ``family_codes`` of the command line's manifest.
+#: task) and in :attr:`LineView.family_code`, with its name: the line
+#: families 0 to 11, the layers of feature edges, intersection lines and
+#: curvature strokes above 65535. The same table as the ``family_codes`` of
+#: the command line's manifest.
 FAMILY_CODES: dict = dict(_shapecue.family_codes())
 
 #: The line families by code (0 to 11): the names ``lines=`` takes and
-#: :meth:`Lines.of` / :meth:`LineView.of` select.
+#: :meth:`LineView.of` selects.
 LINE_FAMILIES: tuple = tuple(n for c, n in sorted(FAMILY_CODES.items()) if c < 1 << 16)
 
 _VERTEX_DTYPES = (np.float64, np.float32)
@@ -538,71 +538,43 @@ def _deprecated_kind(owner: str) -> None:
 
 
 @dataclass
-class Lines:
-    """Line segments of :func:`lines` from one eye, one row per segment.
+class LineView:
+    """One view of :func:`lines`: its lines split where their visibility
+    changes (exact, in object space) and chained, one row per piece, in the
+    library's canonical order. One eye gives the rows of ``shapecue lines
+    MESH -o FILE.svg --segments FILE.json`` (its ``segments`` list), a view
+    of ``cameras`` those of the NPZ of ``shapecue lines --views N --npz``:
+    the same rows, in the same order, bit for bit.
 
-    ``segments`` (S, 2, 3) float32 end points (world coordinates);
-    ``family`` (S,) each segment's family name (str, as ``lines=`` names
-    them); ``family_code`` (S,) uint32 its code, the number that NPZ files
-    hold in their ``family`` array (:data:`FAMILY_CODES` maps codes to
-    names); ``strength`` (S,) float32 in [0, 1]; ``feature_size`` the length
+    ``a``, ``b`` (P, 3) float32 piece ends (world coordinates), also as
+    ``segments`` (P, 2, 3); ``family`` (P,) each piece's family name (str)
+    and ``family_code`` (P,) uint32 its code, the number NPZ files hold in
+    their ``family`` array (:data:`FAMILY_CODES` maps codes to names);
+    ``strength`` (P,) float32 in (0, 1]; ``visible`` (P,) bool; ``chain``
+    (P,) uint32 the chain (polyline) of each piece; provenance: ``faces``
+    (P, 4) int64 the faces its segment lies on (-1 past the last), ``face``
+    (P,) int64 the face it lies in and ``bary`` (P, 2, 3) float32 each
+    end's barycentric coordinates in that face, so that ``a ==
+    (bary[:, 0, :, None] * vertices[faces_of_mesh[face]]).sum(1)``.
+    ``fields`` (with ``fields=True``): per vertex ``ndotv``, ``kr`` (κr
+    sin²θ), ``dwkr`` (D_w κr) and ``q1`` (apparent ridges' view-dependent
+    curvature, as rtsc keeps it), world units. ``npz`` (with ``npz=True``):
+    ``{"segments": bytes, "fields": bytes}``, the bytes of the view's
+    ``_segments.npz`` and (with ``fields=True``) ``_fields.npz`` files as
+    ``shapecue lines --views N --out DIR --npz --fields`` writes them.
+    ``camera``: eye, target, up, fov (degrees) or ortho (height), near and
+    far, as the command line's manifest lists them. ``passes``: the passes
+    that ran for this view (the first view also runs the pose's:
+    curvature, the feature size, the BVH), ``passes_ms`` their own clocks
+    summed and ``kernel_ms`` the part the device clocked (kernels);
+    ``wall_ms`` the wall-clock ms from the end of the view before (for the
+    first, from the start of the call: opening the device and the pose
+    passes included) to the end of this one. ``feature_size``: the length
     the dimensionless thresholds were scaled by: with ``feature_size="rtsc"``
     (the default) rtsc's, 0.01 over the 10th percentile of |k1| and |k2| at
     500 sampled vertices and at most 5 % of the bounding sphere's radius,
-    with ``"edge"`` the median edge length, or the length given;
-    ``kernel_ms`` the kernels' time; ``device`` the device's name.
-
-    ``kind``: deprecated, the earlier name of ``family_code`` (reading it
-    warns).
-    """
-
-    segments: np.ndarray
-    family_code: np.ndarray
-    family: np.ndarray
-    strength: np.ndarray
-    feature_size: float
-    kernel_ms: float
-    device: str
-
-    @property
-    def kind(self) -> np.ndarray:
-        """Deprecated: :attr:`family_code` under its earlier name."""
-        _deprecated_kind("Lines")
-        return self.family_code
-
-    def of(self, family: str) -> np.ndarray:
-        """The (n, 2, 3) segments of one family (a name of
-        :data:`LINE_FAMILIES`; another name raises :class:`ValueError`)."""
-        return self.segments[self.family == _known_family(family)]
-
-
-@dataclass
-class LineView:
-    """One view of :func:`lines` with ``cameras``: its lines split where
-    their visibility changes (exact, in object space) and chained, one row
-    per piece, in the library's canonical order (the same rows, in the same
-    order, as the NPZ of ``shapecue lines --views N --npz``).
-
-    ``a``, ``b`` (P, 3) float32 piece ends (world coordinates); ``family``
-    (P,) each piece's family name (str) and ``family_code`` (P,) uint32 its
-    code, the number NPZ files hold in their ``family`` array
-    (:data:`FAMILY_CODES` maps codes to names); ``strength`` (P,) float32 in
-    [0, 1]; ``visible`` (P,) bool; ``chain`` (P,) uint32 the chain
-    (polyline) of each piece; provenance: ``faces`` (P, 4) int64 the faces
-    its segment lies on (-1 past the last), ``face`` (P,) int64 the face it
-    lies in and ``bary`` (P, 2, 3) float32 each end's barycentric
-    coordinates in that face, so that ``a == (bary[:, 0, :, None] *
-    vertices[faces_of_mesh[face]]).sum(1)``. ``fields`` (with
-    ``fields=True``): per vertex ``ndotv``, ``kr`` (κr sin²θ), ``dwkr`` (D_w
-    κr) and ``q1`` (apparent ridges' view-dependent curvature, as rtsc keeps
-    it), world units. ``camera``: eye, target, up, fov (degrees) or ortho
-    (height). ``passes``: the passes that ran for this view (the first view
-    also runs the pose's: curvature, the feature size, the BVH) and
-    ``passes_ms`` their own clocks summed; ``wall_ms`` the wall-clock ms
-    from the end of the view before (for the first, from the start of the
-    call: opening the device and the pose passes included) to the end of
-    this one. ``feature_size``: the length the thresholds were scaled by
-    (see :class:`Lines`).
+    with ``"edge"`` the median edge length, or the length given.
+    ``device``: the device's name.
 
     ``kind``: deprecated, the earlier name of ``family_code`` (reading it
     warns).
@@ -622,9 +594,17 @@ class LineView:
     camera: dict
     passes: list
     passes_ms: float
+    kernel_ms: float
     wall_ms: float
     feature_size: float
     device: str
+    npz: Optional[dict] = None
+
+    @property
+    def segments(self) -> np.ndarray:
+        """The (P, 2, 3) pieces, ``a`` and ``b`` of each row (visible or
+        not)."""
+        return np.stack([self.a, self.b], axis=1)
 
     @property
     def kind(self) -> np.ndarray:
@@ -640,6 +620,14 @@ class LineView:
         if visible_only:
             keep &= self.visible
         return np.stack([self.a[keep], self.b[keep]], axis=1)
+
+
+#: The earlier name of the result of :func:`lines` from one eye, kept so
+#: that code naming it still runs: one eye now gives a :class:`LineView`
+#: (pieces with exact visibility, as the command line draws them) instead
+#: of whole segments with no visibility. Its ``segments`` are the pieces,
+#: and ``of(family)`` gives the visible ones unless ``visible_only=False``.
+Lines = LineView
 
 
 _CAMERA_SET_WORDS = "a number of views from 1 to {}, a list of camera dicts or a camera JSON file"
@@ -724,6 +712,35 @@ def _levels(isophotes: Any) -> int:
     return n
 
 
+def _vec3(x: Any, what: str) -> Optional[Tuple[float, float, float]]:
+    """``x`` as three finite floats, or None for None."""
+    if x is None:
+        return None
+    try:
+        t = tuple(float(c) for c in x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: expected three finite numbers, got {x!r}") from None
+    if len(t) != 3 or not all(math.isfinite(c) for c in t):
+        raise ValueError(f"{what}: expected three finite numbers, got {x!r}")
+    return t
+
+
+def _one_shot(
+    eye: Any, direction: Any, target: Any, up: Any
+) -> Tuple[Optional[tuple], tuple, Optional[tuple], Optional[tuple]]:
+    """The one camera of :func:`lines` without ``cameras``, as the binding
+    takes it: (eye, direction, target, up)."""
+    e = _vec3(eye, "eye")
+    d = _vec3((1.0, 1.0, 1.0) if direction is None else direction, "direction")
+    if not any(d):
+        raise ValueError("direction: expected three finite numbers, not all zero")
+    if e is None and target is not None:
+        raise ValueError("target goes with eye: a camera fitted from direction looks at the centre")
+    if e is not None and direction is not None:
+        raise ValueError("give eye or direction, not both: direction fits the camera when no eye is given")
+    return e, d, _vec3(target, "target"), _vec3(up, "up")
+
+
 def lines(
     vertices: Any,
     faces: Any = None,
@@ -731,10 +748,13 @@ def lines(
     lines: Union[str, Sequence[str]] = "contours,suggestive",
     cameras: Any = None,
     fields: bool = False,
+    npz: bool = False,
     size: Tuple[int, int] = (800, 600),
     fov: float = 40.0,
     eye: Optional[Sequence[float]] = None,
-    direction: Sequence[float] = (1.0, 1.0, 1.0),
+    direction: Optional[Sequence[float]] = None,
+    target: Optional[Sequence[float]] = None,
+    up: Optional[Sequence[float]] = None,
     ortho: bool = False,
     sc_threshold: float = 0.01,
     rv_threshold: float = 0.1,
@@ -753,10 +773,42 @@ def lines(
     compat: str = "exact",
     accumulate: str = "auto",
     device: Union[int, str, None] = None,
-) -> Union[Lines, List[LineView]]:
-    """The line families of rtsc (Rusinkiewicz and DeCarlo) on a mesh seen
-    from ``eye`` (a point; with ``ortho``, the direction towards the viewer),
-    by default three bounding radii from the centre along ``direction``.
+) -> Union[LineView, List[LineView]]:
+    """The line families of rtsc (Rusinkiewicz and DeCarlo) on a mesh, from
+    one camera (a :class:`LineView`) or many (``cameras``: a list of them),
+    by one route: the library's views of one setup (curvature, the feature
+    size and the BVH once, the view passes per camera), each view's lines
+    split by exact visibility and chained, with their faces and barycentric
+    coordinates. No OpenGL is needed.
+
+    **One camera** (no ``cameras``): the camera of ``shapecue lines MESH -o
+    FILE.svg``, at ``eye`` (a point, also with ``ortho``, as ``--eye``)
+    looking at ``target`` (default: the centre of the bounding box) with
+    ``up`` (default +Y, or +Z when looking along Y); without ``eye`` fitted
+    from ``direction`` (default (1, 1, 1)), the bounding sphere filling the
+    view with a 5 % margin. Returns one :class:`LineView` with the rows of
+    ``shapecue lines MESH -o FILE.svg --segments FILE.json`` with the same
+    options: the same pieces, in the same order, bit for bit. One eye now
+    returns a LineView with exact visibility, as the command line draws it;
+    earlier it returned whole segments with no visibility (``Lines``, now a
+    name of :class:`LineView`), from an eye three bounding radii out, and
+    with ``ortho`` ``eye`` was a direction.
+
+    **Many views** (``cameras``: a number N of views on the Fibonacci
+    lattice around the mesh, a list of ``{"eye", "target", "up"?, "fov"? |
+    "ortho"?}`` dicts, or a camera JSON file as ``shapecue lines
+    --cameras`` reads): returns a list of :class:`LineView`, one per camera.
+    The rows are the same, in the same order, as those of ``shapecue lines
+    MESH --views N --npz`` (or ``--cameras FILE``) with the same options.
+    Ctrl-C (``KeyboardInterrupt``) stops a call of many views within one
+    view's time.
+
+    ``size`` (width, height) is the image the fitted views frame and the
+    visibility's sample spacing is for; ``fov`` and ``ortho`` are the
+    cameras' defaults. ``fields=True`` adds each view's per-vertex fields;
+    ``npz=True`` each view's ``npz``, the bytes of the command line's
+    ``_segments.npz`` (and with ``fields`` ``_fields.npz``) files. The same
+    options give the same bytes every call.
 
     ``lines``: names among contours, suggestive, ridges, valleys,
     apparent-ridges, suggestive-highlights, principal-highlights, isophotes,
@@ -774,21 +826,6 @@ def lines(
 
     ``vertices`` may also be a mesh file (.obj/.ply/.off), read by
     :func:`load_mesh`.
-
-    **Many views** (``cameras``: a number N of views on the Fibonacci
-    lattice around the mesh, a list of ``{"eye", "target", "up"?, "fov"? |
-    "ortho"?}`` dicts, or a camera JSON file as ``shapecue lines
-    --cameras`` reads): returns a list of :class:`LineView`, one per camera,
-    computed in one setup (curvature and the BVH once, the view passes per
-    camera), each view's lines split by exact visibility and chained, with
-    their faces and barycentric coordinates, and with ``fields=True`` the
-    per-vertex fields. ``size`` (width, height) is the image the fitted
-    views frame and the visibility's sample spacing is for; ``fov`` and
-    ``ortho`` are the cameras' defaults. No OpenGL is needed. The rows are
-    the same, in the same order, as those of ``shapecue lines MESH --views N
-    --npz`` (or ``--cameras FILE``) with the same options, and the same
-    bytes every call. Ctrl-C (``KeyboardInterrupt``) stops a call of many
-    views within one view's time.
     """
     if isinstance(vertices, (str, os.PathLike)) and faces is None:
         vertices, faces = load_mesh(vertices)
@@ -804,45 +841,23 @@ def lines(
     )
     switches = (bool(cull), bool(test), bool(fade), bool(hermite), bool(hermite_kh))
     setup = (str(feature_size), str(compat), str(accumulate))
-    l3 = tuple(float(c) for c in light)
+    l3 = _vec3(light, "light")
     levels = _levels(isophotes)
-    if cameras is None and fields:
-        raise ValueError("fields come with the views of cameras=; one eye gives the segments only")
+    text = file = n = shot = None
     if cameras is not None:
-        if eye is not None:
-            raise ValueError("eye sets the one camera; with cameras give each its eye")
+        for k, x in (("eye", eye), ("direction", direction), ("target", target), ("up", up)):
+            if x is not None:
+                raise ValueError(f"{k} sets the one camera; with cameras give each its eye")
         text, file, n = _camera_set(cameras)
-        w, h = (int(x) for x in size)
-        views = _shapecue.lines_views(
-            v, f, names, text, file, n, (float(fov), bool(ortho), w, h),
-            thresholds, levels, l3, switches, setup, bool(fields), _device(device),
-        )
-        return [_line_view(d) for d in views]
-    if eye is None:
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        d = np.asarray(direction, dtype=np.float64)
-        if d.shape != (3,) or not np.all(np.isfinite(d)) or not np.any(d):
-            raise ValueError("direction: expected three finite numbers, not all zero")
-        d = d / np.linalg.norm(d)
-        r = 0.5 * float(np.linalg.norm(hi - lo))
-        eye = d if ortho else 0.5 * (lo + hi) + 3.0 * max(r, 1e-30) * d
-    e = tuple(float(c) for c in eye)
-    if len(e) != 3 or len(l3) != 3:
-        raise ValueError("eye and light: expected three numbers")
-    d = _shapecue.lines(
-        v,
-        f,
-        names,
-        e,
-        bool(ortho),
-        thresholds,
-        levels,
-        l3,
-        switches,
-        setup,
-        _device(device),
+    else:
+        shot = _one_shot(eye, direction, target, up)
+    w, h = (int(x) for x in size)
+    views = _shapecue.lines_views(
+        v, f, names, text, file, n, shot, (float(fov), bool(ortho), w, h),
+        thresholds, levels, l3, switches, setup, bool(fields), bool(npz), _device(device),
     )
-    return Lines(family=_family_names(d["family_code"]), **d)
+    out = [_line_view(d) for d in views]
+    return out if cameras is not None else out[0]
 
 
 def _line_view(d: dict) -> LineView:

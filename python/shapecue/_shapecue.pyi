@@ -59,19 +59,6 @@ def feature_edges(
     marked: Optional[list[list[int]]],
     device: Optional[str],
 ) -> dict[str, Any]: ...
-def lines(
-    vertices: npt.NDArray[np.floating],
-    faces: npt.NDArray[np.integer],
-    families: str,
-    eye: Tuple[float, float, float],
-    ortho: bool,
-    thresholds: Tuple[float, float, float, float, float, float],
-    isophotes: int,
-    light: Tuple[float, float, float],
-    switches: Tuple[bool, bool, bool, bool, bool],
-    setup: Tuple[str, str, str],
-    device: Optional[str],
-) -> dict[str, Any]: ...
 def lines_views(
     vertices: npt.NDArray[np.floating],
     faces: npt.NDArray[np.integer],
@@ -79,6 +66,14 @@ def lines_views(
     cameras: Optional[str],
     camera_file: Optional[str],
     views: Optional[int],
+    shot: Optional[
+        Tuple[
+            Optional[Tuple[float, float, float]],
+            Tuple[float, float, float],
+            Optional[Tuple[float, float, float]],
+            Optional[Tuple[float, float, float]],
+        ]
+    ],
     camera: Tuple[float, bool, int, int],
     thresholds: Tuple[float, float, float, float, float, float],
     isophotes: int,
@@ -86,6 +81,7 @@ def lines_views(
     switches: Tuple[bool, bool, bool, bool, bool],
     setup: Tuple[str, str, str],
     fields: bool,
+    npz: bool,
     device: Optional[str],
 ) -> list[dict[str, Any]]: ...
 def check_cameras(
@@ -105,6 +101,9 @@ def render_text(
     json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]
 ) -> str: ...
 def load_mesh(path: str, weld: bool) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
+def generated_mesh(name: str, vertices: int) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+    """The command line's generated meshes (torus, sphere, ellipsoid, cylinder,
+    plane) at about ``vertices`` vertices, for tests that compare with it."""
 def load_volume(
     path: str,
 ) -> Tuple[npt.NDArray[np.float32], Tuple[float, float, float], Tuple[float, float, float]]: ...

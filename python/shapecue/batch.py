@@ -31,18 +31,23 @@ Tasks:
   ``options={"iso": value}`` is required;
 - ``"render"``: a scene file, its images and report into ``<stem>/``;
 - ``"lines"``: a mesh file's line drawings from many views
-  (:func:`shapecue.lines` with ``cameras``) into ``<stem>/``: per view
-  ``view_NNN.npz`` with the pieces under the names and in the row order of
-  ``shapecue lines --views N --npz`` (``a``, ``b``, ``family`` (uint32
-  codes), ``strength``, ``visible``, ``faces``, ``chain``, ``face``,
-  ``bary``) followed by the code table ``family_codes`` (uint32) and
-  ``family_names`` (``<U24``; ``family_names[i]`` is the name of code
-  ``family_codes[i]``, as :data:`shapecue.FAMILY_CODES`), then the per-vertex fields (``ndotv``, ``kr``,
-  ``dwkr``, ``q1``; unless ``options={"fields": False}``) and the camera
-  (``eye``, ``target``, ``up``); and ``views.json`` (the input, its vertex
-  and face counts, the device, the options, the same code table
-  ``family_codes`` as the command line's manifest, each view's file,
-  camera and piece count). ``options``: ``views`` (a number of views,
+  (:func:`shapecue.lines` with ``cameras``) into ``<stem>/``, the files of
+  ``shapecue lines MESH --views N --out DIR --npz --fields`` under their
+  names and byte for byte: per view ``<stem>_f0000_v<NN>_segments.npz``
+  (the pieces: ``a``, ``b``, ``family`` (uint32 codes), ``strength``,
+  ``visible``, ``faces``, ``chain``, ``face``, ``bary``, then the code
+  table ``family_codes`` (uint32) and ``family_names`` (``<U24``;
+  ``family_names[i]`` names code ``family_codes[i]``, as
+  :data:`shapecue.FAMILY_CODES`)) and, unless ``options={"fields":
+  False}``, ``<stem>_f0000_v<NN>_fields.npz`` (the per-vertex ``ndotv``,
+  ``kr``, ``dwkr``, ``q1``); ``<NN>`` the view's index with 2 digits, or as
+  many as the last index needs. The bytes are the library's, made from the
+  same arrays as the command line's. Then ``views.json``: the input, its
+  vertex and face counts, the device, the options, the code table
+  ``family_codes`` of the command line's manifest, and per view its
+  ``index``, ``camera`` (eye, target, up, fov, ortho, near, far), piece
+  count and ``files`` (``{"name", "sha256"}`` each, as the command line's
+  manifest lists a view's files). ``options``: ``views`` (a number of views,
   default 16) or ``cameras`` (a list of camera dicts, or a camera JSON
   file), ``fields``, and the keyword options of :func:`shapecue.lines`
   (``lines``, ``size``, ``fov``, ``ortho``, the thresholds, ...), checked
@@ -52,11 +57,14 @@ Tasks:
   over the wall-clock time of computing them) and, in ``timings``, the
   wall-clock ``first_view_ms`` (device set-up and the pose passes
   included) and ``later_views_ms``. A rerun redoes an input whose
-  options changed.
+  options changed. (Before, each view was one ``view_NNN.npz`` holding
+  the pieces, the fields and the camera; the cameras are in
+  ``views.json``.)
 
 The curvature, isosurface and lines tasks give the same bytes for the same
 inputs and options: the NPZ files are written with fixed zip time stamps
-(``numpy.savez`` stamps the time of writing) and ``views.json`` holds no
+(``numpy.savez`` stamps the time of writing; the lines task's are the
+library's bytes, as the command line writes them) and ``views.json`` holds no
 timing; the run's timings and workers are in ``manifest.jsonl`` (and a
 render task's scene report, written by the library, has its own).
 """
@@ -184,7 +192,10 @@ def _sha256(path: str) -> str:
 _LINES_TASK_KEYS = ("views", "cameras", "fields", "device")
 #: Keyword options of shapecue.lines the task does not take: they set the
 #: one camera of a single view.
-_LINES_ONE_EYE = ("eye", "direction")
+_LINES_ONE_EYE = ("eye", "direction", "target", "up")
+#: Keyword options of shapecue.lines the task sets itself: it always
+#: writes the files' bytes.
+_LINES_SET = ("npz",)
 
 
 def _lines_defaults() -> Dict[str, Any]:
@@ -192,7 +203,7 @@ def _lines_defaults() -> Dict[str, Any]:
     with their defaults."""
     import shapecue
 
-    skip = set(_LINES_TASK_KEYS) | set(_LINES_ONE_EYE)
+    skip = set(_LINES_TASK_KEYS) | set(_LINES_ONE_EYE) | set(_LINES_SET)
     return {
         k: p.default
         for k, p in inspect.signature(shapecue.lines).parameters.items()
@@ -291,41 +302,30 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
     t0 = time.perf_counter()
     v, f = shapecue.load_mesh(path)
     t1 = time.perf_counter()
-    views = shapecue.lines(v, f, device=device, **kwargs)
+    views = shapecue.lines(v, f, device=device, npz=True, **kwargs)
     t2 = time.perf_counter()
     codes = sorted(shapecue.FAMILY_CODES.items())
-    # The code table as the command line's NPZ holds it (names as <U24).
-    table = {
-        "family_codes": np.asarray([c for c, _ in codes], dtype=np.uint32),
-        "family_names": np.asarray([n for _, n in codes], dtype="<U24"),
-    }
+    stem = os.path.splitext(os.path.basename(path))[0] or "mesh"
     part = f"{out}.part-{uuid.uuid4().hex[:8]}"
     os.makedirs(part)
     try:
-        digits = max(3, len(str(len(views) - 1)))
+        # The command line's names (output_paths in the library): the view
+        # number with 2 digits, or as many as the last index needs.
+        digits = max(2, len(str(len(views) - 1)))
         entries = []
         for i, view in enumerate(views):
-            # The command line's NPZ first (its names, dtypes and order),
-            # then the fields and the camera.
-            arrays: Dict[str, Any] = {
-                "a": view.a,
-                "b": view.b,
-                "family": view.family_code,
-                "strength": view.strength,
-                "visible": view.visible.astype(np.uint8),
-                "faces": view.faces,
-                "chain": view.chain,
-                "face": view.face,
-                "bary": view.bary,
-                **table,
-            }
-            if view.fields is not None:
-                arrays.update(view.fields)
-            for k in ("eye", "target", "up"):
-                arrays[k] = np.asarray(view.camera[k], dtype=np.float32)
-            name = f"view_{i:0{digits}d}.npz"
-            _write_npz(os.path.join(part, name), arrays)
-            entries.append({"file": name, "camera": view.camera, "pieces": int(len(view.a))})
+            files = []
+            for what in ("segments", "fields"):
+                data = view.npz.get(what)
+                if data is None:
+                    continue
+                name = f"{stem}_f0000_v{i:0{digits}d}_{what}.npz"
+                with open(os.path.join(part, name), "wb") as fh:
+                    fh.write(data)
+                files.append({"name": name, "sha256": hashlib.sha256(data).hexdigest()})
+            entries.append(
+                {"index": i, "camera": view.camera, "pieces": int(len(view.a)), "files": files}
+            )
         doc = {
             "input": path,
             "vertices": int(len(v)),

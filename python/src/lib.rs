@@ -730,6 +730,29 @@ fn load_mesh<'py>(
     ))
 }
 
+/// generated_mesh(name, vertices) -> (vertices float64 (V, 3), faces uint32 (F, 3))
+///
+/// The command line's generated meshes (`shapecue lines torus --vertices
+/// N`: torus, sphere, ellipsoid, cylinder, plane), for comparing with it.
+#[pyfunction]
+fn generated_mesh<'py>(
+    py: Python<'py>,
+    name: &str,
+    vertices: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    shapecue::spec::limits::check_mesh_vertices("vertices", vertices).map_err(to_py)?;
+    let Some((_, m)) = shapecue::mesh::generated_by_name(name, vertices) else {
+        return Err(value_err(format!(
+            "{name:?} names no generated mesh: torus, sphere, ellipsoid, cylinder or plane"
+        )));
+    };
+    let (nv, nf) = (m.n_vertices(), m.n_faces());
+    Ok((
+        array(py, m.positions.into_flattened(), &[nv, 3])?,
+        array(py, m.faces.into_flattened(), &[nf, 3])?,
+    ))
+}
+
 /// load_volume(path) -> (values float32 (z, y, x), spacing (x, y, z), origin (x, y, z))
 #[pyfunction]
 fn load_volume(py: Python<'_>, path: PathBuf) -> PyResult<(Bound<'_, PyAny>, [f64; 3], [f64; 3])> {
@@ -753,7 +776,6 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::feature_edges, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_text, m)?)?;
-    m.add_function(wrap_pyfunction!(lines::lines, m)?)?;
     m.add_function(wrap_pyfunction!(lines::lines_views, m)?)?;
     m.add_function(wrap_pyfunction!(lines::check_cameras, m)?)?;
     m.add_function(wrap_pyfunction!(lines::line_families, m)?)?;
@@ -761,6 +783,7 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_VIEWS", shapecue::api::MAX_VIEWS)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(load_volume, m)?)?;
+    m.add_function(wrap_pyfunction!(generated_mesh, m)?)?;
     m.add_class::<PyEstimator>()?;
     Ok(())
 }

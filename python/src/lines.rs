@@ -1,72 +1,31 @@
-//! Line drawings: `lines` (every line family of rtsc, Rusinkiewicz and
+//! Line drawings: `lines_views` (every line family of rtsc, Rusinkiewicz and
 //! DeCarlo's real-time suggestive contours program) through the front door
-//! [`shapecue::api::line_segments_on`]: 3-D segments with their family and
-//! strength, no picture.
+//! [`shapecue::api::line_views_on`], the one route of one view and of many:
+//! per view the pieces of its lines split by exact visibility and chained,
+//! with their provenance, and on request the bytes of the command line's
+//! NPZ files.
 
 use super::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyBytes, PyList};
 use shapecue::api::{
-    CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot, ViewSpec,
-    VisibilityMethod, fibonacci_views, line_views_on, load_camera_file, parse_camera_file,
-    segment_arrays,
+    Camera, CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot,
+    ViewFields, ViewSpec, VisibilityMethod, check_fov, fibonacci_views, line_views_on,
+    load_camera_file, parse_camera_file, segment_arrays,
 };
+use shapecue::export::npz::{SegmentArrays, fields_npz_bytes, segments_npz_bytes};
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
-use shapecue::spec::view::View;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// lines(vertices, faces, families, eye, ortho, thresholds, isophotes,
-/// light, switches, setup, device) -> dict
-///
-/// thresholds: (sc, rv, ar, ph, sh, fade); switches: (cull, test, fade,
-/// hermite, hermite_kh); setup: (feature_size, compat, accumulate) by their
-/// command-line names ("rtsc" | "edge" | a length; "exact" | "trimesh2";
-/// "auto" | a scheme).
-#[pyfunction]
-#[pyo3(signature = (vertices, faces, families, eye, ortho, thresholds, isophotes, light, switches, setup, device))]
-// PyO3 takes the arguments one by one (the positional signature of
-// `_shapecue.pyi`); the body only collects them into `LinesArgs`.
-#[allow(clippy::too_many_arguments)]
-pub fn lines<'py>(
-    py: Python<'py>,
-    vertices: &Bound<'py, PyAny>,
-    faces: &Bound<'py, PyAny>,
-    families: &str,
-    eye: [f32; 3],
-    ortho: bool,
-    thresholds: [f32; 6],
-    isophotes: u32,
-    light: [f32; 3],
-    switches: [bool; 5],
-    setup: (String, String, String),
-    device: Option<String>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let args = LinesArgs {
-        families,
-        eye,
-        ortho,
-        thresholds,
-        isophotes,
-        light,
-        switches,
-        setup,
-        device,
-    };
-    lines_with(py, (vertices, faces), args)
-}
-
-/// The keyword options of `lines`, as the Python layer passes them (see
-/// [`lines`] for the order within the tuples).
+/// The keyword options of `lines_views`, as the Python layer passes them
+/// (see [`lines_views`] for the order within the tuples).
 struct LinesArgs<'a> {
     families: &'a str,
-    eye: [f32; 3],
-    ortho: bool,
     thresholds: [f32; 6],
     isophotes: u32,
     light: [f32; 3],
     switches: [bool; 5],
     setup: (String, String, String),
-    device: Option<String>,
 }
 
 impl LinesArgs<'_> {
@@ -119,61 +78,34 @@ impl LinesArgs<'_> {
     }
 }
 
-/// [`lines`] with its options collected.
-fn lines_with<'py>(
-    py: Python<'py>,
-    (vertices, faces): (&Bound<'py, PyAny>, &Bound<'py, PyAny>),
-    args: LinesArgs<'_>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let mesh = read_mesh(vertices, faces)?;
-    let opts = args.line_options()?;
-    let setup = args.setup()?;
-    let view = View::from_eye(args.eye, args.ortho);
-    let device = args.device;
-    let (ls, name) = py
-        .detach(|| {
-            let gpu = open_gpu(device.as_deref())?;
-            let ls = shapecue::api::line_segments_on(&gpu, &mesh, view, &opts, &setup)?;
-            Ok::<_, Error>((ls, gpu.info.name.clone()))
-        })
-        .map_err(to_py)?;
-    let n = ls.segments.len();
-    let pts: Vec<f32> = ls
-        .segments
-        .iter()
-        .flat_map(|s| s.0.into_iter().chain(s.1))
-        .collect();
-    let code: Vec<u32> = ls.segments.iter().map(|s| s.2).collect();
-    let strength: Vec<f32> = ls.segments.iter().map(|s| s.3).collect();
-    let d = PyDict::new(py);
-    d.set_item("segments", array(py, pts, &[n, 2, 3])?)?;
-    d.set_item("family_code", array(py, code, &[n])?)?;
-    d.set_item("strength", array(py, strength, &[n])?)?;
-    d.set_item("feature_size", ls.feature_size)?;
-    d.set_item("kernel_ms", ls.timing.kernel_ms)?;
-    d.set_item("device", name)?;
-    Ok(d)
-}
-
 /// lines_views(vertices, faces, families, cameras, camera_file, views,
-/// camera, thresholds, isophotes, light, switches, setup, fields, device)
-/// -> list of dicts
+/// shot, camera, thresholds, isophotes, light, switches, setup, fields,
+/// npz, device) -> list of dicts
 ///
-/// The lines of many views in one setup (the pose passes once, the view
-/// passes per view), each split by exact visibility and chained. The
-/// cameras, one of three: `cameras`, the JSON text of a camera list
+/// The lines of one view or many in one setup (the pose passes once, the
+/// view passes per view), each split by exact visibility and chained. The
+/// cameras, one of four: `cameras`, the JSON text of a camera list
 /// (`{"cameras": [...]}`, errors name `cameras` and the camera);
 /// `camera_file`, a camera file read as the command line reads it (errors
-/// name the file); `views`, that many cameras on the Fibonacci lattice.
-/// `camera`: (fov, ortho, width, height), the cameras' defaults and the
-/// image size the fitted views and the visibility's spacing are for.
+/// name the file); `views`, that many cameras on the Fibonacci lattice;
+/// `shot`: (eye, direction, target, up), the one camera of the command
+/// line's `shapecue lines MESH -o FILE` (its `--eye`, `--target`, `--up`):
+/// at `eye` looking at `target` (default the centre of the bounds), or
+/// without an eye fitted to the bounds from `direction`. `camera`: (fov,
+/// ortho, width, height), the cameras' defaults and the image size the
+/// fitted views and the visibility's spacing are for.
+///
+/// `fields` adds each view's per-vertex fields; `npz` each view's
+/// `segments_npz` (and with `fields` its `fields_npz`): the bytes of the
+/// files `shapecue lines --views N --out DIR --npz --fields` writes for
+/// the view, from the same arrays.
 ///
 /// Between views the thread takes the GIL back for a moment to see whether
 /// Python has a signal waiting (Ctrl-C): the Python handler's exception
 /// (`KeyboardInterrupt`) ends the run, so a call of many views stops within
 /// one view's time instead of at its end.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, families, cameras, camera_file, views, camera, thresholds, isophotes, light, switches, setup, fields, device))]
+#[pyo3(signature = (vertices, faces, families, cameras, camera_file, views, shot, camera, thresholds, isophotes, light, switches, setup, fields, npz, device))]
 #[allow(clippy::too_many_arguments)]
 pub fn lines_views<'py>(
     py: Python<'py>,
@@ -183,6 +115,7 @@ pub fn lines_views<'py>(
     cameras: Option<String>,
     camera_file: Option<PathBuf>,
     views: Option<usize>,
+    shot: Option<ShotArg>,
     camera: (f32, bool, u32, u32),
     thresholds: [f32; 6],
     isophotes: u32,
@@ -190,27 +123,30 @@ pub fn lines_views<'py>(
     switches: [bool; 5],
     setup: (String, String, String),
     fields: bool,
+    npz: bool,
     device: Option<String>,
 ) -> PyResult<Bound<'py, PyList>> {
     let args = LinesArgs {
         families,
-        eye: [0.0; 3],
-        ortho: camera.1,
         thresholds,
         isophotes,
         light,
         switches,
         setup,
-        device,
     };
     let mesh = Arc::new(read_mesh(vertices, faces)?);
+    let (fov, ortho, width, height) = camera;
+    let base = Shot {
+        fov_deg: fov,
+        ortho,
+        size: [width, height],
+        ..Default::default()
+    };
+    let one = shot.map(|s| one_shot(s, base));
     let opts = LinesPictureOptions {
-        shot: Shot {
-            fov_deg: camera.0,
-            ortho: camera.1,
-            size: [camera.2, camera.3],
-            ..Default::default()
-        },
+        // The one camera's shot where there is one: the options of the
+        // command line's single picture.
+        shot: one.unwrap_or(base),
         lines: args.line_options()?,
         image: false,
         svg: true,
@@ -218,22 +154,26 @@ pub fn lines_views<'py>(
         setup: args.setup()?,
         ..Default::default()
     };
-    let defaults = CameraDefaults {
-        fov: camera.0,
-        ortho: camera.1,
-    };
-    let specs = camera_specs(cameras, camera_file, views, defaults)?;
-    let device = args.device.clone();
+    let specs = camera_specs(
+        cameras,
+        camera_file,
+        views,
+        one,
+        CameraDefaults { fov, ortho },
+    )?;
     let mut interrupt: Option<PyErr> = None;
     let done = py.detach(|| {
-        let start = Instant::now();
+        // The first view's wall clock counts opening the device.
+        let mut last = Instant::now();
         let gpu = open_gpu(device.as_deref())?;
         let mut out = Vec::with_capacity(specs.len());
-        let mut last = start;
         line_views_on(&gpu, mesh.clone(), &opts, &specs, fields, &mut |_, v| {
+            // The arrays (and files' bytes) made here, without the GIL.
+            let mut view = ViewOut::new(v, &mesh, npz)?;
             let now = Instant::now();
-            out.push((v, (now - last).as_secs_f64() * 1e3));
+            view.wall_ms = (now - last).as_secs_f64() * 1e3;
             last = now;
+            out.push(view);
             if let Err(e) = Python::attach(|py| py.check_signals()) {
                 interrupt = Some(e);
                 // Only ends the run: the Python exception is raised below.
@@ -248,29 +188,53 @@ pub fn lines_views<'py>(
     }
     let (views, name) = done.map_err(to_py)?;
     let list = PyList::empty(py);
-    for (v, wall_ms) in views {
-        let d = view_dict(py, &mesh, v, &name)?;
-        d.set_item("wall_ms", wall_ms)?;
-        list.append(d)?;
+    for v in views {
+        list.append(v.into_dict(py, &name)?)?;
     }
     Ok(list)
 }
 
+/// The one camera of `lines_views`' `shot`: (eye, direction, target, up).
+type ShotArg = (
+    Option<[f32; 3]>,
+    [f32; 3],
+    Option<[f32; 3]>,
+    Option<[f32; 3]>,
+);
+
+/// The one camera of a [`ShotArg`] as the command line's `-o` picture has
+/// it, on `base` (its fov, projection and image size).
+fn one_shot((eye, direction, target, up): ShotArg, base: Shot) -> Shot {
+    Shot {
+        eye: eye.map(glam::Vec3::from),
+        target: target.map(glam::Vec3::from),
+        up: up.map(glam::Vec3::from),
+        fit_direction: glam::Vec3::from(direction),
+        ..base
+    }
+}
+
 /// The cameras of [`lines_views`]: one of a camera list's JSON text, a
-/// camera file or a number of fitted views.
+/// camera file, a number of fitted views or the one shot.
 fn camera_specs(
     cameras: Option<String>,
     camera_file: Option<PathBuf>,
     views: Option<usize>,
+    shot: Option<Shot>,
     defaults: CameraDefaults,
 ) -> PyResult<Vec<ViewSpec>> {
-    match (cameras, camera_file, views) {
-        (Some(text), None, None) => parse_camera_file(&text, "cameras", defaults),
-        (None, Some(path), None) => load_camera_file(&path, defaults),
-        (None, None, Some(n)) => fibonacci_views(n, defaults),
+    match (cameras, camera_file, views, shot) {
+        (Some(text), None, None, None) => parse_camera_file(&text, "cameras", defaults),
+        (None, Some(path), None, None) => load_camera_file(&path, defaults),
+        (None, None, Some(n), None) => fibonacci_views(n, defaults),
+        (None, None, None, Some(s)) => match check_fov(s.fov_deg) {
+            Ok(()) => Ok(vec![s.view()]),
+            Err(e) => return Err(value_err(format!("fov: {e}"))),
+        },
         _ => {
             return Err(value_err(
-                "cameras: give a number of views, a list of camera dicts or a camera JSON file",
+                "cameras: give a number of views, a list of camera dicts, a camera JSON file \
+                 or one eye",
             ));
         }
     }
@@ -292,7 +256,7 @@ pub fn check_cameras(
     ortho: bool,
 ) -> PyResult<usize> {
     let defaults = CameraDefaults { fov, ortho };
-    Ok(camera_specs(cameras, camera_file, views, defaults)?.len())
+    Ok(camera_specs(cameras, camera_file, views, None, defaults)?.len())
 }
 
 /// line_families(names) -> list of str
@@ -316,51 +280,106 @@ pub fn family_codes() -> Vec<(u32, &'static str)> {
     shapecue::spec::feature_lines::family_codes()
 }
 
-/// One view of [`lines_views`] as a dict of numpy arrays.
-fn view_dict<'py>(
-    py: Python<'py>,
-    mesh: &Mesh,
-    v: LineView,
-    device: &str,
-) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let vis = v
-        .visible
-        .as_ref()
-        .ok_or_else(|| value_err("internal: the view was not classified"))?;
-    let s = segment_arrays(vis, mesh);
-    let n = s.a.len();
-    let flat3 = |v: &[[f32; 3]]| v.concat();
-    d.set_item("a", array(py, flat3(&s.a), &[n, 3])?)?;
-    d.set_item("b", array(py, flat3(&s.b), &[n, 3])?)?;
-    d.set_item("family_code", array(py, s.family, &[n])?)?;
-    d.set_item("strength", array(py, s.strength, &[n])?)?;
-    d.set_item("visible", array(py, s.visible, &[n])?)?;
-    d.set_item("faces", array(py, s.faces.concat(), &[n, 4])?)?;
-    d.set_item("chain", array(py, s.chain, &[n])?)?;
-    d.set_item("face", array(py, s.face, &[n])?)?;
-    let bary: Vec<f32> = s.bary.iter().flatten().flatten().copied().collect();
-    d.set_item("bary", array(py, bary, &[n, 2, 3])?)?;
-    if let Some(f) = v.fields {
-        let nv = f.ndotv.len();
-        d.set_item("ndotv", array(py, f.ndotv, &[nv])?)?;
-        d.set_item("kr", array(py, f.kr, &[nv])?)?;
-        d.set_item("dwkr", array(py, f.dwkr, &[nv])?)?;
-        d.set_item("q1", array(py, f.q1, &[nv])?)?;
+/// One view of [`lines_views`], its pieces as the command line's arrays.
+struct ViewOut {
+    /// The pieces ([`segment_arrays`], as the command line's NPZ and
+    /// segments document hold them).
+    arrays: SegmentArrays,
+    /// The per-vertex fields, where asked.
+    fields: Option<ViewFields>,
+    /// The bytes of the view's `_segments.npz` and, with the fields, its
+    /// `_fields.npz`, where asked.
+    npz: Option<(Vec<u8>, Option<Vec<u8>>)>,
+    camera: Camera,
+    passes: Vec<&'static str>,
+    /// The passes' own clocks, summed.
+    passes_ms: f64,
+    /// The summed ms of the passes clocked by the device (kernels).
+    kernel_ms: f64,
+    feature_size: f32,
+    /// Wall clock from the end of the view before (or the start).
+    wall_ms: f64,
+}
+
+impl ViewOut {
+    /// The arrays of a view of `mesh` (and the NPZ files' bytes with `npz`).
+    fn new(v: LineView, mesh: &Mesh, npz: bool) -> shapecue::Result<ViewOut> {
+        let vis = v.visible.as_ref().ok_or_else(|| {
+            Error::InvalidArgument("internal: the view was not classified".into())
+        })?;
+        let arrays = segment_arrays(vis, mesh);
+        let npz = if npz {
+            let fields = v.fields.as_ref().map(fields_npz_bytes).transpose()?;
+            Some((segments_npz_bytes(&arrays)?, fields))
+        } else {
+            None
+        };
+        let sum = |clock: Option<&str>| {
+            (v.passes.iter())
+                .filter(|p| clock.is_none_or(|c| p.clock == c))
+                .map(|p| p.ms)
+                .sum()
+        };
+        Ok(ViewOut {
+            npz,
+            passes_ms: sum(None),
+            kernel_ms: sum(Some("kernel")),
+            passes: v.passes.iter().map(|p| p.pass.name()).collect(),
+            arrays,
+            fields: v.fields,
+            camera: v.camera,
+            feature_size: v.feature_size,
+            wall_ms: 0.0,
+        })
     }
-    let c = v.camera;
-    let cam = PyDict::new(py);
-    cam.set_item("eye", c.eye.to_array())?;
-    cam.set_item("target", c.target.to_array())?;
-    cam.set_item("up", c.up.to_array())?;
-    cam.set_item("fov", c.fov_y_deg)?;
-    cam.set_item("ortho", c.ortho_height)?;
-    d.set_item("camera", cam)?;
-    let ms: f64 = v.passes.iter().map(|p| p.ms).sum();
-    d.set_item("passes_ms", ms)?;
-    let passes: Vec<&str> = v.passes.iter().map(|p| p.pass.name()).collect();
-    d.set_item("passes", passes)?;
-    d.set_item("feature_size", v.feature_size)?;
-    d.set_item("device", device)?;
-    Ok(d)
+
+    /// The view as a dict of numpy arrays (and bytes).
+    fn into_dict<'py>(self, py: Python<'py>, device: &str) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let s = self.arrays;
+        let n = s.a.len();
+        d.set_item("a", array(py, s.a.concat(), &[n, 3])?)?;
+        d.set_item("b", array(py, s.b.concat(), &[n, 3])?)?;
+        d.set_item("family_code", array(py, s.family, &[n])?)?;
+        d.set_item("strength", array(py, s.strength, &[n])?)?;
+        d.set_item("visible", array(py, s.visible, &[n])?)?;
+        d.set_item("faces", array(py, s.faces.concat(), &[n, 4])?)?;
+        d.set_item("chain", array(py, s.chain, &[n])?)?;
+        d.set_item("face", array(py, s.face, &[n])?)?;
+        let bary: Vec<f32> = s.bary.iter().flatten().flatten().copied().collect();
+        d.set_item("bary", array(py, bary, &[n, 2, 3])?)?;
+        if let Some(f) = self.fields {
+            let nv = f.ndotv.len();
+            d.set_item("ndotv", array(py, f.ndotv, &[nv])?)?;
+            d.set_item("kr", array(py, f.kr, &[nv])?)?;
+            d.set_item("dwkr", array(py, f.dwkr, &[nv])?)?;
+            d.set_item("q1", array(py, f.q1, &[nv])?)?;
+        }
+        if let Some((segments, fields)) = self.npz {
+            let files = PyDict::new(py);
+            files.set_item("segments", PyBytes::new(py, &segments))?;
+            if let Some(f) = fields {
+                files.set_item("fields", PyBytes::new(py, &f))?;
+            }
+            d.set_item("npz", files)?;
+        }
+        // As the command line's manifest lists a view's camera.
+        let c = self.camera;
+        let cam = PyDict::new(py);
+        cam.set_item("eye", c.eye.to_array())?;
+        cam.set_item("target", c.target.to_array())?;
+        cam.set_item("up", c.up.to_array())?;
+        cam.set_item("fov", c.fov_y_deg)?;
+        cam.set_item("ortho", c.ortho_height)?;
+        cam.set_item("near", c.near)?;
+        cam.set_item("far", c.far)?;
+        d.set_item("camera", cam)?;
+        d.set_item("passes", self.passes)?;
+        d.set_item("passes_ms", self.passes_ms)?;
+        d.set_item("kernel_ms", self.kernel_ms)?;
+        d.set_item("wall_ms", self.wall_ms)?;
+        d.set_item("feature_size", self.feature_size)?;
+        d.set_item("device", device)?;
+        Ok(d)
+    }
 }

@@ -180,12 +180,18 @@ def test_lines_batch_over_awkward_and_broken_meshes(device, client, tmp_path):
         assert r["status"] == "ok", (name, r["error"])
         assert r["views"] == 3
         doc = json.loads((out / name / "views.json").read_text())
-        assert [e["file"] for e in doc["views"]] == ["view_000.npz", "view_001.npz", "view_002.npz"]
-        z = np.load(out / name / "view_001.npz")
-        for k in ("a", "b", "family", "family_codes", "family_names", "visible", "face", "bary", "ndotv", "q1", "eye"):
+        names = [[x["name"] for x in e["files"]] for e in doc["views"]]
+        assert names == [[f"{name}_f0000_v{i:02d}_segments.npz", f"{name}_f0000_v{i:02d}_fields.npz"]
+                         for i in range(3)]
+        assert [e["index"] for e in doc["views"]] == [0, 1, 2]
+        z = np.load(out / name / names[1][0])
+        for k in ("a", "b", "family", "family_codes", "family_names", "visible", "face", "bary"):
             assert k in z.files, (name, k)
-        assert np.all(np.isfinite(z["a"])) and np.all(np.isfinite(z["ndotv"]))
-        assert len(z["ndotv"]) == doc["vertices"]
+        fz = np.load(out / name / names[1][1])
+        assert fz.files == ["ndotv", "kr", "dwkr", "q1"]
+        assert np.all(np.isfinite(z["a"])) and np.all(np.isfinite(fz["ndotv"]))
+        assert len(fz["ndotv"]) == doc["vertices"] and len(z["a"]) == doc["views"][1]["pieces"]
+        assert sorted(p.name for p in (out / name).iterdir()) == sorted(sum(names, ["views.json"]))
     assert sum(len(json.loads((out / n / "views.json").read_text())["views"]) for n in good) == 3 * len(good)
     for name, words in broken.items():
         r = by[name]
@@ -269,7 +275,8 @@ def test_lines_batch_records_its_options_and_redoes_what_changed(device, client,
         folder = out / r["output"].rsplit("/", 1)[-1]
         doc = json.loads((folder / "views.json").read_text())
         assert len(doc["views"]) == 8 and doc["options"]["views"] == 8
-        assert len(list(folder.glob("view_*.npz"))) == 8
+        assert len(list(folder.glob("*_segments.npz"))) == 8
+        assert len(list(folder.glob("*_fields.npz"))) == 8
     assert batch.run(str(src / "*.obj"), out, task="lines", client=client,
                      options={"views": 8, "size": (320, 240)}) == []
 
@@ -308,21 +315,77 @@ def test_batch_outputs_are_the_same_bytes_every_run(device, client, tmp_path):
             recs = batch.run(str(src / "*.obj"), out, task=task, client=client, options=o)
             assert [r["status"] for r in recs] == ["ok", "ok"], recs
         outs.append(sha256_tree(out))
-    assert len(outs[0]) == 2 * (1 + 3) + 2, sorted(outs[0])
+    # Per input views.json and 3 views of two files; the curvature NPZ.
+    assert len(outs[0]) == 2 * (1 + 3 * 2) + 2, sorted(outs[0])
     assert outs[0] == outs[1]
 
-    z = np.load(tmp_path / "out0" / "t0" / "view_001.npz")
+    z = np.load(tmp_path / "out0" / "t0" / "t0_f0000_v01_segments.npz")
     cli_names = ["a", "b", "family", "strength", "visible", "faces", "chain", "face", "bary",
                  "family_codes", "family_names"]
-    assert z.files[: len(cli_names)] == cli_names
+    assert z.files == cli_names
     dtypes = ["float32", "float32", "uint32", "float32", "uint8", "int64", "uint32", "int64",
               "float32", "uint32", "<U24"]
     assert [str(z[k].dtype) for k in cli_names[:-1]] == dtypes[:-1]
     assert z["family_names"].dtype.str == "<U24"
-    assert "kind" not in z.files
     table = dict(zip(z["family_codes"].tolist(), z["family_names"].tolist()))
     assert table == shapecue.FAMILY_CODES
     assert set(z["family"].tolist()) <= {0, 1, 2}
     doc = json.loads((tmp_path / "out0" / "t0" / "views.json").read_text())
     assert {int(c): n for c, n in doc["family_codes"].items()} == shapecue.FAMILY_CODES
     assert "timing" not in doc and not any("ms" in k for e in doc["views"] for k in e)
+    # Each file's SHA-256 as views.json lists it.
+    for e in doc["views"]:
+        for x in e["files"]:
+            assert outs[0][f"t0/{x['name']}"] == x["sha256"]
+
+
+def test_lines_task_writes_the_command_lines_files(device, client, cli, tmp_path):
+    """The lines task writes each view's `_segments.npz` and `_fields.npz`
+    under the names `shapecue lines MESH --views 3 --out DIR --npz --fields`
+    gives them and with the same bytes (SHA-256), and views.json lists them
+    and the cameras as the command line's manifest does. Before, the task
+    wrote one view_NNN.npz of its own per view."""
+    import subprocess
+
+    from conftest import REPO
+    from shapecue import batch
+
+    mesh = tmp_path / "in" / "spot.obj"
+    mesh.parent.mkdir()
+    mesh.write_bytes((REPO / "data" / "spot.obj").read_bytes())
+    fams = "contours,suggestive,ridges"
+    cli_out = tmp_path / "cli"
+    run = subprocess.run(
+        [cli, "lines", str(mesh), "--views", "3", "--out", str(cli_out), "--npz", "--fields",
+         "--lines", fams, "--size", "320x240"],
+        capture_output=True, text=True, timeout=600,
+    )
+    assert run.returncode == 0, run.stderr
+    manifest = json.loads((cli_out / "manifest.json").read_text())
+    recs = batch.run([str(mesh)], tmp_path / "out", task="lines", client=client,
+                     options={"views": 3, "lines": fams, "size": (320, 240)})
+    assert [r["status"] for r in recs] == ["ok"], recs
+    folder = tmp_path / "out" / "spot"
+    doc = json.loads((folder / "views.json").read_text())
+    assert len(doc["views"]) == len(manifest["views"]) == 3
+    checked = 0
+    for ours, theirs in zip(doc["views"], manifest["views"]):
+        assert ours["index"] == theirs["index"]
+        for k in ("eye", "target", "up", "fov", "ortho", "near", "far"):
+            assert ours["camera"][k] == theirs["camera"][k], k
+        npz = [x for x in theirs["files"] if x["name"].endswith(("_segments.npz", "_fields.npz"))]
+        assert [x["name"] for x in npz] == [x["name"] for x in ours["files"]]
+        stem = f"spot_f0000_v{ours['index']:02d}"
+        assert [x["name"] for x in npz] == [f"{stem}_segments.npz", f"{stem}_fields.npz"]
+        for x, y in zip(npz, ours["files"]):
+            assert x == y, (x, y)
+            assert sha256_file(folder / y["name"]) == sha256_file(cli_out / x["name"]) == x["sha256"]
+            checked += 1
+    assert checked == 6
+    assert doc["family_codes"] == manifest["family_codes"]
+
+
+def sha256_file(p):
+    import hashlib
+
+    return hashlib.sha256(p.read_bytes()).hexdigest()

@@ -19,7 +19,7 @@ def torus(R=1.0, r=0.4, nu=80, nv=40):
 def test_parabolic_lines_of_a_torus_are_its_top_and_bottom_circles():
     v, f = torus()
     out = shapecue.lines(v, f, lines="k-zero,contours", cull=False)
-    k = out.of("k-zero")
+    k = out.of("k-zero", visible_only=False)
     assert len(k) > 100
     rho = np.hypot(k[..., 0], k[..., 1])
     assert np.all(np.abs(rho - 1.0) < 0.03)
@@ -104,8 +104,17 @@ def test_bad_cameras_are_clear_errors():
         shapecue.lines(v, f, cameras=2, eye=(0, 0, 3))
     with pytest.raises(ValueError, match="0 views|1 to"):
         shapecue.lines(v, f, cameras=0)
-    with pytest.raises(ValueError, match="fields"):
-        shapecue.lines(v, f, fields=True)
+    for kw, words in (
+        ({"cameras": 2, "direction": (0, 0, 1)}, "direction sets the one camera"),
+        ({"target": (0, 0, 0)}, "target goes with eye"),
+        ({"eye": (0, 0, 3), "direction": (0, 0, 1)}, "give eye or direction, not both"),
+        ({"direction": (0, 0, 0)}, "direction: expected three finite numbers, not all zero"),
+        ({"eye": (0, float("nan"), 3)}, "eye: expected three finite numbers"),
+        ({"up": (0, 1)}, "up: expected three finite numbers"),
+        ({"fov": 0.0}, "fov: fov 0 degrees is outside"),
+    ):
+        with pytest.raises(ValueError, match=words):
+            shapecue.lines(v, f, **kw)
 
 
 def test_isophotes_of_no_level_are_refused_as_on_the_command_line():
@@ -136,7 +145,8 @@ def test_pieces_of_an_unknown_family_are_refused_naming_the_families():
         assert "unknown line family" in msg and "contours, suggestive, ridges" in msg, msg
     # A known family that was not asked for has no pieces, and no error.
     assert one.of("ridges").shape == (0, 2, 3) and view.of("ridges").shape == (0, 2, 3)
-    assert len(one.of("contours")) == len(one.segments)
+    assert len(one.of("contours", visible_only=False)) == len(one.segments)
+    assert len(one.of("contours")) == int(one.visible.sum()) < len(one.segments)
 
 
 def test_family_codes_are_the_files_codes_with_names_beside_them():
@@ -333,3 +343,86 @@ def test_the_feature_size_is_rtscs_unless_asked_otherwise():
     for doc in (shapecue.Lines.__doc__, shapecue.lines.__doc__):
         assert "rtsc" in doc and "10th percentile" in doc
     assert "scaled by (the median edge length)" not in shapecue.Lines.__doc__
+
+
+def segments_json_rows(doc):
+    """The pieces of a `shapecue lines -o X.svg --segments S.json` document
+    as the arrays of a LineView. The document's floats are f32 values
+    written as f64 (serde_json widens them): read as float64 and narrowed
+    to float32 they are the f32 bits again. A piece on no face has face
+    null and bary null there (-1 and zeros in the arrays)."""
+    segs = doc["segments"]
+
+    def f32(x):
+        return np.asarray(x, dtype=np.float64).astype(np.float32)
+
+    return {
+        "a": f32([s["a"] for s in segs]),
+        "b": f32([s["b"] for s in segs]),
+        "family": np.array([s["family"] for s in segs], dtype=str),
+        "strength": f32([s["strength"] for s in segs]),
+        "visible": np.array([s["visible"] for s in segs], dtype=bool),
+        "chain": np.array([s["chain"] for s in segs], dtype=np.uint32),
+        "faces": np.array([s["faces"] + [-1] * (4 - len(s["faces"])) for s in segs], dtype=np.int64),
+        "face": np.array([-1 if s["face"] is None else s["face"] for s in segs], dtype=np.int64),
+        "bary": f32([np.zeros((2, 3)) if s["bary"] is None else s["bary"] for s in segs]),
+    }
+
+
+@pytest.mark.parametrize("mesh", ["spot", "torus"])
+def test_one_eye_is_the_command_lines_picture(device, cli, mesh, tmp_path):
+    """shapecue.lines(mesh) from one camera gives the pieces of `shapecue
+    lines MESH -o X.svg --segments S.json` (the fitted camera, exact
+    visibility): the same rows in the same order, bit for bit; also for an
+    explicit orthographic eye with target, up, fov and size. Before, one
+    eye went by a route of its own, from another eye, with no visibility."""
+    import json
+    import subprocess
+    from conftest import REPO
+
+    if mesh == "spot":
+        path = REPO / "data" / "spot.obj"
+        arg, v, f = str(path), *shapecue.load_mesh(path)
+    else:
+        # The command line's generated torus, the same vertices here.
+        arg = "torus"
+        v, f = shapecue._shapecue.generated_mesh("torus", 3000)
+    c = (v.min(0) + v.max(0)) / 2
+    fams = "contours,suggestive,ridges"
+    eye = (c + [1.5, 0.3, 2.0]).tolist()
+    target = (c + [0.0, 0.1, 0.0]).tolist()
+    cases = [
+        ([], {}),
+        (["--eye", ",".join(map(str, eye)), "--target", ",".join(map(str, target)),
+          "--up", "0,1,0.1", "--ortho", "--fov", "30", "--size", "400x300"],
+         {"eye": eye, "target": target, "up": (0, 1, 0.1), "ortho": True, "fov": 30,
+          "size": (400, 300)}),
+    ]
+    hidden = 0
+    for k, (flags, kw) in enumerate(cases):
+        seg = tmp_path / f"s{k}.json"
+        cmd = [cli, "lines", arg, "-o", str(tmp_path / f"x{k}.svg"), "--segments", str(seg),
+               "--lines", fams, *flags]
+        if mesh == "torus":
+            cmd += ["--vertices", "3000"]
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stderr
+        doc = json.loads(seg.read_text())
+        view = shapecue.lines(v, f, lines=fams, **kw)
+        assert isinstance(view, shapecue.LineView) and view.visible.dtype == bool
+        expect = segments_json_rows(doc)
+        assert len(view.a) == len(expect["a"]) > 100, (k, len(view.a), len(expect["a"]))
+        assert view.visible.any()
+        hidden += int((~view.visible).sum())
+        for name, e in expect.items():
+            got = getattr(view, name)
+            assert got.dtype == e.dtype and got.shape == e.shape, (k, name)
+            if name == "family":
+                assert got.tolist() == e.tolist(), (k, name)
+            else:
+                assert got.tobytes() == e.tobytes(), (k, name)
+        assert view.feature_size == doc["feature_size"]
+        assert view.segments.shape == (len(view.a), 2, 3)
+        np.testing.assert_array_equal(view.segments[:, 1], view.b)
+    # Visibility is compared, not only its default: some pieces are hidden.
+    assert hidden > 0
