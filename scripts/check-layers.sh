@@ -326,6 +326,16 @@ for f in files:
 sys.exit(1 if found else 0)
 PY
 
+# The scene executor holds its state in one value per lifetime (run,
+# topology, pose, view: src/scene/exec/passes/state.rs), not a field per
+# quantity: at most 15 fields.
+exec_fields=$(awk '/^pub\(super\) struct Executor/ {on = 1; next} on && /^}/ {on = 0}
+    on && /^    [a-z_]+(\([a-z]+\))? ?[a-z_]*:/ && !/^    \/\// {n++} END {print n + 0}' src/scene/exec/passes/mod.rs)
+if [ "$exec_fields" -gt 15 ] || [ "$exec_fields" -eq 0 ]; then
+    echo "src/scene/exec/passes/mod.rs: the executor has $exec_fields fields, more than 15 (or none found): group new state by lifetime in passes/state.rs"
+    status=1
+fi
+
 # The command-line parser belongs to the binary: the library's option enums
 # implement spec::Choice, from which src/cli builds clap's parsers.
 while IFS= read -r hit; do

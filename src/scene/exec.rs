@@ -44,24 +44,27 @@ mod load;
 mod passes;
 mod report;
 mod vector;
+mod walk;
 
 pub use draw::{EdgeCounts, EdgeInfo, ViewDone, ViewOutputs};
-pub use live::{Change, LiveFrame, LiveRequest};
+pub use live::{LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};
 pub use vector::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES, VisibleLines};
+pub use walk::Change;
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
 use crate::scene::file::{Scene, Source};
-use crate::scene::planner::{Input, Lifetime, Outputs, Pass, Plan, plan_for};
+use crate::scene::planner::{Outputs, Pass, Plan, plan_for};
 use load::load;
 use passes::Executor;
 use report::ms_since;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
+use walk::Walker;
 
 /// Command-line overrides of a scene.
 #[derive(Clone, Debug, Default)]
@@ -414,15 +417,15 @@ fn render_all(
                 pose: now.pose - uploads_before.pose,
             }
         },
-        segments: ex.segments,
-        chains: report::Chains::new(ex.chains),
-        lines: std::mem::take(&mut ex.line_segments),
-        strokes: ex.stroke_count,
+        segments: ex.run.segments,
+        chains: report::Chains::new(ex.run.chains),
+        lines: std::mem::take(&mut ex.run.line_segments),
+        strokes: ex.run.stroke_count,
         notes: notes
             .into_iter()
-            .chain(ex.feature_size_note.take())
+            .chain(ex.run.feature_size_note.take())
             .collect(),
-        outputs: std::mem::take(&mut ex.outputs),
+        outputs: std::mem::take(&mut ex.run.outputs),
         timing: crate::spec::timing::Timing {
             wall_ms: ms_since(t_all),
             kernel_ms,
@@ -468,57 +471,21 @@ fn run_frames(
         views,
     } = laps;
     let runs = |v: usize| views.is_none_or(|set| set.contains(&v));
-    let input = scene.source.input();
-    // The plan's passes by lifetime, each list in plan order.
-    let of = |keep: &dyn Fn(Lifetime) -> bool| -> Vec<Pass> {
-        plan.passes
-            .iter()
-            .copied()
-            .filter(|p| keep(p.lifetime(input)))
-            .collect()
-    };
-    let first_pose = of(&|l| l != Lifetime::View);
-    let later_poses = of(&|l| l == Lifetime::Pose);
-    let view_passes = of(&|l| l == Lifetime::View);
-
-    let mut timing = crate::spec::timing::Timing::default();
+    let mut walker = Walker::new(plan, scene.source.input());
     let total_views = frames.len() * (0..scene.views.len()).filter(|&v| runs(v)).count();
     let mut done = 0;
-    for (fi, &frame) in frames.iter().enumerate() {
-        // Pose passes: once in all for a static mesh; topology passes with
-        // the first pose (an isosurface's are pose passes).
-        if fi == 0 || input != Input::Static {
-            let t_pose = Instant::now();
-            ex.begin_pose();
-            for &p in if fi == 0 { &first_pose } else { &later_poses } {
-                ex.pose_pass(p, frame)?;
-            }
-            ex.end_pose(frame)?;
-            timing.lap("pose", ex.rec.lap());
-            timing.lap("pose_wall", ms_since(t_pose));
-        }
+    for &frame in frames {
+        walker.pose(ex, frame)?;
         for (vi, cam) in ex.cameras().iter().enumerate() {
             if !runs(vi) {
                 continue;
             }
-            let t_view = Instant::now();
             let paths: Vec<&PathBuf> = images
                 .iter()
                 .filter(|i| i.0 == frame && i.1 == vi)
                 .map(|i| &i.2)
                 .collect();
-            ex.begin_view();
-            let mut drawing = false;
-            for &p in &view_passes {
-                if matches!(p, Pass::Render | Pass::Svg) && !drawing {
-                    timing.lap("view", ex.rec.lap());
-                    drawing = true;
-                }
-                ex.view_pass(p, cam, &paths)?;
-            }
-            ex.end_view(cam);
-            timing.lap("render", ex.rec.lap());
-            timing.lap("view_wall", ms_since(t_view));
+            walker.view(ex, cam, &paths)?;
             if let Some(each) = each.as_deref_mut() {
                 let files = paths.into_iter().cloned().collect();
                 each(ex.view_done((frame, vi), cam, files))?;
@@ -527,7 +494,7 @@ fn run_frames(
             progress(done, total_views);
         }
     }
-    Ok(timing)
+    Ok(walker.timing)
 }
 
 /// What [`check_scenes`] learnt of one scene: the input it loaded to check

@@ -18,10 +18,11 @@ use super::draw::ViewOutputs;
 use super::load::{Loaded, load};
 use super::passes::Executor;
 use super::report::{PassRecord, Recorder};
+use super::walk::{Change, Walker};
 use super::{ExecOptions, Session, frame_indices, plan_of};
 use crate::error::{Error, Result};
 use crate::scene::file::Scene;
-use crate::scene::planner::{Input, Lifetime, Pass, Plan};
+use crate::scene::planner::{Input, Plan};
 use std::path::PathBuf;
 
 /// One frame to draw: the scene with the camera (its first view) and the
@@ -36,17 +37,6 @@ pub struct LiveRequest {
     pub scene: Scene,
     /// Also write the lines of the frame as SVG here.
     pub svg: Option<PathBuf>,
-}
-
-/// What a request changed, and so what ran for it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Change {
-    /// A new plan or input: every pass of the plan ran.
-    Scene,
-    /// Another frame of the animation: its pose passes and the view passes.
-    Pose,
-    /// Only the camera (or nothing): the view passes.
-    View,
 }
 
 /// A drawn frame.
@@ -104,13 +94,13 @@ impl Session {
         let renderer = self.renderer(scene, &plan)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-        ex.keep_image = true;
-        ex.keep_mesh = true;
+        ex.keep.image = true;
+        ex.keep.mesh = true;
         let mut live = Live {
             plan: &plan,
             input,
             n_frames,
-            pose: None,
+            walker: Walker::new(&plan, input),
         };
         let req = LiveRequest {
             scene: scene.clone(),
@@ -171,12 +161,12 @@ impl Session {
         let renderer = self.renderer(scene, &plan)?;
         let n_frames = loaded.frames();
         let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-        ex.keep_image = true;
+        ex.keep.image = true;
         let mut live = Live {
             plan: &plan,
             input,
             n_frames,
-            pose: None,
+            walker: Walker::new(&plan, input),
         };
         let mut req = first;
         loop {
@@ -207,18 +197,11 @@ struct Live<'p> {
     plan: &'p Plan,
     input: Input,
     n_frames: usize,
-    /// The frame whose pose passes ran last.
-    pose: Option<usize>,
+    /// The plan's walker (it knows the pose that ran last).
+    walker: Walker,
 }
 
 impl Live<'_> {
-    /// The plan's passes of the lifetimes `keep` accepts, in plan order.
-    fn passes(&self, keep: impl Fn(Lifetime) -> bool) -> Vec<Pass> {
-        (self.plan.passes.iter().copied())
-            .filter(|p| keep(p.lifetime(self.input)))
-            .collect()
-    }
-
     /// Draws one request: pose passes when its frame is not the last one
     /// drawn (all but the view passes on the first), then the view passes.
     fn frame(&mut self, ex: &mut Executor<'_, '_>, req: &LiveRequest) -> Result<LiveFrame> {
@@ -234,32 +217,11 @@ impl Live<'_> {
             Error::InvalidArgument(format!("{}: no camera", req.scene.path.display()))
         })?;
         ex.rec = Recorder::new(self.input);
-        let change = match self.pose {
-            None => Change::Scene,
-            Some(f) if f != frame && self.input != Input::Static => Change::Pose,
-            Some(_) => Change::View,
-        };
-        if change != Change::View {
-            let passes = match change {
-                Change::Scene => self.passes(|l| l != Lifetime::View),
-                _ => self.passes(|l| l == Lifetime::Pose),
-            };
-            // A failure ends the setup: the next request builds it anew.
-            ex.begin_pose();
-            for p in passes {
-                ex.pose_pass(p, frame)?;
-            }
-            ex.end_pose(frame)?;
-            self.pose = Some(frame);
-        }
+        let change = self.walker.pose(ex, frame)?;
         let cam = ex.camera_of(view)?;
         let paths: Vec<&PathBuf> = req.svg.iter().collect();
-        ex.keep_layers = req.scene.svg;
-        ex.begin_view();
-        for p in self.passes(|l| l == Lifetime::View) {
-            ex.view_pass(p, &cam, &paths)?;
-        }
-        ex.end_view(&cam);
+        ex.keep.layers = req.scene.svg;
+        self.walker.view(ex, &cam, &paths)?;
         let view = ex.kept.take().ok_or_else(|| {
             Error::InvalidArgument(format!(
                 "{}: no cue is asked for, so there is nothing to draw",

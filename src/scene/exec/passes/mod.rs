@@ -13,14 +13,14 @@
 //! itself, uploaded once for the run, and need no mesh pass.
 
 mod stages;
+mod state;
 mod view;
 mod visibility;
 
-use super::draw::{self, PoseData, ViewLines};
+use super::draw::{self, ViewLines};
 use super::interop::{SharedEdges, interop_offer};
 use super::load::Loaded;
 use super::report::{Recorder, ms_since};
-use super::vector::VisibleLines;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
@@ -32,20 +32,19 @@ use crate::scene::file::Scene;
 use crate::scene::planner::{Pass, Plan};
 use crate::spec::curvature::CurvatureOptions;
 use crate::spec::edges::{EdgeOutput, EdgeParams};
-use crate::spec::feature_lines::{LineInputs, Segment};
+use crate::spec::feature_lines::LineInputs;
 use crate::spec::interop::{InteropDecision, InteropOffer, InteropRoute, decide_interop};
 use crate::spec::marching_cubes::IsoNormals;
-use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
+use crate::spec::sdf_lines::Stroke;
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::bvh::Bvh;
 use crate::stages::curvature::CurvatureEstimator;
-use crate::stages::edges::{EdgeStage, SharedDrawn};
-use crate::stages::feature_lines::{LineExtractor, LineOptions};
-use crate::stages::marching_cubes::Isosurfacer;
-use crate::stages::pipeline::PosePipeline;
-use crate::stages::sdf_lines::SdfLines;
+use crate::stages::edges::EdgeStage;
+use crate::stages::feature_lines::LineExtractor;
 use stages::{isosurfacer, line_options, skinning_pipeline, strokes_stage};
+pub(super) use state::Keep;
+use state::{PoseState, RunStages, RunState, ViewState};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -75,6 +74,8 @@ struct Topology {
     bvh: Option<Bvh>,
     /// The intersection lines' search (made by the first pose).
     isect: Option<crate::stages::intersections::Intersections>,
+    /// Whether the renderer holds this topology's faces.
+    gl: bool,
 }
 
 impl Topology {
@@ -92,6 +93,7 @@ impl Topology {
             edge_pairs: Vec::new(),
             bvh: None,
             isect: None,
+            gl: false,
         }
     }
 }
@@ -110,7 +112,8 @@ struct Framing {
     ao_radius: f32,
 }
 
-/// The executor's state over a run.
+/// The executor's state over a run: what it was given, its recorder and
+/// renderer, and one value per lifetime ([`state`]).
 pub(super) struct Executor<'s, 'g> {
     scene: &'s Scene,
     plan: &'s Plan,
@@ -120,72 +123,18 @@ pub(super) struct Executor<'s, 'g> {
     /// The renderer, where the plan draws a frame (none for a vector
     /// drawing with exact visibility: no GL context is opened).
     renderer: Option<Renderer>,
-    curv_opts: CurvatureOptions,
-    line_opts: LineOptions,
-    /// Skinning, curvature and AO of a skinned input.
-    pipe: Option<PosePipeline>,
-    iso: Option<Isosurfacer>,
-    /// AO of an unskinned input.
-    ao: Option<AoStage>,
-    /// Curvature-directed strokes of a volume input, and its voxel size.
-    sdf_lines: Option<(SdfLines, f64)>,
-    /// This pose: the strokes run (seeds, strokes in world units, stats).
-    strokes: SdfLinesOutput,
-    /// This pose: an isosurface's unit normals from the volume gradient
-    /// (when normals are planned without curvature).
-    iso_normals: Option<Vec<[f32; 3]>>,
-    /// Strokes over all poses.
-    pub(super) stroke_count: usize,
-    /// What the line families' thresholds were scaled by, for the run's
-    /// notes (the first topology's).
-    pub(super) feature_size_note: Option<String>,
+    /// The stages and options built for the run.
+    stages: RunStages,
+    /// What the run fixes on its first pose and counts over all.
+    pub(super) run: RunState,
+    /// The current topology.
     topo: Option<Topology>,
-    framing: Option<Framing>,
-    color_scale: Option<f32>,
-    pose: PoseData,
-    /// This pose: a flipbook frame's positions.
-    frame_pos: Option<Vec<[f64; 3]>>,
-    /// This pose: the curvature run (normals, curvature, dcurv steps).
-    curv: Option<Timing>,
-    /// This pose: whether the host copies are made.
-    pose_ready: bool,
-    /// Whether the renderer holds this topology's faces, and this pose's
-    /// positions, normals and colours (uploaded by the first view).
-    gl_topology: bool,
-    gl_pose: bool,
-    /// How the edges frame's buffers reach GL, and what was offered
-    /// (decided once, when feature edges are planned).
-    interop: Option<(InteropDecision, InteropOffer)>,
-    /// This view: what the edge stage compacted into the shared buffer.
-    shared_drawn: Option<SharedDrawn>,
-    /// This view: its lines classified and chained (exact visibility), the
-    /// frame drawn and the SVG groups found.
-    vis: Option<VisibleLines>,
-    /// This view's per-vertex fields, where the plan keeps them.
-    fields: Option<crate::spec::feature_lines::ViewFields>,
-    frame: Option<crate::render::Frame>,
-    layers: Option<Vec<crate::export::svg::SvgLayer>>,
-    /// Visible chains and their pieces over all views.
-    pub(super) chains: [usize; 2],
-    /// This pose: its intersection lines (scene frame).
-    isect_segs: Vec<Segment>,
-    /// This view: the lines and the edge stage's run and outputs.
-    segs: Vec<Segment>,
-    lines_ran: Option<Timing>,
-    edges_ran: Option<(Timing, EdgeOutput)>,
-    /// Contour and suggestive-contour segments over all views.
-    pub(super) segments: [usize; 2],
-    /// Segments of each curvature line cue's family over all views.
-    pub(super) line_segments: std::collections::BTreeMap<&'static str, usize>,
-    /// Files written.
-    pub(super) outputs: Vec<PathBuf>,
-    /// Keep each view's outputs in [`Executor::kept`] (a live scene or a
-    /// picture hands them to its caller instead of writing a PNG).
-    pub(super) keep_image: bool,
-    /// Also hand each kept view's surface (world coordinates).
-    pub(super) keep_mesh: bool,
-    /// Also find each kept view's SVG groups.
-    pub(super) keep_layers: bool,
+    /// The current pose.
+    pose: PoseState,
+    /// The current view.
+    view: ViewState,
+    /// What the caller keeps of each view.
+    pub(super) keep: Keep,
     /// The last view's outputs, when kept.
     pub(super) kept: Option<super::draw::ViewOutputs>,
 }
@@ -225,42 +174,23 @@ impl<'s, 'g> Executor<'s, 'g> {
             gpu,
             rec: Recorder::new(plan.input),
             renderer,
-            curv_opts,
-            line_opts,
-            pipe,
-            iso,
-            ao,
-            sdf_lines,
-            strokes: SdfLinesOutput::default(),
-            iso_normals: None,
-            stroke_count: 0,
-            feature_size_note: None,
+            stages: RunStages {
+                curv_opts,
+                line_opts,
+                pipe,
+                iso,
+                ao,
+                sdf_lines,
+                interop,
+            },
+            run: RunState {
+                color_scale: fx.curvature_scale,
+                ..Default::default()
+            },
             topo: None,
-            framing: None,
-            color_scale: fx.curvature_scale,
-            pose: PoseData::default(),
-            frame_pos: None,
-            curv: None,
-            pose_ready: false,
-            gl_topology: false,
-            gl_pose: false,
-            interop,
-            shared_drawn: None,
-            vis: None,
-            fields: None,
-            frame: None,
-            layers: None,
-            chains: [0; 2],
-            isect_segs: Vec::new(),
-            segs: Vec::new(),
-            lines_ran: None,
-            edges_ran: None,
-            segments: [0; 2],
-            line_segments: Default::default(),
-            outputs: Vec::new(),
-            keep_image: false,
-            keep_layers: false,
-            keep_mesh: false,
+            pose: PoseState::default(),
+            view: ViewState::default(),
+            keep: Keep::default(),
             kept: None,
         })
     }
@@ -302,7 +232,7 @@ impl<'s, 'g> Executor<'s, 'g> {
 
     /// The curvature estimator of the current pose, wherever it lives.
     fn est(&self) -> Option<&CurvatureEstimator> {
-        match &self.pipe {
+        match &self.stages.pipe {
             Some(p) => p.estimator(),
             None => self.topo.as_ref().and_then(|t| t.est.as_ref()),
         }
@@ -310,18 +240,15 @@ impl<'s, 'g> Executor<'s, 'g> {
 
     /// Starts a pose: nothing of the last one is reused.
     pub(super) fn begin_pose(&mut self) {
-        self.frame_pos = None;
-        self.curv = None;
-        self.pose_ready = false;
-        self.gl_pose = false;
+        self.pose = PoseState::default();
     }
 
     /// Ends a pose: host copies made (if no pass needed them), the colour
     /// scale fixed on the first pose.
     pub(super) fn end_pose(&mut self, frame: usize) -> Result<()> {
         self.host_pose(frame)?;
-        if self.color_scale.is_none() && !self.pose.k.is_empty() {
-            self.color_scale = Some(curvature_scale(&self.pose.k));
+        if self.run.color_scale.is_none() && !self.pose.host.k.is_empty() {
+            self.run.color_scale = Some(curvature_scale(&self.pose.host.k));
         }
         Ok(())
     }
@@ -334,11 +261,11 @@ impl<'s, 'g> Executor<'s, 'g> {
                 Loaded::Static(m, _) => m.clone(),
                 Loaded::Skinned { mesh, .. } => mesh.rest.clone(),
                 Loaded::Flipbook(fb) => {
-                    let p = match self.frame_pos.take() {
+                    let p = match self.pose.frame_pos.take() {
                         Some(p) => p,
                         None => fb.frame(frame)?,
                     };
-                    self.frame_pos = Some(p.clone());
+                    self.pose.frame_pos = Some(p.clone());
                     let name = fb.frames[frame].display().to_string();
                     Mesh::new(p, fb.faces.clone(), &name)?
                 }
@@ -349,7 +276,6 @@ impl<'s, 'g> Executor<'s, 'g> {
                 }
             };
             self.topo = Some(Topology::new(mesh));
-            self.gl_topology = false;
         }
         Ok(self.topo.as_mut().expect("made above"))
     }
@@ -360,25 +286,25 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// planned normals pass fills them (`edges_detect` and `caps_adjacency`
     /// do not read them, and a lines-only mesh is drawn flat).
     fn host_pose(&mut self, frame: usize) -> Result<()> {
-        if self.pose_ready {
+        if self.pose.ready {
             return Ok(());
         }
         self.topology(frame)?;
         let t = self.topo.as_ref().expect("made above");
-        let skinned = match &self.pipe {
+        let skinned = match &self.stages.pipe {
             Some(p) => Some(p.skinner().read()?),
             None => None,
         };
-        let host: Vec<[f64; 3]> = match (&skinned, &self.frame_pos) {
+        let host: Vec<[f64; 3]> = match (&skinned, &self.pose.frame_pos) {
             (Some(p), _) => p.iter().map(|q| q.map(f64::from)).collect(),
             (None, Some(p)) => p.clone(),
             (None, None) => t.mesh.positions.clone(),
         };
-        let o = match &self.framing {
+        let o = match &self.run.framing {
             Some(f) => f.origin,
             None => draw::centre(draw::bounds_of(host.iter().copied(), &t.used)),
         };
-        self.pose.pos = match &skinned {
+        self.pose.host.pos = match &skinned {
             // f32 positions: subtract in f64 from the f32 values.
             Some(p) => p
                 .iter()
@@ -389,9 +315,9 @@ impl<'s, 'g> Executor<'s, 'g> {
                 .map(|q| std::array::from_fn(|i| (q[i] - o[i]) as f32))
                 .collect(),
         };
-        self.pose.nrm = vec![[0.0; 3]; t.mesh.n_vertices()];
-        if self.framing.is_none() {
-            let b = draw::bounds_of(self.pose.pos.iter().map(|q| q.map(f64::from)), &t.used);
+        self.pose.host.nrm = vec![[0.0; 3]; t.mesh.n_vertices()];
+        if self.run.framing.is_none() {
+            let b = draw::bounds_of(self.pose.host.pos.iter().map(|q| q.map(f64::from)), &t.used);
             let diag = ((0..3).map(|i| (b.1[i] - b.0[i]).powi(2)).sum::<f64>()).sqrt();
             let [w, h] = self.scene.size;
             let cameras = self
@@ -400,36 +326,36 @@ impl<'s, 'g> Executor<'s, 'g> {
                 .iter()
                 .map(|v| draw::camera(v, b, w as f32 / h as f32, o))
                 .collect::<Result<_>>()?;
-            self.framing = Some(Framing {
+            self.run.framing = Some(Framing {
                 origin: o,
                 bounds: b,
                 cameras,
                 ao_radius: (self.scene.effects.ao_radius as f64 * diag.max(1e-30)) as f32,
             });
         }
-        self.pose_ready = true;
+        self.pose.ready = true;
         Ok(())
     }
 
     /// The curvature run of this pose (normals, curvature, dcurv), run on
     /// first use: from the skinned buffer, or from the host positions.
     fn curvature_run(&mut self, frame: usize) -> Result<Timing> {
-        if let Some(t) = &self.curv {
+        if let Some(t) = &self.pose.curv {
             return Ok(t.clone());
         }
-        let t = match self.pipe.as_mut() {
+        let t = match self.stages.pipe.as_mut() {
             Some(p) => p.curvature()?,
             None => {
                 self.topology(frame)?;
-                let fp = self.frame_pos.take();
+                let fp = self.pose.frame_pos.take();
                 let t = self.topo.as_mut().expect("made above");
                 let est = t.est.as_mut().expect("planned with the one-rings");
                 est.set_positions(fp.as_deref().unwrap_or(&t.mesh.positions))?;
-                self.frame_pos = fp;
+                self.pose.frame_pos = fp;
                 est.run()?
             }
         };
-        self.curv = Some(t.clone());
+        self.pose.curv = Some(t.clone());
         Ok(t)
     }
 
@@ -445,7 +371,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 let t0 = Instant::now();
                 let p = fb.frame(frame)?;
                 self.rec.wall(pass, ms_since(t0), "read the frame file");
-                self.frame_pos = Some(p);
+                self.pose.frame_pos = Some(p);
             }
             Pass::EdgeBuffer => self.edge_buffer(frame)?,
             Pass::OneRings => self.one_rings(frame)?,
@@ -459,7 +385,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             Pass::Curvature => {
                 let t = self.curvature_run(frame)?;
                 // What ran, as the options chose it.
-                let o = self.curv_opts;
+                let o = self.stages.curv_opts;
                 let how = format!(
                     "tensor + principal (Rusinkiewicz; {} accumulation, {}, {} least squares)",
                     o.accumulate.name(),
@@ -507,7 +433,11 @@ impl<'s, 'g> Executor<'s, 'g> {
             unreachable!("planned for a skinned input")
         };
         let mats = poses(frame)?;
-        let pipe = self.pipe.as_mut().expect("built for the skinning pass");
+        let pipe = self
+            .stages
+            .pipe
+            .as_mut()
+            .expect("built for the skinning pass");
         let t = pipe.skin(&mats)?;
         self.rec
             .kernels(Pass::Skinning, &t, "skin_lbs (linear blend, ≤ 4 joints)");
@@ -556,7 +486,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let t0 = Instant::now();
         let t = self.topo.as_mut().expect("made by the host copies");
         let es = t.edges.as_mut().expect("planned with the edge buffer");
-        es.set_positions(&self.pose.pos, &self.pose.nrm)?;
+        es.set_positions(&self.pose.host.pos, &self.pose.host.nrm)?;
         self.rec.wall(
             Pass::FaceNormals,
             ms_since(t0),
@@ -570,7 +500,11 @@ impl<'s, 'g> Executor<'s, 'g> {
         let Loaded::Volume(v, iso_value, negated) = &self.loaded else {
             unreachable!("planned for a volume input")
         };
-        let ex = self.iso.as_mut().expect("built for the isosurface pass");
+        let ex = self
+            .stages
+            .iso
+            .as_mut()
+            .expect("built for the isosurface pass");
         let s = ex.extract(*iso_value, crate::spec::vertex_fusion::Fusion::Direct)?;
         self.rec.kernels(
             Pass::Isosurface,
@@ -583,7 +517,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         // normals (smoother than the faces' on marching cubes' chords).
         let gradient =
             self.plan.contains(Pass::VertexNormals) && !self.plan.contains(Pass::Curvature);
-        self.iso_normals = gradient.then(|| {
+        self.pose.iso_normals = gradient.then(|| {
             crate::volume::gradient::gradient_normals(v, &ipos)
                 .iter()
                 .map(|n| n.map(|c| c as f32))
@@ -610,7 +544,6 @@ impl<'s, 'g> Executor<'s, 'g> {
             ));
         }
         self.topo = Some(Topology::new(m));
-        self.gl_topology = false;
         Ok(())
     }
 
@@ -631,28 +564,31 @@ impl<'s, 'g> Executor<'s, 'g> {
             };
             format!("one-ring lists or owning faces (atomic_max){program}")
         };
-        if let Some(p) = &self.pipe {
+        if let Some(p) = &self.stages.pipe {
             let est = p.estimator().expect("built for the one-rings pass");
             let ms = est.topology_ms();
             self.rec
                 .wall(Pass::OneRings, ms, &format!("upload faces, {}", how(est)));
             return Ok(());
         }
-        if let Some(ex) = self.iso.as_ref() {
-            let (est, timing) =
-                crate::stages::marching_cubes::curvature(ex, self.curv_opts, IsoNormals::Gradient)?;
-            let faces = if self.curv_opts.accumulate.scatters() {
+        if let Some(ex) = self.stages.iso.as_ref() {
+            let (est, timing) = crate::stages::marching_cubes::curvature(
+                ex,
+                self.stages.curv_opts,
+                IsoNormals::Gradient,
+            )?;
+            let faces = if self.stages.curv_opts.accumulate.scatters() {
                 "faces copied on the device"
             } else {
                 "faces read back once for the gather scheme's one-rings"
             };
             let how = format!("{faces}, {}", how(&est));
             self.rec.wall(Pass::OneRings, est.topology_ms(), &how);
-            self.curv = Some(timing);
+            self.pose.curv = Some(timing);
             self.topo.as_mut().expect("made by the isosurface").est = Some(est);
             return Ok(());
         }
-        let (gpu, opts) = (self.gpu.clone(), self.curv_opts);
+        let (gpu, opts) = (self.gpu.clone(), self.stages.curv_opts);
         let t = self.topology(frame)?;
         let est = CurvatureEstimator::new(gpu, t.mesh.n_vertices(), &t.mesh.faces, opts)?;
         let (ms, how) = (est.topology_ms(), how(&est));
@@ -669,21 +605,21 @@ impl<'s, 'g> Executor<'s, 'g> {
         if self.est().is_some() {
             let t = self.curvature_run(frame)?;
             let f = self.est().expect("checked above").read()?;
-            self.pose.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
-            self.pose.k =
+            self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
+            self.pose.host.k =
                 f.k1.iter()
                     .zip(&f.k2)
                     .map(|(&a, &b)| [a as f32, b as f32])
                     .collect();
-            let normals = if self.iso.is_some() {
+            let normals = if self.stages.iso.is_some() {
                 "then replaced by the volume's gradient"
             } else {
                 "curvature normals (area-weighted)"
             };
             let how = format!("clear + normals_areas + frames ({normals})");
             self.rec.kernels(Pass::VertexNormals, &t, &how);
-        } else if let Some(n) = &self.iso_normals {
-            self.pose.nrm = n.clone();
+        } else if let Some(n) = &self.pose.iso_normals {
+            self.pose.host.nrm = n.clone();
             self.rec.wall(
                 Pass::VertexNormals,
                 0.0,
@@ -693,10 +629,16 @@ impl<'s, 'g> Executor<'s, 'g> {
             let t0 = Instant::now();
             let faces = self.topo.as_ref().expect("made above").mesh.faces.clone();
             let m = Mesh {
-                positions: self.pose.pos.iter().map(|p| p.map(f64::from)).collect(),
+                positions: self
+                    .pose
+                    .host
+                    .pos
+                    .iter()
+                    .map(|p| p.map(f64::from))
+                    .collect(),
                 faces,
             };
-            self.pose.nrm = vertex_normals(&m);
+            self.pose.host.nrm = vertex_normals(&m);
             self.rec.wall(
                 Pass::VertexNormals,
                 ms_since(t0),
@@ -710,24 +652,25 @@ impl<'s, 'g> Executor<'s, 'g> {
     fn ao(&mut self, frame: usize) -> Result<()> {
         self.host_pose(frame)?;
         let radius = self
+            .run
             .framing
             .as_ref()
             .expect("made by the host copies")
             .ao_radius;
         let mode = self.scene.effects.ao_mode;
-        let t = match self.pipe.as_mut() {
+        let t = match self.stages.pipe.as_mut() {
             Some(p) => {
                 p.set_ao_radius(radius);
                 let t = p.run_ao(mode)?;
-                self.pose.ao = p.read_ao()?;
+                self.pose.host.ao = p.read_ao()?;
                 t
             }
             None => {
                 let est = self.topo.as_ref().and_then(|t| t.est.as_ref());
                 let est = est.expect("planned with curvature");
-                let ao = self.ao.as_mut().expect("built for the AO pass");
+                let ao = self.stages.ao.as_mut().expect("built for the AO pass");
                 let t = Timing::of(Step::AoVertex, ao.run_device(est, radius, mode)?);
-                self.pose.ao = ao.read(self.pose.pos.len())?;
+                self.pose.host.ao = ao.read(self.pose.host.pos.len())?;
                 t
             }
         };
@@ -738,7 +681,11 @@ impl<'s, 'g> Executor<'s, 'g> {
 
     /// Curvature-directed strokes of this pose, traced on the volume.
     fn sdf_lines(&mut self) -> Result<()> {
-        let (stage, _) = self.sdf_lines.as_mut().expect("built for the strokes pass");
+        let (stage, _) = self
+            .stages
+            .sdf_lines
+            .as_mut()
+            .expect("built for the strokes pass");
         let out = stage.run()?;
         let st = &out.stats;
         let t = st.timing.clone();
@@ -758,8 +705,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             }
         );
         self.rec.kernels(Pass::SdfLines, &t, &how);
-        self.stroke_count += out.strokes.len();
-        self.strokes = out;
+        self.run.stroke_count += out.strokes.len();
+        self.pose.strokes = out;
         Ok(())
     }
 }

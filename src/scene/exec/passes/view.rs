@@ -13,14 +13,15 @@ impl Executor<'_, '_> {
         &self,
         v: &crate::scene::file::ViewSpec,
     ) -> Result<Camera> {
-        let f = self.framing.as_ref().expect("a pose ran");
+        let f = self.run.framing.as_ref().expect("a pose ran");
         let [w, h] = self.scene.size;
         draw::camera(v, f.bounds, w as f32 / h as f32, f.origin)
     }
 
     /// The cameras fixed by the first pose.
     pub(in crate::scene::exec) fn cameras(&self) -> Vec<Camera> {
-        self.framing
+        self.run
+            .framing
             .as_ref()
             .map(|f| f.cameras.clone())
             .unwrap_or_default()
@@ -28,14 +29,7 @@ impl Executor<'_, '_> {
 
     /// Starts a view.
     pub(in crate::scene::exec) fn begin_view(&mut self) {
-        self.segs.clear();
-        self.lines_ran = None;
-        self.edges_ran = None;
-        self.shared_drawn = None;
-        self.vis = None;
-        self.fields = None;
-        self.frame = None;
-        self.layers = None;
+        self.view = super::ViewState::default();
     }
 
     /// Runs one view pass from `cam`; the render pass writes `paths`.
@@ -55,7 +49,7 @@ impl Executor<'_, '_> {
                 );
             }
             Pass::SuggestiveContours => {
-                let shared = self.lines_ran.is_some();
+                let shared = self.view.lines_ran.is_some();
                 let t = self.lines(cam)?;
                 if shared {
                     self.rec.shared(
@@ -83,7 +77,11 @@ impl Executor<'_, '_> {
             Pass::ViewFields => self.view_fields_pass(cam)?,
             Pass::Edges => self.edges_pass(pass, cam, paths)?,
             Pass::Caps => {
-                let (timing, _) = self.edges_ran.as_ref().expect("planned after the edges");
+                let (timing, _) = self
+                    .view
+                    .edges_ran
+                    .as_ref()
+                    .expect("planned after the edges");
                 let how = format!("caps_{}", self.scene.effects.caps.name());
                 self.rec.kernels(pass, timing, &how);
             }
@@ -137,7 +135,7 @@ impl Executor<'_, '_> {
         let lx = (self.topo.as_ref())
             .and_then(|t| t.lines.as_ref())
             .expect("the lines ran");
-        self.fields = Some(lx.read_view_fields()?);
+        self.view.fields = Some(lx.read_view_fields()?);
         self.rec.wall(
             Pass::ViewFields,
             ms_since(t0),
@@ -153,9 +151,9 @@ impl Executor<'_, '_> {
         let caps = self.caps();
         // The external-memory route draws from the shared buffer (CL-GL
         // sharing is not built: `GL_SHARING_BUILT`).
-        let shared =
-            (self.interop.as_ref()).is_some_and(|(d, _)| d.route == InteropRoute::ExternalMemory);
-        let svg = self.keep_layers
+        let shared = (self.stages.interop.as_ref())
+            .is_some_and(|(d, _)| d.route == InteropRoute::ExternalMemory);
+        let svg = self.keep.layers
             || paths
                 .iter()
                 .any(|p| p.extension().is_none_or(|e| e != "png"));
@@ -173,7 +171,7 @@ impl Executor<'_, '_> {
             &timing,
             "edges_detect (contour, crease, boundary) into edge-out",
         );
-        self.edges_ran = Some((timing, out));
+        self.view.edges_ran = Some((timing, out));
         Ok(())
     }
 
@@ -227,7 +225,7 @@ impl Executor<'_, '_> {
         if svg {
             out.edge_out = sh.read_edges(self.gpu, &d)?;
         }
-        self.shared_drawn = Some(d);
+        self.view.shared_drawn = Some(d);
         Ok(out)
     }
 
@@ -240,15 +238,15 @@ impl Executor<'_, '_> {
         let pngs: Vec<&PathBuf> = paths.iter().copied().filter(|p| draw::is_png(p)).collect();
         let depth = self.plan.contains(Pass::Svg)
             && !self.plan.contains(Pass::Visibility)
-            && (pngs.len() < paths.len() || self.keep_layers);
+            && (pngs.len() < paths.len() || self.keep.layers);
         let frame = self.draw(cam, &pngs, depth)?;
         self.rec.wall(
             pass,
             ms_since(t0),
             "draw mesh, line quads, edge quads and stroke strips; read back",
         );
-        self.outputs.extend(pngs.into_iter().cloned());
-        self.frame = Some(frame);
+        self.run.outputs.extend(pngs.into_iter().cloned());
+        self.view.frame = Some(frame);
         Ok(())
     }
 
@@ -258,7 +256,7 @@ impl Executor<'_, '_> {
         // A plan with nothing to draw or write keeps nothing: the caller
         // says there is nothing to draw.
         let drawn = self.plan.contains(Pass::Render) || self.plan.contains(Pass::Svg);
-        if self.keep_image && drawn {
+        if self.keep.image && drawn {
             self.kept = Some(self.kept_view(cam));
         }
     }
@@ -266,24 +264,24 @@ impl Executor<'_, '_> {
     /// The mesh to GL once per topology (faces) and once per pose
     /// (positions, normals, colours), not once per view.
     fn upload_mesh(&mut self) -> Result<()> {
-        let t = self.topo.as_ref().expect("a pose ran");
+        let t = self.topo.as_mut().expect("a pose ran");
         let r = self
             .renderer
             .as_mut()
             .expect("a renderer is made where the plan draws a frame");
-        if !self.gl_topology {
+        if !t.gl {
             r.upload_topology(&t.mesh.faces)?;
-            self.gl_topology = true;
+            t.gl = true;
         }
-        if !self.gl_pose {
+        if !self.pose.gl {
             let colors = draw::mesh_colors(
                 self.scene,
                 self.plan,
-                &self.pose,
-                self.color_scale.unwrap_or(1.0),
+                &self.pose.host,
+                self.run.color_scale.unwrap_or(1.0),
             );
-            r.upload_pose(&self.pose.pos, &self.pose.nrm, &colors)?;
-            self.gl_pose = true;
+            r.upload_pose(&self.pose.host.pos, &self.pose.host.nrm, &colors)?;
+            self.pose.gl = true;
         }
         Ok(())
     }
@@ -300,10 +298,10 @@ impl Executor<'_, '_> {
         let strokes = self.scene_strokes();
         let t = self.topo.as_ref().expect("a pose ran");
         let lines = ViewLines {
-            segments: &self.segs,
-            intersections: &self.isect_segs,
-            edges: self.edges_ran.as_ref().map(|e| &e.1),
-            shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
+            segments: &self.view.segs,
+            intersections: &self.pose.isect_segs,
+            edges: self.view.edges_ran.as_ref().map(|e| &e.1),
+            shared: (t.shared.as_ref()).zip(self.view.shared_drawn.as_ref()),
             strokes: &strokes,
             stroke_lift: self.stroke_lift(),
         };
@@ -316,10 +314,10 @@ impl Executor<'_, '_> {
     pub(super) fn view_lines<'a>(&'a self, strokes: &'a [Stroke]) -> ViewLines<'a> {
         let t = self.topo.as_ref().expect("a pose ran");
         ViewLines {
-            segments: &self.segs,
-            intersections: &self.isect_segs,
-            edges: self.edges_ran.as_ref().map(|e| &e.1),
-            shared: (t.shared.as_ref()).zip(self.shared_drawn.as_ref()),
+            segments: &self.view.segs,
+            intersections: &self.pose.isect_segs,
+            edges: self.view.edges_ran.as_ref().map(|e| &e.1),
+            shared: (t.shared.as_ref()).zip(self.view.shared_drawn.as_ref()),
             strokes,
             stroke_lift: self.stroke_lift(),
         }
@@ -328,38 +326,38 @@ impl Executor<'_, '_> {
     /// The strokes' lift towards the eye: half a voxel (they lie on the
     /// interpolated surface, which marching cubes cuts as chords).
     pub(super) fn stroke_lift(&self) -> f32 {
-        self.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32
+        self.stages.sdf_lines.as_ref().map_or(0.0, |s| 0.5 * s.1) as f32
     }
 
     /// Adds the view's contour and suggestive-contour segments, and its
     /// segments of each curvature line family, to the run's counts (drawn
     /// segments: none of no strength).
     fn count_segments(&mut self) {
-        for (k, n) in self.segments.iter_mut().enumerate() {
-            *n += (self.segs.iter())
+        for (k, n) in self.run.segments.iter_mut().enumerate() {
+            *n += (self.view.segs.iter())
                 .filter(|s| s.2 == k as u32 && draw::shown(s))
                 .count();
         }
         let fx = &self.scene.effects;
         for st in &fx.lines.styles_for(&fx.cues) {
             let kind = st.family as u32;
-            let n = (self.segs.iter())
+            let n = (self.view.segs.iter())
                 .filter(|s| s.2 == kind && draw::shown(s))
                 .count();
-            *self.line_segments.entry(st.family.name()).or_default() += n;
+            *self.run.line_segments.entry(st.family.name()).or_default() += n;
         }
-        if let Some(v) = &self.vis {
+        if let Some(v) = &self.view.vis {
             let visible = v.chains.iter().filter(|c| c.visible);
-            self.chains[0] += visible.clone().count();
-            self.chains[1] += visible.map(|c| c.pieces.len()).sum::<usize>();
+            self.run.chains[0] += visible.clone().count();
+            self.run.chains[1] += visible.map(|c| c.pieces.len()).sum::<usize>();
         }
     }
 
     /// The strokes in the scene frame (world minus the scene origin).
     pub(super) fn scene_strokes(&self) -> Vec<Stroke> {
-        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let o = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
-        (self.strokes.strokes.iter())
+        (self.pose.strokes.strokes.iter())
             .map(|s| Stroke {
                 points: s.points.iter().map(local).collect(),
                 strip: s.strip.iter().map(local).collect(),
@@ -376,7 +374,7 @@ impl Executor<'_, '_> {
         cam: &Camera,
         files: Vec<PathBuf>,
     ) -> draw::ViewDone {
-        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let o = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let world =
             |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
         let shift = glam::DVec3::from(o).as_vec3();
@@ -388,11 +386,11 @@ impl Executor<'_, '_> {
                 target: cam.target + shift,
                 ..*cam
             },
-            segments: (self.segs.iter())
+            segments: (self.view.segs.iter())
                 .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
                 .collect(),
-            visible: self.vis.as_ref().map(|v| v.shifted(o)),
-            fields: self.fields.take(),
+            visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
+            fields: self.view.fields.take(),
             feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
             files,
         }
@@ -403,13 +401,13 @@ impl Executor<'_, '_> {
     /// the strokes, the camera (world coordinates) and the kernel time of
     /// the pose and the view.
     fn kept_view(&mut self, cam: &Camera) -> draw::ViewOutputs {
-        let o = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let o = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let world =
             |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
-        let mut timing = self.curv.clone().unwrap_or_default();
+        let mut timing = self.pose.curv.clone().unwrap_or_default();
         for t in [
-            &self.lines_ran,
-            &self.edges_ran.as_ref().map(|e| e.0.clone()),
+            &self.view.lines_ran,
+            &self.view.edges_ran.as_ref().map(|e| e.0.clone()),
         ]
         .into_iter()
         .flatten()
@@ -418,26 +416,27 @@ impl Executor<'_, '_> {
         }
         let topo = self.topo.as_ref();
         draw::ViewOutputs {
-            image: self.frame.take(),
-            layers: self.layers.take(),
-            visible: self.vis.as_ref().map(|v| v.shifted(o)),
-            fields: self.fields.take(),
-            segments: (self.segs.iter())
+            image: self.view.frame.take(),
+            layers: self.view.layers.take(),
+            visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
+            fields: self.view.fields.take(),
+            segments: (self.view.segs.iter())
                 .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
                 .collect(),
-            edges: self.edges_ran.as_ref().map(|e| e.1.clone()),
-            strokes: self.strokes.clone(),
+            edges: self.view.edges_ran.as_ref().map(|e| e.1.clone()),
+            strokes: self.pose.strokes.clone(),
             camera: *cam,
             origin: o,
-            mesh: topo.filter(|_| self.keep_mesh).map(|t| t.mesh.clone()),
+            mesh: topo.filter(|_| self.keep.mesh).map(|t| t.mesh.clone()),
             edge_info: self
+                .stages
                 .interop
                 .as_ref()
                 .map(|(decision, offer)| draw::EdgeInfo {
                     counts: topo.and_then(|t| t.edge_counts).unwrap_or_default(),
                     decision: decision.clone(),
                     offer: offer.clone(),
-                    drawn_caps: match (&self.shared_drawn, &self.edges_ran) {
+                    drawn_caps: match (&self.view.shared_drawn, &self.view.edges_ran) {
                         (Some(d), _) => d.adjacency_caps,
                         (None, Some((_, out))) => out.cap_adj.len() / 4,
                         (None, None) => 0,
@@ -454,13 +453,13 @@ impl Executor<'_, '_> {
     /// the device from the curvature buffers, or from host normals when no
     /// curvature is planned (contours, isophotes, boundaries).
     fn lines(&mut self, cam: &Camera) -> Result<Timing> {
-        if let Some(t) = &self.lines_ran {
+        if let Some(t) = &self.view.lines_ran {
             return Ok(t.clone());
         }
         let [w, h] = self.scene.size;
         let v = cam.view(w, h);
-        let origin = self.framing.as_ref().map_or([0.0; 3], |f| f.origin);
-        let opts = self.line_opts;
+        let origin = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        let opts = self.stages.line_opts;
         let Topology {
             mesh,
             feature_size,
@@ -468,7 +467,7 @@ impl Executor<'_, '_> {
             lines,
             ..
         } = self.topo.as_mut().expect("a pose ran");
-        let est = match &self.pipe {
+        let est = match &self.stages.pipe {
             Some(p) => p.estimator(),
             None => est.as_ref(),
         };
@@ -489,7 +488,7 @@ impl Executor<'_, '_> {
                     self.plan,
                     mesh,
                     est,
-                    &mut self.feature_size_note,
+                    &mut self.run.feature_size_note,
                 )?;
                 *feature_size = Some(fs);
                 fs
@@ -498,11 +497,11 @@ impl Executor<'_, '_> {
         let (s, stats) = match est {
             Some(est) => lx.extract_device_at(est, v, feature_size, opts, origin)?,
             None => {
-                let n = self.pose.pos.len();
+                let n = self.pose.host.pos.len();
                 let z3 = vec![[0f32; 3]; n];
                 let x = LineInputs {
-                    pos: &self.pose.pos,
-                    nrm: &self.pose.nrm,
+                    pos: &self.pose.host.pos,
+                    nrm: &self.pose.host.nrm,
                     d1: &z3,
                     d2: &z3,
                     k: &vec![[0f32; 2]; n],
@@ -511,8 +510,8 @@ impl Executor<'_, '_> {
                 lx.extract(&x, v, feature_size, opts)?
             }
         };
-        self.segs = s;
-        self.lines_ran = Some(stats.timing.clone());
+        self.view.segs = s;
+        self.view.lines_ran = Some(stats.timing.clone());
         Ok(stats.timing)
     }
 }

@@ -15,12 +15,12 @@ impl Executor<'_, '_> {
         let t = self.topo.as_mut().expect("made by the host copies");
         let how = match &mut t.bvh {
             Some(b) => {
-                b.refit(&self.pose.pos)?;
+                b.refit(&self.pose.host.pos)?;
                 "bvh_refit (boxes of the same tree to this pose)"
             }
             None => {
                 let mut b = Bvh::new(self.gpu.clone(), t.mesh.n_vertices(), &t.mesh.faces)?;
-                b.build(&self.pose.pos)?;
+                b.build(&self.pose.host.pos)?;
                 t.bvh = Some(b);
                 "bvh_morton, radix sort, bvh_build, bvh_refit (a new topology: Karras's tree)"
             }
@@ -55,7 +55,7 @@ impl Executor<'_, '_> {
         };
         let (segs, stats) = search.find(bvh)?;
         let layer = super::super::vector::LAYER_INTERSECTIONS;
-        self.isect_segs = (segs.iter())
+        self.pose.isect_segs = (segs.iter())
             .map(|s| {
                 let ends = [[LINE_FREE, s.faces[0]], [LINE_FREE, s.faces[1]]];
                 (s.a, s.b, layer, 1.0, ends)
@@ -82,17 +82,22 @@ impl Executor<'_, '_> {
             false => Vec::new(),
         };
         let t = self.topo.as_mut().expect("a pose ran");
-        let edges = (self.edges_ran.as_ref()).map(|e| (&e.1, t.edge_pairs.as_slice()));
-        let mut segs = gather(&self.scene.effects, &self.segs, edges, &self.pose.pos);
-        segs.extend_from_slice(&self.isect_segs);
+        let edges = (self.view.edges_ran.as_ref()).map(|e| (&e.1, t.edge_pairs.as_slice()));
+        let mut segs = gather(
+            &self.scene.effects,
+            &self.view.segs,
+            edges,
+            &self.pose.host.pos,
+        );
+        segs.extend_from_slice(&self.pose.isect_segs);
         segs.extend(strokes);
         let n = segs.len();
-        let scale = self.framing.as_ref().map_or(1.0, |f| {
+        let scale = self.run.framing.as_ref().map_or(1.0, |f| {
             let (lo, hi) = f.bounds;
             (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max) as f32
         });
         let bvh = t.bvh.as_mut().expect("planned with the BVH pass");
-        let mesh = (self.pose.pos.as_slice(), t.mesh.faces.as_slice());
+        let mesh = (self.pose.host.pos.as_slice(), t.mesh.faces.as_slice());
         let (vis, c) = classify_view(bvh, mesh, segs, &view, scale)?;
         let host = ms_since(t0) - c.timing.kernel_ms;
         let how = format!(
@@ -104,7 +109,7 @@ impl Executor<'_, '_> {
             vis.mean_chain_length(),
         );
         self.rec.kernels(Pass::Visibility, &c.timing, &how);
-        self.vis = Some(vis);
+        self.view.vis = Some(vis);
         Ok(())
     }
 
@@ -114,12 +119,12 @@ impl Executor<'_, '_> {
     pub(super) fn svg_pass(&mut self, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
         let t0 = Instant::now();
         let svgs: Vec<&PathBuf> = paths.iter().copied().filter(|p| !draw::is_png(p)).collect();
-        if svgs.is_empty() && !self.keep_layers {
+        if svgs.is_empty() && !self.keep.layers {
             // Nothing asked for in this view (a live view without an SVG
             // request): the pass does not run.
             return Ok(());
         }
-        let layers = match (&self.vis, &self.frame) {
+        let layers = match (&self.view.vis, &self.view.frame) {
             (Some(vis), _) => svg_layers_exact(self.scene, cam, vis),
             (None, Some(frame)) if self.plan.contains(Pass::Render) => {
                 let strokes = self.scene_strokes();
@@ -132,16 +137,16 @@ impl Executor<'_, '_> {
         let [w, h] = self.scene.size;
         for p in svgs {
             crate::export::svg::write_svg_layers(p, &layers, w, h)?;
-            self.outputs.push(p.clone());
+            self.run.outputs.push(p.clone());
         }
-        let how = if self.vis.is_some() {
+        let how = if self.view.vis.is_some() {
             "SVG groups of the visible chains (exact visibility)"
         } else {
             "SVG groups of the lines visible against the frame's depth"
         };
         self.rec.wall(Pass::Svg, ms_since(t0), how);
-        if self.keep_layers {
-            self.layers = Some(layers);
+        if self.keep.layers {
+            self.view.layers = Some(layers);
         }
         Ok(())
     }
