@@ -45,13 +45,99 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let inputs: Vec<&Path> = c.inputs().into_iter().chain(a.cameras.as_deref()).collect();
     let gpu = Arc::new(Gpu::new(device)?);
+    let plan = plan_run(&a, &c, (&mesh, &gpu, &scene), &files, &inputs)?;
+    let t_run = Instant::now();
+    let mut run = ViewsRun {
+        mesh: &mesh,
+        segments: files.segments.as_deref(),
+        npz: files.npz.as_deref(),
+        fields: files.fields.as_deref(),
+        dir: &out,
+        log: manifest::Log::new(plan.head, plan.kept, files.manifest.clone()),
+        written: Vec::new(),
+        hand_ms: 0.0,
+    };
+    // Written before the first view: an interrupted run can be resumed.
+    run.log.write(None)?;
+    let exec = ExecOptions {
+        force: true,
+        views: Some(plan.todo.clone()),
+        keep_done: true,
+        ..Default::default()
+    };
+    let result = if plan.todo.is_empty() {
+        Ok(None)
+    } else {
+        Session::on(gpu)
+            .run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
+            .map(Some)
+    };
+    let report = match result {
+        Ok(r) => r,
+        Err(e) => return Err(run.failed(e, &plan.fresh, &files.manifest)),
+    };
+    let run_ms = ms_since(t_run);
+    let timing = match &report {
+        Some(r) => timing_doc(r, plan.todo.len(), (load_ms, run_ms, run.hand_ms)),
+        None => json!({"load_ms": load_ms, "run_ms": run_ms, "views_computed": 0}),
+    };
+    run.log.finish(
+        report.as_ref().map(|r| r.renderer.clone()),
+        Some(timing.clone()),
+    )?;
+    super::super::print(format_args!(
+        "{}: {} views ({} computed, {} kept from the earlier run); views {:.1} ms ({:.2} views/s); {}",
+        out.display(),
+        scene.views.len(),
+        plan.todo.len(),
+        scene.views.len() - plan.todo.len(),
+        timing["views_ms"].as_f64().unwrap_or(0.0),
+        timing["views_per_second"].as_f64().unwrap_or(0.0),
+        files.manifest.display()
+    ))?;
+    Ok(())
+}
+
+/// What a views run does, decided before it starts.
+struct RunPlan {
+    /// The manifest's head.
+    head: manifest::Head,
+    /// The views of an earlier run kept (`--resume`).
+    kept: Vec<manifest::ViewEntry>,
+    /// The views to compute.
+    todo: Vec<usize>,
+    /// What the run creates, to remove again if it fails before listing a
+    /// view.
+    fresh: Fresh,
+}
+
+/// What a run creates: the folders (deepest first), the images, and
+/// whether the manifest is new.
+struct Fresh {
+    dirs: Vec<PathBuf>,
+    images: Vec<PathBuf>,
+    manifest: bool,
+}
+
+/// Plans a views run of `a` on `mesh` with `gpu`: the manifest's head, what
+/// an earlier run in the folder leaves (refused without --resume or
+/// --force; --resume keeps its whole views; --force removes its files this
+/// run does not write), the outputs checked against the `inputs`.
+fn plan_run(
+    a: &LinesArgs,
+    c: &super::Common,
+    (mesh, gpu, scene): (&shapecue::Mesh, &Gpu, &shapecue::api::Scene),
+    files: &Files,
+    inputs: &[&Path],
+) -> Result<RunPlan> {
+    let out = files.manifest.parent().unwrap_or(Path::new("."));
     let mut head = manifest::Head::new(
-        &a,
-        &c,
-        &mesh,
+        a,
+        c,
+        mesh,
         &gpu.info.name,
         scene.views.len(),
-        options_doc(&a, &c)?,
+        options_doc(a, c)?,
     )?;
     head.insert("report", name(&files.report).into());
     head.insert("family_codes", family_codes());
@@ -66,16 +152,8 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
             out.display()
         );
     }
-    let manifest_fresh = earlier.is_none();
-    // The images the executor will create (it keeps them on failure, for
-    // --resume; they go again where no view is listed).
-    let new_images: Vec<PathBuf> = (files.images.iter())
-        .map(|i| i.1.clone())
-        .filter(|p| !p.exists())
-        .collect();
-    // The views an earlier run of the same options left whole (--resume).
     let kept = match (&earlier, a.resume) {
-        (Some(m), true) => m.views_to_keep(&head, &files.manifest, &out)?,
+        (Some(m), true) => m.views_to_keep(&head, &files.manifest, out)?,
         (None, true) => bail!(
             "--resume: {} has no manifest.json of an earlier run to continue; run without \
              --resume (add --force to overwrite what is there)",
@@ -86,99 +164,33 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let todo: Vec<usize> = (0..scene.views.len())
         .filter(|v| !kept.iter().any(|k| k.index == *v))
         .collect();
+    let fresh = Fresh {
+        dirs: (out.ancestors())
+            .filter(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(PathBuf::from)
+            .collect(),
+        images: (files.images.iter())
+            .map(|i| i.1.clone())
+            .filter(|p| !p.exists())
+            .collect(),
+        manifest: earlier.is_none(),
+    };
     let per_view = files.per_view();
     let outputs = (todo.iter().flat_map(|&v| per_view[v].iter()))
         .map(|p| p.as_path())
         .chain([files.report.as_path(), files.manifest.as_path()]);
-    // The folders the run makes (deepest first), to remove if it fails.
-    let new_dirs: Vec<PathBuf> = (out.ancestors())
-        .filter(|d| !d.as_os_str().is_empty() && !d.exists())
-        .map(PathBuf::from)
-        .collect();
     // --resume overwrites only the files of its own run (the manifest names
     // them); the inputs are never outputs, with or without it.
     check_outputs(inputs.iter().copied(), outputs, a.force || a.resume)?;
     if let (Some(m), true, false) = (&earlier, a.force, a.resume) {
-        m.remove_stale(&out, &per_view, &inputs);
+        m.remove_stale(out, &per_view, inputs);
     }
-    let t_run = Instant::now();
-    let mut run = ViewsRun {
-        mesh: &mesh,
-        segments: files.segments.as_deref(),
-        npz: files.npz.as_deref(),
-        fields: files.fields.as_deref(),
-        dir: &out,
-        log: manifest::Log::new(head, kept, files.manifest.clone()),
-        written: Vec::new(),
-        hand_ms: 0.0,
-    };
-    // Written before the first view: an interrupted run can be resumed.
-    run.log.write(None)?;
-    let exec = ExecOptions {
-        force: true,
-        views: Some(todo.clone()),
-        keep_done: true,
-        ..Default::default()
-    };
-    let result = if todo.is_empty() {
-        Ok(None)
-    } else {
-        Session::on(gpu)
-            .run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
-            .map(Some)
-    };
-    let report = match result {
-        Ok(r) => r,
-        Err(e) => {
-            // The views finished before the failure are whole and listed:
-            // the run can be continued with --resume.
-            let listed = run.log.write(None).is_ok() && run.log.views() > 0;
-            if !listed {
-                if manifest_fresh {
-                    let _ = std::fs::remove_file(&files.manifest);
-                }
-                for p in &new_images {
-                    let _ = std::fs::remove_file(p);
-                }
-                run.remove_written(&new_dirs);
-            }
-            let hint = if listed {
-                format!(
-                    "; the {} view(s) finished are kept: continue with --resume",
-                    run.log.views()
-                )
-            } else {
-                String::new()
-            };
-            return Err(anyhow::Error::from(e).context(format!(
-                "shapecue lines --out {}: the run stopped{hint}",
-                out.display()
-            )));
-        }
-    };
-    let run_ms = ms_since(t_run);
-    let timing = Some(match &report {
-        Some(r) => timing_doc(r, todo.len(), (load_ms, run_ms, run.hand_ms)),
-        None => json!({"load_ms": load_ms, "run_ms": run_ms, "views_computed": 0}),
-    });
-    let renderer = report.as_ref().map(|r| r.renderer.clone());
-    run.log.finish(renderer, timing.clone())?;
-    let views_per_second = (timing.as_ref())
-        .and_then(|t| t["views_per_second"].as_f64())
-        .unwrap_or(0.0);
-    super::super::print(format_args!(
-        "{}: {} views ({} computed, {} kept from the earlier run); views {:.1} ms ({:.2} views/s); {}",
-        out.display(),
-        scene.views.len(),
-        todo.len(),
-        scene.views.len() - todo.len(),
-        timing
-            .as_ref()
-            .map_or(0.0, |t| t["views_ms"].as_f64().unwrap_or(0.0)),
-        views_per_second,
-        files.manifest.display()
-    ))?;
-    Ok(())
+    Ok(RunPlan {
+        head,
+        kept,
+        todo,
+        fresh,
+    })
 }
 
 /// `--explain`: the plan, its lifetimes and run counts, and the files; runs
@@ -422,16 +434,33 @@ impl ViewsRun<'_> {
         Ok(name(p))
     }
 
-    /// After a failed run: removes the segments files it created, and the
-    /// folders the run made (`new_dirs`, deepest first) where they are left
-    /// empty (the executor removes its own files).
-    fn remove_written(&self, new_dirs: &[PathBuf]) {
-        for p in &self.written {
-            let _ = std::fs::remove_file(p);
-        }
-        for d in new_dirs {
-            let _ = std::fs::remove_dir(d);
-        }
+    /// After a failed run: the views finished before the failure are whole
+    /// and listed, and the run can be continued with --resume; where none
+    /// is, what the run created goes again (its files, the manifest if it
+    /// was new, its folders where left empty). Returns the error to report.
+    fn failed(&mut self, e: shapecue::Error, fresh: &Fresh, manifest: &Path) -> anyhow::Error {
+        let listed = self.log.write(None).is_ok() && self.log.views() > 0;
+        let hint = if listed {
+            format!(
+                "; the {} view(s) finished are kept: continue with --resume",
+                self.log.views()
+            )
+        } else {
+            if fresh.manifest {
+                let _ = std::fs::remove_file(manifest);
+            }
+            for p in fresh.images.iter().chain(&self.written) {
+                let _ = std::fs::remove_file(p);
+            }
+            for d in &fresh.dirs {
+                let _ = std::fs::remove_dir(d);
+            }
+            String::new()
+        };
+        anyhow::Error::from(e).context(format!(
+            "shapecue lines --out {}: the run stopped{hint}",
+            self.dir.display()
+        ))
     }
 }
 
