@@ -375,7 +375,11 @@ impl ViewsRun<'_> {
     /// One view done: its segments written (whole), its entry kept.
     fn view(&mut self, v: ViewDone) -> shapecue::Result<()> {
         let t = Instant::now();
-        let mut files: Vec<String> = v.files.iter().map(|p| name(p)).collect();
+        // The executor's images, hashed from the disk; the files written
+        // here, hashed from the bytes written.
+        let mut listed = (v.files.iter())
+            .map(|p| manifest::sha256_file(p).map(|h| json!({"name": name(p), "sha256": h})))
+            .collect::<shapecue::Result<Vec<Value>>>()?;
         // The pieces' arrays once, for the JSON and the NPZ.
         let arrays = match (&v.visible, self.segments.is_some() || self.npz.is_some()) {
             (Some(vis), true) => Some((vis, shapecue::api::segment_arrays(vis, self.mesh))),
@@ -385,25 +389,16 @@ impl ViewsRun<'_> {
             let visible = arrays.as_ref().map(|(v, a)| (*v, a));
             let doc = segments_doc(visible, &v.segments, v.feature_size.unwrap_or(0.0));
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
-            files.push(self.keep(&paths[v.view], |p| {
-                shapecue::export::output::write_bytes_atomic(p, text.as_bytes())
-            })?);
+            listed.push(self.keep(&paths[v.view], text.into_bytes())?);
         }
         if let (Some(paths), Some((_, a))) = (self.npz, &arrays) {
-            files.push(self.keep(&paths[v.view], |p| {
-                shapecue::export::npz::write_segments(p, a)
-            })?);
+            let bytes = shapecue::export::npz::segments_npz_bytes(a)?;
+            listed.push(self.keep(&paths[v.view], bytes)?);
         }
         if let (Some(paths), Some(f)) = (self.fields, v.fields.as_ref()) {
-            files.push(self.keep(&paths[v.view], |p| {
-                shapecue::export::npz::write_fields(p, f)
-            })?);
+            let bytes = shapecue::export::npz::fields_npz_bytes(f)?;
+            listed.push(self.keep(&paths[v.view], bytes)?);
         }
-        let listed = (files.iter())
-            .map(|f| {
-                manifest::sha256_file(&self.dir.join(f)).map(|h| json!({"name": f, "sha256": h}))
-            })
-            .collect::<shapecue::Result<Vec<Value>>>()?;
         let entry = manifest::ViewEntry {
             index: v.view,
             doc: json!({
@@ -419,19 +414,15 @@ impl ViewsRun<'_> {
         Ok(())
     }
 
-    /// Writes `p` (whole, by `write`), remembering it if the run created
-    /// it; returns its name for the manifest.
-    fn keep(
-        &mut self,
-        p: &Path,
-        write: impl FnOnce(&Path) -> shapecue::Result<()>,
-    ) -> shapecue::Result<String> {
+    /// Writes `bytes` to `p` whole, remembering it if the run created it;
+    /// returns its manifest entry (its name and the SHA-256 of the bytes).
+    fn keep(&mut self, p: &Path, bytes: Vec<u8>) -> shapecue::Result<Value> {
         let fresh = !p.exists();
-        write(p)?;
+        shapecue::export::output::write_bytes_atomic(p, &bytes)?;
         if fresh {
             self.written.push(p.to_path_buf());
         }
-        Ok(name(p))
+        Ok(json!({"name": name(p), "sha256": manifest::sha256_bytes(&bytes)}))
     }
 
     /// After a failed run: the views finished before the failure are whole

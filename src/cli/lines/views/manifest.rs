@@ -37,6 +37,11 @@ pub fn sha256_file(path: &Path) -> shapecue::Result<String> {
     Ok(hex(&h.finalize()))
 }
 
+/// The SHA-256 of bytes in memory, as [`sha256_file`] gives it.
+pub fn sha256_bytes(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
 fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
@@ -308,13 +313,13 @@ impl Log {
         Ok(())
     }
 
-    /// Writes the manifest after a view while that costs at most a
-    /// twentieth of the run's time (every view of a small run; a run of
-    /// thousands of views writes it less often, and `--resume` computes
-    /// the few views finished since its last write again).
+    /// Writes the manifest after a view while that costs at most 2 % of
+    /// the run's time (after every view where views take far longer than
+    /// a write, less often where they are quick; `--resume` computes the
+    /// views finished since the last write again).
     pub fn write_now_and_then(&mut self) -> shapecue::Result<()> {
         let elapsed = self.started.elapsed().as_secs_f64() * 1e3;
-        if self.views.len() <= 16 || self.write_ms <= 0.05 * elapsed {
+        if self.write_ms <= 0.02 * elapsed {
             self.write(None)
                 .map_err(|e| match e.downcast::<shapecue::Error>() {
                     Ok(e) => e,
