@@ -215,13 +215,11 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.{n}.partial", std::process::id()))
 }
 
-fn pending(path: &Path, add: bool) {
+/// Takes a temporary file of [`create_pending`] off the pending list (it
+/// was renamed into place, or removed).
+fn unlist_pending(path: &Path) {
     let mut list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-    if add {
-        list.push(path.to_path_buf());
-    } else {
-        list.retain(|p| p != path);
-    }
+    list.retain(|p| p != path);
 }
 
 /// Creates the temporary file `path` and lists it as pending, under the
@@ -347,7 +345,7 @@ pub fn write_atomic(
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    pending(&tmp, false);
+    unlist_pending(&tmp);
     result
 }
 
@@ -393,14 +391,6 @@ pub fn install_interrupt_cleanup(note: &'static str) {
 /// Whether the interrupt handler of [`install_interrupt_cleanup`] has run.
 pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::SeqCst)
-}
-
-/// Removes every temporary file still being written (for an interrupt handler).
-pub fn remove_pending() {
-    let list = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-    for p in list.iter() {
-        let _ = std::fs::remove_file(p);
-    }
 }
 
 #[cfg(test)]

@@ -135,7 +135,30 @@ pub fn lines_views<'py>(
         setup,
     };
     let mesh = Arc::new(read_mesh(vertices, faces)?);
-    let (fov, ortho, width, height) = camera;
+    let (fov, ortho, ..) = camera;
+    let (opts, one) = views_options(&args, shot, camera)?;
+    let specs = camera_specs(
+        cameras,
+        camera_file,
+        views,
+        one,
+        CameraDefaults { fov, ortho },
+    )?;
+    let (views, name) = run_views(py, &mesh, &opts, &specs, (fields, npz), device)?;
+    let list = PyList::empty(py);
+    for v in views {
+        list.append(v.into_dict(py, &name)?)?;
+    }
+    Ok(list)
+}
+
+/// The picture options of `lines_views` and its one camera's shot, if it
+/// was given one: the options of the command line's single picture.
+fn views_options(
+    args: &LinesArgs,
+    shot: Option<ShotArg>,
+    (fov, ortho, width, height): (f32, bool, u32, u32),
+) -> PyResult<(LinesPictureOptions, Option<Shot>)> {
     let base = Shot {
         fov_deg: fov,
         ortho,
@@ -144,8 +167,6 @@ pub fn lines_views<'py>(
     };
     let one = shot.map(|s| one_shot(s, base));
     let opts = LinesPictureOptions {
-        // The one camera's shot where there is one: the options of the
-        // command line's single picture.
         shot: one.unwrap_or(base),
         lines: args.line_options()?,
         image: false,
@@ -154,22 +175,29 @@ pub fn lines_views<'py>(
         setup: args.setup()?,
         ..Default::default()
     };
-    let specs = camera_specs(
-        cameras,
-        camera_file,
-        views,
-        one,
-        CameraDefaults { fov, ortho },
-    )?;
+    Ok((opts, one))
+}
+
+/// Runs the views with the GIL released, each view's arrays (and files'
+/// bytes, with `npz`) made as it is handed over; Python's signals are
+/// checked between views. Returns the views and the device's name.
+fn run_views(
+    py: Python<'_>,
+    mesh: &Arc<Mesh>,
+    opts: &LinesPictureOptions,
+    specs: &[ViewSpec],
+    (fields, npz): (bool, bool),
+    device: Option<String>,
+) -> PyResult<(Vec<ViewOut>, String)> {
     let mut interrupt: Option<PyErr> = None;
     let done = py.detach(|| {
         // The first view's wall clock counts opening the device.
         let mut last = Instant::now();
         let gpu = open_gpu(device.as_deref())?;
         let mut out = Vec::with_capacity(specs.len());
-        line_views_on(&gpu, mesh.clone(), &opts, &specs, fields, &mut |_, v| {
+        line_views_on(&gpu, mesh.clone(), opts, specs, fields, &mut |_, v| {
             // The arrays (and files' bytes) made here, without the GIL.
-            let mut view = ViewOut::new(v, &mesh, npz)?;
+            let mut view = ViewOut::new(v, mesh, npz)?;
             let now = Instant::now();
             view.wall_ms = (now - last).as_secs_f64() * 1e3;
             last = now;
@@ -186,12 +214,7 @@ pub fn lines_views<'py>(
     if let Some(e) = interrupt {
         return Err(e);
     }
-    let (views, name) = done.map_err(to_py)?;
-    let list = PyList::empty(py);
-    for v in views {
-        list.append(v.into_dict(py, &name)?)?;
-    }
-    Ok(list)
+    done.map_err(to_py)
 }
 
 /// The one camera of `lines_views`' `shot`: (eye, direction, target, up).

@@ -7,13 +7,9 @@
 /// triangle `t` (least squares in f64; they sum to 1). A triangle with no
 /// area gives the weights of its nearest corner.
 pub fn barycentric(p: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
-    let sub = |a: [f64; 3], b: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let (e1, e2, d) = (sub(t[1], t[0]), sub(t[2], t[0]), sub(p, t[0]));
-    let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
-    let det = a * c - b * b;
+    let g = Gram::of(t);
     // No area, or a NaN: the nearest corner.
-    if !has_area(t) {
+    if !g.has_area() {
         let dist = |q: [f64; 3]| dot(sub(p, q), sub(p, q));
         let k = (0..3)
             .min_by(|&i, &j| dist(t[i]).total_cmp(&dist(t[j])))
@@ -22,10 +18,53 @@ pub fn barycentric(p: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
         w[k] = 1.0;
         return w;
     }
-    let (r1, r2) = (dot(d, e1), dot(d, e2));
-    let u = (c * r1 - b * r2) / det;
-    let v = (a * r2 - b * r1) / det;
+    let d = sub(p, t[0]);
+    let (r1, r2) = (dot(d, g.e1), dot(d, g.e2));
+    let u = (g.c * r1 - g.b * r2) / g.det;
+    let v = (g.a * r2 - g.b * r1) / g.det;
     [1.0 - u - v, u, v]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| a[i] - b[i])
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A triangle's edges from its first corner and their Gram matrix
+/// `[[a, b], [b, c]]` with its determinant: what the barycentric solve
+/// and the test for an area both read.
+struct Gram {
+    e1: [f64; 3],
+    e2: [f64; 3],
+    a: f64,
+    b: f64,
+    c: f64,
+    det: f64,
+}
+
+impl Gram {
+    fn of(t: [[f64; 3]; 3]) -> Gram {
+        let (e1, e2) = (sub(t[1], t[0]), sub(t[2], t[0]));
+        let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+        Gram {
+            e1,
+            e2,
+            a,
+            b,
+            c,
+            det: a * c - b * b,
+        }
+    }
+
+    /// Whether the triangle has an area [`barycentric`] can place points
+    /// in (not a repeated corner, not three corners on a line, no NaN).
+    fn has_area(&self) -> bool {
+        let m = self.a.max(self.c);
+        self.det.partial_cmp(&(1e-24 * m * m)) == Some(std::cmp::Ordering::Greater)
+    }
 }
 
 /// Of `candidates` (face indices into `faces`), the face both `a` and `b`
@@ -44,7 +83,7 @@ pub fn face_of_segment(
         let t = corners(f);
         let w = [barycentric(a, t), barycentric(b, t)];
         let worst = w.iter().flatten().fold(0.0f64, |m, &x| m.min(x));
-        (has_area(t), worst, w)
+        (Gram::of(t).has_area(), worst, w)
     };
     candidates
         .iter()
@@ -52,17 +91,6 @@ pub fn face_of_segment(
         .map(|&f| (f, score(f)))
         .max_by(|x, y| x.1.0.cmp(&y.1.0).then(x.1.1.total_cmp(&y.1.1)))
         .map(|(f, (_, _, w))| (f, w))
-}
-
-/// Whether the triangle `t` has an area [`barycentric`] can place points
-/// in (not a repeated corner, not three corners on a line, no NaN).
-fn has_area(t: [[f64; 3]; 3]) -> bool {
-    let sub = |a: [f64; 3], b: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let (e1, e2) = (sub(t[1], t[0]), sub(t[2], t[0]));
-    let (a, b, c) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
-    let det = a * c - b * b;
-    det.partial_cmp(&(1e-24 * a.max(c) * a.max(c))) == Some(std::cmp::Ordering::Greater)
 }
 
 #[cfg(test)]

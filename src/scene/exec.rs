@@ -85,11 +85,9 @@ pub struct ExecOptions {
     pub keep_done: bool,
 }
 
-impl ExecOptions {
-    /// Whether view `v` runs.
-    fn runs_view(&self, v: usize) -> bool {
-        self.views.as_ref().is_none_or(|set| set.contains(&v))
-    }
+/// Whether view `v` runs, of the `views` asked for (`None`: all).
+fn runs_view(views: Option<&[usize]>, v: usize) -> bool {
+    views.is_none_or(|set| set.contains(&v))
 }
 
 /// What the scene runs of one process share: the OpenCL device (its
@@ -268,11 +266,7 @@ fn run_loaded(
         .out_dir
         .clone()
         .unwrap_or_else(|| scene.out_dir.clone());
-    let mut outputs = RunOutputs::new(scene, &frames, &out_dir);
-    outputs.images.retain(|i| opts.runs_view(i.1));
-    outputs
-        .new_files
-        .retain(|f| f == &outputs.report || outputs.images.iter().any(|i| &i.2 == f));
+    let outputs = RunOutputs::new(scene, &frames, &out_dir, opts.views.as_deref());
     let input = RunInput {
         loaded,
         frames,
@@ -312,9 +306,16 @@ struct RunOutputs {
 }
 
 impl RunOutputs {
-    /// The outputs of `scene`'s `frames` in `out_dir`, before the run.
-    fn new(scene: &Scene, frames: &[usize], out_dir: &std::path::Path) -> RunOutputs {
-        let (images, report) = output_paths(scene, frames, out_dir);
+    /// The outputs of `scene`'s `frames` and `views` (`None`: all) in
+    /// `out_dir`, before the run.
+    fn new(
+        scene: &Scene,
+        frames: &[usize],
+        out_dir: &std::path::Path,
+        views: Option<&[usize]>,
+    ) -> RunOutputs {
+        let (mut images, report) = output_paths(scene, frames, out_dir);
+        images.retain(|i| runs_view(views, i.1));
         let new_dirs: Vec<PathBuf> = out_dir
             .ancestors()
             .filter(|d| !d.as_os_str().is_empty() && !d.exists())
@@ -470,7 +471,7 @@ fn run_frames(
         images,
         views,
     } = laps;
-    let runs = |v: usize| views.is_none_or(|set| set.contains(&v));
+    let runs = |v: usize| runs_view(views, v);
     let mut walker = Walker::new(plan, scene.source.input());
     let total_views = frames.len() * (0..scene.views.len()).filter(|&v| runs(v)).count();
     let mut done = 0;

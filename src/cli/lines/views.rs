@@ -430,7 +430,7 @@ impl ViewsRun<'_> {
     /// is, what the run created goes again (its files, the manifest if it
     /// was new, its folders where left empty). Returns the error to report.
     fn failed(&mut self, e: shapecue::Error, fresh: &Fresh, manifest: &Path) -> anyhow::Error {
-        let listed = self.log.write(None).is_ok() && self.log.views() > 0;
+        let listed = self.log.views() > 0 && self.log.write(None).is_ok();
         let hint = if listed {
             format!(
                 "; the {} view(s) finished are kept: continue with --resume",

@@ -14,7 +14,6 @@ use anyhow::{Result, bail};
 use serde_json::{Map, Value, json};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -26,14 +25,7 @@ pub fn sha256_file(path: &Path) -> shapecue::Result<String> {
     };
     let mut f = std::fs::File::open(path).map_err(io)?;
     let mut h = Sha256::new();
-    let mut buf = vec![0u8; 1 << 20];
-    loop {
-        let n = f.read(&mut buf).map_err(io)?;
-        if n == 0 {
-            break;
-        }
-        h.update(&buf[..n]);
-    }
+    std::io::copy(&mut f, &mut h).map_err(io)?;
     Ok(hex(&h.finalize()))
 }
 
