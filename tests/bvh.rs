@@ -126,7 +126,11 @@ fn triangles(n: usize) -> Mesh {
         [1.0, 1.0, 0.5],
     ];
     let faces = [[0, 1, 2], [1, 3, 2]][..n].to_vec();
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 fn meshes() -> Vec<(&'static str, Mesh)> {

@@ -116,7 +116,11 @@ fn random_soup(nv: u32, nf: usize, seed: u64) -> Mesh {
             [a, b, c]
         })
         .collect();
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 #[test]

@@ -298,6 +298,7 @@ pub fn line_segments_on(
         ..setup.curvature
     };
     let mut est = CurvatureEstimator::new(gpu.clone(), mesh.n_vertices(), &mesh.faces, copts)?;
+    est.set_stored_normals(mesh.normals.as_deref())?;
     est.set_positions(&mesh.positions)?;
     let mut timing = est.run()?;
     let fs = est.feature_size(setup.feature_size, &mesh.positions, &mesh.faces)? as f32;

@@ -19,7 +19,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use shapecue::api::OrderedEstimator;
 use shapecue::mesh::order::MeshOrder;
-use shapecue::mesh::{Generated, LoadOptions, Mesh};
+use shapecue::mesh::{Generated, LoadOptions, Mesh, NormalsSource};
 use shapecue::spec::curvature::{
     AccumulateChoice, Compat, CurvatureCounts, CurvatureField, CurvatureOptions, Lanes, Precision,
     VertexCurvature,
@@ -51,6 +51,11 @@ pub struct CurvatureArgs {
     /// Merge vertices with bit-identical positions before computing.
     #[arg(long)]
     weld: bool,
+    /// Vertex normals the curvature starts from: file (those a mesh file
+    /// stores, OBJ vn or PLY nx ny nz, as trimesh2 and rtsc use them; the
+    /// faces' where it stores none) or computed (always from the faces).
+    #[arg(long, value_parser = super::choice::<NormalsSource>(), default_value = "file")]
+    normals: NormalsSource,
     /// One-ring accumulation: float atomics per face (Griffin et al.; as
     /// compare-and-swap loops, or atomic-native: the device's own float
     /// atomic add, cl_ext_float_atomics or NVIDIA's PTX red.global.add), or
@@ -201,7 +206,13 @@ fn check_args(a: &CurvatureArgs) -> Result<MeshSource> {
                     path.display()
                 );
             }
-            MeshSource::File(path.to_path_buf(), LoadOptions { weld: a.weld })
+            MeshSource::File(
+                path.to_path_buf(),
+                LoadOptions {
+                    weld: a.weld,
+                    normals: a.normals,
+                },
+            )
         }
         (None, None) => bail!("give an input mesh or --generate"),
     })
@@ -259,6 +270,11 @@ impl Record {
         stats["input"] = serde_json::json!(c.name);
         stats["vertices"] = serde_json::json!(c.mesh.n_vertices());
         stats["faces"] = serde_json::json!(c.mesh.n_faces());
+        stats["normals"] = serde_json::json!(if c.mesh.normals.is_some() {
+            "file"
+        } else {
+            "computed"
+        });
         stats["options"] = serde_json::to_value(c.opts)?;
         stats["counts"] = serde_json::to_value(c.counts)?;
         stats["mostly_degenerate"] = serde_json::json!(mostly_degenerate);
@@ -476,11 +492,17 @@ fn print_summary(c: &Computed, k: &Ranges, total_ms: f64) -> Result<bool> {
     let (name, mesh, counts) = (&c.name, &c.mesh, &c.counts);
     out!(
         "{name}: {} vertices, {} faces; k1 in [{k1min:.4}, {k1max:.4}], k2 in [{k2min:.4}, {k2max:.4}]; \
-         {} degenerate faces skipped, {} vertices without curvature; {total_ms:.1} ms",
+         {} degenerate faces skipped, {} vertices without curvature; normals from the {}; \
+         {total_ms:.1} ms",
         mesh.n_vertices(),
         mesh.n_faces(),
         counts.degenerate_faces,
-        counts.vertices_without_curvature
+        counts.vertices_without_curvature,
+        if mesh.normals.is_some() {
+            "file"
+        } else {
+            "faces"
+        }
     );
     let mostly_degenerate = counts.mostly_degenerate(mesh.n_faces());
     if mostly_degenerate {

@@ -14,7 +14,7 @@ use shapecue::LinesPictureOptions;
 use shapecue::api::Gpu;
 use shapecue::api::{Hidden, LineSetup, VisibilityMethod, VisibleLines};
 use shapecue::export::npz::SegmentArrays;
-use shapecue::mesh::LoadOptions;
+use shapecue::mesh::{LoadOptions, NormalsSource};
 use shapecue::spec::curvature::{AccumulateChoice, Compat, CurvatureOptions};
 use shapecue::spec::feature_lines::FeatureSize;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
@@ -91,6 +91,11 @@ pub struct LinesArgs {
     /// median edge length), or a length in the mesh's units.
     #[arg(long, default_value = "rtsc")]
     feature_size: String,
+    /// Vertex normals the curvature starts from: file (those a mesh file
+    /// stores, OBJ vn or PLY nx ny nz, as trimesh2 and rtsc use them; the
+    /// faces' where it stores none) or computed (always from the faces).
+    #[arg(long, value_parser = super::choice::<NormalsSource>(), default_value = "file")]
+    normals: NormalsSource,
     /// Curvature's least squares: exact, or trimesh2 2.16's (the curvature
     /// rtsc itself computes).
     #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
@@ -192,6 +197,8 @@ struct Common {
     path: PathBuf,
     /// A generated mesh's vertex count (`None`: a file).
     generated: Option<usize>,
+    /// Keep or drop the normals the file stores.
+    normals: NormalsSource,
 }
 
 /// The checks of both ways of `shapecue lines`.
@@ -226,6 +233,7 @@ fn common(a: &LinesArgs) -> Result<Common> {
         feature_size,
         path,
         generated: generated.then_some(vertices),
+        normals: a.normals,
     })
 }
 
@@ -246,7 +254,13 @@ impl Common {
                     .expect("checked by common")
                     .1
             }
-            None => shapecue::mesh::load(&self.path, &LoadOptions::default())?,
+            None => {
+                let opts = LoadOptions {
+                    normals: self.normals,
+                    ..LoadOptions::default()
+                };
+                shapecue::mesh::load(&self.path, &opts)?
+            }
         })
     }
 }
@@ -311,8 +325,9 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     }
     let found = summary(&pic.segments);
     super::print(format_args!(
-        "{}: {found}, kernels {:.2} ms",
+        "{}: {found}, {}, kernels {:.2} ms",
         output.display(),
+        normals_used(&mesh),
         pic.timing.kernel_ms
     ))?;
     Ok(())
@@ -413,6 +428,17 @@ fn segments_doc(
 }
 
 /// What the run found, in words: the segments per family.
+/// Which normals the curvature started from, as the run's summary says it.
+fn normals_used(mesh: &shapecue::Mesh) -> String {
+    if mesh.normals.is_none() {
+        return "normals from the faces".into();
+    }
+    match mesh.normals_against_faces() {
+        0 => "normals from the file".into(),
+        n => format!("normals from the file ({n} point against the faces' orientation)"),
+    }
+}
+
 fn summary(segments: &[Segment]) -> String {
     let mut counts = std::collections::BTreeMap::<&str, usize>::new();
     for s in segments {

@@ -355,6 +355,18 @@ impl State {
         }
     }
 
+    /// `curv_override_normals`: the given normals (a file's stored ones) in
+    /// place of the summed face normals, where their f32 length is finite
+    /// and non-zero, as the kernel tests it.
+    pub fn override_normals(&mut self, normals: &[[f32; 3]]) {
+        for (v, n) in normals.iter().enumerate().take(self.normals.len()) {
+            let l2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+            if l2.is_finite() && l2 > 0.0 {
+                self.normals[v] = n.map(f64::from);
+            }
+        }
+    }
+
     /// Step `frames`: unit normals and initial frames from the owner face.
     pub fn frames(&mut self) {
         for v in 0..self.pos.len() {
@@ -509,6 +521,9 @@ pub fn estimate(mesh: &Mesh, opts: &CurvatureOptions) -> (CurvatureField, Curvat
     let norm = Normalization::of_masked(&mesh.positions, Some(&mesh.referenced()));
     let mut s = State::for_precision(mesh, &norm, opts.precision);
     s.normals_areas();
+    if let Some(n) = &mesh.normals {
+        s.override_normals(n);
+    }
     s.frames();
     s.tensor(opts.compat);
     s.principal(opts.compat);

@@ -305,6 +305,7 @@ impl Flipbook {
         Ok(Mesh {
             positions: self.frame(i)?,
             faces: self.faces.clone(),
+            normals: None,
         })
     }
 }

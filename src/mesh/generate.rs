@@ -40,6 +40,7 @@ pub fn torus(big_r: f64, r: f64, nu: usize, nv: usize) -> Mesh {
     Mesh {
         positions,
         faces: grid_faces(nu, nv, true, true),
+        normals: None,
     }
 }
 
@@ -68,6 +69,7 @@ pub fn cylinder(r: f64, h: f64, nu: usize, nv: usize) -> Mesh {
     Mesh {
         positions,
         faces: grid_faces(nu, nv, true, false),
+        normals: None,
     }
 }
 
@@ -85,6 +87,7 @@ pub fn plane(n: usize, s: f64) -> Mesh {
     Mesh {
         positions,
         faces: grid_faces(n, n, false, false),
+        normals: None,
     }
 }
 
@@ -160,7 +163,11 @@ pub fn icosphere(r: f64, level: u32) -> Mesh {
     for p in positions.iter_mut() {
         *p = [p[0] * r, p[1] * r, p[2] * r];
     }
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 /// An ellipsoid with semi-axes `a`, `b`, `c` (an [`icosphere`] scaled per axis).
@@ -255,7 +262,11 @@ pub fn uv_ellipsoid(a: f64, b: f64, c: f64, nu: usize, nv: usize) -> Mesh {
             faces.push([p, r, s]);
         }
     }
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 /// A generated mesh with analytic curvature, as the CLI's `--generate` and

@@ -17,14 +17,50 @@ pub struct LoadOptions {
     /// Merge vertices with bit-identical positions (see [`Mesh::weld`]), as
     /// needed for exports that split vertices per corner or per UV seam.
     pub weld: bool,
+    /// Keep the normals the file stores ([`NormalsSource::File`], checked
+    /// by [`Mesh::check_normals`]) or drop them.
+    pub normals: NormalsSource,
 }
+
+/// Where the vertex normals that curvature (and so every line family) starts
+/// from come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalsSource {
+    /// The normals the mesh file stores (OBJ `vn`, PLY `nx ny nz`), as
+    /// trimesh2 reads them and rtsc uses them; computed where the file
+    /// stores none, and on animations (a file's normals are its rest pose's).
+    #[default]
+    File,
+    /// Always computed from the faces (area-weighted), whatever the file
+    /// stores.
+    Computed,
+}
+
+impl NormalsSource {
+    /// Both choices, in the order `--help` lists them.
+    pub const ALL: [NormalsSource; 2] = [NormalsSource::File, NormalsSource::Computed];
+
+    /// The name used on the command line (`--normals`), in scenes and stats.
+    pub fn name(self) -> &'static str {
+        match self {
+            NormalsSource::File => "file",
+            NormalsSource::Computed => "computed",
+        }
+    }
+}
+
+crate::spec::named_choice!(NormalsSource, "normals source");
 
 /// Loads a triangle mesh from an `.obj`, `.ply` or `.off` file (extension
 /// matched case-insensitively), welds it if asked, and validates it.
 ///
-/// Polygons are fan-triangulated. OBJ vertices keep the order of the file;
-/// OBJ texture coordinates, normals, groups and materials are ignored, as are
-/// any PLY and OFF properties other than positions and face indices.
+/// Polygons are fan-triangulated. OBJ vertices keep the order of the file.
+/// Stored vertex normals are kept as trimesh2 2.16 reads them (OBJ `vn`
+/// lines in order when there is one per vertex, PLY `nx ny nz`; OFF stores
+/// none) and checked, or dropped, as `opts.normals` says. OBJ texture
+/// coordinates, groups and materials are ignored, as are any other PLY and
+/// OFF properties.
 ///
 /// # Errors
 ///
@@ -74,6 +110,10 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Mesh> {
     };
     // Validate before welding: `Mesh::weld` indexes with the face indices.
     mesh.validate(&name)?;
+    match opts.normals {
+        NormalsSource::File => mesh.check_normals(&name)?,
+        NormalsSource::Computed => mesh.normals = None,
+    }
     if opts.weld {
         mesh = mesh.weld().0;
     }

@@ -21,7 +21,7 @@ mod solids;
 pub mod topology;
 
 pub use generate::*;
-pub use load::{LoadOptions, header_counts, load, load_several};
+pub use load::{LoadOptions, NormalsSource, header_counts, load, load_several};
 pub use quality::{MeshQuality, quality};
 pub use solids::*;
 
@@ -40,12 +40,22 @@ pub struct Mesh {
     pub positions: Vec<[f64; 3]>,
     /// Triangles, counter-clockwise seen from outside.
     pub faces: Vec<[u32; 3]>,
+    /// The vertex normals the file stored, one per vertex (OBJ `vn` lines
+    /// in order, PLY `nx ny nz`), as trimesh2 2.16 reads them: `None` when
+    /// the file stores none, or not exactly one per vertex. Kept as stored
+    /// (not normalized); [`Mesh::check_normals`] says whether they can be
+    /// used.
+    pub normals: Option<Vec<[f32; 3]>>,
 }
 
 impl Mesh {
     /// Builds a mesh and validates it; `source` names where it came from in errors.
     pub fn new(positions: Vec<[f64; 3]>, faces: Vec<[u32; 3]>, source: &str) -> Result<Self> {
-        let m = Mesh { positions, faces };
+        let m = Mesh {
+            positions,
+            faces,
+            normals: None,
+        };
         m.validate(source)?;
         Ok(m)
     }
@@ -76,12 +86,22 @@ impl Mesh {
         let mut out = Mesh {
             positions: Vec::with_capacity(total),
             faces: Vec::new(),
+            normals: None,
         };
         for m in meshes {
             let base = out.positions.len() as u32;
             out.positions.extend_from_slice(&m.positions);
             out.faces
                 .extend(m.faces.iter().map(|f| f.map(|v| v + base)));
+        }
+        // Stored normals survive only where every mesh has them.
+        if meshes.iter().all(|m| m.normals.is_some()) {
+            out.normals = Some(
+                meshes
+                    .iter()
+                    .flat_map(|m| m.normals.iter().flatten().copied())
+                    .collect(),
+            );
         }
         Ok(out)
     }
@@ -90,7 +110,66 @@ impl Mesh {
     /// non-finite coordinates, or more elements than 32-bit indices address.
     pub fn validate(&self, source: &str) -> Result<()> {
         check_faces(self.positions.len(), &self.faces, source)?;
-        check_positions(&self.positions, source)
+        check_positions(&self.positions, source)?;
+        match &self.normals {
+            Some(n) if n.len() != self.positions.len() => Err(Error::input(
+                source,
+                "normals",
+                format!(
+                    "{} stored normals for {} vertices (one per vertex is needed)",
+                    n.len(),
+                    self.positions.len()
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// Refuses stored normals that no curvature can start from: a zero or
+    /// non-finite normal at a vertex some face uses, naming the vertex.
+    /// Normals of any other length are scaled to unit length where they are
+    /// used; normals that point against the faces' orientation are used as
+    /// they are, as trimesh2 uses them ([`Mesh::normals_against_faces`]
+    /// counts them).
+    pub fn check_normals(&self, source: &str) -> Result<()> {
+        let Some(normals) = &self.normals else {
+            return Ok(());
+        };
+        let used = self.referenced();
+        for (i, n) in normals.iter().enumerate() {
+            // In f32, as the device takes them: a length it cannot square is
+            // none.
+            let l2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+            if used[i] && !(l2.is_finite() && l2 >= f32::MIN_POSITIVE) {
+                return Err(Error::input(
+                    source,
+                    format!("vertex {i}"),
+                    format!(
+                        "its stored normal ({}, {}, {}) has no direction; fix the file, or \
+                         compute the normals from the faces instead (normals \"computed\")",
+                        n[0], n[1], n[2]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// How many used vertices' stored normals point against the
+    /// area-weighted normal of their faces (0 without stored normals).
+    pub fn normals_against_faces(&self) -> usize {
+        let Some(stored) = &self.normals else {
+            return 0;
+        };
+        let computed = topology::vertex_normals(self);
+        stored
+            .iter()
+            .zip(&computed)
+            .filter(|(s, c)| {
+                let d: f32 = (0..3).map(|k| s[k] * c[k]).sum();
+                d < 0.0
+            })
+            .count()
     }
 
     /// Merges vertices with bit-identical positions (as in unwelded exports
@@ -116,7 +195,25 @@ impl Mesh {
             .iter()
             .map(|f| f.map(|v| remap[v as usize]))
             .collect();
-        (Mesh { positions, faces }, remap)
+        // A welded vertex's stored normal is the sum of its copies' (unit
+        // length where it is used).
+        let normals = self.normals.as_ref().map(|stored| {
+            let mut sum = vec![[0f32; 3]; positions.len()];
+            for (n, &to) in stored.iter().zip(&remap) {
+                for k in 0..3 {
+                    sum[to as usize][k] += n[k];
+                }
+            }
+            sum
+        });
+        (
+            Mesh {
+                positions,
+                faces,
+                normals,
+            },
+            remap,
+        )
     }
 
     /// For each vertex, whether some face uses it.
@@ -137,11 +234,13 @@ impl Mesh {
         (lo, hi)
     }
 
-    /// Returns a copy with every position transformed by `f`.
+    /// Returns a copy with every position transformed by `f`. Stored
+    /// normals are dropped: `f` need not be a rotation.
     pub fn map_positions(&self, mut f: impl FnMut([f64; 3]) -> [f64; 3]) -> Mesh {
         Mesh {
             positions: self.positions.iter().map(|&p| f(p)).collect(),
             faces: self.faces.clone(),
+            normals: None,
         }
     }
 }

@@ -199,6 +199,10 @@ impl LocalityOrder {
                 .iter()
                 .map(|&f| mesh.faces[f as usize].map(|v| new_of[v as usize]))
                 .collect(),
+            normals: mesh
+                .normals
+                .as_ref()
+                .map(|n| self.input_vertex.iter().map(|&i| n[i as usize]).collect()),
         }
     }
 
@@ -285,7 +289,11 @@ mod tests {
                 faces.push([a, a + n + 1, a + n]);
             }
         }
-        Mesh { positions, faces }
+        Mesh {
+            positions,
+            faces,
+            normals: None,
+        }
     }
 
     #[test]

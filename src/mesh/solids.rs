@@ -29,7 +29,11 @@ pub fn cube(s: f64) -> Mesh {
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
         .collect();
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 /// A closed cylinder along z, radius `r`, height `h`, centred at the origin:
@@ -55,7 +59,11 @@ pub fn capped_cylinder(r: f64, h: f64, n: usize) -> Mesh {
         faces.push([bot, b, a]);
         faces.push([top, d, c]);
     }
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 /// A closed cone along z: base disc of radius `r` at z = −h/2 (with a centre
@@ -77,7 +85,11 @@ pub fn cone(r: f64, h: f64, n: usize) -> Mesh {
         faces.push([i, j, apex]);
         faces.push([bot, j, i]);
     }
-    Mesh { positions, faces }
+    Mesh {
+        positions,
+        faces,
+        normals: None,
+    }
 }
 
 /// `mesh` moved and scaled so that its bounding box is centred at the origin

@@ -195,6 +195,7 @@ pub fn middle_frame(path: &Path) -> Result<Mesh> {
     Ok(Mesh {
         positions: posed.iter().map(|q| q.map(f64::from)).collect(),
         faces: m.rest.faces.clone(),
+        normals: None,
     })
 }
 

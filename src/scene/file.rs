@@ -154,6 +154,8 @@ pub struct Scene {
     pub source: Source,
     /// Weld mesh files.
     pub weld: bool,
+    /// Keep the normals mesh files store (the default), or compute them.
+    pub normals: crate::mesh::NormalsSource,
     /// First frame, end (exclusive; None = whole animation), step.
     pub frames: (usize, Option<usize>, usize),
     /// Frames per second of glTF sampling.
@@ -320,6 +322,7 @@ impl Scene {
             name,
             source: input.source,
             weld: input.weld,
+            normals: input.normals,
             frames,
             fps,
             views,

@@ -523,6 +523,7 @@ fn options_doc(a: &LinesArgs, c: &super::Common) -> Result<Value> {
         "sh_threshold": plain(a.sh_threshold),
         "isophotes": a.isophotes,
         "compat": a.compat.name(),
+        "normals": a.normals.name(),
         "cull": !a.no_cull,
         "test": !a.no_test,
         "fade_lines": !a.no_fade,

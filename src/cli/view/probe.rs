@@ -42,7 +42,10 @@ fn volume_bounds(v: &shapecue::volume::Volume) -> ([f64; 3], [f64; 3]) {
 
 /// Loads the scene's input once for its frame count and bounds.
 pub fn probe(scene: &Scene) -> Result<Probe> {
-    let opts = LoadOptions { weld: scene.weld };
+    let opts = LoadOptions {
+        weld: scene.weld,
+        normals: scene.normals,
+    };
     let mut values = None;
     let mut files = Vec::new();
     let (available, bounds) = match &scene.source {

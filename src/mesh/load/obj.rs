@@ -84,11 +84,15 @@ fn corner(tok: &[u8], seen: usize) -> Option<i64> {
     }
 }
 
-/// One pass over the bytes: `v` and `f` statements, everything else
-/// (texture coordinates, normals, groups, objects, materials, lines,
-/// comments) skipped. Polygons are fan-triangulated.
+/// One pass over the bytes: `v`, `vn` and `f` statements, everything else
+/// (texture coordinates, groups, objects, materials, lines, comments)
+/// skipped. Polygons are fan-triangulated. Normals are kept as trimesh2
+/// 2.16 reads them: the `vn` lines in order, one per vertex, and only when
+/// there are exactly as many as vertices (the faces' normal indices are not
+/// used).
 fn scan(bytes: &[u8]) -> std::result::Result<Mesh, Stop> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut max_index = -1i64;
     let mut poly: Vec<i64> = Vec::new();
@@ -122,6 +126,14 @@ fn scan(bytes: &[u8]) -> std::result::Result<Mesh, Stop> {
                 }
                 positions.push(p);
             }
+            b'v' if line.get(1) == Some(&b'n') && (line.len() == 2 || is_space(line[2])) => {
+                let mut t = tokens(&line[2..]);
+                let mut n = [0f32; 3];
+                for x in &mut n {
+                    *x = t.next().and_then(number).ok_or(Stop::Line(ln))? as f32;
+                }
+                normals.push(n);
+            }
             b'f' if statement => {
                 poly.clear();
                 for tok in tokens(&line[1..]) {
@@ -147,7 +159,12 @@ fn scan(bytes: &[u8]) -> std::result::Result<Mesh, Stop> {
     if max_index >= positions.len() as i64 {
         return Err(Stop::Range);
     }
-    Ok(Mesh { positions, faces })
+    let normals = (normals.len() == positions.len()).then_some(normals);
+    Ok(Mesh {
+        positions,
+        faces,
+        normals,
+    })
 }
 
 fn too_big(source: &str) -> Error {
@@ -162,7 +179,7 @@ fn locate(text: &str, source: &str, line: Option<usize>) -> Error {
         .lines()
         .filter(|l| uncomment(l).split_whitespace().next() == Some("v"))
         .count();
-    let (mut nv, mut nf) = (0usize, 0usize);
+    let (mut nv, mut nf, mut nn) = (0usize, 0usize, 0usize);
     for (i, line) in text.lines().enumerate() {
         let ln = i + 1;
         let mut toks = uncomment(line).split_whitespace();
@@ -187,6 +204,21 @@ fn locate(text: &str, source: &str, line: Option<usize>) -> Error {
                     return Error::input(source, format!("vertex {nv}"), format!("line {ln}: {p}"));
                 }
                 nv += 1;
+            }
+            Some("vn") => {
+                let rest: Vec<&str> = toks.collect();
+                let problem = if rest.len() < 3 {
+                    Some(format!("expected 3 numbers, found {}", rest.len()))
+                } else {
+                    rest[..3]
+                        .iter()
+                        .find(|t| t.parse::<f64>().is_err())
+                        .map(|bad| format!("cannot parse '{bad}' as a number"))
+                };
+                if let Some(p) = problem {
+                    return Error::input(source, format!("normal {nn}"), format!("line {ln}: {p}"));
+                }
+                nn += 1;
             }
             Some("f") => {
                 let corners: Vec<&str> = toks.collect();

@@ -29,7 +29,11 @@ pub(super) fn parse(bytes: &[u8], source: &str) -> Result<Mesh> {
         face(lines.next(), j, (nv, nf), source, &mut poly)?;
         fan(&poly, &mut faces);
     }
-    Ok(Mesh { positions, faces })
+    Ok(Mesh {
+        positions,
+        faces,
+        normals: None,
+    })
 }
 
 /// Reads the header: the optional `OFF` keyword and the vertex and face

@@ -69,7 +69,10 @@ fn weld_skinned(
 
 /// Loads the scene's input; what was assumed or dropped goes to `notes`.
 pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
-    let opts = LoadOptions { weld: scene.weld };
+    let opts = LoadOptions {
+        weld: scene.weld,
+        normals: scene.normals,
+    };
     Ok(match &scene.source {
         Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?, Vec::new()),
         Source::Meshes(ps) => {
@@ -87,10 +90,14 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         },
         Source::Gltf(p, clip) => gltf_input(scene, p, clip.as_ref(), notes)?,
         Source::Lbs(p) => lbs_input(scene, p, notes)?,
+        // A flipbook's frames are positions: stored normals are not read.
         Source::Flipbook(pat) => Loaded::Flipbook(crate::mesh::flipbook::Flipbook::open(
             pat,
             Path::new(""),
-            &opts,
+            &LoadOptions {
+                normals: crate::mesh::NormalsSource::Computed,
+                ..opts
+            },
         )?),
         Source::Volume(p, iso, above) => inside_below(crate::volume::load(p, None)?, *iso, *above),
         Source::Sdf(kind, res, iso, above) => {

@@ -14,6 +14,8 @@ pub(super) struct InputPart {
     pub source: Source,
     /// Weld mesh files.
     pub weld: bool,
+    /// Keep or drop the normals mesh files store.
+    pub normals: crate::mesh::NormalsSource,
     /// The source's key (`mesh`, `gltf`, ...), for errors that name it.
     pub kind: &'static str,
 }
@@ -37,9 +39,17 @@ pub(super) fn resolve(ck: &Checker<'_>, input: Spanned<InputSpec>) -> Result<Inp
             "resolution {n}: a generated mesh needs 12..=20000000 vertices"
         )));
     }
+    let normals = match &inp.normals {
+        None => crate::mesh::NormalsSource::default(),
+        Some(v) => v
+            .get_ref()
+            .parse()
+            .map_err(|e: crate::error::Error| ck.err(v.span(), format!("input.normals: {e}")))?,
+    };
     Ok(InputPart {
         source,
         weld: inp.weld,
+        normals,
         kind,
     })
 }
@@ -86,8 +96,8 @@ impl Table<'_> {
         Ok(given[0])
     }
 
-    /// Checks that `clip`, `iso`, `resolution`, `inside` and `weld` go with
-    /// the `kind` source.
+    /// Checks that `clip`, `iso`, `resolution`, `inside`, `weld` and
+    /// `normals` go with the `kind` source.
     fn keys_apply(&self, kind: &str) -> Result<()> {
         let inp = self.inp;
         let only = |key: &str, ok: bool| -> Result<()> {
@@ -118,6 +128,10 @@ impl Table<'_> {
                 || inp.flipbook.is_some()
                 || inp.gltf.is_some()
                 || inp.lbs.is_some(),
+        )?;
+        only(
+            "normals",
+            inp.normals.is_none() || inp.mesh.is_some() || inp.meshes.is_some(),
         )
     }
 

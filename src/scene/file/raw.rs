@@ -111,6 +111,10 @@ pub struct InputSpec {
     /// (skinned vertices keep the weights of the first of those merged).
     #[serde(default)]
     pub weld: bool,
+    /// Which vertex normals a mesh file's curvature starts from: `file`
+    /// (those it stores, as trimesh2 and rtsc use them; the default) or
+    /// `computed` (from the faces).
+    pub normals: Option<Spanned<String>>,
 }
 
 /// A glTF clip by index or by name.

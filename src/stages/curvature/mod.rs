@@ -551,6 +551,34 @@ impl CurvatureEstimator {
         self.normal_override = normals;
     }
 
+    /// Starts every later run from these vertex normals (a mesh file's
+    /// stored normals, [`crate::Mesh::normals`], one per vertex; scaled to
+    /// unit length by the frames pass), as trimesh2 starts from the normals
+    /// a file stores. `None` goes back to the computed normals.
+    ///
+    /// # Errors
+    /// A count other than the vertices'; OpenCL failures.
+    pub fn set_stored_normals(&mut self, normals: Option<&[[f32; 3]]>) -> Result<()> {
+        let Some(n) = normals else {
+            self.normal_override = None;
+            return Ok(());
+        };
+        if n.len() != self.nv {
+            return Err(Error::InvalidArgument(format!(
+                "{} stored normals for a mesh of {} vertices",
+                n.len(),
+                self.nv
+            )));
+        }
+        let flat: Vec<f32> = n.iter().flatten().copied().collect();
+        let mut b = self.gpu.buffer::<f32>(flat.len().max(1))?;
+        if !flat.is_empty() {
+            self.gpu.write(&mut b, &flat)?;
+        }
+        self.normal_override = Some(b);
+        Ok(())
+    }
+
     /// The normalization of the current pose.
     pub fn normalization(&self) -> Normalization {
         self.norm

@@ -87,6 +87,7 @@ impl OrderedEstimator {
         if let Some(f) = &plan.frame_faces {
             est.set_frame_faces(f)?;
         }
+        est.set_stored_normals(m.normals.as_deref())?;
         est.set_positions(&m.positions)?;
         Ok(OrderedEstimator {
             est,

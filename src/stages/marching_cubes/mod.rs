@@ -304,6 +304,7 @@ impl Isosurfacer {
                 .map(|p| std::array::from_fn(|i| self.origin[i] + self.spacing[i] * p[i] as f64))
                 .collect(),
             faces,
+            normals: None,
         }
     }
 }

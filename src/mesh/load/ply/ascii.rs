@@ -30,14 +30,22 @@ pub(super) fn parse_ascii(
     };
 
     let mut positions = Vec::new();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
+    let mut with_normals = false;
     let mut faces = Vec::new();
     let mut poly: Vec<u32> = Vec::new();
     for (name, def) in &header.elements {
         match name.as_str() {
             "vertex" => {
                 positions.reserve(capacity(def, header.encoding, payload));
+                with_normals = ["nx", "ny", "nz"]
+                    .iter()
+                    .all(|n| def.properties.contains_key(*n));
                 stream.read_all(def, source, |_, v: Vertex| {
                     positions.push(v.0);
+                    if with_normals {
+                        normals.push(v.1);
+                    }
                     Ok(())
                 })?;
             }
@@ -50,7 +58,11 @@ pub(super) fn parse_ascii(
             _ => stream.read_all(def, source, |_, _: Skip| Ok(()))?,
         }
     }
-    Ok(Mesh { positions, faces })
+    Ok(Mesh {
+        positions,
+        faces,
+        normals: with_normals.then_some(normals),
+    })
 }
 
 /// One-line description of a parser error met while reading element

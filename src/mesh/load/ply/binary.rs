@@ -14,28 +14,42 @@ use crate::mesh::Mesh;
 pub(super) enum Role {
     /// Coordinate 0, 1 or 2 of a vertex.
     Axis(usize),
+    /// Coordinate 0, 1 or 2 of a vertex's stored normal (`nx ny nz`).
+    Normal(usize),
     /// The vertex index list of a face.
     Indices,
     Skip,
 }
 
-/// The row size and the offsets and types of the three coordinates of an
-/// element whose properties are all scalars; `None` when one is a list.
+/// The offsets and types of three coordinates in a row.
+pub(super) type Axes = [(usize, ScalarType); 3];
+
+/// The row size, the offsets and types of the three coordinates and of the
+/// stored normal (where the layout has `nx ny nz`) of an element whose
+/// properties are all scalars; `None` when one is a list.
 pub(super) fn fixed_rows(
     layout: &[(&PropertyType, Role, &str)],
-) -> Option<(usize, [(usize, ScalarType); 3])> {
+) -> Option<(usize, Axes, Option<Axes>)> {
     let mut offset = 0;
-    let mut axes: [(usize, ScalarType); 3] = std::array::from_fn(|_| (0, ScalarType::Float));
+    let mut axes: Axes = std::array::from_fn(|_| (0, ScalarType::Float));
+    let mut normal: Axes = std::array::from_fn(|_| (0, ScalarType::Float));
     for &(ty, role, _) in layout {
         let PropertyType::Scalar(t) = ty else {
             return None;
         };
-        if let Role::Axis(k) = role {
-            axes[k] = (offset, t.clone());
+        match role {
+            Role::Axis(k) => axes[k] = (offset, t.clone()),
+            Role::Normal(k) => normal[k] = (offset, t.clone()),
+            _ => {}
         }
         offset += scalar_size(t);
     }
-    Some((offset, axes))
+    Some((offset, axes, has_normals(layout).then_some(normal)))
+}
+
+/// Whether a vertex layout has all three of `nx ny nz`.
+pub(super) fn has_normals(layout: &[(&PropertyType, Role, &str)]) -> bool {
+    (0..3).all(|k| layout.iter().any(|&(_, r, _)| r == Role::Normal(k)))
 }
 
 /// One binary value of type `t` at the start of `b` (which holds at least
@@ -107,8 +121,11 @@ pub(super) fn parse_binary<B: Body>(
         }
         // Fixed-size elements with their coordinates at fixed offsets (the
         // usual vertex element) are read many rows at a time without the walk.
-        if is_vertex && let Some((stride, axes)) = fixed_rows(&el.layout) {
-            read_fixed_vertices(body, &el, stride, &axes, &mut out.positions)?;
+        if is_vertex {
+            out.with_normals = has_normals(&el.layout);
+        }
+        if is_vertex && let Some((stride, axes, normal)) = fixed_rows(&el.layout) {
+            read_fixed_vertices(body, &el, stride, (&axes, normal.as_ref()), &mut out)?;
             continue;
         }
         // A face element of the index list alone (the usual one) is read
@@ -126,6 +143,7 @@ pub(super) fn parse_binary<B: Body>(
     Ok(Mesh {
         positions: out.positions,
         faces: out.faces,
+        normals: out.with_normals.then_some(out.normals),
     })
 }
 
@@ -148,6 +166,9 @@ struct Element<'h> {
 #[derive(Default)]
 struct Built {
     positions: Vec<[f64; 3]>,
+    /// The stored normals, where the vertex element has `nx ny nz`.
+    normals: Vec<[f32; 3]>,
+    with_normals: bool,
     faces: Vec<[u32; 3]>,
     /// The polygon [`add_polygon`] triangulates.
     poly: Vec<u32>,
@@ -169,6 +190,9 @@ fn layout(def: &ElementDef, is_vertex: bool, is_face: bool) -> Vec<(&PropertyTyp
                 ("x", PropertyType::Scalar(_)) if is_vertex => Role::Axis(0),
                 ("y", PropertyType::Scalar(_)) if is_vertex => Role::Axis(1),
                 ("z", PropertyType::Scalar(_)) if is_vertex => Role::Axis(2),
+                ("nx", PropertyType::Scalar(_)) if is_vertex => Role::Normal(0),
+                ("ny", PropertyType::Scalar(_)) if is_vertex => Role::Normal(1),
+                ("nz", PropertyType::Scalar(_)) if is_vertex => Role::Normal(2),
                 (n, PropertyType::List(..)) if list == Some(&n) => Role::Indices,
                 _ => Role::Skip,
             };
@@ -178,13 +202,14 @@ fn layout(def: &ElementDef, is_vertex: bool, is_face: bool) -> Vec<(&PropertyTyp
 }
 
 /// Reads a vertex element of fixed-size rows (`stride` bytes, coordinates
-/// at `axes`) many rows at a time.
+/// at `axes`, the stored normal at `normal` where there is one) many rows
+/// at a time.
 fn read_fixed_vertices<B: Body>(
     body: &mut B,
     el: &Element,
     stride: usize,
-    axes: &[(usize, ScalarType); 3],
-    positions: &mut Vec<[f64; 3]>,
+    (axes, normal): (&Axes, Option<&Axes>),
+    out: &mut Built,
 ) -> Result<()> {
     let def = el.def;
     let batch = (BODY_CHUNK / stride).max(1);
@@ -192,11 +217,16 @@ fn read_fixed_vertices<B: Body>(
     while done < def.count {
         let k = batch.min(def.count - done);
         let rows = body.take(k * stride)?;
-        positions.extend(
+        out.positions.extend(
             rows.chunks_exact(stride).map(|r| {
                 std::array::from_fn(|k| binary_value(&r[axes[k].0..], &axes[k].1, el.big))
             }),
         );
+        if let Some(n) = normal {
+            out.normals.extend(rows.chunks_exact(stride).map(|r| {
+                std::array::from_fn(|k| binary_value(&r[n[k].0..], &n[k].1, el.big) as f32)
+            }));
+        }
         if rows.len() < k * stride {
             let i = done + rows.len() / stride;
             return Err(Error::input(
@@ -257,6 +287,7 @@ fn read_element<B: Body>(body: &mut B, el: &Element, i: usize, out: &mut Built) 
     let element = || format!("{} {i}", el.name);
     let eof = || Error::input(source, element(), eof_problem(el.def));
     let mut p = [0.0; 3];
+    let mut n = [0f32; 3];
     out.indices.clear();
     for &(ty, role, pname) in &el.layout {
         match ty {
@@ -266,8 +297,10 @@ fn read_element<B: Body>(body: &mut B, el: &Element, i: usize, out: &mut Built) 
                 if b.len() < size {
                     return Err(eof());
                 }
-                if let Role::Axis(k) = role {
-                    p[k] = binary_value(b, t, big);
+                match role {
+                    Role::Axis(k) => p[k] = binary_value(b, t, big),
+                    Role::Normal(k) => n[k] = binary_value(b, t, big) as f32,
+                    _ => {}
                 }
             }
             PropertyType::List(c, t) => {
@@ -302,6 +335,9 @@ fn read_element<B: Body>(body: &mut B, el: &Element, i: usize, out: &mut Built) 
     }
     if el.is_vertex {
         out.positions.push(p);
+        if out.with_normals {
+            out.normals.push(n);
+        }
     } else if el.is_face {
         let indices = out.indices.iter().copied();
         add_polygon(indices, i, el.nv, source, &mut out.poly, &mut out.faces)?;

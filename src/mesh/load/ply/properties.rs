@@ -7,21 +7,24 @@ use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
 /// Names accepted for the face index list.
 pub(super) const FACE_LISTS: [&str; 2] = ["vertex_indices", "vertex_index"];
 
-/// A vertex: only x, y and z are kept, converted to f64.
-pub(super) struct Vertex(pub(super) [f64; 3]);
+/// A vertex: x, y and z converted to f64, and its stored normal `nx ny nz`.
+pub(super) struct Vertex(pub(super) [f64; 3], pub(super) [f32; 3]);
 
 impl PropertyAccess for Vertex {
     fn new() -> Self {
-        Vertex([0.0; 3])
+        Vertex([0.0; 3], [0.0; 3])
     }
     fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
-        let k = match name {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
+        let (k, normal) = match name {
+            "x" => (0, false),
+            "y" => (1, false),
+            "z" => (2, false),
+            "nx" => (0, true),
+            "ny" => (1, true),
+            "nz" => (2, true),
             _ => return PropertyAccessResult::Ignored,
         };
-        self.0[k] = match property {
+        let v: f64 = match property {
             Property::Char(v) => v.into(),
             Property::UChar(v) => v.into(),
             Property::Short(v) => v.into(),
@@ -32,6 +35,11 @@ impl PropertyAccess for Vertex {
             Property::Double(v) => v,
             _ => return PropertyAccessResult::UnsupportedType,
         };
+        if normal {
+            self.1[k] = v as f32;
+        } else {
+            self.0[k] = v;
+        }
         PropertyAccessResult::Set
     }
 }

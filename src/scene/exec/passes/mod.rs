@@ -386,8 +386,16 @@ impl<'s, 'g> Executor<'s, 'g> {
                 let t = self.curvature_run(frame)?;
                 // What ran, as the options chose it.
                 let o = self.stages.curv_opts;
+                let normals = if self.stages.iso.is_some() {
+                    "the volume's gradient"
+                } else if self.stored_normals().is_some() {
+                    "the file's"
+                } else {
+                    "computed"
+                };
                 let how = format!(
-                    "tensor + principal (Rusinkiewicz; {} accumulation, {}, {} least squares)",
+                    "tensor + principal (Rusinkiewicz; {} accumulation, {}, {} least squares, \
+                     normals {normals})",
                     o.accumulate.name(),
                     o.precision.name(),
                     o.compat.name()
@@ -590,16 +598,33 @@ impl<'s, 'g> Executor<'s, 'g> {
         }
         let (gpu, opts) = (self.gpu.clone(), self.stages.curv_opts);
         let t = self.topology(frame)?;
-        let est = CurvatureEstimator::new(gpu, t.mesh.n_vertices(), &t.mesh.faces, opts)?;
-        let (ms, how) = (est.topology_ms(), how(&est));
+        let mut est = CurvatureEstimator::new(gpu, t.mesh.n_vertices(), &t.mesh.faces, opts)?;
+        let mut how = how(&est);
+        if t.mesh.normals.is_some() {
+            // A static mesh's stored normals (only those keep them): the
+            // curvature starts from them, as trimesh2's does.
+            est.set_stored_normals(t.mesh.normals.as_deref())?;
+            how.push_str(", the normals the file stores uploaded");
+        }
+        let ms = est.topology_ms();
         t.est = Some(est);
         self.rec
             .wall(Pass::OneRings, ms, &format!("upload faces, {how}"));
         Ok(())
     }
 
+    /// The normals the mesh file stores, where the scene's mesh is a static
+    /// one that kept them ([`crate::mesh::NormalsSource::File`]).
+    fn stored_normals(&self) -> Option<&[[f32; 3]]> {
+        let t = self.topo.as_ref()?;
+        match &self.loaded {
+            Loaded::Static(..) => t.mesh.normals.as_deref(),
+            _ => None,
+        }
+    }
+
     /// Vertex normals: from the curvature run when curvature is planned,
-    /// else area-weighted on the host.
+    /// else area-weighted on the host (or the file's, where it stores some).
     fn vertex_normals(&mut self, frame: usize) -> Result<()> {
         self.host_pose(frame)?;
         if self.est().is_some() {
@@ -613,6 +638,8 @@ impl<'s, 'g> Executor<'s, 'g> {
                     .collect();
             let normals = if self.stages.iso.is_some() {
                 "then replaced by the volume's gradient"
+            } else if self.stored_normals().is_some() {
+                "then replaced by the normals the mesh file stores"
             } else {
                 "curvature normals (area-weighted)"
             };
@@ -624,6 +651,14 @@ impl<'s, 'g> Executor<'s, 'g> {
                 Pass::VertexNormals,
                 0.0,
                 "from the volume's gradient at the isosurface's vertices (with the isosurface)",
+            );
+        } else if let Some(n) = self.stored_normals() {
+            let t0 = Instant::now();
+            self.pose.host.nrm = n.iter().map(|&v| unit(v)).collect();
+            self.rec.wall(
+                Pass::VertexNormals,
+                ms_since(t0),
+                "the normals the mesh file stores, at unit length (no curvature planned)",
             );
         } else {
             let t0 = Instant::now();
@@ -637,6 +672,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                     .map(|p| p.map(f64::from))
                     .collect(),
                 faces,
+                normals: None,
             };
             self.pose.host.nrm = vertex_normals(&m);
             self.rec.wall(
@@ -709,4 +745,10 @@ impl<'s, 'g> Executor<'s, 'g> {
         self.pose.strokes = out;
         Ok(())
     }
+}
+
+/// `v` at unit length (the caller's normals are checked to have a length).
+fn unit(v: [f32; 3]) -> [f32; 3] {
+    let l = v.iter().map(|c| c * c).sum::<f32>().sqrt();
+    v.map(|c| c / l)
 }
