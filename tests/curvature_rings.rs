@@ -36,6 +36,7 @@ fn device_built_one_rings_give_the_host_built_bits() {
     let mut fan = Mesh {
         positions: vec![[0.0, 0.0, 0.2]],
         faces: Vec::new(),
+        normals: None,
     };
     for i in 0..300u32 {
         let a = i as f64 / 300.0 * std::f64::consts::TAU;
@@ -45,6 +46,7 @@ fn device_built_one_rings_give_the_host_built_bits() {
     let single = Mesh {
         positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.3]],
         faces: vec![[0, 1, 2]],
+        normals: None,
     };
     let meshes = [
         ("torus", mesh::torus(1.0, 0.4, 40, 24)),

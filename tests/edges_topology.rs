@@ -169,6 +169,7 @@ fn a_face_past_the_vertices_is_a_clear_error() {
     let m = Mesh {
         positions: vec![[0.0; 3]; 3],
         faces: vec![[0, 1, 2], [0, 2, 7]],
+        normals: None,
     };
     let e = EdgeTopology::without_caps(&m, &[], "bad.obj").unwrap_err();
     let msg = e.to_string();

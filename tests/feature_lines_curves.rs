@@ -626,6 +626,7 @@ fn a_skinned_frame_gives_the_lines_of_the_static_mesh_in_the_same_pose() {
     let mesh = Mesh {
         positions: posed.iter().map(|q| q.map(f64::from)).collect(),
         faces: m.rest.faces.clone(),
+        normals: None,
     };
     let copts = CurvatureOptions {
         accumulate: Accumulate::Atomic,

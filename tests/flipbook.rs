@@ -208,12 +208,16 @@ fn welding_uses_the_first_frame_map() {
         faces: (0..m.faces.len() as u32)
             .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
             .collect(),
+        normals: None,
     };
     let dir = scratch("weld");
     for f in 0..3 {
         write_obj(&dir.join(format!("w_{f}.obj")), &split(&pose(&b, f)));
     }
-    let weld = LoadOptions { weld: true };
+    let weld = LoadOptions {
+        weld: true,
+        ..Default::default()
+    };
     let fb = Flipbook::open("w_*.obj", &dir, &weld).unwrap();
     assert_eq!(fb.n_vertices, b.n_vertices());
     for f in 0..3 {

@@ -24,6 +24,7 @@ fn concat(meshes: &[Mesh]) -> (Mesh, Vec<usize>) {
     let mut out = Mesh {
         positions: Vec::new(),
         faces: Vec::new(),
+        normals: None,
     };
     for m in meshes {
         let base = out.positions.len() as u32;

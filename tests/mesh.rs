@@ -21,7 +21,14 @@ use shapecue::mesh::{LoadOptions, Mesh, load};
 fn check_counts(file: &str, weld: bool, nv: usize, nf: usize) {
     let Some(dir) = shared("meshes") else { return };
     let path = dir.join(file);
-    let m = load(&path, &LoadOptions { weld }).unwrap_or_else(|e| panic!("{e}"));
+    let m = load(
+        &path,
+        &LoadOptions {
+            weld,
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         (m.n_vertices(), m.n_faces()),
         (nv, nf),
@@ -653,7 +660,13 @@ fn no_panic_on_truncated_or_corrupted_input() {
                 };
             }
             std::fs::write(&p, &b).unwrap();
-            let _ = load(&p, &LoadOptions { weld: true });
+            let _ = load(
+                &p,
+                &LoadOptions {
+                    weld: true,
+                    ..Default::default()
+                },
+            );
         }
     }
     // Headers that declare far more elements than the file holds.
@@ -690,6 +703,7 @@ fn welding_merges_duplicated_positions() {
             [0.0, 1.0, -0.0],
         ],
         faces: vec![[0, 1, 2], [3, 4, 5]],
+        normals: None,
     };
     let (w, remap) = m.weld();
     assert_eq!(w.n_vertices(), 4);
@@ -706,7 +720,14 @@ fn welding_merges_duplicated_positions() {
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\n",
     );
     assert_eq!(load(&p, &plain()).unwrap().n_vertices(), 6);
-    let welded = load(&p, &LoadOptions { weld: true }).unwrap();
+    let welded = load(
+        &p,
+        &LoadOptions {
+            weld: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert_eq!(welded.n_vertices(), 4);
     assert_eq!(welded.faces, vec![[0, 1, 2], [0, 2, 3]]);
     let _ = std::fs::remove_dir_all(&dir);

@@ -411,11 +411,13 @@ fn hard_cases_are_clear_errors() {
             [3.0, 0.0, 0.0],
         ],
         faces: vec![[0, 1, 2], [1, 2, 3], [0, 0, 3]],
+        normals: None,
     };
     expect_err(&line, opts(32), &["all 3 faces are degenerate"]);
     let point = Mesh {
         positions: vec![[1.0, 1.0, 1.0]; 3],
         faces: vec![[0, 1, 2]],
+        normals: None,
     };
     expect_err(&point, opts(32), &["degenerate"]);
     let mut nan = icosphere(1.0, 1);

@@ -381,6 +381,7 @@ fn brainstem_frame_chained_on_device_matches_cpu_skinned_host_path() {
     let posed = Mesh {
         positions: cpu_pose.iter().map(|p| p.map(f64::from)).collect(),
         faces: m.rest.faces.clone(),
+        normals: None,
     };
     let est2 = estimator(&posed, f32_opts(), Pass::Dcurv);
     let host2 = LineArrays::new(cpu_pose.clone(), &est2.read().unwrap());

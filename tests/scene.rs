@@ -79,8 +79,9 @@ fn expected(cue: Cue, input: Input) -> BTreeSet<Pass> {
             LinesCurves,
             Render,
         ],
-        Cue::Isophotes => vec![VertexNormals, LinesView, LinesCurves, Render],
-        Cue::Boundaries => vec![VertexNormals, LinesCurves, Render],
+        // The curvature's normals (its one-rings), as every family uses.
+        Cue::Isophotes => vec![OneRings, VertexNormals, LinesView, LinesCurves, Render],
+        Cue::Boundaries => vec![OneRings, VertexNormals, LinesCurves, Render],
         // Found over the BVH of the pose.
         Cue::IntersectionLines => vec![Bvh, Intersections, Render],
     };
@@ -185,10 +186,10 @@ fn line_family_cues_plan_only_what_they_read_with_their_lifetimes() {
     let iso = plan(&[Cue::Isophotes], st);
     assert_eq!(
         iso.passes,
-        vec![VertexNormals, LinesView, LinesCurves, Render]
+        vec![OneRings, VertexNormals, LinesView, LinesCurves, Render]
     );
     let b = plan(&[Cue::Boundaries], st);
-    assert_eq!(b.passes, vec![VertexNormals, LinesCurves, Render]);
+    assert_eq!(b.passes, vec![OneRings, VertexNormals, LinesCurves, Render]);
     let ar = plan(&[Cue::ApparentRidges], st);
     assert!(ar.contains(LinesDt1q1) && ar.contains(Curvature));
     assert!(!ar.contains(Dcurv) && !ar.contains(LinesPose));

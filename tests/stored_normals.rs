@@ -248,3 +248,37 @@ fn lines_say_which_normals_they_used_and_computed_ignores_the_file() {
     );
     assert_ne!(file, computed, "the stored normals must change the drawing");
 }
+
+/// Isophotes and boundaries alone start from the curvature's normals, as
+/// with any other family (rtsc's): the same rows either way.
+#[test]
+fn every_family_starts_from_the_same_normals() {
+    let dir = scratch("same-normals");
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
+    let rows = |lines: &str, out: &str| {
+        let json = dir.join(out);
+        let o = cli()
+            .args(["lines", spot, "--lines", lines, "--eye", "3,1,2", "-o"])
+            .arg(dir.join(format!("{out}.svg")))
+            .arg("--segments")
+            .arg(&json)
+            .output()
+            .unwrap();
+        common::assert_succeeded(&o);
+        let doc: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        let mut v: Vec<String> = doc["segments"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s["family"] == "isophotes")
+            .map(|s| format!("{} {}", s["a"], s["b"]))
+            .collect();
+        v.sort();
+        v
+    };
+    let alone = rows("isophotes", "alone.json");
+    let with = rows("isophotes,contours", "with.json");
+    assert!(!alone.is_empty());
+    assert_eq!(alone, with);
+}

@@ -192,6 +192,7 @@ fn a_segment_behind_another_object_is_hidden_and_visible_without_it() {
     let alone = Mesh {
         positions: m.positions.clone(),
         faces: m.faces[..nb].to_vec(),
+        normals: None,
     };
     let front = in_face(&m, top_face(&m, nb..m.faces.len()));
     // Zero length, at the back face's centroid.

@@ -310,6 +310,7 @@ mod tests {
                 .iter()
                 .map(|f| f.map(|v| perm[v as usize]))
                 .collect(),
+            normals: None,
         };
         assert!(LocalityOrder::scattered(4096, &shuffled.faces));
         let o = LocalityOrder::choose(&shuffled, MeshOrder::Auto).expect("reordered");
@@ -361,12 +362,14 @@ mod tests {
         let m = Mesh {
             positions: vec![[-1e308, 0.0, 0.0], [1e308, 0.0, 0.0], [0.0, 1.0, 0.0]],
             faces: vec![[0, 1, 2]],
+            normals: None,
         };
         let o = LocalityOrder::spatial(&m);
         assert_eq!(o.apply(&m).n_faces(), 1);
         let one = Mesh {
             positions: vec![[2.0; 3]; 3],
             faces: vec![[0, 1, 2]],
+            normals: None,
         };
         assert_eq!(LocalityOrder::spatial(&one).input_vertex, vec![0, 1, 2]);
     }

@@ -467,8 +467,9 @@ impl Pass {
             Pass::LinesPose => vec![Pass::Dcurv],
             Pass::LinesView => vec![Pass::VertexNormals],
             Pass::LinesDt1q1 => vec![Pass::LinesView],
-            // n·v per vertex, for back-face culling and fading.
-            Pass::LinesCurves => vec![Pass::VertexNormals],
+            // n·v per vertex, for back-face culling and fading, from the
+            // curvature's normals (so the same with every family).
+            Pass::LinesCurves => vec![Pass::VertexNormals, Pass::OneRings],
             // κr needs the curvature, D_w κr its derivative, q1 the view terms.
             Pass::ViewFields => vec![Pass::Dcurv, Pass::LinesView, Pass::VertexNormals],
             Pass::Edges => vec![Pass::EdgeBuffer, Pass::FaceNormals],

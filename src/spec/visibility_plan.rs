@@ -290,7 +290,11 @@ impl Plan {
                 end_ids: [0; 2],
             });
         }
-        let ends = shared_ends(segments, &mut segs, positions.len());
+        // The two faces of an edge round its crossing apart by a few ulps
+        // of the coordinates.
+        let reach = positions.iter().flatten().fold(0f32, |m, c| m.max(c.abs()));
+        let tol = (1e-6 * diag).max(64.0 * f32::EPSILON * reach);
+        let ends = shared_ends(segments, &mut segs, positions.len(), tol);
         Ok(Plan {
             segs,
             ends,
@@ -438,17 +442,28 @@ struct KeyedEnd {
     key: u64,
     /// `2 × segment + end`.
     at: u32,
+    /// The segment's family kind: ends of different families never meet.
+    family: u32,
     p: [f32; 3],
     offset: f32,
     exclude: Faces,
 }
 
 /// The shared end samples of `segs` (setting each one's `end_ids`): ends
-/// with one key ([`end_key`]) share one, in the order of the key, then of
-/// the segment. The keyed ends are put in that order by a counting sort on
-/// the key's lesser vertex (`n_vertices` of them, checked by the plan),
-/// then a sort of each vertex's few.
-fn shared_ends(segments: &[Segment], segs: &mut [SegPlan], n_vertices: usize) -> Vec<EndPlan> {
+/// of one family at one point of one mesh edge or vertex (one key,
+/// [`end_key`], and within `tol` of each other: the two faces of an edge
+/// round its crossing apart) share one, in the order of the key, then of
+/// the segment. Ends of other lines on the same edge (another family, or
+/// another isophote level) keep their own, so that a line's visibility does
+/// not depend on which other families are drawn. The keyed ends are put in
+/// that order by a counting sort on the key's lesser vertex (`n_vertices`
+/// of them, checked by the plan), then a sort of each vertex's few.
+fn shared_ends(
+    segments: &[Segment],
+    segs: &mut [SegPlan],
+    n_vertices: usize,
+    tol: f32,
+) -> Vec<EndPlan> {
     let mut ends = Vec::new();
     let mut start = vec![0u32; n_vertices + 1];
     for (i, s) in segments.iter().enumerate() {
@@ -479,6 +494,7 @@ fn shared_ends(segments: &[Segment], segs: &mut [SegPlan], n_vertices: usize) ->
                 keyed[*at as usize] = KeyedEnd {
                     key,
                     at: (2 * i + e) as u32,
+                    family: s.2,
                     p: if e == 0 { sp.a } else { sp.b },
                     offset: sp.offset,
                     exclude: sp.exclude,
@@ -490,10 +506,32 @@ fn shared_ends(segments: &[Segment], segs: &mut [SegPlan], n_vertices: usize) ->
     for v in 0..n_vertices {
         keyed[start[v] as usize..start[v + 1] as usize].sort_unstable_by_key(|x| (x.key, x.at));
     }
+    let mut point: Vec<KeyedEnd> = Vec::new();
     for group in keyed.chunk_by(|x, y| x.key == y.key) {
-        share_end(group, segs, &mut ends);
+        // The ends of the key at one point of one family, in the order of
+        // their first end.
+        let mut taken = vec![false; group.len()];
+        for i in 0..group.len() {
+            if taken[i] {
+                continue;
+            }
+            point.clear();
+            for j in i..group.len() {
+                let (x, y) = (&group[i], &group[j]);
+                if !taken[j] && x.family == y.family && dist(x.p, y.p) <= tol {
+                    taken[j] = true;
+                    point.push(*y);
+                }
+            }
+            share_end(&point, segs, &mut ends);
+        }
     }
     ends
+}
+
+/// The distance between two points.
+fn dist(a: [f32; 3], b: [f32; 3]) -> f32 {
+    norm(sub(a, b))
 }
 
 /// The end sample of one `group` of ends with one key (in order) into

@@ -45,6 +45,7 @@ pub fn square() -> Mesh {
             [0.0, 1.0, 1e-3],
         ],
         faces: vec![[0, 1, 2], [0, 2, 3]],
+        normals: None,
     }
 }
 

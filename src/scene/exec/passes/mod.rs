@@ -359,6 +359,22 @@ impl<'s, 'g> Executor<'s, 'g> {
         Ok(t)
     }
 
+    /// The normals of this pose alone (the curvature run up to its frames
+    /// pass), for line families that need no curvature; a static mesh's
+    /// topology is made here if it is not yet.
+    fn normals_run(&mut self, frame: usize) -> Result<Timing> {
+        if let Some(p) = self.stages.pipe.as_mut() {
+            return p.curvature();
+        }
+        self.topology(frame)?;
+        let fp = self.pose.frame_pos.take();
+        let t = self.topo.as_mut().expect("made above");
+        let est = t.est.as_mut().expect("planned with the one-rings");
+        est.set_positions(fp.as_deref().unwrap_or(&t.mesh.positions))?;
+        self.pose.frame_pos = fp;
+        est.run_until(crate::stages::curvature::Pass::Frames)
+    }
+
     /// Runs one topology or pose pass.
     pub(super) fn pose_pass(&mut self, pass: Pass, frame: usize) -> Result<()> {
         match pass {
@@ -627,7 +643,20 @@ impl<'s, 'g> Executor<'s, 'g> {
     /// else area-weighted on the host (or the file's, where it stores some).
     fn vertex_normals(&mut self, frame: usize) -> Result<()> {
         self.host_pose(frame)?;
-        if self.est().is_some() {
+        if self.est().is_some() && !self.plan.contains(Pass::Curvature) {
+            // Line families without curvature (isophotes, boundaries): the
+            // curvature's own normals (normals_areas + frames), so that they
+            // are the same as with any other family, as rtsc's are.
+            let t = self.normals_run(frame)?;
+            let f = self.est().expect("checked above").read()?;
+            self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
+            let how = if self.stored_normals().is_some() {
+                "clear + normals_areas + frames (then replaced by the normals the mesh file stores)"
+            } else {
+                "clear + normals_areas + frames (the curvature's normals; no curvature planned)"
+            };
+            self.rec.kernels(Pass::VertexNormals, &t, how);
+        } else if self.est().is_some() {
             let t = self.curvature_run(frame)?;
             let f = self.est().expect("checked above").read()?;
             self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
