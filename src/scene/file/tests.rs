@@ -312,3 +312,21 @@ fn output_interop_is_a_mode() {
     );
     assert!(e.contains("line 6") && e.contains("output.interop"), "{e}");
 }
+
+#[test]
+fn normals_choose_the_file_s_or_computed_ones_for_mesh_inputs() {
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/data/spot.obj");
+    let with =
+        |extra: &str| format!("[input]\nmesh = \"{spot}\"\n{extra}[effects]\nshading = {{}}\n");
+    let s = parse(&with("")).unwrap();
+    assert_eq!(s.normals, crate::mesh::NormalsSource::File);
+    let s = parse(&with("normals = \"computed\"\n")).unwrap();
+    assert_eq!(s.normals, crate::mesh::NormalsSource::Computed);
+    let e = err(&with("normals = \"stored\"\n"));
+    assert!(e.contains("line 3") && e.contains("file, computed"), "{e}");
+    let e = err("[input]\ngenerate = \"torus\"\nnormals = \"file\"\n[effects]\nshading = {}\n");
+    assert!(
+        e.contains("`normals` does not apply to a generate input"),
+        "{e}"
+    );
+}
