@@ -44,12 +44,12 @@ fn same(dev: Vec<Segment>, cpu: Vec<Segment>, what: &str) {
     let close = |a: &Segment, b: &Segment| {
         let d = |p: [f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-5);
         // Endpoints and the mesh edges they lie on, in the same order.
-        a.2 == b.2
-            && (d(a.0, b.0) && d(a.1, b.1) && a.4 == b.4
-                || d(a.0, b.1) && d(a.1, b.0) && a.4 == [b.4[1], b.4[0]])
-            && (a.3 - b.3).abs() < 1e-4
+        a.family == b.family
+            && (d(a.a, b.a) && d(a.b, b.b) && a.ends == b.ends
+                || d(a.a, b.b) && d(a.b, b.a) && a.ends == [b.ends[1], b.ends[0]])
+            && (a.strength - b.strength).abs() < 1e-4
     };
-    let key = |s: &Segment| (s.0[0] + s.1[0]) * 0.5;
+    let key = |s: &Segment| (s.a[0] + s.b[0]) * 0.5;
     let mut c = cpu.clone();
     c.sort_by(|a, b| key(a).total_cmp(&key(b)));
     let mut used = vec![false; c.len()];
@@ -91,7 +91,10 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
     // Along the axis: the outer and inner equators (radius 1.4 and 0.6, z = 0).
     let s = device(&m, &x, View::from_eye([0.0, 0.0, 1.0], true), contours);
     assert!(s.len() > 300, "{}", s.len());
-    for (a, b, kind, _, _) in &s {
+    for Segment {
+        a, b, family: kind, ..
+    } in &s
+    {
         assert_eq!(*kind, 0);
         for p in [a, b] {
             let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
@@ -106,7 +109,7 @@ fn torus_contours_lie_on_the_analytic_silhouettes() {
     // the plane x = 0 and the top and bottom circles z = ±0.4.
     let s = device(&m, &x, View::from_eye([1.0, 0.0, 0.0], true), contours);
     assert!(s.len() > 300);
-    for (a, b, _, _, _) in &s {
+    for Segment { a, b, .. } in &s {
         for p in [a, b] {
             assert!(
                 p[0].abs() < 0.01 || (p[2].abs() - 0.4).abs() < 0.01,
@@ -131,7 +134,7 @@ fn each_segment_end_lies_on_its_mesh_edge_and_closed_contours_meet_in_pairs() {
     let s = device(&m, &x, View::from_eye([0.3, 0.2, 1.0], true), contours);
     assert!(s.len() > 300, "{}", s.len());
     let mut count: std::collections::HashMap<[u32; 2], usize> = Default::default();
-    for (a, b, _, _, ends) in &s {
+    for Segment { a, b, ends, .. } in &s {
         for (p, e) in [(a, ends[0]), (b, ends[1])] {
             assert!(e[0] < e[1], "{e:?} is a sorted vertex pair");
             // p = v0 + t (v1 − v0) for some t in [0, 1].
@@ -197,7 +200,7 @@ fn device_matches_cpu_twin() {
                 opts.scaled_fade(1.0),
             );
             assert!(
-                cpu.iter().any(|s| s.2 == 0) && cpu.iter().any(|s| s.2 == 1),
+                cpu.iter().any(|s| s.family == 0) && cpu.iter().any(|s| s.family == 1),
                 "{name}: both kinds"
             );
             same(dev, cpu, name);
@@ -209,7 +212,7 @@ fn length(s: &[Segment]) -> f32 {
     s.iter()
         .map(|s| {
             (0..3)
-                .map(|i| (s.1[i] - s.0[i]).powi(2))
+                .map(|i| (s.b[i] - s.a[i]).powi(2))
                 .sum::<f32>()
                 .sqrt()
         })
@@ -237,7 +240,11 @@ fn suggestive_contours_respect_the_threshold_and_facing() {
         length(&strict),
         length(&loose)
     );
-    assert!(loose.iter().all(|s| s.2 == 1 && (0.0..=1.0).contains(&s.3)));
+    assert!(
+        loose
+            .iter()
+            .all(|s| s.family == 1 && (0.0..=1.0).contains(&s.strength))
+    );
     // A sphere is convex everywhere: radial curvature never crosses zero.
     let sphere = mesh::icosphere(1.0, 4);
     let xs = inputs(&sphere);
@@ -291,11 +298,11 @@ fn suggestive_contours_are_cut_where_the_test_crosses_its_threshold() {
         };
         let (s, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
         assert!(!s.is_empty());
-        let ys: Vec<f32> = s.iter().flat_map(|s| [s.0[1], s.1[1]]).collect();
+        let ys: Vec<f32> = s.iter().flat_map(|s| [s.a[1], s.b[1]]).collect();
         let lo = ys.iter().copied().fold(f32::INFINITY, f32::min);
         let hi = ys.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         // On x = 0, from y = t (the cut, exact: the test is linear) to 1.
-        assert!(s.iter().all(|s| s.0[0].abs() < 1e-5 && s.1[0].abs() < 1e-5));
+        assert!(s.iter().all(|s| s.a[0].abs() < 1e-5 && s.b[0].abs() < 1e-5));
         assert!(
             (lo - t).abs() < 1e-5 && (hi - 1.0).abs() < 1e-5,
             "{lo} {hi}"
@@ -304,19 +311,23 @@ fn suggestive_contours_are_cut_where_the_test_crosses_its_threshold() {
         // One end is cut inside a face; every other end lies on an edge.
         let free: Vec<_> = s
             .iter()
-            .flat_map(|s| [(s.0, s.4[0]), (s.1, s.4[1])])
+            .flat_map(|s| [(s.a, s.ends[0]), (s.b, s.ends[1])])
             .filter(|(_, e)| e[0] == shapecue::spec::feature_lines::LINE_FREE)
             .collect();
         assert_eq!(free.len(), 1, "{free:?}");
         assert!((free[0].0[1] - t).abs() < 1e-5);
         // rtsc's fade r / (r + 0.03) with r = y − t: 0 at the cut, rising.
         let mut by_y: Vec<&Segment> = s.iter().collect();
-        by_y.sort_by(|a, b| (a.0[1] + a.1[1]).total_cmp(&(b.0[1] + b.1[1])));
+        by_y.sort_by(|a, b| (a.a[1] + a.b[1]).total_cmp(&(b.a[1] + b.b[1])));
         for seg in &by_y {
-            let r0 = (seg.0[1] - t).max(0.0);
-            let r1 = (seg.1[1] - t).max(0.0);
+            let r0 = (seg.a[1] - t).max(0.0);
+            let r1 = (seg.b[1] - t).max(0.0);
             let want = 0.5 * (r0 / (r0 + 0.03) + r1 / (r1 + 0.03));
-            assert!((seg.3 - want).abs() < 1e-4, "{} vs {want}", seg.3);
+            assert!(
+                (seg.strength - want).abs() < 1e-4,
+                "{} vs {want}",
+                seg.strength
+            );
         }
         // The twin cuts at the same place.
         let terms = lines_vertex(&li(&x), view);
@@ -338,7 +349,7 @@ fn suggestive_contours_are_cut_where_the_test_crosses_its_threshold() {
             )
             .unwrap();
         assert!((length(&all) - 2.0).abs() < 1e-4, "{}", length(&all));
-        assert!(all.iter().all(|s| s.3 == 1.0));
+        assert!(all.iter().all(|s| s.strength == 1.0));
     }
 }
 
@@ -414,7 +425,7 @@ fn contours_keep_their_parts_with_positive_radial_curvature() {
     let scale = t.kr.iter().map(|k| k.abs()).fold(0.0, f32::max);
     let mut cut = 0;
     for s in &tested {
-        for (p, e) in [(s.0, s.4[0]), (s.1, s.4[1])] {
+        for (p, e) in [(s.a, s.ends[0]), (s.b, s.ends[1])] {
             assert!(kr_at(p, e) >= -1e-4 * scale, "κr {} at {p:?}", kr_at(p, e));
             cut += usize::from(e[0] == shapecue::spec::feature_lines::LINE_FREE);
         }
@@ -435,7 +446,7 @@ fn nasty_views_give_finite_segments_or_clear_errors() {
             .unwrap();
         assert!(
             s.iter()
-                .all(|s| s.0.iter().chain(&s.1).all(|c| c.is_finite()))
+                .all(|s| s.a.iter().chain(&s.b).all(|c| c.is_finite()))
         );
     }
     assert!(
@@ -493,7 +504,7 @@ fn a_face_with_more_pieces_than_the_first_buffer_holds_grows_it() {
     let view = View::from_eye([0.0, 0.0, 1.0], true);
     let mut ex = LineExtractor::new(gpu(), 3, &faces).unwrap();
     let (s, _) = ex.extract(&li(&x), view, 1.0, opts).unwrap();
-    let sc: Vec<&Segment> = s.iter().filter(|s| s.2 == 1).collect();
+    let sc: Vec<&Segment> = s.iter().filter(|s| s.family == 1).collect();
     assert_eq!((s.len(), sc.len()), (3, 2), "{s:?}");
     let t = lines_vertex(&li(&x), view);
     let cpu = lines_face(

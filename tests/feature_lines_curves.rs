@@ -56,7 +56,7 @@ fn device(m: &Mesh, x: &LineArrays, view: View, fs: f32, opts: LineOptions) -> V
 
 fn finite(s: &[Segment]) -> bool {
     s.iter()
-        .all(|s| s.0.iter().chain(&s.1).all(|c| c.is_finite()) && s.3.is_finite())
+        .all(|s| s.a.iter().chain(&s.b).all(|c| c.is_finite()) && s.strength.is_finite())
 }
 
 /// Both lists match segment for segment (endpoints within `tol`, same
@@ -65,21 +65,21 @@ fn finite(s: &[Segment]) -> bool {
 fn same(dev: &[Segment], cpu: &[Segment], tol: f32, slack: f64, what: &str) {
     let close = |a: &Segment, b: &Segment| {
         let d = |p: [f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() < tol);
-        a.2 == b.2
-            && (d(a.0, b.0) && d(a.1, b.1) && a.4 == b.4
-                || d(a.0, b.1) && d(a.1, b.0) && a.4 == [b.4[1], b.4[0]])
-            && (a.3 - b.3).abs() < 1e-3
+        a.family == b.family
+            && (d(a.a, b.a) && d(a.b, b.b) && a.ends == b.ends
+                || d(a.a, b.b) && d(a.b, b.a) && a.ends == [b.ends[1], b.ends[0]])
+            && (a.strength - b.strength).abs() < 1e-3
     };
     let mut used = vec![false; cpu.len()];
     let mut unmatched = 0;
     let mut by_edge: std::collections::HashMap<[[u32; 2]; 2], Vec<usize>> = Default::default();
     for (i, c) in cpu.iter().enumerate() {
-        let mut k = c.4;
+        let mut k = c.ends;
         k.sort();
         by_edge.entry(k).or_default().push(i);
     }
     for d in dev {
-        let mut k = d.4;
+        let mut k = d.ends;
         k.sort();
         let hit = by_edge
             .get(&k)
@@ -216,13 +216,13 @@ fn device_matches_cpu_twin_step_by_step() {
             assert!(finite(&dev), "{name}: finite");
             for f in LineFamily::ALL[2..].iter().copied() {
                 let pick = |s: &[Segment]| -> Vec<Segment> {
-                    s.iter().filter(|s| s.2 == f as u32).copied().collect()
+                    s.iter().filter(|s| s.family == f as u32).copied().collect()
                 };
                 let (a, b) = (pick(&dev), pick(&cpu));
                 same(&a, &b, 1e-4, 0.01, &format!("{name} {}", f.name()));
             }
             assert!(
-                cpu.iter().any(|s| s.2 == LineFamily::Isophotes as u32),
+                cpu.iter().any(|s| s.family == LineFamily::Isophotes as u32),
                 "{name}: isophotes drawn"
             );
         }
@@ -241,7 +241,7 @@ fn ellipsoid_ridges_lie_in_its_principal_planes() {
     });
     let s = device(&m, &x, View::from_eye([0.0, 0.0, 1.0], true), fs, opts);
     assert!(
-        s.iter().all(|s| s.2 == LineFamily::Ridges as u32),
+        s.iter().all(|s| s.family == LineFamily::Ridges as u32),
         "no valleys"
     );
     assert!(s.len() > 200, "{} ridge segments", s.len());
@@ -249,7 +249,7 @@ fn ellipsoid_ridges_lie_in_its_principal_planes() {
     let near = s
         .iter()
         .filter(|s| {
-            let p: [f32; 3] = std::array::from_fn(|i| 0.5 * (s.0[i] + s.1[i]));
+            let p: [f32; 3] = std::array::from_fn(|i| 0.5 * (s.a[i] + s.b[i]));
             p.iter().any(|c| c.abs() < tol)
         })
         .count();
@@ -288,7 +288,7 @@ fn sphere_isophotes_lie_at_the_latitudes_n_dot_l_gives() {
     let s = device(&m, &x, View::from_eye([0.0, 0.0, 5.0], false), 0.05, opts);
     let mut levels = std::collections::BTreeSet::new();
     for seg in &s {
-        for p in [seg.0, seg.1] {
+        for p in [seg.a, seg.b] {
             // On the unit sphere n·l = z: the nearest level is j / N.
             let j = (p[2] * n as f32).round();
             assert!((p[2] - j / n as f32).abs() < 0.01, "{p:?}");
@@ -313,7 +313,7 @@ fn torus_parabolic_error(hermite: bool) -> (f64, f64, usize) {
     let (s, st) = ex.extract(&x.inputs(), view, 0.05, opts).unwrap();
     let mut err = 0.0;
     for seg in &s {
-        for p in [seg.0, seg.1] {
+        for p in [seg.a, seg.b] {
             let rho = (p[0] as f64).hypot(p[1] as f64);
             err += ((rho - big).powi(2) + (p[2].abs() as f64 - r).powi(2)).sqrt();
         }
@@ -362,7 +362,7 @@ fn apparent_ridges_of_an_obliquely_seen_cylinder_lie_at_its_contours() {
     let at = s
         .iter()
         .filter(|s| {
-            let (x, y) = (0.5 * (s.0[0] + s.1[0]), 0.5 * (s.0[1] + s.1[1]));
+            let (x, y) = (0.5 * (s.a[0] + s.b[0]), 0.5 * (s.a[1] + s.b[1]));
             (x * c + y * sn).abs() < 0.1
         })
         .count();
@@ -381,8 +381,8 @@ fn cylinder_boundaries_are_its_two_rims() {
     let s = device(&m, &x, View::from_eye([3.0, 0.0, 0.5], false), 0.05, opts);
     assert_eq!(s.len(), 80);
     for seg in &s {
-        assert!((seg.0[2].abs() - 1.0).abs() < 1e-6 && (seg.1[2] - seg.0[2]).abs() < 1e-6);
-        assert_eq!(seg.4[0][0], seg.4[0][1], "ends keyed by their vertex");
+        assert!((seg.a[2].abs() - 1.0).abs() < 1e-6 && (seg.b[2] - seg.a[2]).abs() < 1e-6);
+        assert_eq!(seg.ends[0][0], seg.ends[0][1], "ends keyed by their vertex");
     }
 }
 
@@ -647,7 +647,10 @@ fn a_skinned_frame_gives_the_lines_of_the_static_mesh_in_the_same_pose() {
     let stat = device(&mesh, &x, view, fs, opts);
     for fam in fams {
         let pick = |s: &[Segment]| -> Vec<Segment> {
-            s.iter().filter(|s| s.2 == fam as u32).copied().collect()
+            s.iter()
+                .filter(|s| s.family == fam as u32)
+                .copied()
+                .collect()
         };
         let (a, b) = (pick(&chained), pick(&stat));
         eprintln!("{}: {} chained, {} static", fam.name(), a.len(), b.len());

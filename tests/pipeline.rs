@@ -54,11 +54,11 @@ fn size(m: &Mesh) -> f64 {
 fn unmatched(a: &[Segment], b: &[Segment], tol: f32) -> usize {
     let close = |p: [f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() <= tol);
     let same = |s: &Segment, t: &Segment| {
-        s.2 == t.2
-            && (close(s.0, t.0) && close(s.1, t.1) || close(s.0, t.1) && close(s.1, t.0))
-            && (s.3 - t.3).abs() < 1e-4
+        s.family == t.family
+            && (close(s.a, t.a) && close(s.b, t.b) || close(s.a, t.b) && close(s.b, t.a))
+            && (s.strength - t.strength).abs() < 1e-4
     };
-    let key = |s: &Segment| 0.5 * (s.0[0] + s.1[0]);
+    let key = |s: &Segment| 0.5 * (s.a[0] + s.b[0]);
     let mut b: Vec<&Segment> = b.iter().collect();
     b.sort_by(|x, y| key(x).total_cmp(&key(y)));
     let mut used = vec![false; b.len()];
@@ -161,7 +161,7 @@ fn chained_lines_equal_lines_of_host_arrays() {
             let (got, st) = ex.extract_device(&est, view, 0.3 * d as f32, opts).unwrap();
             let what = format!("{name} {view:?}");
             assert!(
-                got.iter().any(|s| s.2 == 0) && got.iter().any(|s| s.2 == 1),
+                got.iter().any(|s| s.family == 0) && got.iter().any(|s| s.family == 1),
                 "{what}: both kinds"
             );
             assert_eq!(got.len(), want.len(), "{what}: segment count");
@@ -184,7 +184,11 @@ fn chained_lines_equal_lines_of_host_arrays() {
                 .iter()
                 .map(|s| {
                     let w = |p: [f32; 3]| std::array::from_fn(|i| (f64::from(p[i]) + c[i]) as f32);
-                    (w(s.0), w(s.1), s.2, s.3, s.4)
+                    Segment {
+                        a: w(s.a),
+                        b: w(s.b),
+                        ..*s
+                    }
                 })
                 .collect();
             assert_eq!(back.len(), got.len(), "{what}: origin-relative count");
@@ -256,7 +260,7 @@ fn untested_contours_need_only_the_normals_pass() {
                     // Reproducible sums: bit-identical positions and normals
                     // in both estimators, so identical segments.
                     let key = |s: &Segment| {
-                        [s.0, s.1]
+                        [s.a, s.b]
                             .concat()
                             .iter()
                             .map(|c| c.to_bits())
@@ -281,7 +285,7 @@ fn untested_contours_need_only_the_normals_pass() {
                     .unwrap();
                 assert!(
                     s.iter()
-                        .all(|s| s.2 == 0 && s.0.iter().chain(&s.1).all(|c| c.is_finite())),
+                        .all(|s| s.family == 0 && s.a.iter().chain(&s.b).all(|c| c.is_finite())),
                     "{what}"
                 );
             }

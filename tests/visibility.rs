@@ -158,7 +158,7 @@ fn in_face(m: &Mesh, f: usize) -> Segment {
     let p = |v: u32| common::to_f32(&[m.positions[v as usize]])[0];
     let c = std::array::from_fn(|k| (p(t[0])[k] + p(t[1])[k] + p(t[2])[k]) / 3.0);
     let e = std::array::from_fn(|k| 0.5 * (p(t[0])[k] + p(t[1])[k]));
-    (
+    Segment::new(
         c,
         e,
         0,
@@ -196,7 +196,7 @@ fn a_segment_behind_another_object_is_hidden_and_visible_without_it() {
     };
     let front = in_face(&m, top_face(&m, nb..m.faces.len()));
     // Zero length, at the back face's centroid.
-    let point = (seg.0, seg.0, 0, 1.0, [seg.4[0], seg.4[0]]);
+    let point = Segment::new(seg.a, seg.a, 0, 1.0, [seg.ends[0], seg.ends[0]]);
     for view in views_down_z() {
         let got = pieces_of(&m, &[seg, front, point], &view);
         assert_eq!(got[0], vec![(0.0, 1.0, false)], "behind the front sphere");
@@ -221,7 +221,7 @@ fn the_silhouette_of_a_convex_mesh_is_visible() {
         let view = camera(&m, dir, ortho).view(W, H);
         let segs: Vec<Segment> = segments(&m, view)
             .into_iter()
-            .filter(|s| s.2 == 0)
+            .filter(|s| s.family == 0)
             .collect();
         assert!(segs.len() > 50, "{} contour segments", segs.len());
         let (dev, twin, _, _) = all_three(&m, &segs, &view);
@@ -239,8 +239,8 @@ fn segments_behind_the_eye_are_hidden_and_one_crossing_its_plane_is_split() {
     let (m, _) = two_spheres();
     let [view, ortho] = views_down_z();
     let free = [[LINE_FREE, 0], [LINE_FREE, 0]];
-    let behind = ([0.0, 0.0, 7.0], [0.1, 0.0, 8.0], 0, 1.0, free);
-    let across = ([0.0, 0.5, 5.0], [0.0, 0.5, 7.0], 0, 1.0, free);
+    let behind = Segment::new([0.0, 0.0, 7.0], [0.1, 0.0, 8.0], 0, 1.0, free);
+    let across = Segment::new([0.0, 0.5, 5.0], [0.0, 0.5, 7.0], 0, 1.0, free);
     let got = pieces_of(&m, &[behind, across], &view);
     assert_eq!(got[0], vec![(0.0, 1.0, false)]);
     assert_eq!(got[1].len(), 2, "{:?}", got[1]);
@@ -269,13 +269,16 @@ fn no_segment_gives_no_piece_and_bad_segments_are_plain_errors() {
     let cases: [(&str, Segment); 3] = [
         (
             "face 99999999",
-            (c, c, 0, 1.0, [[LINE_FREE, 99_999_999], ok.4[1]]),
+            Segment::new(c, c, 0, 1.0, [[LINE_FREE, 99_999_999], ok.ends[1]]),
         ),
         (
             "vertex 4000000000",
-            (c, c, 0, 1.0, [ok.4[0], [7, 4_000_000_000]]),
+            Segment::new(c, c, 0, 1.0, [ok.ends[0], [7, 4_000_000_000]]),
         ),
-        ("non-finite", ([f32::NAN, -10.0, -10.0], c, 0, 1.0, ok.4)),
+        (
+            "non-finite",
+            Segment::new([f32::NAN, -10.0, -10.0], c, 0, 1.0, ok.ends),
+        ),
     ];
     let others = [in_face(&m, 1), in_face(&m, 2), in_face(&m, 3)];
     for (want, seg) in cases {

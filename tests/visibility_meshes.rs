@@ -251,7 +251,7 @@ fn count(tree: &Tree, p: &[[f32; 3]], faces: &[[u32; 3]], q: &BvhQuery) -> (bool
 fn per_family(segs: &[Segment]) -> String {
     let mut n = [0usize; LineFamily::ALL.len()];
     for s in segs {
-        n[s.2 as usize] += 1;
+        n[s.family as usize] += 1;
     }
     (LineFamily::ALL.iter().zip(n))
         .filter(|(_, k)| *k > 0)

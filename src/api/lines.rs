@@ -351,8 +351,8 @@ pub fn segment_arrays(v: &VisibleLines, mesh: &Mesh) -> crate::export::npz::Segm
             .push(on.map_or([[0.0; 3]; 2], |o| o.1.map(|w| w.map(|x| x as f32))));
         out.a.push(a);
         out.b.push(b);
-        out.family.push(s.2);
-        out.strength.push(s.3);
+        out.family.push(s.family);
+        out.strength.push(s.strength);
         out.visible.push(u8::from(p.visible));
         let f = &v.faces[p.seg as usize];
         out.faces.push(std::array::from_fn(|k| {

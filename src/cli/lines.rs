@@ -392,8 +392,8 @@ fn segments_doc(
                     let s = &v.segments[p.seg as usize];
                     let face = (arr.face[i] >= 0).then_some(arr.face[i]);
                     serde_json::json!({
-                        "family": family(s.2),
-                        "strength": s.3,
+                        "family": family(s.family),
+                        "strength": s.strength,
                         "a": arr.a[i],
                         "b": arr.b[i],
                         "visible": p.visible,
@@ -420,7 +420,7 @@ fn segments_doc(
         }
         None => {
             let segs: Vec<serde_json::Value> = (segments.iter())
-                .map(|s| serde_json::json!({"family": family(s.2), "strength": s.3, "a": s.0, "b": s.1}))
+                .map(|s| serde_json::json!({"family": family(s.family), "strength": s.strength, "a": s.a, "b": s.b}))
                 .collect();
             serde_json::json!({"feature_size": feature_size, "segments": segs})
         }
@@ -442,7 +442,7 @@ fn normals_used(mesh: &shapecue::Mesh) -> String {
 fn summary(segments: &[Segment]) -> String {
     let mut counts = std::collections::BTreeMap::<&str, usize>::new();
     for s in segments {
-        if let Some(f) = LineFamily::from_kind(s.2) {
+        if let Some(f) = LineFamily::from_kind(s.family) {
             *counts.entry(f.name()).or_default() += 1;
         }
     }

@@ -208,7 +208,7 @@ pub fn emit_tested(
     fam: u32,
 ) {
     if !test {
-        out.push((pa, pb, fam, 1.0, [ea, eb]));
+        out.push(Segment::new(pa, pb, fam, 1.0, [ea, eb]));
         return;
     }
     for [s0, s1] in test_pieces(na, nb, da, db) {
@@ -220,7 +220,7 @@ pub fn emit_tested(
         let q1 = if s1 == 1.0 { pb } else { at(s1) };
         let e0 = if s0 == 0.0 { ea } else { [LINE_FREE, f] };
         let e1 = if s1 == 1.0 { eb } else { [LINE_FREE, f] };
-        out.push((q0, q1, fam, st, [e0, e1]));
+        out.push(Segment::new(q0, q1, fam, st, [e0, e1]));
     }
 }
 

@@ -208,7 +208,7 @@ struct Out<'a> {
 
 impl Out<'_> {
     fn emit(&mut self, a: V3, b: V3, fam: LineFamily, s: f32, e: [[u32; 2]; 2]) {
-        self.segs.push((a, b, fam as u32, s, e));
+        self.segs.push(Segment::new(a, b, fam as u32, s, e));
     }
 }
 

@@ -105,20 +105,21 @@ pub fn segment_lines(
     opacity: impl Fn(f32) -> f32,
 ) -> Vec<ClipLine> {
     let mut out = Vec::new();
-    for s in segments.iter().filter(|s| s.2 == kind) {
-        let Some((a, b, cut)) = clip_segment(view_proj, s.0, s.1) else {
+    for s in segments.iter().filter(|s| s.family == kind) {
+        let Some((a, b, cut)) = clip_segment(view_proj, s.a, s.b) else {
             continue;
         };
         // A cut end no longer lies on its mesh edge; an end that a line's
         // test cut inside a face never lay on one.
         // An end on no face (a stroke on a distance field) has no edge.
         let edge = |i: usize| {
-            (!cut[i] && s.4[i][0] != LINE_FREE && s.4[i] != NO_FACE).then(|| edge_key(s.4[i]))
+            (!cut[i] && s.ends[i][0] != LINE_FREE && s.ends[i] != NO_FACE)
+                .then(|| edge_key(s.ends[i]))
         };
         out.push(ClipLine {
             ends: [a.to_array(), b.to_array()],
             edges: [edge(0), edge(1)],
-            opacity: opacity(s.3),
+            opacity: opacity(s.strength),
         });
     }
     out

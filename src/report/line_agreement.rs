@@ -28,7 +28,7 @@ pub const DEPTH_POINTS: usize = 32;
 /// World length of a segment.
 pub fn seg_len(s: &Segment) -> f64 {
     (0..3)
-        .map(|k| f64::from(s.1[k] - s.0[k]).powi(2))
+        .map(|k| f64::from(s.b[k] - s.a[k]).powi(2))
         .sum::<f64>()
         .sqrt()
 }
@@ -96,7 +96,14 @@ pub fn fitted_camera(m: &Mesh, dir: Vec3, ortho: bool, aspect: f32) -> Result<Ca
 /// order they finish) by family and ends: the same list every run, so that
 /// a subset of it is too.
 pub fn sort_segments(segs: &mut [Segment]) {
-    segs.sort_by_key(|s| (s.2, s.0.map(f32::to_bits), s.1.map(f32::to_bits), s.4));
+    segs.sort_by_key(|s| {
+        (
+            s.family,
+            s.a.map(f32::to_bits),
+            s.b.map(f32::to_bits),
+            s.ends,
+        )
+    });
 }
 
 /// The segments of `plan` the reference checks: every k-th (k ≥ 1), k the
@@ -176,16 +183,16 @@ pub fn depth_share_in(frame: &Frame, cam: &Camera, segs: &[Segment], reference: 
     };
     let (mut same, mut total) = (0.0, 0.0);
     for (s, refp) in segs.iter().zip(reference) {
-        let lines = segment_lines(vp, std::slice::from_ref(s), s.2, |_| 1.0);
+        let lines = segment_lines(vp, std::slice::from_ref(s), s.family, |_| 1.0);
         let vis = visible_joined(&lines, frame, DEFAULT_BIAS);
-        let (a, b) = (px(s.0), px(s.1));
+        let (a, b) = (px(s.a), px(s.b));
         let d = [b[0] - a[0], b[1] - a[1]];
         let dd = (d[0] * d[0] + d[1] * d[1]).max(1e-12);
         let param = |q: [f32; 2]| ((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / dd;
         let len = seg_len(s) / DEPTH_POINTS as f64;
         for k in 0..DEPTH_POINTS {
             let t = (k as f32 + 0.5) / DEPTH_POINTS as f32;
-            let q = px(std::array::from_fn(|i| s.0[i] + t * (s.1[i] - s.0[i])));
+            let q = px(std::array::from_fn(|i| s.a[i] + t * (s.b[i] - s.a[i])));
             let u = param(q);
             let on = vis.iter().any(|l| {
                 let first = l.points[0];
@@ -207,7 +214,7 @@ mod tests {
     use super::*;
 
     fn seg(a: [f32; 3], b: [f32; 3]) -> Segment {
-        (a, b, 0, 1.0, [[0, 1], [1, 2]])
+        Segment::new(a, b, 0, 1.0, [[0, 1], [1, 2]])
     }
 
     #[test]

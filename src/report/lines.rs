@@ -61,7 +61,7 @@ pub fn analytic_errors(gpu: &Arc<Gpu>, compat: Compat) -> Result<LineErrors> {
     let torus = mesh::torus(1.0, 0.4, 90, 36);
     let view = View::from_eye([0.0, 0.0, 4.0], false);
     let (s, t1) = segments(gpu, &torus, view, LineFamily::KZero, compat)?;
-    let ends: Vec<[f32; 3]> = s.iter().flat_map(|s| [s.0, s.1]).collect();
+    let ends: Vec<[f32; 3]> = s.iter().flat_map(|s| [s.a, s.b]).collect();
     let torus_k_zero = ends
         .iter()
         .map(|p| {
@@ -77,7 +77,7 @@ pub fn analytic_errors(gpu: &Arc<Gpu>, compat: Compat) -> Result<LineErrors> {
         .iter()
         .map(|s| {
             (0..3)
-                .map(|i| (0.5 * (f64::from(s.0[i]) + f64::from(s.1[i]))).abs())
+                .map(|i| (0.5 * (f64::from(s.a[i]) + f64::from(s.b[i]))).abs())
                 .fold(f64::INFINITY, f64::min)
         })
         .sum::<f64>()

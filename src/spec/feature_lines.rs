@@ -4,12 +4,39 @@
 //! (`stages::feature_lines`) and the CPU twin
 //! (`cpu::feature_lines`).
 
-/// A segment: endpoints, kind (0 contour, 1 suggestive), strength, and the
-/// mesh edge each endpoint lies on (sorted vertex pairs). The segments of two
+/// A segment of a line family: its ends, its family's code, its strength,
+/// and the mesh edge each end lies on (sorted vertex pairs). The segments of two
 /// faces sharing an edge meet on it, so chaining by these edges is exact
 /// (see [`edge_key`]). An end inside a face has no edge: `[LINE_FREE, face]`
 /// where a test cut the segment, `[u32::MAX, face]` at a face centre.
-pub type Segment = ([f32; 3], [f32; 3], u32, f32, [[u32; 2]; 2]);
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Segment {
+    /// The first end.
+    pub a: [f32; 3],
+    /// The second end.
+    pub b: [f32; 3],
+    /// The family's code ([`LineFamily::kind`]).
+    pub family: u32,
+    /// The strength (rtsc's fade), in [0, 1].
+    pub strength: f32,
+    /// What each end lies on: a mesh edge as its sorted vertex pair, or
+    /// `[LINE_FREE, face]` / `[u32::MAX, face]` inside a face.
+    pub ends: [[u32; 2]; 2],
+}
+
+impl Segment {
+    /// A segment from its parts.
+    pub fn new(a: [f32; 3], b: [f32; 3], family: u32, strength: f32, ends: [[u32; 2]; 2]) -> Self {
+        Segment {
+            a,
+            b,
+            family,
+            strength,
+            ends,
+        }
+    }
+}
 
 /// The per-vertex fields of one view that rtsc's line families are zero
 /// crossings of, in world units, one value per vertex: what dataset
@@ -68,9 +95,9 @@ pub fn edge_key(e: [u32; 2]) -> u64 {
 ///   every chain through it.
 pub fn canonical(segments: &mut Vec<Segment>) {
     let on_edge = |e: [u32; 2]| e[0] != LINE_FREE && e[0] != u32::MAX;
-    segments.retain(|s| !(on_edge(s.4[0]) && s.4[0] == s.4[1]));
+    segments.retain(|s| !(on_edge(s.ends[0]) && s.ends[0] == s.ends[1]));
     let bits = |p: [f32; 3]| p.map(f32::to_bits);
-    let key = |s: &Segment| (s.2, s.4, bits(s.0), bits(s.1), s.3.to_bits());
+    let key = |s: &Segment| (s.family, s.ends, bits(s.a), bits(s.b), s.strength.to_bits());
     // The family and the ends' edges packed in two integers sort the rows
     // nearly whole, far faster than the whole key; runs of equal packings
     // (segments on the same two edges: isophotes of several levels) are
@@ -85,9 +112,9 @@ pub fn canonical(segments: &mut Vec<Segment>) {
         }
     };
     let head = |s: &Segment| -> u64 {
-        (u64::from(s.2.min(15)) << 60) | (squeeze(s.4[0][0]) << 30) | squeeze(s.4[0][1])
+        (u64::from(s.family.min(15)) << 60) | (squeeze(s.ends[0][0]) << 30) | squeeze(s.ends[0][1])
     };
-    let second = |s: &Segment| -> u64 { (u64::from(s.4[1][0]) << 32) | u64::from(s.4[1][1]) };
+    let second = |s: &Segment| -> u64 { (u64::from(s.ends[1][0]) << 32) | u64::from(s.ends[1][1]) };
     let mut order: Vec<(u64, u64, u32)> = (segments.iter().enumerate())
         .map(|(i, s)| (head(s), second(s), i as u32))
         .collect();
@@ -702,12 +729,24 @@ mod tests {
         for i in 0..200u32 {
             let e = |a: u32, b: u32| [a % 97, 97 + b % 89];
             let p = |k: u32| [i as f32 * 0.5, k as f32, (i % 7) as f32];
-            segs.push((p(0), p(1), i % 12, 0.5, [e(i, i + 1), e(i + 3, i)]));
-            segs.push((p(2), p(3), 7, 1.0, [e(i, i + 1), e(i + 3, i)]));
-            segs.push((p(4), p(5), 1, 0.25, [[LINE_FREE, i], [u32::MAX, i]]));
+            segs.push(Segment::new(
+                p(0),
+                p(1),
+                i % 12,
+                0.5,
+                [e(i, i + 1), e(i + 3, i)],
+            ));
+            segs.push(Segment::new(p(2), p(3), 7, 1.0, [e(i, i + 1), e(i + 3, i)]));
+            segs.push(Segment::new(
+                p(4),
+                p(5),
+                1,
+                0.25,
+                [[LINE_FREE, i], [u32::MAX, i]],
+            ));
         }
         segs.push(segs[10]);
-        segs.push(([0.0; 3], [0.0; 3], 0, 1.0, [[3, 9], [3, 9]]));
+        segs.push(Segment::new([0.0; 3], [0.0; 3], 0, 1.0, [[3, 9], [3, 9]]));
         let mut a = segs.clone();
         canonical(&mut a);
         // Shuffled by a fixed permutation: the same rows.
@@ -719,11 +758,11 @@ mod tests {
             v.iter()
                 .map(|s| {
                     (
-                        s.2,
-                        s.4,
-                        s.0.map(f32::to_bits),
-                        s.1.map(f32::to_bits),
-                        s.3.to_bits(),
+                        s.family,
+                        s.ends,
+                        s.a.map(f32::to_bits),
+                        s.b.map(f32::to_bits),
+                        s.strength.to_bits(),
                     )
                 })
                 .collect()
@@ -734,6 +773,6 @@ mod tests {
         let k = bits(&a);
         assert!(k.windows(2).all(|w| w[0] < w[1]), "sorted, each row once");
         assert_eq!(a.len(), 3 * 200);
-        assert!(!a.iter().any(|s| s.4 == [[3, 9], [3, 9]]));
+        assert!(!a.iter().any(|s| s.ends == [[3, 9], [3, 9]]));
     }
 }

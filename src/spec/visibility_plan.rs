@@ -174,8 +174,8 @@ impl<'a> Topology<'a> {
 /// The faces segment `s` (index `i`) lies on (at most four); `f0` and `f1`
 /// are scratch space for its ends' faces.
 fn lies_on(topo: &Topology, s: &Segment, i: usize, [f0, f1]: [&mut Vec<u32>; 2]) -> Result<Faces> {
-    topo.end_faces(s.4[0], i, "first", f0)?;
-    topo.end_faces(s.4[1], i, "second", f1)?;
+    topo.end_faces(s.ends[0], i, "first", f0)?;
+    topo.end_faces(s.ends[1], i, "second", f1)?;
     let mut both = Faces::default();
     for &f in f0.iter().filter(|f| f1.contains(f)) {
         if !both.push(f) {
@@ -267,7 +267,7 @@ impl Plan {
         let mut segs = Vec::with_capacity(segments.len());
         let (mut f0, mut f1) = (Vec::new(), Vec::new());
         for (i, s) in segments.iter().enumerate() {
-            if !s.0.iter().chain(&s.1).all(|c| c.is_finite()) {
+            if !s.a.iter().chain(&s.b).all(|c| c.is_finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "visibility: segment {i} has a non-finite end"
                 )));
@@ -278,14 +278,14 @@ impl Plan {
                     let p = faces[f as usize].map(|v| positions[v as usize]);
                     (norm(sub(p[1], p[0])) + norm(sub(p[2], p[1])) + norm(sub(p[0], p[2]))) / 3.0
                 }
-                None => norm(sub(s.1, s.0)),
+                None => norm(sub(s.b, s.a)),
             };
             let edge = if edge > 0.0 { edge } else { 1e-3 * diag };
             segs.push(SegPlan {
-                a: s.0,
-                b: s.1,
+                a: s.a,
+                b: s.b,
                 exclude,
-                intervals: intervals(view, opts.spacing, diag, s.0, s.1).max(grazing_intervals(s)),
+                intervals: intervals(view, opts.spacing, diag, s.a, s.b).max(grazing_intervals(s)),
                 offset: opts.contour_offset * edge,
                 end_ids: [0; 2],
             });
@@ -421,13 +421,13 @@ impl Plan {
 /// where a short segment can be hidden in its middle behind the fold it
 /// bounds while both its ends are seen; 1 for the others.
 fn grazing_intervals(s: &Segment) -> usize {
-    if s.2 <= 1 { 2 } else { 1 }
+    if s.family <= 1 { 2 } else { 1 }
 }
 
 /// The key of a segment's end `e` where other ends may meet it: its mesh
 /// edge or vertex; `None` for an end inside a face.
 fn end_key(s: &Segment, e: usize) -> Option<u64> {
-    let [u, v] = s.4[e];
+    let [u, v] = s.ends[e];
     if u == LINE_FREE || u == u32::MAX {
         return None;
     }
@@ -494,7 +494,7 @@ fn shared_ends(
                 keyed[*at as usize] = KeyedEnd {
                     key,
                     at: (2 * i + e) as u32,
-                    family: s.2,
+                    family: s.family,
                     p: if e == 0 { sp.a } else { sp.b },
                     offset: sp.offset,
                     exclude: sp.exclude,

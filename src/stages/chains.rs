@@ -73,8 +73,8 @@ pub fn point_key(p: [f32; 3], scale: f32) -> EndKey {
 /// edge or vertex it lies on, or for an end inside a face its
 /// [`point_key`] at the scene size `scale`.
 pub fn end_key(s: &Segment, e: usize, scale: f32) -> EndKey {
-    let [u, v] = s.4[e];
-    let p = if e == 0 { s.0 } else { s.1 };
+    let [u, v] = s.ends[e];
+    let p = if e == 0 { s.a } else { s.b };
     if u == LINE_FREE || u == u32::MAX {
         point_key(p, scale)
     } else if u == v {
@@ -100,7 +100,7 @@ pub fn chain_pieces(segments: &[Segment], pieces: &[Pieces], scale: f32) -> Vec<
         };
         for &(t0, t1, visible) in ps {
             out.push(ChainPiece {
-                layer: s.2,
+                layer: s.family,
                 visible,
                 seg: i as u32,
                 t: [t0, t1],

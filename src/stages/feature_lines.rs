@@ -338,8 +338,8 @@ impl LineExtractor {
             })
         };
         for s in &mut segs {
-            s.0 = world(s.0);
-            s.1 = world(s.1);
+            s.a = world(s.a);
+            s.b = world(s.b);
         }
         Ok((segs, stats))
     }
@@ -491,7 +491,7 @@ impl LineExtractor {
             .chunks_exact(8)
             .zip(ends.chunks_exact(4))
             .map(|(s, e)| {
-                (
+                Segment::new(
                     [s[0], s[1], s[2]],
                     [s[3], s[4], s[5]],
                     s[6] as u32,

@@ -379,7 +379,7 @@ impl CurveStage {
             .chunks_exact(8)
             .zip(ends.chunks_exact(4))
             .map(|(s, e)| {
-                (
+                Segment::new(
                     [s[0], s[1], s[2]],
                     [s[3], s[4], s[5]],
                     s[6] as u32,

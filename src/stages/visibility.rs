@@ -100,7 +100,7 @@ pub fn spatial_order(segments: &[Segment]) -> Vec<usize> {
     if segments.len() > u32::MAX as usize {
         return (0..segments.len()).collect();
     }
-    let mid = |s: &Segment| -> [f32; 3] { std::array::from_fn(|k| 0.5 * s.0[k] + 0.5 * s.1[k]) };
+    let mid = |s: &Segment| -> [f32; 3] { std::array::from_fn(|k| 0.5 * s.a[k] + 0.5 * s.b[k]) };
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for m in segments.iter().map(mid) {
         for k in 0..3 {

@@ -404,7 +404,7 @@ impl ViewsRun<'_> {
             doc: json!({
                 "index": v.view,
                 "camera": manifest::camera_doc(&v.camera),
-                "segments": v.segments.iter().filter(|s| s.3 > 0.0).count(),
+                "segments": v.segments.iter().filter(|s| s.strength > 0.0).count(),
                 "files": listed,
             }),
         };

@@ -193,8 +193,10 @@ fn draw_line_families(renderer: &mut Renderer, fx: &Effects, segments: &[Segment
             }
             let pts: Vec<[f32; 3]> = segments
                 .iter()
-                .filter(|s| s.2 == kind && shown(s) && (!faded || strength_bin(s.3) == bi))
-                .flat_map(|s| [s.0, s.1])
+                .filter(|s| {
+                    s.family == kind && shown(s) && (!faded || strength_bin(s.strength) == bi)
+                })
+                .flat_map(|s| [s.a, s.b])
                 .collect();
             if pts.is_empty() {
                 continue;
@@ -219,7 +221,7 @@ fn draw_edges_and_strokes(
     let fx = &scene.effects;
     if !lines.intersections.is_empty() {
         let pts: Vec<[f32; 3]> = (lines.intersections.iter())
-            .flat_map(|s| [s.0, s.1])
+            .flat_map(|s| [s.a, s.b])
             .collect();
         let [r, g, b] = fx.intersection.1;
         renderer.draw_lines(&pts, [r, g, b, 1.0], fx.intersection.0)?;
@@ -301,7 +303,7 @@ fn family_layers(
     let kind = st.family as u32;
     let (w, h) = (image.width, image.height);
     let ours: Vec<Segment> = (segments.iter())
-        .filter(|s| s.2 == kind && shown(s))
+        .filter(|s| s.family == kind && shown(s))
         .copied()
         .collect();
     if st.hidden != Hidden::Remove {
@@ -311,7 +313,7 @@ fn family_layers(
         let hidden = (ours.iter())
             .filter_map(|s| {
                 Some(SvgPolyline {
-                    points: vec![pixel(vp, s.0, w, h)?, pixel(vp, s.1, w, h)?],
+                    points: vec![pixel(vp, s.a, w, h)?, pixel(vp, s.b, w, h)?],
                     opacity,
                 })
             })

@@ -43,7 +43,13 @@ pub(super) fn stroke_segments(strokes: &[Stroke], view: &View, lift: f32) -> Vec
     for st in strokes {
         let pts: Vec<[f32; 3]> = st.points.iter().map(towards).collect();
         for w in pts.windows(2) {
-            out.push((w[0], w[1], LAYER_STROKES, 1.0, [NO_FACE, NO_FACE]));
+            out.push(Segment::new(
+                w[0],
+                w[1],
+                LAYER_STROKES,
+                1.0,
+                [NO_FACE, NO_FACE],
+            ));
         }
     }
     out
@@ -52,7 +58,7 @@ pub(super) fn stroke_segments(strokes: &[Stroke], view: &View, lift: f32) -> Vec
 /// Whether a segment is drawn at all: one of no strength (faded out, or a
 /// non-finite test) is not, in the image nor in the SVG.
 pub(super) fn shown(s: &Segment) -> bool {
-    s.3 > 0.0
+    s.strength > 0.0
 }
 
 /// Every line family a scene draws, in drawing order (contours, suggestive
@@ -121,7 +127,7 @@ impl VisibleLines {
     /// The point at `t` of segment `seg`.
     pub fn point(&self, seg: u32, t: f32) -> [f32; 3] {
         let s = &self.segments[seg as usize];
-        std::array::from_fn(|k| s.0[k] + t * (s.1[k] - s.0[k]))
+        std::array::from_fn(|k| s.a[k] + t * (s.b[k] - s.a[k]))
     }
 
     /// The points of a chain, in walking order.
@@ -165,7 +171,11 @@ impl VisibleLines {
         };
         VisibleLines {
             segments: (self.segments.iter())
-                .map(|s| (mv(s.0), mv(s.1), s.2, s.3, s.4))
+                .map(|s| Segment {
+                    a: mv(s.a),
+                    b: mv(s.b),
+                    ..*s
+                })
                 .collect(),
             ..self.clone()
         }
@@ -184,7 +194,7 @@ pub(super) fn gather(
 ) -> Vec<Segment> {
     let kinds: Vec<u32> = line_styles(fx).iter().map(|s| s.0.family as u32).collect();
     let mut out: Vec<Segment> = (segs.iter())
-        .filter(|s| kinds.contains(&s.2) && shown(s))
+        .filter(|s| kinds.contains(&s.family) && shown(s))
         .copied()
         .collect();
     if let Some((eo, pairs)) = edges {
@@ -194,7 +204,13 @@ pub(super) fn gather(
             }
             let [a, b] = *pair;
             let (pa, pb) = (positions[a as usize], positions[b as usize]);
-            out.push((pa, pb, LAYER_FEATURE_EDGES, 1.0, [[a, a], [b, b]]));
+            out.push(Segment::new(
+                pa,
+                pb,
+                LAYER_FEATURE_EDGES,
+                1.0,
+                [[a, a], [b, b]],
+            ));
         }
     }
     out
@@ -313,7 +329,7 @@ fn family_layer(
         let sum: f32 = (c.pieces.iter())
             .map(|&(i, _)| {
                 let seg = vis.chain_pieces[i as usize].seg;
-                vis.segments[seg as usize].3.clamp(0.0, 1.0)
+                vis.segments[seg as usize].strength.clamp(0.0, 1.0)
             })
             .sum();
         sum / c.pieces.len().max(1) as f32

@@ -20,7 +20,7 @@ fn quad() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, View) {
 fn a_segment_lies_on_the_faces_both_ends_name() {
     let (p, f, view) = quad();
     let opts = VisibilityOptions::default();
-    let s = |e0: [u32; 2], e1: [u32; 2]| ([0.2; 3], [0.4; 3], 0, 1.0, [e0, e1]);
+    let s = |e0: [u32; 2], e1: [u32; 2]| Segment::new([0.2; 3], [0.4; 3], 0, 1.0, [e0, e1]);
     let segs = [
         s([0, 1], [1, 2]),         // face 0 only
         s([1, 2], [1, 2]),         // along the shared edge: both
@@ -42,10 +42,10 @@ fn rounds_place_the_split_by_bisection_and_merge_equal_neighbours() {
         bisect: 12,
         contour_offset: 0.0,
     };
-    let seg = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0, 1.0, [[0, 0], [1, 1]]);
+    let seg = Segment::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0, 1.0, [[0, 0], [1, 1]]);
     // The same line with ends of its own (ends at one vertex share
     // their sample: see the next test).
-    let other = (seg.0, seg.1, 0, 1.0, [[2, 2], [3, 3]]);
+    let other = Segment::new(seg.a, seg.b, 0, 1.0, [[2, 2], [3, 3]]);
     let plan = Plan::new(&p, &f, &[seg, other], &view, &opts).unwrap();
     let mut rounds = 0;
     let got = classify_by(&plan, |casts| {
@@ -72,15 +72,15 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
     };
     // Two ridges (one interval each) crossing edge (1, 2) from faces 0 and
     // 1, meeting there (their crossings differ by rounding), and a third.
-    let a = ([0.1, 0.1, 0.0], [0.5, 0.5, 0.0], 2, 1.0, [[0, 1], [1, 2]]);
-    let b = (
+    let a = Segment::new([0.1, 0.1, 0.0], [0.5, 0.5, 0.0], 2, 1.0, [[0, 1], [1, 2]]);
+    let b = Segment::new(
         [0.5000001, 0.5, 0.0],
         [0.9, 0.9, 0.0],
         2,
         1.0,
         [[2, 1], [1, 3]],
     );
-    let c = (
+    let c = Segment::new(
         [0.2, 0.0, 0.0],
         [0.3, 0.0, 0.0],
         2,
@@ -92,7 +92,7 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
     assert_eq!(plan.ends.len(), 5);
     let shared = &plan.ends[plan.segs[0].end_ids[1] as usize];
     // The least point (by its bits), both faces left out.
-    assert_eq!(shared.p, a.1);
+    assert_eq!(shared.p, a.b);
     assert_eq!(shared.exclude.to_vec(), vec![0, 1]);
     let mut casts = Vec::new();
     classify_by(&plan, |c| {
@@ -105,7 +105,7 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
     let q = plan.query((1, 0.0)).unwrap();
     assert_eq!(q, plan.query((0, 1.0)).unwrap());
     // A contour (kind 0) as short gets two intervals: a sample inside.
-    let contour = (a.0, a.1, 0, 1.0, a.4);
+    let contour = Segment::new(a.a, a.b, 0, 1.0, a.ends);
     let plan = Plan::new(&p, &f, &[contour], &view, &opts).unwrap();
     assert_eq!(plan.segs[0].intervals, 2);
 }

@@ -335,14 +335,14 @@ impl Executor<'_, '_> {
     fn count_segments(&mut self) {
         for (k, n) in self.run.segments.iter_mut().enumerate() {
             *n += (self.view.segs.iter())
-                .filter(|s| s.2 == k as u32 && draw::shown(s))
+                .filter(|s| s.family == k as u32 && draw::shown(s))
                 .count();
         }
         let fx = &self.scene.effects;
         for st in &fx.lines.styles_for(&fx.cues) {
             let kind = st.family as u32;
             let n = (self.view.segs.iter())
-                .filter(|s| s.2 == kind && draw::shown(s))
+                .filter(|s| s.family == kind && draw::shown(s))
                 .count();
             *self.run.line_segments.entry(st.family.name()).or_default() += n;
         }
@@ -387,7 +387,11 @@ impl Executor<'_, '_> {
                 ..*cam
             },
             segments: (self.view.segs.iter())
-                .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
+                .map(|s| crate::spec::feature_lines::Segment {
+                    a: world(s.a),
+                    b: world(s.b),
+                    ..*s
+                })
                 .collect(),
             visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
             fields: self.view.fields.take(),
@@ -421,7 +425,11 @@ impl Executor<'_, '_> {
             visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
             fields: self.view.fields.take(),
             segments: (self.view.segs.iter())
-                .map(|s| (world(s.0), world(s.1), s.2, s.3, s.4))
+                .map(|s| crate::spec::feature_lines::Segment {
+                    a: world(s.a),
+                    b: world(s.b),
+                    ..*s
+                })
                 .collect(),
             edges: self.view.edges_ran.as_ref().map(|e| e.1.clone()),
             strokes: self.pose.strokes.clone(),

@@ -58,7 +58,7 @@ impl Executor<'_, '_> {
         self.pose.isect_segs = (segs.iter())
             .map(|s| {
                 let ends = [[LINE_FREE, s.faces[0]], [LINE_FREE, s.faces[1]]];
-                (s.a, s.b, layer, 1.0, ends)
+                crate::spec::feature_lines::Segment::new(s.a, s.b, layer, 1.0, ends)
             })
             .collect();
         let how = format!(
