@@ -117,6 +117,32 @@ def _mesh_arrays(vertices: Any, faces: Any) -> Tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
+def _mesh(vertices: Any, faces: Any, normals: Any) -> "_shapecue._Mesh":
+    """The mesh of a call that takes ``normals``, as the library holds it: a
+    mesh file (``vertices`` a path, no ``faces``) read by the library's
+    loader, keeping its stored normals with ``normals="file"`` and dropping
+    them with ``"computed"``, as ``--normals`` on the command line; or
+    arrays (or an object with ``.vertices`` and ``.faces``) with, where
+    ``normals`` is an array, those vertex normals."""
+    if isinstance(vertices, _shapecue._Mesh) and faces is None:
+        # Held already (the batch's tasks load the file once).
+        return vertices
+    if isinstance(vertices, (str, os.PathLike)) and faces is None:
+        if not isinstance(normals, str):
+            raise ValueError(
+                "normals: with a mesh file give 'file' (the normals it stores, if any) or "
+                "'computed' (from the faces); an array of normals goes with vertices and faces"
+            )
+        return _shapecue.load_mesh(os.fspath(vertices), False, normals)
+    v, f = _mesh_arrays(vertices, faces)
+    # A name is passed on (the library checks it: arrays store no normals,
+    # so "file" and "computed" both compute them from the faces).
+    n = normals
+    if normals is not None and not isinstance(normals, str):
+        n = _as_array(normals, _VERTEX_DTYPES, np.float64, 2, "normals")
+    return _shapecue.mesh_from_arrays(v, f, n)
+
+
 def _accumulate(accumulate: str) -> str:
     # "auto": the command line's default, decided for the device by the
     # library: gather (the faster exact scheme on CPU devices and GPUs
@@ -218,6 +244,7 @@ def curvature(
     vertices: Any,
     faces: Any = None,
     *,
+    normals: Any = "file",
     accumulate: str = "auto",
     precision: str = "f32",
     compat: Optional[str] = None,
@@ -229,10 +256,22 @@ def curvature(
     curvature derivative of a triangle mesh.
 
     ``vertices`` (V, 3) and ``faces`` (F, 3) arrays, or one object with
-    ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``). Isolated vertices,
+    ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``), or a mesh file
+    (.obj/.ply/.off) read by the library's loader as ``shapecue curvature
+    FILE`` reads it. Isolated vertices,
     degenerate and duplicate faces, boundaries and non-manifold edges are
     handled (counted in the result); NaN coordinates, out-of-range indices and
     empty meshes raise :class:`ValueError`.
+
+    ``normals``: the vertex normals the curvature starts from, as the
+    command line's ``--normals``. For a file, "file" (the default: the
+    normals it stores, OBJ ``vn`` lines one per vertex or PLY ``nx ny nz``,
+    as trimesh2 and rtsc use them; from the faces where it stores none) or
+    "computed" (always from the faces). With arrays, a (V, 3) float array
+    of normals to start from (any non-zero length; a zero or non-finite
+    normal at a vertex some face uses raises :class:`ValueError` naming the
+    vertex), or "file"/"computed"/None: from the faces. The result's
+    ``normals`` are then those normals at unit length.
 
     ``accumulate``: "auto" (gather, the faster exact scheme on CPU devices
     and GPUs measured), "atomic" (Griffin et al.'s float
@@ -241,10 +280,8 @@ def curvature(
     ordering). ``reference=True`` computes with the single-threaded f64 CPU
     reference instead of the device.
     """
-    v, f = _mesh_arrays(vertices, faces)
     d = _shapecue.curvature(
-        v,
-        f,
+        _mesh(vertices, faces, normals),
         _accumulate(accumulate),
         precision,
         compat or "exact",
@@ -499,7 +536,10 @@ def render(
     ``out_dir`` (default: the scene's ``[output] dir``) and returns the
     report as a dict. Existing outputs raise :class:`ValueError` unless
     ``force``. Relative paths in a dict are relative to ``base_dir``
-    (default: the working directory)."""
+    (default: the working directory). A mesh file's stored normals are
+    used as on the command line: ``{"input": {"mesh": "m.obj", "normals":
+    "computed"}}`` (``normals = "computed"`` in the TOML) drops them; the
+    default is "file"."""
     out = None if out_dir is None else os.fspath(out_dir)
     if isinstance(scene, dict):
         anchor = os.path.join(os.fspath(base_dir or os.getcwd()), "scene.toml")
@@ -770,6 +810,7 @@ def lines(
     hermite: bool = False,
     hermite_kh: bool = False,
     feature_size: Union[str, float] = "rtsc",
+    normals: Any = "file",
     compat: str = "exact",
     accumulate: str = "auto",
     device: Union[int, str, None] = None,
@@ -824,12 +865,19 @@ def lines(
     least 1 when isophotes are drawn, as on the command line). ``compat =
     "trimesh2"`` computes the curvature as trimesh2 (and so rtsc) does.
 
-    ``vertices`` may also be a mesh file (.obj/.ply/.off), read by
-    :func:`load_mesh`.
+    ``vertices`` may also be a mesh file (.obj/.ply/.off), read by the
+    library's loader as ``shapecue lines FILE`` reads it. ``normals``: the
+    vertex normals the curvature, and so every line family, starts from, as
+    ``--normals`` on the command line: for a file "file" (the default: those
+    it stores, OBJ ``vn`` or PLY ``nx ny nz``, as rtsc uses them; from the
+    faces where it stores none) or "computed" (from the faces); with arrays
+    a (V, 3) float array of normals (checked: a zero or non-finite normal at
+    a vertex some face uses raises :class:`ValueError` naming the vertex),
+    or "file"/"computed"/None for the faces' normals. A file with ``vn``
+    lines and its arrays with those normals (``load_mesh(path,
+    return_normals=True)``) give the same rows.
     """
-    if isinstance(vertices, (str, os.PathLike)) and faces is None:
-        vertices, faces = load_mesh(vertices)
-    v, f = _mesh_arrays(vertices, faces)
+    mesh = _mesh(vertices, faces, normals)
     names = lines if isinstance(lines, str) else ",".join(lines)
     thresholds = (
         float(sc_threshold),
@@ -853,7 +901,7 @@ def lines(
         shot = _one_shot(eye, direction, target, up)
     w, h = (int(x) for x in size)
     views = _shapecue.lines_views(
-        v, f, names, text, file, n, shot, (float(fov), bool(ortho), w, h),
+        mesh, names, text, file, n, shot, (float(fov), bool(ortho), w, h),
         thresholds, levels, l3, switches, setup, bool(fields), bool(npz), _device(device),
     )
     out = [_line_view(d) for d in views]
@@ -868,12 +916,31 @@ def _line_view(d: dict) -> LineView:
     return LineView(family=_family_names(d["family_code"]), fields=fields, **d)
 
 
-def load_mesh(path: Union[str, os.PathLike], *, weld: bool = False) -> Tuple[np.ndarray, np.ndarray]:
+def load_mesh(
+    path: Union[str, os.PathLike],
+    *,
+    weld: bool = False,
+    normals: str = "file",
+    return_normals: bool = False,
+) -> Union[Tuple[np.ndarray, np.ndarray], Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]]:
     """Reads an .obj, .ply or .off mesh: ``(vertices float64 (V, 3), faces
     uint32 (F, 3))``, polygons fan-triangulated; ``weld`` merges vertices with
     bit-identical positions. Malformed files raise :class:`ValueError`
-    naming the file and the element."""
-    return _shapecue.load_mesh(os.fspath(path), bool(weld))
+    naming the file and the element.
+
+    ``return_normals=True`` returns ``(vertices, faces, normals)``:
+    ``normals`` the (V, 3) float32 vertex normals the file stores (OBJ ``vn``
+    lines, one per vertex, in order; PLY ``nx ny nz``; as trimesh2 reads
+    them, not normalized; summed over merged copies with ``weld``), or None
+    where it stores none. ``normals``: "file" (the default) keeps and checks
+    them (a zero or non-finite normal at a vertex some face uses raises
+    :class:`ValueError` naming the vertex), "computed" drops them (then
+    ``normals`` is None), as the command line's ``--normals``. Passing them
+    on, ``lines(vertices, faces, normals=normals)`` draws what
+    ``lines(path)`` draws."""
+    m = _shapecue.load_mesh(os.fspath(path), bool(weld), normals)
+    v, f, n = m.arrays()
+    return (v, f, n) if return_normals else (v, f)
 
 
 def load_volume(path: Union[str, os.PathLike]) -> Volume:

@@ -2,7 +2,7 @@
 package, whose functions check and convert their arguments and wrap the
 dicts returned here in result objects."""
 
-from typing import Any, Optional, Tuple
+from typing import Any, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -19,8 +19,7 @@ def build_kernels(
     accumulate: list[str], precision: list[str], compat: list[str], device: str | None
 ) -> list[dict[str, Any]]: ...
 def curvature(
-    vertices: npt.NDArray[np.floating],
-    faces: npt.NDArray[np.integer],
+    mesh: _Mesh,
     accumulate: str,
     precision: str,
     compat: str,
@@ -60,8 +59,7 @@ def feature_edges(
     device: Optional[str],
 ) -> dict[str, Any]: ...
 def lines_views(
-    vertices: npt.NDArray[np.floating],
-    faces: npt.NDArray[np.integer],
+    mesh: _Mesh,
     families: str,
     cameras: Optional[str],
     camera_file: Optional[str],
@@ -100,7 +98,16 @@ def render_file(path: str, out_dir: Optional[str], force: bool, device: Optional
 def render_text(
     json: str, anchor: str, out_dir: Optional[str], force: bool, device: Optional[str]
 ) -> str: ...
-def load_mesh(path: str, weld: bool) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
+def load_mesh(path: str, weld: bool, normals: str) -> _Mesh:
+    """The file read by the library's loader; ``normals`` "file" keeps the
+    normals it stores (checked), "computed" drops them."""
+def mesh_from_arrays(
+    vertices: npt.NDArray[np.floating],
+    faces: npt.NDArray[np.integer],
+    normals: Optional[Union[str, npt.NDArray[np.floating]]],
+) -> _Mesh:
+    """A mesh of arrays, with the (V, 3) normals given (checked) or none
+    (None, "file" or "computed")."""
 def generated_mesh(name: str, vertices: int) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
     """The command line's generated meshes (torus, sphere, ellipsoid, cylinder,
     plane) at about ``vertices`` vertices, for tests that compare with it."""
@@ -130,3 +137,17 @@ class _CurvatureEstimator:
     def topology_ms(self) -> float: ...
     @property
     def device_bytes(self) -> int: ...
+
+class _Mesh:
+    """A mesh the library holds (positions, faces and stored normals, if
+    any), as ``curvature`` and ``lines_views`` take it."""
+
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def n_faces(self) -> int: ...
+    @property
+    def has_normals(self) -> bool: ...
+    def arrays(
+        self,
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], Optional[npt.NDArray[np.float32]]]: ...

@@ -26,6 +26,10 @@ Tasks:
 
 - ``"curvature"``: a mesh file (.obj/.ply/.off) to ``<stem>.npz`` with the
   arrays of :class:`shapecue.Curvature` (plus ``vertices`` and ``faces``);
+  the file is read by the library's loader (``options={"weld": True}``
+  welds it) and the curvature starts from the normals it stores, unless
+  ``options={"normals": "computed"}`` (as ``shapecue curvature
+  --normals``);
 - ``"isosurface"``: a volume file to ``<stem>.npz`` with ``vertices``,
   ``faces`` (and the curvature arrays with ``options={"curvature": True}``);
   ``options={"iso": value}`` is required;
@@ -50,7 +54,8 @@ Tasks:
   manifest lists a view's files). ``options``: ``views`` (a number of views,
   default 16) or ``cameras`` (a list of camera dicts, or a camera JSON
   file), ``fields``, and the keyword options of :func:`shapecue.lines`
-  (``lines``, ``size``, ``fov``, ``ortho``, the thresholds, ...), checked
+  (``lines``, ``size``, ``fov``, ``ortho``, the thresholds, ``normals``
+  "file" or "computed", ...), checked
   by :func:`run` before any task starts. The folder is written whole
   (made beside it, then renamed). The task's record adds the options as
   ``views.json`` lists them, ``views``, ``views_per_second`` (the views
@@ -267,6 +272,11 @@ def _lines_options(options: Optional[Dict[str, Any]]) -> Tuple[Dict[str, Any], D
     levels = shapecue._levels(merged["isophotes"])
     if "isophotes" in families and levels == 0:
         raise ValueError("the lines task: isophotes=0: isophotes need at least 1 level")
+    if not isinstance(merged["normals"], str) or merged["normals"] not in ("file", "computed"):
+        raise ValueError(
+            f"the lines task: normals={merged['normals']!r}: give 'file' (the normals the mesh "
+            f"files store, if any) or 'computed' (from the faces)"
+        )
     fov, ortho = float(merged["fov"]), bool(merged["ortho"])
     doc: Dict[str, Any] = {"views": views, "cameras": None}
     if cameras is not None:
@@ -297,12 +307,14 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
     import shutil
 
     import shapecue
+    from shapecue import _shapecue
 
     kwargs, doc_options = _lines_options(options)
     t0 = time.perf_counter()
-    v, f = shapecue.load_mesh(path)
+    # Read by the library's loader, as `shapecue lines FILE --normals ...`.
+    mesh = _shapecue.load_mesh(path, False, kwargs.pop("normals"))
     t1 = time.perf_counter()
-    views = shapecue.lines(v, f, device=device, npz=True, **kwargs)
+    views = shapecue.lines(mesh, device=device, npz=True, **kwargs)
     t2 = time.perf_counter()
     codes = sorted(shapecue.FAMILY_CODES.items())
     stem = os.path.splitext(os.path.basename(path))[0] or "mesh"
@@ -328,8 +340,8 @@ def _lines_task(path: str, out: str, device: Optional[str], options: Dict[str, A
             )
         doc = {
             "input": path,
-            "vertices": int(len(v)),
-            "faces": int(len(f)),
+            "vertices": int(mesh.n_vertices),
+            "faces": int(mesh.n_faces),
             "device": views[0].device if views else None,
             "options": doc_options,
             "family_codes": {str(c): n for c, n in codes},
@@ -365,6 +377,7 @@ def process_one(
     returns its manifest record; never raises for a failure of the input or
     the device, which is recorded as ``status: "error"``."""
     import shapecue
+    from shapecue import _shapecue
 
     options = dict(options or {})
     device = options.pop("device", None) or os.environ.get("SHAPECUE_DEVICE") or None
@@ -386,9 +399,18 @@ def process_one(
     timings = {"load_ms": 0.0, "compute_ms": 0.0, "write_ms": 0.0}
     try:
         if task == "curvature":
-            v, f = shapecue.load_mesh(path, weld=bool(options.pop("weld", False)))
+            # Read by the library's loader, the file's stored normals kept
+            # unless options={"normals": "computed"} (as --normals).
+            weld = bool(options.pop("weld", False))
+            normals = options.pop("normals", "file")
+            if not isinstance(normals, str):
+                raise ValueError(
+                    f"the curvature task: normals={normals!r}: give 'file' or 'computed'"
+                )
+            mesh = _shapecue.load_mesh(path, weld, normals)
+            v, f, _ = mesh.arrays()
             t1 = time.perf_counter()
-            c = shapecue.curvature(v, f, device=device, **options)
+            c = shapecue.curvature(mesh, device=device, **options)
             t2 = time.perf_counter()
             arrays = {"vertices": v, "faces": f, **_curvature_arrays("", c)}
             _save_npz(out, arrays)

@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use shapecue::api::CurvatureEstimator as RustEstimator;
 use shapecue::api::Gpu;
+use shapecue::mesh::NormalsSource;
 use shapecue::spec::curvature::{
     Accumulate, AccumulateChoice, Compat, Curvature, CurvatureOptions, Precision,
 };
@@ -169,6 +170,35 @@ fn read_faces(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
             "{what}: expected a 2-D int32, int64 or uint32 array of shape (F, 3)"
         )))
     }
+}
+
+/// Reads an (N, 3) array of f32 or f64 (any strides) into f32 rows, as the
+/// library holds stored normals.
+fn read_rows3f32(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f32; 3]>> {
+    if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, f32>>() {
+        let shape = a.shape();
+        if shape[1] != 3 {
+            return Err(value_err(format!(
+                "{what}: expected shape (N, 3), got ({}, {})",
+                shape[0], shape[1]
+            )));
+        }
+        if let Some(s) = c_slice(&a) {
+            return Ok(s.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());
+        }
+        return Ok(a
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1], r[2]])
+            .collect());
+    }
+    // f64 (or an error naming both dtypes), rounded to f32 as the device
+    // takes them.
+    Ok(read_rows3f(obj, what)?
+        .into_iter()
+        .map(|r| r.map(|c| c as f32))
+        .collect())
 }
 
 fn read_mesh(vertices: &Bound<'_, PyAny>, faces: &Bound<'_, PyAny>) -> PyResult<Mesh> {
@@ -352,16 +382,18 @@ fn build_kernels<'py>(
     Ok(out)
 }
 
-/// curvature(vertices, faces, accumulate, precision, compat, dcurv, device, reference) -> dict
+/// curvature(mesh, accumulate, precision, compat, dcurv, device, reference) -> dict
+///
+/// The curvature of a [`PyMesh`]; where it holds stored normals (a file's,
+/// or the array given), the curvature starts from them.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, accumulate, precision, compat, dcurv, device, reference))]
+#[pyo3(signature = (mesh, accumulate, precision, compat, dcurv, device, reference))]
 // PyO3 takes the arguments one by one (the positional signature of
 // `_shapecue.pyi`); the body only collects them into `CurvatureArgs`.
 #[allow(clippy::too_many_arguments)]
 fn curvature<'py>(
     py: Python<'py>,
-    vertices: &Bound<'py, PyAny>,
-    faces: &Bound<'py, PyAny>,
+    mesh: PyRef<'py, PyMesh>,
     accumulate: &str,
     precision: &str,
     compat: &str,
@@ -376,18 +408,17 @@ fn curvature<'py>(
         dcurv,
         device,
     };
-    curvature_with(py, (vertices, faces), args, reference)
+    curvature_with(py, mesh.mesh.clone(), args, reference)
 }
 
 /// [`curvature`] with its options collected: on the device, or with the
 /// single-threaded f64 CPU reference when `reference`.
 fn curvature_with<'py>(
     py: Python<'py>,
-    (vertices, faces): (&Bound<'py, PyAny>, &Bound<'py, PyAny>),
+    mesh: Arc<Mesh>,
     args: CurvatureArgs<'_>,
     reference: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mesh = read_mesh(vertices, faces)?;
     let opts = args.options()?;
     let device = args.device;
     let mut library_ms = 0.0;
@@ -711,23 +742,105 @@ fn isosurface_dict<'py>(
     Ok(d)
 }
 
-/// load_mesh(path, weld) -> (vertices float64 (V, 3), faces uint32 (F, 3))
+/// A mesh the library holds for the calls that take one (`curvature`,
+/// `lines_views`): loaded from a file by the library's loader, which keeps
+/// the vertex normals the file stores (as the command line loads it), or
+/// made from arrays, with the normals given, if any.
+#[pyclass(name = "_Mesh", module = "shapecue._shapecue", frozen)]
+pub(crate) struct PyMesh {
+    pub(crate) mesh: Arc<Mesh>,
+}
+
+#[pymethods]
+impl PyMesh {
+    #[getter]
+    fn n_vertices(&self) -> usize {
+        self.mesh.n_vertices()
+    }
+
+    #[getter]
+    fn n_faces(&self) -> usize {
+        self.mesh.n_faces()
+    }
+
+    /// Whether the mesh holds stored normals (a file's, or the array given).
+    #[getter]
+    fn has_normals(&self) -> bool {
+        self.mesh.normals.is_some()
+    }
+
+    /// arrays() -> (vertices float64 (V, 3), faces uint32 (F, 3), normals
+    /// float32 (V, 3) or None): copies of what the library holds.
+    fn arrays<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let m = &self.mesh;
+        let (nv, nf) = (m.n_vertices(), m.n_faces());
+        let normals = match &m.normals {
+            Some(n) => array(py, n.as_flattened().to_vec(), &[nv, 3])?,
+            None => py.None().into_bound(py),
+        };
+        Ok((
+            array(py, m.positions.as_flattened().to_vec(), &[nv, 3])?,
+            array(py, m.faces.as_flattened().to_vec(), &[nf, 3])?,
+            normals,
+        ))
+    }
+}
+
+/// load_mesh(path, weld, normals) -> _Mesh
+///
+/// The mesh file read by the library's loader, as the command line reads
+/// it: `normals` "file" keeps (and checks) the vertex normals it stores,
+/// "computed" drops them (`--normals`).
 #[pyfunction]
-#[pyo3(signature = (path, weld))]
-fn load_mesh<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-    weld: bool,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let opts = shapecue::mesh::LoadOptions { weld };
+#[pyo3(signature = (path, weld, normals))]
+fn load_mesh(py: Python<'_>, path: PathBuf, weld: bool, normals: &str) -> PyResult<PyMesh> {
+    let opts = shapecue::mesh::LoadOptions {
+        weld,
+        normals: parse::<NormalsSource>(normals)?,
+    };
     let m = py
         .detach(|| shapecue::mesh::load(Path::new(&path), &opts))
         .map_err(to_py)?;
-    let (nv, nf) = (m.n_vertices(), m.n_faces());
-    Ok((
-        array(py, m.positions.into_flattened(), &[nv, 3])?,
-        array(py, m.faces.into_flattened(), &[nf, 3])?,
-    ))
+    Ok(PyMesh { mesh: Arc::new(m) })
+}
+
+/// mesh_from_arrays(vertices, faces, normals) -> _Mesh
+///
+/// A mesh of arrays. `normals`: a (V, 3) float array of vertex normals the
+/// curvature starts from (as from a file's), checked as the loader checks
+/// a file's (`Mesh::check_normals`: a zero or non-finite normal at a vertex
+/// some face uses is refused, naming the vertex); or None, or the name
+/// "file" or "computed" (checked by the library's parser): arrays store no
+/// normals, so both compute them from the faces.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, normals))]
+fn mesh_from_arrays(
+    vertices: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    normals: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyMesh> {
+    let mut mesh = read_mesh(vertices, faces)?;
+    if let Some(name) = normals.and_then(|n| n.extract::<String>().ok()) {
+        parse::<NormalsSource>(&name)?;
+    } else if let Some(n) = normals {
+        let n = read_rows3f32(n, "normals")?;
+        if n.len() != mesh.n_vertices() {
+            return Err(value_err(format!(
+                "normals: {} rows for {} vertices: give one normal per vertex, shape ({}, 3)",
+                n.len(),
+                mesh.n_vertices(),
+                mesh.n_vertices()
+            )));
+        }
+        mesh.normals = Some(n);
+        mesh.check_normals("normals").map_err(to_py)?;
+    }
+    Ok(PyMesh {
+        mesh: Arc::new(mesh),
+    })
 }
 
 /// generated_mesh(name, vertices) -> (vertices float64 (V, 3), faces uint32 (F, 3))
@@ -782,8 +895,10 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lines::family_codes, m)?)?;
     m.add("MAX_VIEWS", shapecue::api::MAX_VIEWS)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_from_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(load_volume, m)?)?;
     m.add_function(wrap_pyfunction!(generated_mesh, m)?)?;
     m.add_class::<PyEstimator>()?;
+    m.add_class::<PyMesh>()?;
     Ok(())
 }

@@ -78,12 +78,14 @@ impl LinesArgs<'_> {
     }
 }
 
-/// lines_views(vertices, faces, families, cameras, camera_file, views,
-/// shot, camera, thresholds, isophotes, light, switches, setup, fields,
-/// npz, device) -> list of dicts
+/// lines_views(mesh, families, cameras, camera_file, views, shot, camera,
+/// thresholds, isophotes, light, switches, setup, fields, npz, device) ->
+/// list of dicts
 ///
 /// The lines of one view or many in one setup (the pose passes once, the
 /// view passes per view), each split by exact visibility and chained. The
+/// mesh is a [`PyMesh`]: where it holds stored normals (a file's, or the
+/// array given), the curvature and so every family start from them. The
 /// cameras, one of four: `cameras`, the JSON text of a camera list
 /// (`{"cameras": [...]}`, errors name `cameras` and the camera);
 /// `camera_file`, a camera file read as the command line reads it (errors
@@ -105,12 +107,11 @@ impl LinesArgs<'_> {
 /// (`KeyboardInterrupt`) ends the run, so a call of many views stops within
 /// one view's time instead of at its end.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, families, cameras, camera_file, views, shot, camera, thresholds, isophotes, light, switches, setup, fields, npz, device))]
+#[pyo3(signature = (mesh, families, cameras, camera_file, views, shot, camera, thresholds, isophotes, light, switches, setup, fields, npz, device))]
 #[allow(clippy::too_many_arguments)]
 pub fn lines_views<'py>(
     py: Python<'py>,
-    vertices: &Bound<'py, PyAny>,
-    faces: &Bound<'py, PyAny>,
+    mesh: PyRef<'py, PyMesh>,
     families: &str,
     cameras: Option<String>,
     camera_file: Option<PathBuf>,
@@ -134,7 +135,7 @@ pub fn lines_views<'py>(
         switches,
         setup,
     };
-    let mesh = Arc::new(read_mesh(vertices, faces)?);
+    let mesh = mesh.mesh.clone();
     let (fov, ortho, ..) = camera;
     let (opts, one) = views_options(&args, shot, camera)?;
     let specs = camera_specs(
