@@ -7,8 +7,6 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use glam::{Vec3, Vec4};
-
 use crate::error::Result;
 use crate::render::Camera;
 use crate::spec::sdf_lines::Stroke;
@@ -22,13 +20,7 @@ pub fn svg_string(strokes: &[Stroke], camera: &Camera, size: [u32; 2], color: &s
     let [w, h] = size;
     let vp = camera.view_proj(w as f32 / h.max(1) as f32);
     let px = |p: [f64; 3]| -> Option<(f32, f32)> {
-        let c = vp * Vec4::from((Vec3::from_array(p.map(|c| c as f32)), 1.0));
-        (c.w > 0.0).then(|| {
-            (
-                (c.x / c.w * 0.5 + 0.5) * w as f32,
-                (0.5 - c.y / c.w * 0.5) * h as f32,
-            )
-        })
+        crate::spec::view::project_to_pixel(vp, p.map(|c| c as f32), w, h).map(|[x, y]| (x, y))
     };
     let mut s = String::new();
     let _ = writeln!(

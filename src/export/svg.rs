@@ -122,17 +122,6 @@ pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
     s
 }
 
-/// `p` in image pixels of a `w` × `h` image (origin top left) through
-/// `view_proj`, or `None` behind the eye.
-pub fn pixel(view_proj: glam::Mat4, p: [f32; 3], w: u32, h: u32) -> Option<[f32; 2]> {
-    let c = view_proj * glam::Vec4::new(p[0], p[1], p[2], 1.0);
-    if c.w.is_nan() || c.w <= 0.0 {
-        return None;
-    }
-    let (x, y) = (c.x / c.w, c.y / c.w);
-    Some([0.5 * (x + 1.0) * w as f32, 0.5 * (1.0 - y) * h as f32])
-}
-
 /// Writes [`svg_layers_text`] to `path` (whole or not at all).
 pub fn write_svg_layers(path: &Path, layers: &[SvgLayer], width: u32, height: u32) -> Result<()> {
     super::output::write_bytes_atomic(path, svg_layers_text(layers, width, height).as_bytes())

@@ -164,12 +164,7 @@ pub fn visible_joined(lines: &[ClipLine], frame: &Frame, bias: f32) -> Vec<SvgPo
 
 /// A clip-space point in image pixels (origin top left), with its window depth.
 fn to_px(c: [f32; 4], frame: &Frame) -> [f32; 3] {
-    let (w, h) = (frame.width as f32, frame.height as f32);
-    [
-        (c[0] / c[3] * 0.5 + 0.5) * w,
-        (0.5 - c[1] / c[3] * 0.5) * h,
-        c[2] / c[3] * 0.5 + 0.5,
-    ]
+    crate::spec::view::clip_to_pixel(c, frame.width, frame.height)
 }
 
 /// Whether the pixel point `p` (with its depth) lies in the image and is not

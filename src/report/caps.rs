@@ -145,12 +145,11 @@ pub fn ideal_coverage(
 ) -> Vec<bool> {
     let (w, h) = (width as usize, height as usize);
     let mut cov = vec![false; w * h];
+    // The midpoint of a and b in clip space, over a's w (the edge's end).
     let px = |a: [f32; 4], b: [f32; 4]| {
-        let (x, y, cw) = (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), a[3]);
-        [
-            (x / cw * 0.5 + 0.5) * w as f32,
-            (0.5 - y / cw * 0.5) * h as f32,
-        ]
+        let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.0, a[3]];
+        let [x, y, _] = crate::spec::view::clip_to_pixel(mid, width, height);
+        [x, y]
     };
     for q in edge_out.chunks_exact(4) {
         if q[0][0].is_nan() || !q.iter().flatten().all(|c| c.is_finite()) {

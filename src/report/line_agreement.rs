@@ -179,7 +179,8 @@ pub fn depth_share_in(frame: &Frame, cam: &Camera, segs: &[Segment], reference: 
     let vp = cam.view_proj(w / h);
     let px = |q: [f32; 3]| {
         let c = vp * Vec4::new(q[0], q[1], q[2], 1.0);
-        [(c.x / c.w * 0.5 + 0.5) * w, (0.5 - c.y / c.w * 0.5) * h]
+        let [x, y, _] = crate::spec::view::clip_to_pixel(c.to_array(), frame.width, frame.height);
+        [x, y]
     };
     let (mut same, mut total) = (0.0, 0.0);
     for (s, refp) in segs.iter().zip(reference) {

@@ -117,3 +117,27 @@ impl View {
         Ok(())
     }
 }
+
+/// The one projection to pixels: a clip-space point `(x, y, z, w)` in the
+/// pixels of a `width` × `height` image (origin top left, y down), with its
+/// window depth in [0, 1] (OpenGL's depth range). `w` must be positive
+/// ([`project_to_pixel`] checks it).
+pub fn clip_to_pixel(c: [f32; 4], width: u32, height: u32) -> [f32; 3] {
+    let (x, y, z) = (c[0] / c[3], c[1] / c[3], c[2] / c[3]);
+    [
+        0.5 * (x + 1.0) * width as f32,
+        0.5 * (1.0 - y) * height as f32,
+        0.5 * (z + 1.0),
+    ]
+}
+
+/// World point `p` in the pixels of a `width` × `height` image seen through
+/// `view_proj` ([`clip_to_pixel`]), or `None` behind the eye.
+pub fn project_to_pixel(view_proj: Mat4, p: [f32; 3], width: u32, height: u32) -> Option<[f32; 2]> {
+    let c = view_proj * glam::Vec4::new(p[0], p[1], p[2], 1.0);
+    if c.w.is_nan() || c.w <= 0.0 {
+        return None;
+    }
+    let [x, y, _] = clip_to_pixel(c.to_array(), width, height);
+    Some([x, y])
+}

@@ -6,9 +6,7 @@ use super::interop::SharedEdges;
 use super::vector::{LAYER_INTERSECTIONS, LAYER_STROKES, other_groups, stroke_segments};
 pub(super) use super::vector::{line_styles, shown};
 use crate::error::Result;
-use crate::export::svg::{
-    DEFAULT_BIAS, SvgLayer, SvgPolyline, pixel, segment_lines, visible_joined,
-};
+use crate::export::svg::{DEFAULT_BIAS, SvgLayer, SvgPolyline, segment_lines, visible_joined};
 use crate::render::colormap::{curvature_color, with_ao};
 use crate::render::edges::draw_edges;
 use crate::render::{Camera, Frame, MeshStyle, Placement, Renderer, framed};
@@ -19,6 +17,7 @@ use crate::spec::feature_lines::{Hidden, Segment, hidden_id};
 use crate::spec::interop::{InteropDecision, InteropOffer};
 use crate::spec::sdf_lines::{SdfLinesOutput, Stroke};
 use crate::spec::timing::Timing;
+use crate::spec::view::project_to_pixel as pixel;
 use crate::stages::edges::SharedDrawn;
 use std::path::PathBuf;
 

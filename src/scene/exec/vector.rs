@@ -7,7 +7,7 @@
 //! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
 
 use crate::error::Result;
-use crate::export::svg::{SvgLayer, SvgPolyline, pixel};
+use crate::export::svg::{SvgLayer, SvgPolyline};
 use crate::render::Camera;
 use crate::scene::file::{Effects, LineStyle, Scene};
 use crate::scene::planner::Cue;
@@ -15,6 +15,7 @@ use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
 use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
+use crate::spec::view::project_to_pixel as pixel;
 use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
 use crate::spec::visibility_plan::Plan as VisPlan;
 use crate::stages::bvh::Bvh;
