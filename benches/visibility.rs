@@ -9,7 +9,7 @@
 //! time:
 //! - `visibility/classify/bunny`: `stages::visibility::classify` (order,
 //!   plan, the sample round and the bisection rounds, transfers);
-//! - `visibility/plan/bunny`: `spec::visibility_plan::Plan::new` alone (the
+//! - `visibility/plan/bunny`: `spec::visibility_plan::RayPlan::new` alone (the
 //!   segments in Morton order, as `classify` takes them);
 //! - `visibility/chains/bunny`: `stages::chains::chain` over the classified
 //!   pieces (keyed by `stages::chains::chain_pieces`, as the vector drawing
@@ -27,7 +27,7 @@ use shapecue::render::Camera;
 use shapecue::spec::curvature::CurvatureOptions;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use shapecue::spec::visibility::VisibilityOptions;
-use shapecue::spec::visibility_plan::Plan;
+use shapecue::spec::visibility_plan::RayPlan;
 use shapecue::stages::bvh::Bvh;
 use shapecue::stages::chains::{chain, chain_pieces};
 use shapecue::stages::curvature::CurvatureEstimator;
@@ -97,7 +97,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     g.bench_function("plan/bunny", |b| {
-        b.iter(|| Plan::new(&p, &m.faces, black_box(&sorted), &view, &vopts).expect("plan"))
+        b.iter(|| RayPlan::new(&p, &m.faces, black_box(&sorted), &view, &vopts).expect("plan"))
     });
     g.bench_function("chains/bunny", |b| b.iter(|| chain(black_box(&cps))));
     g.finish();

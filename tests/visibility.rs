@@ -2,7 +2,7 @@
 //! the device's pieces equal the CPU twin's bit for bit; both agree with
 //! the f64 brute-force reference on nearly all of the line length (torus,
 //! sphere and spot, perspective and orthographic views, contours and
-//! suggestive contours); the depth-buffer method of `render::visibility`
+//! suggestive contours); the depth-buffer method of `render::depth_visibility`
 //! is measured against the same reference (skipped, with a message,
 //! without headless GL). Hard cases: a segment behind another object, the
 //! silhouette of a convex mesh, segments behind the eye, zero-length
@@ -21,7 +21,7 @@ use shapecue::render::Camera;
 use shapecue::spec::feature_lines::{LINE_FREE, Segment};
 use shapecue::spec::view::View;
 use shapecue::spec::visibility::{Pieces, Spacing, VisibilityOptions};
-use shapecue::spec::visibility_plan::Plan;
+use shapecue::spec::visibility_plan::RayPlan;
 use shapecue::stages::bvh::Bvh;
 use shapecue::stages::visibility::{classify, spatial_order};
 use visibility_support::*;
@@ -59,7 +59,7 @@ fn all_three(
     assert_eq!(overflows, 0);
     let tree = Tree::new("test mesh", &p, &m.faces).unwrap();
     let t0 = Instant::now();
-    let plan = Plan::new(&p, &m.faces, segs, view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &m.faces, segs, view, &opts).unwrap();
     let twin = classify_twin(&tree, &p, &m.faces, &plan).unwrap();
     let twin_ms = t0.elapsed().as_secs_f64() * 1e3;
     let reference = classify_reference(&m.positions, &m.faces, &plan).unwrap();
@@ -73,7 +73,7 @@ fn fine_reference(m: &Mesh, segs: &[Segment], view: &View) -> Vec<Pieces> {
         spacing: Spacing::View(0.0005),
         ..Default::default()
     };
-    let plan = Plan::new(&f32s(m), &m.faces, segs, view, &opts).unwrap();
+    let plan = RayPlan::new(&f32s(m), &m.faces, segs, view, &opts).unwrap();
     classify_reference(&m.positions, &m.faces, &plan).unwrap()
 }
 

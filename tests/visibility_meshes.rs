@@ -39,7 +39,7 @@ use shapecue::mesh::Mesh;
 use shapecue::render::Camera;
 use shapecue::report::line_agreement::{pick, reference_subset};
 use shapecue::spec::bvh::{BvhQuery, LEAF};
-use shapecue::spec::visibility_plan::{Plan, classify_by};
+use shapecue::spec::visibility_plan::{RayPlan, classify_by};
 use shapecue::spec::visibility_plan::{hidden_from, queries_of};
 // The views and the families (the bunny: every family) of the report.
 use shapecue::report::visibility::{MeshLines, NAMED, VIEWS, middle_frame};
@@ -82,7 +82,7 @@ impl Lines {
 
 /// Every k-th segment (k ≥ 1), k the least that keeps the reference's
 /// ray–face tests of the subset within [`REFERENCE_BUDGET`].
-fn subset(plan: &Plan, n_faces: usize) -> Vec<usize> {
+fn subset(plan: &RayPlan, n_faces: usize) -> Vec<usize> {
     reference_subset(plan, n_faces, REFERENCE_BUDGET)
 }
 
@@ -116,7 +116,7 @@ fn device(m: &Mesh, bvh: &mut Bvh, segs: &[Segment], cam: &Camera) -> (Vec<Piece
 fn measure(m: &Mesh, tree: &Tree, segs: &[Segment], dev: &[Pieces], cam: &Camera) -> Measured {
     let view = cam.view(W, H);
     let (p, opts) = (f32s(m), VisibilityOptions::default());
-    let plan = Plan::new(&p, &m.faces, segs, &view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &m.faces, segs, &view, &opts).unwrap();
     let twin = classify_twin(tree, &p, &m.faces, &plan).unwrap();
     assert!(dev == twin, "device vs twin differ");
     let at = subset(&plan, m.faces.len());
@@ -146,7 +146,7 @@ fn profile(bvh: &mut Bvh, tree: &Tree, m: &Mesh, segs: &[Segment], dev: &[Pieces
     let sorted: Vec<Segment> = order.iter().map(|&i| segs[i]).collect();
     let order_ms = ms(t0);
     let t0 = Instant::now();
-    let plan = Plan::new(&p, &m.faces, &sorted, &cam.view(W, H), &opts).unwrap();
+    let plan = RayPlan::new(&p, &m.faces, &sorted, &cam.view(W, H), &opts).unwrap();
     let plan_ms = ms(t0);
     // Per round: casts, host ms, occluded wall ms, kernel ms.
     let mut rounds: Vec<[f64; 4]> = Vec::new();

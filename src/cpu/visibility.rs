@@ -8,7 +8,7 @@
 use crate::cpu::bvh::{Tree, occluded_brute};
 use crate::error::{Error, Result};
 use crate::spec::visibility::Pieces;
-use crate::spec::visibility_plan::{Plan, classify_by, hidden_from, queries_of};
+use crate::spec::visibility_plan::{RayPlan, classify_by, hidden_from, queries_of};
 
 /// The twin: [`classify_by`] with [`Tree::occluded`] (f32, the device's
 /// arithmetic) over the tree of `positions` (an error where the tree holds
@@ -17,7 +17,7 @@ pub fn classify_twin(
     tree: &Tree,
     positions: &[[f32; 3]],
     faces: &[[u32; 3]],
-    plan: &Plan,
+    plan: &RayPlan,
 ) -> Result<Vec<Pieces>> {
     if tree.faces_sorted.len() != faces.len() {
         return Err(Error::InvalidArgument(format!(
@@ -42,7 +42,7 @@ pub fn classify_twin(
 pub fn classify_reference(
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
-    plan: &Plan,
+    plan: &RayPlan,
 ) -> Result<Vec<Pieces>> {
     crate::spec::bvh::check_faces("visibility reference mesh", positions.len(), faces)?;
     classify_by(plan, |casts| {

@@ -3,14 +3,14 @@
 //! `shapecue lines`, one SVG group per cue or family (its own
 //! id, class, colour and stroke width, so that users can restyle each cue).
 //! Which parts of the lines are visible, joined into polylines, the renderer
-//! finds against its depth buffer ([`crate::render::visibility`], whose items
+//! finds against its depth buffer ([`crate::render::depth_visibility`], whose items
 //! are re-exported here).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::Result;
-pub use crate::render::visibility::{
+pub use crate::render::depth_visibility::{
     ClipLine, DEFAULT_BIAS, SvgPolyline, edge_out_lines, segment_lines, visible_joined,
 };
 

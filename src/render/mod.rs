@@ -34,12 +34,13 @@
 //! shaded meshes), `draw_clip.rs` (clip-space quads, triangles and lines),
 //! `readback.rs` (resolve and read-back into a [`Frame`]); `edges.rs` and
 //! `strokes.rs` draw those cues; `camera.rs`, `lines.rs`, `colormap.rs` and
-//! `visibility.rs` (which parts of a line the depth buffer shows) are plain
+//! `depth_visibility.rs` (which parts of a line the depth buffer shows) are plain
 //! arithmetic on the CPU.
 
 mod camera;
 pub mod colormap;
 mod context;
+pub mod depth_visibility;
 mod draw_clip;
 mod draw_mesh;
 pub mod edges;
@@ -51,7 +52,6 @@ mod readback;
 mod state;
 pub mod strokes;
 mod targets;
-pub mod visibility;
 
 pub use camera::{Camera, Placement, fit_sphere, framed};
 pub use frame::Frame;

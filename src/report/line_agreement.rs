@@ -3,7 +3,7 @@
 //! (`tests/visibility*.rs`), one implementation for both. The exact method
 //! ([`crate::stages::visibility`]) and its f64 reference
 //! ([`crate::cpu::visibility::classify_reference`]) give pieces along each
-//! segment; the depth-buffer method ([`crate::render::visibility`]) gives
+//! segment; the depth-buffer method ([`crate::render::depth_visibility`]) gives
 //! visible polylines in pixels, read back here at 32 points per segment.
 //!
 //! The reference tests every face of the mesh per query, so on large meshes
@@ -14,11 +14,11 @@
 
 use crate::error::Result;
 use crate::mesh::{Mesh, topology::vertex_normals};
-use crate::render::visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
+use crate::render::depth_visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
 use crate::render::{Camera, Frame, MeshStyle, RenderOptions, Renderer};
 use crate::spec::feature_lines::Segment;
 use crate::spec::visibility::Pieces;
-use crate::spec::visibility_plan::Plan;
+use crate::spec::visibility_plan::RayPlan;
 use crate::spec::visibility_plan::agreement;
 use glam::{Vec3, Vec4};
 
@@ -110,7 +110,7 @@ pub fn sort_segments(segs: &mut [Segment]) {
 /// least that keeps its ray–face tests (a query per sample and bisection
 /// step, bounded by `intervals + 1` per segment, times `n_faces`) within
 /// `budget`.
-pub fn reference_subset(plan: &Plan, n_faces: usize, budget: f64) -> Vec<usize> {
+pub fn reference_subset(plan: &RayPlan, n_faces: usize, budget: f64) -> Vec<usize> {
     let casts: usize = plan.segs.iter().map(|s| s.intervals + 1).sum();
     let work = casts as f64 * n_faces as f64;
     let k = (work / budget.max(1.0)).ceil().max(1.0) as usize;

@@ -1,7 +1,7 @@
 //! `shapecue report visibility`: exact, object-space visibility of line
 //! segments ([`crate::stages::visibility`]) against its f64 brute-force
 //! reference ([`crate::cpu::visibility::classify_reference`]), with the
-//! depth-buffer method ([`crate::render::visibility`]) beside it, and what
+//! depth-buffer method ([`crate::render::depth_visibility`]) beside it, and what
 //! each costs in time per view.
 //!
 //! Per mesh (default: spot bundled with the repository, the full Stanford
@@ -28,13 +28,13 @@ use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::skinned::{SkinnedMesh, load_gltf};
 use crate::mesh::{self, Mesh, topology::vertex_normals};
-use crate::render::visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
+use crate::render::depth_visibility::{DEFAULT_BIAS, segment_lines, visible_joined};
 use crate::render::{Camera, Renderer};
 use crate::spec::curvature::CurvatureOptions;
 use crate::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
-use crate::spec::visibility_plan::Plan;
+use crate::spec::visibility_plan::RayPlan;
 use crate::stages::bvh::Bvh;
 use crate::stages::curvature::CurvatureEstimator;
 use crate::stages::feature_lines::{LineExtractor, LineOptions};
@@ -505,7 +505,7 @@ impl<'a> MeshRun<'a> {
         }
         let (dev, exact_ms, overflows) = self.exact(&segs, &view, runs)?;
         let opts = VisibilityOptions::default();
-        let plan = Plan::new(&self.p, &self.m.faces, &segs, &view, &opts)?;
+        let plan = RayPlan::new(&self.p, &self.m.faces, &segs, &view, &opts)?;
         let at = la::reference_subset(&plan, self.m.faces.len(), o.reference_tests);
         let t0 = Instant::now();
         let reference = classify_reference(&self.m.positions, &self.m.faces, &plan.subset(&at))?;

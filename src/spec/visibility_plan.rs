@@ -5,7 +5,7 @@
 //! (`cpu::visibility`): the plan of the queries and the rounds that turn
 //! their answers into pieces.
 //!
-//! [`Plan::new`] reads the segments once: the faces each one lies on (left
+//! [`RayPlan::new`] reads the segments once: the faces each one lies on (left
 //! out of its queries, at most four), its number of sampling intervals, the
 //! local edge length that scales the contour offset, and the bounding sphere
 //! that orthographic queries cross. [`classify_by`] runs the rounds (the
@@ -45,7 +45,7 @@ pub struct SegPlan {
     pub intervals: usize,
     /// Start of each query along the ray (world units).
     pub offset: f32,
-    /// Its ends' samples ([`Plan::ends`]).
+    /// Its ends' samples ([`RayPlan::ends`]).
     pub end_ids: [u32; 2],
 }
 
@@ -68,7 +68,7 @@ pub struct EndPlan {
 
 /// The segments of one view, ready to classify.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Plan {
+pub struct RayPlan {
     /// Per segment.
     pub segs: Vec<SegPlan>,
     /// The segments' end samples, shared where ends meet.
@@ -83,14 +83,14 @@ pub struct Plan {
 
 /// Faces around each vertex, in compressed rows: `around[start[v]..start[v
 /// + 1]]`, in face order, a face once per corner at the vertex.
-struct Topology<'a> {
+struct VertexFaces<'a> {
     faces: &'a [[u32; 3]],
     start: Vec<usize>,
     around: Vec<u32>,
 }
 
-impl<'a> Topology<'a> {
-    fn new(n_vertices: usize, faces: &'a [[u32; 3]]) -> Topology<'a> {
+impl<'a> VertexFaces<'a> {
+    fn new(n_vertices: usize, faces: &'a [[u32; 3]]) -> VertexFaces<'a> {
         let mut start = vec![0usize; n_vertices + 1];
         for &v in faces.iter().flatten() {
             start[v as usize + 1] += 1;
@@ -106,7 +106,7 @@ impl<'a> Topology<'a> {
                 next[v as usize] += 1;
             }
         }
-        Topology {
+        VertexFaces {
             faces,
             start,
             around,
@@ -173,7 +173,12 @@ impl<'a> Topology<'a> {
 
 /// The faces segment `s` (index `i`) lies on (at most four); `f0` and `f1`
 /// are scratch space for its ends' faces.
-fn lies_on(topo: &Topology, s: &Segment, i: usize, [f0, f1]: [&mut Vec<u32>; 2]) -> Result<Faces> {
+fn lies_on(
+    topo: &VertexFaces,
+    s: &Segment,
+    i: usize,
+    [f0, f1]: [&mut Vec<u32>; 2],
+) -> Result<Faces> {
     topo.end_faces(s.ends[0], i, "first", f0)?;
     topo.end_faces(s.ends[1], i, "second", f1)?;
     let mut both = Faces::default();
@@ -246,7 +251,7 @@ fn intervals(view: &View, spacing: Spacing, diag: f32, a: [f32; 3], b: [f32; 3])
     }
 }
 
-impl Plan {
+impl RayPlan {
     /// Reads `segments` over the mesh (`positions`, `faces`) seen in
     /// `view`. Errors, in plain words: bad options or view, a non-finite
     /// end, an end naming a vertex or face the mesh lacks.
@@ -256,12 +261,12 @@ impl Plan {
         segments: &[Segment],
         view: &View,
         opts: &VisibilityOptions,
-    ) -> Result<Plan> {
+    ) -> Result<RayPlan> {
         opts.check()?;
         view.check("visibility")?;
         crate::spec::bvh::check_faces("visibility mesh", positions.len(), faces)?;
         crate::spec::bvh::check_positions("visibility mesh", positions.len(), positions)?;
-        let topo = Topology::new(positions.len(), faces);
+        let topo = VertexFaces::new(positions.len(), faces);
         let sphere = bounding_sphere(positions);
         let diag = (2.0 * sphere.1).max(f32::MIN_POSITIVE);
         let mut segs = Vec::with_capacity(segments.len());
@@ -295,7 +300,7 @@ impl Plan {
         let reach = positions.iter().flatten().fold(0f32, |m, c| m.max(c.abs()));
         let tol = (1e-6 * diag).max(64.0 * f32::EPSILON * reach);
         let ends = shared_ends(segments, &mut segs, positions.len(), tol);
-        Ok(Plan {
+        Ok(RayPlan {
             segs,
             ends,
             view: *view,
@@ -304,11 +309,11 @@ impl Plan {
         })
     }
 
-    /// The plan of the segments `at` only (indices into [`Plan::segs`]),
+    /// The plan of the segments `at` only (indices into [`RayPlan::segs`]),
     /// their ends sampled as in the whole view (shared with segments left
     /// out): a reference over a subset answers as over every segment.
-    pub fn subset(&self, at: &[usize]) -> Plan {
-        Plan {
+    pub fn subset(&self, at: &[usize]) -> RayPlan {
+        RayPlan {
             segs: at.iter().map(|&i| self.segs[i].clone()).collect(),
             ends: self.ends.clone(),
             view: self.view,
@@ -370,7 +375,7 @@ impl Plan {
     }
 
     /// The f64 query of a cast (the reference's): the same construction as
-    /// [`Plan::query`] in f64, as its origin, target and the faces it
+    /// [`RayPlan::query`] in f64, as its origin, target and the faces it
     /// leaves out; `None` behind the eye (hidden).
     pub fn query_f64(&self, cast: Cast) -> Option<([f64; 3], [f64; 3], &[u32])> {
         let s = &self.segs[cast.0 as usize];
@@ -586,7 +591,7 @@ fn share_end(group: &[KeyedEnd], segs: &mut [SegPlan], ends: &mut Vec<EndPlan>) 
 
 /// The queries of `casts` that need one, and for each cast the index of
 /// its query (`None`: behind the eye, hidden).
-pub fn queries_of(plan: &Plan, casts: &[Cast]) -> (Vec<BvhQuery>, Vec<Option<usize>>) {
+pub fn queries_of(plan: &RayPlan, casts: &[Cast]) -> (Vec<BvhQuery>, Vec<Option<usize>>) {
     let mut qs = Vec::with_capacity(casts.len());
     let at = casts
         .iter()
@@ -612,7 +617,7 @@ pub fn hidden_from(at: &[Option<usize>], answers: &[u32]) -> Vec<bool> {
 /// The first round's casts: every segment's samples `t = k / n`, its ends
 /// sampled once per shared end ([`EndPlan`]); for each sample (segments in
 /// order, `k` in order) its cast's index; each segment's first sample.
-fn sample_casts(plan: &Plan) -> (Vec<Cast>, Vec<usize>, Vec<usize>) {
+fn sample_casts(plan: &RayPlan) -> (Vec<Cast>, Vec<usize>, Vec<usize>) {
     let mut casts = Vec::new();
     let mut slots = Vec::new();
     let mut first = Vec::with_capacity(plan.segs.len());
@@ -654,7 +659,7 @@ struct Bracket {
 /// The rounds of a classification through `cast` (one call per round: the
 /// samples, then one per bisection level), turned into pieces.
 pub fn classify_by(
-    plan: &Plan,
+    plan: &RayPlan,
     mut cast: impl FnMut(&[Cast]) -> Result<Vec<bool>>,
 ) -> Result<Vec<Pieces>> {
     let (casts, slots, first) = sample_casts(plan);
@@ -699,7 +704,7 @@ pub fn classify_by(
 }
 
 /// Pieces from the sample answers and the final brackets.
-fn pieces(plan: &Plan, first: &[usize], hidden: &[bool], brackets: &[Bracket]) -> Vec<Pieces> {
+fn pieces(plan: &RayPlan, first: &[usize], hidden: &[bool], brackets: &[Bracket]) -> Vec<Pieces> {
     let mut next = brackets.iter().peekable();
     let mut out = Vec::with_capacity(plan.segs.len());
     for (i, s) in plan.segs.iter().enumerate() {

@@ -20,7 +20,7 @@ use crate::spec::feature_lines::Segment;
 use crate::spec::timing::Timing;
 use crate::spec::view::View;
 use crate::spec::visibility::{Pieces, VisibilityOptions};
-use crate::spec::visibility_plan::{Plan, classify_by, hidden_from, queries_of};
+use crate::spec::visibility_plan::{RayPlan, classify_by, hidden_from, queries_of};
 use crate::stages::bvh::Bvh;
 
 /// The pieces of `segments` seen in `view` over the mesh (`positions`,
@@ -45,12 +45,12 @@ pub fn classify(
     }
     let order = spatial_order(segments);
     let sorted: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
-    let plan = match Plan::new(positions, faces, &sorted, view, opts) {
+    let plan = match RayPlan::new(positions, faces, &sorted, view, opts) {
         Ok(plan) => plan,
         // The error names a segment by its place in `sorted`: the caller's
         // order names it by the caller's index.
         Err(e) => {
-            return Err(Plan::new(positions, faces, segments, view, opts)
+            return Err(RayPlan::new(positions, faces, segments, view, opts)
                 .err()
                 .unwrap_or(e));
         }
@@ -74,11 +74,11 @@ pub struct Classified {
     pub timing: Timing,
 }
 
-/// [`classify`] of segments already read into a [`Plan`] (whose faces each
+/// [`classify`] of segments already read into a [`RayPlan`] (whose faces each
 /// segment lies on the caller may want too), in the plan's order (build it
 /// from segments in [`spatial_order`] for speed), over a tree of the plan's
 /// mesh.
-pub fn classify_planned(bvh: &mut Bvh, plan: &Plan) -> Result<Classified> {
+pub fn classify_planned(bvh: &mut Bvh, plan: &RayPlan) -> Result<Classified> {
     let mut c = Classified::default();
     let pieces = classify_by(plan, |casts| {
         let (qs, at) = queries_of(plan, casts);
@@ -117,7 +117,7 @@ pub fn spatial_order(segments: &[Segment]) -> Vec<usize> {
         }
     });
     // NaN and the infinities land in a cell like any other value (`as`
-    // saturates); Plan::new rejects them after.
+    // saturates); RayPlan::new rejects them after.
     let spread = |v: u64| (0..10).fold(0, |m, b| m | (((v >> b) & 1) << (3 * b)));
     let cell =
         |m: [f32; 3], k: usize| spread(((m[k] - lo[k]) * scale[k]).clamp(0.0, 1023.0) as u64);

@@ -17,7 +17,7 @@ use crate::spec::sdf_lines::Stroke;
 use crate::spec::view::View;
 use crate::spec::view::project_to_pixel as pixel;
 use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
-use crate::spec::visibility_plan::Plan as VisPlan;
+use crate::spec::visibility_plan::RayPlan;
 use crate::stages::bvh::Bvh;
 use crate::stages::chains::{Chain, ChainPiece, chain, chain_pieces};
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
@@ -234,7 +234,7 @@ pub(super) fn classify_view(
     // queries of neighbouring work-items walk the same part of the tree.
     let order = spatial_order(&segments);
     let segments: Vec<Segment> = order.iter().map(|&i| segments[i]).collect();
-    let plan = VisPlan::new(positions, faces, &segments, view, &opts)?;
+    let plan = RayPlan::new(positions, faces, &segments, view, &opts)?;
     let mut c = classify_planned(bvh, &plan)?;
     let chain_pieces = chain_pieces(&segments, &c.pieces, scale);
     let chains = chain(&chain_pieces);

@@ -28,7 +28,7 @@ fn a_segment_lies_on_the_faces_both_ends_name() {
         s([u32::MAX, 0], [1, 3]),  // face 0 and an edge of face 1: the union
         s([0, 3], [0, 3]),         // no such edge: nothing
     ];
-    let plan = Plan::new(&p, &f, &segs, &view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &f, &segs, &view, &opts).unwrap();
     let ex: Vec<Vec<u32>> = plan.segs.iter().map(|s| s.exclude.to_vec()).collect();
     assert_eq!(ex, vec![vec![0], vec![0, 1], vec![1], vec![0, 1], vec![]]);
     assert!(plan.segs.iter().all(|s| s.offset > 0.0 && s.intervals >= 1));
@@ -46,7 +46,7 @@ fn rounds_place_the_split_by_bisection_and_merge_equal_neighbours() {
     // The same line with ends of its own (ends at one vertex share
     // their sample: see the next test).
     let other = Segment::new(seg.a, seg.b, 0, 1.0, [[2, 2], [3, 3]]);
-    let plan = Plan::new(&p, &f, &[seg, other], &view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &f, &[seg, other], &view, &opts).unwrap();
     let mut rounds = 0;
     let got = classify_by(&plan, |casts| {
         rounds += 1;
@@ -87,7 +87,7 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
         1.0,
         [[LINE_FREE, 0], [LINE_FREE, 0]],
     );
-    let plan = Plan::new(&p, &f, &[a, b, c], &view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &f, &[a, b, c], &view, &opts).unwrap();
     assert_eq!(plan.segs[0].end_ids[1], plan.segs[1].end_ids[0]);
     assert_eq!(plan.ends.len(), 5);
     let shared = &plan.ends[plan.segs[0].end_ids[1] as usize];
@@ -106,7 +106,7 @@ fn ends_on_one_edge_or_vertex_share_one_sample() {
     assert_eq!(q, plan.query((0, 1.0)).unwrap());
     // A contour (kind 0) as short gets two intervals: a sample inside.
     let contour = Segment::new(a.a, a.b, 0, 1.0, a.ends);
-    let plan = Plan::new(&p, &f, &[contour], &view, &opts).unwrap();
+    let plan = RayPlan::new(&p, &f, &[contour], &view, &opts).unwrap();
     assert_eq!(plan.segs[0].intervals, 2);
 }
 

@@ -50,7 +50,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Per-topology state.
-struct Topology {
+struct TopologyState {
     mesh: Mesh,
     /// The scale of the line families' thresholds, as the scene asks for it
     /// ([`crate::mesh::feature_size::resolve`]), from the topology's first
@@ -78,10 +78,10 @@ struct Topology {
     gl: bool,
 }
 
-impl Topology {
+impl TopologyState {
     fn new(mesh: Mesh) -> Self {
         let used = crate::mesh::referenced(mesh.n_vertices(), &mesh.faces);
-        Topology {
+        TopologyState {
             feature_size: None,
             used,
             mesh,
@@ -128,7 +128,7 @@ pub(super) struct Executor<'s, 'g> {
     /// What the run fixes on its first pose and counts over all.
     pub(super) run: RunState,
     /// The current topology.
-    topo: Option<Topology>,
+    topo: Option<TopologyState>,
     /// The current pose.
     pose: PoseState,
     /// The current view.
@@ -255,7 +255,7 @@ impl<'s, 'g> Executor<'s, 'g> {
 
     /// The current topology, made from the input on the first pose (an
     /// isosurface's comes from its pass).
-    fn topology(&mut self, frame: usize) -> Result<&mut Topology> {
+    fn topology(&mut self, frame: usize) -> Result<&mut TopologyState> {
         if self.topo.is_none() {
             let mesh = match &self.loaded {
                 Loaded::Static(m, _) => m.clone(),
@@ -275,7 +275,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                     ));
                 }
             };
-            self.topo = Some(Topology::new(mesh));
+            self.topo = Some(TopologyState::new(mesh));
         }
         Ok(self.topo.as_mut().expect("made above"))
     }
@@ -567,7 +567,7 @@ impl<'s, 'g> Executor<'s, 'g> {
                 },
             ));
         }
-        self.topo = Some(Topology::new(m));
+        self.topo = Some(TopologyState::new(m));
         Ok(())
     }
 

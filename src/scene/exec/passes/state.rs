@@ -1,6 +1,6 @@
 //! The executor's state, one value per lifetime (geometry-central's way of
 //! keeping quantities): what lives for the whole run (the stages built for
-//! it, the framing and the totals), per topology ([`super::Topology`]), per
+//! it, the framing and the totals), per topology ([`super::TopologyState`]), per
 //! pose and per view. A new pose or view replaces its value whole, so
 //! nothing is reset field by field; and what a run keeps for its caller is
 //! a set of outputs the caller gives ([`Keep`]), not flags on the executor.

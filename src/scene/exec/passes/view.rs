@@ -468,7 +468,7 @@ impl Executor<'_, '_> {
         let v = cam.view(w, h);
         let origin = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         let opts = self.stages.line_opts;
-        let Topology {
+        let TopologyState {
             mesh,
             feature_size,
             est,
