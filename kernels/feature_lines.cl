@@ -93,6 +93,11 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
         float f[3];
         for (uint i = 0; i < 3; ++i)
             f[i] = kind == 0 ? ndv[v[i]] : kr[v[i]];
+        // rtsc's draw_isolines: a face draws only where some corner is
+        // above zero and some below (a corner at 0 alone crosses nothing).
+        if (!((f[0] > 0.0f || f[1] > 0.0f || f[2] > 0.0f) &&
+              (f[0] < 0.0f || f[1] < 0.0f || f[2] < 0.0f)))
+            continue;
         // The corner whose sign differs from the other two.
         const bool s0 = f[0] >= 0.0f, s1 = f[1] >= 0.0f, s2 = f[2] >= 0.0f;
         if (s0 == s1 && s1 == s2)

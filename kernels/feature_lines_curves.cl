@@ -275,8 +275,13 @@ inline float zero_linear(float fa, float fb)
 }
 
 // The corner whose sign differs from the other two, or 3 when none does.
+// As rtsc's draw_isolines, a face crosses zero only where some corner is
+// above it and some below (corners at 0 with the others on one side draw
+// nothing: no segment along an edge whose ends are both 0).
 inline uint odd_corner(float3 f)
 {
+    if (!((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && (f.x < 0.0f || f.y < 0.0f || f.z < 0.0f)))
+        return 3;
     const bool s0 = f.x >= 0.0f, s1 = f.y >= 0.0f, s2 = f.z >= 0.0f;
     if (s0 == s1 && s1 == s2)
         return 3;

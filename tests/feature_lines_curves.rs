@@ -688,3 +688,55 @@ fn the_default_solve_draws_analytic_lines_at_least_as_well_as_rtsc_s() {
     assert!(exact.torus_k_zero <= rtsc.torus_k_zero * 1.001);
     assert!(exact.ellipsoid_ridges <= rtsc.ellipsoid_ridges * 1.001);
 }
+
+/// rtsc's draw_isolines draws in a face only where some corner is above
+/// zero and some below: a face whose corners are 0, 0 and negative crosses
+/// nothing (it drew a segment along its zero edge, as on fandisk, whose
+/// flat patches have K exactly 0 at 1,471 vertices).
+#[test]
+fn faces_touching_zero_without_crossing_it_draw_nothing() {
+    let n = 9;
+    let m = mesh::plane(n, 2.0);
+    let nv = m.n_vertices();
+    // K = k1 k2 is 0 on the first rows, negative on the others; H = (k1 +
+    // k2) / 2 is 0 on the last rows, positive on the others.
+    let k: Vec<[f32; 2]> = (0..nv)
+        .map(|v| {
+            if v / n < n / 2 {
+                [1.0, 0.0]
+            } else {
+                [1.0, -1.0]
+            }
+        })
+        .collect();
+    let x = LineArrays {
+        pos: to_f32(&m.positions),
+        nrm: vec![[0.0, 0.0, 1.0]; nv],
+        d1: vec![[1.0, 0.0, 0.0]; nv],
+        d2: vec![[0.0, 1.0, 0.0]; nv],
+        k,
+        dk: vec![[0.0; 4]; nv],
+    };
+    let view = View::from_eye([0.3, 0.2, 5.0], false);
+    for fam in [LineFamily::KZero, LineFamily::HZero] {
+        let s = device(&m, &x, view, 1.0, only(&[fam], |_| {}));
+        assert!(
+            s.is_empty(),
+            "{fam:?}: {} segments on faces that cross no zero",
+            s.len()
+        );
+    }
+    // A real crossing still draws: K from −1 to +1 across the rows.
+    let mut y = x;
+    y.k = (0..nv)
+        .map(|v| {
+            if v / n < n / 2 {
+                [1.0, 1.0]
+            } else {
+                [1.0, -1.0]
+            }
+        })
+        .collect();
+    let s = device(&m, &y, view, 1.0, only(&[LineFamily::KZero], |_| {}));
+    assert!(!s.is_empty());
+}

@@ -250,6 +250,9 @@ pub fn lines_face(
                 continue;
             }
             let fv = v.map(|i| if kind == 0 { t.ndv[i] } else { t.kr[i] });
+            if !crosses_zero(fv) {
+                continue;
+            }
             let s = fv.map(|x| x >= 0.0);
             if s[0] == s[1] && s[1] == s[2] {
                 continue;
@@ -308,6 +311,11 @@ pub fn lines_face(
         }
     }
     out
+}
+
+/// rtsc's draw_isolines test: some corner above zero and some below.
+pub(crate) fn crosses_zero(f: [f32; 3]) -> bool {
+    f.iter().any(|&x| x > 0.0) && f.iter().any(|&x| x < 0.0)
 }
 
 #[cfg(test)]

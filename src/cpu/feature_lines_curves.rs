@@ -350,6 +350,9 @@ fn zero_linear(fa: f32, fb: f32) -> f32 {
 }
 
 fn odd_corner(f: [f32; 3]) -> Option<usize> {
+    if !super::feature_lines::crosses_zero(f) {
+        return None;
+    }
     let s = f.map(|x| x >= 0.0);
     if s[0] == s[1] && s[1] == s[2] {
         None
