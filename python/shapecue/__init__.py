@@ -811,7 +811,7 @@ def lines(
     hermite_kh: bool = False,
     feature_size: Union[str, float] = "rtsc",
     normals: Any = "file",
-    compat: str = "exact",
+    compat: str = "trimesh2",
     accumulate: str = "auto",
     device: Union[int, str, None] = None,
 ) -> Union[LineView, List[LineView]]:
@@ -862,8 +862,9 @@ def lines(
     500 sampled vertices and at most 5 % of the bounding sphere's radius;
     "edge" for the median edge length; or a length in the mesh's units).
     ``isophotes``: the levels N of isophotes, n·l = j/N for |j| < N (at
-    least 1 when isophotes are drawn, as on the command line). ``compat =
-    "trimesh2"`` computes the curvature as trimesh2 (and so rtsc) does.
+    least 1 when isophotes are drawn, as on the command line). ``compat``:
+    "trimesh2" (the default, as the command line's) computes the curvature
+    as trimesh2 (and so rtsc) does; "exact" is the exact least-squares solve.
 
     ``vertices`` may also be a mesh file (.obj/.ply/.off), read by the
     library's loader as ``shapecue lines FILE`` reads it. ``normals``: the

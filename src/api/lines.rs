@@ -14,7 +14,7 @@ use crate::render::{Camera, Frame, RenderOptions};
 use crate::scene::exec::{ExecOptions, PassRecord, Session, VisibleLines};
 use crate::scene::file::{HeldMesh, LineStyle, Scene, Shot, Source, ViewSpec};
 use crate::scene::planner::Cue;
-use crate::spec::curvature::CurvatureOptions;
+use crate::spec::curvature::{Compat, CurvatureOptions};
 use crate::spec::feature_lines::{FeatureSize, LineFamily, Segment};
 pub use crate::spec::feature_lines::{Hidden, family_style, hidden_id};
 use crate::spec::timing::Timing;
@@ -51,13 +51,27 @@ pub struct LinesPictureOptions {
 /// What the line families are computed from besides the view: the
 /// curvature estimator's options (the derivative is on where a family
 /// needs it) and the feature size the thresholds are scaled by.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineSetup {
     /// Scheme, precision and least squares of the curvature (default:
-    /// gather, f32, the exact solve; `Compat::Trimesh2` gives rtsc's own).
+    /// gather, f32, trimesh2's least squares, the curvature rtsc computes its
+    /// lines from: [`Compat::default_for`]; `Compat::Exact` is the exact
+    /// solve).
     pub curvature: CurvatureOptions,
     /// The thresholds' scale (default: rtsc's).
     pub feature_size: FeatureSize,
+}
+
+impl Default for LineSetup {
+    fn default() -> Self {
+        LineSetup {
+            curvature: CurvatureOptions {
+                compat: Compat::default_for(true),
+                ..CurvatureOptions::default()
+            },
+            feature_size: FeatureSize::default(),
+        }
+    }
 }
 
 impl Default for LinesPictureOptions {

@@ -96,9 +96,10 @@ pub struct LinesArgs {
     /// faces' where it stores none) or computed (always from the faces).
     #[arg(long, value_parser = super::choice::<NormalsSource>(), default_value = "file")]
     normals: NormalsSource,
-    /// Curvature's least squares: exact, or trimesh2 2.16's (the curvature
-    /// rtsc itself computes).
-    #[arg(long, value_parser = super::choice::<Compat>(), default_value = "exact")]
+    /// Curvature's least squares: trimesh2 2.16's (the curvature rtsc
+    /// computes its lines from), or the exact solve (closer to the analytic
+    /// lines, but it moves rtsc's on thin triangles and flat patches).
+    #[arg(long, value_parser = super::choice::<Compat>(), default_value = "trimesh2")]
     compat: Compat,
     /// Curvature's one-ring accumulation (default: gather, bitwise
     /// reproducible).

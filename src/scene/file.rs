@@ -308,9 +308,13 @@ impl Scene {
         if let Some(l) = &file.lines {
             settings::lines(&ck, l, &mut effects)?;
         }
+        let rtsc_lines = effects.cues.iter().any(|c| c.is_rtsc_family());
         let curvature = match &file.curvature {
-            Some(c) => settings::curvature(&ck, c)?,
-            None => CurvatureOptions::default(),
+            Some(c) => settings::curvature(&ck, c, rtsc_lines)?,
+            None => CurvatureOptions {
+                compat: crate::spec::curvature::Compat::default_for(rtsc_lines),
+                ..CurvatureOptions::default()
+            },
         };
         if let Some(p) = (file.curvature.as_ref()).and_then(|c| c.precision.as_ref()) {
             settings::check_precision(&ck, p.span(), &curvature, &effects, input.source.input())?;

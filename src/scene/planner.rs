@@ -561,6 +561,15 @@ impl Outputs {
 }
 
 impl Cue {
+    /// Whether the cue is one of rtsc's line families (occluding and
+    /// suggestive contours and the curvature families), which are computed
+    /// from trimesh2's curvature by default ([`Compat::default_for`]).
+    ///
+    /// [`Compat::default_for`]: crate::spec::curvature::Compat::default_for
+    pub fn is_rtsc_family(self) -> bool {
+        self.family().is_some() || matches!(self, Cue::Contours | Cue::SuggestiveContours)
+    }
+
     /// Whether the cue draws lines (whose hidden parts a vector drawing
     /// must find).
     pub fn draws_lines(self) -> bool {

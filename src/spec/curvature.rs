@@ -247,6 +247,21 @@ impl Compat {
     /// Both modes, in the order of tables and benches.
     pub const ALL: [Compat; 2] = [Compat::Exact, Compat::Trimesh2];
 
+    /// The least squares a computation takes when none is given, the one
+    /// place that decides it: trimesh2's where any of rtsc's line families
+    /// is drawn (rtsc computes its lines from trimesh2's curvature, and the
+    /// exact solve moves them on thin triangles and flat patches:
+    /// `docs/lines.md`), the exact solve where curvature is the result
+    /// (curvature as data, its colours, ambient occlusion), whose `k1 ≥
+    /// k2` is signed and whose values are closer to the analytic ones.
+    pub fn default_for(draws_rtsc_lines: bool) -> Compat {
+        if draws_rtsc_lines {
+            Compat::Trimesh2
+        } else {
+            Compat::Exact
+        }
+    }
+
     /// The name used on the command line (`--compat`), in stats and bench ids.
     pub fn name(self) -> &'static str {
         match self {

@@ -7,7 +7,8 @@
 //! [curvature]
 //! accumulate = "gather"      # atomic | atomic-native | gather
 //! precision = "f32"          # f32 | f64
-//! compat = "exact"           # exact | trimesh2 (rtsc's own curvature)
+//! compat = "trimesh2"        # exact | trimesh2 (default: trimesh2's where
+//!                            # one of rtsc's line families is drawn, as rtsc)
 //!
 //! [lines]
 //! feature_size = "rtsc"      # rtsc | edge | a length
@@ -22,8 +23,14 @@ use crate::error::{Error, Result};
 use crate::spec::curvature::CurvatureOptions;
 use toml::Spanned;
 
-/// `[curvature]`, over the defaults.
-pub(super) fn curvature(ck: &Checker<'_>, c: &CurvatureSpec) -> Result<CurvatureOptions> {
+/// `[curvature]`, over the defaults (the least squares by
+/// [`crate::spec::curvature::Compat::default_for`]: trimesh2's where the
+/// scene draws one of rtsc's line families, `rtsc_lines`).
+pub(super) fn curvature(
+    ck: &Checker<'_>,
+    c: &CurvatureSpec,
+    rtsc_lines: bool,
+) -> Result<CurvatureOptions> {
     fn pick<T: std::str::FromStr<Err = Error>>(
         ck: &Checker<'_>,
         v: &Option<Spanned<String>>,
@@ -37,7 +44,10 @@ pub(super) fn curvature(ck: &Checker<'_>, c: &CurvatureSpec) -> Result<Curvature
         }
         Ok(())
     }
-    let mut o = CurvatureOptions::default();
+    let mut o = CurvatureOptions {
+        compat: crate::spec::curvature::Compat::default_for(rtsc_lines),
+        ..CurvatureOptions::default()
+    };
     pick(ck, &c.accumulate, &mut o.accumulate)?;
     pick(ck, &c.precision, &mut o.precision)?;
     pick(ck, &c.compat, &mut o.compat)?;
