@@ -137,3 +137,47 @@ fn a_broken_file_is_an_error_naming_the_element() {
     );
     assert!(!d.join("nan.svg").exists() && !d.join("index.svg").exists());
 }
+
+/// A triangle soup (no two faces share a vertex, as STL files give) draws
+/// nothing, and says why and what to do; `--weld` draws what the welded
+/// mesh draws.
+#[test]
+fn a_triangle_soup_says_so_and_draws_once_welded() {
+    let dir = scratch("soup");
+    let m = icosphere(1.0, 3);
+    let positions: Vec<[f64; 3]> = m
+        .faces
+        .iter()
+        .flat_map(|f| f.map(|v| m.positions[v as usize]))
+        .collect();
+    let faces: Faces = (0..m.faces.len() as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    let soup = write(&dir, "soup.obj", obj_text(positions, &faces));
+    let run = |extra: &[&str], out: &str| {
+        let o = cli_no_gl(&dir)
+            .args(["lines", "--lines", "contours,k-zero"])
+            .arg(&soup)
+            .args(extra)
+            .arg("-o")
+            .arg(dir.join(out))
+            .output()
+            .unwrap();
+        common::assert_succeeded(&o);
+        (
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (said, warned) = run(&[], "soup.svg");
+    assert!(said.contains("no segments"), "{said}");
+    assert!(
+        warned.contains("no two of its 1280 faces share a vertex") && warned.contains("--weld"),
+        "{warned}"
+    );
+    let (said, warned) = run(&["--weld"], "welded.svg");
+    assert!(
+        !said.contains("no segments") && warned.is_empty(),
+        "{said}{warned}"
+    );
+}

@@ -96,6 +96,12 @@ pub struct LinesArgs {
     /// faces' where it stores none) or computed (always from the faces).
     #[arg(long, value_parser = super::choice::<NormalsSource>(), default_value = "file")]
     normals: NormalsSource,
+    /// Merge vertices at identical positions before computing: for files
+    /// that split every face from its neighbours (STL-like triangle soups,
+    /// on which no line is found) or along UV and normal seams (drawn as
+    /// boundaries otherwise, as rtsc draws them).
+    #[arg(long)]
+    weld: bool,
     /// Curvature's least squares: trimesh2 2.16's (the curvature rtsc
     /// computes its lines from), or the exact solve (closer to the analytic
     /// lines, but it moves rtsc's on thin triangles and flat patches).
@@ -200,6 +206,8 @@ struct Common {
     generated: Option<usize>,
     /// Keep or drop the normals the file stores.
     normals: NormalsSource,
+    /// Merge vertices at identical positions.
+    weld: bool,
 }
 
 /// The checks of both ways of `shapecue lines`.
@@ -235,6 +243,7 @@ fn common(a: &LinesArgs) -> Result<Common> {
         path,
         generated: generated.then_some(vertices),
         normals: a.normals,
+        weld: a.weld,
     })
 }
 
@@ -258,9 +267,13 @@ impl Common {
             None => {
                 let opts = LoadOptions {
                     normals: self.normals,
-                    ..LoadOptions::default()
+                    weld: self.weld,
                 };
-                shapecue::mesh::load(&self.path, &opts)?
+                let m = shapecue::mesh::load(&self.path, &opts)?;
+                if let Some(w) = m.soup_warning(&self.path.display().to_string()) {
+                    eprintln!("warning: {w}");
+                }
+                m
             }
         })
     }

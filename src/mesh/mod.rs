@@ -216,6 +216,36 @@ impl Mesh {
         )
     }
 
+    /// Whether no two faces share a vertex (and there are two or more): a
+    /// triangle soup, as STL files and some exports give, on which
+    /// curvature has no one-ring and line families find nothing until the
+    /// vertices are welded ([`Mesh::weld`]).
+    pub fn shares_no_vertex(&self) -> bool {
+        let mut used = vec![false; self.n_vertices()];
+        for f in &self.faces {
+            for &v in f {
+                if std::mem::replace(&mut used[v as usize], true) {
+                    // Used by an earlier face (or twice by this one).
+                    return false;
+                }
+            }
+        }
+        self.faces.len() > 1
+    }
+
+    /// Why a mesh shared by no two faces draws no lines, and what to do,
+    /// for `source`'s run; `None` for a mesh whose faces share vertices.
+    pub fn soup_warning(&self, source: &str) -> Option<String> {
+        self.shares_no_vertex().then(|| {
+            format!(
+                "{source}: no two of its {} faces share a vertex (a triangle soup, as STL \
+                 exports give), so curvature and the line families find nothing; weld it \
+                 (--weld, or weld = true in a scene) to join the faces at identical positions",
+                self.n_faces()
+            )
+        })
+    }
+
     /// For each vertex, whether some face uses it.
     pub fn referenced(&self) -> Vec<bool> {
         referenced(self.n_vertices(), &self.faces)

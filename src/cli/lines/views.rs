@@ -524,6 +524,7 @@ fn options_doc(a: &LinesArgs, c: &super::Common) -> Result<Value> {
         "isophotes": a.isophotes,
         "compat": a.compat.name(),
         "normals": a.normals.name(),
+        "weld": a.weld,
         "cull": !a.no_cull,
         "test": !a.no_test,
         "fade_lines": !a.no_fade,

@@ -74,7 +74,11 @@ pub(super) fn load(scene: &Scene, notes: &mut Vec<String>) -> Result<Loaded> {
         normals: scene.normals,
     };
     Ok(match &scene.source {
-        Source::Mesh(p) => Loaded::Static(crate::mesh::load(p, &opts)?, Vec::new()),
+        Source::Mesh(p) => {
+            let m = crate::mesh::load(p, &opts)?;
+            notes.extend(m.soup_warning(&p.display().to_string()));
+            Loaded::Static(m, Vec::new())
+        }
         Source::Meshes(ps) => {
             let what = scene.path.display().to_string();
             let (m, counts) = crate::mesh::load_several(ps, &opts, &what)?;
