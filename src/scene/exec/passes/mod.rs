@@ -683,7 +683,17 @@ impl<'s, 'g> Executor<'s, 'g> {
             );
         } else if let Some(n) = self.stored_normals() {
             let t0 = Instant::now();
-            self.pose.host.nrm = n.iter().map(|&v| unit(v)).collect();
+            // A stored normal without a direction (copies that cancel where
+            // welding summed them) takes the faces' there, as on the device.
+            let faces = || vertex_normals(&self.topo.as_ref().expect("made above").mesh);
+            let mut computed: Option<Vec<[f32; 3]>> = None;
+            let nrm = (n.iter().enumerate())
+                .map(|(i, &v)| match unit(v) {
+                    Some(u) => u,
+                    None => computed.get_or_insert_with(faces)[i],
+                })
+                .collect();
+            self.pose.host.nrm = nrm;
             self.rec.wall(
                 Pass::VertexNormals,
                 ms_since(t0),
@@ -776,8 +786,8 @@ impl<'s, 'g> Executor<'s, 'g> {
     }
 }
 
-/// `v` at unit length (the caller's normals are checked to have a length).
-fn unit(v: [f32; 3]) -> [f32; 3] {
+/// `v` at unit length, or `None` where it has no direction.
+fn unit(v: [f32; 3]) -> Option<[f32; 3]> {
     let l = v.iter().map(|c| c * c).sum::<f32>().sqrt();
-    v.map(|c| c / l)
+    (l.is_finite() && l > 0.0).then(|| v.map(|c| c / l))
 }
