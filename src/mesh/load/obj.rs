@@ -181,70 +181,31 @@ fn locate(text: &str, source: &str, line: Option<usize>) -> Error {
         .count();
     let (mut nv, mut nf, mut nn) = (0usize, 0usize, 0usize);
     for (i, line) in text.lines().enumerate() {
-        let ln = i + 1;
         let mut toks = uncomment(line).split_whitespace();
-        match toks.next() {
-            Some("v") => {
-                let rest: Vec<&str> = toks.collect();
-                let n = if rest.len() == 4 {
-                    4
-                } else {
-                    rest.len().min(3)
-                };
-                let problem = if rest.len() < 3 {
-                    Some(format!("expected 3 coordinates, found {}", rest.len()))
-                } else if let Some(bad) = rest[..n].iter().find(|t| t.parse::<f64>().is_err()) {
-                    Some(format!("cannot parse '{bad}' as a number"))
-                } else if n == 4 && rest[3].parse::<f64>() == Ok(0.0) {
-                    Some("homogeneous coordinate w is 0".into())
-                } else {
-                    None
-                };
-                if let Some(p) = problem {
-                    return Error::input(source, format!("vertex {nv}"), format!("line {ln}: {p}"));
-                }
-                nv += 1;
-            }
-            Some("vn") => {
-                let rest: Vec<&str> = toks.collect();
-                let problem = if rest.len() < 3 {
-                    Some(format!("expected 3 numbers, found {}", rest.len()))
-                } else {
-                    rest[..3]
-                        .iter()
-                        .find(|t| t.parse::<f64>().is_err())
-                        .map(|bad| format!("cannot parse '{bad}' as a number"))
-                };
-                if let Some(p) = problem {
-                    return Error::input(source, format!("normal {nn}"), format!("line {ln}: {p}"));
-                }
-                nn += 1;
-            }
+        let (element, problem) = match toks.next() {
+            Some("v") => (
+                ("vertex", &mut nv),
+                vertex_problem(&toks.collect::<Vec<_>>()),
+            ),
+            Some("vn") => (
+                ("normal", &mut nn),
+                normal_problem(&toks.collect::<Vec<_>>()),
+            ),
             Some("f") => {
                 let corners: Vec<&str> = toks.collect();
-                for tok in &corners {
-                    if let Some(p) = check_corner(tok, nv, total) {
-                        return Error::input(
-                            source,
-                            format!("face {nf}"),
-                            format!("line {ln}: {p}"),
-                        );
-                    }
-                }
-                if corners.len() < 3 {
-                    return Error::input(
-                        source,
-                        format!("face {nf}"),
-                        format!(
-                            "line {ln}: {} vertex indices; a face needs at least 3",
-                            corners.len()
-                        ),
-                    );
-                }
-                nf += 1;
+                (("face", &mut nf), face_problem(&corners, nv, total))
             }
-            _ => {}
+            _ => continue,
+        };
+        let (name, count) = element;
+        if let Some(p) = problem {
+            return Error::input(
+                source,
+                format!("{name} {count}"),
+                format!("line {}: {p}", i + 1),
+            );
         }
+        *count += 1;
     }
     match line {
         Some(ln) => Error::input(
@@ -254,6 +215,49 @@ fn locate(text: &str, source: &str, line: Option<usize>) -> Error {
         ),
         None => Error::input(source, "file", "a face index is out of range"),
     }
+}
+
+/// What is wrong with a `v` statement's values, if anything: three
+/// coordinates and an optional non-zero weight w.
+fn vertex_problem(rest: &[&str]) -> Option<String> {
+    let n = if rest.len() == 4 {
+        4
+    } else {
+        rest.len().min(3)
+    };
+    if rest.len() < 3 {
+        Some(format!("expected 3 coordinates, found {}", rest.len()))
+    } else if let Some(bad) = rest[..n].iter().find(|t| t.parse::<f64>().is_err()) {
+        Some(format!("cannot parse '{bad}' as a number"))
+    } else if n == 4 && rest[3].parse::<f64>() == Ok(0.0) {
+        Some("homogeneous coordinate w is 0".into())
+    } else {
+        None
+    }
+}
+
+/// What is wrong with a `vn` statement's values, if anything.
+fn normal_problem(rest: &[&str]) -> Option<String> {
+    if rest.len() < 3 {
+        return Some(format!("expected 3 numbers, found {}", rest.len()));
+    }
+    rest[..3]
+        .iter()
+        .find(|t| t.parse::<f64>().is_err())
+        .map(|bad| format!("cannot parse '{bad}' as a number"))
+}
+
+/// What is wrong with an `f` statement's corners, if anything, `seen` of
+/// the file's `total` vertices read before it.
+fn face_problem(corners: &[&str], seen: usize, total: usize) -> Option<String> {
+    if let Some(p) = corners
+        .iter()
+        .find_map(|tok| check_corner(tok, seen, total))
+    {
+        return Some(p);
+    }
+    (corners.len() < 3)
+        .then(|| format!("{} vertex indices; a face needs at least 3", corners.len()))
 }
 
 /// Describes what is wrong with one face corner `v[/vt[/vn]]`, if anything.

@@ -39,7 +39,7 @@ use crate::spec::sdf_lines::Stroke;
 use crate::spec::timing::{Step, Timing};
 use crate::stages::ao::AoStage;
 use crate::stages::bvh::Bvh;
-use crate::stages::curvature::CurvatureEstimator;
+use crate::stages::curvature::{CurvatureEstimator, Pass as CurvPass};
 use crate::stages::edges::EdgeStage;
 use crate::stages::feature_lines::LineExtractor;
 use stages::{isosurfacer, line_options, skinning_pipeline, strokes_stage};
@@ -343,26 +343,15 @@ impl<'s, 'g> Executor<'s, 'g> {
         if let Some(t) = &self.pose.curv {
             return Ok(t.clone());
         }
-        let t = match self.stages.pipe.as_mut() {
-            Some(p) => p.curvature()?,
-            None => {
-                self.topology(frame)?;
-                let fp = self.pose.frame_pos.take();
-                let t = self.topo.as_mut().expect("made above");
-                let est = t.est.as_mut().expect("planned with the one-rings");
-                est.set_positions(fp.as_deref().unwrap_or(&t.mesh.positions))?;
-                self.pose.frame_pos = fp;
-                est.run()?
-            }
-        };
+        let t = self.estimator_run(frame, CurvPass::Dcurv)?;
         self.pose.curv = Some(t.clone());
         Ok(t)
     }
 
-    /// The normals of this pose alone (the curvature run up to its frames
-    /// pass), for line families that need no curvature; a static mesh's
-    /// topology is made here if it is not yet.
-    fn normals_run(&mut self, frame: usize) -> Result<Timing> {
+    /// This pose's estimator passes up to `last` (the skinned pipeline runs
+    /// them all): the host positions set, a static mesh's topology made
+    /// here if it is not yet.
+    fn estimator_run(&mut self, frame: usize, last: CurvPass) -> Result<Timing> {
         if let Some(p) = self.stages.pipe.as_mut() {
             return p.curvature();
         }
@@ -372,7 +361,7 @@ impl<'s, 'g> Executor<'s, 'g> {
         let est = t.est.as_mut().expect("planned with the one-rings");
         est.set_positions(fp.as_deref().unwrap_or(&t.mesh.positions))?;
         self.pose.frame_pos = fp;
-        est.run_until(crate::stages::curvature::Pass::Frames)
+        est.run_until(last)
     }
 
     /// Runs one topology or pose pass.
@@ -639,41 +628,12 @@ impl<'s, 'g> Executor<'s, 'g> {
         }
     }
 
-    /// Vertex normals: from the curvature run when curvature is planned,
-    /// else area-weighted on the host (or the file's, where it stores some).
+    /// Vertex normals: from the curvature estimator where there is one,
+    /// from the volume's gradient with an isosurface, else on the host.
     fn vertex_normals(&mut self, frame: usize) -> Result<()> {
         self.host_pose(frame)?;
-        if self.est().is_some() && !self.plan.contains(Pass::Curvature) {
-            // Line families without curvature (isophotes, boundaries): the
-            // curvature's own normals (normals_areas + frames), so that they
-            // are the same as with any other family, as rtsc's are.
-            let t = self.normals_run(frame)?;
-            let f = self.est().expect("checked above").read()?;
-            self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
-            let how = if self.stored_normals().is_some() {
-                "clear + normals_areas + frames (then replaced by the normals the mesh file stores)"
-            } else {
-                "clear + normals_areas + frames (the curvature's normals; no curvature planned)"
-            };
-            self.rec.kernels(Pass::VertexNormals, &t, how);
-        } else if self.est().is_some() {
-            let t = self.curvature_run(frame)?;
-            let f = self.est().expect("checked above").read()?;
-            self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
-            self.pose.host.k =
-                f.k1.iter()
-                    .zip(&f.k2)
-                    .map(|(&a, &b)| [a as f32, b as f32])
-                    .collect();
-            let normals = if self.stages.iso.is_some() {
-                "then replaced by the volume's gradient"
-            } else if self.stored_normals().is_some() {
-                "then replaced by the normals the mesh file stores"
-            } else {
-                "curvature normals (area-weighted)"
-            };
-            let how = format!("clear + normals_areas + frames ({normals})");
-            self.rec.kernels(Pass::VertexNormals, &t, &how);
+        if self.est().is_some() {
+            self.device_normals(frame)
         } else if let Some(n) = &self.pose.iso_normals {
             self.pose.host.nrm = n.clone();
             self.rec.wall(
@@ -681,46 +641,75 @@ impl<'s, 'g> Executor<'s, 'g> {
                 0.0,
                 "from the volume's gradient at the isosurface's vertices (with the isosurface)",
             );
-        } else if let Some(n) = self.stored_normals() {
-            let t0 = Instant::now();
+            Ok(())
+        } else {
+            self.host_normals();
+            Ok(())
+        }
+    }
+
+    /// The estimator's normals (and curvature, where it is planned). Line
+    /// families without curvature (isophotes, boundaries) run it up to its
+    /// frames pass: the curvature's own normals, the same as with any other
+    /// family, as rtsc's are.
+    fn device_normals(&mut self, frame: usize) -> Result<()> {
+        let curvature = self.plan.contains(Pass::Curvature);
+        let t = if curvature {
+            self.curvature_run(frame)?
+        } else {
+            self.estimator_run(frame, CurvPass::Frames)?
+        };
+        let f = self.est().expect("the caller checked it").read()?;
+        self.pose.host.nrm = f.normals.iter().map(|p| p.map(|c| c as f32)).collect();
+        if curvature {
+            self.pose.host.k =
+                f.k1.iter()
+                    .zip(&f.k2)
+                    .map(|(&a, &b)| [a as f32, b as f32])
+                    .collect();
+        }
+        let normals = if self.stages.iso.is_some() {
+            "then replaced by the volume's gradient"
+        } else if self.stored_normals().is_some() {
+            "then replaced by the normals the mesh file stores"
+        } else if curvature {
+            "curvature normals (area-weighted)"
+        } else {
+            "the curvature's normals; no curvature planned"
+        };
+        let how = format!("clear + normals_areas + frames ({normals})");
+        self.rec.kernels(Pass::VertexNormals, &t, &how);
+        Ok(())
+    }
+
+    /// Host normals where no estimator is planned: the file's at unit
+    /// length, or area-weighted from the pose.
+    fn host_normals(&mut self) {
+        let t0 = Instant::now();
+        let mesh = &self.topo.as_ref().expect("made by the host pose").mesh;
+        let how = if let Some(n) = self.stored_normals() {
             // A stored normal without a direction (copies that cancel where
             // welding summed them) takes the faces' there, as on the device.
-            let faces = || vertex_normals(&self.topo.as_ref().expect("made above").mesh);
             let mut computed: Option<Vec<[f32; 3]>> = None;
-            let nrm = (n.iter().enumerate())
+            self.pose.host.nrm = (n.iter().enumerate())
                 .map(|(i, &v)| match unit(v) {
                     Some(u) => u,
-                    None => computed.get_or_insert_with(faces)[i],
+                    None => computed.get_or_insert_with(|| vertex_normals(mesh))[i],
                 })
                 .collect();
-            self.pose.host.nrm = nrm;
-            self.rec.wall(
-                Pass::VertexNormals,
-                ms_since(t0),
-                "the normals the mesh file stores, at unit length (no curvature planned)",
-            );
+            "the normals the mesh file stores, at unit length (no curvature planned)"
         } else {
-            let t0 = Instant::now();
-            let faces = self.topo.as_ref().expect("made above").mesh.faces.clone();
             let m = Mesh {
-                positions: self
-                    .pose
-                    .host
-                    .pos
-                    .iter()
+                positions: (self.pose.host.pos.iter())
                     .map(|p| p.map(f64::from))
                     .collect(),
-                faces,
+                faces: mesh.faces.clone(),
                 normals: None,
             };
             self.pose.host.nrm = vertex_normals(&m);
-            self.rec.wall(
-                Pass::VertexNormals,
-                ms_since(t0),
-                "area-weighted, host (no curvature planned)",
-            );
-        }
-        Ok(())
+            "area-weighted, host (no curvature planned)"
+        };
+        self.rec.wall(Pass::VertexNormals, ms_since(t0), how);
     }
 
     /// Ambient occlusion from the pose's curvatures.
