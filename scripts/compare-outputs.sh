@@ -67,18 +67,34 @@ def strip(v, root):
         return MS.sub("<ms>", v.replace(root, "<out>"))
     return v
 
+def where(x, y, at=""):
+    """The paths (key/index) where two JSON values differ, at most 4."""
+    if isinstance(x, dict) and isinstance(y, dict):
+        out = []
+        for k in sorted(set(x) | set(y)):
+            if k not in x or k not in y:
+                out.append(f"{at}/{k} ({'new' if k in y else 'old'} only)")
+            else:
+                out += where(x[k], y[k], f"{at}/{k}")
+        return out[:4]
+    if isinstance(x, list) and isinstance(y, list) and len(x) == len(y):
+        return [w for i, (p, q) in enumerate(zip(x, y)) for w in where(p, q, f"{at}/{i}")][:4]
+    return [] if x == y else [at or "/"]
+
 def same(a, b):
+    """None where the files are the same, else a few words of where not."""
     if a.endswith(".log"):
-        return True
+        return None
     x, y = open(a, "rb").read(), open(b, "rb").read()
     if x == y:
-        return True
+        return None
     if a.endswith(".json"):
         try:
-            return strip(json.loads(x), old) == strip(json.loads(y), new)
+            p, q = strip(json.loads(x), old), strip(json.loads(y), new)
         except ValueError:
-            return False
-    return False
+            return "not JSON"
+        return None if p == q else "at " + ", ".join(where(p, q))
+    return "bytes"
 
 files = set()
 for root in (old, new):
@@ -90,8 +106,8 @@ for f in sorted(files):
     if not os.path.exists(a) or not os.path.exists(b):
         print(f"only in {'new' if os.path.exists(b) else 'old'}: {f}")
         differ += 1
-    elif not same(a, b):
-        print(f"differs: {f} ({os.path.getsize(a)} -> {os.path.getsize(b)} bytes)")
+    elif (how := same(a, b)) is not None:
+        print(f"differs: {f} ({os.path.getsize(a)} -> {os.path.getsize(b)} bytes) {how}")
         differ += 1
 print(f"{len(files) - differ} of {len(files)} files the same, {differ} differ")
 sys.exit(1 if differ else 0)

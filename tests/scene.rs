@@ -304,6 +304,7 @@ fn outputs_decide_the_drawing_passes() {
         raster,
         vector,
         visibility,
+        pieces: false,
         fields: false,
     };
     let cues = [Cue::Shading, Cue::Contours, Cue::FeatureEdges];
@@ -351,6 +352,35 @@ fn outputs_decide_the_drawing_passes() {
         );
         assert!(!shade.contains(Pass::Visibility) && !shade.contains(Pass::VertexNormals));
         assert!(shade.contains(Pass::Svg));
+        // The pieces without an SVG: exact visibility is a plan of its own
+        // (the BVH and the visibility pass, no SVG pass, no render, no GL);
+        // none with the depth-buffer method, none without lines.
+        let pieces = |raster, visibility| Outputs {
+            pieces: true,
+            ..out(raster, false, visibility)
+        };
+        let alone = p(pieces(false, Exact));
+        for (pass, planned) in [
+            (Pass::Render, false),
+            (Pass::Svg, false),
+            (Pass::Bvh, true),
+            (Pass::Visibility, true),
+            (Pass::Contours, true),
+            (Pass::Edges, true),
+        ] {
+            assert_eq!(alone.contains(pass), planned, "pieces {input:?} {pass:?}");
+        }
+        let with_png = p(pieces(true, Exact));
+        assert!(with_png.contains(Pass::Render) && with_png.contains(Pass::Visibility));
+        assert!(!with_png.contains(Pass::Svg));
+        assert!(!p(pieces(false, Depth)).contains(Pass::Visibility));
+        let shade_pieces = plan_for(
+            &[Cue::Shading],
+            input,
+            CapMode::Adjacency,
+            pieces(false, Exact),
+        );
+        assert!(!shade_pieces.contains(Pass::Visibility));
         // The view fields: read after the line passes, with the curvature's
         // derivative and the view terms; none for shading or edges alone.
         let fields = Outputs {

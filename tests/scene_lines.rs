@@ -23,6 +23,7 @@ fn both_exact() -> Outputs {
         raster: true,
         vector: true,
         visibility: VisibilityMethod::Exact,
+        pieces: false,
         fields: false,
     }
 }

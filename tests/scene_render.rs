@@ -100,6 +100,7 @@ fn static_scenes_run_exactly_their_passes() {
                     raster: true,
                     vector: true,
                     visibility: VisibilityMethod::Exact,
+                    pieces: false,
                     fields: false,
                 }
             ),

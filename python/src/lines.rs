@@ -1,6 +1,6 @@
 //! Line drawings: `lines_views` (every line family of rtsc, Rusinkiewicz and
 //! DeCarlo's real-time suggestive contours program) through the front door
-//! [`shapecue::api::line_views_on`], the one route of one view and of many:
+//! [`shapecue::api::lines_on`], the one route of one view and of many:
 //! per view the pieces of its lines split by exact visibility and chained,
 //! with their provenance, and on request the bytes of the command line's
 //! NPZ files.
@@ -9,7 +9,8 @@ use super::*;
 use pyo3::types::{PyBytes, PyList};
 use shapecue::api::{
     Camera, CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot,
-    ViewFields, ViewSpec, VisibilityMethod, check_fov, fibonacci_views, line_views_on,
+    ViewFields, ViewSpec, VisibilityMethod, check_fov, fibonacci_views, LineFiles,
+    lines_on, lines_views_scene,
     load_camera_file, parse_camera_file, segment_arrays,
 };
 use shapecue::export::npz::{SegmentArrays, fields_npz_bytes, segments_npz_bytes};
@@ -171,7 +172,8 @@ fn views_options(
         shot: one.unwrap_or(base),
         lines: args.line_options()?,
         image: false,
-        svg: true,
+        svg: false,
+        pieces: true,
         visibility: VisibilityMethod::Exact,
         setup: args.setup()?,
         ..Default::default()
@@ -196,7 +198,9 @@ fn run_views(
         let mut last = Instant::now();
         let gpu = open_gpu(device.as_deref())?;
         let mut out = Vec::with_capacity(specs.len());
-        line_views_on(&gpu, mesh.clone(), opts, specs, fields, &mut |_, v| {
+        let mut scene = lines_views_scene(mesh.clone(), opts, specs.to_vec());
+        scene.fields = fields;
+        lines_on(&gpu, &scene, LineFiles::Memory, &mut |v| {
             // The arrays (and files' bytes) made here, without the GIL.
             let mut view = ViewOut::new(v, mesh, npz)?;
             let now = Instant::now();

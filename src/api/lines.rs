@@ -11,7 +11,7 @@ use crate::export::svg::SvgLayer;
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame, RenderOptions};
-use crate::scene::exec::{ExecOptions, PassRecord, Session, VisibleLines};
+use crate::scene::exec::{ExecOptions, PassRecord, RunReport, Session, ViewDone, VisibleLines};
 use crate::scene::file::{HeldMesh, LineStyle, Scene, Shot, Source, ViewSpec};
 use crate::scene::planner::Cue;
 use crate::spec::curvature::{Compat, CurvatureOptions};
@@ -41,6 +41,10 @@ pub struct LinesPictureOptions {
     pub image: bool,
     /// Also find the SVG groups.
     pub svg: bool,
+    /// Also split the lines where their visibility changes and chain them
+    /// ([`LineView::visible`]), with or without the SVG groups (exact
+    /// visibility only: the depth-buffer method finds no pieces).
+    pub pieces: bool,
     /// How the SVG's hidden lines are found: exactly, over the mesh's BVH
     /// (default), or against the picture's depth (which draws it).
     pub visibility: VisibilityMethod,
@@ -83,6 +87,7 @@ impl Default for LinesPictureOptions {
             hidden: Hidden::Remove,
             image: true,
             svg: false,
+            pieces: false,
             visibility: VisibilityMethod::Exact,
             setup: LineSetup::default(),
         }
@@ -117,30 +122,29 @@ pub fn lines_picture(mesh: &Mesh, opts: &LinesPictureOptions) -> Result<LinesPic
 }
 
 /// Every requested line family of `mesh` from the options' camera: the
-/// scene of [`lines_scene`] run by the scene executor.
+/// scene of [`lines_scene`] run in memory by [`lines_on`], a single view
+/// being many views of one.
 pub fn lines_picture_on(
     gpu: &Arc<Gpu>,
     mesh: &Mesh,
     opts: &LinesPictureOptions,
 ) -> Result<LinesPicture> {
-    if wanted(&opts.lines).is_empty() {
-        return Err(crate::error::Error::InvalidArgument(
-            "no line family is asked for, so there is nothing to draw".into(),
-        ));
-    }
     let scene = lines_scene(Arc::new(mesh.clone()), opts);
-    let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
-    let v = f.view;
-    let camera = v.world_camera();
+    let mut one = None;
+    lines_on(gpu, &scene, LineFiles::Memory, &mut |v| {
+        one = Some(v);
+        Ok(())
+    })?;
+    let v = one.expect("a one-view scene hands one view");
     Ok(LinesPicture {
         frame: v.image,
         segments: v.segments,
         layers: v.layers,
         visible: v.visible,
         timing: v.timing,
-        passes: f.passes,
-        camera,
-        feature_size: v.feature_size.unwrap_or(0.0),
+        passes: v.passes,
+        camera: v.camera,
+        feature_size: v.feature_size,
     })
 }
 
@@ -154,6 +158,7 @@ pub fn lines_scene(mesh: Arc<Mesh>, opts: &LinesPictureOptions) -> Scene {
     s.msaa = RenderOptions::default().msaa;
     s.png = opts.image;
     s.svg = opts.svg;
+    s.pieces = opts.pieces;
     s.visibility = opts.visibility;
     s.curvature = opts.setup.curvature;
     let fx = &mut s.effects;
@@ -192,11 +197,8 @@ pub fn lines_scene(mesh: Arc<Mesh>, opts: &LinesPictureOptions) -> Scene {
 
 /// The scene of a lines drawing from many views in one run: the scene of
 /// [`lines_scene`] (its shot gives the image size) with `views` instead of
-/// the shot's camera. The executor runs the pose passes (curvature, the
-/// feature size) once and the view passes (the lines, their visibility,
-/// the drawing) once per view; [`crate::scene::exec::Session::run_each`]
-/// hands each view's lines to the caller. Set the scene's `out_dir` and
-/// `prefix` for its files.
+/// the shot's camera, for [`lines_on`]. Set the scene's `out_dir` and
+/// `prefix` for its files, `fields` for each view's per-vertex fields.
 pub fn lines_views_scene(
     mesh: Arc<Mesh>,
     opts: &LinesPictureOptions,
@@ -207,83 +209,90 @@ pub fn lines_views_scene(
     s
 }
 
-/// One view of [`line_views_on`], world coordinates.
+/// One view of [`lines_on`], world coordinates.
 pub struct LineView {
+    /// The view's index in the scene's views.
+    pub view: usize,
     /// The camera as resolved (a fitted view's eye placed).
     pub camera: Camera,
     /// The line segments found for this view.
     pub segments: Vec<Segment>,
-    /// The segments classified and chained by exact visibility (where the
-    /// options ask for it).
+    /// The segments split where their visibility changes and chained, by
+    /// exact visibility (where the scene asks for its SVG or its pieces).
     pub visible: Option<VisibleLines>,
     /// The per-vertex fields of the view, where asked.
     pub fields: Option<crate::spec::feature_lines::ViewFields>,
+    /// The picture (lines over the mesh in white), in memory where the
+    /// scene asks for a PNG.
+    pub image: Option<Frame>,
+    /// The SVG groups, one per family (and one per family's hidden parts),
+    /// in memory where the scene asks for its SVG.
+    pub layers: Option<Vec<SvgLayer>>,
+    /// The files the view wrote (into a folder: its SVG and PNG).
+    pub files: Vec<std::path::PathBuf>,
     /// The passes that ran for this view (the first view also runs the
-    /// pose's), with their ms.
+    /// pose's), in plan order, with their ms and clocks.
     pub passes: Vec<PassRecord>,
+    /// Kernel ms of the pose's curvature and of this view's line steps.
+    pub timing: Timing,
     /// The feature size the thresholds were scaled by.
     pub feature_size: f32,
 }
 
-/// The lines of `mesh` from each of `views`, in memory and in one setup of
-/// the scene executor (the scene of [`lines_scene`] with the SVG groups
-/// found, no file written, no GL context unless the options draw a
-/// picture): the pose passes (curvature, the feature size, the BVH) run
-/// once and the view passes once per view, as `shapecue lines --views`
-/// runs them. `fields` keeps each view's per-vertex fields. Each view goes
-/// to `each` as it is done; an error of a view, or of `each`, ends the run
-/// with it.
-pub fn line_views_on(
+/// Where the views of [`lines_on`] go besides its caller.
+#[derive(Clone, Copy, Debug)]
+pub enum LineFiles<'a> {
+    /// Nowhere: each view's image and SVG groups, where the scene asks
+    /// for them, come back in its [`LineView`]; nothing is written.
+    Memory,
+    /// Into the scene's `out_dir`, named by its `prefix`
+    /// ([`crate::scene::exec::output_paths`]), with the run's report, as a
+    /// scene run writes them; the options say which views run, whether
+    /// existing files are replaced and what a failed run keeps.
+    Folder(&'a ExecOptions),
+}
+
+/// The one route of every line drawing (`shapecue lines -o`, `--views`
+/// and `--cameras`, Python's `lines` with one camera or many, the batch
+/// task): runs `scene` (of [`lines_scene`] or [`lines_views_scene`]) in
+/// the scene executor, the pose passes (curvature, the feature size, the
+/// BVH) once and the view passes (the lines, their visibility, the
+/// drawing) once per view, and hands each view to `each` as it is done.
+/// An error of a view, or of `each`, ends the run with it (a run into a
+/// folder then removes what it created, unless its options keep the views
+/// done). Returns the run's report.
+pub fn lines_on(
     gpu: &Arc<Gpu>,
-    mesh: Arc<Mesh>,
-    opts: &LinesPictureOptions,
-    views: &[ViewSpec],
-    fields: bool,
-    each: &mut dyn FnMut(usize, LineView) -> Result<()>,
-) -> Result<()> {
-    if wanted(&opts.lines).is_empty() {
+    scene: &Scene,
+    files: LineFiles<'_>,
+    each: &mut dyn FnMut(LineView) -> Result<()>,
+) -> Result<RunReport> {
+    if scene.effects.cues.is_empty() {
         return Err(crate::error::Error::InvalidArgument(
             "no line family is asked for, so there is nothing to draw".into(),
         ));
     }
-    let mut scene = lines_scene(mesh, opts);
-    scene.svg = true;
-    scene.fields = fields;
-    let request = |i: usize| {
-        let mut s = scene.clone();
-        s.views = vec![views[i].clone()];
-        crate::scene::exec::LiveRequest {
-            scene: s,
-            svg: None,
-        }
+    let mut hand = |d: ViewDone| {
+        let o = d.out;
+        each(LineView {
+            view: d.view,
+            camera: o.world_camera(),
+            segments: o.segments,
+            visible: o.visible,
+            fields: o.fields,
+            image: o.image,
+            layers: o.layers,
+            files: d.files,
+            passes: d.passes,
+            timing: o.timing,
+            feature_size: o.feature_size.unwrap_or(0.0),
+        })
     };
-    let Some(first) = views.first().map(|_| request(0)) else {
-        return Ok(());
-    };
-    let mut done = 0;
-    let mut failed = None;
-    let mut next = |f: Result<crate::scene::exec::LiveFrame>| {
-        let handed = f.and_then(|f| {
-            let v = f.view;
-            let view = LineView {
-                camera: v.world_camera(),
-                segments: v.segments,
-                visible: v.visible,
-                fields: v.fields,
-                passes: f.passes,
-                feature_size: v.feature_size.unwrap_or(0.0),
-            };
-            each(done, view)
-        });
-        if let Err(e) = handed {
-            failed = Some(e);
-            return None;
-        }
-        done += 1;
-        (done < views.len()).then(|| request(done))
-    };
-    Session::on(gpu.clone()).live(&ExecOptions::default(), first, &mut next);
-    failed.map_or(Ok(()), Err)
+    let mut session = Session::on(gpu.clone());
+    match files {
+        LineFiles::Memory => session.run_in_memory(scene, &ExecOptions::default(), &mut hand),
+        LineFiles::Folder(opts) => session.run_each(scene, opts, &mut |_, _| {}, &mut hand),
+    }
 }
 
 /// The segments of [`line_segments_on`].

@@ -54,7 +54,7 @@ pub use crate::gpu::{DeviceInfo, Gpu, list_devices};
 pub use crate::render::{Camera, Placement, framed};
 pub use crate::scene::exec::{
     Checked, ExecOptions, LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES, RunReport,
-    Session, ViewDone, VisibleLines, check_scenes, explain, output_paths, run as run_scene,
+    Session, VisibleLines, check_scenes, explain, output_paths, run as run_scene,
     run_on as run_scene_on,
 };
 pub use crate::scene::file::{
@@ -69,9 +69,9 @@ pub use crate::stages::curvature::{
 };
 pub use crate::stages::feature_lines::LineOptions;
 pub use lines::{
-    Hidden, LineSegments, LineSetup, LineView, LinesPicture, LinesPictureOptions, family_style,
-    hidden_id, line_segments_on, line_views_on, lines_picture, lines_picture_on, lines_scene,
-    lines_views_scene, segment_arrays, wanted,
+    Hidden, LineFiles, LineSegments, LineSetup, LineView, LinesPicture, LinesPictureOptions,
+    family_style, hidden_id, line_segments_on, lines_on, lines_picture, lines_picture_on,
+    lines_scene, lines_views_scene, segment_arrays, wanted,
 };
 
 pub use strokes::{

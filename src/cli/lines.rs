@@ -321,9 +321,10 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     check_outputs(c.inputs(), outputs, a.force)?;
     let mesh = c.mesh(&a.mesh)?;
     let mut opts = picture_options(&a, &c)?;
-    // The segments' visibility comes with the SVG groups.
     opts.image = !svg;
-    opts.svg = svg || segments.is_some();
+    opts.svg = svg;
+    // The segments' visibility is planned for them, with or without an SVG.
+    opts.pieces = segments.is_some();
     let gpu = Arc::new(Gpu::new(device)?);
     let pic = shapecue::lines_picture_on(&gpu, &mesh, &opts)?;
     match (&pic.layers, &pic.frame) {

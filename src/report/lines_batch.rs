@@ -11,8 +11,8 @@
 use super::metrics::median;
 use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::api::{
-    CameraDefaults, ExecOptions, LinesPictureOptions, Session, fibonacci_views, lines_views_scene,
-    segment_arrays,
+    CameraDefaults, ExecOptions, LineFiles, LinesPictureOptions, fibonacci_views, lines_on,
+    lines_views_scene, segment_arrays,
 };
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -210,7 +210,7 @@ fn measure(
     };
     let mut npz_ms = vec![0.0; views];
     let mut pieces = 0usize;
-    let run = Session::on(gpu.clone()).run_each(&scene, &exec, &mut |_, _| {}, &mut |v| {
+    let run = lines_on(gpu, &scene, LineFiles::Folder(&exec), &mut |v| {
         let t = Instant::now();
         if let Some(vis) = &v.visible {
             let a = segment_arrays(vis, m);

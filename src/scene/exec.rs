@@ -144,6 +144,34 @@ impl Session {
         run_loaded(self, scene, None, opts, progress, Some(each))
     }
 
+    /// A scene run that writes nothing (no image, no SVG, no report): each
+    /// view goes to `each` as soon as it is done, with the image where the
+    /// scene's `png` asks for one and the SVG groups where its `svg` does
+    /// ([`ViewDone::out`]). The same walk as [`Session::run_each`]: the
+    /// pose passes once per pose, the view passes once per camera. The
+    /// report comes back; the output folder and `force` are not read.
+    pub fn run_in_memory(
+        &mut self,
+        scene: &Scene,
+        opts: &ExecOptions,
+        each: &mut dyn FnMut(ViewDone) -> Result<()>,
+    ) -> Result<RunReport> {
+        let mut notes = Vec::new();
+        let loaded = load(scene, &mut notes)?;
+        let frames = frame_indices(scene, loaded.frames())?;
+        let input = RunInput {
+            loaded,
+            frames,
+            notes,
+            t_all: Instant::now(),
+        };
+        let calls = Calls {
+            progress: &mut |_, _| {},
+            each: Some(each),
+        };
+        render_all(self, scene, opts, calls, input, None)
+    }
+
     /// [`run_checked`] in this session.
     pub fn run_checked(
         &mut self,
@@ -199,6 +227,7 @@ fn plan_of(scene: &Scene, image: bool) -> crate::scene::planner::Plan {
         raster: scene.png || image,
         vector: scene.svg,
         visibility: scene.visibility,
+        pieces: scene.pieces,
         fields: scene.fields,
     };
     plan_for(&fx.cues, scene.source.input(), fx.caps, outputs)
@@ -282,7 +311,7 @@ fn run_loaded(
         })
         .and_then(|()| {
             let calls = Calls { progress, each };
-            render_all(session, scene, opts, calls, input, &outputs)
+            render_all(session, scene, opts, calls, input, Some(&outputs))
         });
     if result.is_err() && !opts.keep_done {
         outputs.remove_created();
@@ -367,14 +396,15 @@ struct Calls<'a, 'b> {
 
 /// The rendering of [`run_loaded`] after the outputs are checked and the
 /// folder exists: builds the executor, runs the frames ([`run_frames`]) and
-/// writes the report last.
+/// writes the report last. With no `outputs` (a run in memory) nothing is
+/// written: each view's image and SVG groups go to the caller's `each`.
 fn render_all(
     session: &mut Session,
     scene: &Scene,
     opts: &ExecOptions,
     calls: Calls<'_, '_>,
     input: RunInput,
-    outputs: &RunOutputs,
+    outputs: Option<&RunOutputs>,
 ) -> Result<RunReport> {
     let RunInput {
         loaded,
@@ -387,9 +417,12 @@ fn render_all(
     let renderer = session.renderer(scene, &plan)?;
     let uploads_before = renderer.as_ref().map(|r| r.uploads()).unwrap_or_default();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
+    if outputs.is_none() {
+        ex.keep.layers = scene.svg;
+    }
     let laps = Laps {
         frames: &frames,
-        images: &outputs.images,
+        images: outputs.map_or(&[], |o| &o.images),
         views: opts.views.as_deref(),
     };
     let timing = run_frames(&mut ex, scene, &plan, laps, calls)?;
@@ -437,8 +470,10 @@ fn render_all(
     if let Some(r) = ex.into_renderer() {
         session.renderer = Some(r);
     }
-    let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
-    crate::export::output::write_bytes_atomic(&outputs.report, json.as_bytes())?;
+    if let Some(o) = outputs {
+        let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
+        crate::export::output::write_bytes_atomic(&o.report, json.as_bytes())?;
+    }
     Ok(report)
 }
 

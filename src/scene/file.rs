@@ -193,6 +193,10 @@ pub struct Scene {
     /// lines, for a caller of [`crate::scene::exec::Session::run_each`]
     /// (not a scene file's key: a scene writes no fields).
     pub fields: bool,
+    /// Keep each view's lines split by exact visibility and chained (the
+    /// pieces with their visibility), with or without an SVG: exact
+    /// visibility is planned for them (not a scene file's key).
+    pub pieces: bool,
 }
 
 /// 1-based line and column of a byte offset.
@@ -340,6 +344,7 @@ impl Scene {
             interop: out.interop,
             visibility: out.visibility,
             fields: false,
+            pieces: false,
         })
     }
 }

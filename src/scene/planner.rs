@@ -524,6 +524,10 @@ pub struct Outputs {
     pub vector: bool,
     /// How the vector drawing's hidden lines are found.
     pub visibility: VisibilityMethod,
+    /// The lines split where their visibility changes and chained are
+    /// kept (segments with visibility, NPZ), with or without a vector
+    /// drawing: exact visibility is planned for them on its own.
+    pub pieces: bool,
     /// The per-vertex view fields are kept beside the lines.
     pub fields: bool,
 }
@@ -534,6 +538,7 @@ impl Outputs {
         raster: true,
         vector: false,
         visibility: VisibilityMethod::Exact,
+        pieces: false,
         fields: false,
     };
 
@@ -546,9 +551,11 @@ impl Outputs {
         }
         if self.vector {
             v.push(Pass::Svg);
-            if self.visibility == VisibilityMethod::Exact && lines {
-                v.push(Pass::Visibility);
-            }
+        }
+        // Exact visibility serves the vector drawing and the kept pieces
+        // alike; it is planned for either, and for neither without lines.
+        if (self.vector || self.pieces) && self.visibility == VisibilityMethod::Exact && lines {
+            v.push(Pass::Visibility);
         }
         // The fields are those of the line families (not of edges alone).
         let families = (cues.iter())

@@ -11,8 +11,8 @@ use super::{LinesArgs, check_outputs, common, picture_options, segments_doc};
 use anyhow::{Result, bail};
 use serde_json::{Value, json};
 use shapecue::api::{
-    CameraDefaults, ExecOptions, Gpu, MAX_VIEWS, RunReport, Session, ViewDone, fibonacci_views,
-    lines_views_scene, load_camera_file, output_paths,
+    CameraDefaults, ExecOptions, Gpu, LineFiles, LineView, MAX_VIEWS, RunReport, fibonacci_views,
+    lines_on, lines_views_scene, load_camera_file, output_paths,
 };
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -68,9 +68,7 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
     let result = if plan.todo.is_empty() {
         Ok(None)
     } else {
-        Session::on(gpu)
-            .run_each(&scene, &exec, &mut |_, _| {}, &mut |v| run.view(v))
-            .map(Some)
+        lines_on(&gpu, &scene, LineFiles::Folder(&exec), &mut |v| run.view(v)).map(Some)
     };
     let report = match result {
         Ok(r) => r,
@@ -373,7 +371,7 @@ struct ViewsRun<'a> {
 
 impl ViewsRun<'_> {
     /// One view done: its segments written (whole), its entry kept.
-    fn view(&mut self, v: ViewDone) -> shapecue::Result<()> {
+    fn view(&mut self, v: LineView) -> shapecue::Result<()> {
         let t = Instant::now();
         // The executor's images, hashed from the disk; the files written
         // here, hashed from the bytes written.
@@ -387,7 +385,7 @@ impl ViewsRun<'_> {
         };
         if let Some(paths) = self.segments {
             let visible = arrays.as_ref().map(|(v, a)| (*v, a));
-            let doc = segments_doc(visible, &v.segments, v.feature_size.unwrap_or(0.0));
+            let doc = segments_doc(visible, &v.segments, v.feature_size);
             let text = serde_json::to_string_pretty(&doc).expect("the segments serialize") + "\n";
             listed.push(self.keep(&paths[v.view], text.into_bytes())?);
         }

@@ -397,28 +397,24 @@ impl ViewOutputs {
 }
 
 /// What a run hands its caller after each view
-/// ([`Session::run_each`](super::Session::run_each)), before the next view
-/// starts: the view's lines in world coordinates and the files it wrote.
+/// ([`Session::run_each`](super::Session::run_each),
+/// [`Session::run_in_memory`](super::Session::run_in_memory)), before the
+/// next view starts: what was found and drawn for it, in world
+/// coordinates, the passes that ran for it, and the files it wrote.
 pub struct ViewDone {
     /// The frame (its index in the input's frames).
     pub frame: usize,
     /// The view (its index in the scene's views).
     pub view: usize,
-    /// The camera as resolved (a fitted view's eye placed), world
-    /// coordinates.
-    pub camera: Camera,
-    /// The line segments found for this view (world coordinates).
-    pub segments: Vec<Segment>,
-    /// The lines classified and chained by exact visibility (world
-    /// coordinates), where the plan ran it.
-    pub visible: Option<super::vector::VisibleLines>,
-    /// The per-vertex fields of the view (world units), where the scene
-    /// keeps them ([`crate::scene::file::Scene::fields`]).
-    pub fields: Option<crate::spec::feature_lines::ViewFields>,
-    /// The feature size the line families' thresholds were scaled by, when
-    /// lines were found.
-    pub feature_size: Option<f32>,
-    /// The images the view wrote (PNG, SVG).
+    /// What the view found and drew: its lines (and, with exact
+    /// visibility, their pieces and chains), the fields where the scene
+    /// keeps them, and in memory the image and SVG groups its scene asks
+    /// for.
+    pub out: ViewOutputs,
+    /// The passes that ran for this view (the pose's too, where they ran
+    /// for it), in plan order, with their ms.
+    pub passes: Vec<super::report::PassRecord>,
+    /// The images the view wrote (PNG, SVG); none in memory.
     pub files: Vec<PathBuf>,
 }
 

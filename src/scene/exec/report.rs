@@ -114,6 +114,9 @@ impl Chains {
 pub(super) struct Recorder {
     input: Input,
     map: BTreeMap<Pass, PassRecord>,
+    /// What ran since the last [`Recorder::take_recent`] (one view's
+    /// passes, and its pose's where they ran for it).
+    recent: BTreeMap<Pass, PassRecord>,
     /// Milliseconds recorded since the last [`Recorder::lap`] (topology
     /// passes left out).
     current: f64,
@@ -124,23 +127,27 @@ impl Recorder {
         Recorder {
             input,
             map: BTreeMap::new(),
+            recent: BTreeMap::new(),
             current: 0.0,
         }
     }
 
     fn add(&mut self, pass: Pass, ms: f64, clock: &'static str, how: &str) {
-        let r = self.map.entry(pass).or_insert_with(|| PassRecord {
-            pass,
-            lifetime: pass.lifetime(self.input),
-            runs: 0,
-            ms: 0.0,
-            clock,
-            how: how.to_string(),
-        });
-        r.runs += 1;
-        r.ms += ms;
+        let lifetime = pass.lifetime(self.input);
+        for map in [&mut self.map, &mut self.recent] {
+            let r = map.entry(pass).or_insert_with(|| PassRecord {
+                pass,
+                lifetime,
+                runs: 0,
+                ms: 0.0,
+                clock,
+                how: how.to_string(),
+            });
+            r.runs += 1;
+            r.ms += ms;
+        }
         // The pose time is that of the passes run per pose.
-        if r.lifetime != Lifetime::Topology {
+        if lifetime != Lifetime::Topology {
             self.current += ms;
         }
     }
@@ -177,6 +184,16 @@ impl Recorder {
         plan.passes
             .iter()
             .filter_map(|p| self.map.get(p).cloned())
+            .collect()
+    }
+
+    /// The records of the passes that ran since the last call (one view's,
+    /// with its pose's where they ran for it), in plan order.
+    pub(super) fn take_recent(&mut self, plan: &Plan) -> Vec<PassRecord> {
+        let mut recent = std::mem::take(&mut self.recent);
+        plan.passes
+            .iter()
+            .filter_map(|p| recent.remove(p))
             .collect()
     }
 }

@@ -367,35 +367,20 @@ impl Executor<'_, '_> {
     }
 
     /// What a run hands its caller after the view of `frame` and `view`
-    /// from `cam` that wrote `files` (world coordinates).
+    /// from `cam` that wrote `files`: what was found and drawn for it
+    /// (world coordinates; the image and SVG groups where the caller keeps
+    /// them), and the passes that ran for it.
     pub(in crate::scene::exec) fn view_done(
         &mut self,
         (frame, view): (usize, usize),
         cam: &Camera,
         files: Vec<PathBuf>,
     ) -> draw::ViewDone {
-        let o = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
-        let world =
-            |p: [f32; 3]| -> [f32; 3] { std::array::from_fn(|i| (f64::from(p[i]) + o[i]) as f32) };
-        let shift = glam::DVec3::from(o).as_vec3();
         draw::ViewDone {
             frame,
             view,
-            camera: Camera {
-                eye: cam.eye + shift,
-                target: cam.target + shift,
-                ..*cam
-            },
-            segments: (self.view.segs.iter())
-                .map(|s| crate::spec::feature_lines::Segment {
-                    a: world(s.a),
-                    b: world(s.b),
-                    ..*s
-                })
-                .collect(),
-            visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
-            fields: self.view.fields.take(),
-            feature_size: self.topo.as_ref().and_then(|t| t.feature_size),
+            out: self.kept_view(cam),
+            passes: self.rec.take_recent(self.plan),
             files,
         }
     }
