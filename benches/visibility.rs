@@ -11,8 +11,8 @@
 //!   plan, the sample round and the bisection rounds, transfers);
 //! - `visibility/plan/bunny`: `spec::visibility_plan::RayPlan::new` alone (the
 //!   segments in Morton order, as `classify` takes them);
-//! - `visibility/chains/bunny`: `stages::chains::chain` over the classified
-//!   pieces (keyed by `stages::chains::chain_pieces`, as the vector drawing
+//! - `visibility/chains/bunny`: `spec::chains::chain` over the classified
+//!   pieces (keyed by `spec::chains::chain_pieces`, as the vector drawing
 //!   keys them: mesh edge, vertex, or a cut where visibility changes).
 //!
 //! The curvature and the segments are computed once, before the groups.
@@ -24,12 +24,12 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shapecue::api::LineSetup;
 use shapecue::render::Camera;
+use shapecue::spec::chains::{chain, chain_pieces};
 use shapecue::spec::curvature::CurvatureOptions;
 use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use shapecue::spec::visibility::VisibilityOptions;
 use shapecue::spec::visibility_plan::RayPlan;
 use shapecue::stages::bvh::Bvh;
-use shapecue::stages::chains::{chain, chain_pieces};
 use shapecue::stages::curvature::CurvatureEstimator;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
 use shapecue::stages::visibility::{classify, spatial_order};

@@ -3,7 +3,7 @@
 //! oracles the tests compare the device with, and never on the path the
 //! product runs (`scripts/check-layers.sh` refuses an import of them from
 //! `stages`, `scene` or `api`). Host steps of the product are stages
-//! (`stages::chains`); what both sides need is in `spec`.
+//! (`spec::chains`); what both sides need is in `spec`.
 
 pub mod ao;
 pub mod bvh;

@@ -3,7 +3,6 @@
 //! camera) and PLY (the strips as a triangle mesh, vertices on the surface,
 //! with their normals), for other tools.
 
-use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
@@ -19,29 +18,20 @@ use crate::spec::sdf_lines::Stroke;
 pub fn svg_string(strokes: &[Stroke], camera: &Camera, size: [u32; 2], color: &str) -> String {
     let [w, h] = size;
     let vp = camera.view_proj(w as f32 / h.max(1) as f32);
-    let px = |p: [f64; 3]| -> Option<(f32, f32)> {
-        crate::spec::view::project_to_pixel(vp, p.map(|c| c as f32), w, h).map(|[x, y]| (x, y))
+    let px = |p: [f64; 3]| -> Option<[f32; 2]> {
+        crate::spec::view::project_to_pixel(vp, p.map(|c| c as f32), w, h)
     };
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">"
-    );
-    let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
+    let mut doc = super::svg::SvgDocument::new(w, h);
+    doc.background("white");
     for st in strokes {
         let left: Option<Vec<_>> = st.strip.iter().step_by(2).map(|&p| px(p)).collect();
         let right: Option<Vec<_>> = st.strip.iter().skip(1).step_by(2).map(|&p| px(p)).collect();
         let (Some(l), Some(r)) = (left, right) else {
             continue;
         };
-        let mut d = String::new();
-        for (i, (x, y)) in l.iter().chain(r.iter().rev()).enumerate() {
-            let _ = write!(d, "{}{x:.2},{y:.2} ", if i == 0 { "M" } else { "L" });
-        }
-        let _ = writeln!(s, "<path d=\"{}Z\" fill=\"{color}\"/>", d);
+        doc.outline(l.into_iter().chain(r.into_iter().rev()), color);
     }
-    s.push_str("</svg>\n");
-    s
+    doc.finish()
 }
 
 /// Writes [`svg_string`] to `path`.

@@ -82,20 +82,39 @@ fn push_hundredths(s: &mut String, x: f32) {
     let _ = write!(s, "{}.{:02}", a / 100, a % 100);
 }
 
-fn svg_open(width: u32, height: u32) -> String {
-    format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" \
-         viewBox=\"0 0 {width} {height}\">\n"
-    )
+/// An SVG document on a `width` × `height` pixel canvas, written in order:
+/// the one SVG writer of shapecue (the line drawings' groups and the
+/// strokes' filled outlines alike), with one number format (two decimals,
+/// [`push_hundredths`]).
+pub struct SvgDocument {
+    s: String,
 }
 
-/// SVG text of `layers` on a `width` × `height` canvas: one group per layer
-/// with its id, class, colour and stroke width; round caps and joins; a
-/// polyline's `stroke-opacity` where it is below 1. Empty layers are kept (as
-/// empty groups), so a stylesheet can rely on every requested cue's group.
-pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
-    let mut s = svg_open(width, height);
-    for layer in layers {
+impl SvgDocument {
+    /// The document's opening tag.
+    pub fn new(width: u32, height: u32) -> SvgDocument {
+        SvgDocument {
+            s: format!(
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" \
+                 viewBox=\"0 0 {width} {height}\">\n"
+            ),
+        }
+    }
+
+    /// A rectangle filling the canvas in `fill` (a CSS colour).
+    pub fn background(&mut self, fill: &str) {
+        let _ = writeln!(
+            self.s,
+            "<rect width=\"100%\" height=\"100%\" fill=\"{fill}\"/>"
+        );
+    }
+
+    /// One group with its id, class, colour and stroke width; round caps
+    /// and joins; a polyline's `stroke-opacity` where it is below 1. An
+    /// empty layer is kept (as an empty group), so a stylesheet can rely on
+    /// every requested cue's group.
+    pub fn layer(&mut self, layer: &SvgLayer) {
+        let s = &mut self.s;
         let _ = writeln!(
             s,
             "<g id=\"{id}\" class=\"{id}\" fill=\"none\" stroke=\"{c}\" stroke-width=\"{w}\" \
@@ -114,12 +133,40 @@ pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
             }
         );
         for l in &layer.lines {
-            push_polyline(&mut s, &l.points, Some(l.opacity));
+            push_polyline(s, &l.points, Some(l.opacity));
         }
         s.push_str("</g>\n");
     }
-    s.push_str("</svg>\n");
-    s
+
+    /// A closed outline through `points` (pixels), filled with `fill`.
+    pub fn outline(&mut self, points: impl IntoIterator<Item = [f32; 2]>, fill: &str) {
+        let s = &mut self.s;
+        s.push_str("<path d=\"");
+        for (i, [x, y]) in points.into_iter().enumerate() {
+            s.push(if i == 0 { 'M' } else { 'L' });
+            push_hundredths(s, x);
+            s.push(',');
+            push_hundredths(s, y);
+            s.push(' ');
+        }
+        let _ = writeln!(s, "Z\" fill=\"{fill}\"/>");
+    }
+
+    /// The document's text, closed.
+    pub fn finish(mut self) -> String {
+        self.s.push_str("</svg>\n");
+        self.s
+    }
+}
+
+/// SVG text of `layers` on a `width` × `height` canvas: one group per
+/// layer ([`SvgDocument::layer`]).
+pub fn svg_layers_text(layers: &[SvgLayer], width: u32, height: u32) -> String {
+    let mut doc = SvgDocument::new(width, height);
+    for layer in layers {
+        doc.layer(layer);
+    }
+    doc.finish()
 }
 
 /// Writes [`svg_layers_text`] to `path` (whole or not at all).

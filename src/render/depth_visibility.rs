@@ -24,11 +24,10 @@
 //! depth, so the depth buffer holds the surfaces only: a line is hidden by
 //! the mesh, never by another line's quad, whatever the stroke width.
 
-use std::collections::HashMap;
-
 use glam::Mat4;
 
 use super::{Frame, clip_segment};
+use crate::spec::chains::{ChainPiece, chain};
 use crate::spec::feature_lines::{LINE_FREE, Segment, edge_key};
 use crate::spec::visibility::NO_FACE;
 
@@ -47,7 +46,8 @@ pub struct ClipLine {
     pub opacity: f32,
 }
 
-/// How the end of a visible piece is matched with others.
+/// How the end of a visible piece is matched with others (the chainer's
+/// key: [`chain_key`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 enum EndKey {
     /// The mesh edge it lies on (exact).
@@ -227,10 +227,22 @@ impl Samples {
     }
 }
 
-/// Joins pieces sharing end keys into polylines: chains start at ends that
-/// are not shared by exactly two pieces, then closed loops remain. The pieces
-/// are first sorted (by keys, then coordinates), so the result does not depend
-/// on their input order.
+/// The chainer's key of a piece end: its mesh edge, or its pixel
+/// position (in 1/64 pixel) as a point.
+fn chain_key(k: EndKey) -> crate::spec::chains::EndKey {
+    use crate::spec::chains::EndKey as C;
+    match k {
+        EndKey::Edge(e) => C::Edge((e >> 32) as u32, e as u32),
+        EndKey::Pixel(x, y) => C::Point([x, y, 0]),
+    }
+}
+
+/// Joins pieces sharing end keys into polylines with the one chainer of
+/// both visibility methods ([`crate::spec::chains::chain`]): chains start
+/// at ends not shared by exactly two pieces, then closed loops remain; at
+/// a branch a chain goes on along the first piece in canonical order. The
+/// pieces are first sorted (by keys, then coordinates) and numbered in that
+/// order, so the result does not depend on their input order.
 fn join(mut pieces: Vec<Piece>) -> Vec<SvgPolyline> {
     let order = |p: &Piece| {
         let mut k = p.keys;
@@ -248,52 +260,38 @@ fn join(mut pieces: Vec<Piece>) -> Vec<SvgPolyline> {
                 .unwrap_or(std::cmp::Ordering::Equal)
         })
     });
-    let mut at: HashMap<EndKey, Vec<usize>> = HashMap::new();
-    for (i, p) in pieces.iter().enumerate() {
-        at.entry(p.keys[0]).or_default().push(i);
-        at.entry(p.keys[1]).or_default().push(i);
-    }
-    let mut used = vec![false; pieces.len()];
-    let mut lines = Vec::new();
-    let walk = |first: usize, from_end: usize, used: &mut Vec<bool>| {
-        let p = &pieces[first];
-        let mut points = vec![p.ends[from_end], p.ends[1 - from_end]];
-        let mut tip = p.keys[1 - from_end];
-        let mut opacity = p.opacity;
-        let mut count = 1usize;
-        used[first] = true;
-        // Through any end with an unused piece: at a branch (three or more
-        // pieces, as at a corner of feature edges) the chain goes on along the
-        // first in canonical order, and the others start chains of their own.
-        loop {
-            let next = at[&tip].iter().copied().find(|&j| !used[j]);
-            let Some(j) = next else { break };
-            used[j] = true;
-            let q = &pieces[j];
-            let far = if q.keys[0] == tip { 1 } else { 0 };
-            points.push(q.ends[far]);
-            tip = q.keys[far];
-            opacity += q.opacity;
-            count += 1;
-        }
-        SvgPolyline {
-            points,
-            opacity: opacity / count as f32,
-        }
-    };
-    for i in 0..pieces.len() {
-        for end in 0..2 {
-            if !used[i] && at[&pieces[i].keys[end]].len() != 2 {
-                lines.push(walk(i, end, &mut used));
+    let keyed: Vec<ChainPiece> = (pieces.iter().enumerate())
+        .map(|(i, p)| ChainPiece {
+            layer: 0,
+            visible: true,
+            seg: i as u32,
+            t: [0.0, 1.0],
+            keys: p.keys.map(chain_key),
+        })
+        .collect();
+    (chain(&keyed).into_iter())
+        .map(|c| {
+            let mut points = Vec::with_capacity(c.pieces.len() + 1);
+            let mut opacity = 0.0;
+            for (k, &(i, reversed)) in c.pieces.iter().enumerate() {
+                let p = &pieces[i as usize];
+                let [a, b] = if reversed {
+                    [p.ends[1], p.ends[0]]
+                } else {
+                    p.ends
+                };
+                if k == 0 {
+                    points.push(a);
+                }
+                points.push(b);
+                opacity += p.opacity;
             }
-        }
-    }
-    for i in 0..pieces.len() {
-        if !used[i] {
-            lines.push(walk(i, 0, &mut used));
-        }
-    }
-    lines
+            SvgPolyline {
+                points,
+                opacity: opacity / c.pieces.len() as f32,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 pub mod ao;
 pub mod bvh;
 pub mod cameras;
+pub mod chains;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

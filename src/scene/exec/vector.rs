@@ -2,7 +2,7 @@
 //! SVG draws ([`gather`]: the drawn line families' segments, then the
 //! drawn feature edges), split where their visibility changes by the
 //! `visibility` family over the mesh's BVH, joined into chains
-//! ([`crate::stages::chains`]), and the SVG groups of those chains
+//! ([`crate::spec::chains`]), and the SVG groups of those chains
 //! ([`svg_layers_exact`]): one polyline per chain, in the same groups, ids
 //! and styles as the depth-buffer method's ([`super::draw::svg_layers`]).
 
@@ -11,6 +11,7 @@ use crate::export::svg::{SvgLayer, SvgPolyline};
 use crate::render::Camera;
 use crate::scene::file::{Effects, LineStyle, Scene};
 use crate::scene::planner::Cue;
+use crate::spec::chains::{Chain, ChainPiece, chain, chain_pieces};
 use crate::spec::edges::{EdgeOutput, KIND_DRAWN};
 use crate::spec::feature_lines::{Hidden, LineFamily, Segment, hidden_id};
 use crate::spec::sdf_lines::Stroke;
@@ -19,7 +20,6 @@ use crate::spec::view::project_to_pixel as pixel;
 use crate::spec::visibility::{Faces, NO_FACE, Pieces, VisibilityOptions};
 use crate::spec::visibility_plan::RayPlan;
 use crate::stages::bvh::Bvh;
-use crate::stages::chains::{Chain, ChainPiece, chain, chain_pieces};
 use crate::stages::visibility::{Classified, classify_planned, spatial_order};
 
 pub use crate::spec::feature_lines::{LAYER_FEATURE_EDGES, LAYER_INTERSECTIONS, LAYER_STROKES};
@@ -151,7 +151,7 @@ impl VisibleLines {
 
     /// Mean pieces per visible chain (0 without one).
     pub fn mean_chain_length(&self) -> f64 {
-        crate::stages::chains::mean_length(self.chains.iter().filter(|c| c.visible))
+        crate::spec::chains::mean_length(self.chains.iter().filter(|c| c.visible))
     }
 
     /// The chain of each piece of [`VisibleLines::chain_pieces`].
