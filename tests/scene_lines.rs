@@ -57,7 +57,7 @@ fn check_minimal(r: &RunReport, what: &str) {
             "{what}: runs of {:?}",
             p.pass
         );
-        assert!(p.ms.is_finite() && p.ms >= 0.0, "{what}: {p:?}");
+        assert!(p.ms().is_finite() && p.ms() >= 0.0, "{what}: {p:?}");
     }
 }
 

@@ -47,7 +47,7 @@ fn check_minimal(r: &RunReport, what: &str) {
             "{what}: runs of {:?}",
             p.pass
         );
-        assert!(p.ms.is_finite() && p.ms >= 0.0, "{what}: {p:?}");
+        assert!(p.ms().is_finite() && p.ms() >= 0.0, "{what}: {p:?}");
     }
     // The mesh goes to GL once per topology and once per pose, not per view.
     let frames = r.frames.len() as u64;

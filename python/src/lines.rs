@@ -345,7 +345,7 @@ impl ViewOut {
         let sum = |clock: Option<&str>| {
             (v.passes.iter())
                 .filter(|p| clock.is_none_or(|c| p.clock == c))
-                .map(|p| p.ms)
+                .map(|p| p.ms())
                 .sum()
         };
         Ok(ViewOut {

@@ -234,10 +234,9 @@ pub fn curvature_of(job: &CurvatureJob) -> Result<CurvatureRun> {
     let mut estimator = OrderedEstimator::with_plan(gpu.clone(), &mesh, opts, plan)?;
     let est = &estimator.est;
     timing.phase("reorder", estimator.reorder_ms());
-    timing.phase("program_build", est.build_ms());
-    timing.phase("topology", est.topology_ms() - est.build_ms());
-    timing.phase("normalise", est.upload_ms().normalise);
-    timing.phase("upload", est.upload_ms().write);
+    for p in &est.host_timing().phases {
+        timing.phase(p.phase, p.ms);
+    }
     // The run's steps, kernel and wall time (the phases' timing has none).
     let run = estimator.est.run()?;
     timing.extend(&run);

@@ -191,7 +191,7 @@ pub fn feature_edges_picture_on(
     let mut timing = v.timing;
     timing.wall_ms = wall_ms;
     for p in &f.passes {
-        timing.phase(p.pass.name(), p.ms);
+        timing.phase(p.pass.name(), p.ms());
     }
     let counts = info.counts;
     Ok(EdgePicture {

@@ -108,8 +108,8 @@ fn print_report(r: &RunReport) -> Result<()> {
             p.pass.name(),
             p.lifetime.name(),
             p.runs,
-            p.ms,
-            p.ms / p.runs.max(1) as f64,
+            p.ms(),
+            p.ms() / p.runs.max(1) as f64,
             p.how,
             p.clock
         );

@@ -108,8 +108,9 @@ pub struct ProgramBuild {
     /// saved where [`cache::saves`] says so, or after
     /// [`Gpu::save_every_build`]).
     pub saved: bool,
-    /// Wall ms of getting the program (read + build, or build from source).
-    pub ms: f64,
+    /// Getting the program (read + build, or build from source): its wall
+    /// time.
+    pub timing: crate::spec::timing::Timing,
 }
 
 impl std::fmt::Debug for Gpu {
@@ -267,7 +268,10 @@ impl Gpu {
             options: options.to_string(),
             cache: outcome,
             saved: false,
-            ms: t0.elapsed().as_secs_f64() * 1e3,
+            timing: crate::spec::timing::Timing {
+                wall_ms: t0.elapsed().as_secs_f64() * 1e3,
+                ..Default::default()
+            },
         });
         programs.insert(map_key, p.clone());
         Ok(p)

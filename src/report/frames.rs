@@ -56,10 +56,10 @@ pub fn timed_frames(gpu: &Arc<Gpu>, scene: &Scene, runs: usize) -> Result<FrameR
         if drawn > 0 {
             frames.push(frame_ms);
             // The kernels of the passes that ran for this frame only.
-            let k = f.passes.iter().filter(|p| p.is_kernel()).map(|p| p.ms);
+            let k = f.passes.iter().filter(|p| p.is_kernel()).map(|p| p.ms());
             kernels.push(k.sum());
             for p in &f.passes {
-                passes.entry(p.pass.name()).or_default().push(p.ms);
+                passes.entry(p.pass.name()).or_default().push(p.ms());
             }
         }
         drawn += 1;

@@ -432,7 +432,7 @@ fn render_all(
     // The run's kernel time: its kernel passes' (the laps are wall time).
     let kernel_ms = (passes.iter())
         .filter(|p| p.is_kernel())
-        .map(|p| p.ms)
+        .map(|p| p.ms())
         .sum();
     let report = RunReport {
         scene: scene.path.display().to_string(),

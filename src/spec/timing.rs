@@ -320,6 +320,15 @@ impl Timing {
         }
     }
 
+    /// Sets the phase `phase` to `ms` (a phase that holds the last run's
+    /// time: a new phase at the end, or the one of that name replaced).
+    pub fn set_phase(&mut self, phase: &'static str, ms: f64) {
+        match self.phases.iter_mut().find(|p| p.phase == phase) {
+            Some(p) => p.ms = ms,
+            None => self.phases.push(PhaseTime { phase, ms }),
+        }
+    }
+
     /// Appends one more run of `phase` (a phase that runs once per pose or
     /// per view keeps one entry per run: [`laps`](Self::laps)).
     pub fn lap(&mut self, phase: &'static str, ms: f64) {

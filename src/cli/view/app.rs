@@ -258,7 +258,7 @@ impl App {
                 let times: Vec<String> = d
                     .passes
                     .iter()
-                    .map(|p| format!("{} {:.1}", p.pass.name(), p.ms))
+                    .map(|p| format!("{} {:.1}", p.pass.name(), p.ms()))
                     .collect();
                 println!("  ms: {}; frame {:.1}", times.join(", "), d.wall_ms);
             }
@@ -476,7 +476,7 @@ impl App {
                                 "{:<20} {:<8} {:>8.2} ms {}",
                                 p.pass.name(),
                                 p.lifetime.name(),
-                                p.ms,
+                                p.ms(),
                                 p.clock
                             ));
                         }

@@ -19,8 +19,10 @@ pub struct PassRecord {
     pub lifetime: Lifetime,
     /// How many times it ran.
     pub runs: usize,
-    /// Total milliseconds over all runs.
-    pub ms: f64,
+    /// Its time over all runs: a device pass's kernel steps (OpenCL
+    /// profiling time, each step's launches summed), a host pass's wall
+    /// time.
+    pub timing: Timing,
     /// `kernel` (OpenCL profiling time) or `wall` (host time).
     pub clock: &'static str,
     /// What the pass did here.
@@ -31,6 +33,15 @@ impl PassRecord {
     /// Whether its ms are OpenCL kernel time (else host wall time).
     pub fn is_kernel(&self) -> bool {
         self.clock == "kernel"
+    }
+
+    /// Its milliseconds over all runs, on its own clock (kernel or wall).
+    pub fn ms(&self) -> f64 {
+        if self.is_kernel() {
+            self.timing.kernel_ms
+        } else {
+            self.timing.wall_ms
+        }
     }
 }
 
@@ -132,19 +143,31 @@ impl Recorder {
         }
     }
 
-    fn add(&mut self, pass: Pass, ms: f64, clock: &'static str, how: &str) {
+    fn add(&mut self, pass: Pass, t: Timing, clock: &'static str, how: &str) {
         let lifetime = pass.lifetime(self.input);
+        let ms = t.kernel_ms + t.wall_ms;
         for map in [&mut self.map, &mut self.recent] {
             let r = map.entry(pass).or_insert_with(|| PassRecord {
                 pass,
                 lifetime,
                 runs: 0,
-                ms: 0.0,
+                timing: Timing::default(),
                 clock,
                 how: how.to_string(),
             });
             r.runs += 1;
-            r.ms += ms;
+            // Each step once, its launches summed over the runs.
+            for s in &t.steps {
+                match r.timing.steps.iter_mut().find(|x| x.step == s.step) {
+                    Some(x) => {
+                        x.kernel_ms += s.kernel_ms;
+                        x.launches += s.launches;
+                    }
+                    None => r.timing.steps.push(*s),
+                }
+            }
+            r.timing.kernel_ms += t.kernel_ms;
+            r.timing.wall_ms += t.wall_ms;
         }
         // The pose time is that of the passes run per pose.
         if lifetime != Lifetime::Topology {
@@ -154,24 +177,33 @@ impl Recorder {
 
     /// One run of a host pass taking `ms` of wall time.
     pub(super) fn wall(&mut self, pass: Pass, ms: f64, how: &str) {
-        self.add(pass, ms, "wall", how);
+        let t = Timing {
+            wall_ms: ms,
+            ..Timing::default()
+        };
+        self.add(pass, t, "wall", how);
     }
 
     /// One run of a device pass: the kernel ms of its steps in `t`.
     pub(super) fn kernels(&mut self, pass: Pass, t: &Timing, how: &str) {
-        self.add(pass, t.ms(pass.kernels()), "kernel", how);
+        self.kernels_of(pass, t, pass.kernels(), how);
     }
 
     /// One run of a device pass counting only `steps` of `t` (the rest of
     /// its launch is counted by another pass).
     pub(super) fn kernels_of(&mut self, pass: Pass, t: &Timing, steps: &[Step], how: &str) {
-        self.add(pass, t.ms(steps), "kernel", how);
+        let mut mine = Timing::default();
+        for s in t.steps.iter().filter(|s| steps.contains(&s.step)) {
+            mine.kernel_ms += s.kernel_ms;
+            mine.steps.push(*s);
+        }
+        self.add(pass, mine, "kernel", how);
     }
 
     /// One run of a device pass whose kernels ran in another pass's launch
     /// (time counted there).
     pub(super) fn shared(&mut self, pass: Pass, how: &str) {
-        self.add(pass, 0.0, "kernel", how);
+        self.add(pass, Timing::default(), "kernel", how);
     }
 
     /// The milliseconds recorded since the last call.

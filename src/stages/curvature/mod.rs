@@ -162,18 +162,9 @@ pub struct CurvatureEstimator {
     counters: Buffer<u32>,
     normal_override: Option<Buffer<f32>>,
     device_bytes: u64,
-    topology_ms: f64,
-    build_ms: f64,
-    upload_ms: UploadMs,
-}
-
-/// Host time of the last [`CurvatureEstimator::set_positions`], in ms.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct UploadMs {
-    /// Validating the pose and computing its normalization (centre, scale).
-    pub normalise: f64,
-    /// Converting to the device precision and the blocking write.
-    pub write: f64,
+    /// Host clocks: `program_build`, `topology`, and of the last pose
+    /// `normalise` and `upload` ([`CurvatureEstimator::host_timing`]).
+    host: Timing,
 }
 
 /// The accumulation scheme an estimator runs, with what it holds of its own.
@@ -402,9 +393,12 @@ impl CurvatureEstimator {
             faces: faces.buffer,
             owner,
             scheme,
-            topology_ms: t0.elapsed().as_secs_f64() * 1e3,
-            build_ms,
-            upload_ms: UploadMs::default(),
+            host: {
+                let mut t = Timing::default();
+                t.phase("program_build", build_ms);
+                t.phase("topology", t0.elapsed().as_secs_f64() * 1e3 - build_ms);
+                t
+            },
         };
         Ok(est)
     }
@@ -453,22 +447,28 @@ impl CurvatureEstimator {
         self.device_bytes
     }
 
-    /// Wall time of building the topology-only data (includes the first
-    /// program build of the process).
+    /// The estimator's host clocks, as phases: `program_build` (getting
+    /// the program and creating the kernels: a build from source, from
+    /// shapecue's binary cache, or nothing when this `Gpu` built it
+    /// before), `topology` (the topology-only data, the build left out),
+    /// and of the last [`CurvatureEstimator::set_positions`] `normalise`
+    /// (validating the pose, its centre and scale) and `upload` (converting
+    /// to the device precision and the blocking write).
+    pub fn host_timing(&self) -> &Timing {
+        &self.host
+    }
+
+    /// Wall time of setting the estimator up for its topology: the
+    /// `program_build` and `topology` phases of
+    /// [`CurvatureEstimator::host_timing`].
     pub fn topology_ms(&self) -> f64 {
-        self.topology_ms
+        self.host.phase_ms("program_build") + self.host.phase_ms("topology")
     }
 
-    /// Wall time of getting the program and creating the kernels (part of
-    /// [`CurvatureEstimator::topology_ms`]): a build from source, from
-    /// shapecue's binary cache, or nothing when this `Gpu` built it before.
+    /// Wall time of getting the program and creating the kernels: the
+    /// `program_build` phase of [`CurvatureEstimator::host_timing`].
     pub fn build_ms(&self) -> f64 {
-        self.build_ms
-    }
-
-    /// Host time of the last [`CurvatureEstimator::set_positions`].
-    pub fn upload_ms(&self) -> UploadMs {
-        self.upload_ms
+        self.host.phase_ms("program_build")
     }
 
     /// The device this estimator runs on.
@@ -503,10 +503,10 @@ impl CurvatureEstimator {
             }
         }
         self.gpu.write(&mut self.pos, &self.staging)?;
-        self.upload_ms = UploadMs {
-            normalise: (t1 - t0).as_secs_f64() * 1e3,
-            write: t1.elapsed().as_secs_f64() * 1e3,
-        };
+        self.host
+            .set_phase("normalise", (t1 - t0).as_secs_f64() * 1e3);
+        self.host
+            .set_phase("upload", t1.elapsed().as_secs_f64() * 1e3);
         Ok(())
     }
 
