@@ -185,7 +185,7 @@ pub fn feature_edges_picture_on(
     let t0 = std::time::Instant::now();
     let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
     let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let v = f.view;
+    let v = f.out;
     let camera = v.world_camera();
     let info = v.edge_info.expect("feature edges are planned");
     let mut timing = v.timing;

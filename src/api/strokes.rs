@@ -231,7 +231,7 @@ pub fn strokes_on(
             check_surface(&vol, iso_below, what)?;
             let scene = strokes_scene(Arc::new(vol.into_owned()), iso_below, opts, p);
             let f = Session::on(gpu.clone()).picture(&scene, &ExecOptions::default())?;
-            let v = f.view;
+            let v = f.out;
             let o = v.origin;
             let local = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| p[i] - o[i]) };
             let strokes = (v.strokes.strokes.iter())

@@ -169,7 +169,55 @@ impl Session {
             progress: &mut |_, _| {},
             each: Some(each),
         };
-        render_all(self, scene, opts, calls, input, None)
+        render_all(self, scene, opts, calls, input, Kept::Memory { mesh: false })
+    }
+
+    /// Draws the first view of the first frame of `scene` into memory (a
+    /// picture of the front door): [`Session::run_in_memory`] of that view
+    /// and frame, with the surface drawn ([`ViewOutputs::mesh`]).
+    pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<ViewDone> {
+        let mut one = scene.clone();
+        one.views.truncate(1);
+        if one.views.is_empty() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: no camera",
+                scene.path.display()
+            )));
+        }
+        let plan = plan_of(&one, false);
+        if !plan.contains(Pass::Render) && !plan.contains(Pass::Svg) {
+            return Err(Error::InvalidArgument(format!(
+                "{}: no cue is asked for, so there is nothing to draw",
+                scene.path.display()
+            )));
+        }
+        let mut notes = Vec::new();
+        let loaded = load(&one, &mut notes)?;
+        let first = frame_indices(&one, loaded.frames())?.first().copied();
+        let frames = first.into_iter().collect::<Vec<_>>();
+        if frames.is_empty() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: the frame range is empty",
+                scene.path.display()
+            )));
+        }
+        let input = RunInput {
+            loaded,
+            frames,
+            notes,
+            t_all: Instant::now(),
+        };
+        let mut done = None;
+        let mut each = |v: ViewDone| {
+            done = Some(v);
+            Ok(())
+        };
+        let calls = Calls {
+            progress: &mut |_, _| {},
+            each: Some(&mut each),
+        };
+        render_all(self, &one, opts, calls, input, Kept::Memory { mesh: true })?;
+        Ok(done.expect("a run of one view and one frame hands one view"))
     }
 
     /// [`run_checked`] in this session.
@@ -311,7 +359,7 @@ fn run_loaded(
         })
         .and_then(|()| {
             let calls = Calls { progress, each };
-            render_all(session, scene, opts, calls, input, Some(&outputs))
+            render_all(session, scene, opts, calls, input, Kept::Files(&outputs))
         });
     if result.is_err() && !opts.keep_done {
         outputs.remove_created();
@@ -394,18 +442,31 @@ struct Calls<'a, 'b> {
     each: EachView<'b>,
 }
 
+/// Where a run's views go besides the caller's `each`.
+enum Kept<'a> {
+    /// The files of a run (images and report), checked and their folder made.
+    Files(&'a RunOutputs),
+    /// Nowhere: each view's image and SVG groups (and with `mesh` its
+    /// surface) go to `each` in memory.
+    Memory { mesh: bool },
+}
+
 /// The rendering of [`run_loaded`] after the outputs are checked and the
 /// folder exists: builds the executor, runs the frames ([`run_frames`]) and
-/// writes the report last. With no `outputs` (a run in memory) nothing is
-/// written: each view's image and SVG groups go to the caller's `each`.
+/// writes the report last. A run in memory writes nothing: each view's image
+/// and SVG groups go to the caller's `each`.
 fn render_all(
     session: &mut Session,
     scene: &Scene,
     opts: &ExecOptions,
     calls: Calls<'_, '_>,
     input: RunInput,
-    outputs: Option<&RunOutputs>,
+    kept: Kept<'_>,
 ) -> Result<RunReport> {
+    let outputs = match kept {
+        Kept::Files(o) => Some(o),
+        Kept::Memory { .. } => None,
+    };
     let RunInput {
         loaded,
         frames,
@@ -417,8 +478,9 @@ fn render_all(
     let renderer = session.renderer(scene, &plan)?;
     let uploads_before = renderer.as_ref().map(|r| r.uploads()).unwrap_or_default();
     let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-    if outputs.is_none() {
+    if let Kept::Memory { mesh } = kept {
         ex.keep.layers = scene.svg;
+        ex.keep.mesh = mesh;
     }
     let laps = Laps {
         frames: &frames,

@@ -10,8 +10,8 @@
 //!
 //! Nothing is written but the SVG a request asks for: no report, no PNG
 //! (the image comes back in the [`LiveFrame`]). A live view's SVG takes its
-//! hidden lines from the frame's depth, which it draws anyway; a picture
-//! ([`Session::picture`]) plans as its scene's outputs and visibility say. Each frame reports the
+//! hidden lines from the frame's depth, which it draws anyway, unless the
+//! scene asks for its SVG groups ([`LiveRequest`]). Each frame reports the
 //! passes that ran for it, as the run report does for a whole run.
 
 use super::draw::ViewOutputs;
@@ -82,37 +82,6 @@ fn same_input(a: &Scene, b: &Scene) -> bool {
 }
 
 impl Session {
-    /// Draws the first view of the first frame of `scene` into memory (a
-    /// picture of the front door): every pass of the plan, nothing written;
-    /// the SVG groups come back when the scene's `svg` is on, and the
-    /// surface drawn ([`ViewOutputs::mesh`]).
-    pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<LiveFrame> {
-        let loaded = load(scene, &mut Vec::new())?;
-        let input = scene.source.input();
-        let plan = plan_of(scene, false);
-        let gpu = self.gpu(opts)?;
-        let renderer = self.renderer(scene, &plan)?;
-        let n_frames = loaded.frames();
-        let mut ex = Executor::new(scene, &plan, loaded, &gpu, renderer)?;
-        ex.keep.image = true;
-        ex.keep.mesh = true;
-        let mut live = Live {
-            plan: &plan,
-            input,
-            n_frames,
-            walker: Walker::new(&plan, input),
-        };
-        let req = LiveRequest {
-            scene: scene.clone(),
-            svg: None,
-        };
-        let frame = live.frame(&mut ex, &req);
-        if let Some(r) = ex.into_renderer() {
-            self.renderer = Some(r);
-        }
-        frame
-    }
-
     /// Draws `first`, hands the frame to `next`, and draws what `next`
     /// returns, until it returns `None`. A failed request is handed to
     /// `next` as its error; the scene is set up anew for the request after
