@@ -17,6 +17,7 @@ use crate::api::{
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::mesh::{self, Mesh};
+use crate::scene::planner::Lifetime;
 use crate::spec::feature_lines::{FamilySet, LineFamily};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -63,9 +64,18 @@ pub fn default_meshes() -> Vec<PathBuf> {
 struct Timed {
     /// Wall ms of the pose part (every pose pass, once).
     pose_ms: f64,
-    /// Wall ms of each view (its passes, the SVG, the NPZ).
+    /// Wall ms between one view handed over and the next, after the first
+    /// (its passes, the SVG, and waiting for the writer thread when the NPZ
+    /// takes longer than the next view).
     view_ms: Vec<f64>,
-    /// Of which the NPZ (the arrays with their provenance, and the file).
+    /// Each view's device ms: the kernel time of its passes.
+    device_ms: Vec<f64>,
+    /// Each view's host ms in the executor: its passes' wall time (line
+    /// kernels waited for, visibility plan and rounds, chains, SVG) less
+    /// its device ms.
+    host_ms: Vec<f64>,
+    /// The NPZ on the writer thread (the pieces' arrays with their
+    /// provenance, and the file), beside the next view.
     npz_ms: Vec<f64>,
     /// Pieces per view (mean).
     pieces: f64,
@@ -80,12 +90,14 @@ pub fn report(gpu: &Arc<Gpu>, o: &LinesBatchOptions) -> Result<Report> {
     r.text(format!(
         "Views per second of `shapecue lines MESH --views N --out DIR --npz`: one run per mesh \
          and family set, Fibonacci cameras at {}x{}, exact visibility, an SVG and the segment \
-         pieces as NPZ written per view. Pose: wall ms of the passes that run once (one-rings, \
-         normals, curvature and its derivative, the feature size, the BVH). Per view: median \
-         wall ms of a view's passes (line kernels, visibility, chains, SVG) and its NPZ, over \
-         the views after the first, and of the NPZ alone (the pieces' arrays with their faces \
-         and barycentric coordinates, and the file); views/s from the per-view ms. The kernels \
-         are built before any timing. rtsc 1.6 draws a view of the bunny with \
+         pieces as NPZ written per view, as the command writes them: on a writer thread beside \
+         the next view. Pose: wall ms of the passes that run once (one-rings, normals, \
+         curvature and its derivative, the feature size, the BVH). Per view: median wall ms \
+         from one view to the next, over the views after the first (views/s from it); of a \
+         view's passes, the device ms (kernel time) and the host ms (their wall time less the \
+         kernels: the visibility plan and rounds, chains, the SVG); and the NPZ on the writer \
+         thread (the pieces' arrays with their faces and barycentric coordinates, and the \
+         file). The kernels are built before any timing. rtsc 1.6 draws a view of the bunny with \
          every family in about 0.2 s on one core.\n",
         o.size[0], o.size[1]
     ));
@@ -98,7 +110,9 @@ pub fn report(gpu: &Arc<Gpu>, o: &LinesBatchOptions) -> Result<Report> {
             Column::new("views", "views"),
             Column::new("pose ms", "pose_ms"),
             Column::new("per view ms", "per_view_ms"),
-            Column::new("of which NPZ ms", "npz_ms"),
+            Column::new("device ms", "device_ms"),
+            Column::new("host ms", "host_ms"),
+            Column::new("NPZ ms (writer)", "npz_ms"),
             Column::new("views/s", "views_per_second"),
             Column::new("pieces per view", "pieces_per_view"),
         ],
@@ -168,6 +182,8 @@ fn generated_torus(faces: usize) -> Mesh {
 fn row(name: &str, m: &Mesh, label: &str, views: usize, mut t: Timed) -> (Row, f64) {
     let per_view = median(&mut t.view_ms);
     let npz = median(&mut t.npz_ms);
+    let device = median(&mut t.device_ms);
+    let host = median(&mut t.host_ms);
     let vps = if per_view > 0.0 { 1e3 / per_view } else { 0.0 };
     let row = Row::new(vec![
         Cell::text(name),
@@ -176,6 +192,8 @@ fn row(name: &str, m: &Mesh, label: &str, views: usize, mut t: Timed) -> (Row, f
         Cell::int(views as u64),
         Cell::num(t.pose_ms, format!("{:.1}", t.pose_ms)),
         Cell::num(per_view, format!("{per_view:.1}")),
+        Cell::num(device, format!("{device:.1}")),
+        Cell::num(host, format!("{host:.1}")),
         Cell::num(npz, format!("{npz:.1}")),
         Cell::num(vps, format!("{vps:.1}")),
         Cell::num(t.pieces, format!("{:.0}", t.pieces)),
@@ -208,30 +226,57 @@ fn measure(
         force: true,
         ..Default::default()
     };
-    let mut npz_ms = vec![0.0; views];
-    let mut pieces = 0usize;
-    let run = lines_on(gpu, &scene, LineFiles::Folder(&exec), &mut |v| {
-        let t = Instant::now();
-        if let Some(vis) = &v.visible {
-            let a = segment_arrays(vis, m);
-            pieces += a.a.len();
-            let p = dir.join(format!("view_{:04}.npz", v.view));
-            crate::export::npz::write_segments(&p, &a)?;
-        }
-        npz_ms[v.view] = t.elapsed().as_secs_f64() * 1e3;
-        Ok(())
+    let (tx, rx) = std::sync::mpsc::sync_channel::<(usize, crate::api::VisibleLines)>(1);
+    let mut handed: Vec<Instant> = Vec::with_capacity(views);
+    let mut device_ms = vec![0.0; views];
+    let (run, written) = std::thread::scope(|scope| {
+        let dir = &dir;
+        let writer = scope.spawn(move || -> Result<(Vec<f64>, usize)> {
+            let (mut npz_ms, mut pieces) = (Vec::new(), 0usize);
+            for (view, vis) in rx {
+                let t = Instant::now();
+                let a = segment_arrays(&vis, m);
+                pieces += a.a.len();
+                let p = dir.join(format!("view_{view:04}.npz"));
+                crate::export::npz::write_segments(&p, &a)?;
+                npz_ms.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+            Ok((npz_ms, pieces))
+        });
+        let run = lines_on(gpu, &scene, LineFiles::Folder(&exec), &mut |v| {
+            handed.push(Instant::now());
+            device_ms[v.view] = (v.passes.iter())
+                .filter(|p| p.lifetime == Lifetime::View && p.is_kernel())
+                .map(|p| p.timing.kernel_ms)
+                .sum();
+            match v.visible {
+                Some(vis) => tx.send((v.view, vis)).map_err(|_| Error::Interrupted),
+                None => Ok(()),
+            }
+        });
+        drop(tx);
+        let written = writer
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
+        (run, written)
     });
     let _ = std::fs::remove_dir_all(&dir);
+    let (npz_ms, pieces) = written?;
     let rep = run?;
     let laps = rep.timing.laps("view_wall");
     let first = 1.min(laps.len().saturating_sub(1));
-    let view_ms: Vec<f64> = (laps.iter().zip(&npz_ms))
+    let view_ms: Vec<f64> = (handed.windows(2))
+        .map(|w| (w[1] - w[0]).as_secs_f64() * 1e3)
+        .collect();
+    let host_ms = (laps.iter().zip(&device_ms))
         .skip(first)
-        .map(|(a, b)| a + b)
+        .map(|(w, d)| w - d)
         .collect();
     Ok(Timed {
         pose_ms: rep.timing.phase_ms("pose_wall"),
         view_ms,
+        device_ms: device_ms[first.min(views)..].to_vec(),
+        host_ms,
         npz_ms: npz_ms[first.min(npz_ms.len())..].to_vec(),
         pieces: pieces as f64 / views.max(1) as f64,
     })

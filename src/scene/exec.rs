@@ -169,7 +169,14 @@ impl Session {
             progress: &mut |_, _| {},
             each: Some(each),
         };
-        render_all(self, scene, opts, calls, input, Kept::Memory { mesh: false })
+        render_all(
+            self,
+            scene,
+            opts,
+            calls,
+            input,
+            Kept::Memory { mesh: false },
+        )
     }
 
     /// Draws the first view of the first frame of `scene` into memory (a

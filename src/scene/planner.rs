@@ -369,6 +369,41 @@ impl Pass {
         }
     }
 
+    /// Where the pass's work runs (`--explain`): `device` (kernels only),
+    /// `host` (the CPU: building lists, reading back, writing), `device +
+    /// host` (kernels, and a host step of the product beside them: the
+    /// line passes' canonical order of the segments read back; the
+    /// visibility's plan, rounds and chains), or `GL` (the renderer).
+    pub fn runs_on(self) -> &'static str {
+        match self {
+            Pass::LoadFrame
+            | Pass::EdgeBuffer
+            | Pass::OneRings
+            | Pass::CapBuffer
+            | Pass::ViewFields
+            | Pass::Svg => "host",
+            Pass::Contours | Pass::SuggestiveContours | Pass::LinesCurves | Pass::Visibility => {
+                "device + host"
+            }
+            Pass::Render => "GL",
+            Pass::Isosurface
+            | Pass::Skinning
+            | Pass::VertexNormals
+            | Pass::FaceNormals
+            | Pass::Curvature
+            | Pass::Dcurv
+            | Pass::Ao
+            | Pass::LinesPose
+            | Pass::Bvh
+            | Pass::Intersections
+            | Pass::SdfLines
+            | Pass::LinesView
+            | Pass::LinesDt1q1
+            | Pass::Edges
+            | Pass::Caps => "device",
+        }
+    }
+
     /// The device steps this pass launches (empty for host passes), by
     /// which the executor joins a stage's [`crate::spec::timing::Timing`]
     /// to the plan. Contours and suggestive contours share one
@@ -734,15 +769,16 @@ impl Plan {
             list(&mut self.cues.iter().map(|c| c.to_string()))
         );
         s.push_str(&format!(
-            "  {:<20} {:<9} {:>5}  reads\n",
-            "pass", "once per", "runs"
+            "  {:<20} {:<9} {:>5}  {:<13}  reads\n",
+            "pass", "once per", "runs", "runs on"
         ));
         for &p in &self.passes {
             s.push_str(&format!(
-                "  {:<20} {:<9} {:>5}  {}\n",
+                "  {:<20} {:<9} {:>5}  {:<13}  {}\n",
                 p.name(),
                 p.lifetime(self.input).name(),
                 self.runs(p, frames, views),
+                p.runs_on(),
                 list(&mut self.reads(p).iter().map(|n| n.to_string()))
             ));
         }

@@ -65,10 +65,13 @@ pub fn run(device: Option<&str>, a: LinesArgs) -> Result<()> {
         keep_done: true,
         ..Default::default()
     };
-    let result = if plan.todo.is_empty() {
-        Ok(None)
+    let (result, mut run) = if plan.todo.is_empty() {
+        (Ok(None), run)
     } else {
-        lines_on(&gpu, &scene, LineFiles::Folder(&exec), &mut |v| run.view(v)).map(Some)
+        let (r, run) = with_writer(run, |each| {
+            lines_on(&gpu, &scene, LineFiles::Folder(&exec), each)
+        });
+        (r.map(Some), run)
     };
     let report = match result {
         Ok(r) => r,
@@ -348,6 +351,46 @@ fn beside_svg(svg: &Path, what: &str) -> PathBuf {
     svg.with_file_name(format!("{stem}_{what}"))
 }
 
+/// Runs `compute` with a writer thread beside it: each view `compute`
+/// hands over goes to `run.view` on that thread (in order, at most one view
+/// waiting), so that a view's files are written, hashed and listed while the
+/// next view is computed. The first error stops both: the writer's, when it
+/// failed, else `compute`'s. Returns the run back once every view handed
+/// over is written (or the writer has stopped).
+fn with_writer<'a, T>(
+    run: ViewsRun<'a>,
+    compute: impl FnOnce(&mut dyn FnMut(LineView) -> shapecue::Result<()>) -> shapecue::Result<T>,
+) -> (shapecue::Result<T>, ViewsRun<'a>) {
+    let (tx, rx) = std::sync::mpsc::sync_channel::<LineView>(1);
+    std::thread::scope(|scope| {
+        let writer = scope.spawn(move || {
+            let mut run = run;
+            let mut failed = None;
+            for v in rx {
+                if let Err(e) = run.view(v) {
+                    failed = Some(e);
+                    break;
+                }
+            }
+            (run, failed)
+        });
+        let computed = compute(&mut |v| {
+            // A closed channel means the writer stopped on an error, which
+            // is the one reported.
+            tx.send(v).map_err(|_| shapecue::Error::Interrupted)
+        });
+        drop(tx);
+        let (run, failed) = match writer.join() {
+            Ok(joined) => joined,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        match failed {
+            Some(e) => (Err(e), run),
+            None => (computed, run),
+        }
+    })
+}
+
 /// What the run gathers view by view.
 struct ViewsRun<'a> {
     /// The output folder.
@@ -365,7 +408,7 @@ struct ViewsRun<'a> {
     /// The segments files written so far.
     written: Vec<PathBuf>,
     /// Wall time spent here (writing the segments documents, gathering the
-    /// manifest's entries), outside the executor's view laps.
+    /// manifest's entries), on the writer thread beside the executor.
     hand_ms: f64,
 }
 
@@ -465,6 +508,7 @@ fn family_codes() -> Value {
 
 /// The run's timing: the pose part (topology and pose passes, wall clock),
 /// the view part (every view's passes, drawing and writing, wall clock),
+/// of which per view the device's (the kernels) and the host's (the rest),
 /// views per second over the view part and over the whole run, the time
 /// spent writing segments documents (outside the view part), and the
 /// passes' own clocks.
@@ -472,6 +516,12 @@ fn timing_doc(r: &RunReport, views: usize, (load_ms, run_ms, hand_ms): (f64, f64
     let t = &r.timing;
     let (pose_ms, views_ms) = (t.phase_ms("pose_wall"), t.phase_ms("view_wall"));
     let n = views.max(1) as f64;
+    // The views' device time: their passes' kernels; the rest of their
+    // wall time is the host's.
+    let device_ms: f64 = (r.passes.iter())
+        .filter(|p| p.lifetime.name() == "view" && p.is_kernel())
+        .map(|p| p.timing.kernel_ms)
+        .sum();
     json!({
         "views_computed": views,
         "load_ms": load_ms,
@@ -479,6 +529,8 @@ fn timing_doc(r: &RunReport, views: usize, (load_ms, run_ms, hand_ms): (f64, f64
         "pose_ms": pose_ms,
         "views_ms": views_ms,
         "per_view_ms": views_ms / n,
+        "device_ms_per_view": device_ms / n,
+        "host_ms_per_view": (views_ms - device_ms) / n,
         "views_per_second": if views_ms > 0.0 { 1e3 * n / views_ms } else { 0.0 },
         "run_views_per_second": if run_ms > 0.0 { 1e3 * n / run_ms } else { 0.0 },
         "segments_ms": hand_ms,
@@ -547,4 +599,82 @@ fn plain(x: f32) -> f64 {
 /// Milliseconds since `t`.
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A view of no lines, numbered `view`.
+    fn empty_view(view: usize) -> LineView {
+        LineView {
+            view,
+            camera: shapecue::api::Camera::look_at(glam::Vec3::Z, glam::Vec3::ZERO),
+            segments: Vec::new(),
+            visible: None,
+            fields: None,
+            image: None,
+            layers: None,
+            files: Vec::new(),
+            passes: Vec::new(),
+            timing: Default::default(),
+            feature_size: 1.0,
+        }
+    }
+
+    #[test]
+    fn the_writer_thread_writes_the_views_in_order_and_stops_the_run_on_its_error() {
+        let dir =
+            std::env::temp_dir().join(format!("shapecue-views-writer-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mesh = shapecue::Mesh::default();
+        // Views 0 and 1 can be written; view 2's folder does not exist.
+        let paths: Vec<PathBuf> = vec![
+            dir.join("v0_segments.json"),
+            dir.join("v1_segments.json"),
+            dir.join("missing/v2_segments.json"),
+            dir.join("v3_segments.json"),
+        ];
+        let run = ViewsRun {
+            dir: &dir,
+            mesh: &mesh,
+            segments: Some(&paths),
+            npz: None,
+            fields: None,
+            log: manifest::Log::new(
+                manifest::Head::empty(),
+                Vec::new(),
+                dir.join("manifest.json"),
+            ),
+            written: Vec::new(),
+            hand_ms: 0.0,
+        };
+        let mut handed = 0;
+        let (result, run) = with_writer(run, |each| {
+            for v in 0..4 {
+                each(empty_view(v))?;
+                handed += 1;
+            }
+            Ok(())
+        });
+        let e = result.expect_err("the writer failed on view 2");
+        // The writer's error, naming the file, not the closed channel's.
+        assert!(e.to_string().contains("missing"), "{e}");
+        assert_eq!(run.written, paths[..2].to_vec());
+        assert_eq!(run.log.views(), 2);
+        assert!((2..=4).contains(&handed), "{handed}");
+        assert!(!paths[3].exists());
+        // Without a failure every view is written, in order.
+        let run = ViewsRun {
+            segments: Some(&paths[..2]),
+            written: Vec::new(),
+            log: manifest::Log::new(manifest::Head::empty(), Vec::new(), dir.join("m.json")),
+            ..run
+        };
+        let (result, run) = with_writer(run, |each| (0..2).try_for_each(|v| each(empty_view(v))));
+        result.unwrap();
+        assert_eq!(run.written.len(), 0, "written before: not new");
+        assert_eq!(run.log.views(), 2);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -20,8 +20,9 @@ pub struct PassRecord {
     /// How many times it ran.
     pub runs: usize,
     /// Its time over all runs: a device pass's kernel steps (OpenCL
-    /// profiling time, each step's launches summed), a host pass's wall
-    /// time.
+    /// profiling time, each step's launches summed) and, for one with a
+    /// host step beside them (visibility), that step's wall time; a host
+    /// pass's wall time.
     pub timing: Timing,
     /// `kernel` (OpenCL profiling time) or `wall` (host time).
     pub clock: &'static str,
@@ -145,7 +146,12 @@ impl Recorder {
 
     fn add(&mut self, pass: Pass, t: Timing, clock: &'static str, how: &str) {
         let lifetime = pass.lifetime(self.input);
-        let ms = t.kernel_ms + t.wall_ms;
+        // On the pass's own clock (a device pass's host time is beside it).
+        let ms = if clock == "kernel" {
+            t.kernel_ms
+        } else {
+            t.wall_ms
+        };
         for map in [&mut self.map, &mut self.recent] {
             let r = map.entry(pass).or_insert_with(|| PassRecord {
                 pass,
@@ -187,6 +193,19 @@ impl Recorder {
     /// One run of a device pass: the kernel ms of its steps in `t`.
     pub(super) fn kernels(&mut self, pass: Pass, t: &Timing, how: &str) {
         self.kernels_of(pass, t, pass.kernels(), how);
+    }
+
+    /// One run of a device pass with a host step beside its kernels (the
+    /// visibility's plan, rounds and chains): its kernel ms, and `host_ms`
+    /// of host wall time as the record's `wall_ms`.
+    pub(super) fn kernels_and_host(&mut self, pass: Pass, t: &Timing, host_ms: f64, how: &str) {
+        let mut mine = Timing::default();
+        for s in t.steps.iter().filter(|s| pass.kernels().contains(&s.step)) {
+            mine.kernel_ms += s.kernel_ms;
+            mine.steps.push(*s);
+        }
+        mine.wall_ms = host_ms;
+        self.add(pass, mine, "kernel", how);
     }
 
     /// One run of a device pass counting only `steps` of `t` (the rest of

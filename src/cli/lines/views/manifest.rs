@@ -68,6 +68,12 @@ pub struct Head {
 }
 
 impl Head {
+    /// A head with nothing in it (tests of the run's writer).
+    #[cfg(test)]
+    pub fn empty() -> Head {
+        Head { doc: Map::new() }
+    }
+
     /// The head of the run of `a` on `mesh` (its file hashed, or the
     /// generated mesh's name and size) on the device named `device`.
     pub fn new(

@@ -108,7 +108,8 @@ impl Executor<'_, '_> {
             vis.chains.iter().filter(|c| c.visible).count(),
             vis.mean_chain_length(),
         );
-        self.rec.kernels(Pass::Visibility, &c.timing, &how);
+        self.rec
+            .kernels_and_host(Pass::Visibility, &c.timing, host, &how);
         self.view.vis = Some(vis);
         Ok(())
     }
