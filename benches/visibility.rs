@@ -1,6 +1,6 @@
 //! Exact visibility benches (`src/stages/visibility.rs` over
 //! `kernels/bvh.cl`, twin `src/cpu/visibility.rs`; chains
-//! `src/cpu/chains.rs`): what one view of a line drawing pays after its
+//! `src/spec/chains.rs`): what one view of a line drawing pays after its
 //! line kernels.
 //!
 //! On the Stanford bunny (shared data; skipped with a message where

@@ -29,6 +29,9 @@ use crate::spec::feature_lines::{LINE_FREE, Segment};
 use crate::spec::view::View;
 use crate::spec::visibility::{Faces, MAX_INTERVALS, NO_FACE, Pieces, Spacing, VisibilityOptions};
 
+mod ends;
+use ends::shared_ends;
+
 /// One sample of one segment: `(segment index, t)`.
 pub type Cast = (u32, f32);
 
@@ -251,6 +254,95 @@ fn intervals(view: &View, spacing: Spacing, diag: f32, a: [f32; 3], b: [f32; 3])
     }
 }
 
+/// What each segment's plan reads of the mesh.
+struct PlanMesh<'a> {
+    positions: &'a [[f32; 3]],
+    faces: &'a [[u32; 3]],
+    topo: &'a VertexFaces<'a>,
+    /// The bounding box's diagonal.
+    diag: f32,
+}
+
+/// Segments per thread below which the plans are made on one thread.
+const SEGMENTS_PER_THREAD: usize = 8192;
+
+/// The threads a plan of `n` segments is made on: the machine's cores (at
+/// most 16), at least [`SEGMENTS_PER_THREAD`] segments each.
+fn plan_threads(n: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (n / SEGMENTS_PER_THREAD).clamp(1, cores.min(16))
+}
+
+/// The plan of each of `segments` (its end samples not yet shared): made
+/// in contiguous runs of segments on the machine's cores, each plan from
+/// its own segment alone, so the plans are the same on any number of
+/// threads. The error is the first segment's (in segment order) that has
+/// one.
+fn seg_plans(
+    mesh: &PlanMesh,
+    segments: &[Segment],
+    view: &View,
+    opts: &VisibilityOptions,
+    threads: usize,
+) -> Result<Vec<SegPlan>> {
+    if threads <= 1 {
+        return seg_plans_of(mesh, segments, 0, view, opts);
+    }
+    let chunk = segments.len().div_ceil(threads);
+    let parts: Vec<Result<Vec<SegPlan>>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (segments.chunks(chunk).enumerate())
+            .map(|(k, part)| scope.spawn(move || seg_plans_of(mesh, part, k * chunk, view, opts)))
+            .collect();
+        (handles.into_iter())
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    let mut segs = Vec::with_capacity(segments.len());
+    for part in parts {
+        segs.extend(part?);
+    }
+    Ok(segs)
+}
+
+/// The plans of `segments`, the first of which is segment `first`.
+fn seg_plans_of(
+    mesh: &PlanMesh,
+    segments: &[Segment],
+    first: usize,
+    view: &View,
+    opts: &VisibilityOptions,
+) -> Result<Vec<SegPlan>> {
+    let (positions, faces, diag) = (mesh.positions, mesh.faces, mesh.diag);
+    let mut segs = Vec::with_capacity(segments.len());
+    let (mut f0, mut f1) = (Vec::new(), Vec::new());
+    for (k, s) in segments.iter().enumerate() {
+        let i = first + k;
+        if !s.a.iter().chain(&s.b).all(|c| c.is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "visibility: segment {i} has a non-finite end"
+            )));
+        }
+        let exclude = lies_on(mesh.topo, s, i, [&mut f0, &mut f1])?;
+        let edge = match exclude.first() {
+            Some(&f) => {
+                let p = faces[f as usize].map(|v| positions[v as usize]);
+                (norm(sub(p[1], p[0])) + norm(sub(p[2], p[1])) + norm(sub(p[0], p[2]))) / 3.0
+            }
+            None => norm(sub(s.b, s.a)),
+        };
+        let edge = if edge > 0.0 { edge } else { 1e-3 * diag };
+        segs.push(SegPlan {
+            a: s.a,
+            b: s.b,
+            exclude,
+            intervals: intervals(view, opts.spacing, diag, s.a, s.b).max(grazing_intervals(s)),
+            offset: opts.contour_offset * edge,
+            end_ids: [0; 2],
+        });
+    }
+    Ok(segs)
+}
+
 impl RayPlan {
     /// Reads `segments` over the mesh (`positions`, `faces`) seen in
     /// `view`. Errors, in plain words: bad options or view, a non-finite
@@ -262,6 +354,19 @@ impl RayPlan {
         view: &View,
         opts: &VisibilityOptions,
     ) -> Result<RayPlan> {
+        let mesh = (positions, faces);
+        Self::on_threads(mesh, segments, view, opts, plan_threads(segments.len()))
+    }
+
+    /// [`RayPlan::new`] made on `threads` threads (the same plan on any
+    /// number).
+    fn on_threads(
+        (positions, faces): (&[[f32; 3]], &[[u32; 3]]),
+        segments: &[Segment],
+        view: &View,
+        opts: &VisibilityOptions,
+        threads: usize,
+    ) -> Result<RayPlan> {
         opts.check()?;
         view.check("visibility")?;
         crate::spec::bvh::check_faces("visibility mesh", positions.len(), faces)?;
@@ -269,37 +374,18 @@ impl RayPlan {
         let topo = VertexFaces::new(positions.len(), faces);
         let sphere = bounding_sphere(positions);
         let diag = (2.0 * sphere.1).max(f32::MIN_POSITIVE);
-        let mut segs = Vec::with_capacity(segments.len());
-        let (mut f0, mut f1) = (Vec::new(), Vec::new());
-        for (i, s) in segments.iter().enumerate() {
-            if !s.a.iter().chain(&s.b).all(|c| c.is_finite()) {
-                return Err(Error::InvalidArgument(format!(
-                    "visibility: segment {i} has a non-finite end"
-                )));
-            }
-            let exclude = lies_on(&topo, s, i, [&mut f0, &mut f1])?;
-            let edge = match exclude.first() {
-                Some(&f) => {
-                    let p = faces[f as usize].map(|v| positions[v as usize]);
-                    (norm(sub(p[1], p[0])) + norm(sub(p[2], p[1])) + norm(sub(p[0], p[2]))) / 3.0
-                }
-                None => norm(sub(s.b, s.a)),
-            };
-            let edge = if edge > 0.0 { edge } else { 1e-3 * diag };
-            segs.push(SegPlan {
-                a: s.a,
-                b: s.b,
-                exclude,
-                intervals: intervals(view, opts.spacing, diag, s.a, s.b).max(grazing_intervals(s)),
-                offset: opts.contour_offset * edge,
-                end_ids: [0; 2],
-            });
-        }
+        let mesh = PlanMesh {
+            positions,
+            faces,
+            topo: &topo,
+            diag,
+        };
+        let mut segs = seg_plans(&mesh, segments, view, opts, threads)?;
         // The two faces of an edge round its crossing apart by a few ulps
         // of the coordinates.
         let reach = positions.iter().flatten().fold(0f32, |m, c| m.max(c.abs()));
         let tol = (1e-6 * diag).max(64.0 * f32::EPSILON * reach);
-        let ends = shared_ends(segments, &mut segs, positions.len(), tol);
+        let ends = shared_ends(segments, &mut segs, positions.len(), tol, threads);
         Ok(RayPlan {
             segs,
             ends,
@@ -427,166 +513,6 @@ impl RayPlan {
 /// bounds while both its ends are seen; 1 for the others.
 fn grazing_intervals(s: &Segment) -> usize {
     if s.family <= 1 { 2 } else { 1 }
-}
-
-/// The key of a segment's end `e` where other ends may meet it: its mesh
-/// edge or vertex; `None` for an end inside a face.
-fn end_key(s: &Segment, e: usize) -> Option<u64> {
-    let [u, v] = s.ends[e];
-    if u == LINE_FREE || u == u32::MAX {
-        return None;
-    }
-    Some((u64::from(u.min(v)) << 32) | u64::from(u.max(v)))
-}
-
-/// A keyed end ([`end_key`]) with what its shared sample reads of it, so
-/// that the samples are made from these in key order (no random reads of
-/// the segments' plans).
-#[derive(Clone, Copy, Default)]
-struct KeyedEnd {
-    key: u64,
-    /// `2 × segment + end`.
-    at: u32,
-    /// The segment's family kind: ends of different families never meet.
-    family: u32,
-    p: [f32; 3],
-    offset: f32,
-    exclude: Faces,
-}
-
-/// The shared end samples of `segs` (setting each one's `end_ids`): ends
-/// of one family at one point of one mesh edge or vertex (one key,
-/// [`end_key`], and within `tol` of each other: the two faces of an edge
-/// round its crossing apart) share one, in the order of the key, then of
-/// the segment. Ends of other lines on the same edge (another family, or
-/// another isophote level) keep their own, so that a line's visibility does
-/// not depend on which other families are drawn. The keyed ends are put in
-/// that order by a counting sort on the key's lesser vertex (`n_vertices`
-/// of them, checked by the plan), then a sort of each vertex's few.
-fn shared_ends(
-    segments: &[Segment],
-    segs: &mut [SegPlan],
-    n_vertices: usize,
-    tol: f32,
-) -> Vec<EndPlan> {
-    let mut ends = Vec::new();
-    let mut start = vec![0u32; n_vertices + 1];
-    for (i, s) in segments.iter().enumerate() {
-        for e in 0..2 {
-            match end_key(s, e) {
-                Some(k) => start[(k >> 32) as usize + 1] += 1,
-                None => {
-                    let sp = &mut segs[i];
-                    sp.end_ids[e] = ends.len() as u32;
-                    ends.push(EndPlan {
-                        p: if e == 0 { sp.a } else { sp.b },
-                        exclude: sp.exclude,
-                        offset: sp.offset,
-                    });
-                }
-            }
-        }
-    }
-    for v in 0..n_vertices {
-        start[v + 1] += start[v];
-    }
-    let mut keyed = vec![KeyedEnd::default(); start[n_vertices] as usize];
-    let mut next = start.clone();
-    for (i, (s, sp)) in segments.iter().zip(segs.iter()).enumerate() {
-        for e in 0..2 {
-            if let Some(key) = end_key(s, e) {
-                let at = &mut next[(key >> 32) as usize];
-                keyed[*at as usize] = KeyedEnd {
-                    key,
-                    at: (2 * i + e) as u32,
-                    family: s.family,
-                    p: if e == 0 { sp.a } else { sp.b },
-                    offset: sp.offset,
-                    exclude: sp.exclude,
-                };
-                *at += 1;
-            }
-        }
-    }
-    for v in 0..n_vertices {
-        keyed[start[v] as usize..start[v + 1] as usize].sort_unstable_by_key(|x| (x.key, x.at));
-    }
-    let mut point: Vec<KeyedEnd> = Vec::new();
-    for group in keyed.chunk_by(|x, y| x.key == y.key) {
-        // The ends of the key at one point of one family, in the order of
-        // their first end.
-        let mut taken = vec![false; group.len()];
-        for i in 0..group.len() {
-            if taken[i] {
-                continue;
-            }
-            point.clear();
-            for j in i..group.len() {
-                let (x, y) = (&group[i], &group[j]);
-                if !taken[j] && x.family == y.family && dist(x.p, y.p) <= tol {
-                    taken[j] = true;
-                    point.push(*y);
-                }
-            }
-            share_end(&point, segs, &mut ends);
-        }
-    }
-    ends
-}
-
-/// The distance between two points.
-fn dist(a: [f32; 3], b: [f32; 3]) -> f32 {
-    norm(sub(a, b))
-}
-
-/// The end sample of one `group` of ends with one key (in order) into
-/// `ends`, or each end's own where they lie on more than four faces.
-fn share_end(group: &[KeyedEnd], segs: &mut [SegPlan], ends: &mut Vec<EndPlan>) {
-    let mut set_id = |x: &KeyedEnd, id: usize| {
-        segs[(x.at / 2) as usize].end_ids[(x.at % 2) as usize] = id as u32;
-    };
-    // The faces they lie on, up to five (five: more than a query leaves
-    // out).
-    let (mut faces, mut n) = ([0u32; 5], 0usize);
-    'all: for x in group {
-        for &f in x.exclude.iter() {
-            if !faces[..n].contains(&f) {
-                if n == 5 {
-                    break 'all;
-                }
-                faces[n] = f;
-                n += 1;
-            }
-        }
-    }
-    faces[..n].sort_unstable();
-    if n > 4 {
-        // More faces than a query leaves out (ends at a vertex of high
-        // valence): each end keeps its own sample and faces.
-        for x in group {
-            set_id(x, ends.len());
-            ends.push(EndPlan {
-                p: x.p,
-                exclude: x.exclude,
-                offset: x.offset,
-            });
-        }
-        return;
-    }
-    let bits = |x: [f32; 3]| x.map(f32::to_bits);
-    let mut end = EndPlan {
-        p: group[0].p,
-        exclude: Faces::of(&faces[..n]),
-        offset: 0.0,
-    };
-    for x in group {
-        set_id(x, ends.len());
-        if bits(x.p) < bits(end.p) {
-            end.p = x.p;
-        }
-        end.offset = end.offset.max(x.offset);
-    }
-    ends.push(end);
 }
 
 /// The queries of `casts` that need one, and for each cast the index of

@@ -119,3 +119,66 @@ fn agreement_is_length_weighted() {
     let (same, len) = agreement(&got[0], &got[1], 2.0);
     assert!((same - 0.6).abs() < 1e-3 && len == 2.0, "{same}");
 }
+
+#[test]
+fn the_plan_is_the_same_on_any_number_of_threads() {
+    // A grid of 60 × 60 cells, two faces each; in every face a line of one
+    // of two families from one edge to another, so that most ends meet
+    // another face's end on a shared edge; some ends inside faces, one at
+    // a vertex.
+    let n = 60u32;
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+            p.push([x, y, 0.05 * (7.0 * x).sin() * (5.0 * y).cos()]);
+        }
+    }
+    let at = |i: u32, j: u32| j * (n + 1) + i;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let mid = |u: u32, v: u32| -> [f32; 3] {
+        let (a, b) = (p[u as usize], p[v as usize]);
+        std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
+    };
+    let mut segs = Vec::new();
+    for (fi, t) in faces.iter().enumerate() {
+        let family = if fi % 3 == 0 { 2 } else { 0 };
+        let e0 = [t[0].min(t[1]), t[0].max(t[1])];
+        let e1 = [t[1].min(t[2]), t[1].max(t[2])];
+        let mut s = Segment::new(mid(t[0], t[1]), mid(t[1], t[2]), family, 1.0, [e0, e1]);
+        if fi % 17 == 0 {
+            s.ends[1] = [LINE_FREE, fi as u32];
+        }
+        if fi == 5 {
+            s.ends[0] = [t[0], t[0]];
+            s.a = p[t[0] as usize];
+        }
+        segs.push(s);
+    }
+    let view = View::from_eye([0.5, 0.4, 3.0], false);
+    let opts = VisibilityOptions::default();
+    let one = RayPlan::on_threads((&p, &faces), &segs, &view, &opts, 1).unwrap();
+    assert!(
+        one.ends.len() < 2 * segs.len() - 1000,
+        "ends are shared: {}",
+        one.ends.len()
+    );
+    for threads in [2, 3, 7] {
+        let many = RayPlan::on_threads((&p, &faces), &segs, &view, &opts, threads).unwrap();
+        assert_eq!(many, one, "{threads} threads");
+    }
+    // The error is the first bad segment's, on any number of threads.
+    let mut bad = segs.clone();
+    bad[6000].a[0] = f32::NAN;
+    bad[2000].b[1] = f32::INFINITY;
+    for threads in [1, 3] {
+        let e = RayPlan::on_threads((&p, &faces), &bad, &view, &opts, threads).unwrap_err();
+        assert!(e.to_string().contains("segment 2000"), "{e}");
+    }
+}
