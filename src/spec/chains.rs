@@ -157,11 +157,17 @@ impl Ends {
     /// visibility's dense rank, the code's tag and 64-bit payload
     /// ([`EndKey::code`]), and the end's index.
     fn group(pieces: &[ChainPiece]) -> Ends {
-        let mut lv: Vec<u64> = pieces.iter().map(layer_vis).collect();
+        // The few layer-and-visibility values, each once, in order.
+        let mut lv: Vec<u64> = Vec::new();
+        for p in pieces {
+            let x = layer_vis(p);
+            if lv.last() != Some(&x) && !lv.contains(&x) {
+                lv.push(x);
+            }
+        }
         lv.sort_unstable();
-        lv.dedup();
         let lv_rank = |p: &ChainPiece| lv.binary_search(&layer_vis(p)).unwrap_or(0) as u128;
-        let mut keys: Vec<u128> = (pieces.iter().enumerate())
+        let keys: Vec<u128> = (pieces.iter().enumerate())
             .flat_map(|(i, p)| {
                 let r = lv_rank(p);
                 (0..2).map(move |e| {
@@ -171,7 +177,7 @@ impl Ends {
                 })
             })
             .collect();
-        keys.sort_unstable();
+        let keys = sort_on_cores(keys);
         let mut group_of = vec![0u32; keys.len()];
         let mut start = Vec::new();
         for (k, x) in keys.iter().enumerate() {
@@ -229,7 +235,7 @@ fn layer_vis(p: &ChainPiece) -> u64 {
 /// it is one sort of 128-bit keys.
 pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
     let mut ends = Ends::group(pieces);
-    let mut keyed: Vec<(u128, u32)> = (pieces.iter().enumerate())
+    let keyed: Vec<(u128, u32)> = (pieces.iter().enumerate())
         .map(|(i, p)| {
             let g = |e: usize| u128::from(ends.group_of[2 * i + e]);
             let (a, b) = (g(0), g(1));
@@ -240,7 +246,7 @@ pub fn chain(pieces: &[ChainPiece]) -> Vec<Chain> {
             (key, i as u32)
         })
         .collect();
-    keyed.sort_unstable();
+    let keyed = sort_on_cores(keyed);
     let order: Vec<u32> = keyed.into_iter().map(|k| k.1).collect();
     ends.fill(&order);
     let mut used = vec![false; pieces.len()];
@@ -282,6 +288,63 @@ fn walk(pieces: &[ChainPiece], ends: &Ends, used: &mut [bool], first: u32, from:
     c
 }
 
+/// Keys per thread below which [`sort_on_cores`] sorts on one thread.
+const KEYS_PER_THREAD: usize = 32768;
+
+/// `keys` sorted: in runs on the machine's cores, then merged. Equal keys
+/// are the same bits, so the result is the one sorted order, whatever the
+/// number of runs.
+fn sort_on_cores<T: Ord + Copy + Send>(mut keys: Vec<T>) -> Vec<T> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = (keys.len() / KEYS_PER_THREAD).clamp(1, cores.min(8));
+    sort_in_runs(&mut keys, threads)
+}
+
+/// [`sort_on_cores`] in `threads` runs.
+fn sort_in_runs<T: Ord + Copy + Send>(keys: &mut Vec<T>, threads: usize) -> Vec<T> {
+    if threads <= 1 || keys.len() < 2 {
+        keys.sort_unstable();
+        return std::mem::take(keys);
+    }
+    let chunk = keys.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        for run in keys.chunks_mut(chunk) {
+            scope.spawn(move || run.sort_unstable());
+        }
+    });
+    let mut runs: Vec<Vec<T>> = keys.chunks(chunk).map(<[T]>::to_vec).collect();
+    while runs.len() > 1 {
+        let mut next = Vec::with_capacity(runs.len().div_ceil(2));
+        let mut it = runs.into_iter();
+        while let Some(a) = it.next() {
+            next.push(match it.next() {
+                Some(b) => merge(&a, &b),
+                None => a,
+            });
+        }
+        runs = next;
+    }
+    runs.pop().unwrap_or_default()
+}
+
+/// Two sorted runs merged into one.
+fn merge<T: Ord + Copy>(a: &[T], b: &[T]) -> Vec<T> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if b[j] < a[i] {
+            out.push(b[j]);
+            j += 1;
+        } else {
+            out.push(a[i]);
+            i += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    out
+}
+
 /// Mean pieces per chain (0 for none).
 pub fn mean_length<'a>(chains: impl IntoIterator<Item = &'a Chain>) -> f64 {
     let (n, pieces) =
@@ -296,6 +359,18 @@ pub fn mean_length<'a>(chains: impl IntoIterator<Item = &'a Chain>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keys_sorted_in_runs_are_sorted_whatever_the_runs() {
+        // A scrambled sequence with repeats.
+        let keys: Vec<u128> = (0..100_003u128).map(|i| (i * 7_919 + 13) % 65_537).collect();
+        let mut want = keys.clone();
+        want.sort_unstable();
+        for threads in [1, 2, 3, 5, 8] {
+            assert_eq!(sort_in_runs(&mut keys.clone(), threads), want, "{threads}");
+        }
+        assert!(sort_in_runs(&mut Vec::<u128>::new(), 4).is_empty());
+    }
 
     fn piece(seg: u32, a: EndKey, b: EndKey) -> ChainPiece {
         ChainPiece {
