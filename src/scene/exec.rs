@@ -148,35 +148,16 @@ impl Session {
     /// view goes to `each` as soon as it is done, with the image where the
     /// scene's `png` asks for one and the SVG groups where its `svg` does
     /// ([`ViewDone::out`]). The same walk as [`Session::run_each`]: the
-    /// pose passes once per pose, the view passes once per camera. The
-    /// report comes back; the output folder and `force` are not read.
+    /// pose passes once per pose, the view passes once per camera, the
+    /// views `opts` names. The report comes back; the output folder and
+    /// `force` are not read.
     pub fn run_in_memory(
         &mut self,
         scene: &Scene,
         opts: &ExecOptions,
         each: &mut dyn FnMut(ViewDone) -> Result<()>,
     ) -> Result<RunReport> {
-        let mut notes = Vec::new();
-        let loaded = load(scene, &mut notes)?;
-        let frames = frame_indices(scene, loaded.frames())?;
-        let input = RunInput {
-            loaded,
-            frames,
-            notes,
-            t_all: Instant::now(),
-        };
-        let calls = Calls {
-            progress: &mut |_, _| {},
-            each: Some(each),
-        };
-        render_all(
-            self,
-            scene,
-            opts,
-            calls,
-            input,
-            Kept::Memory { mesh: false },
-        )
+        self.in_memory(scene, opts, (false, false), each)
     }
 
     /// Draws the first view of the first frame of `scene` into memory (a
@@ -185,23 +166,43 @@ impl Session {
     pub fn picture(&mut self, scene: &Scene, opts: &ExecOptions) -> Result<ViewDone> {
         let mut one = scene.clone();
         one.views.truncate(1);
-        if one.views.is_empty() {
-            return Err(Error::InvalidArgument(format!(
-                "{}: no camera",
-                scene.path.display()
-            )));
-        }
         let plan = plan_of(&one, false);
-        if !plan.contains(Pass::Render) && !plan.contains(Pass::Svg) {
+        let nothing = if one.views.is_empty() {
+            Some("no camera")
+        } else if !plan.contains(Pass::Render) && !plan.contains(Pass::Svg) {
+            Some("no cue is asked for, so there is nothing to draw")
+        } else {
+            None
+        };
+        if let Some(why) = nothing {
             return Err(Error::InvalidArgument(format!(
-                "{}: no cue is asked for, so there is nothing to draw",
+                "{}: {why}",
                 scene.path.display()
             )));
         }
+        let mut done = None;
+        self.in_memory(&one, opts, (true, true), &mut |v| {
+            done = Some(v);
+            Ok(())
+        })?;
+        Ok(done.expect("a run of one view and one frame hands one view"))
+    }
+
+    /// A run in memory ([`Session::run_in_memory`]); `(first, mesh)`: of
+    /// the first frame only, and with each view's surface.
+    fn in_memory(
+        &mut self,
+        scene: &Scene,
+        opts: &ExecOptions,
+        (first, mesh): (bool, bool),
+        each: &mut dyn FnMut(ViewDone) -> Result<()>,
+    ) -> Result<RunReport> {
         let mut notes = Vec::new();
-        let loaded = load(&one, &mut notes)?;
-        let first = frame_indices(&one, loaded.frames())?.first().copied();
-        let frames = first.into_iter().collect::<Vec<_>>();
+        let loaded = load(scene, &mut notes)?;
+        let mut frames = frame_indices(scene, loaded.frames())?;
+        if first {
+            frames.truncate(1);
+        }
         if frames.is_empty() {
             return Err(Error::InvalidArgument(format!(
                 "{}: the frame range is empty",
@@ -214,17 +215,11 @@ impl Session {
             notes,
             t_all: Instant::now(),
         };
-        let mut done = None;
-        let mut each = |v: ViewDone| {
-            done = Some(v);
-            Ok(())
-        };
         let calls = Calls {
             progress: &mut |_, _| {},
-            each: Some(&mut each),
+            each: Some(each),
         };
-        render_all(self, &one, opts, calls, input, Kept::Memory { mesh: true })?;
-        Ok(done.expect("a run of one view and one frame hands one view"))
+        render_all(self, scene, opts, calls, input, Kept::Memory { mesh })
     }
 
     /// [`run_checked`] in this session.
