@@ -42,6 +42,7 @@ __all__ = [
     "FeatureEdges",
     "Isosurface",
     "LINE_FAMILIES",
+    "Chains",
     "LineView",
     "Lines",
     "RenderError",
@@ -616,6 +617,14 @@ class LineView:
     with ``"edge"`` the median edge length, or the length given.
     ``device``: the device's name.
 
+    The chains in walking order: ``chain_order`` (P,) uint32 the rows,
+    chain after chain, each chain's as it is walked (the ``chains`` of the
+    segments document, concatenated); ``chain_reversed`` (P,) bool whether
+    that row is walked from ``b`` to ``a``; ``chain_start`` (C + 1,) uint32
+    each chain's first index into ``chain_order``; ``chain_family_code``
+    (C,) uint32 and ``chain_visible`` (C,) bool. :meth:`chains` turns them
+    into polylines.
+
     ``kind``: deprecated, the earlier name of ``family_code`` (reading it
     warns).
     """
@@ -638,7 +647,64 @@ class LineView:
     wall_ms: float
     feature_size: float
     device: str
+    chain_order: np.ndarray
+    chain_reversed: np.ndarray
+    chain_start: np.ndarray
+    chain_family_code: np.ndarray
+    chain_visible: np.ndarray
     npz: Optional[dict] = None
+
+    def chains(self, family: Optional[str] = None, visible_only: bool = True) -> "Chains":
+        """The chains as polylines, each an ordered array of points (one
+        more than its pieces: where two pieces meet, the point that ends the
+        first), with each point's face and barycentric coordinates (where
+        the point begins a piece, that piece's; the last point, the last
+        piece's end), so a stroke can follow the surface in any pose. Only
+        ``family`` (a name of :data:`LINE_FAMILIES`) where given; only the
+        visible chains by default."""
+        keep = np.ones(len(self.chain_visible), dtype=bool)
+        if family is not None:
+            keep &= _family_names(self.chain_family_code) == _known_family(family)
+        if visible_only:
+            keep &= self.chain_visible
+        ids = np.flatnonzero(keep).astype(np.uint32)
+        start, stop = self.chain_start[:-1][ids], self.chain_start[1:][ids]
+        counts = (stop - start).astype(np.int64)
+        # The rows of the kept chains, in walking order.
+        at = np.repeat(start.astype(np.int64) - np.cumsum(counts) + counts, counts)
+        at += np.arange(int(counts.sum()), dtype=np.int64)
+        rows = self.chain_order[at].astype(np.int64)
+        rev = self.chain_reversed[at]
+        first = np.where(rev, 1, 0)
+        ends = np.stack([self.a[rows], self.b[rows]], axis=1)
+        p0 = ends[np.arange(len(rows)), first]
+        p1 = ends[np.arange(len(rows)), 1 - first]
+        bary0 = self.bary[rows, first]
+        bary1 = self.bary[rows, 1 - first]
+        face = self.face[rows]
+        # Each chain: its first piece's start, then every piece's end.
+        heads = np.cumsum(counts) - counts
+        points = np.insert(p1, heads, p0[heads], axis=0)
+        bary = np.insert(bary1, heads, bary0[heads], axis=0)
+        # A point that begins a piece takes that piece's face: the chain's
+        # first point its first piece's, the others their next piece's.
+        faces = np.insert(face, heads, face[heads])
+        nxt = np.arange(len(rows)) + 1
+        inner = np.ones(len(rows), dtype=bool)
+        inner[np.cumsum(counts)[counts > 0] - 1] = False
+        at_points = np.arange(len(rows)) + np.repeat(np.arange(len(ids)), counts) + 1
+        faces[at_points[inner]] = face[nxt[inner]]
+        bary[at_points[inner]] = bary0[nxt[inner]]
+        offsets = np.concatenate([[0], np.cumsum(counts + 1)]).astype(np.int64)
+        return Chains(
+            points=points.astype(np.float32),
+            face=faces.astype(np.int64),
+            bary=bary.astype(np.float32),
+            start=offsets,
+            id=ids,
+            family=_family_names(self.chain_family_code[ids]),
+            visible=self.chain_visible[ids].astype(bool),
+        )
 
     @property
     def segments(self) -> np.ndarray:
@@ -660,6 +726,35 @@ class LineView:
         if visible_only:
             keep &= self.visible
         return np.stack([self.a[keep], self.b[keep]], axis=1)
+
+
+@dataclass
+class Chains:
+    """Chains of a :class:`LineView` as polylines (:meth:`LineView.chains`):
+    ``points`` (N, 3) float32, chain after chain; ``start`` (K + 1,) int64
+    each chain's first index into ``points``; ``face`` (N,) int64 and
+    ``bary`` (N, 3) float32 each point's face and barycentric coordinates
+    in it (-1 and zeros for a line on no face); ``id`` (K,) uint32 each
+    chain's number (the ``chain`` of its pieces); ``family`` (K,) str;
+    ``visible`` (K,) bool. ``len(chains)`` is K, ``chains[k]`` the points of
+    chain k, and iterating gives each chain's points."""
+
+    points: np.ndarray
+    face: np.ndarray
+    bary: np.ndarray
+    start: np.ndarray
+    id: np.ndarray
+    family: np.ndarray
+    visible: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.id)
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        return self.points[self.start[k] : self.start[k + 1]]
+
+    def __iter__(self):
+        return iter(np.split(self.points, self.start[1:-1]))
 
 
 #: The earlier name of the result of :func:`lines` from one eye, kept so
@@ -914,6 +1009,8 @@ def _line_view(d: dict) -> LineView:
     if "ndotv" in d:
         fields = {k: d.pop(k) for k in ("ndotv", "kr", "dwkr", "q1")}
     d["visible"] = d["visible"].astype(bool)
+    d["chain_reversed"] = d["chain_reversed"].astype(bool)
+    d["chain_visible"] = d["chain_visible"].astype(bool)
     return LineView(family=_family_names(d["family_code"]), fields=fields, **d)
 
 

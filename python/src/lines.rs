@@ -8,10 +8,9 @@
 use super::*;
 use pyo3::types::{PyBytes, PyList};
 use shapecue::api::{
-    Camera, CameraDefaults, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot,
-    ViewFields, ViewSpec, VisibilityMethod, check_fov, fibonacci_views, LineFiles,
-    lines_on, lines_views_scene,
-    load_camera_file, parse_camera_file, segment_arrays,
+    Camera, CameraDefaults, LineFiles, LineOptions, LineSetup, LineView, LinesPictureOptions, Shot,
+    ViewFields, ViewSpec, VisibilityMethod, VisibleLines, check_fov, fibonacci_views, lines_on,
+    lines_views_scene, load_camera_file, parse_camera_file, segment_arrays,
 };
 use shapecue::export::npz::{SegmentArrays, fields_npz_bytes, segments_npz_bytes};
 use shapecue::spec::feature_lines::{CurveOptions, FamilySet, FeatureSize, LineFamily};
@@ -308,11 +307,54 @@ pub fn family_codes() -> Vec<(u32, &'static str)> {
     shapecue::spec::feature_lines::family_codes()
 }
 
+/// The chains of a view in walking order: each chain's pieces (rows of
+/// the view's arrays) one after another, as the command line's segments
+/// document lists them, with whether each is walked from `b` to `a`.
+struct Walk {
+    /// The rows, chain after chain, each chain's in walking order.
+    order: Vec<u32>,
+    /// Per row of `order`: walked from its `b` to its `a` (1) or not (0).
+    reversed: Vec<u8>,
+    /// Each chain's first index into `order`, and one past the last.
+    start: Vec<u32>,
+    /// Each chain's family or layer code.
+    family: Vec<u32>,
+    /// Each chain's visibility (1 visible).
+    visible: Vec<u8>,
+}
+
+impl Walk {
+    /// The walk of `vis`'s chains (its pieces are the rows).
+    fn of(vis: &VisibleLines) -> Walk {
+        let n = vis.chain_pieces.len();
+        let mut w = Walk {
+            order: Vec::with_capacity(n),
+            reversed: Vec::with_capacity(n),
+            start: Vec::with_capacity(vis.chains.len() + 1),
+            family: Vec::with_capacity(vis.chains.len()),
+            visible: Vec::with_capacity(vis.chains.len()),
+        };
+        for c in &vis.chains {
+            w.start.push(w.order.len() as u32);
+            w.family.push(c.layer);
+            w.visible.push(u8::from(c.visible));
+            for &(i, reversed) in &c.pieces {
+                w.order.push(i);
+                w.reversed.push(u8::from(reversed));
+            }
+        }
+        w.start.push(w.order.len() as u32);
+        w
+    }
+}
+
 /// One view of [`lines_views`], its pieces as the command line's arrays.
 struct ViewOut {
     /// The pieces ([`segment_arrays`], as the command line's NPZ and
     /// segments document hold them).
     arrays: SegmentArrays,
+    /// The chains in walking order ([`Walk`]).
+    walk: Walk,
     /// The per-vertex fields, where asked.
     fields: Option<ViewFields>,
     /// The bytes of the view's `_segments.npz` and, with the fields, its
@@ -336,6 +378,7 @@ impl ViewOut {
             Error::InvalidArgument("internal: the view was not classified".into())
         })?;
         let arrays = segment_arrays(vis, mesh);
+        let walk = Walk::of(vis);
         let npz = if npz {
             let fields = v.fields.as_ref().map(fields_npz_bytes).transpose()?;
             Some((segments_npz_bytes(&arrays)?, fields))
@@ -354,6 +397,7 @@ impl ViewOut {
             kernel_ms: sum(Some("kernel")),
             passes: v.passes.iter().map(|p| p.pass.name()).collect(),
             arrays,
+            walk,
             fields: v.fields,
             camera: v.camera,
             feature_size: v.feature_size,
@@ -376,6 +420,13 @@ impl ViewOut {
         d.set_item("face", array(py, s.face, &[n])?)?;
         let bary: Vec<f32> = s.bary.iter().flatten().flatten().copied().collect();
         d.set_item("bary", array(py, bary, &[n, 2, 3])?)?;
+        let w = self.walk;
+        let (k, c) = (w.order.len(), w.visible.len());
+        d.set_item("chain_order", array(py, w.order, &[k])?)?;
+        d.set_item("chain_reversed", array(py, w.reversed, &[k])?)?;
+        d.set_item("chain_start", array(py, w.start, &[c + 1])?)?;
+        d.set_item("chain_family_code", array(py, w.family, &[c])?)?;
+        d.set_item("chain_visible", array(py, w.visible, &[c])?)?;
         if let Some(f) = self.fields {
             let nv = f.ndotv.len();
             d.set_item("ndotv", array(py, f.ndotv, &[nv])?)?;

@@ -426,3 +426,60 @@ def test_one_eye_is_the_command_lines_picture(device, cli, mesh, tmp_path):
         np.testing.assert_array_equal(view.segments[:, 1], view.b)
     # Visibility is compared, not only its default: some pieces are hidden.
     assert hidden > 0
+
+
+def test_chains_are_polylines_in_the_command_lines_walking_order(device, cli, tmp_path):
+    """LineView.chains(): each chain an ordered polyline whose pieces are
+    the rows the command line's segments document lists for it, in its
+    order; consecutive pieces meet (each walked the right way round), every
+    point rebuilt from its face and barycentric coordinates, and a family
+    or the hidden chains asked for alone."""
+    import json
+    import subprocess
+    from conftest import REPO
+
+    path = REPO / "data" / "spot.obj"
+    v, f = shapecue.load_mesh(path)
+    fams = "contours,suggestive,ridges,valleys"
+    seg = tmp_path / "s.json"
+    run = subprocess.run([cli, "lines", str(path), "-o", str(tmp_path / "x.svg"), "--segments", str(seg),
+                          "--lines", fams], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(seg.read_text())
+    view = shapecue.lines(v, f, lines=fams)
+    # The walk is the document's chains, concatenated.
+    assert len(view.chain_visible) == len(doc["chains"]) > 50
+    assert view.chain_order.tolist() == [i for c in doc["chains"] for i in c["segments"]]
+    assert view.chain_visible.tolist() == [c["visible"] for c in doc["chains"]]
+    every = view.chains(visible_only=False)
+    assert len(every) == len(doc["chains"])
+    assert every.id.tolist() == list(range(len(every)))
+    assert every.family.tolist() == [c["family"] for c in doc["chains"]]
+    assert len(every.points) == len(view.a) + len(every)
+    diag = float(np.linalg.norm(v.max(0) - v.min(0)))
+    longest = 0
+    for k, pts in enumerate(every):
+        rows = view.chain_order[view.chain_start[k]:view.chain_start[k + 1]]
+        assert len(pts) == len(rows) + 1
+        assert np.all(view.chain[rows] == k)
+        # Consecutive pieces meet: the polyline's points are its pieces'
+        # ends, each piece walked from the point before it.
+        ends = np.stack([view.a[rows], view.b[rows]], 1)
+        rev = view.chain_reversed[view.chain_start[k]:view.chain_start[k + 1]]
+        walked = np.where(rev[:, None, None], ends[:, ::-1], ends)
+        assert np.allclose(walked[:, 0], pts[:-1], atol=1e-4 * diag)
+        assert np.allclose(walked[:, 1], pts[1:], atol=1e-4 * diag)
+        longest = max(longest, len(rows))
+    assert longest > 10
+    # Each point from its face and barycentric coordinates.
+    on = every.face >= 0
+    assert on.mean() > 0.99
+    rebuilt = (every.bary[on, :, None] * v[f[every.face[on]]]).sum(1)
+    assert np.allclose(rebuilt, every.points[on], atol=1e-4 * diag)
+    # One family, visible chains only (the default), and the hidden ones.
+    ridges = view.chains("ridges")
+    assert len(ridges) > 0 and set(ridges.family) == {"ridges"} and ridges.visible.all()
+    assert len(ridges) == sum(c["family"] == "ridges" and c["visible"] for c in doc["chains"])
+    assert len(view.chains()) == int(view.chain_visible.sum()) < len(every)
+    with pytest.raises(ValueError, match="creases"):
+        view.chains("creases")

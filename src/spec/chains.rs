@@ -363,7 +363,9 @@ mod tests {
     #[test]
     fn keys_sorted_in_runs_are_sorted_whatever_the_runs() {
         // A scrambled sequence with repeats.
-        let keys: Vec<u128> = (0..100_003u128).map(|i| (i * 7_919 + 13) % 65_537).collect();
+        let keys: Vec<u128> = (0..100_003u128)
+            .map(|i| (i * 7_919 + 13) % 65_537)
+            .collect();
         let mut want = keys.clone();
         want.sort_unstable();
         for threads in [1, 2, 3, 5, 8] {
