@@ -118,6 +118,51 @@ def _mesh_arrays(vertices: Any, faces: Any) -> Tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
+def _is_several(vertices: Any, faces: Any) -> bool:
+    """Whether ``vertices`` is a list of meshes (each a mesh file, a
+    ``(vertices, faces)`` pair or an object with ``.vertices`` and
+    ``.faces``), not the vertices of one."""
+    if faces is not None or not isinstance(vertices, list) or not vertices:
+        return False
+
+    def one(m: Any) -> bool:
+        if isinstance(m, (str, os.PathLike)) or hasattr(m, "faces"):
+            return True
+        return isinstance(m, tuple) and len(m) == 2
+    return all(one(m) for m in vertices)
+
+
+def _several(meshes: list, normals: Any) -> Tuple["_shapecue._Mesh", np.ndarray]:
+    """The meshes of a list joined into one (their faces' vertex indices
+    shifted past the meshes before), so that each hides the others, and
+    each mesh's first face in the joined faces (one more entry: the total).
+    A file keeps the normals it stores (``normals="file"``) where every
+    mesh of the list stores some; else the normals come from the faces."""
+    if not isinstance(normals, str):
+        raise ValueError(
+            "normals: with several meshes give 'file' (the normals the files store) or "
+            "'computed' (from the faces)"
+        )
+    vs, fs, ns = [], [], []
+    for k, m in enumerate(meshes):
+        if isinstance(m, (str, os.PathLike)):
+            v, f, n = load_mesh(m, normals=normals, return_normals=True)
+        else:
+            v, f = _mesh_arrays(*(m if isinstance(m, tuple) else (m, None)))
+            n = None
+        if len(f) == 0:
+            raise ValueError(f"meshes[{k}]: has no faces")
+        vs.append(np.asarray(v, dtype=np.float64))
+        fs.append(np.asarray(f, dtype=np.int64))
+        ns.append(n)
+    shift = np.cumsum([0] + [len(v) for v in vs[:-1]])
+    faces = np.concatenate([f + d for f, d in zip(fs, shift)])
+    first = np.cumsum([0] + [len(f) for f in fs]).astype(np.int64)
+    stored = normals == "file" and all(n is not None for n in ns)
+    n = np.concatenate(ns).astype(np.float64) if stored else normals
+    return _shapecue.mesh_from_arrays(np.concatenate(vs), faces, n), first
+
+
 def _mesh(vertices: Any, faces: Any, normals: Any) -> "_shapecue._Mesh":
     """The mesh of a call that takes ``normals``, as the library holds it: a
     mesh file (``vertices`` a path, no ``faces``) read by the library's
@@ -617,6 +662,11 @@ class LineView:
     with ``"edge"`` the median edge length, or the length given.
     ``device``: the device's name.
 
+    From a list of meshes (``lines([mesh_a, mesh_b, ...])``): ``mesh`` (P,)
+    int32 the mesh of the list each piece lies on and ``mesh_face`` (P,)
+    int64 its face in that mesh (``face`` and ``faces`` number the faces of
+    the meshes one after another); None otherwise.
+
     The chains in walking order: ``chain_order`` (P,) uint32 the rows,
     chain after chain, each chain's as it is walked (the ``chains`` of the
     segments document, concatenated); ``chain_reversed`` (P,) bool whether
@@ -653,6 +703,8 @@ class LineView:
     chain_family_code: np.ndarray
     chain_visible: np.ndarray
     npz: Optional[dict] = None
+    mesh: Optional[np.ndarray] = None
+    mesh_face: Optional[np.ndarray] = None
 
     def chains(self, family: Optional[str] = None, visible_only: bool = True) -> "Chains":
         """The chains as polylines, each an ordered array of points (one
@@ -962,7 +1014,11 @@ def lines(
     as trimesh2 (and so rtsc) does; "exact" is the exact least-squares solve.
 
     ``vertices`` may also be a mesh file (.obj/.ply/.off), read by the
-    library's loader as ``shapecue lines FILE`` reads it. ``normals``: the
+    library's loader as ``shapecue lines FILE`` reads it, or a list of
+    meshes (each a file, a ``(vertices, faces)`` pair or an object with
+    ``.vertices`` and ``.faces``), drawn together so that each hides the
+    others' lines: each piece names its mesh (``mesh``) and its face there
+    (``mesh_face``). ``normals``: the
     vertex normals the curvature, and so every line family, starts from, as
     ``--normals`` on the command line: for a file "file" (the default: those
     it stores, OBJ ``vn`` or PLY ``nx ny nz``, as rtsc uses them; from the
@@ -973,7 +1029,11 @@ def lines(
     lines and its arrays with those normals (``load_mesh(path,
     return_normals=True)``) give the same rows.
     """
-    mesh = _mesh(vertices, faces, normals)
+    first_face = None
+    if _is_several(vertices, faces):
+        mesh, first_face = _several(vertices, normals)
+    else:
+        mesh = _mesh(vertices, faces, normals)
     names = lines if isinstance(lines, str) else ",".join(lines)
     thresholds = (
         float(sc_threshold),
@@ -1000,11 +1060,17 @@ def lines(
         mesh, names, text, file, n, shot, (float(fov), bool(ortho), w, h),
         thresholds, levels, l3, switches, setup, bool(fields), bool(npz), _device(device),
     )
-    out = [_line_view(d) for d in views]
+    out = [_line_view(d, first_face) for d in views]
     return out if cameras is not None else out[0]
 
 
-def _line_view(d: dict) -> LineView:
+def _line_view(d: dict, first_face: Optional[np.ndarray] = None) -> LineView:
+    if first_face is not None:
+        # Each piece's mesh of the list, and its face in that mesh.
+        on = d["face"] >= 0
+        of = np.searchsorted(first_face, np.where(on, d["face"], d["faces"][:, 0]), "right") - 1
+        d["mesh"] = of.astype(np.int32)
+        d["mesh_face"] = np.where(on, d["face"] - first_face[of], -1)
     fields = None
     if "ndotv" in d:
         fields = {k: d.pop(k) for k in ("ndotv", "kr", "dwkr", "q1")}

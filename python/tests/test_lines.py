@@ -483,3 +483,40 @@ def test_chains_are_polylines_in_the_command_lines_walking_order(device, cli, tm
     assert len(view.chains()) == int(view.chain_visible.sum()) < len(every)
     with pytest.raises(ValueError, match="creases"):
         view.chains("creases")
+
+
+def test_several_meshes_hide_each_other_and_each_piece_names_its_mesh(device, tmp_path):
+    """lines([a, b]) draws the meshes together: the same rows as the meshes
+    joined into one by hand, each piece naming its mesh and its face there,
+    and the mesh in front hiding lines of the one behind it."""
+    from conftest import write_obj
+
+    v0, f0 = torus(nu=60, nv=30)
+    v1 = v0 + [0.4, 0.3, -2.5]
+    f1 = f0.copy()
+    eye = (0.0, 0.0, 6.0)
+    kw = dict(lines="contours,suggestive,ridges", eye=eye, target=(0.0, 0.0, -1.0))
+    path = tmp_path / "behind.obj"
+    write_obj(path, v1, f1)
+    both = shapecue.lines([(v0, f0), path], **kw)
+    joined = shapecue.lines(np.concatenate([v0, v1]), np.concatenate([f0, f1 + len(v0)]), **kw)
+    for name in ("a", "b", "visible", "face", "chain_order"):
+        np.testing.assert_array_equal(getattr(both, name), getattr(joined, name), err_msg=name)
+    assert joined.mesh is None
+    assert set(both.mesh.tolist()) == {0, 1}
+    np.testing.assert_array_equal(both.mesh_face, both.face - np.where(both.mesh == 1, len(f0), 0))
+    for k, (v, f) in enumerate([(v0, f0), (v1, f1)]):
+        rows = both.mesh == k
+        assert np.all((both.mesh_face[rows] >= 0) & (both.mesh_face[rows] < len(f)))
+        rebuilt = (both.bary[rows, 0, :, None] * v[f[both.mesh_face[rows]]]).sum(1)
+        np.testing.assert_allclose(rebuilt, both.a[rows], atol=1e-4)
+    # The torus in front hides part of the one behind: less of its length
+    # is visible than when it is drawn alone.
+    alone = shapecue.lines(v1, f1, **kw)
+    length = lambda a, b, keep: float(np.linalg.norm(b[keep] - a[keep], axis=1).sum())  # noqa: E731
+    behind = both.mesh == 1
+    seen_alone = length(alone.a, alone.b, alone.visible)
+    seen_behind = length(both.a, both.b, behind & both.visible)
+    assert seen_behind < 0.8 * seen_alone, (seen_behind, seen_alone)
+    with pytest.raises(ValueError, match="several meshes"):
+        shapecue.lines([(v0, f0), (v1, f1)], normals=np.zeros((3, 3)))
