@@ -33,8 +33,10 @@ import numpy as np
 
 from . import _shapecue
 from ._shapecue import DeviceError, RenderError
+from .cameras import blender_camera, camera_from_matrix, from_blender
 
 __all__ = [
+    "Chains",
     "Curvature",
     "CurvatureEstimator",
     "DeviceError",
@@ -42,15 +44,17 @@ __all__ = [
     "FeatureEdges",
     "Isosurface",
     "LINE_FAMILIES",
-    "Chains",
     "LineView",
     "Lines",
     "RenderError",
     "Volume",
+    "blender_camera",
     "build_kernels",
+    "camera_from_matrix",
     "curvature",
     "devices",
     "feature_edges",
+    "from_blender",
     "isosurface",
     "lines",
     "load_mesh",
