@@ -810,6 +810,8 @@ class Chains:
         return self.points[self.start[k] : self.start[k + 1]]
 
     def __iter__(self):
+        if len(self) == 0:
+            return iter([])
         return iter(np.split(self.points, self.start[1:-1]))
 
 

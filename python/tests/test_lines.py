@@ -483,6 +483,9 @@ def test_chains_are_polylines_in_the_command_lines_walking_order(device, cli, tm
     assert len(view.chains()) == int(view.chain_visible.sum()) < len(every)
     with pytest.raises(ValueError, match="creases"):
         view.chains("creases")
+    # A family with no chain (a closed mesh has no boundary): none at all.
+    none = shapecue.lines(v, f, lines="contours,boundaries").chains("boundaries")
+    assert len(none) == 0 and list(none) == [] and none.points.shape == (0, 3)
 
 
 def test_several_meshes_hide_each_other_and_each_piece_names_its_mesh(device, tmp_path):
