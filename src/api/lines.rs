@@ -295,6 +295,48 @@ pub fn lines_on(
     }
 }
 
+/// Runs `produce` with a consumer thread beside it: each item `produce`
+/// hands over goes to `consume(&mut state, item)` on that thread, in order,
+/// with at most one item waiting, so that one view's files are written while
+/// the next view is computed (`shapecue lines --views`, `report
+/// lines-batch`). The first error stops both: the consumer's, when it
+/// failed (`produce` then sees a closed channel), else `produce`'s. Returns
+/// the state once every item handed over is consumed, or the consumer has
+/// stopped.
+pub fn with_consumer<T: Send, S: Send, R>(
+    state: S,
+    mut consume: impl FnMut(&mut S, T) -> Result<()> + Send,
+    produce: impl FnOnce(&mut dyn FnMut(T) -> Result<()>) -> Result<R>,
+) -> (Result<R>, S) {
+    let (tx, rx) = std::sync::mpsc::sync_channel::<T>(1);
+    std::thread::scope(|scope| {
+        let consumer = scope.spawn(move || {
+            let mut state = state;
+            let mut failed = None;
+            for item in rx {
+                if let Err(e) = consume(&mut state, item) {
+                    failed = Some(e);
+                    break;
+                }
+            }
+            (state, failed)
+        });
+        let produced = produce(&mut |item| {
+            // A closed channel means the consumer stopped on an error, which
+            // is the one reported.
+            tx.send(item).map_err(|_| crate::error::Error::Interrupted)
+        });
+        drop(tx);
+        let (state, failed) = consumer
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        match failed {
+            Some(e) => (Err(e), state),
+            None => (produced, state),
+        }
+    })
+}
+
 /// The segments of [`line_segments_on`].
 pub struct LineSegments {
     /// Every segment, world coordinates, with its family (`kind`) and strength.

@@ -71,7 +71,7 @@ pub use crate::stages::feature_lines::LineOptions;
 pub use lines::{
     Hidden, LineFiles, LineSegments, LineSetup, LineView, LinesPicture, LinesPictureOptions,
     family_style, hidden_id, line_segments_on, lines_on, lines_picture, lines_picture_on,
-    lines_scene, lines_views_scene, segment_arrays, wanted,
+    lines_scene, lines_views_scene, segment_arrays, wanted, with_consumer,
 };
 
 pub use strokes::{

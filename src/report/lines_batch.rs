@@ -11,8 +11,8 @@
 use super::metrics::median;
 use super::{Block, Cell, Chart, Column, Report, Row, Table};
 use crate::api::{
-    CameraDefaults, ExecOptions, LineFiles, LinesPictureOptions, fibonacci_views, lines_on,
-    lines_views_scene, segment_arrays,
+    CameraDefaults, ExecOptions, LineFiles, LinesPictureOptions, VisibleLines, fibonacci_views,
+    lines_on, lines_views_scene, segment_arrays, with_consumer,
 };
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -64,9 +64,9 @@ pub fn default_meshes() -> Vec<PathBuf> {
 struct Timed {
     /// Wall ms of the pose part (every pose pass, once).
     pose_ms: f64,
-    /// Wall ms between one view handed over and the next, after the first
-    /// (its passes, the SVG, and waiting for the writer thread when the NPZ
-    /// takes longer than the next view).
+    /// Wall ms from one view's NPZ done to the next's, after the first:
+    /// the rate views come out with every file written (at least the view's
+    /// own NPZ ms).
     view_ms: Vec<f64>,
     /// Each view's device ms: the kernel time of its passes.
     device_ms: Vec<f64>,
@@ -93,7 +93,8 @@ pub fn report(gpu: &Arc<Gpu>, o: &LinesBatchOptions) -> Result<Report> {
          pieces as NPZ written per view, as the command writes them: on a writer thread beside \
          the next view. Pose: wall ms of the passes that run once (one-rings, normals, \
          curvature and its derivative, the feature size, the BVH). Per view: median wall ms \
-         from one view to the next, over the views after the first (views/s from it); of a \
+         from one view's files done to the next's, over the views after the first (views/s \
+         from it); of a \
          view's passes, the device ms (kernel time) and the host ms (their wall time less the \
          kernels: the visibility plan and rounds, chains, the SVG); and the NPZ on the writer \
          thread (the pieces' arrays with their faces and barycentric coordinates, and the \
@@ -226,46 +227,38 @@ fn measure(
         force: true,
         ..Default::default()
     };
-    let (tx, rx) = std::sync::mpsc::sync_channel::<(usize, crate::api::VisibleLines)>(1);
-    let mut handed: Vec<Instant> = Vec::with_capacity(views);
     let mut device_ms = vec![0.0; views];
-    let (run, written) = std::thread::scope(|scope| {
-        let dir = &dir;
-        let writer = scope.spawn(move || -> Result<(Vec<f64>, usize)> {
-            let (mut npz_ms, mut pieces) = (Vec::new(), 0usize);
-            for (view, vis) in rx {
-                let t = Instant::now();
-                let a = segment_arrays(&vis, m);
-                pieces += a.a.len();
-                let p = dir.join(format!("view_{view:04}.npz"));
-                crate::export::npz::write_segments(&p, &a)?;
-                npz_ms.push(t.elapsed().as_secs_f64() * 1e3);
-            }
-            Ok((npz_ms, pieces))
-        });
-        let run = lines_on(gpu, &scene, LineFiles::Folder(&exec), &mut |v| {
-            handed.push(Instant::now());
+    // The NPZ on a writer thread beside the next view, as the command
+    // writes it: its ms per view, the pieces written, and when each view's
+    // file was done.
+    let write = |w: &mut Written, (view, vis): (usize, VisibleLines)| {
+        let t = Instant::now();
+        let a = segment_arrays(&vis, m);
+        w.pieces += a.a.len();
+        crate::export::npz::write_segments(&dir.join(format!("view_{view:04}.npz")), &a)?;
+        w.npz_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        w.done.push(Instant::now());
+        Ok(())
+    };
+    let (run, written) = with_consumer(Written::default(), write, |each| {
+        lines_on(gpu, &scene, LineFiles::Folder(&exec), &mut |v| {
             device_ms[v.view] = (v.passes.iter())
                 .filter(|p| p.lifetime == Lifetime::View && p.is_kernel())
                 .map(|p| p.timing.kernel_ms)
                 .sum();
             match v.visible {
-                Some(vis) => tx.send((v.view, vis)).map_err(|_| Error::Interrupted),
+                Some(vis) => each((v.view, vis)),
                 None => Ok(()),
             }
-        });
-        drop(tx);
-        let written = writer
-            .join()
-            .unwrap_or_else(|p| std::panic::resume_unwind(p));
-        (run, written)
+        })
     });
     let _ = std::fs::remove_dir_all(&dir);
-    let (npz_ms, pieces) = written?;
     let rep = run?;
     let laps = rep.timing.laps("view_wall");
     let first = 1.min(laps.len().saturating_sub(1));
-    let view_ms: Vec<f64> = (handed.windows(2))
+    // From one view's file done to the next's: each at least that view's
+    // NPZ, which starts after the view before it is done.
+    let view_ms: Vec<f64> = (written.done.windows(2))
         .map(|w| (w[1] - w[0]).as_secs_f64() * 1e3)
         .collect();
     let host_ms = (laps.iter().zip(&device_ms))
@@ -277,9 +270,20 @@ fn measure(
         view_ms,
         device_ms: device_ms[first.min(views)..].to_vec(),
         host_ms,
-        npz_ms: npz_ms[first.min(npz_ms.len())..].to_vec(),
-        pieces: pieces as f64 / views.max(1) as f64,
+        npz_ms: written.npz_ms[first.min(written.npz_ms.len())..].to_vec(),
+        pieces: written.pieces as f64 / views.max(1) as f64,
     })
+}
+
+/// What the writer thread of [`measure`] keeps.
+#[derive(Default)]
+struct Written {
+    /// Each view's NPZ ms, in view order.
+    npz_ms: Vec<f64>,
+    /// Pieces written over all views.
+    pieces: usize,
+    /// When each view's file was done.
+    done: Vec<Instant>,
 }
 
 /// A fresh scratch folder of this process.

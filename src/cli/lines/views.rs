@@ -12,7 +12,7 @@ use anyhow::{Result, bail};
 use serde_json::{Value, json};
 use shapecue::api::{
     CameraDefaults, ExecOptions, Gpu, LineFiles, LineView, MAX_VIEWS, RunReport, fibonacci_views,
-    lines_on, lines_views_scene, load_camera_file, output_paths,
+    lines_on, lines_views_scene, load_camera_file, output_paths, with_consumer,
 };
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -351,44 +351,16 @@ fn beside_svg(svg: &Path, what: &str) -> PathBuf {
     svg.with_file_name(format!("{stem}_{what}"))
 }
 
-/// Runs `compute` with a writer thread beside it: each view `compute`
-/// hands over goes to `run.view` on that thread (in order, at most one view
-/// waiting), so that a view's files are written, hashed and listed while the
-/// next view is computed. The first error stops both: the writer's, when it
-/// failed, else `compute`'s. Returns the run back once every view handed
-/// over is written (or the writer has stopped).
+/// Runs `compute` with a writer thread beside it ([`with_consumer`]):
+/// each view `compute` hands over goes to `run.view` on that thread, so that
+/// a view's files are written, hashed and listed while the next view is
+/// computed. Returns the run back once every view handed over is written
+/// (or the writer has stopped on its error, the one reported).
 fn with_writer<'a, T>(
     run: ViewsRun<'a>,
     compute: impl FnOnce(&mut dyn FnMut(LineView) -> shapecue::Result<()>) -> shapecue::Result<T>,
 ) -> (shapecue::Result<T>, ViewsRun<'a>) {
-    let (tx, rx) = std::sync::mpsc::sync_channel::<LineView>(1);
-    std::thread::scope(|scope| {
-        let writer = scope.spawn(move || {
-            let mut run = run;
-            let mut failed = None;
-            for v in rx {
-                if let Err(e) = run.view(v) {
-                    failed = Some(e);
-                    break;
-                }
-            }
-            (run, failed)
-        });
-        let computed = compute(&mut |v| {
-            // A closed channel means the writer stopped on an error, which
-            // is the one reported.
-            tx.send(v).map_err(|_| shapecue::Error::Interrupted)
-        });
-        drop(tx);
-        let (run, failed) = match writer.join() {
-            Ok(joined) => joined,
-            Err(panic) => std::panic::resume_unwind(panic),
-        };
-        match failed {
-            Some(e) => (Err(e), run),
-            None => (computed, run),
-        }
-    })
+    with_consumer(run, |run, v| run.view(v), compute)
 }
 
 /// What the run gathers view by view.
