@@ -490,15 +490,60 @@ fn render_all(
         views: opts.views.as_deref(),
     };
     let timing = run_frames(&mut ex, scene, &plan, laps, calls)?;
+    let run = RunDone {
+        frames,
+        notes,
+        t_all,
+        timing,
+        uploads_before,
+    };
+    let report = run_report(&mut ex, scene, &plan, &gpu, run);
+    // The next scene of the session draws with the same GL context.
+    if let Some(r) = ex.into_renderer() {
+        session.renderer = Some(r);
+    }
+    if let Some(o) = outputs {
+        let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
+        crate::export::output::write_bytes_atomic(&o.report, json.as_bytes())?;
+    }
+    Ok(report)
+}
 
+/// What a run's report takes from its walk besides the executor: the
+/// frames run, what loading said, when the run started, the walk's laps,
+/// and the GL uploads before it.
+struct RunDone {
+    frames: Vec<usize>,
+    notes: Vec<String>,
+    t_all: Instant,
+    timing: crate::spec::timing::Timing,
+    uploads_before: crate::render::Uploads,
+}
+
+/// The report of a run walked by `ex`: the passes in plan order with their
+/// kernel time summed, the counts, the notes and outputs, the timing.
+fn run_report(
+    ex: &mut Executor<'_, '_>,
+    scene: &Scene,
+    plan: &Plan,
+    gpu: &Gpu,
+    run: RunDone,
+) -> RunReport {
+    let RunDone {
+        frames,
+        notes,
+        t_all,
+        timing,
+        uploads_before,
+    } = run;
     let (vertices, faces) = ex.counts();
-    let passes = ex.rec.in_plan_order(&plan);
+    let passes = ex.rec.in_plan_order(plan);
     // The run's kernel time: its kernel passes' (the laps are wall time).
     let kernel_ms = (passes.iter())
         .filter(|p| p.is_kernel())
         .map(|p| p.ms())
         .sum();
-    let report = RunReport {
+    RunReport {
         scene: scene.path.display().to_string(),
         device: gpu.info.name.clone(),
         renderer: ex.gl_info(),
@@ -529,16 +574,7 @@ fn render_all(
             kernel_ms,
             ..timing
         },
-    };
-    // The next scene of the session draws with the same GL context.
-    if let Some(r) = ex.into_renderer() {
-        session.renderer = Some(r);
     }
-    if let Some(o) = outputs {
-        let json = serde_json::to_string_pretty(&report).expect("the report serializes") + "\n";
-        crate::export::output::write_bytes_atomic(&o.report, json.as_bytes())?;
-    }
-    Ok(report)
 }
 
 /// What the frame loop walks: the frames, each view's images, and the
