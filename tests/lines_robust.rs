@@ -155,19 +155,15 @@ fn a_triangle_soup_says_so_and_draws_once_welded() {
         .collect();
     let soup = write(&dir, "soup.obj", obj_text(positions, &faces));
     let run = |extra: &[&str], out: &str| {
-        let o = cli_no_gl(&dir)
-            .args(["lines", "--lines", "contours,k-zero"])
-            .arg(&soup)
-            .args(extra)
-            .arg("-o")
-            .arg(dir.join(out))
-            .output()
-            .unwrap();
-        common::assert_succeeded(&o);
-        (
-            String::from_utf8_lossy(&o.stdout).into_owned(),
-            String::from_utf8_lossy(&o.stderr).into_owned(),
-        )
+        let (o, said) = common::succeeded(
+            cli_no_gl(&dir)
+                .args(["lines", "--lines", "contours,k-zero"])
+                .arg(&soup)
+                .args(extra)
+                .arg("-o")
+                .arg(dir.join(out)),
+        );
+        (said, String::from_utf8_lossy(&o.stderr).into_owned())
     };
     let (said, warned) = run(&[], "soup.svg");
     assert!(said.contains("no segments"), "{said}");

@@ -317,19 +317,27 @@ fn outputs_decide_the_drawing_passes() {
         assert!(!png.contains(Pass::Bvh) && !png.contains(Pass::Visibility));
         // An SVG with exact visibility: no render (no GL), no caps, no
         // shading normals; the BVH per pose and the visibility per view.
+        // Each pass planned or not, as listed.
+        let planned = |plan: &shapecue::scene::planner::Plan, what: &str, list: &[(Pass, bool)]| {
+            for &(pass, on) in list {
+                assert_eq!(plan.contains(pass), on, "{what} {input:?} {pass:?}");
+            }
+        };
         let svg = p(out(false, true, Exact));
-        for (pass, planned) in [
-            (Pass::Render, false),
-            (Pass::Caps, false),
-            (Pass::CapBuffer, false),
-            (Pass::Bvh, true),
-            (Pass::Visibility, true),
-            (Pass::Svg, true),
-            (Pass::Edges, true),
-            (Pass::Contours, true),
-        ] {
-            assert_eq!(svg.contains(pass), planned, "{input:?} {pass:?}");
-        }
+        planned(
+            &svg,
+            "svg",
+            &[
+                (Pass::Render, false),
+                (Pass::Caps, false),
+                (Pass::CapBuffer, false),
+                (Pass::Bvh, true),
+                (Pass::Visibility, true),
+                (Pass::Svg, true),
+                (Pass::Edges, true),
+                (Pass::Contours, true),
+            ],
+        );
         assert_eq!(svg.reads(Pass::Svg), vec![Pass::Visibility]);
         let reads = svg.reads(Pass::Visibility);
         assert!(reads.contains(&Pass::Bvh) && reads.contains(&Pass::Contours));
@@ -359,17 +367,18 @@ fn outputs_decide_the_drawing_passes() {
             pieces: true,
             ..out(raster, false, visibility)
         };
-        let alone = p(pieces(false, Exact));
-        for (pass, planned) in [
-            (Pass::Render, false),
-            (Pass::Svg, false),
-            (Pass::Bvh, true),
-            (Pass::Visibility, true),
-            (Pass::Contours, true),
-            (Pass::Edges, true),
-        ] {
-            assert_eq!(alone.contains(pass), planned, "pieces {input:?} {pass:?}");
-        }
+        planned(
+            &p(pieces(false, Exact)),
+            "pieces",
+            &[
+                (Pass::Render, false),
+                (Pass::Svg, false),
+                (Pass::Bvh, true),
+                (Pass::Visibility, true),
+                (Pass::Contours, true),
+                (Pass::Edges, true),
+            ],
+        );
         let with_png = p(pieces(true, Exact));
         assert!(with_png.contains(Pass::Render) && with_png.contains(Pass::Visibility));
         assert!(!with_png.contains(Pass::Svg));

@@ -220,6 +220,15 @@ pub fn assert_succeeded(out: &Output) {
     );
 }
 
+/// Runs `cmd`, fails the test unless it succeeded (with its stderr), and
+/// returns its output with its stdout as text.
+pub fn succeeded(cmd: &mut Command) -> (Output, String) {
+    let out = cmd.output().expect("run the shapecue binary");
+    assert_succeeded(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    (out, stdout)
+}
+
 /// Runs the `shapecue` binary with `args` and returns what it did.
 pub fn run_cli<I, S>(args: I) -> Output
 where
