@@ -21,7 +21,9 @@
 // and suggestive contours, on faces with a corner facing the viewer, their
 // parts with sinθ·D_w κr / (n·v) ≥ `sc_thresh` (the threshold already
 // divided by the square of the feature size on the host), each faded by
-// r / (r + fade) (`fade` likewise scaled; 0: no fade).
+// r / (r + fade) (`fade` likewise scaled; 0: no fade). held uint[F], next
+// uint[F], low: the hysteresis of isoline.h (held faces test suggestive
+// contours against sc_thresh·low).
 
 inline void view_at(float px, float py, float pz, float ex, float ey, float ez, uint ortho,
                     float *vx, float *vy, float *vz)
@@ -80,13 +82,16 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
                          __global const float *sc, __global const float *gkr,
                          uint want_contours, uint want_suggestive, uint test, uint hermite,
                          float sc_thresh, float fade, uint cap, __global float *seg,
-                         __global uint *ends, volatile __global uint *counter)
+                         __global uint *ends, volatile __global uint *counter,
+                         __global const uint *held, __global uint *next, float low)
 {
     GID_OR_RETURN(nf);
     uint v[3];
     v[0] = faces[3 * gid];
     v[1] = faces[3 * gid + 1];
     v[2] = faces[3 * gid + 2];
+    const uint hb = held[gid];
+    uint drawn = 0;
     for (uint kind = 0; kind < 2; ++kind) {
         if ((kind == 0 && !want_contours) || (kind == 1 && !want_suggestive))
             continue;
@@ -131,9 +136,10 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
             dc = ndv[v[c]];
             da = ndv[v[a]];
             db = ndv[v[b]];
-            nc = sc[v[c]] - sc_thresh * dc;
-            na = sc[v[a]] - sc_thresh * da;
-            nb = sc[v[b]] - sc_thresh * db;
+            const float t = held_thr(hb, 1, sc_thresh, low);
+            nc = sc[v[c]] - t * dc;
+            na = sc[v[a]] - t * da;
+            nb = sc[v[b]] - t * db;
         }
         const float n0 = nc + ta * (na - nc), n1 = nc + tb * (nb - nc);
         const float d0 = dc + ta * (da - dc), d1 = dc + tb * (db - dc);
@@ -142,7 +148,9 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
         // segments chain into polylines exactly, by edge.
         const uint2 ea = (uint2)(min(v[c], v[a]), max(v[c], v[a]));
         const uint2 eb = (uint2)(min(v[c], v[b]), max(v[c], v[b]));
-        emit_tested(pa, pb, ea, eb, gid, n0, n1, d0, d1, test, kind == 0 ? 0.0f : fade, kind,
-                    cap, seg, ends, counter);
+        if (emit_tested(pa, pb, ea, eb, gid, n0, n1, d0, d1, test, kind == 0 ? 0.0f : fade, kind,
+                        cap, seg, ends, counter))
+            drawn |= 1u << kind;
     }
+    mark_drawn(next, gid, drawn);
 }

@@ -38,7 +38,9 @@
 // 3 Hermite placement of K = 0 and H = 0 (from grad), 4 of the suggestive
 // highlights' κr = 0 (from gkr, lines_vertex's ∇(κr sin²θ), float[3V]).
 // Thresholds (and sh_fade) arrive divided by the feature size (rv) or its
-// square (ar, ph, sh, sc).
+// square (ar, ph, sh, sc). held uint[F], next uint[F], low: the hysteresis
+// of isoline.h; held faces test ridges, valleys, apparent ridges and both
+// highlights against their threshold times `low` (their strength too).
 
 #define LF_RIDGES 2u
 #define LF_VALLEYS 3u
@@ -187,7 +189,7 @@ inline float ridge_w(float ea, float eb)
 // i1–i2 (or to the face centre). With `judd`, Judd et al.'s test of apparent
 // ridges: the direction of increasing q1 (t0, t1, t2 at i0, i1, i2) points
 // towards the segment at every corner, so the segment is a maximum.
-inline void ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const float *pos,
+inline uint ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const float *pos,
                           float thr, uint fade, bool centre, uint fam, bool judd, float3 t0,
                           float3 t1, float3 t2, uint cap, __global float *seg,
                           __global uint *ends, volatile __global uint *counter)
@@ -210,16 +212,17 @@ inline void ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const 
         eb = edge_of(vi.y, vi.z);
     }
     if (!(ka > thr) && !(kb > thr))
-        return;
+        return 0;
     if (judd) {
         // Towards i1 across the segment, in the face's plane.
         const float3 perp = cross(cross(p1 - p0, p2 - p0), pa - pb);
         if (!(dot(t0, perp) > 0.0f && dot(t1, perp) < 0.0f && dot(t2, perp) > 0.0f))
-            return;
+            return 0;
     }
     const float s = 0.5f * (ridge_strength(ka, thr, fade) + ridge_strength(kb, thr, fade));
     const uint2 ea = edge_of(vi.x, vi.y);
     emit(pa, pb, fam, s, (uint4)(ea, eb), cap, seg, ends, counter);
+    return 1;
 }
 
 // Zero crossings of t_i = sgn·e_i·dir_i across the face (Ohtake et al.'s
@@ -227,15 +230,15 @@ inline void ridge_segment(uint f, uint3 vi, float3 e, float3 kk, __global const 
 // extremum check: rtsc's lenient one for ridges and valleys (the direction
 // at either end of a crossed edge points across it the right way), Judd et
 // al.'s for apparent ridges (`judd`: every corner's direction points towards
-// the segment).
-inline void ridge_face(uint f, uint3 v, float3 e, float3 t0, float3 t1, float3 t2, float3 kk,
+// the segment). Returns the segments emitted.
+inline uint ridge_face(uint f, uint3 v, float3 e, float3 t0, float3 t1, float3 t2, float3 kk,
                        __global const float *pos, uint test, float thr, uint fade, uint fam,
                        bool judd, uint cap, __global float *seg, __global uint *ends,
                        volatile __global uint *counter)
 {
     bool z01 = dot(t0, t1) <= 0.0f, z12 = dot(t1, t2) <= 0.0f, z20 = dot(t2, t0) <= 0.0f;
     if ((uint)z01 + (uint)z12 + (uint)z20 < 2)
-        return;
+        return 0;
     const bool jt = judd && test;
     if (test && !judd) {
         const float3 p0 = ld3(pos, v.x), p1 = ld3(pos, v.y), p2 = ld3(pos, v.z);
@@ -243,27 +246,26 @@ inline void ridge_face(uint f, uint3 v, float3 e, float3 t0, float3 t1, float3 t
         z12 = z12 && (dot(t1, p2 - p1) >= 0.0f || dot(t2, p2 - p1) <= 0.0f);
         z20 = z20 && (dot(t2, p0 - p2) >= 0.0f || dot(t0, p0 - p2) <= 0.0f);
         if ((uint)z01 + (uint)z12 + (uint)z20 < 2)
-            return;
+            return 0;
     }
     const uint3 r1 = v.yzx, r2 = v.zxy;
     const float3 e1 = e.yzx, e2 = e.zxy, k1 = kk.yzx, k2 = kk.zxy;
     if (!z01)
-        ridge_segment(f, r1, e1, k1, pos, thr, fade, false, fam, jt, t1, t2, t0, cap, seg, ends,
-                      counter);
-    else if (!z12)
-        ridge_segment(f, r2, e2, k2, pos, thr, fade, false, fam, jt, t2, t0, t1, cap, seg, ends,
-                      counter);
-    else if (!z20)
-        ridge_segment(f, v, e, kk, pos, thr, fade, false, fam, jt, t0, t1, t2, cap, seg, ends,
-                      counter);
-    else {
-        ridge_segment(f, r1, e1, k1, pos, thr, fade, true, fam, jt, t1, t2, t0, cap, seg, ends,
-                      counter);
-        ridge_segment(f, r2, e2, k2, pos, thr, fade, true, fam, jt, t2, t0, t1, cap, seg, ends,
-                      counter);
-        ridge_segment(f, v, e, kk, pos, thr, fade, true, fam, jt, t0, t1, t2, cap, seg, ends,
-                      counter);
-    }
+        return ridge_segment(f, r1, e1, k1, pos, thr, fade, false, fam, jt, t1, t2, t0, cap, seg,
+                             ends, counter);
+    if (!z12)
+        return ridge_segment(f, r2, e2, k2, pos, thr, fade, false, fam, jt, t2, t0, t1, cap, seg,
+                             ends, counter);
+    if (!z20)
+        return ridge_segment(f, v, e, kk, pos, thr, fade, false, fam, jt, t0, t1, t2, cap, seg,
+                             ends, counter);
+    uint n = ridge_segment(f, r1, e1, k1, pos, thr, fade, true, fam, jt, t1, t2, t0, cap, seg,
+                           ends, counter);
+    n += ridge_segment(f, r2, e2, k2, pos, thr, fade, true, fam, jt, t2, t0, t1, cap, seg, ends,
+                       counter);
+    n += ridge_segment(f, v, e, kk, pos, thr, fade, true, fam, jt, t0, t1, t2, cap, seg, ends,
+                       counter);
+    return n;
 }
 
 
@@ -314,7 +316,7 @@ inline float3 lerp3(float3 a, float3 b, float t) { return a + t * (b - a); }
 
 // The segment of an isoline family through face v at edge parameters tt
 // from odd corner c.
-inline void iso_emit(uint3 v, uint c, float2 tt, __global const float *pos, uint fam, float s,
+inline uint iso_emit(uint3 v, uint c, float2 tt, __global const float *pos, uint fam, float s,
                      uint cap, __global float *seg, __global uint *ends,
                      volatile __global uint *counter)
 {
@@ -323,6 +325,7 @@ inline void iso_emit(uint3 v, uint c, float2 tt, __global const float *pos, uint
     const float3 pc = ld3(pos, ic);
     emit(lerp3(pc, ld3(pos, ia), tt.x), lerp3(pc, ld3(pos, ib), tt.y), fam, s,
          (uint4)(edge_of(ic, ia), edge_of(ic, ib)), cap, seg, ends, counter);
+    return 1;
 }
 
 inline float3 gather3(__global const float *a, uint stride, uint off, uint3 v)
@@ -339,10 +342,13 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
                            uint flags, float rv_thr, float ar_thr, float ph_thr, float sh_thr,
                            float sc_thr, float sh_fade, uint iso_n, uint cap,
                            __global float *seg, __global uint *ends,
-                           volatile __global uint *counter)
+                           volatile __global uint *counter, __global const uint *held,
+                           __global uint *next, float low)
 {
     GID_OR_RETURN(nf);
     const uint3 v = vload3(gid, faces);
+    const uint hb = held[gid];
+    uint drawn = 0;
     const uint cull = flags & 1u, test = (flags >> 1) & 1u, fade = (flags >> 2) & 1u;
     const uint hermite = (flags >> 3) & 1u, hermite_sh = (flags >> 4) & 1u;
     const float3 nd = gather3(ndv, 1, 0, v);
@@ -356,21 +362,26 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const uint ia = compu(v, j), ib = compu(v, (j + 1) % 3);
             emit(ld3(pos, ia), ld3(pos, ib), LF_BOUNDARIES, 1.0f, (uint4)(ia, ia, ib, ib), cap,
                  seg, ends, counter);
+            drawn |= 1u << LF_BOUNDARIES;
         }
     }
     if (want & (1u << LF_APPARENT)) {
         // No back-face culling, as in rtsc (apparent ridges reach contours
         // across faces that are just barely back-facing).
         const float3 q = gather3(view, 8, 0, v), e = gather3(dt, 1, 0, v);
-        if (q.x > ar_thr || q.y > ar_thr || q.z > ar_thr) {
+        const float thr = held_thr(hb, LF_APPARENT, ar_thr, low);
+        if (q.x > thr || q.y > thr || q.z > thr) {
             const float3 t0 = vload3(0, view + 8 * v.x + 1), t1 = vload3(0, view + 8 * v.y + 1);
             const float3 t2 = vload3(0, view + 8 * v.z + 1);
-            ridge_face(gid, v, e, e.x * t0, e.y * t1, e.z * t2, q, pos, test, ar_thr, fade,
-                       LF_APPARENT, true, cap, seg, ends, counter);
+            if (ridge_face(gid, v, e, e.x * t0, e.y * t1, e.z * t2, q, pos, test, thr, fade,
+                           LF_APPARENT, true, cap, seg, ends, counter))
+                drawn |= 1u << LF_APPARENT;
         }
     }
-    if (back)
+    if (back) {
+        mark_drawn(next, gid, drawn);
         return;
+    }
     if (want & ((1u << LF_RIDGES) | (1u << LF_VALLEYS))) {
         const float3 km = gather3(pose, 8, 0, v), em = gather3(pose, 8, 1, v);
         const float3 d0 = vload3(0, pose + 8 * v.x + 2), d1 = vload3(0, pose + 8 * v.y + 2);
@@ -382,8 +393,10 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const float sg = fam == LF_RIDGES ? 1.0f : -1.0f;
             if (!(sg * km.x > 0.0f && sg * km.y > 0.0f && sg * km.z > 0.0f))
                 continue;
-            ridge_face(gid, v, em, sg * em.x * d0, sg * em.y * d1, sg * em.z * d2, km, pos,
-                       test, rv_thr, fade, fam, false, cap, seg, ends, counter);
+            if (ridge_face(gid, v, em, sg * em.x * d0, sg * em.y * d1, sg * em.z * d2, km, pos,
+                           test, held_thr(hb, fam, rv_thr, low), fade, fam, false, cap, seg,
+                           ends, counter))
+                drawn |= 1u << fam;
         }
     }
     if (want & (1u << LF_PRIN_HL)) {
@@ -413,15 +426,19 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
         const bool z01 = dots.x * dots.y <= 0.0f, z12 = dots.y * dots.z <= 0.0f;
         const bool z20 = dots.z * dots.x <= 0.0f;
         if (ok && flavour && (uint)z01 + (uint)z12 + (uint)z20 >= 2) {
+            const float thr = held_thr(hb, LF_PRIN_HL, ph_thr, low);
+            uint n = 0;
             if (!z01)
-                ridge_segment(gid, v.yzx, dots.yzx, tst.yzx, pos, ph_thr, fade, false,
-                              LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
+                n = ridge_segment(gid, v.yzx, dots.yzx, tst.yzx, pos, thr, fade, false,
+                                  LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
             else if (!z12)
-                ridge_segment(gid, v.zxy, dots.zxy, tst.zxy, pos, ph_thr, fade, false,
-                              LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
+                n = ridge_segment(gid, v.zxy, dots.zxy, tst.zxy, pos, thr, fade, false,
+                                  LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
             else if (!z20)
-                ridge_segment(gid, v, dots, tst, pos, ph_thr, fade, false, LF_PRIN_HL, false,
-                              Z3, Z3, Z3, cap, seg, ends, counter);
+                n = ridge_segment(gid, v, dots, tst, pos, thr, fade, false, LF_PRIN_HL, false,
+                                  Z3, Z3, Z3, cap, seg, ends, counter);
+            if (n)
+                drawn |= 1u << LF_PRIN_HL;
         }
     }
     if (want & (1u << LF_SUG_HL)) {
@@ -434,15 +451,16 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const float2 tt = iso_params(v, f, c, pos, gkr, 1, 0, hermite_sh);
             const uint a = (c + 1) % 3, b = (c + 2) % 3;
             const uint ic = compu(v, c), ia = compu(v, a), ib = compu(v, b);
-            const float3 num = -gather3(sc, 1, 0, v) - sh_thr * nd;
+            const float3 num = -gather3(sc, 1, 0, v) - held_thr(hb, LF_SUG_HL, sh_thr, low) * nd;
             const float n0 = comp(num, c) + tt.x * (comp(num, a) - comp(num, c));
             const float n1 = comp(num, c) + tt.y * (comp(num, b) - comp(num, c));
             const float d0 = comp(nd, c) + tt.x * (comp(nd, a) - comp(nd, c));
             const float d1 = comp(nd, c) + tt.y * (comp(nd, b) - comp(nd, c));
             const float3 pc = ld3(pos, ic);
-            emit_tested(lerp3(pc, ld3(pos, ia), tt.x), lerp3(pc, ld3(pos, ib), tt.y),
-                        edge_of(ic, ia), edge_of(ic, ib), gid, n0, n1, d0, d1, test, sh_fade,
-                        LF_SUG_HL, cap, seg, ends, counter);
+            if (emit_tested(lerp3(pc, ld3(pos, ia), tt.x), lerp3(pc, ld3(pos, ib), tt.y),
+                            edge_of(ic, ia), edge_of(ic, ib), gid, n0, n1, d0, d1, test, sh_fade,
+                            LF_SUG_HL, cap, seg, ends, counter))
+                drawn |= 1u << LF_SUG_HL;
         }
     }
     for (uint fam = LF_K_ZERO; fam <= LF_DWKR_ZERO; ++fam) {
@@ -456,7 +474,7 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             continue;
         const uint h = hermite && fam != LF_DWKR_ZERO;
         const float2 tt = iso_params(v, f, c, pos, grad, 2, fam == LF_K_ZERO ? 0 : 1, h);
-        iso_emit(v, c, tt, pos, fam, 1.0f, cap, seg, ends, counter);
+        drawn |= iso_emit(v, c, tt, pos, fam, 1.0f, cap, seg, ends, counter) << fam;
     }
     if ((want & (1u << LF_ISOPHOTES)) && iso_n > 0) {
         // Levels n·l = j / N for |j| < N, as rtsc's lit and unlit isophotes.
@@ -470,8 +488,10 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const uint c = odd_corner(f);
             if (c == 3)
                 continue;
-            iso_emit(v, c, iso_params(v, f, c, pos, grad, 2, 0, 0), pos, LF_ISOPHOTES, 1.0f, cap,
-                     seg, ends, counter);
+            drawn |= iso_emit(v, c, iso_params(v, f, c, pos, grad, 2, 0, 0), pos, LF_ISOPHOTES,
+                              1.0f, cap, seg, ends, counter)
+                     << LF_ISOPHOTES;
         }
     }
+    mark_drawn(next, gid, drawn);
 }

@@ -7,7 +7,7 @@ mod common;
 
 use common::{LineArrays, gpu, to_f32};
 
-use shapecue::cpu::feature_lines::{lines_face, lines_vertex};
+use shapecue::cpu::feature_lines::{Hold, lines_face, lines_vertex};
 use shapecue::mesh::{self, Mesh};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
 use shapecue::spec::feature_lines::{LineInputs, Segment};
@@ -198,6 +198,7 @@ fn device_matches_cpu_twin() {
                 hermite,
                 0.0,
                 opts.scaled_fade(1.0),
+                &mut Hold::none(),
             );
             assert!(
                 cpu.iter().any(|s| s.family == 0) && cpu.iter().any(|s| s.family == 1),
@@ -331,7 +332,17 @@ fn suggestive_contours_are_cut_where_the_test_crosses_its_threshold() {
         }
         // The twin cuts at the same place.
         let terms = lines_vertex(&li(&x), view);
-        let cpu = lines_face(&faces, &x.pos, &terms, [false, true], true, false, t, 0.03);
+        let cpu = lines_face(
+            &faces,
+            &x.pos,
+            &terms,
+            [false, true],
+            true,
+            false,
+            t,
+            0.03,
+            &mut Hold::none(),
+        );
         same(s.clone(), cpu, "made-up grid");
         // Without the test: the whole zero set of κr (rtsc's κr = 0 loops).
         let (all, _) = ex
@@ -516,6 +527,7 @@ fn a_face_with_more_pieces_than_the_first_buffer_holds_grows_it() {
         false,
         0.0,
         opts.scaled_fade(1.0),
+        &mut Hold::none(),
     );
     same(s.clone(), cpu, "one face, three pieces");
     // A second extraction reuses the grown buffer.
@@ -553,5 +565,118 @@ fn a_picture_of_nothing_is_an_error() {
             );
         }
         Ok(_) => panic!("a scene of no cue drew something"),
+    }
+}
+
+/// The bits of `segs`.
+fn bits(segs: &[Segment]) -> &[u32] {
+    bytemuck::cast_slice(segs)
+}
+
+/// Hysteresis over frames (two thresholds): a sequence whose suggestive
+/// contours' test hovers at its threshold (the threshold alternates 30 %
+/// above and below a middle value, which moves the test's margin as a
+/// deforming surface would). Without hysteresis every other frame loses a
+/// part of the lines; with it (held faces tested at half the threshold)
+/// they stay. The first frame is today's lines bit for bit, a slot whose
+/// last frame is not the one before starts afresh, and the device equals
+/// its twin frame by frame, marks included.
+#[test]
+fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
+    use shapecue::stages::feature_lines::HoldAt;
+    let m = mesh::torus(1.0, 0.4, 120, 60);
+    let x = inputs(&m);
+    let view = View::from_eye([2.2, 0.9, 1.6], false);
+    let opts_at = |k: usize| LineOptions {
+        contours: false,
+        suggestive: true,
+        threshold: 10.0 * if k % 2 == 0 { 0.7 } else { 1.3 },
+        ..Default::default()
+    };
+    let low = 0.5;
+    let mut plain = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
+    let mut held = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
+    let mut twin_held = vec![0u32; m.faces.len()];
+    let t = lines_vertex(&li(&x), view);
+    let (mut without, mut with) = (Vec::new(), Vec::new());
+    for k in 0..6 {
+        let o = opts_at(k);
+        let (a, _) = plain.extract(&li(&x), view, 1.0, o).unwrap();
+        held.hold_at(Some(HoldAt {
+            slot: 0,
+            frame: k,
+            follows: k.checked_sub(1),
+            low,
+        }))
+        .unwrap();
+        let (b, _) = held.extract(&li(&x), view, 1.0, o).unwrap();
+        if k == 0 {
+            assert!(
+                bits(&a) == bits(&b),
+                "frame 0 with hysteresis is today's lines bit for bit"
+            );
+        }
+        // The twin from its own marks.
+        let mut next = vec![0u32; m.faces.len()];
+        let cpu = lines_face(
+            &m.faces,
+            &x.pos,
+            &t,
+            [false, true],
+            true,
+            false,
+            o.scaled_threshold(1.0),
+            o.scaled_fade(1.0),
+            &mut Hold {
+                held: &twin_held,
+                next: &mut next,
+                low,
+            },
+        );
+        same(b.clone(), cpu, &format!("hysteresis frame {k}"));
+        let (marks, frame) = held.read_marks(0).unwrap().expect("the slot ran");
+        assert_eq!(frame, Some(k));
+        let differ = marks.iter().zip(&next).filter(|(a, b)| a != b).count();
+        assert!(
+            differ <= m.faces.len() / 200,
+            "frame {k}: {differ} faces' marks differ from the twin's"
+        );
+        twin_held = next;
+        without.push(length(&a));
+        with.push(length(&b));
+    }
+    // Without: the high-threshold frames lose lines; with: they keep them.
+    let dip = |l: &[f32]| {
+        (1..6)
+            .step_by(2)
+            .map(|k| l[k] / l[k - 1])
+            .fold(1.0, f32::min)
+    };
+    assert!(dip(&without) < 0.8, "the test hovers: {without:?}");
+    assert!(
+        dip(&with) > 0.97,
+        "held lines stay: {with:?} (without: {without:?})"
+    );
+    // A slot whose last frame is not the one before starts afresh.
+    held.hold_at(Some(HoldAt {
+        slot: 0,
+        frame: 9,
+        follows: Some(8),
+        low,
+    }))
+    .unwrap();
+    let o = opts_at(1);
+    let (b, _) = held.extract(&li(&x), view, 1.0, o).unwrap();
+    let (a, _) = plain.extract(&li(&x), view, 1.0, o).unwrap();
+    assert!(bits(&a) == bits(&b), "a fresh slot draws today's lines");
+    // A fraction outside (0, 1] is refused.
+    for bad in [0.0, 1.5, f32::NAN] {
+        let at = HoldAt {
+            slot: 0,
+            frame: 0,
+            follows: None,
+            low: bad,
+        };
+        assert!(held.hold_at(Some(at)).is_err(), "{bad}");
     }
 }

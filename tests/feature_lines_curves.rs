@@ -10,7 +10,7 @@ mod common;
 
 use common::{LineArrays, gpu, to_f32};
 
-use shapecue::cpu::feature_lines::lines_vertex;
+use shapecue::cpu::feature_lines::{Hold, lines_vertex};
 use shapecue::cpu::feature_lines_curves::{
     CurveTerms, ScaledThresholds, boundary_mask, lines_curves, lines_dt1q1, lines_pose, lines_view,
 };
@@ -212,6 +212,7 @@ fn device_matches_cpu_twin_step_by_step() {
                     fs,
                     (opts.scaled_threshold(fs), opts.scaled_fade(fs)),
                 ),
+                &mut Hold::none(),
             );
             assert!(finite(&dev), "{name}: finite");
             for f in LineFamily::ALL[2..].iter().copied() {

@@ -142,14 +142,14 @@ inline float test_alpha(float num, float den, float fade)
 // The segment pa → pb of face f (its ends on the mesh edges ea, eb), with
 // the test's num and den at its ends: without the test the whole segment
 // (strength 1), else its tested pieces, each with the mean of its ends'
-// fades as its strength.
-inline void emit_tested(float3 pa, float3 pb, uint2 ea, uint2 eb, uint f, float na, float nb,
+// fades as its strength. Returns the pieces emitted.
+inline uint emit_tested(float3 pa, float3 pb, uint2 ea, uint2 eb, uint f, float na, float nb,
                         float da, float db, uint test, float fade, uint fam, uint cap,
                         __global float *seg, __global uint *ends, volatile __global uint *counter)
 {
     if (!test) {
         emit(pa, pb, fam, 1.0f, (uint4)(ea, eb), cap, seg, ends, counter);
-        return;
+        return 1;
     }
     float2 pc[2];
     const uint np = test_pieces(na, nb, da, db, pc);
@@ -164,4 +164,24 @@ inline void emit_tested(float3 pa, float3 pb, uint2 ea, uint2 eb, uint f, float 
         const float3 q1 = s1 == 1.0f ? pb : pa + s1 * (pb - pa);
         emit(q0, q1, fam, st, (uint4)(e0, e1), cap, seg, ends, counter);
     }
+    return np;
+}
+
+// Hysteresis over the frames of one pose sequence (two thresholds, as
+// Canny's edge detector): `held` holds, per face, a bit per family (bit =
+// family code) set where the face drew that family in the previous frame;
+// such a face tests the family against its threshold times `low`. Every
+// face adds the families it draws to `next` (its own word: no race, the
+// same bits whatever the order). All zero: nothing held, today's lines.
+// Held faces only, not their neighbours: a line cannot creep along the
+// surface from frame to frame.
+inline float held_thr(uint bits, uint fam, float thr, float low)
+{
+    return ((bits >> fam) & 1u) ? thr * low : thr;
+}
+
+inline void mark_drawn(__global uint *next, uint f, uint bits)
+{
+    if (bits)
+        next[f] |= bits;
 }

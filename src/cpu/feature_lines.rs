@@ -194,6 +194,7 @@ pub fn test_alpha(num: f32, den: f32, fade: f32) -> f32 {
 /// `emit_tested` of kernels/common/isoline.h: the segment `pa → pb` of face
 /// `f` (its ends on the mesh edges `ea`, `eb`) whole (without the test), or
 /// its tested pieces, each with the mean of its ends' fades as strength.
+/// Returns the pieces emitted.
 // Mirrors emit_tested of kernels/common/isoline.h argument for argument
 // (pairs grouped; its outputs as `out`).
 #[allow(clippy::too_many_arguments)]
@@ -206,12 +207,13 @@ pub fn emit_tested(
     test: bool,
     fade: f32,
     fam: u32,
-) {
+) -> usize {
     if !test {
         out.push(Segment::new(pa, pb, fam, 1.0, [ea, eb]));
-        return;
+        return 1;
     }
-    for [s0, s1] in test_pieces(na, nb, da, db) {
+    let pieces = test_pieces(na, nb, da, db);
+    for &[s0, s1] in &pieces {
         let (n0, n1) = (na + s0 * (nb - na), na + s1 * (nb - na));
         let (d0, d1) = (da + s0 * (db - da), da + s1 * (db - da));
         let st = 0.5 * (test_alpha(n0, d0, fade) + test_alpha(n1, d1, fade));
@@ -222,15 +224,65 @@ pub fn emit_tested(
         let e1 = if s1 == 1.0 { eb } else { [LINE_FREE, f] };
         out.push(Segment::new(q0, q1, fam, st, [e0, e1]));
     }
+    pieces.len()
+}
+
+/// The hysteresis of kernels/common/isoline.h: the families (a bit per
+/// family code) that face `f` drew in the previous frame (`held`, per
+/// face; empty: none).
+pub fn held_bits(held: &[u32], f: usize) -> u32 {
+    held.get(f).copied().unwrap_or(0)
+}
+
+/// A family's threshold on a face holding bits `bits`: times `low` where
+/// the face holds the family.
+pub fn held_thr(bits: u32, fam: u32, thr: f32, low: f32) -> f32 {
+    if (bits >> fam) & 1 != 0 {
+        thr * low
+    } else {
+        thr
+    }
+}
+
+/// Adds the families `bits` face `f` drew to `next` (empty: not kept).
+pub fn mark_drawn(next: &mut [u32], f: usize, bits: u32) {
+    if let Some(m) = next.get_mut(f) {
+        *m |= bits;
+    }
+}
+
+/// The hysteresis state of one frame's extraction, as the kernels take
+/// it: the previous frame's marks per face (`held`, empty: none), the
+/// marks this frame makes (`next`, empty: not kept) and the fraction of a
+/// threshold that a held face tests against.
+pub struct Hold<'a> {
+    /// The previous frame's marks per face.
+    pub held: &'a [u32],
+    /// This frame's marks per face (OR-ed in).
+    pub next: &'a mut [u32],
+    /// The fraction of its threshold a held face's family is tested against.
+    pub low: f32,
+}
+
+impl Hold<'_> {
+    /// No hysteresis: nothing held, nothing marked.
+    pub fn none() -> Hold<'static> {
+        Hold {
+            held: &[],
+            next: &mut [],
+            low: 1.0,
+        }
+    }
 }
 
 /// `lines_face`: segments of the requested kinds, with rtsc's tests when
 /// `test` (contours: κr ≥ 0; suggestive contours: sinθ D_w κr / (n·v) ≥
 /// `sc_thresh`, faded by `fade`), suggestive contours placed by rtsc's
-/// Hermite fit when `hermite`.
+/// Hermite fit when `hermite`; held faces (`hold`) test suggestive
+/// contours against `sc_thresh` times its `low`.
 // Mirrors the kernel lines_face of kernels/feature_lines.cl argument for
-// argument (ndv, kr, sc, gkr as `t`, the two wants as `want`; its outputs
-// returned).
+// argument (ndv, kr, sc, gkr as `t`, the two wants as `want`, held, next
+// and low as `hold`; its outputs returned).
 #[allow(clippy::too_many_arguments)]
 pub fn lines_face(
     faces: &[[u32; 3]],
@@ -241,10 +293,13 @@ pub fn lines_face(
     hermite: bool,
     sc_thresh: f32,
     fade: f32,
+    hold: &mut Hold,
 ) -> Vec<Segment> {
     let mut out = Vec::new();
     for (fi, f) in faces.iter().enumerate() {
         let v = f.map(|i| i as usize);
+        let hb = held_bits(hold.held, fi);
+        let mut drawn = 0u32;
         for kind in 0..2u32 {
             if !want[kind as usize] {
                 continue;
@@ -288,7 +343,8 @@ pub fn lines_face(
                 (v.map(|i| t.kr[i]), [1.0; 3])
             } else {
                 let d = v.map(|i| t.ndv[i]);
-                (std::array::from_fn(|j| t.sc[v[j]] - sc_thresh * d[j]), d)
+                let th = held_thr(hb, 1, sc_thresh, hold.low);
+                (std::array::from_fn(|j| t.sc[v[j]] - th * d[j]), d)
             };
             let li = |x: [f32; 3], t: f32, p: usize| x[c] + t * (x[p] - x[c]);
             let ends = [
@@ -298,7 +354,7 @@ pub fn lines_face(
                 li(den, tb, b),
             ];
             let edge = |p: usize| [v[c].min(v[p]) as u32, v[c].max(v[p]) as u32];
-            emit_tested(
+            let n = emit_tested(
                 &mut out,
                 (lerp(ta, a), lerp(tb, b)),
                 (edge(a), edge(b)),
@@ -308,7 +364,11 @@ pub fn lines_face(
                 if kind == 0 { 0.0 } else { fade },
                 kind,
             );
+            if n > 0 {
+                drawn |= 1 << kind;
+            }
         }
+        mark_drawn(hold.next, fi, drawn);
     }
     out
 }

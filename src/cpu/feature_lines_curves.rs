@@ -7,7 +7,7 @@
 //! lists.
 
 pub use super::feature_lines::zero_hermite;
-use super::feature_lines::{VertexTerms, emit_tested};
+use super::feature_lines::{Hold, VertexTerms, emit_tested, held_bits, held_thr, mark_drawn};
 use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
 pub use crate::spec::feature_lines::{ScaledThresholds, boundary_mask};
 use crate::spec::view::View;
@@ -408,48 +408,67 @@ fn iso_emit(
     );
 }
 
-/// `lines_curves`: the segments of `o.families` (the contours excluded).
+/// `lines_curves`: the segments of `o.families` (the contours excluded);
+/// held faces (`hold`) test ridges, valleys, apparent ridges and both
+/// highlights against their threshold times its `low`.
+// Mirrors the kernel lines_curves (held, next and low as `hold`).
 pub fn lines_curves(
     faces: &[[u32; 3]],
     pos: &[V3],
     x: &CurveTerms,
     o: &CurveOptions,
     thr: ScaledThresholds,
+    hold: &mut Hold,
 ) -> Vec<Segment> {
     let mut segs = Vec::new();
-    let mut out = Out { segs: &mut segs };
-    let want = o.families;
     for (fi, face) in faces.iter().enumerate() {
-        let f = CurveFace {
-            fi,
-            v: *face,
-            pos,
-            x,
-            o,
-            thr,
-        };
-        if want.has(LineFamily::Boundaries) {
-            f.boundaries(&mut out);
-        }
-        if want.has(LineFamily::ApparentRidges) {
-            f.apparent_ridges(&mut out);
-        }
-        if o.cull && f.g(&x.vertex.ndv).iter().all(|&n| n <= 0.0) {
-            continue;
-        }
-        f.ridges_valleys(&mut out);
-        if want.has(LineFamily::PrincipalHighlights) {
-            f.principal_highlights(&mut out);
-        }
-        if want.has(LineFamily::SuggestiveHighlights) {
-            f.suggestive_highlights(&mut out);
-        }
-        f.zero_sets(&mut out);
-        if want.has(LineFamily::Isophotes) && o.isophotes > 0 {
-            f.isophotes(&mut out);
-        }
+        let before = segs.len();
+        let mut out = Out { segs: &mut segs };
+        curve_face(
+            &mut out,
+            &CurveFace {
+                fi,
+                v: *face,
+                pos,
+                x,
+                o,
+                thr,
+                held: held_bits(hold.held, fi),
+                low: hold.low,
+            },
+        );
+        let drawn = segs[before..].iter().fold(0, |b, s| b | 1 << s.family);
+        mark_drawn(hold.next, fi, drawn);
     }
     segs
+}
+
+/// The families of one face of [`lines_curves`], in the kernel's order.
+fn curve_face(out: &mut Out, f: &CurveFace) {
+    let (o, x) = (f.o, f.x);
+    let want = o.families;
+    {
+        if want.has(LineFamily::Boundaries) {
+            f.boundaries(out);
+        }
+        if want.has(LineFamily::ApparentRidges) {
+            f.apparent_ridges(out);
+        }
+        if o.cull && f.g(&x.vertex.ndv).iter().all(|&n| n <= 0.0) {
+            return;
+        }
+        f.ridges_valleys(out);
+        if want.has(LineFamily::PrincipalHighlights) {
+            f.principal_highlights(out);
+        }
+        if want.has(LineFamily::SuggestiveHighlights) {
+            f.suggestive_highlights(out);
+        }
+        f.zero_sets(out);
+        if want.has(LineFamily::Isophotes) && o.isophotes > 0 {
+            f.isophotes(out);
+        }
+    }
 }
 
 /// One face of [`lines_curves`] and what its families read; its methods
@@ -462,9 +481,18 @@ struct CurveFace<'a> {
     x: &'a CurveTerms<'a>,
     o: &'a CurveOptions,
     thr: ScaledThresholds,
+    /// The families the previous frame drew around the face
+    /// ([`held_bits`]) and the fraction of a threshold they are tested at.
+    held: u32,
+    low: f32,
 }
 
 impl CurveFace<'_> {
+    /// `fam`'s threshold `thr` on this face ([`held_thr`]).
+    fn thr_of(&self, fam: LineFamily, thr: f32) -> f32 {
+        held_thr(self.held, fam as u32, thr, self.low)
+    }
+
     /// The corners' values of a per-vertex array.
     fn g(&self, a: &[f32]) -> [f32; 3] {
         self.v.map(|i| a[i as usize])
@@ -492,11 +520,12 @@ impl CurveFace<'_> {
         let (v, wt, thr) = (self.v, self.x.view, self.thr);
         let q = self.g(&wt.q1);
         let e = self.g(self.x.dt);
-        if q.iter().any(|&qq| qq > thr.ar) {
+        let fam = LineFamily::ApparentRidges;
+        let ar = self.thr_of(fam, thr.ar);
+        if q.iter().any(|&qq| qq > ar) {
             let t = [0, 1, 2].map(|i| mul(e[i], wt.t1[v[i] as usize]));
-            let fam = LineFamily::ApparentRidges;
             let (f, pos, test, fade) = (self.fi as u32, self.pos, self.o.test, self.o.fade);
-            ridge_face(out, f, v, e, t, q, pos, test, thr.ar, fade, fam, true);
+            ridge_face(out, f, v, e, t, q, pos, test, ar, fade, fam, true);
         }
     }
 
@@ -521,7 +550,7 @@ impl CurveFace<'_> {
                 km,
                 pos,
                 test,
-                self.thr.rv,
+                self.thr_of(fam, self.thr.rv),
                 fade,
                 fam,
                 false,
@@ -568,7 +597,7 @@ impl CurveFace<'_> {
                 (v, dots, tst)
             };
             if !(z01 && z12 && z20) {
-                let (pos, ph, fade) = (self.pos, self.thr.ph, self.o.fade);
+                let (pos, ph, fade) = (self.pos, self.thr_of(fam, self.thr.ph), self.o.fade);
                 ridge_segment(out, f, rv, rd, rt, pos, ph, fade, false, fam, None);
             }
         }
@@ -596,7 +625,8 @@ impl CurveFace<'_> {
         let (a, b) = ((c + 1) % 3, (c + 2) % 3);
         let nd = self.g(&vt.ndv);
         let s3 = self.g(&vt.sc);
-        let num: [f32; 3] = std::array::from_fn(|i| -s3[i] - thr.sh * nd[i]);
+        let sh = self.thr_of(LineFamily::SuggestiveHighlights, thr.sh);
+        let num: [f32; 3] = std::array::from_fn(|i| -s3[i] - sh * nd[i]);
         let ends = [
             num[c] + tt.0 * (num[a] - num[c]),
             num[c] + tt.1 * (num[b] - num[c]),

@@ -140,6 +140,39 @@ pub struct LineExtractor {
     view_fields: bool,
     /// The world length of one unit of the last run's coordinates.
     scale: f64,
+    /// The hysteresis over the frames of a pose sequence.
+    hold: HoldState,
+}
+
+/// Where the next extraction keeps its hysteresis state
+/// ([`LineExtractor::hold_at`]): a slot (one per view of a pose sequence)
+/// and the frame it runs, with the frame before it in the sequence.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoldAt {
+    /// The state's slot (the view's index in its scene).
+    pub slot: usize,
+    /// The frame this extraction runs.
+    pub frame: usize,
+    /// The frame before it in the sequence (`None`: the first): the slot's
+    /// marks hold only where they are that frame's.
+    pub follows: Option<usize>,
+    /// The fraction of its threshold a face that drew a family in the
+    /// previous frame tests that family against (in (0, 1]).
+    pub low: f32,
+}
+
+/// The hysteresis buffers of one extractor: the marks of each slot's last
+/// frame, the marks being made, and an all-zero `held` (and a scratch
+/// `next`) for extractions without hysteresis.
+struct HoldState {
+    zeros: Buffer<u32>,
+    scratch: Buffer<u32>,
+    /// Per slot: the last frame's marks, the frame they are of.
+    slots: std::collections::HashMap<usize, (Buffer<u32>, Option<usize>)>,
+    /// This frame's marks (swapped into the slot after the run).
+    next: Buffer<u32>,
+    /// The next run's place, where set.
+    at: Option<HoldAt>,
 }
 
 impl LineExtractor {
@@ -177,6 +210,17 @@ impl LineExtractor {
             curves: None,
             view_fields: false,
             scale: 1.0,
+            hold: HoldState {
+                zeros: {
+                    let mut z = gpu.buffer(faces.len().max(1))?;
+                    gpu.zero(&mut z, faces.len().max(1))?;
+                    z
+                },
+                scratch: gpu.buffer(faces.len().max(1))?,
+                slots: Default::default(),
+                next: gpu.buffer(faces.len().max(1))?,
+                at: None,
+            },
             gpu,
             nv,
             nf: faces.len(),
@@ -257,6 +301,69 @@ impl LineExtractor {
             q1: stage.read_q1()?,
         };
         Ok(fields.from_local(self.scale))
+    }
+
+    /// Where the next extraction keeps its hysteresis state (`None`: no
+    /// hysteresis, today's lines). Over the frames of one pose sequence,
+    /// a face that drew a thresholded family (suggestive contours, ridges, valleys, apparent
+    /// ridges, principal and suggestive highlights) in the slot's previous
+    /// frame tests it against its threshold times `low`, as Canny's two
+    /// thresholds. A slot whose last frame is not `follows` starts afresh:
+    /// the first frame of a sequence draws today's lines exactly.
+    pub fn hold_at(&mut self, at: Option<HoldAt>) -> Result<()> {
+        if let Some(h) = at
+            && !(h.low > 0.0 && h.low <= 1.0)
+        {
+            return Err(Error::InvalidArgument(format!(
+                "the hysteresis' lower threshold must be a fraction in (0, 1] of the threshold, got {}",
+                h.low
+            )));
+        }
+        self.hold.at = at;
+        Ok(())
+    }
+
+    /// The hysteresis marks of `slot`'s last frame, per face (bit =
+    /// family code), with that frame; `None` where the slot never ran.
+    pub fn read_marks(&self, slot: usize) -> Result<Option<(Vec<u32>, Option<usize>)>> {
+        let Some((b, frame)) = self.hold.slots.get(&slot) else {
+            return Ok(None);
+        };
+        let mut m = vec![0u32; self.nf];
+        if self.nf > 0 {
+            self.gpu.read(b, &mut m)?;
+        }
+        Ok(Some((m, *frame)))
+    }
+
+    /// The hysteresis arguments of the next run (held, next, low), with
+    /// the slot's marks cleared where they are not of the frame before.
+    fn hold_args(&mut self) -> Result<(Arg, Arg, f32)> {
+        let g = self.gpu.clone();
+        let n = self.nf.max(1);
+        let Some(h) = self.hold.at else {
+            return Ok((buf(&self.hold.zeros), buf(&self.hold.scratch), 1.0));
+        };
+        if !self.hold.slots.contains_key(&h.slot) {
+            self.hold.slots.insert(h.slot, (g.buffer(n)?, None));
+        }
+        let (held, last) = self.hold.slots.get_mut(&h.slot).expect("inserted above");
+        if h.follows.is_none() || *last != h.follows {
+            g.zero(held, n)?;
+        }
+        g.zero(&mut self.hold.next, n)?;
+        let (held, _) = &self.hold.slots[&h.slot];
+        Ok((buf(held), buf(&self.hold.next), h.low))
+    }
+
+    /// After a run with hysteresis: this frame's marks become the slot's.
+    fn hold_done(&mut self) {
+        if let Some(h) = self.hold.at
+            && let Some((held, last)) = self.hold.slots.get_mut(&h.slot)
+        {
+            std::mem::swap(held, &mut self.hold.next);
+            *last = Some(h.frame);
+        }
     }
 
     /// The curve families' stage, once a run has asked for one of them.
@@ -360,10 +467,11 @@ impl LineExtractor {
             c.view_changed();
         }
         self.gpu.zero(&mut self.counter, 1)?;
+        let hold = self.hold_args()?;
         let e1 = self.lines_vertex(inputs, view, &opts)?;
         let curve_fams = opts.curves.families.curves();
         let contours = opts.contours || opts.suggestive || curve_fams == Default::default();
-        let (e2, found) = self.lines_face(inputs[0], feature_size, &opts, contours)?;
+        let (e2, found) = self.lines_face(inputs[0], feature_size, &opts, contours, hold)?;
         let mut segs = self.read_segments(found)?;
         let mut timing = Timing::default();
         if let Some(e) = &e1 {
@@ -373,10 +481,11 @@ impl LineExtractor {
             timing.add(Step::LinesFace, event_ms(e));
         }
         if curve_fams != Default::default() {
-            let (more, t) = self.curve_lines(inputs, view, feature_size, &opts)?;
+            let (more, t) = self.curve_lines(inputs, view, feature_size, &opts, hold)?;
             timing.extend(&t);
             segs.extend(more);
         }
+        self.hold_done();
         if self.view_fields {
             timing.extend(&self.view_terms(inputs, view, &opts)?);
         }
@@ -424,6 +533,7 @@ impl LineExtractor {
         feature_size: f32,
         opts: &LineOptions,
         contours: bool,
+        hold: (Arg, Arg, f32),
     ) -> Result<(Vec<Event>, usize)> {
         let g = self.gpu.clone();
         // Twice at most: a pass that counts more segments than the buffer
@@ -458,6 +568,9 @@ impl LineExtractor {
                     buf(&self.seg),
                     buf(&self.ends),
                     buf(&self.counter),
+                    hold.0,
+                    hold.1,
+                    Arg::F32(hold.2),
                 ],
             )?;
             e2.extend(e);
@@ -504,11 +617,12 @@ impl LineExtractor {
 
     /// The curve stage's arguments: `inputs`, this extractor's per-vertex
     /// terms and its faces.
-    fn curve_args(&self, inputs: [Arg; 6]) -> CurveArgs {
+    fn curve_args(&self, inputs: [Arg; 6], hold: (Arg, Arg, f32)) -> CurveArgs {
         CurveArgs {
             inputs,
             terms: self.terms.each_ref().map(buf),
             faces: buf(&self.faces),
+            hold,
         }
     }
 
@@ -529,7 +643,8 @@ impl LineExtractor {
         view: ([f32; 3], bool),
         opts: &LineOptions,
     ) -> Result<Timing> {
-        let args = self.curve_args(inputs);
+        let hold = (buf(&self.hold.zeros), buf(&self.hold.scratch), 1.0);
+        let args = self.curve_args(inputs, hold);
         let stage = self.curve_stage_mut()?;
         stage.view_terms(&args, view, &opts.curves)
     }
@@ -542,8 +657,9 @@ impl LineExtractor {
         view: ([f32; 3], bool),
         feature_size: f32,
         opts: &LineOptions,
+        hold: (Arg, Arg, f32),
     ) -> Result<(Vec<Segment>, Timing)> {
-        let args = self.curve_args(inputs);
+        let args = self.curve_args(inputs, hold);
         let stage = self.curve_stage_mut()?;
         let sc = (
             opts.scaled_threshold(feature_size),

@@ -31,6 +31,10 @@ pub struct CurveArgs {
     pub terms: [Arg; 4],
     /// The faces (uint[3F]).
     pub faces: Arg,
+    /// The hysteresis: the previous frame's marks per vertex, this frame's
+    /// (uint[V] each), and the fraction of a threshold a held face tests
+    /// against (kernels/common/isoline.h).
+    pub hold: (Arg, Arg, f32),
 }
 
 /// The curve families' kernels and buffers for one topology.
@@ -340,6 +344,9 @@ impl CurveStage {
                 buf(&self.seg),
                 buf(&self.ends),
                 buf(&self.counter),
+                a.hold.0,
+                a.hold.1,
+                Arg::F32(a.hold.2),
             ],
         )?;
         time(events, Step::LinesCurves, e);
