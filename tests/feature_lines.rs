@@ -590,7 +590,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
     let opts_at = |k: usize| LineOptions {
         contours: false,
         suggestive: true,
-        threshold: 10.0 * if k % 2 == 0 { 0.7 } else { 1.3 },
+        threshold: 10.0 * if k.is_multiple_of(2) { 0.7 } else { 1.3 },
         ..Default::default()
     };
     let low = 0.5;

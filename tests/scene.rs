@@ -306,6 +306,7 @@ fn outputs_decide_the_drawing_passes() {
         visibility,
         pieces: false,
         fields: false,
+        npz: false,
     };
     let cues = [Cue::Shading, Cue::Contours, Cue::FeatureEdges];
     for input in INPUTS {
@@ -394,6 +395,7 @@ fn outputs_decide_the_drawing_passes() {
         // derivative and the view terms; none for shading or edges alone.
         let fields = Outputs {
             fields: true,
+            npz: false,
             ..out(false, true, Exact)
         };
         let f = plan_for(&cues, input, CapMode::Adjacency, fields);

@@ -25,6 +25,7 @@ fn both_exact() -> Outputs {
         visibility: VisibilityMethod::Exact,
         pieces: false,
         fields: false,
+        npz: false,
     }
 }
 use std::path::Path;

@@ -102,6 +102,7 @@ fn static_scenes_run_exactly_their_passes() {
                     visibility: VisibilityMethod::Exact,
                     pieces: false,
                     fields: false,
+                    npz: false,
                 }
             ),
             "{cues:?}"

@@ -211,6 +211,8 @@ pub fn lines_views_scene(
 
 /// One view of [`lines_on`], world coordinates.
 pub struct LineView {
+    /// The frame (its index in the input's frames; 0 for a static mesh).
+    pub frame: usize,
     /// The view's index in the scene's views.
     pub view: usize,
     /// The camera as resolved (a fitted view's eye placed).
@@ -222,6 +224,10 @@ pub struct LineView {
     pub visible: Option<VisibleLines>,
     /// The per-vertex fields of the view, where asked.
     pub fields: Option<crate::spec::feature_lines::ViewFields>,
+    /// The pieces as NPZ arrays, with the face and barycentric coordinates
+    /// each lies at on this frame's pose (the same point of the rest mesh
+    /// on every frame), where the scene writes NPZ (`scene.npz`).
+    pub npz: Option<crate::export::npz::SegmentArrays>,
     /// The picture (lines over the mesh in white), in memory where the
     /// scene asks for a PNG.
     pub image: Option<Frame>,
@@ -275,11 +281,13 @@ pub fn lines_on(
     let mut hand = |d: ViewDone| {
         let o = d.out;
         each(LineView {
+            frame: d.frame,
             view: d.view,
             camera: o.world_camera(),
             segments: o.segments,
             visible: o.visible,
             fields: o.fields,
+            npz: o.npz,
             image: o.image,
             layers: o.layers,
             files: d.files,
@@ -391,39 +399,7 @@ pub fn wanted(o: &LineOptions) -> Vec<LineFamily> {
 }
 
 /// The pieces of a view's classified lines as NPZ-ready arrays
-/// ([`crate::export::npz`]): one row per piece (world coordinates), its
-/// segment's family or layer code (a [`LineFamily`] as `u32`, or the
-/// feature edges', intersection lines' or strokes' layer), strength,
-/// visibility, the faces it lies on (`-1` past the last), its chain, and
-/// the face of `mesh` it lies in with each end's barycentric coordinates
-/// there ([`crate::mesh::barycentric::face_of_segment`]; `-1` and zeros for
-/// a line on no face).
+/// ([`VisibleLines::arrays`] on `mesh`'s positions).
 pub fn segment_arrays(v: &VisibleLines, mesh: &Mesh) -> crate::export::npz::SegmentArrays {
-    let chain_of = v.chain_of_pieces();
-    let mut out = crate::export::npz::SegmentArrays::default();
-    let wide = |p: [f32; 3]| p.map(f64::from);
-    for (i, p) in v.chain_pieces.iter().enumerate() {
-        let s = &v.segments[p.seg as usize];
-        let (a, b) = (v.point(p.seg, p.t[0]), v.point(p.seg, p.t[1]));
-        let on = crate::mesh::barycentric::face_of_segment(
-            (wide(a), wide(b)),
-            &v.faces[p.seg as usize],
-            &mesh.positions,
-            &mesh.faces,
-        );
-        out.face.push(on.map_or(-1, |o| i64::from(o.0)));
-        out.bary
-            .push(on.map_or([[0.0; 3]; 2], |o| o.1.map(|w| w.map(|x| x as f32))));
-        out.a.push(a);
-        out.b.push(b);
-        out.family.push(s.family);
-        out.strength.push(s.strength);
-        out.visible.push(u8::from(p.visible));
-        let f = &v.faces[p.seg as usize];
-        out.faces.push(std::array::from_fn(|k| {
-            f.get(k).map_or(-1, |&x| i64::from(x))
-        }));
-        out.chain.push(chain_of[i]);
-    }
-    out
+    v.arrays(&mesh.positions, &mesh.faces)
 }

@@ -279,6 +279,7 @@ fn plan_of(scene: &Scene, image: bool) -> crate::scene::planner::Plan {
         visibility: scene.visibility,
         pieces: scene.pieces,
         fields: scene.fields,
+        npz: scene.npz,
     };
     plan_for(&fx.cues, scene.source.input(), fx.caps, outputs)
 }
@@ -567,6 +568,12 @@ fn run_report(
         notes: notes
             .into_iter()
             .chain(ex.run.feature_size_note.take())
+            .chain(ex.run.held_low.map(|low| {
+                format!(
+                    "lines held over the frames (coherence): a face that drew a thresholded \
+                     family in its view's previous frame tests it at {low} of its threshold"
+                )
+            }))
             .collect(),
         outputs: std::mem::take(&mut ex.run.outputs),
         timing: crate::spec::timing::Timing {
@@ -610,14 +617,14 @@ fn run_frames(
     let mut walker = Walker::new(plan, scene.source.input());
     let total_views = frames.len() * (0..scene.views.len()).filter(|&v| runs(v)).count();
     let mut done = 0;
-    for &frame in frames {
+    for (i, &frame) in frames.iter().enumerate() {
         walker.pose(ex, frame)?;
         for (vi, cam) in ex.cameras().iter().enumerate() {
             if !runs(vi) {
                 continue;
             }
-            let paths: Vec<&PathBuf> = images
-                .iter()
+            ex.hold = walk::hold_at(scene, frames, i, vi);
+            let paths: Vec<&PathBuf> = (images.iter())
                 .filter(|i| i.0 == frame && i.1 == vi)
                 .map(|i| &i.2)
                 .collect();

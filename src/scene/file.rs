@@ -174,6 +174,10 @@ pub struct Scene {
     pub png: bool,
     /// Write SVG line drawings.
     pub svg: bool,
+    /// Write each view's line pieces as NPZ (`formats = [.., "npz"]`):
+    /// family, strength, visibility, chain, and the face and barycentric
+    /// coordinates each piece lies at.
+    pub npz: bool,
     /// MSAA samples.
     pub msaa: u32,
     /// Background.
@@ -339,6 +343,7 @@ impl Scene {
             size: out.size,
             png: out.png,
             svg: out.svg,
+            npz: out.npz,
             msaa: out.msaa,
             background: out.background,
             interop: out.interop,

@@ -12,10 +12,12 @@
 //! isosurface changes topology with every pose, so its topology passes are
 //! pose passes.
 
+mod outputs;
 use crate::spec::edges::CapMode;
 use crate::spec::feature_lines::LineFamily;
 use crate::spec::timing::Step;
 use crate::spec::visibility::VisibilityMethod;
+pub use outputs::Outputs;
 use serde::Serialize;
 
 /// A shape cue a scene can ask for.
@@ -286,6 +288,11 @@ pub enum Pass {
     /// Write the view's vector drawing (SVG groups of chains), its hidden
     /// lines from the visibility pass or from the frame's depth.
     Svg,
+    /// Write the view's lines as NPZ: every piece of the visibility pass
+    /// with its family, strength, visibility, chain, and the face and
+    /// barycentric coordinates it lies at (which name the same point of
+    /// the rest mesh on every frame of an animation).
+    Npz,
 }
 
 impl std::fmt::Display for Cue {
@@ -356,6 +363,7 @@ impl Pass {
             Pass::Intersections => "intersections",
             Pass::Visibility => "visibility",
             Pass::Svg => "svg",
+            Pass::Npz => "npz",
             Pass::LinesView => "lines_view",
             Pass::LinesDt1q1 => "lines_dt1q1",
             Pass::LinesCurves => "lines_curves",
@@ -381,7 +389,8 @@ impl Pass {
             | Pass::OneRings
             | Pass::CapBuffer
             | Pass::ViewFields
-            | Pass::Svg => "host",
+            | Pass::Svg
+            | Pass::Npz => "host",
             Pass::Contours | Pass::SuggestiveContours | Pass::LinesCurves | Pass::Visibility => {
                 "device + host"
             }
@@ -468,7 +477,8 @@ impl Pass {
             | Pass::FaceNormals
             | Pass::Render
             | Pass::ViewFields
-            | Pass::Svg => &[],
+            | Pass::Svg
+            | Pass::Npz => &[],
         }
     }
 
@@ -519,6 +529,7 @@ impl Pass {
             Pass::Visibility => vec![Pass::Bvh],
             Pass::Intersections => vec![Pass::Bvh],
             Pass::Svg => vec![],
+            Pass::Npz => vec![Pass::Visibility],
         };
         v.sort();
         v
@@ -540,65 +551,10 @@ impl Pass {
             | Pass::Caps
             | Pass::Visibility
             | Pass::Render
-            | Pass::Svg => Lifetime::View,
+            | Pass::Svg
+            | Pass::Npz => Lifetime::View,
             _ => Lifetime::Pose,
         }
-    }
-}
-
-/// What a scene's views are written as, which decides the passes after
-/// the cues' own: a raster image (PNG, or an image held in memory) needs
-/// the GL render pass; a vector drawing (SVG, segments) needs the SVG
-/// pass, and its hidden lines either the exact visibility pass (over the
-/// BVH, no GL) or the rendered depth.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-pub struct Outputs {
-    /// A raster image is drawn.
-    pub raster: bool,
-    /// A vector drawing is written.
-    pub vector: bool,
-    /// How the vector drawing's hidden lines are found.
-    pub visibility: VisibilityMethod,
-    /// The lines split where their visibility changes and chained are
-    /// kept (segments with visibility, NPZ), with or without a vector
-    /// drawing: exact visibility is planned for them on its own.
-    pub pieces: bool,
-    /// The per-vertex view fields are kept beside the lines.
-    pub fields: bool,
-}
-
-impl Outputs {
-    /// A raster image only (PNG, or an image held in memory).
-    pub const RASTER: Outputs = Outputs {
-        raster: true,
-        vector: false,
-        visibility: VisibilityMethod::Exact,
-        pieces: false,
-        fields: false,
-    };
-
-    /// The passes that end a view drawn from `cues`.
-    fn terminals(self, cues: &[Cue]) -> Vec<Pass> {
-        let lines = cues.iter().any(|c| c.draws_lines());
-        let mut v = Vec::new();
-        if self.raster || (self.vector && self.visibility == VisibilityMethod::Depth) {
-            v.push(Pass::Render);
-        }
-        if self.vector {
-            v.push(Pass::Svg);
-        }
-        // Exact visibility serves the vector drawing and the kept pieces
-        // alike; it is planned for either, and for neither without lines.
-        if (self.vector || self.pieces) && self.visibility == VisibilityMethod::Exact && lines {
-            v.push(Pass::Visibility);
-        }
-        // The fields are those of the line families (not of edges alone).
-        let families = (cues.iter())
-            .any(|c| c.family().is_some() || matches!(c, Cue::Contours | Cue::SuggestiveContours));
-        if self.fields && families {
-            v.push(Pass::ViewFields);
-        }
-        v
     }
 }
 

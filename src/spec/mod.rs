@@ -13,6 +13,7 @@ pub mod ao;
 pub mod bvh;
 pub mod cameras;
 pub mod chains;
+pub mod coherence;
 pub mod curvature;
 pub mod edges;
 pub mod feature_lines;

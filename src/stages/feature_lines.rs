@@ -344,10 +344,10 @@ impl LineExtractor {
         let Some(h) = self.hold.at else {
             return Ok((buf(&self.hold.zeros), buf(&self.hold.scratch), 1.0));
         };
-        if !self.hold.slots.contains_key(&h.slot) {
-            self.hold.slots.insert(h.slot, (g.buffer(n)?, None));
-        }
-        let (held, last) = self.hold.slots.get_mut(&h.slot).expect("inserted above");
+        let (held, last) = match self.hold.slots.entry(h.slot) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => e.insert((g.buffer(n)?, None)),
+        };
         if h.follows.is_none() || *last != h.follows {
             g.zero(held, n)?;
         }

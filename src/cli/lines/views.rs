@@ -580,11 +580,13 @@ mod tests {
     /// A view of no lines, numbered `view`.
     fn empty_view(view: usize) -> LineView {
         LineView {
+            frame: 0,
             view,
             camera: shapecue::api::Camera::look_at(glam::Vec3::Z, glam::Vec3::ZERO),
             segments: Vec::new(),
             visible: None,
             fields: None,
+            npz: None,
             image: None,
             layers: None,
             files: Vec::new(),

@@ -151,9 +151,14 @@ pub(super) fn draw_view(
     Ok(image)
 }
 
-/// Whether an output path is a PNG (else an SVG).
+/// Whether an output path is a PNG.
 pub(super) fn is_png(path: &std::path::Path) -> bool {
-    path.extension().is_some_and(|e| e == "png")
+    has_ext(path, "png")
+}
+
+/// Whether an output path ends in `.ext`.
+pub(super) fn has_ext(path: &std::path::Path, ext: &str) -> bool {
+    path.extension().is_some_and(|e| e == ext)
 }
 
 /// The mesh's style: shaded, or flat in the background colour when only
@@ -355,6 +360,9 @@ pub struct ViewOutputs {
     /// The per-vertex fields of the view (world units), where the scene
     /// keeps them ([`crate::scene::file::Scene::fields`]).
     pub fields: Option<crate::spec::feature_lines::ViewFields>,
+    /// The pieces as NPZ arrays (world coordinates, with the face and
+    /// barycentric coordinates each lies at), where the scene writes NPZ.
+    pub npz: Option<crate::export::npz::SegmentArrays>,
     /// The line segments found for this view (world coordinates).
     pub segments: Vec<Segment>,
     /// The edge stage's outputs as drawn, when feature edges are planned.

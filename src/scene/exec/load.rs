@@ -243,7 +243,7 @@ pub fn output_paths(
     let digits = (scene.views.len().saturating_sub(1).to_string().len()).max(2);
     for &f in frames {
         for view in 0..scene.views.len() {
-            for (on, ext) in [(scene.png, "png"), (scene.svg, "svg")] {
+            for (on, ext) in [(scene.png, "png"), (scene.svg, "svg"), (scene.npz, "npz")] {
                 if on {
                     let name = format!("{}_f{f:04}_v{view:0digits$}.{ext}", scene.prefix);
                     v.push((f, view, out_dir.join(name)));

@@ -125,6 +125,45 @@ pub struct VisibleLines {
 }
 
 impl VisibleLines {
+    /// The pieces as NPZ-ready arrays ([`crate::export::npz`]): one row
+    /// per piece (the coordinates of the segments), its segment's family or
+    /// layer code (a [`crate::spec::feature_lines::LineFamily`] as `u32`,
+    /// or the feature edges', intersection lines' or strokes' layer),
+    /// strength, visibility, the faces it lies on (`-1` past the last), its
+    /// chain, and the face of the mesh (`positions`, `faces`, in the
+    /// segments' coordinates) it lies in with each end's barycentric
+    /// coordinates there ([`crate::mesh::barycentric::face_of_segment`];
+    /// `-1` and zeros for a line on no face).
+    pub fn arrays(
+        &self,
+        positions: &[[f64; 3]],
+        faces: &[[u32; 3]],
+    ) -> crate::export::npz::SegmentArrays {
+        let chain_of = self.chain_of_pieces();
+        let mut out = crate::export::npz::SegmentArrays::default();
+        let wide = |p: [f32; 3]| p.map(f64::from);
+        for (i, p) in self.chain_pieces.iter().enumerate() {
+            let s = &self.segments[p.seg as usize];
+            let (a, b) = (self.point(p.seg, p.t[0]), self.point(p.seg, p.t[1]));
+            let f = &self.faces[p.seg as usize];
+            let on =
+                crate::mesh::barycentric::face_of_segment((wide(a), wide(b)), f, positions, faces);
+            out.face.push(on.map_or(-1, |o| i64::from(o.0)));
+            out.bary
+                .push(on.map_or([[0.0; 3]; 2], |o| o.1.map(|w| w.map(|x| x as f32))));
+            out.a.push(a);
+            out.b.push(b);
+            out.family.push(s.family);
+            out.strength.push(s.strength);
+            out.visible.push(u8::from(p.visible));
+            out.faces.push(std::array::from_fn(|k| {
+                f.get(k).map_or(-1, |&x| i64::from(x))
+            }));
+            out.chain.push(chain_of[i]);
+        }
+        out
+    }
+
     /// The point at `t` of segment `seg`.
     pub fn point(&self, seg: u32, t: f32) -> [f32; 3] {
         let s = &self.segments[seg as usize];

@@ -112,3 +112,21 @@ impl Walker {
         Ok(())
     }
 }
+
+/// Where view `view` of the `i`-th of `frames` keeps its lines' hysteresis
+/// state: its own slot, following the frame before it in the run, where
+/// the scene's coherence holds over that many frames; `None` otherwise.
+pub(super) fn hold_at(
+    scene: &crate::scene::file::Scene,
+    frames: &[usize],
+    i: usize,
+    view: usize,
+) -> Option<crate::stages::feature_lines::HoldAt> {
+    let lines = &scene.effects.lines;
+    (lines.coherence.holds(frames.len())).then(|| crate::stages::feature_lines::HoldAt {
+        slot: view,
+        frame: frames[i],
+        follows: i.checked_sub(1).map(|p| frames[p]),
+        low: lines.coherence_low,
+    })
+}

@@ -119,6 +119,7 @@ impl Scene {
         s.size = shot.size;
         s.png = false;
         s.svg = false;
+        s.npz = false;
         s
     }
 }

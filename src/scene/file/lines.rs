@@ -23,6 +23,7 @@
 
 use super::raw::{IsophoteSpec, PlainLineSpec, ThresholdLineSpec};
 use crate::scene::planner::Cue;
+use crate::spec::coherence::Coherence;
 use crate::spec::feature_lines::{CurveOptions, FamilySet, Hidden, LineFamily, family_style};
 
 /// One curvature line cue's stroke.
@@ -39,13 +40,29 @@ pub struct LineStyle {
 }
 
 /// The curvature line cues of a scene, resolved.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct LineEffects {
     /// One style per asked family, in family order.
     pub styles: Vec<LineStyle>,
     /// The feature-line stage's options (families, thresholds, isophotes,
     /// light, culling, fading).
     pub curves: CurveOptions,
+    /// Hysteresis over an animation's frames (`[lines] coherence`).
+    pub coherence: Coherence,
+    /// Its lower threshold, a fraction of each family's (`[lines]
+    /// coherence_low`, default [`Coherence::DEFAULT_LOW`]).
+    pub coherence_low: f32,
+}
+
+impl Default for LineEffects {
+    fn default() -> Self {
+        LineEffects {
+            styles: Vec::new(),
+            curves: CurveOptions::default(),
+            coherence: Coherence::default(),
+            coherence_low: Coherence::DEFAULT_LOW,
+        }
+    }
 }
 
 impl LineStyle {
@@ -157,7 +174,11 @@ pub(super) fn resolve(fx: &super::EffectsSpec, cues: &mut Vec<Cue>) -> Result<Li
     curves.families = FamilySet::of(&families);
     curves.fade = shared_by.fade.is_none_or(|f| f.0);
     curves.cull = shared_by.cull.is_none_or(|c| c.0);
-    Ok(LineEffects { styles, curves })
+    Ok(LineEffects {
+        styles,
+        curves,
+        ..LineEffects::default()
+    })
 }
 
 /// The settings every family shares, each with the first table that set it.

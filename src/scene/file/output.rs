@@ -21,6 +21,8 @@ pub(super) struct OutputPart {
     pub png: bool,
     /// Write SVG line drawings.
     pub svg: bool,
+    /// Write the line pieces as NPZ.
+    pub npz: bool,
     /// MSAA samples.
     pub msaa: u32,
     /// Background.
@@ -50,7 +52,7 @@ pub(super) fn resolve(
     if ![0, 2, 4, 8].contains(&msaa) {
         return Err(t.err(format!("output.msaa {msaa} must be 0, 2, 4 or 8")));
     }
-    let (png, svg) = t.formats(&out)?;
+    let [png, svg, npz] = t.formats(&out)?;
     let background =
         color(out.background, [1.0, 1.0, 1.0], "output.background").map_err(|p| t.err(p))?;
     let interop = match &out.interop {
@@ -78,6 +80,7 @@ pub(super) fn resolve(
         size,
         png,
         svg,
+        npz,
         msaa,
         background,
         interop,
@@ -100,27 +103,28 @@ impl Table<'_> {
         Ok(size)
     }
 
-    /// `formats`: whether to write PNG and SVG (default: PNG only).
-    fn formats(&self, out: &OutputSpec) -> Result<(bool, bool)> {
+    /// `formats`: whether to write PNG, SVG and NPZ (default: PNG only).
+    fn formats(&self, out: &OutputSpec) -> Result<[bool; 3]> {
         let Some(f) = &out.formats else {
-            return Ok((true, false));
+            return Ok([true, false, false]);
         };
-        let (mut png, mut svg) = (false, false);
+        let mut on = [false; 3];
         for x in f.get_ref() {
             match x.as_str() {
-                "png" => png = true,
-                "svg" => svg = true,
+                "png" => on[0] = true,
+                "svg" => on[1] = true,
+                "npz" => on[2] = true,
                 other => {
                     return Err(self.ck.err(
                         f.span(),
-                        format!("output format {other:?}: expected png or svg"),
+                        format!("output format {other:?}: expected png, svg or npz"),
                     ));
                 }
             }
         }
-        if !png && !svg {
+        if on == [false; 3] {
             return Err(self.ck.err(f.span(), "output.formats is empty"));
         }
-        Ok((png, svg))
+        Ok(on)
     }
 }

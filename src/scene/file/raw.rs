@@ -60,6 +60,11 @@ pub struct LinesSpec {
     pub hermite: Option<bool>,
     /// Hermite placement of K = 0 and H = 0.
     pub hermite_kh: Option<bool>,
+    /// `"auto"` (default), `"on"` or `"off"`: hysteresis over an
+    /// animation's frames.
+    pub coherence: Option<Spanned<String>>,
+    /// The hysteresis' lower threshold, a fraction of each threshold.
+    pub coherence_low: Option<f32>,
 }
 
 /// `[curvature]`: the estimator's options, by their command-line names.

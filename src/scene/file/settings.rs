@@ -15,6 +15,9 @@
 //! test = true                # rtsc's tests
 //! hermite = false            # rtsc's Hermite placement of suggestive lines
 //! hermite_kh = false         # the same for K = 0 and H = 0
+//! coherence = "auto"         # auto | on | off: hysteresis over an
+//!                            # animation's frames (auto: on for more than one)
+//! coherence_low = 0.5        # its lower threshold, a fraction of each threshold
 //! ```
 
 use super::raw::{CurvatureSpec, LinesSpec};
@@ -108,5 +111,18 @@ pub(super) fn lines(ck: &Checker<'_>, l: &Spanned<LinesSpec>, fx: &mut Effects) 
     c.test = l.test.unwrap_or(c.test);
     c.hermite = l.hermite.unwrap_or(c.hermite);
     c.hermite_kh = l.hermite_kh.unwrap_or(c.hermite_kh);
+    if let Some(m) = &l.coherence {
+        fx.lines.coherence = (m.get_ref().parse())
+            .map_err(|e: Error| ck.err(m.span(), format!("lines.coherence: {e}")))?;
+    }
+    if let Some(low) = l.coherence_low {
+        if !(low > 0.0 && low <= 1.0) {
+            return Err(ck.err(
+                span,
+                format!("lines.coherence_low {low} must be a fraction in (0, 1] of each threshold"),
+            ));
+        }
+        fx.lines.coherence_low = low;
+    }
     Ok(())
 }

@@ -137,6 +137,9 @@ pub(super) struct Executor<'s, 'g> {
     pub(super) keep: Keep,
     /// The last view's outputs, when kept.
     pub(super) kept: Option<super::draw::ViewOutputs>,
+    /// Where the next view's lines keep their hysteresis state (a run over
+    /// an animation's frames with coherence on sets it; `None`: none).
+    pub(super) hold: Option<crate::stages::feature_lines::HoldAt>,
 }
 
 impl<'s, 'g> Executor<'s, 'g> {
@@ -192,6 +195,7 @@ impl<'s, 'g> Executor<'s, 'g> {
             view: ViewState::default(),
             keep: Keep::default(),
             kept: None,
+            hold: None,
         })
     }
 
@@ -433,7 +437,8 @@ impl<'s, 'g> Executor<'s, 'g> {
             | Pass::Caps
             | Pass::Visibility
             | Pass::Render
-            | Pass::Svg => {
+            | Pass::Svg
+            | Pass::Npz => {
                 unreachable!("{pass:?} is a view pass")
             }
         }

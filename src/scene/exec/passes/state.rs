@@ -57,6 +57,9 @@ pub(in crate::scene::exec) struct RunState {
     pub(in crate::scene::exec) line_segments: std::collections::BTreeMap<&'static str, usize>,
     /// Files written.
     pub(in crate::scene::exec) outputs: Vec<PathBuf>,
+    /// The hysteresis' lower threshold where the lines were held over the
+    /// frames.
+    pub(in crate::scene::exec) held_low: Option<f32>,
 }
 
 /// One pose: its host copies and what its passes made.
@@ -101,6 +104,8 @@ pub(super) struct ViewState {
     pub(super) lines_ran: Option<Timing>,
     /// The edge stage's run and outputs.
     pub(super) edges_ran: Option<(Timing, EdgeOutput)>,
+    /// The pieces as NPZ arrays (world coordinates), where the NPZ pass ran.
+    pub(super) npz: Option<crate::export::npz::SegmentArrays>,
 }
 
 /// What a caller keeps of each view in memory instead of (or besides) the

@@ -88,6 +88,7 @@ impl Executor<'_, '_> {
             Pass::Visibility => self.visibility_pass(cam)?,
             Pass::Render => self.render_pass(pass, cam, paths)?,
             Pass::Svg => self.svg_pass(cam, paths)?,
+            Pass::Npz => self.npz_pass(paths)?,
             _ => unreachable!("{pass:?} is not a view pass"),
         }
         Ok(())
@@ -409,6 +410,7 @@ impl Executor<'_, '_> {
             layers: self.view.layers.take(),
             visible: self.view.vis.as_ref().map(|v| v.shifted(o)),
             fields: self.view.fields.take(),
+            npz: self.view.npz.take(),
             segments: (self.view.segs.iter())
                 .map(|s| crate::spec::feature_lines::Segment {
                     a: world(s.a),
@@ -473,6 +475,10 @@ impl Executor<'_, '_> {
             )?),
         };
         lx.keep_view_fields(self.plan.contains(Pass::ViewFields));
+        lx.hold_at(self.hold)?;
+        if let Some(h) = self.hold {
+            self.run.held_low = Some(h.low);
+        }
         let feature_size = match *feature_size {
             Some(fs) => fs,
             None => {

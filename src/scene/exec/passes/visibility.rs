@@ -119,7 +119,9 @@ impl Executor<'_, '_> {
     /// for the caller when asked.
     pub(super) fn svg_pass(&mut self, cam: &Camera, paths: &[&PathBuf]) -> Result<()> {
         let t0 = Instant::now();
-        let svgs: Vec<&PathBuf> = paths.iter().copied().filter(|p| !draw::is_png(p)).collect();
+        let svgs: Vec<&PathBuf> = (paths.iter().copied())
+            .filter(|p| draw::has_ext(p, "svg"))
+            .collect();
         if svgs.is_empty() && !self.keep.layers {
             // Nothing asked for in this view (a live view without an SVG
             // request): the pass does not run.
@@ -149,6 +151,41 @@ impl Executor<'_, '_> {
         if self.keep.layers {
             self.view.layers = Some(layers);
         }
+        Ok(())
+    }
+
+    /// The NPZ of the view: every piece of the visibility pass with its
+    /// family, strength, visibility and chain, world coordinates, and the
+    /// face and barycentric coordinates it lies at on this pose (which
+    /// name the same point of the rest mesh on every frame), written to
+    /// the NPZ `paths`.
+    pub(super) fn npz_pass(&mut self, paths: &[&PathBuf]) -> Result<()> {
+        let t0 = Instant::now();
+        let vis = self
+            .view
+            .vis
+            .as_ref()
+            .expect("planned after the visibility");
+        let t = self.topo.as_ref().expect("a pose ran");
+        let pos: Vec<[f64; 3]> = (self.pose.host.pos.iter())
+            .map(|p| p.map(f64::from))
+            .collect();
+        let mut arrays = vis.arrays(&pos, &t.mesh.faces);
+        // Scene frame to world.
+        let origin = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
+        for p in arrays.a.iter_mut().chain(arrays.b.iter_mut()) {
+            *p = std::array::from_fn(|i| (f64::from(p[i]) + origin[i]) as f32);
+        }
+        for p in paths.iter().filter(|p| draw::has_ext(p, "npz")) {
+            crate::export::npz::write_segments(p, &arrays)?;
+            self.run.outputs.push(p.to_path_buf());
+        }
+        let how = format!(
+            "{} pieces with their faces and barycentric coordinates",
+            arrays.a.len()
+        );
+        self.rec.wall(Pass::Npz, ms_since(t0), &how);
+        self.view.npz = Some(arrays);
         Ok(())
     }
 }
