@@ -21,9 +21,9 @@
 // and suggestive contours, on faces with a corner facing the viewer, their
 // parts with sinθ·D_w κr / (n·v) ≥ `sc_thresh` (the threshold already
 // divided by the square of the feature size on the host), each faded by
-// r / (r + fade) (`fade` likewise scaled; 0: no fade). held uint[F], next
-// uint[F], low: the hysteresis of isoline.h (held faces test suggestive
-// contours against sc_thresh·low).
+// r / (r + fade) (`fade` likewise scaled; 0: no fade). held uint[F], near
+// uint[V], next_held, next_near, low, birth: the coherence of isoline.h
+// (held faces test suggestive contours against sc_thresh·low).
 
 inline void view_at(float px, float py, float pz, float ex, float ey, float ez, uint ortho,
                     float *vx, float *vy, float *vz)
@@ -83,15 +83,19 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
                          uint want_contours, uint want_suggestive, uint test, uint hermite,
                          float sc_thresh, float fade, uint cap, __global float *seg,
                          __global uint *ends, volatile __global uint *counter,
-                         __global const uint *held, __global uint *next, float low)
+                         __global const uint *held, __global const uint *near,
+                         __global uint *next_held, __global uint *next_near, float low,
+                         uint birth)
 {
     GID_OR_RETURN(nf);
     uint v[3];
     v[0] = faces[3 * gid];
     v[1] = faces[3 * gid + 1];
     v[2] = faces[3 * gid + 2];
-    const uint hb = held[gid];
-    uint drawn = 0;
+    const uint3 v3 = (uint3)(v[0], v[1], v[2]);
+    const uint hb = held[gid], nb = near[v[0]] | near[v[1]] | near[v[2]];
+    const uint may = may_draw(hb, nb, birth);
+    uint found = 0;
     for (uint kind = 0; kind < 2; ++kind) {
         if ((kind == 0 && !want_contours) || (kind == 1 && !want_suggestive))
             continue;
@@ -148,9 +152,9 @@ __kernel void lines_face(uint nf, __global const uint *faces, __global const flo
         // segments chain into polylines exactly, by edge.
         const uint2 ea = (uint2)(min(v[c], v[a]), max(v[c], v[a]));
         const uint2 eb = (uint2)(min(v[c], v[b]), max(v[c], v[b]));
-        if (emit_tested(pa, pb, ea, eb, gid, n0, n1, d0, d1, test, kind == 0 ? 0.0f : fade, kind,
-                        cap, seg, ends, counter))
-            drawn |= 1u << kind;
+        if (emit_tested(pa, pb, ea, eb, gid, n0, n1, d0, d1, test, kind == 0 ? 0.0f : fade,
+                        unborn(may, kind), cap, seg, ends, counter))
+            found |= 1u << kind;
     }
-    mark_drawn(next, gid, drawn);
+    mark_found(next_held, next_near, gid, v3, hb, nb, found, may, birth);
 }

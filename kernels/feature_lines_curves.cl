@@ -5,7 +5,8 @@
 //   lines_pose   per vertex, once per pose: kmax (the principal curvature of
 //                larger magnitude), emax (its derivative along its direction,
 //                from dcurv), that direction; K = k1k2, H = (k1+k2)/2 and, for
-//                Hermite placement, their gradients
+//                Hermite placement, their gradients; with coherence, K's and
+//                H's signs held within a band (signs uint[V])
 //   lines_view   per vertex, once per view: the view-dependent curvature q1
 //                and its direction t1 (Judd, Durand & Adelson 2007), v·dmax
 //                and (k1² − k2²)(n·v) for principal highlights (DeCarlo &
@@ -38,9 +39,10 @@
 // 3 Hermite placement of K = 0 and H = 0 (from grad), 4 of the suggestive
 // highlights' κr = 0 (from gkr, lines_vertex's ∇(κr sin²θ), float[3V]).
 // Thresholds (and sh_fade) arrive divided by the feature size (rv) or its
-// square (ar, ph, sh, sc). held uint[F], next uint[F], low: the hysteresis
-// of isoline.h; held faces test ridges, valleys, apparent ridges and both
-// highlights against their threshold times `low` (their strength too).
+// square (ar, ph, sh, sc). held uint[F], near uint[V], next_held,
+// next_near, low, birth: the coherence of isoline.h; held faces test
+// ridges, valleys, apparent ridges and both highlights against their
+// threshold times `low` (their strength too).
 
 #define LF_RIDGES 2u
 #define LF_VALLEYS 3u
@@ -59,7 +61,8 @@ inline float3 ld3(__global const float *a, uint i) { return vload3(i, a); }
 
 __kernel void lines_pose(uint nv, __global const float *d1, __global const float *d2,
                          __global const float *k, __global const float *dk, uint grads,
-                         __global float *pose, __global float *grad)
+                         __global float *pose, __global float *grad, __global uint *signs,
+                         uint sign_mode, float band_k, float band_h)
 {
     GID_OR_RETURN(nv);
     const float k1 = k[2 * gid], k2 = k[2 * gid + 1];
@@ -72,8 +75,24 @@ __kernel void lines_pose(uint nv, __global const float *d1, __global const float
     pose[8 * gid + 2] = dm.x;
     pose[8 * gid + 3] = dm.y;
     pose[8 * gid + 4] = dm.z;
-    pose[8 * gid + 5] = k1 * k2;
-    pose[8 * gid + 6] = 0.5f * (k1 + k2);
+    float kg = k1 * k2, km = 0.5f * (k1 + k2);
+    if (sign_mode != 0) {
+        // Coherence: a Schmitt trigger on the signs of K and H. Within the
+        // band around 0, a vertex keeps the sign of the previous frame
+        // (mode 2), so that a zero set does not wander with values that
+        // only round or jitter about 0; mode 1 (a sequence's first frame)
+        // only records the signs.
+        const uint s = signs[gid];
+        if (sign_mode == 2) {
+            if (fabs(kg) < band_k && ((s & 1u) != 0) != (kg < 0.0f))
+                kg = -kg;
+            if (fabs(km) < band_h && ((s & 2u) != 0) != (km < 0.0f))
+                km = -km;
+        }
+        signs[gid] = (kg < 0.0f ? 1u : 0u) | (km < 0.0f ? 2u : 0u);
+    }
+    pose[8 * gid + 5] = kg;
+    pose[8 * gid + 6] = km;
     pose[8 * gid + 7] = 0.0f;
     if (grads) {
         // ∇k1 = C111 d1 + C112 d2, ∇k2 = C122 d1 + C222 d2.
@@ -343,11 +362,13 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
                            float sc_thr, float sh_fade, uint iso_n, uint cap,
                            __global float *seg, __global uint *ends,
                            volatile __global uint *counter, __global const uint *held,
-                           __global uint *next, float low)
+                           __global const uint *near, __global uint *next_held,
+                           __global uint *next_near, float low, uint birth)
 {
     GID_OR_RETURN(nf);
     const uint3 v = vload3(gid, faces);
-    const uint hb = held[gid];
+    const uint hb = held[gid], nb = near[v.x] | near[v.y] | near[v.z];
+    const uint may = may_draw(hb, nb, birth);
     uint drawn = 0;
     const uint cull = flags & 1u, test = (flags >> 1) & 1u, fade = (flags >> 2) & 1u;
     const uint hermite = (flags >> 3) & 1u, hermite_sh = (flags >> 4) & 1u;
@@ -374,12 +395,12 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const float3 t0 = vload3(0, view + 8 * v.x + 1), t1 = vload3(0, view + 8 * v.y + 1);
             const float3 t2 = vload3(0, view + 8 * v.z + 1);
             if (ridge_face(gid, v, e, e.x * t0, e.y * t1, e.z * t2, q, pos, test, thr, fade,
-                           LF_APPARENT, true, cap, seg, ends, counter))
+                           unborn(may, LF_APPARENT), true, cap, seg, ends, counter))
                 drawn |= 1u << LF_APPARENT;
         }
     }
     if (back) {
-        mark_drawn(next, gid, drawn);
+        mark_found(next_held, next_near, gid, v, hb, nb, drawn, may, birth);
         return;
     }
     if (want & ((1u << LF_RIDGES) | (1u << LF_VALLEYS))) {
@@ -394,8 +415,8 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             if (!(sg * km.x > 0.0f && sg * km.y > 0.0f && sg * km.z > 0.0f))
                 continue;
             if (ridge_face(gid, v, em, sg * em.x * d0, sg * em.y * d1, sg * em.z * d2, km, pos,
-                           test, held_thr(hb, fam, rv_thr, low), fade, fam, false, cap, seg,
-                           ends, counter))
+                           test, held_thr(hb, fam, rv_thr, low), fade, unborn(may, fam), false,
+                           cap, seg, ends, counter))
                 drawn |= 1u << fam;
         }
     }
@@ -427,16 +448,17 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
         const bool z20 = dots.z * dots.x <= 0.0f;
         if (ok && flavour && (uint)z01 + (uint)z12 + (uint)z20 >= 2) {
             const float thr = held_thr(hb, LF_PRIN_HL, ph_thr, low);
+            const uint fc = unborn(may, LF_PRIN_HL);
             uint n = 0;
             if (!z01)
-                n = ridge_segment(gid, v.yzx, dots.yzx, tst.yzx, pos, thr, fade, false,
-                                  LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
-            else if (!z12)
-                n = ridge_segment(gid, v.zxy, dots.zxy, tst.zxy, pos, thr, fade, false,
-                                  LF_PRIN_HL, false, Z3, Z3, Z3, cap, seg, ends, counter);
-            else if (!z20)
-                n = ridge_segment(gid, v, dots, tst, pos, thr, fade, false, LF_PRIN_HL, false,
+                n = ridge_segment(gid, v.yzx, dots.yzx, tst.yzx, pos, thr, fade, false, fc, false,
                                   Z3, Z3, Z3, cap, seg, ends, counter);
+            else if (!z12)
+                n = ridge_segment(gid, v.zxy, dots.zxy, tst.zxy, pos, thr, fade, false, fc, false,
+                                  Z3, Z3, Z3, cap, seg, ends, counter);
+            else if (!z20)
+                n = ridge_segment(gid, v, dots, tst, pos, thr, fade, false, fc, false, Z3, Z3, Z3,
+                                  cap, seg, ends, counter);
             if (n)
                 drawn |= 1u << LF_PRIN_HL;
         }
@@ -459,7 +481,7 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             const float3 pc = ld3(pos, ic);
             if (emit_tested(lerp3(pc, ld3(pos, ia), tt.x), lerp3(pc, ld3(pos, ib), tt.y),
                             edge_of(ic, ia), edge_of(ic, ib), gid, n0, n1, d0, d1, test, sh_fade,
-                            LF_SUG_HL, cap, seg, ends, counter))
+                            unborn(may, LF_SUG_HL), cap, seg, ends, counter))
                 drawn |= 1u << LF_SUG_HL;
         }
     }
@@ -474,7 +496,7 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
             continue;
         const uint h = hermite && fam != LF_DWKR_ZERO;
         const float2 tt = iso_params(v, f, c, pos, grad, 2, fam == LF_K_ZERO ? 0 : 1, h);
-        drawn |= iso_emit(v, c, tt, pos, fam, 1.0f, cap, seg, ends, counter) << fam;
+        drawn |= iso_emit(v, c, tt, pos, unborn(may, fam), 1.0f, cap, seg, ends, counter) << fam;
     }
     if ((want & (1u << LF_ISOPHOTES)) && iso_n > 0) {
         // Levels n·l = j / N for |j| < N, as rtsc's lit and unlit isophotes.
@@ -493,5 +515,5 @@ __kernel void lines_curves(uint nf, __global const uint *faces, __global const f
                      << LF_ISOPHOTES;
         }
     }
-    mark_drawn(next, gid, drawn);
+    mark_found(next_held, next_near, gid, v, hb, nb, drawn, may, birth);
 }

@@ -597,6 +597,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
     let mut plain = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
     let mut held = LineExtractor::new(gpu(), m.n_vertices(), &m.faces).unwrap();
     let mut twin_held = vec![0u32; m.faces.len()];
+    let mut twin_near = vec![0u32; m.n_vertices()];
     let t = lines_vertex(&li(&x), view);
     let (mut without, mut with) = (Vec::new(), Vec::new());
     for k in 0..6 {
@@ -607,6 +608,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
             frame: k,
             follows: k.checked_sub(1),
             low,
+            birth: 0,
         }))
         .unwrap();
         let (b, _) = held.extract(&li(&x), view, 1.0, o).unwrap();
@@ -618,6 +620,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
         }
         // The twin from its own marks.
         let mut next = vec![0u32; m.faces.len()];
+        let mut next_near = vec![0u32; m.n_vertices()];
         let cpu = lines_face(
             &m.faces,
             &x.pos,
@@ -629,19 +632,23 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
             o.scaled_fade(1.0),
             &mut Hold {
                 held: &twin_held,
-                next: &mut next,
+                near: &twin_near,
+                next_held: &mut next,
+                next_near: &mut next_near,
                 low,
+                birth: 0,
             },
         );
         same(b.clone(), cpu, &format!("hysteresis frame {k}"));
-        let (marks, frame) = held.read_marks(0).unwrap().expect("the slot ran");
-        assert_eq!(frame, Some(k));
-        let differ = marks.iter().zip(&next).filter(|(a, b)| a != b).count();
+        let marks = held.read_marks(0).unwrap().expect("the slot ran");
+        assert_eq!(marks.frame, Some(k));
+        let differ = marks.held.iter().zip(&next).filter(|(a, b)| a != b).count();
         assert!(
             differ <= m.faces.len() / 200,
             "frame {k}: {differ} faces' marks differ from the twin's"
         );
         twin_held = next;
+        twin_near = next_near;
         without.push(length(&a));
         with.push(length(&b));
     }
@@ -663,6 +670,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
         frame: 9,
         follows: Some(8),
         low,
+        birth: 0,
     }))
     .unwrap();
     let o = opts_at(1);
@@ -676,7 +684,16 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
             frame: 0,
             follows: None,
             low: bad,
+            birth: 0,
         };
         assert!(held.hold_at(Some(at)).is_err(), "{bad}");
     }
+    let late = HoldAt {
+        slot: 0,
+        frame: 0,
+        follows: None,
+        low,
+        birth: 3,
+    };
+    assert!(held.hold_at(Some(late)).is_err(), "a delay of 3 frames");
 }

@@ -167,21 +167,58 @@ inline uint emit_tested(float3 pa, float3 pb, uint2 ea, uint2 eb, uint f, float 
     return np;
 }
 
-// Hysteresis over the frames of one pose sequence (two thresholds, as
-// Canny's edge detector): `held` holds, per face, a bit per family (bit =
-// family code) set where the face drew that family in the previous frame;
-// such a face tests the family against its threshold times `low`. Every
-// face adds the families it draws to `next` (its own word: no race, the
-// same bits whatever the order). All zero: nothing held, today's lines.
-// Held faces only, not their neighbours: a line cannot creep along the
-// surface from frame to frame.
+// Coherence over the frames of one pose sequence (Canny's two thresholds,
+// and a delay of births). The state, a bit per family (bit = family code):
+//   held uint[F]  the families each face drew in the previous frame; such a
+//                 face tests a family against its threshold times `low`
+//                 (held faces only, not their neighbours: a line cannot
+//                 creep along the surface from frame to frame);
+//   near uint[V]  at each face's corners, the families it found in the
+//                 previous frame (drawn or not; low 16 bits), and those it
+//                 found there having found them around it the frame before
+//                 too (high 16 bits: established).
+// With `birth` = 1 (2), a face draws a family only where it held it, or
+// where it was found around it in the previous frame (established there):
+// a line that appears away from every line of its family is drawn from its
+// second (third) frame, so that blips of one (two) frames are not drawn.
+// Contours, isophotes and boundaries are never delayed. A face found but
+// not drawn emits its segment with LINE_UNBORN added to its family, which
+// the host drops. The next state: next_held (own word, no race), next_near
+// (atomic or at the corners: the same bits whatever the order). All zero
+// and birth 0 (the first frame, or no coherence): today's lines.
+#define LINE_UNBORN 0x100u
+#define LINE_UNGATED ((1u << 0) | (1u << 7) | (1u << 11))
+
 inline float held_thr(uint bits, uint fam, float thr, float low)
 {
     return ((bits >> fam) & 1u) ? thr * low : thr;
 }
 
-inline void mark_drawn(__global uint *next, uint f, uint bits)
+// The families face f may draw: all without a delay of births, else those
+// it held, those found (established) around it, and the undelayed ones.
+inline uint may_draw(uint held, uint near, uint birth)
 {
-    if (bits)
-        next[f] |= bits;
+    if (birth == 0)
+        return 0xffffffffu;
+    return held | (birth == 1 ? (near & 0xffffu) : (near >> 16)) | LINE_UNGATED;
+}
+
+// The family code a segment of `fam` is emitted with.
+inline uint unborn(uint may, uint fam) { return ((may >> fam) & 1u) ? fam : fam | LINE_UNBORN; }
+
+// Face f (corners v) found families `found`: the drawn ones are held next
+// frame; the found ones, and those established, are marked at its corners.
+inline void mark_found(__global uint *next_held, __global uint *next_near, uint f, uint3 v,
+                       uint held, uint near, uint found, uint may, uint birth)
+{
+    const uint drawn = found & may;
+    if (drawn)
+        next_held[f] |= drawn;
+    const uint est = birth == 0 ? found : found & ((near & 0xffffu) | held);
+    const uint m = found | (est << 16);
+    if (m) {
+        atomic_or(&next_near[v.x], m);
+        atomic_or(&next_near[v.y], m);
+        atomic_or(&next_near[v.z], m);
+    }
 }

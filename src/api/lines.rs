@@ -226,8 +226,9 @@ pub struct LineView {
     pub fields: Option<crate::spec::feature_lines::ViewFields>,
     /// The pieces as NPZ arrays, with the face and barycentric coordinates
     /// each lies at on this frame's pose (the same point of the rest mesh
-    /// on every frame), where the scene writes NPZ (`scene.npz`).
-    pub npz: Option<crate::export::npz::SegmentArrays>,
+    /// on every frame), and that pose, where the scene writes NPZ
+    /// (`scene.npz`).
+    pub npz: Option<crate::scene::exec::PosedPieces>,
     /// The picture (lines over the mesh in white), in memory where the
     /// scene asks for a PNG.
     pub image: Option<Frame>,

@@ -135,6 +135,22 @@ enum Topic {
         #[command(flatten)]
         out: Outputs,
     },
+    /// Flicker of the line families on animations, with hysteresis over
+    /// the frames off and on, beside a control where only the view moves:
+    /// per family, the share of line length that pops between frames and
+    /// that lives fewer than 3 frames, mapped to the rest pose (default:
+    /// the elephant, BrainStem and Fox animations of the shared data, and
+    /// the Fox bundled with the repository).
+    Coherence {
+        /// Scene files of skinned animations (their input, frames and first
+        /// camera are used).
+        scenes: Vec<PathBuf>,
+        /// Image size, e.g. 640x480.
+        #[arg(long, default_value = "640x480")]
+        size: String,
+        #[command(flatten)]
+        out: Outputs,
+    },
     /// Exact visibility of lines against its f64 reference, with the
     /// depth-buffer method beside it: per mesh and view, the share of line
     /// length each method agrees with the reference on, and its ms (default
@@ -286,6 +302,16 @@ pub fn run(device: Option<&str>, a: ReportArgs) -> Result<()> {
                 size: super::size_arg(&size).map(|(w, h)| [w, h])?,
             };
             (lines_batch(&gpu, o, &out)?, out)
+        }
+        Topic::Coherence { scenes, size, out } => {
+            found(&scenes, "give the scene files of animations")?;
+            let paths: Vec<&Path> = scenes.iter().map(PathBuf::as_path).collect();
+            check(&paths, &out)?;
+            let o = report::coherence::CoherenceOptions {
+                scenes,
+                size: Some(super::size_arg(&size).map(|(w, h)| [w, h])?),
+            };
+            (report::coherence::report(&gpu()?, &o)?, out)
         }
         Topic::Visibility(v) => visibility(&gpu, v)?,
         Topic::Memory { out } => {

@@ -227,12 +227,7 @@ pub fn emit_tested(
     pieces.len()
 }
 
-/// The hysteresis of kernels/common/isoline.h: the families (a bit per
-/// family code) that face `f` drew in the previous frame (`held`, per
-/// face; empty: none).
-pub fn held_bits(held: &[u32], f: usize) -> u32 {
-    held.get(f).copied().unwrap_or(0)
-}
+pub use crate::spec::coherence::{LINE_UNBORN, LINE_UNGATED};
 
 /// A family's threshold on a face holding bits `bits`: times `low` where
 /// the face holds the family.
@@ -244,42 +239,99 @@ pub fn held_thr(bits: u32, fam: u32, thr: f32, low: f32) -> f32 {
     }
 }
 
-/// Adds the families `bits` face `f` drew to `next` (empty: not kept).
-pub fn mark_drawn(next: &mut [u32], f: usize, bits: u32) {
-    if let Some(m) = next.get_mut(f) {
-        *m |= bits;
+/// The families a face may draw (`may_draw` of isoline.h).
+pub fn may_draw(held: u32, near: u32, birth: u32) -> u32 {
+    match birth {
+        0 => u32::MAX,
+        1 => held | (near & 0xffff) | LINE_UNGATED,
+        _ => held | (near >> 16) | LINE_UNGATED,
     }
 }
 
-/// The hysteresis state of one frame's extraction, as the kernels take
-/// it: the previous frame's marks per face (`held`, empty: none), the
-/// marks this frame makes (`next`, empty: not kept) and the fraction of a
-/// threshold that a held face tests against.
+/// The family code a segment of `fam` is emitted with.
+pub fn unborn(may: u32, fam: u32) -> u32 {
+    if (may >> fam) & 1 != 0 {
+        fam
+    } else {
+        fam | LINE_UNBORN
+    }
+}
+
+/// The coherence state of one frame's extraction, as the kernels take it
+/// (kernels/common/isoline.h): the previous frame's families per face
+/// (`held`) and at the corners (`near`), empty for none; the marks this
+/// frame makes (`next_held`, `next_near`, OR-ed in; empty: not kept); the
+/// fraction of a threshold a held face tests against; the delay of births
+/// in frames (0: none, and on a sequence's first frame).
 pub struct Hold<'a> {
-    /// The previous frame's marks per face.
+    /// The families each face drew in the previous frame.
     pub held: &'a [u32],
-    /// This frame's marks per face (OR-ed in).
-    pub next: &'a mut [u32],
+    /// The families found around each vertex in the previous frame (low 16
+    /// bits) and established there (high 16 bits).
+    pub near: &'a [u32],
+    /// This frame's `held`.
+    pub next_held: &'a mut [u32],
+    /// This frame's `near`.
+    pub next_near: &'a mut [u32],
     /// The fraction of its threshold a held face's family is tested against.
     pub low: f32,
+    /// The delay of births in frames (0, 1 or 2).
+    pub birth: u32,
 }
 
 impl Hold<'_> {
-    /// No hysteresis: nothing held, nothing marked.
+    /// No coherence: nothing held, nothing marked.
     pub fn none() -> Hold<'static> {
         Hold {
             held: &[],
-            next: &mut [],
+            near: &[],
+            next_held: &mut [],
+            next_near: &mut [],
             low: 1.0,
+            birth: 0,
         }
     }
+
+    /// Face `f`'s (corners `v`) held families, the families found around
+    /// it, and those it may draw.
+    pub fn face(&self, f: usize, v: [u32; 3]) -> (u32, u32, u32) {
+        let held = self.held.get(f).copied().unwrap_or(0);
+        let near = match self.near.is_empty() {
+            true => 0,
+            false => v.iter().fold(0, |b, &i| b | self.near[i as usize]),
+        };
+        (held, near, may_draw(held, near, self.birth))
+    }
+
+    /// `mark_found` of isoline.h: face `f` (corners `v`) found `found`.
+    pub fn mark(&mut self, f: usize, v: [u32; 3], (held, near, may): (u32, u32, u32), found: u32) {
+        if let Some(m) = self.next_held.get_mut(f) {
+            *m |= found & may;
+        }
+        let est = if self.birth == 0 {
+            found
+        } else {
+            found & ((near & 0xffff) | held)
+        };
+        if !self.next_near.is_empty() {
+            for i in v {
+                self.next_near[i as usize] |= found | (est << 16);
+            }
+        }
+    }
+}
+
+/// Drops the segments found but not drawn (a delayed birth).
+pub fn drop_unborn(segs: &mut Vec<Segment>) {
+    segs.retain(|s| s.family & LINE_UNBORN == 0);
 }
 
 /// `lines_face`: segments of the requested kinds, with rtsc's tests when
 /// `test` (contours: κr ≥ 0; suggestive contours: sinθ D_w κr / (n·v) ≥
 /// `sc_thresh`, faded by `fade`), suggestive contours placed by rtsc's
 /// Hermite fit when `hermite`; held faces (`hold`) test suggestive
-/// contours against `sc_thresh` times its `low`.
+/// contours against `sc_thresh` times its `low`, and births are delayed as
+/// it says (the segments found but not drawn are dropped).
 // Mirrors the kernel lines_face of kernels/feature_lines.cl argument for
 // argument (ndv, kr, sc, gkr as `t`, the two wants as `want`, held, next
 // and low as `hold`; its outputs returned).
@@ -298,8 +350,9 @@ pub fn lines_face(
     let mut out = Vec::new();
     for (fi, f) in faces.iter().enumerate() {
         let v = f.map(|i| i as usize);
-        let hb = held_bits(hold.held, fi);
-        let mut drawn = 0u32;
+        let state = hold.face(fi, *f);
+        let (hb, _, may) = state;
+        let mut found = 0u32;
         for kind in 0..2u32 {
             if !want[kind as usize] {
                 continue;
@@ -362,14 +415,15 @@ pub fn lines_face(
                 ends,
                 test,
                 if kind == 0 { 0.0 } else { fade },
-                kind,
+                unborn(may, kind),
             );
             if n > 0 {
-                drawn |= 1 << kind;
+                found |= 1 << kind;
             }
         }
-        mark_drawn(hold.next, fi, drawn);
+        hold.mark(fi, *f, state, found);
     }
+    drop_unborn(&mut out);
     out
 }
 

@@ -7,7 +7,7 @@
 //! lists.
 
 pub use super::feature_lines::zero_hermite;
-use super::feature_lines::{Hold, VertexTerms, emit_tested, held_bits, held_thr, mark_drawn};
+use super::feature_lines::{Hold, VertexTerms, drop_unborn, emit_tested, held_thr, unborn};
 use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
 pub use crate::spec::feature_lines::{ScaledThresholds, boundary_mask};
 use crate::spec::view::View;
@@ -56,6 +56,22 @@ pub struct PoseTerms {
 
 /// `lines_pose`: kmax, emax, dmax, K, H and, with `grads`, ∇K and ∇H.
 pub fn lines_pose(x: &LineInputs, grads: bool) -> PoseTerms {
+    lines_pose_held(x, grads, &mut [], 0, (0.0, 0.0))
+}
+
+/// [`lines_pose`] with coherence's Schmitt trigger on the signs of K and H
+/// (kernels/feature_lines_curves.cl): `sign_mode` 0 off, 1 records the
+/// signs in `signs` (a sequence's first frame), 2 keeps each vertex's sign
+/// of the previous frame where |K| < `bands.0` (|H| < `bands.1`).
+// Mirrors the kernel lines_pose argument for argument (band_k, band_h as
+// `bands`; its outputs returned).
+pub fn lines_pose_held(
+    x: &LineInputs,
+    grads: bool,
+    signs: &mut [u32],
+    sign_mode: u32,
+    (band_k, band_h): (f32, f32),
+) -> PoseTerms {
     let mut t = PoseTerms::default();
     for i in 0..x.k.len() {
         let [k1, k2] = x.k[i];
@@ -64,8 +80,21 @@ pub fn lines_pose(x: &LineInputs, grads: bool) -> PoseTerms {
         t.kmax.push(if first { k1 } else { k2 });
         t.emax.push(if first { c[0] } else { c[3] });
         t.dmax.push(if first { x.d1[i] } else { x.d2[i] });
-        t.gauss.push(k1 * k2);
-        t.mean.push(0.5 * (k1 + k2));
+        let (mut kg, mut km) = (k1 * k2, 0.5 * (k1 + k2));
+        if let Some(held) = signs.get_mut(i).filter(|_| sign_mode != 0) {
+            let s = *held;
+            if sign_mode == 2 {
+                if kg.abs() < band_k && ((s & 1) != 0) != (kg < 0.0) {
+                    kg = -kg;
+                }
+                if km.abs() < band_h && ((s & 2) != 0) != (km < 0.0) {
+                    km = -km;
+                }
+            }
+            *held = u32::from(kg < 0.0) | (u32::from(km < 0.0) << 1);
+        }
+        t.gauss.push(kg);
+        t.mean.push(km);
         if grads {
             let g1 = add(mul(c[0], x.d1[i]), mul(c[1], x.d2[i]));
             let g2 = add(mul(c[2], x.d1[i]), mul(c[3], x.d2[i]));
@@ -204,11 +233,15 @@ pub struct CurveTerms<'a> {
 
 struct Out<'a> {
     segs: &'a mut Vec<Segment>,
+    /// The families the face may draw ([`Hold::face`]): the others are
+    /// emitted with [`super::feature_lines::LINE_UNBORN`].
+    may: u32,
 }
 
 impl Out<'_> {
     fn emit(&mut self, a: V3, b: V3, fam: LineFamily, s: f32, e: [[u32; 2]; 2]) {
-        self.segs.push(Segment::new(a, b, fam as u32, s, e));
+        let code = unborn(self.may, fam as u32);
+        self.segs.push(Segment::new(a, b, code, s, e));
     }
 }
 
@@ -423,7 +456,11 @@ pub fn lines_curves(
     let mut segs = Vec::new();
     for (fi, face) in faces.iter().enumerate() {
         let before = segs.len();
-        let mut out = Out { segs: &mut segs };
+        let state = hold.face(fi, *face);
+        let mut out = Out {
+            segs: &mut segs,
+            may: state.2,
+        };
         curve_face(
             &mut out,
             &CurveFace {
@@ -433,13 +470,14 @@ pub fn lines_curves(
                 x,
                 o,
                 thr,
-                held: held_bits(hold.held, fi),
+                held: state.0,
                 low: hold.low,
             },
         );
-        let drawn = segs[before..].iter().fold(0, |b, s| b | 1 << s.family);
-        mark_drawn(hold.next, fi, drawn);
+        let found = (segs[before..].iter()).fold(0, |b, s| b | 1 << (s.family & 0xff));
+        hold.mark(fi, *face, state, found);
     }
+    drop_unborn(&mut segs);
     segs
 }
 
@@ -481,8 +519,8 @@ struct CurveFace<'a> {
     x: &'a CurveTerms<'a>,
     o: &'a CurveOptions,
     thr: ScaledThresholds,
-    /// The families the previous frame drew around the face
-    /// ([`held_bits`]) and the fraction of a threshold they are tested at.
+    /// The families the face drew in the previous frame and the fraction
+    /// of a threshold they are tested at ([`Hold::face`]).
     held: u32,
     low: f32,
 }
@@ -645,7 +683,7 @@ impl CurveFace<'_> {
             ends,
             self.o.test,
             thr.sh_fade,
-            LineFamily::SuggestiveHighlights as u32,
+            unborn(out.may, LineFamily::SuggestiveHighlights as u32),
         );
     }
 

@@ -9,6 +9,7 @@
 //! ([`crate::spec::timing::Timing`]) and know nothing of tables.
 
 pub mod caps;
+pub mod coherence;
 pub mod curvature;
 pub mod frames;
 pub mod isosurface;

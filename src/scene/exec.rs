@@ -46,7 +46,7 @@ mod report;
 mod vector;
 mod walk;
 
-pub use draw::{EdgeCounts, EdgeInfo, ViewDone, ViewOutputs};
+pub use draw::{EdgeCounts, EdgeInfo, PosedPieces, ViewDone, ViewOutputs};
 pub use live::{LiveFrame, LiveRequest};
 pub use load::{frame_indices, output_paths};
 pub use report::{PassRecord, RunReport};

@@ -30,6 +30,15 @@ impl Coherence {
     /// from the previous frame tests against (Canny's lower threshold).
     pub const DEFAULT_LOW: f32 = 0.5;
 
+    /// The frames a line found away from every line of its family waits
+    /// before it is drawn (0, 1 or 2).
+    pub const DEFAULT_BIRTH: u32 = 2;
+
+    /// The band of the Schmitt trigger on the signs of K and H, in units
+    /// of the feature size s: |K| < band / s² and |H| < band / s keep the
+    /// sign of the previous frame.
+    pub const DEFAULT_BAND: f32 = 0.05;
+
     /// The name on the command line, in scene files and in reports.
     pub fn name(self) -> &'static str {
         match self {
@@ -49,3 +58,13 @@ impl Coherence {
 }
 
 crate::spec::named_choice!(Coherence, "coherence");
+
+/// The family bit added to a segment found but not drawn (its birth
+/// delayed, `LINE_UNBORN` of kernels/common/isoline.h); the line stage
+/// drops such segments.
+pub const LINE_UNBORN: u32 = 0x100;
+
+/// The families whose births are never delayed: contours (which must
+/// follow their motion without lag), isophotes and boundaries
+/// (`LINE_UNGATED` of kernels/common/isoline.h).
+pub const LINE_UNGATED: u32 = (1 << 0) | (1 << 7) | (1 << 11);

@@ -144,6 +144,18 @@ pub struct LineExtractor {
     hold: HoldState,
 }
 
+/// The coherence marks of a slot's last frame ([`LineExtractor::read_marks`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Marks {
+    /// Per face, the families drawn.
+    pub held: Vec<u32>,
+    /// Per vertex, the families found around it (low 16 bits) and
+    /// established (high 16 bits).
+    pub near: Vec<u32>,
+    /// The frame they are of.
+    pub frame: Option<usize>,
+}
+
 /// Where the next extraction keeps its hysteresis state
 /// ([`LineExtractor::hold_at`]): a slot (one per view of a pose sequence)
 /// and the frame it runs, with the frame before it in the sequence.
@@ -159,21 +171,36 @@ pub struct HoldAt {
     /// The fraction of its threshold a face that drew a family in the
     /// previous frame tests that family against (in (0, 1]).
     pub low: f32,
+    /// The delay of births in frames (0, 1 or 2): a line found away from
+    /// every line of its family in the frames before is drawn from its
+    /// second (third) frame on.
+    pub birth: u32,
+    /// The band of the Schmitt trigger on the signs of K and H, in units
+    /// of the feature size s (|K| < band / s², |H| < band / s keep the
+    /// previous frame's sign; 0: none).
+    pub band: f32,
 }
 
-/// The hysteresis buffers of one extractor: the marks of each slot's last
-/// frame, the marks being made, and an all-zero `held` (and a scratch
-/// `next`) for extractions without hysteresis.
+/// The coherence buffers of one extractor (kernels/common/isoline.h): per
+/// face (`held`) and per vertex (`near`), the marks of each slot's last
+/// frame, the marks being made, and all-zero marks (and scratch ones to
+/// write) for extractions without coherence.
 struct HoldState {
-    zeros: Buffer<u32>,
-    scratch: Buffer<u32>,
+    zeros: [Buffer<u32>; 2],
+    scratch: [Buffer<u32>; 2],
     /// Per slot: the last frame's marks, the frame they are of.
-    slots: std::collections::HashMap<usize, (Buffer<u32>, Option<usize>)>,
+    slots: std::collections::HashMap<usize, ([Buffer<u32>; 2], Option<usize>)>,
     /// This frame's marks (swapped into the slot after the run).
-    next: Buffer<u32>,
+    next: [Buffer<u32>; 2],
     /// The next run's place, where set.
     at: Option<HoldAt>,
+    /// Whether the last run started its slot's sequence afresh.
+    fresh: bool,
 }
+
+/// The coherence arguments of the line kernels: held, near, next_held,
+/// next_near, low, birth.
+pub(crate) type HoldArgs = ([Arg; 4], f32, u32);
 
 impl LineExtractor {
     /// Uploads the faces and allocates the buffers.
@@ -212,14 +239,16 @@ impl LineExtractor {
             scale: 1.0,
             hold: HoldState {
                 zeros: {
-                    let mut z = gpu.buffer(faces.len().max(1))?;
-                    gpu.zero(&mut z, faces.len().max(1))?;
-                    z
+                    let (mut a, mut b) = (gpu.buffer(faces.len().max(1))?, gpu.buffer(nv.max(1))?);
+                    gpu.zero(&mut a, faces.len().max(1))?;
+                    gpu.zero(&mut b, nv.max(1))?;
+                    [a, b]
                 },
-                scratch: gpu.buffer(faces.len().max(1))?,
+                scratch: [gpu.buffer(faces.len().max(1))?, gpu.buffer(nv.max(1))?],
                 slots: Default::default(),
-                next: gpu.buffer(faces.len().max(1))?,
+                next: [gpu.buffer(faces.len().max(1))?, gpu.buffer(nv.max(1))?],
                 at: None,
+                fresh: true,
             },
             gpu,
             nv,
@@ -311,57 +340,85 @@ impl LineExtractor {
     /// thresholds. A slot whose last frame is not `follows` starts afresh:
     /// the first frame of a sequence draws today's lines exactly.
     pub fn hold_at(&mut self, at: Option<HoldAt>) -> Result<()> {
-        if let Some(h) = at
-            && !(h.low > 0.0 && h.low <= 1.0)
-        {
-            return Err(Error::InvalidArgument(format!(
-                "the hysteresis' lower threshold must be a fraction in (0, 1] of the threshold, got {}",
-                h.low
-            )));
+        if let Some(h) = at {
+            if !(h.low > 0.0 && h.low <= 1.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "the hysteresis' lower threshold must be a fraction in (0, 1] of the threshold, got {}",
+                    h.low
+                )));
+            }
+            if h.birth > 2 {
+                return Err(Error::InvalidArgument(format!(
+                    "the delay of births is 0, 1 or 2 frames, got {}",
+                    h.birth
+                )));
+            }
         }
         self.hold.at = at;
         Ok(())
     }
 
-    /// The hysteresis marks of `slot`'s last frame, per face (bit =
-    /// family code), with that frame; `None` where the slot never ran.
-    pub fn read_marks(&self, slot: usize) -> Result<Option<(Vec<u32>, Option<usize>)>> {
-        let Some((b, frame)) = self.hold.slots.get(&slot) else {
+    /// The coherence marks of `slot`'s last frame (bit = family code):
+    /// per face the families drawn, per vertex those found around it (low
+    /// 16 bits) and established (high 16 bits); with that frame; `None`
+    /// where the slot never ran.
+    pub fn read_marks(&self, slot: usize) -> Result<Option<Marks>> {
+        let Some(([held, near], frame)) = self.hold.slots.get(&slot) else {
             return Ok(None);
         };
-        let mut m = vec![0u32; self.nf];
+        let mut m = Marks {
+            held: vec![0u32; self.nf],
+            near: vec![0u32; self.nv],
+            frame: *frame,
+        };
         if self.nf > 0 {
-            self.gpu.read(b, &mut m)?;
+            self.gpu.read(held, &mut m.held)?;
         }
-        Ok(Some((m, *frame)))
+        if self.nv > 0 {
+            self.gpu.read(near, &mut m.near)?;
+        }
+        Ok(Some(m))
     }
 
     /// The hysteresis arguments of the next run (held, next, low), with
     /// the slot's marks cleared where they are not of the frame before.
-    fn hold_args(&mut self) -> Result<(Arg, Arg, f32)> {
+    fn hold_args(&mut self) -> Result<HoldArgs> {
         let g = self.gpu.clone();
-        let n = self.nf.max(1);
+        let n = [self.nf.max(1), self.nv.max(1)];
         let Some(h) = self.hold.at else {
-            return Ok((buf(&self.hold.zeros), buf(&self.hold.scratch), 1.0));
+            let [z0, z1] = &self.hold.zeros;
+            let [s0, s1] = &self.hold.scratch;
+            return Ok(([buf(z0), buf(z1), buf(s0), buf(s1)], 1.0, 0));
         };
-        let (held, last) = match self.hold.slots.entry(h.slot) {
+        let (marks, last) = match self.hold.slots.entry(h.slot) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => e.insert((g.buffer(n)?, None)),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(([g.buffer(n[0])?, g.buffer(n[1])?], None))
+            }
         };
-        if h.follows.is_none() || *last != h.follows {
-            g.zero(held, n)?;
+        // A sequence's first frame: nothing held, no birth delayed.
+        let fresh = h.follows.is_none() || *last != h.follows;
+        if fresh {
+            for (b, n) in marks.iter_mut().zip(n) {
+                g.zero(b, n)?;
+            }
         }
-        g.zero(&mut self.hold.next, n)?;
-        let (held, _) = &self.hold.slots[&h.slot];
-        Ok((buf(held), buf(&self.hold.next), h.low))
+        for (b, n) in self.hold.next.iter_mut().zip(n) {
+            g.zero(b, n)?;
+        }
+        let ([held, near], _) = &self.hold.slots[&h.slot];
+        let [n0, n1] = &self.hold.next;
+        let birth = if fresh { 0 } else { h.birth };
+        self.hold.fresh = fresh;
+        Ok(([buf(held), buf(near), buf(n0), buf(n1)], h.low, birth))
     }
 
     /// After a run with hysteresis: this frame's marks become the slot's.
     fn hold_done(&mut self) {
         if let Some(h) = self.hold.at
-            && let Some((held, last)) = self.hold.slots.get_mut(&h.slot)
+            && let Some((marks, last)) = self.hold.slots.get_mut(&h.slot)
         {
-            std::mem::swap(held, &mut self.hold.next);
+            std::mem::swap(marks, &mut self.hold.next);
             *last = Some(h.frame);
         }
     }
@@ -486,6 +543,8 @@ impl LineExtractor {
             segs.extend(more);
         }
         self.hold_done();
+        // Found but not drawn: a birth the coherence delays.
+        segs.retain(|s| s.family & crate::spec::coherence::LINE_UNBORN == 0);
         if self.view_fields {
             timing.extend(&self.view_terms(inputs, view, &opts)?);
         }
@@ -533,7 +592,7 @@ impl LineExtractor {
         feature_size: f32,
         opts: &LineOptions,
         contours: bool,
-        hold: (Arg, Arg, f32),
+        hold: HoldArgs,
     ) -> Result<(Vec<Event>, usize)> {
         let g = self.gpu.clone();
         // Twice at most: a pass that counts more segments than the buffer
@@ -568,9 +627,12 @@ impl LineExtractor {
                     buf(&self.seg),
                     buf(&self.ends),
                     buf(&self.counter),
-                    hold.0,
-                    hold.1,
-                    Arg::F32(hold.2),
+                    hold.0[0],
+                    hold.0[1],
+                    hold.0[2],
+                    hold.0[3],
+                    Arg::F32(hold.1),
+                    Arg::U32(hold.2),
                 ],
             )?;
             e2.extend(e);
@@ -617,12 +679,23 @@ impl LineExtractor {
 
     /// The curve stage's arguments: `inputs`, this extractor's per-vertex
     /// terms and its faces.
-    fn curve_args(&self, inputs: [Arg; 6], hold: (Arg, Arg, f32)) -> CurveArgs {
+    fn curve_args(&self, inputs: [Arg; 6], hold: HoldArgs, feature_size: f32) -> CurveArgs {
+        // The signs of K and H follow the hysteresis' slot: recorded on a
+        // sequence's first frame, held on the next ones.
+        let signs = match self.hold.at {
+            Some(h) if h.band > 0.0 => {
+                let mode = if self.hold.fresh { 1 } else { 2 };
+                let s = feature_size;
+                (mode, h.band / (s * s), h.band / s)
+            }
+            _ => (0, 0.0, 0.0),
+        };
         CurveArgs {
             inputs,
             terms: self.terms.each_ref().map(buf),
             faces: buf(&self.faces),
             hold,
+            signs,
         }
     }
 
@@ -643,8 +716,11 @@ impl LineExtractor {
         view: ([f32; 3], bool),
         opts: &LineOptions,
     ) -> Result<Timing> {
-        let hold = (buf(&self.hold.zeros), buf(&self.hold.scratch), 1.0);
-        let args = self.curve_args(inputs, hold);
+        let [z0, z1] = &self.hold.zeros;
+        let [s0, s1] = &self.hold.scratch;
+        let hold = ([buf(z0), buf(z1), buf(s0), buf(s1)], 1.0, 0);
+        let mut args = self.curve_args(inputs, hold, 1.0);
+        args.signs = (0, 0.0, 0.0);
         let stage = self.curve_stage_mut()?;
         stage.view_terms(&args, view, &opts.curves)
     }
@@ -657,9 +733,9 @@ impl LineExtractor {
         view: ([f32; 3], bool),
         feature_size: f32,
         opts: &LineOptions,
-        hold: (Arg, Arg, f32),
+        hold: HoldArgs,
     ) -> Result<(Vec<Segment>, Timing)> {
-        let args = self.curve_args(inputs, hold);
+        let args = self.curve_args(inputs, hold, feature_size);
         let stage = self.curve_stage_mut()?;
         let sc = (
             opts.scaled_threshold(feature_size),

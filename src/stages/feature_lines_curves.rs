@@ -31,10 +31,13 @@ pub struct CurveArgs {
     pub terms: [Arg; 4],
     /// The faces (uint[3F]).
     pub faces: Arg,
-    /// The hysteresis: the previous frame's marks per vertex, this frame's
-    /// (uint[V] each), and the fraction of a threshold a held face tests
-    /// against (kernels/common/isoline.h).
-    pub hold: (Arg, Arg, f32),
+    /// The coherence (kernels/common/isoline.h): held, near, next_held,
+    /// next_near; low; birth.
+    pub hold: super::feature_lines::HoldArgs,
+    /// Coherence's Schmitt trigger on the signs of K and H (`lines_pose`):
+    /// mode (0 off, 1 record, 2 hold) and the bands of K and H, in the
+    /// inputs' coordinates.
+    pub signs: (u32, f32, f32),
 }
 
 /// The curve families' kernels and buffers for one topology.
@@ -50,6 +53,8 @@ pub struct CurveStage {
     grad: Buffer<f32>,
     view: Buffer<f32>,
     dt: Buffer<f32>,
+    /// The signs of K and H of the last pose (coherence's Schmitt trigger).
+    signs: Buffer<u32>,
     seg: Buffer<f32>,
     ends: Buffer<u32>,
     cap: usize,
@@ -94,6 +99,7 @@ impl CurveStage {
             grad: gpu.buffer(6 * n)?,
             view: gpu.buffer(8 * n)?,
             dt: gpu.buffer(n)?,
+            signs: gpu.buffer(n)?,
             seg: gpu.buffer(8)?,
             ends: gpu.buffer(4)?,
             cap: 1,
@@ -198,6 +204,10 @@ impl CurveStage {
                 Arg::U32(u32::from(grads)),
                 buf(&self.pose),
                 buf(&self.grad),
+                buf(&self.signs),
+                Arg::U32(a.signs.0),
+                Arg::F32(a.signs.1),
+                Arg::F32(a.signs.2),
             ],
         )?;
         time(events, Step::LinesPose, e);
@@ -344,9 +354,12 @@ impl CurveStage {
                 buf(&self.seg),
                 buf(&self.ends),
                 buf(&self.counter),
-                a.hold.0,
-                a.hold.1,
-                Arg::F32(a.hold.2),
+                a.hold.0[0],
+                a.hold.0[1],
+                a.hold.0[2],
+                a.hold.0[3],
+                Arg::F32(a.hold.1),
+                Arg::U32(a.hold.2),
             ],
         )?;
         time(events, Step::LinesCurves, e);

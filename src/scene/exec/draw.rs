@@ -360,9 +360,9 @@ pub struct ViewOutputs {
     /// The per-vertex fields of the view (world units), where the scene
     /// keeps them ([`crate::scene::file::Scene::fields`]).
     pub fields: Option<crate::spec::feature_lines::ViewFields>,
-    /// The pieces as NPZ arrays (world coordinates, with the face and
-    /// barycentric coordinates each lies at), where the scene writes NPZ.
-    pub npz: Option<crate::export::npz::SegmentArrays>,
+    /// The pieces as NPZ arrays, with the pose they lie on, where the scene
+    /// writes NPZ.
+    pub npz: Option<PosedPieces>,
     /// The line segments found for this view (world coordinates).
     pub segments: Vec<Segment>,
     /// The edge stage's outputs as drawn, when feature edges are planned.
@@ -390,6 +390,17 @@ pub struct ViewOutputs {
     /// Kernel time of this pose's curvature run and this view's lines and
     /// edges.
     pub timing: Timing,
+}
+
+/// A view's pieces as NPZ arrays (world coordinates, with the face and
+/// barycentric coordinates each lies at) and the pose's vertex positions
+/// (world) those coordinates refer to.
+#[derive(Clone, Debug, Default)]
+pub struct PosedPieces {
+    /// The pieces.
+    pub arrays: crate::export::npz::SegmentArrays,
+    /// The pose's vertex positions.
+    pub positions: Vec<[f64; 3]>,
 }
 
 impl ViewOutputs {

@@ -128,5 +128,7 @@ pub(super) fn hold_at(
         frame: frames[i],
         follows: i.checked_sub(1).map(|p| frames[p]),
         low: lines.coherence_low,
+        birth: lines.coherence_birth,
+        band: lines.coherence_band,
     })
 }

@@ -52,6 +52,13 @@ pub struct LineEffects {
     /// Its lower threshold, a fraction of each family's (`[lines]
     /// coherence_low`, default [`Coherence::DEFAULT_LOW`]).
     pub coherence_low: f32,
+    /// The delay of births in frames (`[lines] coherence_birth`, default
+    /// [`Coherence::DEFAULT_BIRTH`]).
+    pub coherence_birth: u32,
+    /// The band of the Schmitt trigger on the signs of K and H, in units
+    /// of the feature size (`[lines] coherence_band`, default
+    /// [`Coherence::DEFAULT_BAND`]; 0: none).
+    pub coherence_band: f32,
 }
 
 impl Default for LineEffects {
@@ -61,6 +68,8 @@ impl Default for LineEffects {
             curves: CurveOptions::default(),
             coherence: Coherence::default(),
             coherence_low: Coherence::DEFAULT_LOW,
+            coherence_birth: Coherence::DEFAULT_BIRTH,
+            coherence_band: Coherence::DEFAULT_BAND,
         }
     }
 }

@@ -65,6 +65,10 @@ pub struct LinesSpec {
     pub coherence: Option<Spanned<String>>,
     /// The hysteresis' lower threshold, a fraction of each threshold.
     pub coherence_low: Option<f32>,
+    /// The delay of births in frames (0, 1 or 2).
+    pub coherence_birth: Option<u32>,
+    /// The band of the signs of K and H, in units of the feature size.
+    pub coherence_band: Option<f32>,
 }
 
 /// `[curvature]`: the estimator's options, by their command-line names.

@@ -18,6 +18,8 @@
 //! coherence = "auto"         # auto | on | off: hysteresis over an
 //!                            # animation's frames (auto: on for more than one)
 //! coherence_low = 0.5        # its lower threshold, a fraction of each threshold
+//! coherence_birth = 2        # frames a new line waits before it is drawn
+//! coherence_band = 0.05      # K and H keep their sign within band/s², band/s
 //! ```
 
 use super::raw::{CurvatureSpec, LinesSpec};
@@ -123,6 +125,24 @@ pub(super) fn lines(ck: &Checker<'_>, l: &Spanned<LinesSpec>, fx: &mut Effects) 
             ));
         }
         fx.lines.coherence_low = low;
+    }
+    if let Some(b) = l.coherence_birth {
+        if b > 2 {
+            return Err(ck.err(
+                span,
+                format!("lines.coherence_birth {b}: give 0, 1 or 2 frames"),
+            ));
+        }
+        fx.lines.coherence_birth = b;
+    }
+    if let Some(b) = l.coherence_band {
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(ck.err(
+                span,
+                format!("lines.coherence_band {b} must be finite and at least 0"),
+            ));
+        }
+        fx.lines.coherence_band = b;
     }
     Ok(())
 }

@@ -275,6 +275,58 @@ fn curvature_and_lines_tables_choose_the_estimator_and_feature_size() {
 }
 
 #[test]
+fn the_lines_table_sets_coherence_over_frames() {
+    use crate::spec::coherence::Coherence;
+    let s = parse(MIN).unwrap();
+    let l = &s.effects.lines;
+    assert_eq!(
+        (
+            l.coherence,
+            l.coherence_low,
+            l.coherence_birth,
+            l.coherence_band
+        ),
+        (
+            Coherence::Auto,
+            Coherence::DEFAULT_LOW,
+            Coherence::DEFAULT_BIRTH,
+            Coherence::DEFAULT_BAND
+        )
+    );
+    let s = parse(&format!(
+        "{MIN}[lines]\ncoherence = \"off\"\ncoherence_low = 0.8\ncoherence_birth = 1\n\
+         coherence_band = 0\n"
+    ))
+    .unwrap();
+    let l = &s.effects.lines;
+    assert_eq!(
+        (
+            l.coherence,
+            l.coherence_low,
+            l.coherence_birth,
+            l.coherence_band
+        ),
+        (Coherence::Off, 0.8, 1, 0.0)
+    );
+    for (bad, says) in [
+        ("coherence = \"always\"", "auto, on, off"),
+        ("coherence_low = 0", "(0, 1]"),
+        ("coherence_low = 1.5", "(0, 1]"),
+        ("coherence_birth = 3", "0, 1 or 2"),
+        ("coherence_band = -1", "at least 0"),
+    ] {
+        let e = err(&format!("{MIN}[lines]\n{bad}\n"));
+        assert!(
+            e.contains(says) && e.contains("lines.coherence"),
+            "{bad}: {e}"
+        );
+    }
+    // Auto holds over more than one frame only.
+    assert!(!Coherence::Auto.holds(1) && Coherence::Auto.holds(2));
+    assert!(!Coherence::Off.holds(60));
+}
+
+#[test]
 fn a_bad_clip_reads_as_toml_words() {
     let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/data/Fox.glb");
     for (clip, bad) in [("-1", "-1"), ("1.5", "1.5"), ("true", "true")] {

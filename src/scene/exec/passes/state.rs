@@ -105,7 +105,7 @@ pub(super) struct ViewState {
     /// The edge stage's run and outputs.
     pub(super) edges_ran: Option<(Timing, EdgeOutput)>,
     /// The pieces as NPZ arrays (world coordinates), where the NPZ pass ran.
-    pub(super) npz: Option<crate::export::npz::SegmentArrays>,
+    pub(super) npz: Option<super::super::draw::PosedPieces>,
 }
 
 /// What a caller keeps of each view in memory instead of (or besides) the

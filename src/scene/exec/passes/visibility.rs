@@ -185,7 +185,10 @@ impl Executor<'_, '_> {
             arrays.a.len()
         );
         self.rec.wall(Pass::Npz, ms_since(t0), &how);
-        self.view.npz = Some(arrays);
+        let positions = (pos.into_iter())
+            .map(|p| std::array::from_fn(|i| p[i] + origin[i]))
+            .collect();
+        self.view.npz = Some(draw::PosedPieces { arrays, positions });
         Ok(())
     }
 }
