@@ -609,6 +609,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
             follows: k.checked_sub(1),
             low,
             birth: 0,
+            band: 0.0,
         }))
         .unwrap();
         let (b, _) = held.extract(&li(&x), view, 1.0, o).unwrap();
@@ -671,6 +672,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
         follows: Some(8),
         low,
         birth: 0,
+        band: 0.0,
     }))
     .unwrap();
     let o = opts_at(1);
@@ -685,6 +687,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
             follows: None,
             low: bad,
             birth: 0,
+            band: 0.0,
         };
         assert!(held.hold_at(Some(at)).is_err(), "{bad}");
     }
@@ -694,6 +697,7 @@ fn hysteresis_holds_lines_whose_test_hovers_at_its_threshold() {
         follows: None,
         low,
         birth: 3,
+        band: 0.0,
     };
     assert!(held.hold_at(Some(late)).is_err(), "a delay of 3 frames");
 }

@@ -21,7 +21,7 @@ use crate::spec::feature_lines::{FamilySet, LineFamily, ViewFields};
 use crate::spec::timing::{Step, Timing};
 use crate::spec::view::View;
 use crate::stages::curvature::CurvatureEstimator;
-use crate::stages::feature_lines_curves::{CurveArgs, CurveStage};
+use crate::stages::feature_lines_curves::{CurveArgs, CurveStage, HoldArgs};
 use crate::stages::kernel_files;
 use opencl3::event::Event;
 use opencl3::kernel::Kernel;
@@ -197,10 +197,6 @@ struct HoldState {
     /// Whether the last run started its slot's sequence afresh.
     fresh: bool,
 }
-
-/// The coherence arguments of the line kernels: held, near, next_held,
-/// next_near, low, birth.
-pub(crate) type HoldArgs = ([Arg; 4], f32, u32);
 
 impl LineExtractor {
     /// Uploads the faces and allocates the buffers.

@@ -33,12 +33,16 @@ pub struct CurveArgs {
     pub faces: Arg,
     /// The coherence (kernels/common/isoline.h): held, near, next_held,
     /// next_near; low; birth.
-    pub hold: super::feature_lines::HoldArgs,
+    pub hold: HoldArgs,
     /// Coherence's Schmitt trigger on the signs of K and H (`lines_pose`):
     /// mode (0 off, 1 record, 2 hold) and the bands of K and H, in the
     /// inputs' coordinates.
     pub signs: (u32, f32, f32),
 }
+
+/// The coherence arguments of the line kernels (kernels/common/isoline.h):
+/// held, near, next_held, next_near; low; birth.
+pub type HoldArgs = ([Arg; 4], f32, u32);
 
 /// The curve families' kernels and buffers for one topology.
 pub struct CurveStage {
