@@ -6,7 +6,8 @@
 //                larger magnitude), emax (its derivative along its direction,
 //                from dcurv), that direction; K = k1k2, H = (k1+k2)/2 and, for
 //                Hermite placement, their gradients; with coherence, K's and
-//                H's signs held within a band (signs uint[V])
+//                H's signs, and emax dmax's side, held within a band (signs
+//                uint[V], evec float[3V])
 //   lines_view   per vertex, once per view: the view-dependent curvature q1
 //                and its direction t1 (Judd, Durand & Adelson 2007), v·dmax
 //                and (k1² − k2²)(n·v) for principal highlights (DeCarlo &
@@ -62,7 +63,8 @@ inline float3 ld3(__global const float *a, uint i) { return vload3(i, a); }
 __kernel void lines_pose(uint nv, __global const float *d1, __global const float *d2,
                          __global const float *k, __global const float *dk, uint grads,
                          __global float *pose, __global float *grad, __global uint *signs,
-                         uint sign_mode, float band_k, float band_h)
+                         __global float *evec, uint sign_mode, float band_k, float band_h,
+                         float band_e)
 {
     GID_OR_RETURN(nv);
     const float k1 = k[2 * gid], k2 = k[2 * gid + 1];
@@ -70,8 +72,18 @@ __kernel void lines_pose(uint nv, __global const float *d1, __global const float
     const float3 e1 = ld3(d1, gid), e2 = ld3(d2, gid);
     const bool first = fabs(k1) >= fabs(k2);
     const float3 dm = first ? e1 : e2;
+    float em = first ? c.x : c.w;
+    if (sign_mode != 0) {
+        // The same for ridges and valleys: where |emax| is within its band,
+        // emax dmax keeps the side of the previous frame's (dmax's sign is
+        // the eigen solver's, so the vector is compared, not emax).
+        const float3 t = em * dm, tp = vload3(gid, evec);
+        if (sign_mode == 2 && fabs(em) < band_e && dot3s(t, tp) < 0.0f)
+            em = -em;
+        vstore3(em * dm, gid, evec);
+    }
     pose[8 * gid] = first ? k1 : k2;
-    pose[8 * gid + 1] = first ? c.x : c.w;
+    pose[8 * gid + 1] = em;
     pose[8 * gid + 2] = dm.x;
     pose[8 * gid + 3] = dm.y;
     pose[8 * gid + 4] = dm.z;

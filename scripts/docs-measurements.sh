@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the measured tables of docs/accuracy.md and docs/performance.md:
+# Regenerates the measured tables of docs/accuracy.md, docs/performance.md and
+# docs/coherence.md:
 # for each `<!-- report TOPIC -->` … `<!-- end report -->` pair in those pages,
 # runs `shapecue report TOPIC` (with the options below) and puts its Markdown
 # output between the markers; everything outside the markers is kept as it is.
@@ -29,6 +30,7 @@ args_of() {
         memory) echo "report memory" ;;
         lines-batch) echo "report lines-batch" ;;
         visibility) echo "report visibility" ;;
+        coherence) echo "report coherence --plot docs/images/coherence.svg --force" ;;
         *) echo "docs-measurements: unknown topic $1" >&2; return 1 ;;
     esac
 }
@@ -36,7 +38,7 @@ args_of() {
 want=("$@")
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-for page in docs/accuracy.md docs/performance.md; do
+for page in docs/accuracy.md docs/performance.md docs/coherence.md; do
     topics=$(sed -nE 's/^<!-- report ([a-z-]+) -->$/\1/p' "$page")
     for t in $topics; do
         if ((${#want[@]})) && [[ ! " ${want[*]} " =~ " $t " ]]; then
@@ -59,4 +61,4 @@ PY
         mv "$page.tmp" "$page"
     done
 done
-echo "docs-measurements: wrote docs/accuracy.md and docs/performance.md" >&2
+echo "docs-measurements: wrote docs/accuracy.md, docs/performance.md and docs/coherence.md" >&2

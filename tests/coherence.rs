@@ -137,7 +137,7 @@ fn coherence_delays_the_birth_of_lines_away_from_every_line_of_their_family() {
             let (dev, _) = ex.extract(&li, view, 1.0, opts).unwrap();
             // The twin from its own marks.
             let t = lines_vertex(&li, view);
-            let p = lines_pose_held(&li, false, &mut [], 0, (0.0, 0.0));
+            let p = lines_pose_held(&li, false, (&mut [], &mut []), 0, [0.0; 3]);
             let w = lines_view(&li, &p, &t, view, opts.curves.unit_light());
             let (off, ring) = mesh::topology::one_rings(nv, &m.faces);
             let dt = lines_dt1q1(&m.faces, &li, &off, &ring, &w, &t);
@@ -245,6 +245,7 @@ fn the_signs_of_k_hold_within_their_band() {
     for band in [0.0f32, 0.1] {
         let mut ex = LineExtractor::new(gpu(), nv, &m.faces).unwrap();
         let mut signs = vec![0u32; nv];
+        let mut evec = vec![[0f32; 3]; nv];
         let mut first: Option<(Vec<_>, Vec<_>)> = None;
         let mut changed = 0;
         for k in 0..5 {
@@ -273,7 +274,7 @@ fn the_signs_of_k_hold_within_their_band() {
                 (true, _) => 2,
             };
             let t = lines_vertex(&li, view);
-            let p = lines_pose_held(&li, false, &mut signs, mode, (band, band));
+            let p = lines_pose_held(&li, false, (&mut signs, &mut evec), mode, [band; 3]);
             let w = lines_view(&li, &p, &t, view, opts.curves.unit_light());
             let (off, ring) = mesh::topology::one_rings(nv, &m.faces);
             let dt = lines_dt1q1(&m.faces, &li, &off, &ring, &w, &t);

@@ -60,6 +60,7 @@ __all__ = [
     "load_mesh",
     "load_volume",
     "render",
+    "scene_lines",
 ]
 
 #: The code of each line family or layer in the ``family`` arrays of the
@@ -679,6 +680,11 @@ class LineView:
     (C,) uint32 and ``chain_visible`` (C,) bool. :meth:`chains` turns them
     into polylines.
 
+    ``frame`` and ``view``: the frame of the input (0 for a static mesh)
+    and the camera's index; :func:`scene_lines` gives every frame of an
+    animation, its ``face`` and ``bary`` naming the same point of the rest
+    mesh on every frame.
+
     ``kind``: deprecated, the earlier name of ``family_code`` (reading it
     warns).
     """
@@ -709,6 +715,8 @@ class LineView:
     npz: Optional[dict] = None
     mesh: Optional[np.ndarray] = None
     mesh_face: Optional[np.ndarray] = None
+    frame: int = 0
+    view: int = 0
 
     def chains(self, family: Optional[str] = None, visible_only: bool = True) -> "Chains":
         """The chains as polylines, each an ordered array of points (one
@@ -1068,6 +1076,23 @@ def lines(
     )
     out = [_line_view(d, first_face) for d in views]
     return out if cameras is not None else out[0]
+
+
+def scene_lines(
+    scene: Union[str, os.PathLike],
+    *,
+    device: Union[int, str, None] = None,
+) -> List[LineView]:
+    """The lines of every frame and view of a scene file, as its line cues
+    and ``[lines]`` settings draw them (for an animation, coherence over the
+    frames included: ``[lines] coherence = "auto"`` holds lines from frame
+    to frame, ``"off"`` finds each frame's on its own), one
+    :class:`LineView` per frame and camera in frame order, with its
+    ``frame`` and ``view``. Each piece's ``face`` and ``bary`` name a point
+    of the rest mesh, the same on every frame, so lines of different frames
+    can be compared where the surface is. Nothing is written."""
+    views = _shapecue.scene_lines(os.fspath(scene), _device(device))
+    return [_line_view(d) for d in views]
 
 
 def _line_view(d: dict, first_face: Optional[np.ndarray] = None) -> LineView:

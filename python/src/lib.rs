@@ -734,6 +734,7 @@ fn _shapecue(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::render_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render_text, m)?)?;
     m.add_function(wrap_pyfunction!(lines::lines_views, m)?)?;
+    m.add_function(wrap_pyfunction!(lines::scene_lines, m)?)?;
     m.add_function(wrap_pyfunction!(lines::check_cameras, m)?)?;
     m.add_function(wrap_pyfunction!(lines::line_families, m)?)?;
     m.add_function(wrap_pyfunction!(lines::family_codes, m)?)?;

@@ -201,7 +201,7 @@ fn run_views(
         scene.fields = fields;
         lines_on(&gpu, &scene, LineFiles::Memory, &mut |v| {
             // The arrays (and files' bytes) made here, without the GIL.
-            let mut view = ViewOut::new(v, mesh, npz)?;
+            let mut view = ViewOut::new(v, Some(mesh), npz)?;
             let now = Instant::now();
             view.wall_ms = (now - last).as_secs_f64() * 1e3;
             last = now;
@@ -369,15 +369,27 @@ struct ViewOut {
     feature_size: f32,
     /// Wall clock from the end of the view before (or the start).
     wall_ms: f64,
+    /// The frame and the view.
+    frame: usize,
+    view: usize,
 }
 
 impl ViewOut {
-    /// The arrays of a view of `mesh` (and the NPZ files' bytes with `npz`).
-    fn new(v: LineView, mesh: &Mesh, npz: bool) -> shapecue::Result<ViewOut> {
+    /// The arrays of a view of `mesh` (and the NPZ files' bytes with `npz`);
+    /// of the view's own pose where the scene made them (an animation).
+    fn new(v: LineView, mesh: Option<&Mesh>, npz: bool) -> shapecue::Result<ViewOut> {
         let vis = v.visible.as_ref().ok_or_else(|| {
             Error::InvalidArgument("internal: the view was not classified".into())
         })?;
-        let arrays = segment_arrays(vis, mesh);
+        let arrays = match (&v.npz, mesh) {
+            (Some(posed), _) => posed.arrays.clone(),
+            (None, Some(mesh)) => segment_arrays(vis, mesh),
+            (None, None) => {
+                return Err(Error::InvalidArgument(
+                    "internal: the view's pieces have no pose".into(),
+                ));
+            }
+        };
         let walk = Walk::of(vis);
         let npz = if npz {
             let fields = v.fields.as_ref().map(fields_npz_bytes).transpose()?;
@@ -402,6 +414,8 @@ impl ViewOut {
             camera: v.camera,
             feature_size: v.feature_size,
             wall_ms: 0.0,
+            frame: v.frame,
+            view: v.view,
         })
     }
 
@@ -459,6 +473,49 @@ impl ViewOut {
         d.set_item("wall_ms", self.wall_ms)?;
         d.set_item("feature_size", self.feature_size)?;
         d.set_item("device", device)?;
+        d.set_item("frame", self.frame)?;
+        d.set_item("view", self.view)?;
         Ok(d)
     }
+}
+
+/// scene_lines(path, device) -> list of dicts
+///
+/// The lines of every frame and view of a scene file (an animation: a
+/// glTF skin, a libigl set, a flipbook; or a static mesh), as its line cues
+/// and `[lines]` settings (coherence over the frames included) draw them:
+/// each view's pieces as [`lines_views`] gives them, with their faces and
+/// barycentric coordinates on that frame's pose (the same rest-mesh point on
+/// every frame), its `frame` and `view`. Nothing is written.
+#[pyfunction]
+#[pyo3(signature = (path, device))]
+pub fn scene_lines<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    device: Option<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut scene = shapecue::api::Scene::load(&path).map_err(to_py)?;
+    scene.png = false;
+    scene.svg = false;
+    scene.npz = true;
+    let done = py.detach(|| {
+        let gpu = open_gpu(device.as_deref())?;
+        let mut out = Vec::new();
+        let mut last = Instant::now();
+        lines_on(&gpu, &scene, LineFiles::Memory, &mut |v| {
+            let mut view = ViewOut::new(v, None, false)?;
+            let now = Instant::now();
+            view.wall_ms = (now - last).as_secs_f64() * 1e3;
+            last = now;
+            out.push(view);
+            Ok(())
+        })?;
+        Ok::<_, Error>((out, gpu.info.name.clone()))
+    });
+    let (views, name) = done.map_err(to_py)?;
+    let list = PyList::empty(py);
+    for v in views {
+        list.append(v.into_dict(py, &name)?)?;
+    }
+    Ok(list)
 }

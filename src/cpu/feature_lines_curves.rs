@@ -56,21 +56,23 @@ pub struct PoseTerms {
 
 /// `lines_pose`: kmax, emax, dmax, K, H and, with `grads`, ∇K and ∇H.
 pub fn lines_pose(x: &LineInputs, grads: bool) -> PoseTerms {
-    lines_pose_held(x, grads, &mut [], 0, (0.0, 0.0))
+    lines_pose_held(x, grads, (&mut [], &mut []), 0, [0.0; 3])
 }
 
 /// [`lines_pose`] with coherence's Schmitt trigger on the signs of K and H
-/// (kernels/feature_lines_curves.cl): `sign_mode` 0 off, 1 records the
-/// signs in `signs` (a sequence's first frame), 2 keeps each vertex's sign
-/// of the previous frame where |K| < `bands.0` (|H| < `bands.1`).
-// Mirrors the kernel lines_pose argument for argument (band_k, band_h as
-// `bands`; its outputs returned).
+/// and the side of emax dmax (kernels/feature_lines_curves.cl):
+/// `sign_mode` 0 off, 1 records them in `signs` and `evec` (a sequence's
+/// first frame), 2 keeps each vertex's sign of the previous frame where
+/// |K| < `bands[0]` (|H| < `bands[1]`), and emax dmax's side where |emax| <
+/// `bands[2]`.
+// Mirrors the kernel lines_pose argument for argument (signs and evec as
+// `state`, band_k, band_h, band_e as `bands`; its outputs returned).
 pub fn lines_pose_held(
     x: &LineInputs,
     grads: bool,
-    signs: &mut [u32],
+    (signs, evec): (&mut [u32], &mut [V3]),
     sign_mode: u32,
-    (band_k, band_h): (f32, f32),
+    [band_k, band_h, band_e]: [f32; 3],
 ) -> PoseTerms {
     let mut t = PoseTerms::default();
     for i in 0..x.k.len() {
@@ -78,8 +80,16 @@ pub fn lines_pose_held(
         let c = x.dk[i];
         let first = k1.abs() >= k2.abs();
         t.kmax.push(if first { k1 } else { k2 });
-        t.emax.push(if first { c[0] } else { c[3] });
-        t.dmax.push(if first { x.d1[i] } else { x.d2[i] });
+        let dm = if first { x.d1[i] } else { x.d2[i] };
+        let mut em = if first { c[0] } else { c[3] };
+        if let Some(tp) = evec.get_mut(i).filter(|_| sign_mode != 0) {
+            if sign_mode == 2 && em.abs() < band_e && dot(mul(em, dm), *tp) < 0.0 {
+                em = -em;
+            }
+            *tp = mul(em, dm);
+        }
+        t.emax.push(em);
+        t.dmax.push(dm);
         let (mut kg, mut km) = (k1 * k2, 0.5 * (k1 + k2));
         if let Some(held) = signs.get_mut(i).filter(|_| sign_mode != 0) {
             let s = *held;

@@ -340,8 +340,10 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
     let size = o.size.unwrap_or([640, 480]);
     let mut r = Report::new("coherence", gpu.info.name.clone());
     r.text(format!(
-        "Flicker of the line families on animations, with hysteresis over the frames off and \
-         on (`[lines] coherence`; held faces test a family at {} of its threshold). Every \
+        "Flicker of the line families on animations, with coherence over the frames off and \
+         on (`[lines] coherence`: held faces test a family at {} of its threshold, a line found \
+         away from every line of its family waits {} frame(s) before it is drawn, and K, H and \
+         emax keep their previous sign within {}·s⁻², s⁻¹, s⁻², s the feature size). Every \
          frame of each animation, one fitted camera at {}x{}, every piece (visible and \
          hidden), mapped to the rest pose by its face and barycentric coordinates. Pop: the \
          share of line length farther than τ = {}·(the rest mesh's bounding-box diagonal) from \
@@ -352,6 +354,8 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
          view explains; view-independent ones do not move (0). Length: the mean line length \
          per frame, on against off. Line ms: the line passes' kernel time per frame.\n",
         Coherence::DEFAULT_LOW,
+        Coherence::DEFAULT_BIRTH,
+        Coherence::DEFAULT_BAND,
         size[0],
         size[1],
         TAU
@@ -396,6 +400,11 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
             (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt()
         };
         let tau = TAU * diag;
+        // The kernels are built before any timing: the first two frames.
+        let mut warm = measured(base, &all, Coherence::On, size);
+        let (start, _, step) = warm.frames;
+        warm.frames = (start, Some(start + 2 * step), step);
+        run(gpu, &warm, &rest)?;
         let off = run(gpu, &measured(base, &all, Coherence::Off, size), &rest)?;
         let on = run(gpu, &measured(base, &all, Coherence::On, size), &rest)?;
         let ctl = control(gpu, base, &rest, &parts, &off, size)?;

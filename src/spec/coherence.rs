@@ -32,12 +32,12 @@ impl Coherence {
 
     /// The frames a line found away from every line of its family waits
     /// before it is drawn (0, 1 or 2).
-    pub const DEFAULT_BIRTH: u32 = 2;
+    pub const DEFAULT_BIRTH: u32 = 1;
 
     /// The band of the Schmitt trigger on the signs of K and H, in units
     /// of the feature size s: |K| < band / s² and |H| < band / s keep the
     /// sign of the previous frame.
-    pub const DEFAULT_BAND: f32 = 0.05;
+    pub const DEFAULT_BAND: f32 = 0.1;
 
     /// The name on the command line, in scene files and in reports.
     pub fn name(self) -> &'static str {

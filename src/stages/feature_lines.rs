@@ -175,9 +175,10 @@ pub struct HoldAt {
     /// every line of its family in the frames before is drawn from its
     /// second (third) frame on.
     pub birth: u32,
-    /// The band of the Schmitt trigger on the signs of K and H, in units
-    /// of the feature size s (|K| < band / s², |H| < band / s keep the
-    /// previous frame's sign; 0: none).
+    /// The band of the Schmitt trigger on the signs of K and H and the
+    /// side of emax dmax (ridges and valleys), in units of the feature size
+    /// s (|K| < band / s², |H| < band / s, |emax| < band / s² keep the
+    /// previous frame's; 0: none).
     pub band: f32,
 }
 
@@ -682,9 +683,9 @@ impl LineExtractor {
             Some(h) if h.band > 0.0 => {
                 let mode = if self.hold.fresh { 1 } else { 2 };
                 let s = feature_size;
-                (mode, h.band / (s * s), h.band / s)
+                (mode, [h.band / (s * s), h.band / s, h.band / (s * s)])
             }
-            _ => (0, 0.0, 0.0),
+            _ => (0, [0.0; 3]),
         };
         CurveArgs {
             inputs,
@@ -716,7 +717,7 @@ impl LineExtractor {
         let [s0, s1] = &self.hold.scratch;
         let hold = ([buf(z0), buf(z1), buf(s0), buf(s1)], 1.0, 0);
         let mut args = self.curve_args(inputs, hold, 1.0);
-        args.signs = (0, 0.0, 0.0);
+        args.signs = (0, [0.0; 3]);
         let stage = self.curve_stage_mut()?;
         stage.view_terms(&args, view, &opts.curves)
     }

@@ -34,10 +34,10 @@ pub struct CurveArgs {
     /// The coherence (kernels/common/isoline.h): held, near, next_held,
     /// next_near; low; birth.
     pub hold: HoldArgs,
-    /// Coherence's Schmitt trigger on the signs of K and H (`lines_pose`):
-    /// mode (0 off, 1 record, 2 hold) and the bands of K and H, in the
-    /// inputs' coordinates.
-    pub signs: (u32, f32, f32),
+    /// Coherence's Schmitt trigger on the signs of K and H and the side of
+    /// emax dmax (`lines_pose`): mode (0 off, 1 record, 2 hold) and the
+    /// bands of K, H and emax, in the inputs' coordinates.
+    pub signs: (u32, [f32; 3]),
 }
 
 /// The coherence arguments of the line kernels (kernels/common/isoline.h):
@@ -57,8 +57,10 @@ pub struct CurveStage {
     grad: Buffer<f32>,
     view: Buffer<f32>,
     dt: Buffer<f32>,
-    /// The signs of K and H of the last pose (coherence's Schmitt trigger).
+    /// The signs of K and H, and emax dmax, of the last pose (coherence's
+    /// Schmitt trigger).
     signs: Buffer<u32>,
+    evec: Buffer<f32>,
     seg: Buffer<f32>,
     ends: Buffer<u32>,
     cap: usize,
@@ -104,6 +106,7 @@ impl CurveStage {
             view: gpu.buffer(8 * n)?,
             dt: gpu.buffer(n)?,
             signs: gpu.buffer(n)?,
+            evec: gpu.buffer(3 * n)?,
             seg: gpu.buffer(8)?,
             ends: gpu.buffer(4)?,
             cap: 1,
@@ -209,9 +212,11 @@ impl CurveStage {
                 buf(&self.pose),
                 buf(&self.grad),
                 buf(&self.signs),
+                buf(&self.evec),
                 Arg::U32(a.signs.0),
-                Arg::F32(a.signs.1),
-                Arg::F32(a.signs.2),
+                Arg::F32(a.signs.1[0]),
+                Arg::F32(a.signs.1[1]),
+                Arg::F32(a.signs.1[2]),
             ],
         )?;
         time(events, Step::LinesPose, e);

@@ -18,8 +18,8 @@
 //! coherence = "auto"         # auto | on | off: hysteresis over an
 //!                            # animation's frames (auto: on for more than one)
 //! coherence_low = 0.5        # its lower threshold, a fraction of each threshold
-//! coherence_birth = 2        # frames a new line waits before it is drawn
-//! coherence_band = 0.05      # K and H keep their sign within band/s², band/s
+//! coherence_birth = 1        # frames a new line waits before it is drawn
+//! coherence_band = 0.1       # K, H and emax keep their sign within band/s², band/s
 //! ```
 
 use super::raw::{CurvatureSpec, LinesSpec};
