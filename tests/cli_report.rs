@@ -350,7 +350,8 @@ fn old_report_flags_are_gone_and_unknown_topics_are_refused() {
     assert!(
         err.contains("speed")
             && err.contains(
-                "curvature, isosurface, strokes, pipeline, caps, lines-batch, visibility, memory"
+                "curvature, isosurface, strokes, pipeline, caps, lines-batch, coherence, visibility, \
+                 memory"
             ),
         "{err}"
     );
@@ -372,4 +373,67 @@ fn old_report_flags_are_gone_and_unknown_topics_are_refused() {
     );
     assert!(!Path::new("missing.glb").exists());
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `report coherence` on the bundled Fox: every measured family has a row
+/// with coherence off and on beside its control, the control of
+/// view-independent families is 0, contours are the same off and on, and
+/// a scene of a static mesh is refused with its name.
+#[test]
+fn report_coherence_measures_flicker_off_and_on_beside_a_control() {
+    let d = scratch("report-coherence");
+    let fox = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/Fox.glb");
+    let scene = common::write(
+        &d,
+        "fox.toml",
+        &format!(
+            "[input]\ngltf = {:?}\nclip = \"Walk\"\nweld = true\n[frames]\nend = 8\n\
+             [[camera]]\ndirection = [1.0, 0.4, 0.2]\n[effects]\ncontours = {{}}\n",
+            fox.display().to_string()
+        ),
+    );
+    let json = d.join("c.json");
+    let out = cli()
+        .args([
+            "report",
+            "coherence",
+            scene.to_str().unwrap(),
+            "--size",
+            "320x240",
+            "--json",
+        ])
+        .arg(&json)
+        .output()
+        .unwrap();
+    common::assert_succeeded(&out);
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = v["tables"]["flicker"]
+        .as_array()
+        .expect("the flicker table");
+    assert_eq!(rows.len(), 8, "{rows:?}");
+    for r in rows {
+        if r["kind"] == "view-independent" {
+            assert_eq!(
+                (r["control_pop"].as_f64(), r["control_short_lived"].as_f64()),
+                (Some(0.0), Some(0.0))
+            );
+        }
+        if r["family"] == "contours" {
+            assert_eq!(r["pop_off"], r["pop_on"], "{r}");
+            assert!(r["control_pop"].as_f64().is_some(), "{r}");
+        }
+    }
+    let cost = v["tables"]["cost"].as_array().expect("the cost table");
+    assert_eq!(cost[0]["frames"], 8);
+    let still = common::write(
+        &d,
+        "still.toml",
+        "[input]\ngenerate = \"torus\"\n[effects]\ncontours = {}\n",
+    );
+    let out = run_cli(["report", "coherence", still.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("still.toml") && err.contains("skinned"),
+        "{err}"
+    );
 }

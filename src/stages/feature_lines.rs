@@ -140,7 +140,7 @@ pub struct LineExtractor {
     view_fields: bool,
     /// The world length of one unit of the last run's coordinates.
     scale: f64,
-    /// The hysteresis over the frames of a pose sequence.
+    /// The coherence over the frames of a pose sequence.
     hold: HoldState,
 }
 
@@ -329,13 +329,17 @@ impl LineExtractor {
         Ok(fields.from_local(self.scale))
     }
 
-    /// Where the next extraction keeps its hysteresis state (`None`: no
-    /// hysteresis, today's lines). Over the frames of one pose sequence,
-    /// a face that drew a thresholded family (suggestive contours, ridges, valleys, apparent
+    /// Where the next extraction keeps its coherence state (`None`: none,
+    /// today's lines). Over the frames of one pose sequence (one slot per
+    /// camera), as kernels/common/isoline.h does it: a face that drew a
+    /// thresholded family (suggestive contours, ridges, valleys, apparent
     /// ridges, principal and suggestive highlights) in the slot's previous
-    /// frame tests it against its threshold times `low`, as Canny's two
-    /// thresholds. A slot whose last frame is not `follows` starts afresh:
-    /// the first frame of a sequence draws today's lines exactly.
+    /// frame tests it against its threshold times `low` (Canny's two
+    /// thresholds); a line found away from every line of its family is
+    /// drawn after `birth` frames (contours, isophotes and boundaries at
+    /// once); K, H and emax dmax keep their previous sign within `band`
+    /// (`lines_pose`). A slot whose last frame is not `follows` starts
+    /// afresh: the first frame of a sequence draws today's lines exactly.
     pub fn hold_at(&mut self, at: Option<HoldAt>) -> Result<()> {
         if let Some(h) = at {
             if !(h.low > 0.0 && h.low <= 1.0) {
@@ -377,8 +381,9 @@ impl LineExtractor {
         Ok(Some(m))
     }
 
-    /// The hysteresis arguments of the next run (held, next, low), with
-    /// the slot's marks cleared where they are not of the frame before.
+    /// The coherence arguments of the next run (held, near, next_held,
+    /// next_near; low; birth), with the slot's marks cleared where they are
+    /// not of the frame before (no birth is delayed then).
     fn hold_args(&mut self) -> Result<HoldArgs> {
         let g = self.gpu.clone();
         let n = [self.nf.max(1), self.nv.max(1)];
