@@ -386,7 +386,7 @@ fn report_coherence_measures_flicker_off_and_on_beside_a_control() {
     let scene = common::write(
         &d,
         "fox.toml",
-        &format!(
+        format!(
             "[input]\ngltf = {:?}\nclip = \"Walk\"\nweld = true\n[frames]\nend = 8\n\
              [[camera]]\ndirection = [1.0, 0.4, 0.2]\n[effects]\ncontours = {{}}\n",
             fox.display().to_string()

@@ -683,7 +683,11 @@ class LineView:
     ``frame`` and ``view``: the frame of the input (0 for a static mesh)
     and the camera's index; :func:`scene_lines` gives every frame of an
     animation, its ``face`` and ``bary`` naming the same point of the rest
-    mesh on every frame.
+    mesh on every frame. Where the scene holds its lines over the frames
+    (``[lines] coherence``), ``chain_id`` (P,) uint32 is each piece's
+    chain's id across frames: a chain takes the id of the previous frame's
+    chain that most of its length lies on, so strokes can be animated one
+    by one; None otherwise.
 
     ``kind``: deprecated, the earlier name of ``family_code`` (reading it
     warns).
@@ -717,6 +721,7 @@ class LineView:
     mesh_face: Optional[np.ndarray] = None
     frame: int = 0
     view: int = 0
+    chain_id: Optional[np.ndarray] = None
 
     def chains(self, family: Optional[str] = None, visible_only: bool = True) -> "Chains":
         """The chains as polylines, each an ordered array of points (one

@@ -434,6 +434,9 @@ impl ViewOut {
         d.set_item("face", array(py, s.face, &[n])?)?;
         let bary: Vec<f32> = s.bary.iter().flatten().flatten().copied().collect();
         d.set_item("bary", array(py, bary, &[n, 2, 3])?)?;
+        if let Some(ids) = s.chain_id {
+            d.set_item("chain_id", array(py, ids, &[n])?)?;
+        }
         let w = self.walk;
         let (k, c) = (w.order.len(), w.visible.len());
         d.set_item("chain_order", array(py, w.order, &[k])?)?;

@@ -37,6 +37,11 @@ def test_every_frame_comes_back_with_its_rest_mesh_provenance(tmp_path):
     for k in ("a", "b", "face", "bary", "family_code"):
         np.testing.assert_array_equal(getattr(off[0], k), getattr(on[0], k))
     assert any(len(a.a) != len(b.a) or (a.a != b.a).any() for a, b in zip(off[1:], on[1:]))
+    # Held lines keep their chains' ids from frame to frame.
+    assert all(v.chain_id is None for v in off)
+    assert all(v.chain_id is not None and len(v.chain_id) == len(v.a) for v in on)
+    kept = [len(set(a.chain_id) & set(b.chain_id)) for a, b in zip(on, on[1:])]
+    assert all(k > 0 for k in kept), kept
 
 
 def test_a_missing_scene_file_names_it(tmp_path):

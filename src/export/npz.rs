@@ -36,6 +36,11 @@ pub struct SegmentArrays {
     /// The barycentric coordinates of each end in `face` (zero where
     /// none), `(n, 2, 3)` float32.
     pub bary: Vec<[[f32; 3]; 2]>,
+    /// Where the lines of an animation keep their chains' identity across
+    /// frames ([`crate::spec::coherence::ChainIds`]): each piece's chain's
+    /// id, the same for a chain and its continuation in the frames before,
+    /// `(n,)` uint32, written as `chain_id`.
+    pub chain_id: Option<Vec<u32>>,
 }
 
 /// Writes `arrays` to `path` as an uncompressed NPZ (`a`, `b`, `family`,
@@ -79,6 +84,7 @@ fn check_lengths(arrays: &SegmentArrays) -> std::result::Result<(), String> {
         arrays.chain.len(),
         arrays.face.len(),
         arrays.bary.len(),
+        arrays.chain_id.as_ref().map_or(n, Vec::len),
     ];
     if lens.iter().any(|&l| l != n) {
         return Err(format!(
@@ -219,6 +225,9 @@ fn encode(arrays: &SegmentArrays) -> std::result::Result<Vec<u8>, String> {
     npz.add("face", &Array1::from(arrays.face.clone()));
     let bary: Vec<f32> = arrays.bary.iter().flatten().flatten().copied().collect();
     npz.add_shaped("bary", Array3::from_shape_vec((n, 2, 3), bary));
+    if let Some(ids) = &arrays.chain_id {
+        npz.add("chain_id", &Array1::from(ids.clone()));
+    }
     // The code-to-name table of `family`, in every file.
     let table = crate::spec::feature_lines::family_codes();
     npz.add(
@@ -292,6 +301,7 @@ mod tests {
             chain: vec![0],
             face: vec![7],
             bary: vec![[[1.0, 0.0, 0.0], [0.0, 0.5, 0.5]]],
+            chain_id: None,
         };
         let bytes = encode(&arrays).unwrap();
         // A zip (local file header) holding the nine .npy files.

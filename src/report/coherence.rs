@@ -32,7 +32,7 @@ use crate::scene::planner::Cue;
 use crate::spec::coherence::Coherence;
 use crate::spec::feature_lines::{FamilySet, LineFamily};
 use glam::DVec3;
-use measure::{Flicker, RestSeg, best_rigid, flicker};
+use measure::{Flicker, RestSeg, best_rigid, chain_ids_kept, flicker};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -180,6 +180,7 @@ fn rest_segments(
                 family: a.family[i],
                 a: at(f, a.bary[i][0]),
                 b: at(f, a.bary[i][1]),
+                chain_id: a.chain_id.as_ref().map_or(u32::MAX, |c| c[i]),
             }
         })
         .collect()
@@ -352,7 +353,10 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
          part (bone of largest weight) from the camera with that part's best rigid motion \
          undone, so that only the view moves: view-dependent lines move there as much as the \
          view explains; view-independent ones do not move (0). Length: the mean line length \
-         per frame, on against off. Line ms: the line passes' kernel time per frame.\n",
+         per frame, on against off. Chain ids kept: with coherence on, the share of line \
+         length whose chain keeps its id into the next frame (chains take the id of the previous \
+         frame's chain most of their length lies on). Line ms: the line passes' kernel time per \
+         frame.\n",
         Coherence::DEFAULT_LOW,
         Coherence::DEFAULT_BIRTH,
         Coherence::DEFAULT_BAND,
@@ -373,6 +377,7 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
             Column::new("control pop", "control_pop"),
             Column::new("control short-lived", "control_short_lived"),
             Column::new("length on/off", "length_ratio"),
+            Column::new("chain ids kept (on)", "chain_ids_kept_on"),
         ],
     );
     let mut cost = Table::new(
@@ -446,6 +451,7 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
                     true => Cell::num(ratio, format!("{ratio:.3}")),
                     false => Cell::text("–"),
                 },
+                pct(chain_ids_kept(&on.frames, code)),
             ]));
             bars.push((
                 format!("{} {}", base.name, fam.name()),

@@ -68,3 +68,145 @@ pub const LINE_UNBORN: u32 = 0x100;
 /// follow their motion without lag), isophotes and boundaries
 /// (`LINE_UNGATED` of kernels/common/isoline.h).
 pub const LINE_UNGATED: u32 = (1 << 0) | (1 << 7) | (1 << 11);
+
+/// Chains that keep their identity across the frames of an animation: each
+/// frame's chains get ids, a chain taking the id of the previous frame's
+/// chain that most of its length lies on (the same faces, the same family)
+/// where that is at least half its length, and a new id otherwise. Where
+/// two chains claim one id, the one with more length on it keeps it. The
+/// first frame (or a frame that does not follow the last one) numbers its
+/// chains 0, 1, 2, ... in order. Deterministic: the same chains give the
+/// same ids.
+#[derive(Clone, Debug, Default)]
+pub struct ChainIds {
+    /// The frame the ids are of.
+    frame: Option<usize>,
+    /// Per (face, family), the ids of the last frame's chains on it with
+    /// their length there.
+    by_face: std::collections::HashMap<(i64, u32), Vec<(u32, f64)>>,
+    /// The next new id.
+    next: u32,
+}
+
+/// One piece of a chain for [`ChainIds::assign`]: its chain (index), face
+/// (`-1`: none), family and length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChainPiece {
+    /// The chain's index in its frame.
+    pub chain: u32,
+    /// The face it lies in (`-1`: none).
+    pub face: i64,
+    /// Its family or layer code.
+    pub family: u32,
+    /// Its length.
+    pub length: f64,
+}
+
+impl ChainIds {
+    /// The ids of `chains` chains of `frame` (pieces: `pieces`, in any
+    /// order), which follows `follows` in its sequence; one id per chain.
+    pub fn assign(
+        &mut self,
+        frame: usize,
+        follows: Option<usize>,
+        chains: usize,
+        pieces: &[ChainPiece],
+    ) -> Vec<u32> {
+        if follows.is_none() || self.frame != follows {
+            self.by_face.clear();
+            self.next = 0;
+        }
+        // Votes: per chain, its length on each previous id.
+        let mut votes: Vec<std::collections::BTreeMap<u32, f64>> = vec![Default::default(); chains];
+        let mut total = vec![0.0f64; chains];
+        for p in pieces {
+            let c = p.chain as usize;
+            total[c] += p.length;
+            if let Some(prev) = self.by_face.get(&(p.face, p.family)) {
+                for &(id, _) in prev {
+                    *votes[c].entry(id).or_default() += p.length;
+                }
+            }
+        }
+        let mut claims: Vec<(f64, usize, u32)> = Vec::new();
+        for (c, v) in votes.iter().enumerate() {
+            for (&id, &len) in v {
+                if len >= 0.5 * total[c] && len > 0.0 {
+                    claims.push((len, c, id));
+                }
+            }
+        }
+        // The longest claims first; ties by chain, then id.
+        claims.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let mut ids: Vec<Option<u32>> = vec![None; chains];
+        let mut taken = std::collections::HashSet::new();
+        for (_, c, id) in claims {
+            if ids[c].is_none() && taken.insert(id) {
+                ids[c] = Some(id);
+            }
+        }
+        let ids: Vec<u32> = ids
+            .into_iter()
+            .map(|id| {
+                id.unwrap_or_else(|| {
+                    self.next += 1;
+                    self.next - 1
+                })
+            })
+            .collect();
+        self.by_face.clear();
+        for p in pieces {
+            let e = self.by_face.entry((p.face, p.family)).or_default();
+            let id = ids[p.chain as usize];
+            match e.iter_mut().find(|x| x.0 == id) {
+                Some(x) => x.1 += p.length,
+                None => e.push((id, p.length)),
+            }
+        }
+        self.frame = Some(frame);
+        ids
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn piece(chain: u32, face: i64, length: f64) -> ChainPiece {
+        ChainPiece {
+            chain,
+            face,
+            family: 2,
+            length,
+        }
+    }
+
+    #[test]
+    fn chains_keep_their_ids_while_most_of_them_persists() {
+        let mut ids = ChainIds::default();
+        // Frame 0: two chains on faces 1..4 and 10..13.
+        let f0: Vec<ChainPiece> = (1..4)
+            .map(|f| piece(0, f, 1.0))
+            .chain((10..13).map(|f| piece(1, f, 1.0)))
+            .collect();
+        assert_eq!(ids.assign(0, None, 2, &f0), vec![0, 1]);
+        // Frame 1: listed the other way round, the first one moved by a
+        // face (2 of 3 faces kept), a new chain far away.
+        let f1: Vec<ChainPiece> = (10..13)
+            .map(|f| piece(0, f, 1.0))
+            .chain((2..5).map(|f| piece(1, f, 1.0)))
+            .chain((50..52).map(|f| piece(2, f, 1.0)))
+            .collect();
+        assert_eq!(ids.assign(1, Some(0), 3, &f1), vec![1, 0, 2]);
+        // Frame 2: chain 1 (id 0) split in two halves: the longer half keeps
+        // the id, the other gets a new one; a family change is a new chain.
+        let mut f2: Vec<ChainPiece> = vec![piece(0, 2, 1.0), piece(0, 3, 1.0), piece(1, 4, 1.0)];
+        f2.push(ChainPiece {
+            family: 3,
+            ..piece(2, 50, 1.0)
+        });
+        assert_eq!(ids.assign(2, Some(1), 3, &f2), vec![0, 3, 4]);
+        // A frame that does not follow starts afresh.
+        assert_eq!(ids.assign(9, Some(8), 3, &f2), vec![0, 1, 2]);
+    }
+}

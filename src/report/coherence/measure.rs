@@ -31,6 +31,8 @@ pub struct RestSeg {
     pub a: DVec3,
     /// Second end.
     pub b: DVec3,
+    /// Its chain's id across frames (`u32::MAX`: none).
+    pub chain_id: u32,
 }
 
 /// The flicker of one family over a sequence of frames.
@@ -179,6 +181,29 @@ pub fn flicker(frames: &[Vec<RestSeg>], family: u32, tau: f64) -> Flicker {
     }
 }
 
+/// The share of `family`'s line length, over every frame but the last,
+/// whose chain id the next frame also has (NaN: no line with an id).
+pub fn chain_ids_kept(frames: &[Vec<RestSeg>], family: u32) -> f64 {
+    let (mut kept, mut total) = (0.0, 0.0);
+    for w in frames.windows(2) {
+        let next: std::collections::HashSet<u32> = (w[1].iter())
+            .filter(|s| s.family == family && s.chain_id != u32::MAX)
+            .map(|s| s.chain_id)
+            .collect();
+        for s in w[0]
+            .iter()
+            .filter(|s| s.family == family && s.chain_id != u32::MAX)
+        {
+            let len = (s.b - s.a).length();
+            total += len;
+            if next.contains(&s.chain_id) {
+                kept += len;
+            }
+        }
+    }
+    if total > 0.0 { kept / total } else { f64::NAN }
+}
+
 /// The rigid motion (rotation, translation) that best maps `rest` onto
 /// `posed` in least squares (Kabsch's problem, solved by Horn's unit
 /// quaternion: the eigenvector of the largest eigenvalue of a symmetric
@@ -270,7 +295,19 @@ mod tests {
             family,
             a: DVec3::from(a),
             b: DVec3::from(b),
+            chain_id: 0,
         }
+    }
+
+    #[test]
+    fn chain_ids_kept_is_the_length_whose_id_the_next_frame_has() {
+        let mut a = seg(2, [0.0; 3], [3.0, 0.0, 0.0]);
+        let mut b = seg(2, [0.0; 3], [1.0, 0.0, 0.0]);
+        b.chain_id = 7;
+        let frames = vec![vec![a, b], vec![a]];
+        assert!((chain_ids_kept(&frames, 2) - 0.75).abs() < 1e-12);
+        a.chain_id = u32::MAX;
+        assert!(chain_ids_kept(&[vec![a], vec![a]], 2).is_nan());
     }
 
     #[test]

@@ -60,6 +60,10 @@ pub(in crate::scene::exec) struct RunState {
     /// The hysteresis' lower threshold where the lines were held over the
     /// frames.
     pub(in crate::scene::exec) held_low: Option<f32>,
+    /// Per camera, the chain ids of its last frame, where the lines are
+    /// held over the frames.
+    pub(in crate::scene::exec) chain_ids:
+        std::collections::HashMap<usize, crate::spec::coherence::ChainIds>,
 }
 
 /// One pose: its host copies and what its passes made.

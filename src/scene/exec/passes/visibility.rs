@@ -171,6 +171,27 @@ impl Executor<'_, '_> {
             .map(|p| p.map(f64::from))
             .collect();
         let mut arrays = vis.arrays(&pos, &t.mesh.faces);
+        // Held over the frames: chains keep their ids from frame to frame.
+        if let Some(h) = self.hold {
+            let pieces: Vec<crate::spec::coherence::ChainPiece> = (0..arrays.a.len())
+                .map(|i| crate::spec::coherence::ChainPiece {
+                    chain: arrays.chain[i],
+                    face: arrays.face[i],
+                    family: arrays.family[i],
+                    length: (0..3)
+                        .map(|k| f64::from(arrays.b[i][k] - arrays.a[i][k]).powi(2))
+                        .sum::<f64>()
+                        .sqrt(),
+                })
+                .collect();
+            let ids = (self.run.chain_ids.entry(h.slot).or_default()).assign(
+                h.frame,
+                h.follows,
+                vis.chains.len(),
+                &pieces,
+            );
+            arrays.chain_id = Some(arrays.chain.iter().map(|&c| ids[c as usize]).collect());
+        }
         // Scene frame to world.
         let origin = self.run.framing.as_ref().map_or([0.0; 3], |f| f.origin);
         for p in arrays.a.iter_mut().chain(arrays.b.iter_mut()) {
