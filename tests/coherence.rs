@@ -428,4 +428,21 @@ fn a_scene_writes_the_pieces_of_every_frame_as_npz() {
     let report = std::fs::read_to_string(dir.join("out/fox_report.json")).unwrap();
     assert!(report.contains("\"npz\""), "the npz pass is in the report");
     assert!(stdout.contains("wrote"), "{stdout}");
+    // Held over the frames (the default for an animation): the notes say
+    // so and each NPZ holds the chains' ids across frames.
+    let has = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).any(|w| w == needle);
+    let npz = || std::fs::read(dir.join("out/fox_f0002_v00.npz")).unwrap();
+    assert!(report.contains("lines held over the frames"), "{report}");
+    assert!(has(&npz(), b"chain_id.npy"));
+    // --coherence off: each frame's lines on their own, no chain ids.
+    common::succeeded(common::cli().args([
+        "render",
+        scene.to_str().unwrap(),
+        "--force",
+        "--coherence",
+        "off",
+    ]));
+    let report = std::fs::read_to_string(dir.join("out/fox_report.json")).unwrap();
+    assert!(!report.contains("lines held over the frames"), "{report}");
+    assert!(!has(&npz(), b"chain_id.npy"));
 }

@@ -8,6 +8,7 @@ use anyhow::Result;
 use clap::Args;
 use shapecue::api::{self as exec, ExecOptions, RunReport, Scene};
 use shapecue::report::metrics::median;
+use shapecue::spec::coherence::Coherence;
 use std::path::PathBuf;
 
 /// The arguments of `shapecue render`.
@@ -26,6 +27,13 @@ pub struct RenderArgs {
     /// without computing or writing anything.
     #[arg(long)]
     explain: bool,
+    /// Hold the lines of an animation from frame to frame (hysteresis,
+    /// delayed births, signs held within a band; the first frame is drawn
+    /// as without): `off` draws each frame's lines on their own, `on` and
+    /// `auto` hold them over more than one frame. Overrides each scene's
+    /// `[lines] coherence`.
+    #[arg(long, value_name = "MODE", value_parser = super::choice::<Coherence>())]
+    coherence: Option<Coherence>,
 }
 
 /// Runs `shapecue render`.
@@ -38,11 +46,16 @@ pub fn run(device: Option<&str>, a: RenderArgs) -> Result<()> {
     };
     // Check every scene before running any, so a typo in the last one does
     // not surface after minutes of rendering.
-    let scenes: Vec<Scene> = a
+    let mut scenes: Vec<Scene> = a
         .scenes
         .iter()
         .map(|p| Scene::load(p))
         .collect::<shapecue::Result<_>>()?;
+    if let Some(c) = a.coherence {
+        for s in &mut scenes {
+            s.effects.lines.coherence = c;
+        }
+    }
     if a.explain {
         for scene in &scenes {
             super::print_str(&exec::explain(scene, &opts)?)?;

@@ -96,6 +96,11 @@ impl CurveStage {
             gpu.write(&mut bnd, &boundary_mask(faces))?;
         }
         let n = nv.max(1);
+        // The coherence's signs start cleared (a sequence's first frame
+        // records them before any frame reads them).
+        let (mut signs, mut evec) = (gpu.buffer(n)?, gpu.buffer(3 * n)?);
+        gpu.zero(&mut signs, n)?;
+        gpu.zero(&mut evec, 3 * n)?;
         Ok(CurveStage {
             kernels: [a?, b?, c?, d?],
             off,
@@ -105,8 +110,8 @@ impl CurveStage {
             grad: gpu.buffer(6 * n)?,
             view: gpu.buffer(8 * n)?,
             dt: gpu.buffer(n)?,
-            signs: gpu.buffer(n)?,
-            evec: gpu.buffer(3 * n)?,
+            signs,
+            evec,
             seg: gpu.buffer(8)?,
             ends: gpu.buffer(4)?,
             cap: 1,
