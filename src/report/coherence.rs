@@ -393,6 +393,9 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
         ],
     );
     let mut bars: Vec<(String, [f64; 3])> = Vec::new();
+    // The pop share over the frames of the first animation's
+    // view-independent families, off and on.
+    let mut over_frames: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     let all: Vec<LineFamily> = VIEW_INDEPENDENT
         .iter()
         .chain(&VIEW_DEPENDENT)
@@ -453,6 +456,14 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
                 },
                 pct(chain_ids_kept(&on.frames, code)),
             ]));
+            if std::ptr::eq(base, &scenes[0]) && VIEW_INDEPENDENT.contains(&fam) {
+                for (f, what) in [(&a, "off"), (&b, "on")] {
+                    let pts = (f.pop_per_pair.iter().enumerate())
+                        .map(|(k, &p)| (k as f64, 100.0 * p))
+                        .collect();
+                    over_frames.push((format!("{} {what}", fam.name()), pts));
+                }
+            }
             bars.push((
                 format!("{} {}", base.name, fam.name()),
                 [a.short_lived, b.short_lived, c.short_lived].map(|x| 100.0 * x),
@@ -473,6 +484,15 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
     r.blocks.push(Block::Table(t));
     r.text("\nThe cost of each run (coherence off, then on):\n".to_string());
     r.blocks.push(Block::Table(cost));
+    r.charts.push(Chart::Lines {
+        title: format!(
+            "{}: pop share between frame k and k + 1 (%), coherence off and on",
+            scenes[0].name
+        ),
+        x_label: "frame k".into(),
+        y_label: "pop share %".into(),
+        series: over_frames,
+    });
     r.charts.push(Chart::Bars {
         title: "Short-lived share of line length (%): coherence off, on, and the control".into(),
         y_label: "short-lived %".into(),

@@ -124,6 +124,17 @@ pub enum Chart {
         /// (series name, [(h, error)]).
         series: Vec<(String, Vec<(f64, f64)>)>,
     },
+    /// Lines over a linear x (frames, sizes) and a linear y, one per series.
+    Lines {
+        /// Title above the chart.
+        title: String,
+        /// Axis captions.
+        x_label: String,
+        /// Axis captions.
+        y_label: String,
+        /// (series name, [(x, y)]); non-finite points are left out.
+        series: Vec<(String, Vec<(f64, f64)>)>,
+    },
     /// Bars: one group per category, one bar per series in each group.
     Bars {
         /// Title above the chart.

@@ -77,6 +77,12 @@ pub fn svg(report: &Report) -> Result<String> {
                     y_label,
                     series,
                 } => convergence(area, title, x_label, y_label, series)?,
+                Chart::Lines {
+                    title,
+                    x_label,
+                    y_label,
+                    series,
+                } => lines(area, title, (x_label, y_label), series)?,
                 Chart::Bars {
                     title,
                     y_label,
@@ -299,6 +305,54 @@ fn convergence(
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
     // Errors fall with h, so the data and the slope run from the lower left
     // to the upper right: the legend goes in the empty upper left.
+    legend_upper_left(&mut chart)
+}
+
+/// Lines on linear axes, one per series, with a legend in the upper left.
+fn lines(
+    area: &Area,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    let ok = |p: &&(f64, f64)| p.0.is_finite() && p.1.is_finite();
+    let all: Vec<(f64, f64)> = (series.iter())
+        .flat_map(|s| s.1.iter().filter(ok).copied())
+        .collect();
+    if all.is_empty() {
+        return no_data(area, title);
+    }
+    let (x0, x1) = all
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.0), h.max(p.0))
+        });
+    let y1 = all.iter().map(|p| p.1).fold(0.0f64, f64::max);
+    let x1 = if x1 > x0 { x1 } else { x0 + 1.0 };
+    let y1 = if y1 > 0.0 { 1.1 * y1 } else { 1.0 };
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 17))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, 0.0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style((FONT, 12))
+        .draw()
+        .map_err(err)?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let c = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> = pts.iter().filter(ok).copied().collect();
+        chart
+            .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+            .map_err(err)?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
     legend_upper_left(&mut chart)
 }
 
