@@ -71,19 +71,20 @@ pub const LINE_UNGATED: u32 = (1 << 0) | (1 << 7) | (1 << 11);
 
 /// Chains that keep their identity across the frames of an animation: each
 /// frame's chains get ids, a chain taking the id of the previous frame's
-/// chain that most of its length lies on (the same faces, the same family)
-/// where that is at least half its length, and a new id otherwise. Where
-/// two chains claim one id, the one with more length on it keeps it. The
-/// first frame (or a frame that does not follow the last one) numbers its
-/// chains 0, 1, 2, ... in order. Deterministic: the same chains give the
-/// same ids.
+/// chain that most of its length lies on (the same faces, the same family;
+/// a face holding pieces of several chains counts for the one with most
+/// length there) where that is at least half its length, and a new id
+/// otherwise. Where two chains claim one id, the one with more length on it
+/// keeps it. The first frame (or a frame that does not follow the last one)
+/// numbers its chains 0, 1, 2, ... in order. Deterministic: the same chains
+/// give the same ids.
 #[derive(Clone, Debug, Default)]
 pub struct ChainIds {
     /// The frame the ids are of.
     frame: Option<usize>,
-    /// Per (face, family), the ids of the last frame's chains on it with
-    /// their length there.
-    by_face: std::collections::HashMap<(i64, u32), Vec<(u32, f64)>>,
+    /// Per (face, family), the id of the last frame's chain with the most
+    /// length on it, and that length.
+    by_face: std::collections::HashMap<(i64, u32), (u32, f64)>,
     /// The next new id.
     next: u32,
 }
@@ -116,24 +117,22 @@ impl ChainIds {
             self.by_face.clear();
             self.next = 0;
         }
-        // Votes: per chain, its length on each previous id.
-        let mut votes: Vec<std::collections::BTreeMap<u32, f64>> = vec![Default::default(); chains];
+        // Votes: (chain, previous id, length), summed per chain and id.
         let mut total = vec![0.0f64; chains];
+        let mut votes: Vec<(u32, u32, f64)> = Vec::with_capacity(pieces.len());
         for p in pieces {
-            let c = p.chain as usize;
-            total[c] += p.length;
-            if let Some(prev) = self.by_face.get(&(p.face, p.family)) {
-                for &(id, _) in prev {
-                    *votes[c].entry(id).or_default() += p.length;
-                }
+            total[p.chain as usize] += p.length;
+            if let Some(&(id, _)) = self.by_face.get(&(p.face, p.family)) {
+                votes.push((p.chain, id, p.length));
             }
         }
-        let mut claims: Vec<(f64, usize, u32)> = Vec::new();
-        for (c, v) in votes.iter().enumerate() {
-            for (&id, &len) in v {
-                if len >= 0.5 * total[c] && len > 0.0 {
-                    claims.push((len, c, id));
-                }
+        votes.sort_unstable_by_key(|v| (v.0, v.1));
+        let mut claims: Vec<(f64, u32, u32)> = Vec::new();
+        for run in votes.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+            let (c, id) = (run[0].0, run[0].1);
+            let len: f64 = run.iter().map(|v| v.2).sum();
+            if len > 0.0 && len >= 0.5 * total[c as usize] {
+                claims.push((len, c, id));
             }
         }
         // The longest claims first; ties by chain, then id.
@@ -141,8 +140,8 @@ impl ChainIds {
         let mut ids: Vec<Option<u32>> = vec![None; chains];
         let mut taken = std::collections::HashSet::new();
         for (_, c, id) in claims {
-            if ids[c].is_none() && taken.insert(id) {
-                ids[c] = Some(id);
+            if ids[c as usize].is_none() && taken.insert(id) {
+                ids[c as usize] = Some(id);
             }
         }
         let ids: Vec<u32> = ids
@@ -154,13 +153,18 @@ impl ChainIds {
                 })
             })
             .collect();
+        // Each (face, family)'s id: the chain with the most length there
+        // (the smaller id on a tie).
+        let mut here: Vec<((i64, u32), u32, f64)> = (pieces.iter())
+            .map(|p| ((p.face, p.family), ids[p.chain as usize], p.length))
+            .collect();
+        here.sort_unstable_by_key(|h| (h.0, h.1));
         self.by_face.clear();
-        for p in pieces {
-            let e = self.by_face.entry((p.face, p.family)).or_default();
-            let id = ids[p.chain as usize];
-            match e.iter_mut().find(|x| x.0 == id) {
-                Some(x) => x.1 += p.length,
-                None => e.push((id, p.length)),
+        for run in here.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+            let len: f64 = run.iter().map(|h| h.2).sum();
+            let e = self.by_face.entry(run[0].0).or_insert((run[0].1, len));
+            if len > e.1 {
+                *e = (run[0].1, len);
             }
         }
         self.frame = Some(frame);
