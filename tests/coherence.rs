@@ -8,28 +8,86 @@
 
 mod common;
 
-use common::gpu;
-use shapecue::cpu::feature_lines::lines_vertex;
+use common::{gpu, only};
+use shapecue::cpu::feature_lines::{Hold, lines_vertex};
 use shapecue::cpu::feature_lines_curves::{
     CurveTerms, ScaledThresholds, boundary_mask, lines_curves, lines_dt1q1, lines_pose_held,
     lines_view,
 };
-use shapecue::mesh;
-use shapecue::spec::feature_lines::{CurveOptions, FamilySet, LineFamily, Segment};
+use shapecue::mesh::{self, Mesh};
+use shapecue::spec::feature_lines::{LineFamily, LineInputs, Segment};
 use shapecue::spec::view::View;
-use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
+use shapecue::stages::feature_lines::{HoldAt, LineExtractor, LineOptions};
 
-fn only(fams: &[LineFamily], f: impl FnOnce(&mut CurveOptions)) -> LineOptions {
-    let mut curves = CurveOptions {
-        families: FamilySet::of(fams),
-        ..Default::default()
-    };
-    f(&mut curves);
-    LineOptions {
-        contours: false,
-        suggestive: false,
-        curves,
-        ..Default::default()
+/// The twin's held signs of K and H and emax dmax (`lines_pose_held`).
+type Signs<'a> = (&'a mut [u32], &'a mut [[f32; 3]]);
+
+/// A flat grid in z = 0 (normal +z, d1 +x, d2 +y, no curvature
+/// derivative) whose principal curvatures a test sets per frame, seen from
+/// above, with the CPU twin of the curve families on it.
+struct Plane {
+    m: Mesh,
+    pos: Vec<[f32; 3]>,
+    frame: [Vec<[f32; 3]>; 3],
+    dk: Vec<[f32; 4]>,
+    bnd: Vec<u32>,
+    rings: (Vec<u32>, Vec<u32>),
+    view: View,
+}
+
+impl Plane {
+    /// The grid of `n` × `n` vertices over [-1, 1]².
+    fn new(n: usize) -> Plane {
+        let m = mesh::plane(n, 2.0);
+        let nv = m.n_vertices();
+        Plane {
+            pos: m.positions.iter().map(|p| p.map(|c| c as f32)).collect(),
+            frame: [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].map(|d| vec![d; nv]),
+            dk: vec![[0.0; 4]; nv],
+            bnd: boundary_mask(&m.faces),
+            rings: mesh::topology::one_rings(nv, &m.faces),
+            view: View::from_eye([0.0, 0.0, 3.0], false),
+            m,
+        }
+    }
+
+    /// The line inputs with the principal curvatures `k`.
+    fn inputs<'a>(&'a self, k: &'a [[f32; 2]]) -> LineInputs<'a> {
+        let [nrm, d1, d2] = &self.frame;
+        LineInputs {
+            pos: &self.pos,
+            nrm,
+            d1,
+            d2,
+            k,
+            dk: &self.dk,
+        }
+    }
+
+    /// The twin's segments of `opts`'s curve families on `li`, the signs
+    /// of K and H held as `lines_pose_held` holds them (`signs`, `mode`,
+    /// `band`) and the families as `hold` holds them.
+    fn twin(
+        &self,
+        li: &LineInputs,
+        opts: &LineOptions,
+        (signs, mode, band): (Signs, u32, f32),
+        hold: &mut Hold,
+    ) -> Vec<Segment> {
+        let t = lines_vertex(li, self.view);
+        let p = lines_pose_held(li, false, signs, mode, [band; 3]);
+        let w = lines_view(li, &p, &t, self.view, opts.curves.unit_light());
+        let (off, ring) = &self.rings;
+        let dt = lines_dt1q1(&self.m.faces, li, off, ring, &w, &t);
+        let terms = CurveTerms {
+            vertex: &t,
+            pose: &p,
+            view: &w,
+            dt: &dt,
+            bnd: &self.bnd,
+        };
+        let thr = ScaledThresholds::of(&opts.curves, 1.0, (0.0, 0.0));
+        lines_curves(&self.m.faces, &self.pos, &terms, &opts.curves, thr, hold)
     }
 }
 
@@ -71,11 +129,9 @@ fn same(dev: &[Segment], cpu: &[Segment], tol: f32, what: &str) {
 /// device equals its twin frame by frame.
 #[test]
 fn coherence_delays_the_birth_of_lines_away_from_every_line_of_their_family() {
-    use shapecue::cpu::feature_lines::Hold;
-    use shapecue::stages::feature_lines::HoldAt;
-    let m = mesh::plane(81, 2.0);
+    let plane = Plane::new(81);
+    let (m, pos) = (&plane.m, &plane.pos);
     let nv = m.n_vertices();
-    let pos: Vec<[f32; 3]> = m.positions.iter().map(|p| p.map(|c| c as f32)).collect();
     let (big, blink, late) = (
         ([-0.4f32, 0.0], 0.35f32),
         ([0.5f32, 0.5], 0.12f32),
@@ -99,32 +155,17 @@ fn coherence_delays_the_birth_of_lines_away_from_every_line_of_their_family() {
             .collect()
     };
     let opts = only(&[LineFamily::KZero], |o| o.cull = false);
-    let (z3, x3, y3) = (
-        vec![[0.0, 0.0, 1.0]; nv],
-        vec![[1.0, 0.0, 0.0]; nv],
-        vec![[0.0, 1.0, 0.0]; nv],
-    );
-    let dk = vec![[0.0f32; 4]; nv];
-    let view = View::from_eye([0.0, 0.0, 3.0], false);
     let near = |s: &[Segment], (c, r): ([f32; 2], f32)| {
         s.iter()
             .filter(|s| (circle(s.a, (c, 0.0)).sqrt() - r).abs() < 0.05)
             .count()
     };
-    let bnd = boundary_mask(&m.faces);
     for birth in [0u32, 1, 2] {
         let mut ex = LineExtractor::new(gpu(), nv, &m.faces).unwrap();
         let (mut held, mut nearv) = (vec![0u32; m.faces.len()], vec![0u32; nv]);
         for k in 0..7 {
             let kk = field(k);
-            let li = shapecue::spec::feature_lines::LineInputs {
-                pos: &pos,
-                nrm: &z3,
-                d1: &x3,
-                d2: &y3,
-                k: &kk,
-                dk: &dk,
-            };
+            let li = plane.inputs(&kk);
             ex.hold_at(Some(HoldAt {
                 slot: 0,
                 frame: k,
@@ -134,36 +175,18 @@ fn coherence_delays_the_birth_of_lines_away_from_every_line_of_their_family() {
                 band: 0.0,
             }))
             .unwrap();
-            let (dev, _) = ex.extract(&li, view, 1.0, opts).unwrap();
+            let (dev, _) = ex.extract(&li, plane.view, 1.0, opts).unwrap();
             // The twin from its own marks.
-            let t = lines_vertex(&li, view);
-            let p = lines_pose_held(&li, false, (&mut [], &mut []), 0, [0.0; 3]);
-            let w = lines_view(&li, &p, &t, view, opts.curves.unit_light());
-            let (off, ring) = mesh::topology::one_rings(nv, &m.faces);
-            let dt = lines_dt1q1(&m.faces, &li, &off, &ring, &w, &t);
-            let terms = CurveTerms {
-                vertex: &t,
-                pose: &p,
-                view: &w,
-                dt: &dt,
-                bnd: &bnd,
-            };
             let (mut nh, mut nn) = (vec![0u32; m.faces.len()], vec![0u32; nv]);
-            let cpu = lines_curves(
-                &m.faces,
-                &pos,
-                &terms,
-                &opts.curves,
-                ScaledThresholds::of(&opts.curves, 1.0, (0.0, 0.0)),
-                &mut Hold {
-                    held: &held,
-                    near: &nearv,
-                    next_held: &mut nh,
-                    next_near: &mut nn,
-                    low: 0.5,
-                    birth: if k == 0 { 0 } else { birth },
-                },
-            );
+            let mut hold = Hold {
+                held: &held,
+                near: &nearv,
+                next_held: &mut nh,
+                next_near: &mut nn,
+                low: 0.5,
+                birth: if k == 0 { 0 } else { birth },
+            };
+            let cpu = plane.twin(&li, &opts, ((&mut [], &mut []), 0, 0.0), &mut hold);
             same(&dev, &cpu, 1e-5, &format!("birth {birth}, frame {k}"));
             let marks = ex.read_marks(0).unwrap().unwrap();
             assert_eq!(
@@ -197,11 +220,9 @@ fn coherence_delays_the_birth_of_lines_away_from_every_line_of_their_family() {
 /// device equals its twin frame by frame.
 #[test]
 fn the_signs_of_k_hold_within_their_band() {
-    use shapecue::cpu::feature_lines::Hold;
-    use shapecue::stages::feature_lines::HoldAt;
-    let m = mesh::plane(61, 2.0);
+    let plane = Plane::new(61);
+    let (m, pos) = (&plane.m, &plane.pos);
     let nv = m.n_vertices();
-    let pos: Vec<[f32; 3]> = m.positions.iter().map(|p| p.map(|c| c as f32)).collect();
     let field = |k: usize| -> Vec<[f32; 2]> {
         pos.iter()
             .map(|&[x, y, _]| {
@@ -216,14 +237,6 @@ fn the_signs_of_k_hold_within_their_band() {
             .collect()
     };
     let opts = only(&[LineFamily::KZero], |o| o.cull = false);
-    let (z3, x3, y3) = (
-        vec![[0.0, 0.0, 1.0]; nv],
-        vec![[1.0, 0.0, 0.0]; nv],
-        vec![[0.0, 1.0, 0.0]; nv],
-    );
-    let dk = vec![[0.0f32; 4]; nv];
-    let view = View::from_eye([0.0, 0.0, 3.0], false);
-    let bnd = boundary_mask(&m.faces);
     let edges = |s: &[Segment], right: bool| -> Vec<[[u32; 2]; 2]> {
         let mut e: Vec<[[u32; 2]; 2]> = (s.iter())
             .filter(|s| {
@@ -250,14 +263,7 @@ fn the_signs_of_k_hold_within_their_band() {
         let mut changed = 0;
         for k in 0..5 {
             let kk = field(k);
-            let li = shapecue::spec::feature_lines::LineInputs {
-                pos: &pos,
-                nrm: &z3,
-                d1: &x3,
-                d2: &y3,
-                k: &kk,
-                dk: &dk,
-            };
+            let li = plane.inputs(&kk);
             ex.hold_at(Some(HoldAt {
                 slot: 0,
                 frame: k,
@@ -267,32 +273,14 @@ fn the_signs_of_k_hold_within_their_band() {
                 band,
             }))
             .unwrap();
-            let (dev, _) = ex.extract(&li, view, 1.0, opts).unwrap();
+            let (dev, _) = ex.extract(&li, plane.view, 1.0, opts).unwrap();
             let mode = match (band > 0.0, k) {
                 (false, _) => 0,
                 (true, 0) => 1,
                 (true, _) => 2,
             };
-            let t = lines_vertex(&li, view);
-            let p = lines_pose_held(&li, false, (&mut signs, &mut evec), mode, [band; 3]);
-            let w = lines_view(&li, &p, &t, view, opts.curves.unit_light());
-            let (off, ring) = mesh::topology::one_rings(nv, &m.faces);
-            let dt = lines_dt1q1(&m.faces, &li, &off, &ring, &w, &t);
-            let terms = CurveTerms {
-                vertex: &t,
-                pose: &p,
-                view: &w,
-                dt: &dt,
-                bnd: &bnd,
-            };
-            let cpu = lines_curves(
-                &m.faces,
-                &pos,
-                &terms,
-                &opts.curves,
-                ScaledThresholds::of(&opts.curves, 1.0, (0.0, 0.0)),
-                &mut Hold::none(),
-            );
+            let signs = (&mut signs[..], &mut evec[..]);
+            let cpu = plane.twin(&li, &opts, (signs, mode, band), &mut Hold::none());
             same(&dev, &cpu, 1e-5, &format!("band {band}, frame {k}"));
             let now = (edges(&dev, false), edges(&dev, true));
             assert!(

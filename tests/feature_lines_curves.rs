@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{LineArrays, gpu, to_f32};
+use common::{LineArrays, gpu, only, to_f32};
 
 use shapecue::cpu::feature_lines::{Hold, lines_vertex};
 use shapecue::cpu::feature_lines_curves::{
@@ -16,7 +16,7 @@ use shapecue::cpu::feature_lines_curves::{
 };
 use shapecue::mesh::{self, Mesh};
 use shapecue::spec::curvature::{Accumulate, Compat, CurvatureField, CurvatureOptions, Precision};
-use shapecue::spec::feature_lines::{CurveOptions, FamilySet, LineFamily, Segment};
+use shapecue::spec::feature_lines::{FamilySet, LineFamily, Segment};
 use shapecue::spec::view::View;
 use shapecue::stages::curvature::estimate;
 use shapecue::stages::feature_lines::{LineExtractor, LineOptions};
@@ -31,20 +31,6 @@ fn inputs(m: &Mesh) -> LineArrays {
     };
     let f: CurvatureField = estimate(gpu(), m, opts).unwrap().field;
     LineArrays::new(to_f32(&m.positions), &f)
-}
-
-fn only(fams: &[LineFamily], f: impl FnOnce(&mut CurveOptions)) -> LineOptions {
-    let mut curves = CurveOptions {
-        families: FamilySet::of(fams),
-        ..Default::default()
-    };
-    f(&mut curves);
-    LineOptions {
-        contours: false,
-        suggestive: false,
-        curves,
-        ..Default::default()
-    }
 }
 
 fn device(m: &Mesh, x: &LineArrays, view: View, fs: f32, opts: LineOptions) -> Vec<Segment> {

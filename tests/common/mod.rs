@@ -325,3 +325,22 @@ pub fn max_abs_diff(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
 pub fn to_f32(p: &[[f64; 3]]) -> Vec<[f32; 3]> {
     p.iter().map(|q| q.map(|c| c as f32)).collect()
 }
+
+/// Line options drawing only the curvature families `fams` (no contours,
+/// no suggestive contours), with `f` setting their controls.
+pub fn only(
+    fams: &[shapecue::spec::feature_lines::LineFamily],
+    f: impl FnOnce(&mut shapecue::spec::feature_lines::CurveOptions),
+) -> shapecue::stages::feature_lines::LineOptions {
+    let mut curves = shapecue::spec::feature_lines::CurveOptions {
+        families: shapecue::spec::feature_lines::FamilySet::of(fams),
+        ..Default::default()
+    };
+    f(&mut curves);
+    shapecue::stages::feature_lines::LineOptions {
+        contours: false,
+        suggestive: false,
+        curves,
+        ..Default::default()
+    }
+}

@@ -277,15 +277,17 @@ fn curvature_and_lines_tables_choose_the_estimator_and_feature_size() {
 #[test]
 fn the_lines_table_sets_coherence_over_frames() {
     use crate::spec::coherence::Coherence;
-    let s = parse(MIN).unwrap();
-    let l = &s.effects.lines;
-    assert_eq!(
+    let settings = |s: Scene| {
+        let l = s.effects.lines;
         (
             l.coherence,
             l.coherence_low,
             l.coherence_birth,
-            l.coherence_band
-        ),
+            l.coherence_band,
+        )
+    };
+    assert_eq!(
+        settings(parse(MIN).unwrap()),
         (
             Coherence::Auto,
             Coherence::DEFAULT_LOW,
@@ -298,16 +300,7 @@ fn the_lines_table_sets_coherence_over_frames() {
          coherence_band = 0\n"
     ))
     .unwrap();
-    let l = &s.effects.lines;
-    assert_eq!(
-        (
-            l.coherence,
-            l.coherence_low,
-            l.coherence_birth,
-            l.coherence_band
-        ),
-        (Coherence::Off, 0.8, 1, 0.0)
-    );
+    assert_eq!(settings(s), (Coherence::Off, 0.8, 1, 0.0));
     for (bad, says) in [
         ("coherence = \"always\"", "auto, on, off"),
         ("coherence_low = 0", "(0, 1]"),
