@@ -333,8 +333,8 @@ pub fn drop_unborn(segs: &mut Vec<Segment>) {
 /// contours against `sc_thresh` times its `low`, and births are delayed as
 /// it says (the segments found but not drawn are dropped).
 // Mirrors the kernel lines_face of kernels/feature_lines.cl argument for
-// argument (ndv, kr, sc, gkr as `t`, the two wants as `want`, held, next
-// and low as `hold`; its outputs returned).
+// argument (ndv, kr, sc, gkr as `t`, the two wants as `want`, held, near,
+// next_held, next_near, low and birth as `hold`; its outputs returned).
 #[allow(clippy::too_many_arguments)]
 pub fn lines_face(
     faces: &[[u32; 3]],
@@ -358,23 +358,10 @@ pub fn lines_face(
                 continue;
             }
             let fv = v.map(|i| if kind == 0 { t.ndv[i] } else { t.kr[i] });
-            if !crosses_zero(fv) {
-                continue;
-            }
-            let s = fv.map(|x| x >= 0.0);
-            if s[0] == s[1] && s[1] == s[2] {
-                continue;
-            }
+            let Some(c) = odd_corner(fv) else { continue };
             if kind == 1 && v.iter().all(|&i| t.ndv[i] <= 0.0) {
                 continue;
             }
-            let c = if s[0] == s[1] {
-                2
-            } else if s[0] == s[2] {
-                1
-            } else {
-                0
-            };
             let (a, b) = ((c + 1) % 3, (c + 2) % 3);
             let pc = pos[v[c]];
             let ea: [f32; 3] = std::array::from_fn(|i| pos[v[a]][i] - pc[i]);
@@ -430,6 +417,25 @@ pub fn lines_face(
 /// rtsc's draw_isolines test: some corner above zero and some below.
 pub(crate) fn crosses_zero(f: [f32; 3]) -> bool {
     f.iter().any(|&x| x > 0.0) && f.iter().any(|&x| x < 0.0)
+}
+
+/// The corner whose sign (≥ 0 or < 0) differs from the other two, where
+/// `f` crosses zero ([`crosses_zero`]); `odd_corner` of
+/// kernels/feature_lines_curves.cl (inline in `lines_face`).
+pub(crate) fn odd_corner(f: [f32; 3]) -> Option<usize> {
+    if !crosses_zero(f) {
+        return None;
+    }
+    let s = f.map(|x| x >= 0.0);
+    if s[0] == s[1] && s[1] == s[2] {
+        None
+    } else if s[0] == s[1] {
+        Some(2)
+    } else if s[0] == s[2] {
+        Some(1)
+    } else {
+        Some(0)
+    }
 }
 
 #[cfg(test)]

@@ -7,7 +7,9 @@
 //! lists.
 
 pub use super::feature_lines::zero_hermite;
-use super::feature_lines::{Hold, VertexTerms, drop_unborn, emit_tested, held_thr, unborn};
+use super::feature_lines::{
+    Hold, VertexTerms, drop_unborn, emit_tested, held_thr, odd_corner, unborn,
+};
 use crate::spec::feature_lines::{CurveOptions, LineFamily, LineInputs, Segment};
 pub use crate::spec::feature_lines::{ScaledThresholds, boundary_mask};
 use crate::spec::view::View;
@@ -390,22 +392,6 @@ fn ridge_face(
 fn zero_linear(fa: f32, fb: f32) -> f32 {
     let d = fa - fb;
     (if d != 0.0 { fa / d } else { 0.5 }).clamp(0.0, 1.0)
-}
-
-fn odd_corner(f: [f32; 3]) -> Option<usize> {
-    if !super::feature_lines::crosses_zero(f) {
-        return None;
-    }
-    let s = f.map(|x| x >= 0.0);
-    if s[0] == s[1] && s[1] == s[2] {
-        None
-    } else if s[0] == s[1] {
-        Some(2)
-    } else if s[0] == s[2] {
-        Some(1)
-    } else {
-        Some(0)
-    }
 }
 
 fn iso_params(

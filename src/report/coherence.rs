@@ -364,44 +364,77 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
         size[1],
         TAU
     ));
-    let mut t = Table::new(
-        "flicker",
-        vec![
-            Column::new("animation", "animation"),
-            Column::new("family", "family"),
-            Column::new("kind", "kind"),
-            Column::new("pop off", "pop_off"),
-            Column::new("pop on", "pop_on"),
-            Column::new("short-lived off", "short_lived_off"),
-            Column::new("short-lived on", "short_lived_on"),
-            Column::new("control pop", "control_pop"),
-            Column::new("control short-lived", "control_short_lived"),
-            Column::new("length on/off", "length_ratio"),
-            Column::new("chain ids kept (on)", "chain_ids_kept_on"),
-        ],
-    );
-    let mut cost = Table::new(
-        "cost",
-        vec![
-            Column::new("animation", "animation"),
-            Column::new("vertices", "vertices"),
-            Column::new("frames", "frames"),
-            Column::new("line ms/frame off", "line_ms_off"),
-            Column::new("line ms/frame on", "line_ms_on"),
-            Column::new("wall ms/frame off", "wall_ms_off"),
-            Column::new("wall ms/frame on", "wall_ms_on"),
-        ],
-    );
-    let mut bars: Vec<(String, [f64; 3])> = Vec::new();
-    // The pop share over the frames of the first animation's
-    // view-independent families, off and on.
-    let mut over_frames: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    let all: Vec<LineFamily> = VIEW_INDEPENDENT
-        .iter()
-        .chain(&VIEW_DEPENDENT)
-        .copied()
-        .collect();
-    for base in &scenes {
+    let mut tables = Tables::new();
+    for (k, base) in scenes.iter().enumerate() {
+        tables.animation(gpu, base, size, k == 0)?;
+    }
+    tables.into_report(&mut r, &scenes[0].name);
+    Ok(r)
+}
+
+/// The report's tables and charts, filled one animation at a time.
+struct Tables {
+    flicker: Table,
+    cost: Table,
+    /// Per animation and family: the short-lived share off, on and of the
+    /// control (%).
+    bars: Vec<(String, [f64; 3])>,
+    /// The pop share over the frames of the first animation's
+    /// view-independent families, off and on.
+    over_frames: Vec<(String, Vec<(f64, f64)>)>,
+}
+
+impl Tables {
+    fn new() -> Tables {
+        let columns = |c: &[(&str, &str)]| c.iter().map(|(t, k)| Column::new(t, k)).collect();
+        Tables {
+            flicker: Table::new(
+                "flicker",
+                columns(&[
+                    ("animation", "animation"),
+                    ("family", "family"),
+                    ("kind", "kind"),
+                    ("pop off", "pop_off"),
+                    ("pop on", "pop_on"),
+                    ("short-lived off", "short_lived_off"),
+                    ("short-lived on", "short_lived_on"),
+                    ("control pop", "control_pop"),
+                    ("control short-lived", "control_short_lived"),
+                    ("length on/off", "length_ratio"),
+                    ("chain ids kept (on)", "chain_ids_kept_on"),
+                ]),
+            ),
+            cost: Table::new(
+                "cost",
+                columns(&[
+                    ("animation", "animation"),
+                    ("vertices", "vertices"),
+                    ("frames", "frames"),
+                    ("line ms/frame off", "line_ms_off"),
+                    ("line ms/frame on", "line_ms_on"),
+                    ("wall ms/frame off", "wall_ms_off"),
+                    ("wall ms/frame on", "wall_ms_on"),
+                ]),
+            ),
+            bars: Vec::new(),
+            over_frames: Vec::new(),
+        }
+    }
+
+    /// Measures the animation of `base`: coherence off and on and the
+    /// control, a row per family and one of cost; with `plot_frames`, its
+    /// view-independent families' pop share over the frames.
+    fn animation(
+        &mut self,
+        gpu: &Arc<Gpu>,
+        base: &Scene,
+        size: [u32; 2],
+        plot_frames: bool,
+    ) -> Result<()> {
+        let all: Vec<LineFamily> = (VIEW_INDEPENDENT.iter())
+            .chain(&VIEW_DEPENDENT)
+            .copied()
+            .collect();
         let (rest, parts) = rest_and_parts(base)?;
         let diag = {
             let (lo, hi) = rest.bounds();
@@ -416,7 +449,6 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
         let off = run(gpu, &measured(base, &all, Coherence::Off, size), &rest)?;
         let on = run(gpu, &measured(base, &all, Coherence::On, size), &rest)?;
         let ctl = control(gpu, base, &rest, &parts, &off, size)?;
-        let n = off.frames.len();
         for &fam in &all {
             let code = fam as u32;
             let (a, b) = (
@@ -431,47 +463,13 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
                     ..Flicker::default()
                 },
             };
-            let pct = |x: f64| match x.is_finite() {
-                true => Cell::num(100.0 * x, format!("{:.1} %", 100.0 * x)),
-                false => Cell::text("–"),
-            };
-            let kind = match VIEW_DEPENDENT.contains(&fam) {
-                true => "view-dependent",
-                false => "view-independent",
-            };
-            let ratio = b.mean_length / a.mean_length;
-            t.rows.push(Row::new(vec![
-                Cell::text(&base.name),
-                Cell::text(fam.name()),
-                Cell::text(kind),
-                pct(a.pop),
-                pct(b.pop),
-                pct(a.short_lived),
-                pct(b.short_lived),
-                pct(c.pop),
-                pct(c.short_lived),
-                match ratio.is_finite() {
-                    true => Cell::num(ratio, format!("{ratio:.3}")),
-                    false => Cell::text("–"),
-                },
-                pct(chain_ids_kept(&on.frames, code)),
-            ]));
-            if std::ptr::eq(base, &scenes[0]) && VIEW_INDEPENDENT.contains(&fam) {
-                for (f, what) in [(&a, "off"), (&b, "on")] {
-                    let pts = (f.pop_per_pair.iter().enumerate())
-                        .map(|(k, &p)| (k as f64, 100.0 * p))
-                        .collect();
-                    over_frames.push((format!("{} {what}", fam.name()), pts));
-                }
-            }
-            bars.push((
-                format!("{} {}", base.name, fam.name()),
-                [a.short_lived, b.short_lived, c.short_lived].map(|x| 100.0 * x),
-            ));
+            let kept = chain_ids_kept(&on.frames, code);
+            self.family(&base.name, fam, [&a, &b, &c], kept, plot_frames);
         }
+        let n = off.frames.len();
         let per = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         let ms = |x: f64| Cell::num(x, format!("{x:.2}"));
-        cost.rows.push(Row::new(vec![
+        self.cost.rows.push(Row::new(vec![
             Cell::text(&base.name),
             Cell::int(rest.n_vertices()),
             Cell::int(n),
@@ -480,29 +478,87 @@ pub fn report(gpu: &Arc<Gpu>, o: &CoherenceOptions) -> Result<Report> {
             ms(off.wall_ms / n.max(1) as f64),
             ms(on.wall_ms / n.max(1) as f64),
         ]));
+        Ok(())
     }
-    r.blocks.push(Block::Table(t));
-    r.text("\nThe cost of each run (coherence off, then on):\n".to_string());
-    r.blocks.push(Block::Table(cost));
-    r.charts.push(Chart::Lines {
-        title: format!(
-            "{}: pop share between frame k and k + 1 (%), coherence off and on",
-            scenes[0].name
-        ),
-        x_label: "frame k".into(),
-        y_label: "pop share %".into(),
-        series: over_frames,
-    });
-    r.charts.push(Chart::Bars {
-        title: "Short-lived share of line length (%): coherence off, on, and the control".into(),
-        y_label: "short-lived %".into(),
-        log_y: false,
-        groups: bars.iter().map(|b| b.0.clone()).collect(),
-        series: ["off", "on", "control"]
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (s.to_string(), bars.iter().map(|b| b.1[i]).collect()))
-            .collect(),
-    });
-    Ok(r)
+
+    /// The row, bars and (with `plot_frames`, for a view-independent
+    /// family) pop share over the frames of one family of `animation`:
+    /// its flicker off, on and in the control, and the share of its length
+    /// whose chain id the next frame keeps.
+    fn family(
+        &mut self,
+        animation: &str,
+        fam: LineFamily,
+        [a, b, c]: [&Flicker; 3],
+        kept: f64,
+        plot_frames: bool,
+    ) {
+        let pct = |x: f64| match x.is_finite() {
+            true => Cell::num(100.0 * x, format!("{:.1} %", 100.0 * x)),
+            false => Cell::text("–"),
+        };
+        let dependent = VIEW_DEPENDENT.contains(&fam);
+        let ratio = b.mean_length / a.mean_length;
+        self.flicker.rows.push(Row::new(vec![
+            Cell::text(animation),
+            Cell::text(fam.name()),
+            Cell::text(match dependent {
+                true => "view-dependent",
+                false => "view-independent",
+            }),
+            pct(a.pop),
+            pct(b.pop),
+            pct(a.short_lived),
+            pct(b.short_lived),
+            pct(c.pop),
+            pct(c.short_lived),
+            match ratio.is_finite() {
+                true => Cell::num(ratio, format!("{ratio:.3}")),
+                false => Cell::text("–"),
+            },
+            pct(kept),
+        ]));
+        if plot_frames && !dependent {
+            for (f, what) in [(a, "off"), (b, "on")] {
+                let pts = (f.pop_per_pair.iter().enumerate())
+                    .map(|(k, &p)| (k as f64, 100.0 * p))
+                    .collect();
+                self.over_frames
+                    .push((format!("{} {what}", fam.name()), pts));
+            }
+        }
+        self.bars.push((
+            format!("{animation} {}", fam.name()),
+            [a.short_lived, b.short_lived, c.short_lived].map(|x| 100.0 * x),
+        ));
+    }
+
+    /// The tables and charts into `r` (`first`: the animation whose frames
+    /// are plotted).
+    fn into_report(self, r: &mut Report, first: &str) {
+        r.blocks.push(Block::Table(self.flicker));
+        r.text("\nThe cost of each run (coherence off, then on):\n".to_string());
+        r.blocks.push(Block::Table(self.cost));
+        r.charts.push(Chart::Lines {
+            title: format!(
+                "{first}: pop share between frame k and k + 1 (%), coherence off and on"
+            ),
+            x_label: "frame k".into(),
+            y_label: "pop share %".into(),
+            series: self.over_frames,
+        });
+        let bars = self.bars;
+        r.charts.push(Chart::Bars {
+            title: "Short-lived share of line length (%): coherence off, on, and the control"
+                .into(),
+            y_label: "short-lived %".into(),
+            log_y: false,
+            groups: bars.iter().map(|b| b.0.clone()).collect(),
+            series: ["off", "on", "control"]
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (s.to_string(), bars.iter().map(|b| b.1[i]).collect()))
+                .collect(),
+        });
+    }
 }

@@ -59,6 +59,27 @@ impl Coherence {
 
 crate::spec::named_choice!(Coherence, "coherence");
 
+/// Checks coherence's settings, naming the first one out of its range (as
+/// a scene's `[lines]` names it): the lower threshold `low` a fraction in
+/// (0, 1] of each threshold, the delay of births `birth` 0, 1 or 2 frames,
+/// the band of the signs `band` finite and at least 0.
+pub fn check(low: f32, birth: u32, band: f32) -> Result<(), String> {
+    if !(low > 0.0 && low <= 1.0) {
+        return Err(format!(
+            "coherence_low {low} must be a fraction in (0, 1] of each threshold"
+        ));
+    }
+    if birth > 2 {
+        return Err(format!("coherence_birth {birth}: give 0, 1 or 2 frames"));
+    }
+    if !(band.is_finite() && band >= 0.0) {
+        return Err(format!(
+            "coherence_band {band} must be finite and at least 0"
+        ));
+    }
+    Ok(())
+}
+
 /// The family bit added to a segment found but not drawn (its birth
 /// delayed, `LINE_UNBORN` of kernels/common/isoline.h); the line stage
 /// drops such segments.

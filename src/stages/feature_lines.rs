@@ -342,18 +342,8 @@ impl LineExtractor {
     /// afresh: the first frame of a sequence draws today's lines exactly.
     pub fn hold_at(&mut self, at: Option<HoldAt>) -> Result<()> {
         if let Some(h) = at {
-            if !(h.low > 0.0 && h.low <= 1.0) {
-                return Err(Error::InvalidArgument(format!(
-                    "the hysteresis' lower threshold must be a fraction in (0, 1] of the threshold, got {}",
-                    h.low
-                )));
-            }
-            if h.birth > 2 {
-                return Err(Error::InvalidArgument(format!(
-                    "the delay of births is 0, 1 or 2 frames, got {}",
-                    h.birth
-                )));
-            }
+            crate::spec::coherence::check(h.low, h.birth, h.band)
+                .map_err(Error::InvalidArgument)?;
         }
         self.hold.at = at;
         Ok(())

@@ -117,32 +117,11 @@ pub(super) fn lines(ck: &Checker<'_>, l: &Spanned<LinesSpec>, fx: &mut Effects) 
         fx.lines.coherence = (m.get_ref().parse())
             .map_err(|e: Error| ck.err(m.span(), format!("lines.coherence: {e}")))?;
     }
-    if let Some(low) = l.coherence_low {
-        if !(low > 0.0 && low <= 1.0) {
-            return Err(ck.err(
-                span,
-                format!("lines.coherence_low {low} must be a fraction in (0, 1] of each threshold"),
-            ));
-        }
-        fx.lines.coherence_low = low;
-    }
-    if let Some(b) = l.coherence_birth {
-        if b > 2 {
-            return Err(ck.err(
-                span,
-                format!("lines.coherence_birth {b}: give 0, 1 or 2 frames"),
-            ));
-        }
-        fx.lines.coherence_birth = b;
-    }
-    if let Some(b) = l.coherence_band {
-        if !(b.is_finite() && b >= 0.0) {
-            return Err(ck.err(
-                span,
-                format!("lines.coherence_band {b} must be finite and at least 0"),
-            ));
-        }
-        fx.lines.coherence_band = b;
-    }
+    let fl = &mut fx.lines;
+    fl.coherence_low = l.coherence_low.unwrap_or(fl.coherence_low);
+    fl.coherence_birth = l.coherence_birth.unwrap_or(fl.coherence_birth);
+    fl.coherence_band = l.coherence_band.unwrap_or(fl.coherence_band);
+    crate::spec::coherence::check(fl.coherence_low, fl.coherence_birth, fl.coherence_band)
+        .map_err(|e| ck.err(span, format!("lines.{e}")))?;
     Ok(())
 }
